@@ -1,0 +1,102 @@
+//! The impedance-display virtual coupling, a shunt spring-damper (eq 20).
+
+use crate::ve::{Port, VirtualEnvironment};
+use crate::{param, Integrator, ParamError, Position, ZTransfer};
+
+/// `Z_cI(z) = b + kTz/(z - 1)` between the device and the VE (paper eq 20).
+///
+/// The device force command and the VE force are both `Z_cI (v_c - v_e)`.
+/// The spring acts on the position error `x_c - x_e` (integer positions), so
+/// it is the sum of velocities exactly and does not drift; with a fixed VE
+/// the force is `k e + b (e - e_prev) / T` on the error `e`.
+///
+/// Sign: a positive force resists positive device motion (it is the
+/// paper's actuator force `f_a`, which enters the device through `G` with a
+/// minus sign), and pulls the VE along +x.
+#[derive(Clone, Copy, Debug)]
+pub struct ImpedanceCoupling {
+    k: f32,
+    b: f32,
+    period_s: f32,
+    z_direct: f32,
+    ve_side: Integrator,
+}
+
+/// One tick of the impedance coupling.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ImpedanceStep {
+    /// Device force command `f_c` (N), equal to the VE force `f_e`.
+    pub force_n: f32,
+    /// VE velocity `v_e` (m/s).
+    pub ve_velocity_mps: f32,
+}
+
+impl ImpedanceCoupling {
+    /// A coupling of stiffness `k_npm` (N/m) and damping `b_nspm` (N s/m) at
+    /// period `period_s` (s), with the VE side at `x`. `kT + b` must be > 0.
+    pub fn new(k_npm: f32, b_nspm: f32, period_s: f32, x: Position) -> Result<Self, ParamError> {
+        let t = param::positive("T (s)", period_s)?;
+        let mut c = ImpedanceCoupling {
+            k: 0.0,
+            b: 0.0,
+            period_s: t,
+            z_direct: 0.0,
+            ve_side: Integrator::new(t, x),
+        };
+        c.set_gains(k_npm, b_nspm)?;
+        Ok(c)
+    }
+
+    /// Change the gains; the state (the spring's stretch) is kept.
+    pub fn set_gains(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
+        let k = param::non_negative("k_c (N/m)", k_npm)?;
+        let b = param::non_negative("b_c (N s/m)", b_nspm)?;
+        let z = param::positive("k_c T + b_c (N s/m)", k * self.period_s + b)?;
+        (self.k, self.b, self.z_direct) = (k, b, z);
+        Ok(())
+    }
+
+    /// Stiffness (N/m) and damping (N s/m).
+    pub fn gains(&self) -> (f32, f32) {
+        (self.k, self.b)
+    }
+
+    /// Put the VE side at `x` (no stretch if `x` is the device position).
+    pub fn reset(&mut self, x: Position) {
+        self.ve_side.reset(x);
+    }
+
+    /// The VE-side position `x_e`.
+    pub fn ve_side(&self) -> Position {
+        self.ve_side.position()
+    }
+
+    /// One tick: device position `x_c` and its velocity estimate `v_c`
+    /// (m/s) in, the VE solved exactly against the coupling, force out.
+    pub fn step<V: VirtualEnvironment + ?Sized>(
+        &mut self,
+        x_c: Position,
+        v_c_mps: f32,
+        ve: &mut V,
+    ) -> ImpedanceStep {
+        let stretch_prev = x_c.minus_m(self.ve_side.position());
+        // f = k (x_c - x_e[k-1] - T v_e) + b (v_c - v_e) = f0 - (kT + b) v_e
+        let port = Port {
+            f0_n: self.k * stretch_prev + self.b * v_c_mps,
+            z_nspm: self.z_direct,
+        };
+        let v_e = ve.step(port).velocity_mps;
+        let x_e = self.ve_side.step(v_e);
+        ImpedanceStep {
+            force_n: self.k * x_c.minus_m(x_e) + self.b * (v_c_mps - v_e),
+            ve_velocity_mps: v_e,
+        }
+    }
+
+    /// `Z_cI(z) = ((b + kT) - b z^-1) / (1 - z^-1)`: force (N) per velocity
+    /// difference `v_c - v_e` (m/s).
+    pub fn tf(&self) -> ZTransfer {
+        let (b, kt) = (self.b as f64, self.k as f64 * self.period_s as f64);
+        ZTransfer::first_order([b + kt, -b], -1.0)
+    }
+}

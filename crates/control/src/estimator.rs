@@ -1,0 +1,41 @@
+//! Velocity from sampled positions.
+
+use crate::{param, ParamError, Position, ZTransfer};
+
+/// First-difference velocity estimate `v[k] = (x[k] - x[k-1]) / T` (m/s),
+/// computed from integer positions so that it has no cancellation error.
+/// This is the estimator of the paper's impedance display (Fig. 5).
+#[derive(Clone, Copy, Debug)]
+pub struct FirstDifference {
+    inv_t: f32,
+    prev: Position,
+}
+
+impl FirstDifference {
+    /// An estimator for sample period `period_s` (s), at rest at `x`.
+    pub fn new(period_s: f32, x: Position) -> Result<Self, ParamError> {
+        let t = param::positive("T (s)", period_s)?;
+        Ok(FirstDifference {
+            inv_t: 1.0 / t,
+            prev: x,
+        })
+    }
+
+    /// Forget the history: the next estimate is relative to `x`.
+    pub fn reset(&mut self, x: Position) {
+        self.prev = x;
+    }
+
+    /// The estimate for the new sample `x[k]` (m/s).
+    pub fn step(&mut self, x: Position) -> f32 {
+        let v = x.minus_m(self.prev) * self.inv_t;
+        self.prev = x;
+        v
+    }
+
+    /// `V(z)/X(z) = (1 - z^-1) / T` ((m/s) per m).
+    pub fn tf(&self) -> ZTransfer {
+        let g = self.inv_t as f64;
+        ZTransfer::first_order([g, -g], 0.0)
+    }
+}

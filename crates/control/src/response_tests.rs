@@ -1,0 +1,283 @@
+//! The law you analyse is the law you run: every law is stepped with
+//! sinusoids at twelve frequencies up to Nyquist, and its measured response
+//! (one DFT bin over a whole number of periods) must equal its own z-domain
+//! form within 1e-4 relative. The four Fig. 7 coupling/VE pairings are checked
+//! against the composition of the parts' forms, which also proves that the
+//! algebraic loops are solved exactly (a one-tick delay would fail).
+
+extern crate std;
+
+use crate::ve::{
+    BilateralConstraint, Causality, CursorMass, Port, Solid, UnilateralWall, VeOutput, VeTransfer,
+    VirtualEnvironment,
+};
+use crate::*;
+use std::f64::consts::PI;
+
+const T: f32 = 1.0e-3;
+const WINDOW: usize = 4000;
+const SETTLE: usize = 3000;
+/// DFT bins: p periods per window; 2000 is Nyquist.
+const BINS: [usize; 12] = [1, 3, 7, 20, 50, 130, 333, 700, 1200, 1800, 1990, 2000];
+
+fn theta(p: usize) -> f64 {
+    2.0 * PI * p as f64 / WINDOW as f64
+}
+
+fn z_of(p: usize) -> Complex64 {
+    let th = theta(p);
+    Complex64::new(th.cos(), th.sin())
+}
+
+/// Drive `tick` with `cos(θk)` for SETTLE + WINDOW ticks; it returns the
+/// (input, output) it really had; the response is their DFT-bin ratio.
+fn measure(p: usize, mut tick: impl FnMut(f64) -> (f64, f64)) -> Complex64 {
+    let z = z_of(p);
+    let mut probe = SineProbe::new(z.re, z.im);
+    for k in 0..SETTLE + WINDOW {
+        let (i, o) = tick(probe.excitation());
+        if k >= SETTLE {
+            probe.record(i, o);
+        } else {
+            probe.skip();
+        }
+    }
+    probe.response()
+}
+
+fn assert_close(what: &str, p: usize, got: Complex64, want: Complex64) {
+    let err = (got - want).norm() / want.norm();
+    assert!(
+        err <= 1e-4,
+        "{what} at bin {p} ({:.1} Hz): measured {got}, z-domain {want}, rel err {err:.2e}",
+        p as f64 / (WINDOW as f64 * T as f64)
+    );
+}
+
+fn pm(x_m: f64) -> Position {
+    Position::from_pm((x_m * 1e12).round() as i64)
+}
+
+/// A test VE that imposes a velocity whatever the force (admittance 0 plus a
+/// source), for driving a coupling by its VE side.
+struct VelocitySource(f32);
+
+impl VirtualEnvironment for VelocitySource {
+    fn causality(&self) -> Causality {
+        Causality::Admittance
+    }
+    fn step(&mut self, port: Port) -> VeOutput {
+        port.at(self.0)
+    }
+    fn reset(&mut self, _: Position) {}
+    fn position(&self) -> Position {
+        Position::ZERO
+    }
+    fn tf(&self) -> VeTransfer {
+        VeTransfer::Admittance(ZTransfer::gain(0.0))
+    }
+}
+
+#[test]
+fn first_difference_estimator() {
+    for p in BINS {
+        let mut est = FirstDifference::new(T, Position::ZERO).unwrap();
+        let got = measure(p, |c| {
+            let x = pm(1e-3 * c);
+            (x.m() as f64, est.step(x) as f64)
+        });
+        assert_close("(1 - z^-1)/T", p, got, est.tf().eval(z_of(p)));
+    }
+}
+
+#[test]
+fn velocity_integrator() {
+    for p in BINS {
+        let mut x = Integrator::new(T, Position::ZERO);
+        let got = measure(p, |c| {
+            let v = (0.2 * c) as f32;
+            (v as f64, x.step(v).pm() as f64 * 1e-12)
+        });
+        assert_close("T/(1 - z^-1)", p, got, x.tf().eval(z_of(p)));
+    }
+}
+
+#[test]
+fn position_regulator() {
+    for p in BINS {
+        let mut r = PositionRegulator::new(51_000.0, 90.0, T).unwrap();
+        let got = measure(p, |c| {
+            let x = pm(1e-3 * c);
+            (x.m() as f64, r.step(x, Position::ZERO) as f64)
+        });
+        assert_close("K_p", p, got, r.tf().eval(z_of(p)));
+    }
+}
+
+#[test]
+fn impedance_coupling_against_a_fixed_ve() {
+    for p in BINS {
+        let mut est = FirstDifference::new(T, Position::ZERO).unwrap();
+        let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T, Position::ZERO).unwrap();
+        let mut ve = BilateralConstraint::new(Position::ZERO);
+        let got = measure(p, |u| {
+            let x = pm(1e-3 * u);
+            let v = est.step(x);
+            (v as f64, c.step(x, v, &mut ve).force_n as f64)
+        });
+        assert_close("Z_cI", p, got, c.tf().eval(z_of(p)));
+    }
+}
+
+#[test]
+fn admittance_coupling_driven_by_velocity() {
+    for p in BINS {
+        let mut c = AdmittanceCoupling::new(5.0, 500.0, T).unwrap();
+        let mut src = VelocitySource(0.0);
+        let got = measure(p, |u| {
+            src.0 = (0.1 * u) as f32;
+            let s = c.step(0.0, &mut src);
+            (s.velocity_mps as f64, s.coupling_force_n as f64)
+        });
+        assert_close("Z_cA", p, got, c.tf().eval(z_of(p)));
+    }
+}
+
+/// Admittance VE laws are measured as velocity per force, impedance ones as
+/// force per velocity, each through a port of arbitrary feedthrough.
+fn ve_response(p: usize, ve: &mut dyn VirtualEnvironment, bias_n: f64, amp_n: f64) -> Complex64 {
+    let adm = ve.causality() == Causality::Admittance;
+    measure(p, |u| {
+        let o = ve.step(Port {
+            f0_n: (bias_n + amp_n * u) as f32,
+            z_nspm: 40.0,
+        });
+        let (f, v) = (o.force_n as f64, o.velocity_mps as f64);
+        if adm {
+            (f, v)
+        } else {
+            (v, f)
+        }
+    })
+}
+
+fn ve_tf(ve: &dyn VirtualEnvironment) -> ZTransfer {
+    match ve.tf() {
+        VeTransfer::Admittance(t) | VeTransfer::Impedance(t) => t,
+    }
+}
+
+#[test]
+fn cursor_mass_ve() {
+    for p in BINS {
+        let mut ve = CursorMass::new(0.25, T, Position::ZERO).unwrap();
+        let got = ve_response(p, &mut ve, 0.0, 10.0);
+        assert_close("cursor (T/m)/(1 - z^-1)", p, got, ve_tf(&ve).eval(z_of(p)));
+    }
+}
+
+fn wall() -> UnilateralWall {
+    UnilateralWall::new(
+        20_000.0,
+        50.0,
+        Position::ZERO,
+        Solid::Above,
+        T,
+        Position::ZERO,
+    )
+    .unwrap()
+}
+
+#[test]
+fn wall_ve_in_contact() {
+    for p in BINS {
+        let mut ve = wall();
+        // 100 +- 30 N keeps the probe 3.5 to 6.5 mm deep: always in contact.
+        let got = ve_response(p, &mut ve, 100.0, 30.0);
+        assert!(ve.in_contact());
+        assert_close("wall b + kT/(1 - z^-1)", p, got, ve_tf(&ve).eval(z_of(p)));
+    }
+}
+
+fn series_adm(z1: Complex64, z2: Complex64) -> Complex64 {
+    // Two impedances whose admittances add.
+    Complex64::new(1.0, 0.0) / (z1.inv() + z2.inv())
+}
+
+/// Fig. 7(a): impedance display, impedance VE (a wall in contact).
+#[test]
+fn fig7a_impedance_coupling_with_impedance_ve() {
+    for p in BINS {
+        let x0 = Position::ZERO;
+        let mut est = FirstDifference::new(T, x0).unwrap();
+        let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T, x0).unwrap();
+        let mut ve = UnilateralWall::new(20_000.0, 50.0, pm(-5e-3), Solid::Above, T, x0).unwrap();
+        // 0.1 mm keeps the wall's damper from ever wanting to pull at 500 Hz,
+        // so the wall stays on its linear (contact) piece.
+        let got = measure(p, |u| {
+            let x = pm(1e-4 * u);
+            let v = est.step(x);
+            (v as f64, c.step(x, v, &mut ve).force_n as f64)
+        });
+        assert!(ve.in_contact());
+        let z = z_of(p);
+        assert_close(
+            "Z_cI + wall",
+            p,
+            got,
+            series_adm(c.tf().eval(z), ve_tf(&ve).eval(z)),
+        );
+    }
+}
+
+/// Fig. 7(b): impedance display, admittance VE (a 0.25 kg cursor).
+#[test]
+fn fig7b_impedance_coupling_with_admittance_ve() {
+    for p in BINS {
+        let x0 = Position::ZERO;
+        let mut est = FirstDifference::new(T, x0).unwrap();
+        let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T, x0).unwrap();
+        let mut ve = CursorMass::new(0.25, T, x0).unwrap();
+        let got = measure(p, |u| {
+            let x = pm(1e-3 * u);
+            let v = est.step(x);
+            (v as f64, c.step(x, v, &mut ve).force_n as f64)
+        });
+        let z = z_of(p);
+        let want = Complex64::new(1.0, 0.0) / (c.tf().eval(z).inv() + ve_tf(&ve).eval(z));
+        assert_close("Z_cI + cursor", p, got, want);
+    }
+}
+
+/// Fig. 7(c): admittance display, impedance VE (a wall in contact).
+#[test]
+fn fig7c_admittance_coupling_with_impedance_ve() {
+    for p in BINS {
+        let mut c = AdmittanceCoupling::new(5.0, 500.0, T).unwrap();
+        let mut ve = wall();
+        let got = measure(p, |u| {
+            let f = (100.0 + 30.0 * u) as f32;
+            (f as f64, c.step(f, &mut ve).velocity_mps as f64)
+        });
+        assert!(ve.in_contact());
+        let z = z_of(p);
+        let want = (c.tf().eval(z) + ve_tf(&ve).eval(z)).inv();
+        assert_close("1/(Z_cA + wall)", p, got, want);
+    }
+}
+
+/// Fig. 7(d): admittance display, admittance VE (a 0.25 kg cursor).
+#[test]
+fn fig7d_admittance_coupling_with_admittance_ve() {
+    for p in BINS {
+        let mut c = AdmittanceCoupling::new(5.0, 500.0, T).unwrap();
+        let mut ve = CursorMass::new(0.25, T, Position::ZERO).unwrap();
+        let got = measure(p, |u| {
+            let f = (30.0 * u) as f32;
+            (f as f64, c.step(f, &mut ve).velocity_mps as f64)
+        });
+        let z = z_of(p);
+        let want = (c.tf().eval(z) + ve_tf(&ve).eval(z).inv()).inv();
+        assert_close("1/(Z_cA + 1/Y_cursor)", p, got, want);
+    }
+}

@@ -1,0 +1,525 @@
+//! The safety layer between every law and the actuator. Whatever a law asks
+//! for, the actuator gets at most this layer's answer; any fault gives zero
+//! force in the same tick, latches, and is reported until explicitly cleared.
+
+use crate::{param, ParamError};
+use core::fmt;
+
+/// A set of fault reasons (bit flags).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Faults(pub u16);
+
+impl Faults {
+    /// No fault.
+    pub const NONE: Faults = Faults(0);
+    /// A sensor gave NaN or infinity.
+    pub const SENSOR_NOT_FINITE: Faults = Faults(1 << 0);
+    /// A sensor reading is beyond its range or at its rail.
+    pub const SENSOR_OUT_OF_RANGE: Faults = Faults(1 << 1);
+    /// The encoder gave a raw value its counter cannot hold.
+    pub const ENCODER_INVALID: Faults = Faults(1 << 2);
+    /// The handle moved faster than the velocity limit.
+    pub const VELOCITY_LIMIT: Faults = Faults(1 << 3);
+    /// The dead-man switch opened while enabled.
+    pub const DEAD_MAN: Faults = Faults(1 << 4);
+    /// A control tick was missed (the tick counter skipped).
+    pub const MISSED_TICK: Faults = Faults(1 << 5);
+    /// No link heartbeat within the timeout while enabled.
+    pub const HEARTBEAT_LOST: Faults = Faults(1 << 6);
+    /// A law produced a non-finite force.
+    pub const COMMAND_NOT_FINITE: Faults = Faults(1 << 7);
+
+    const NAMES: [(Faults, &'static str); 8] = [
+        (Faults::SENSOR_NOT_FINITE, "sensor reading not finite"),
+        (Faults::SENSOR_OUT_OF_RANGE, "sensor reading out of range"),
+        (Faults::ENCODER_INVALID, "encoder value invalid"),
+        (Faults::VELOCITY_LIMIT, "velocity limit exceeded"),
+        (Faults::DEAD_MAN, "dead-man switch released"),
+        (Faults::MISSED_TICK, "control tick missed"),
+        (Faults::HEARTBEAT_LOST, "link heartbeat lost"),
+        (Faults::COMMAND_NOT_FINITE, "force command not finite"),
+    ];
+
+    /// Whether no fault is set.
+    pub const fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// Whether every fault of `other` is set.
+    pub const fn contains(self, other: Faults) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// The union.
+    pub const fn with(self, other: Faults) -> Faults {
+        Faults(self.0 | other.0)
+    }
+
+    /// The lowest-numbered fault set, alone.
+    pub const fn lowest(self) -> Faults {
+        Faults(self.0 & self.0.wrapping_neg())
+    }
+
+    /// Each set fault's description.
+    pub fn names(self) -> impl Iterator<Item = &'static str> {
+        Self::NAMES
+            .into_iter()
+            .filter(move |(f, _)| self.contains(*f))
+            .map(|(_, n)| n)
+    }
+}
+
+impl fmt::Display for Faults {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.is_empty() {
+            return f.write_str("no fault");
+        }
+        for (i, n) in self.names().enumerate() {
+            if i > 0 {
+                f.write_str(", ")?;
+            }
+            f.write_str(n)?;
+        }
+        Ok(())
+    }
+}
+
+/// Limits of one actuator axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SafetyConfig {
+    /// Sample period `T` (s).
+    pub period_s: f32,
+    /// Largest force at any instant (N).
+    pub peak_force_n: f32,
+    /// Largest force that may be held indefinitely (N).
+    pub continuous_force_n: f32,
+    /// Time at peak force from cold before the thermal budget folds the limit
+    /// back to the continuous force (s). Sets the I^2 t budget
+    /// `(peak^2 - continuous^2) * peak_duration`.
+    pub peak_duration_s: f32,
+    /// Largest handle speed (m/s).
+    pub max_velocity_mps: f32,
+    /// Load-cell range (N): a reading beyond it is a fault.
+    pub max_sensor_force_n: f32,
+    /// Ticks without a link heartbeat before a fault; 0 disables the check.
+    pub heartbeat_timeout_ticks: u32,
+    /// Ticks over which force ramps in after enable or clear (>= 1).
+    pub ramp_ticks: u32,
+    /// Whether an open dead-man switch is a fault.
+    pub require_dead_man: bool,
+}
+
+impl SafetyConfig {
+    /// Excalibur's axis: 200 N peak, 100 N continuous (paper section III),
+    /// 2 s at peak, 1 m/s, a 250 N load cell, 100 ms ramp, 1 kHz.
+    pub const fn excalibur() -> Self {
+        SafetyConfig {
+            period_s: 1.0e-3,
+            peak_force_n: 200.0,
+            continuous_force_n: 100.0,
+            peak_duration_s: 2.0,
+            max_velocity_mps: 1.0,
+            max_sensor_force_n: 250.0,
+            heartbeat_timeout_ticks: 0,
+            ramp_ticks: 100,
+            require_dead_man: false,
+        }
+    }
+
+    /// Check every field; the error names the field.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        param::positive("safety.period_s (s)", self.period_s)?;
+        param::positive("safety.peak_force_n (N)", self.peak_force_n)?;
+        param::positive("safety.continuous_force_n (N)", self.continuous_force_n)?;
+        if self.continuous_force_n > self.peak_force_n {
+            return Err(ParamError {
+                name: "safety.continuous_force_n (N)",
+                value: self.continuous_force_n,
+                problem: "must not exceed safety.peak_force_n",
+            });
+        }
+        param::non_negative("safety.peak_duration_s (s)", self.peak_duration_s)?;
+        param::positive("safety.max_velocity_mps (m/s)", self.max_velocity_mps)?;
+        param::positive("safety.max_sensor_force_n (N)", self.max_sensor_force_n)?;
+        if self.ramp_ticks == 0 {
+            return Err(ParamError {
+                name: "safety.ramp_ticks",
+                value: 0.0,
+                problem: "must be >= 1",
+            });
+        }
+        Ok(())
+    }
+
+    fn thermal_budget(&self) -> f32 {
+        let (p, c) = (self.peak_force_n, self.continuous_force_n);
+        (p * p - c * c) * self.peak_duration_s
+    }
+}
+
+/// What the safety layer needs to know besides the force command.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SafetyInputs {
+    /// The control tick number from the timer (wraps).
+    pub tick: u32,
+    /// Whether the dead-man switch is closed (operator present).
+    pub dead_man_closed: bool,
+    /// Handle or actuator velocity estimate (m/s).
+    pub velocity_mps: f32,
+    /// Faults the sensor checks found this tick.
+    pub sensor_faults: Faults,
+}
+
+/// The actuator command after the safety layer.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SafeForce {
+    /// The force to hold on the actuator this tick (N).
+    pub force_n: f32,
+    /// Every latched fault (empty when running).
+    pub faults: Faults,
+    /// Whether the force was clipped (peak, thermal fold-back or ramp).
+    pub limited: bool,
+}
+
+/// Limits, guards, watchdogs, the fault latch and the ramp-in.
+#[derive(Clone, Copy, Debug)]
+pub struct SafetyLayer {
+    cfg: SafetyConfig,
+    budget: f32,
+    enabled: bool,
+    latched: Faults,
+    first: Faults,
+    ramp_done: u32,
+    /// I^2 t state above the continuous rating (N^2 s), >= 0.
+    heat: f32,
+    last_tick: Option<u32>,
+    heartbeat_age: u32,
+}
+
+impl SafetyLayer {
+    /// A disabled layer with the given limits.
+    pub fn new(cfg: SafetyConfig) -> Result<Self, ParamError> {
+        cfg.validate()?;
+        Ok(SafetyLayer {
+            budget: cfg.thermal_budget(),
+            cfg,
+            enabled: false,
+            latched: Faults::NONE,
+            first: Faults::NONE,
+            ramp_done: 0,
+            heat: 0.0,
+            last_tick: None,
+            heartbeat_age: 0,
+        })
+    }
+
+    /// The limits.
+    pub fn config(&self) -> &SafetyConfig {
+        &self.cfg
+    }
+
+    /// Enable force output, ramping in. Refused while a fault is latched.
+    pub fn enable(&mut self) -> Result<(), Faults> {
+        if !self.latched.is_empty() {
+            return Err(self.latched);
+        }
+        if !self.enabled {
+            self.enabled = true;
+            self.ramp_done = 0;
+            self.heartbeat_age = 0;
+        }
+        Ok(())
+    }
+
+    /// Disable force output (not a fault).
+    pub fn disable(&mut self) {
+        self.enabled = false;
+    }
+
+    /// Whether force output is enabled (it may still be faulted).
+    pub fn is_enabled(&self) -> bool {
+        self.enabled
+    }
+
+    /// Clear the latch. If enabled, force ramps in again from zero; a
+    /// condition that persists latches again on the next tick.
+    pub fn clear(&mut self) {
+        self.latched = Faults::NONE;
+        self.first = Faults::NONE;
+        self.ramp_done = 0;
+        self.heartbeat_age = 0;
+    }
+
+    /// A link heartbeat arrived.
+    pub fn heartbeat(&mut self) {
+        self.heartbeat_age = 0;
+    }
+
+    /// Latched faults.
+    pub fn faults(&self) -> Faults {
+        self.latched
+    }
+
+    /// The fault that latched first (the likely cause).
+    pub fn first_fault(&self) -> Faults {
+        self.first
+    }
+
+    /// The thermal state as a fraction of the I^2 t budget (1 = folded back).
+    pub fn thermal_load(&self) -> f32 {
+        if self.budget > 0.0 {
+            self.heat / self.budget
+        } else if self.heat > 0.0 {
+            1.0
+        } else {
+            0.0
+        }
+    }
+
+    /// Latch `f` now (faults found outside `step`, e.g. by the link).
+    pub fn trip(&mut self, f: Faults) {
+        if f.is_empty() {
+            return;
+        }
+        if self.latched.is_empty() {
+            self.first = f.lowest();
+        }
+        self.latched = self.latched.with(f);
+    }
+
+    /// One tick: check, latch, limit, ramp. Call exactly once per tick.
+    pub fn step(&mut self, inputs: &SafetyInputs, command_n: f32) -> SafeForce {
+        let mut new = inputs.sensor_faults;
+        if !inputs.velocity_mps.is_finite() {
+            new = new.with(Faults::SENSOR_NOT_FINITE);
+        } else if inputs.velocity_mps.abs() > self.cfg.max_velocity_mps {
+            new = new.with(Faults::VELOCITY_LIMIT);
+        }
+        if let Some(last) = self.last_tick {
+            if inputs.tick != last.wrapping_add(1) {
+                new = new.with(Faults::MISSED_TICK);
+            }
+        }
+        self.last_tick = Some(inputs.tick);
+        if self.enabled {
+            if self.cfg.require_dead_man && !inputs.dead_man_closed {
+                new = new.with(Faults::DEAD_MAN);
+            }
+            self.heartbeat_age = self.heartbeat_age.saturating_add(1);
+            let timeout = self.cfg.heartbeat_timeout_ticks;
+            if timeout > 0 && self.heartbeat_age > timeout {
+                new = new.with(Faults::HEARTBEAT_LOST);
+            }
+        }
+        if !command_n.is_finite() {
+            new = new.with(Faults::COMMAND_NOT_FINITE);
+        }
+        self.trip(new);
+
+        let mut out = SafeForce {
+            force_n: 0.0,
+            faults: self.latched,
+            limited: false,
+        };
+        if self.enabled && self.latched.is_empty() {
+            let limit = if self.heat >= self.budget {
+                self.cfg.continuous_force_n
+            } else {
+                self.cfg.peak_force_n
+            };
+            let clipped = command_n.clamp(-limit, limit);
+            self.ramp_done = (self.ramp_done + 1).min(self.cfg.ramp_ticks);
+            let scale = self.ramp_done as f32 / self.cfg.ramp_ticks as f32;
+            out.force_n = clipped * scale;
+            out.limited = clipped != command_n || scale < 1.0;
+        } else {
+            self.ramp_done = 0;
+        }
+        let c = self.cfg.continuous_force_n;
+        let f = out.force_n;
+        self.heat = (self.heat + (f * f - c * c) * self.cfg.period_s).max(0.0);
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cfg() -> SafetyConfig {
+        SafetyConfig {
+            heartbeat_timeout_ticks: 5,
+            require_dead_man: true,
+            ..SafetyConfig::excalibur()
+        }
+    }
+
+    fn ok_inputs(tick: u32) -> SafetyInputs {
+        SafetyInputs {
+            tick,
+            dead_man_closed: true,
+            velocity_mps: 0.0,
+            sensor_faults: Faults::NONE,
+        }
+    }
+
+    /// Enabled, past the ramp, heartbeat fresh, at tick `*t`.
+    fn running(t: &mut u32) -> SafetyLayer {
+        let mut s = SafetyLayer::new(cfg()).unwrap();
+        s.enable().unwrap();
+        for _ in 0..cfg().ramp_ticks {
+            s.heartbeat();
+            s.step(&ok_inputs(*t), 10.0);
+            *t += 1;
+        }
+        assert_eq!(s.step(&ok_inputs(*t), 10.0).force_n, 10.0);
+        *t += 1;
+        s
+    }
+
+    /// Each fault path: zero force in the tick it appears, latched (zero
+    /// force, reported) while the condition is gone, until `clear`.
+    #[test]
+    fn every_fault_gives_zero_force_at_once_and_latches() {
+        type Inject = fn(&mut SafetyInputs, &mut f32);
+        let cases: [(Faults, Inject); 7] = [
+            (Faults::SENSOR_NOT_FINITE, |i, _| i.velocity_mps = f32::NAN),
+            (Faults::SENSOR_OUT_OF_RANGE, |i, _| {
+                i.sensor_faults = Faults::SENSOR_OUT_OF_RANGE
+            }),
+            (Faults::ENCODER_INVALID, |i, _| {
+                i.sensor_faults = Faults::ENCODER_INVALID
+            }),
+            (Faults::VELOCITY_LIMIT, |i, _| i.velocity_mps = -1.5),
+            (Faults::DEAD_MAN, |i, _| i.dead_man_closed = false),
+            (Faults::MISSED_TICK, |i, _| i.tick += 1),
+            (Faults::COMMAND_NOT_FINITE, |_, f| *f = f32::INFINITY),
+        ];
+        for (fault, inject) in cases {
+            let mut t = 0;
+            let mut s = running(&mut t);
+            let (mut i, mut f) = (ok_inputs(t), 50.0);
+            inject(&mut i, &mut f);
+            let out = s.step(&i, f);
+            assert_eq!(out.force_n, 0.0, "{fault}");
+            assert!(out.faults.contains(fault), "{fault}: got {}", out.faults);
+            assert_eq!(s.first_fault(), fault);
+            t = i.tick + 1;
+            for _ in 0..50 {
+                s.heartbeat();
+                let out = s.step(&ok_inputs(t), 50.0);
+                t += 1;
+                assert_eq!(out.force_n, 0.0, "{fault} must stay latched");
+                assert!(out.faults.contains(fault));
+            }
+            assert_eq!(s.enable(), Err(s.faults()));
+            s.clear();
+            s.heartbeat();
+            let out = s.step(&ok_inputs(t), 50.0);
+            assert!(out.faults.is_empty(), "{fault}: {}", out.faults);
+            assert!(
+                out.force_n > 0.0 && out.force_n < 50.0,
+                "ramps in after clear"
+            );
+        }
+    }
+
+    /// With a 5-tick timeout, five ticks after a heartbeat still run; the
+    /// sixth gives zero force and the fault.
+    #[test]
+    fn heartbeat_loss_trips_after_the_timeout() {
+        let mut t = 0;
+        let mut s = running(&mut t);
+        s.heartbeat();
+        let timeout = cfg().heartbeat_timeout_ticks;
+        for n in 1..=timeout + 1 {
+            let out = s.step(&ok_inputs(t), 10.0);
+            t += 1;
+            let lost = out.faults.contains(Faults::HEARTBEAT_LOST);
+            assert_eq!(lost, n > timeout, "tick {n} after the heartbeat");
+            assert_eq!(out.force_n == 0.0, lost);
+        }
+    }
+
+    #[test]
+    fn ramp_in_is_bounded_by_elapsed_fraction_of_peak() {
+        let c = cfg();
+        let mut s = SafetyLayer::new(c).unwrap();
+        s.enable().unwrap();
+        for n in 1..=c.ramp_ticks + 10 {
+            s.heartbeat();
+            let out = s.step(&ok_inputs(n), 1.0e6);
+            let bound = c.peak_force_n * (n.min(c.ramp_ticks) as f32 / c.ramp_ticks as f32);
+            assert!(
+                out.force_n <= bound * (1.0 + 1e-6),
+                "tick {n}: {}",
+                out.force_n
+            );
+            assert!(out.limited);
+            if n >= c.ramp_ticks {
+                assert_eq!(out.force_n, c.peak_force_n);
+            }
+        }
+    }
+
+    #[test]
+    fn disabled_gives_zero_and_enable_is_refused_while_latched() {
+        let mut s = SafetyLayer::new(cfg()).unwrap();
+        assert_eq!(s.step(&ok_inputs(0), 80.0).force_n, 0.0);
+        s.trip(Faults::HEARTBEAT_LOST);
+        assert_eq!(s.enable(), Err(Faults::HEARTBEAT_LOST));
+        s.clear();
+        assert_eq!(s.enable(), Ok(()));
+    }
+
+    /// Held at peak, the force folds back to the continuous rating once the
+    /// I^2 t budget is spent (2 s at 200 N from cold), and the RMS over a
+    /// long run stays at the continuous rating.
+    #[test]
+    fn thermal_budget_folds_back_to_continuous() {
+        let c = SafetyConfig::excalibur();
+        let mut s = SafetyLayer::new(c).unwrap();
+        s.enable().unwrap();
+        let (mut sum_sq, mut fold_tick) = (0.0f64, None);
+        let n = 20_000u32;
+        for k in 0..n {
+            let f = s.step(&ok_inputs(k), 500.0).force_n;
+            if fold_tick.is_none() && k > c.ramp_ticks && f < c.peak_force_n {
+                fold_tick = Some(k);
+            }
+            sum_sq += (f as f64) * (f as f64);
+        }
+        let fold_s = fold_tick.expect("must fold back") as f32 * c.period_s;
+        assert!((fold_s - 2.05).abs() < 0.1, "folded at {fold_s} s");
+        let rms_tail = {
+            let mut s2 = s;
+            let mut acc = 0.0f64;
+            for k in n..n + 10_000 {
+                let f = s2.step(&ok_inputs(k), 500.0).force_n as f64;
+                acc += f * f;
+            }
+            (acc / 10_000.0).sqrt()
+        };
+        assert!(
+            rms_tail <= c.continuous_force_n as f64 * 1.01,
+            "rms {rms_tail}"
+        );
+        assert!(sum_sq > 0.0);
+    }
+
+    #[test]
+    fn refuses_bad_config_naming_the_field() {
+        let e = SafetyLayer::new(SafetyConfig {
+            continuous_force_n: 300.0,
+            ..SafetyConfig::excalibur()
+        })
+        .unwrap_err();
+        assert_eq!(e.name, "safety.continuous_force_n (N)");
+        let e = SafetyLayer::new(SafetyConfig {
+            max_velocity_mps: f32::NAN,
+            ..SafetyConfig::excalibur()
+        })
+        .unwrap_err();
+        assert!(e.name.starts_with("safety.max_velocity_mps"));
+    }
+}

@@ -1,0 +1,429 @@
+//! Virtual environments that run on the board, and the exact solution of the
+//! algebraic loop between a coupling and a VE.
+//!
+//! Every virtual coupling in this crate has direct feedthrough: this tick's
+//! VE velocity changes this tick's coupling force. The coupling therefore
+//! hands the VE a [`Port`], its own law for this tick written as the affine
+//! relation `f = f0 - z v` between the force `f` it applies to the VE and the
+//! VE velocity `v`. The VE intersects that line with its own law and commits
+//! the one consistent answer, so no one-tick delay is ever inserted (a delay
+//! would change the two-port the designer proved stable).
+//!
+//! Sign convention: `f` is the force applied *to* the VE along +x (N), `v`
+//! is the VE velocity along +x (m/s), and positions are [`Position`]s.
+
+use crate::{param, Integrator, ParamError, Position, ZTransfer};
+
+/// The paper's Fig. 7 causality of a VE's own law.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Causality {
+    /// Force from velocity, `f = Z_e v` (Fig. 7(a), 7(c)).
+    Impedance,
+    /// Velocity from force, `v = Y_e f` (Fig. 7(b), 7(d)).
+    Admittance,
+}
+
+/// A coupling's law for this tick, as seen by the VE: it applies
+/// `f0_n - z_nspm * v` (N) to the VE for a VE velocity `v` (m/s).
+/// `z_nspm > 0` (N s/m) always: it is the coupling's direct feedthrough.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Port {
+    /// Force at zero VE velocity (N).
+    pub f0_n: f32,
+    /// Direct-feedthrough impedance (N s/m), > 0.
+    pub z_nspm: f32,
+}
+
+/// What a VE settled on this tick.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct VeOutput {
+    /// VE velocity `v_e` (m/s).
+    pub velocity_mps: f32,
+    /// Force applied to the VE along +x, `f_e` (N).
+    pub force_n: f32,
+}
+
+impl Port {
+    /// Intersect with an admittance law `v = v0 + y f` (y >= 0, m/(N s)).
+    pub fn solve_admittance(self, v0_mps: f32, y: f32) -> VeOutput {
+        let v = (v0_mps + y * self.f0_n) / (1.0 + y * self.z_nspm);
+        self.at(v)
+    }
+
+    /// Intersect with an impedance law `f = g + h v` (h >= 0, N s/m).
+    pub fn solve_impedance(self, g_n: f32, h: f32) -> VeOutput {
+        let v = (self.f0_n - g_n) / (self.z_nspm + h);
+        self.at(v)
+    }
+
+    /// The port's force at VE velocity `v`.
+    pub fn at(self, v_mps: f32) -> VeOutput {
+        VeOutput {
+            velocity_mps: v_mps,
+            force_n: self.f0_n - self.z_nspm * v_mps,
+        }
+    }
+}
+
+/// The linear(ised) law of a VE as a z-domain transfer function.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum VeTransfer {
+    /// `F_e(z)/V_e(z)` (N s/m).
+    Impedance(ZTransfer),
+    /// `V_e(z)/F_e(z)` (m/(N s)).
+    Admittance(ZTransfer),
+}
+
+/// A virtual environment stepped once per tick against a coupling's [`Port`].
+/// `step` must not allocate, panic or loop without bound, and must leave its
+/// state unchanged when the port holds a non-finite number.
+pub trait VirtualEnvironment {
+    /// The causality of this VE's own law.
+    fn causality(&self) -> Causality;
+    /// Solve this tick exactly against the coupling's law and commit.
+    fn step(&mut self, port: Port) -> VeOutput;
+    /// Put the VE at rest at `x`.
+    fn reset(&mut self, x: Position);
+    /// The VE's current position.
+    fn position(&self) -> Position;
+    /// The VE's law in the z-domain (for a piecewise law: the piece named in
+    /// its documentation, e.g. a wall in contact).
+    fn tf(&self) -> VeTransfer;
+}
+
+/// A free cursor (or grabbed block) of mass `m`: `v[k] = v[k-1] + T f[k] / m`,
+/// backward Euler, which is discrete-time passive for every `m > 0`.
+/// Admittance causality. The paper's VBB needed `m >= 0.25 kg` with its
+/// explicit integrator ([`PAPER_MIN_CURSOR_MASS_KG`]).
+#[derive(Clone, Copy, Debug)]
+pub struct CursorMass {
+    mass_kg: f32,
+    t_over_m: f32,
+    velocity_mps: f32,
+    x: Integrator,
+}
+
+/// The smallest cursor mass the paper's experiments ran stably (kg).
+pub const PAPER_MIN_CURSOR_MASS_KG: f32 = 0.25;
+
+impl CursorMass {
+    /// A mass of `mass_kg` (kg) at rest at `x`, period `period_s` (s).
+    pub fn new(mass_kg: f32, period_s: f32, x: Position) -> Result<Self, ParamError> {
+        let m = param::positive("cursor mass (kg)", mass_kg)?;
+        let t = param::positive("T (s)", period_s)?;
+        Ok(CursorMass {
+            mass_kg: m,
+            t_over_m: t / m,
+            velocity_mps: 0.0,
+            x: Integrator::new(t, x),
+        })
+    }
+
+    /// The mass (kg).
+    pub fn mass_kg(&self) -> f32 {
+        self.mass_kg
+    }
+
+    /// The current velocity (m/s).
+    pub fn velocity_mps(&self) -> f32 {
+        self.velocity_mps
+    }
+}
+
+impl VirtualEnvironment for CursorMass {
+    fn causality(&self) -> Causality {
+        Causality::Admittance
+    }
+
+    fn step(&mut self, port: Port) -> VeOutput {
+        let out = port.solve_admittance(self.velocity_mps, self.t_over_m);
+        if out.velocity_mps.is_finite() {
+            self.velocity_mps = out.velocity_mps;
+            self.x.step(out.velocity_mps);
+        }
+        out
+    }
+
+    fn reset(&mut self, x: Position) {
+        self.velocity_mps = 0.0;
+        self.x.reset(x);
+    }
+
+    fn position(&self) -> Position {
+        self.x.position()
+    }
+
+    /// `V/F = (T/m) / (1 - z^-1)`.
+    fn tf(&self) -> VeTransfer {
+        VeTransfer::Admittance(ZTransfer::first_order([self.t_over_m as f64, 0.0], -1.0))
+    }
+}
+
+/// Which side of the wall surface is solid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Solid {
+    /// Positions above the surface are inside the wall.
+    Above,
+    /// Positions below the surface are inside the wall.
+    Below,
+}
+
+/// A one-sided spring-damper wall touched by a massless probe. Impedance
+/// causality: in contact the force needed to hold the probe at penetration
+/// `p` moving inward at `p'` is `k p + b p'`, never pulling (`>= 0`); out of
+/// contact it is zero. Penetration is summed from velocities like the
+/// coupling's spring (`p[k] = p[k-1] + T p'[k]`), so in contact the law is
+/// exactly `Z_e(z) = b + kT/(1 - z^-1)`.
+#[derive(Clone, Copy, Debug)]
+pub struct UnilateralWall {
+    k: f32,
+    b: f32,
+    kt: f32,
+    period_s: f32,
+    surface: Position,
+    solid: Solid,
+    probe: Integrator,
+}
+
+impl UnilateralWall {
+    /// A wall of stiffness `k_npm` (N/m) and damping `b_nspm` (N s/m) whose
+    /// surface is at `surface`, solid on the `solid` side; the probe starts
+    /// at rest at `probe`.
+    pub fn new(
+        k_npm: f32,
+        b_nspm: f32,
+        surface: Position,
+        solid: Solid,
+        period_s: f32,
+        probe: Position,
+    ) -> Result<Self, ParamError> {
+        let k = param::non_negative("wall stiffness (N/m)", k_npm)?;
+        let b = param::non_negative("wall damping (N s/m)", b_nspm)?;
+        let t = param::positive("T (s)", period_s)?;
+        Ok(UnilateralWall {
+            k,
+            b,
+            kt: k * t,
+            period_s: t,
+            surface,
+            solid,
+            probe: Integrator::new(t, probe),
+        })
+    }
+
+    /// Move the surface (the probe stays where it is).
+    pub fn set_surface(&mut self, surface: Position) {
+        self.surface = surface;
+    }
+
+    /// Change stiffness and damping.
+    pub fn set_gains(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
+        self.k = param::non_negative("wall stiffness (N/m)", k_npm)?;
+        self.b = param::non_negative("wall damping (N s/m)", b_nspm)?;
+        self.kt = self.k * self.period_s;
+        Ok(())
+    }
+
+    /// +1 when solid above, -1 when below.
+    fn sign(&self) -> f32 {
+        match self.solid {
+            Solid::Above => 1.0,
+            Solid::Below => -1.0,
+        }
+    }
+
+    /// Penetration (m, > 0 inside) and inward push (N, before clamping) of
+    /// the probe at velocity `v` this tick.
+    fn contact(&self, d_m: f32, v: f32) -> (f32, f32) {
+        let s = self.sign();
+        let pen = s * (d_m + self.period_s * v);
+        (pen, self.k * pen + self.b * s * v)
+    }
+
+    /// Whether the probe is in the wall.
+    pub fn in_contact(&self) -> bool {
+        let d = self.probe.position().minus_m(self.surface);
+        self.sign() * d > 0.0
+    }
+}
+
+impl VirtualEnvironment for UnilateralWall {
+    fn causality(&self) -> Causality {
+        Causality::Impedance
+    }
+
+    fn step(&mut self, port: Port) -> VeOutput {
+        let d = self.probe.position().minus_m(self.surface);
+        // The force needed is non-decreasing in v, so exactly one of three
+        // cases holds: free, pushed by the wall, or stopped at the surface
+        // (the damper's jump on first touch).
+        let free = port.at(port.f0_n / port.z_nspm);
+        let (pen, push) = self.contact(d, free.velocity_mps);
+        let out = if pen <= 0.0 || push <= 0.0 {
+            free
+        } else {
+            // f = k (x - surface) + (kT + b) v, the same for both sides.
+            let touched = port.solve_impedance(self.k * d, self.kt + self.b);
+            let (pen, push) = self.contact(d, touched.velocity_mps);
+            if pen > 0.0 && push >= 0.0 {
+                touched
+            } else {
+                port.at(-d / self.period_s)
+            }
+        };
+        if out.velocity_mps.is_finite() {
+            self.probe.step(out.velocity_mps);
+        }
+        out
+    }
+
+    fn reset(&mut self, x: Position) {
+        self.probe.reset(x);
+    }
+
+    fn position(&self) -> Position {
+        self.probe.position()
+    }
+
+    /// In contact: `F/V = b + kT/(1 - z^-1)`.
+    fn tf(&self) -> VeTransfer {
+        let (b, kt) = (self.b as f64, self.kt as f64);
+        VeTransfer::Impedance(ZTransfer::first_order([b + kt, -b], -1.0))
+    }
+}
+
+/// A bilateral constraint: the VE point is fixed, `v_e = 0`, whatever the
+/// force (admittance zero). The paper's "bilaterally constrained block".
+#[derive(Clone, Copy, Debug)]
+pub struct BilateralConstraint {
+    at: Position,
+}
+
+impl BilateralConstraint {
+    /// A constraint holding the VE at `at`.
+    pub fn new(at: Position) -> Self {
+        BilateralConstraint { at }
+    }
+}
+
+impl VirtualEnvironment for BilateralConstraint {
+    fn causality(&self) -> Causality {
+        Causality::Admittance
+    }
+
+    fn step(&mut self, port: Port) -> VeOutput {
+        port.at(0.0)
+    }
+
+    fn reset(&mut self, x: Position) {
+        self.at = x;
+    }
+
+    fn position(&self) -> Position {
+        self.at
+    }
+
+    /// `V/F = 0`.
+    fn tf(&self) -> VeTransfer {
+        VeTransfer::Admittance(ZTransfer::gain(0.0))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const T: f32 = 1.0e-3;
+
+    fn wall_at_zero(probe_m: f32) -> UnilateralWall {
+        let probe = Position::from_m(probe_m).unwrap();
+        UnilateralWall::new(10_000.0, 20.0, Position::ZERO, Solid::Above, T, probe).unwrap()
+    }
+
+    #[test]
+    fn wall_is_free_outside_and_pushes_inside() {
+        // Far outside, pulled gently: free, the port's force is zero.
+        let mut w = wall_at_zero(-0.01);
+        let out = w.step(Port {
+            f0_n: 1.0,
+            z_nspm: 100.0,
+        });
+        assert_eq!(out.force_n, 0.0);
+        assert!((out.velocity_mps - 0.01).abs() < 1e-7);
+        // Inside by 1 mm, held: force k d + (kT + b) v balances f0 - z v.
+        let mut w = wall_at_zero(1e-3);
+        let out = w.step(Port {
+            f0_n: 10.0,
+            z_nspm: 100.0,
+        });
+        let expect_v = (10.0 - 10_000.0 * 1e-3) / (100.0 + 10.0 + 20.0);
+        assert!((out.velocity_mps - expect_v).abs() < 1e-6);
+        assert!(out.force_n >= 0.0);
+    }
+
+    #[test]
+    fn wall_stops_a_fast_probe_at_the_surface_and_never_pulls() {
+        // 0.1 mm outside, driven hard inward: the damper's jump on touch
+        // leaves the probe exactly on the surface this tick.
+        let mut w = wall_at_zero(-1e-4);
+        let out = w.step(Port {
+            f0_n: 2.0,
+            z_nspm: 10.0,
+        });
+        assert!((out.velocity_mps - 0.1).abs() < 1e-5, "{out:?}");
+        assert!(out.force_n >= 0.0);
+        assert!(w.position().pm().abs() < 1_000, "{:?}", w.position());
+        // Inside but pulled out fast: the wall lets go (force 0, not < 0).
+        let mut w = wall_at_zero(1e-4);
+        let out = w.step(Port {
+            f0_n: -50.0,
+            z_nspm: 10.0,
+        });
+        assert_eq!(out.force_n, 0.0);
+        // A wall solid below mirrors it.
+        let mut w = UnilateralWall::new(
+            10_000.0,
+            20.0,
+            Position::ZERO,
+            Solid::Below,
+            T,
+            Position::from_m(-1e-3).unwrap(),
+        )
+        .unwrap();
+        assert!(w.in_contact());
+        let out = w.step(Port {
+            f0_n: -10.0,
+            z_nspm: 100.0,
+        });
+        assert!(out.force_n <= 0.0, "pushes toward +x: {out:?}");
+    }
+
+    #[test]
+    fn ve_state_survives_a_non_finite_port() {
+        let mut m = CursorMass::new(0.25, T, Position::ZERO).unwrap();
+        m.step(Port {
+            f0_n: f32::NAN,
+            z_nspm: 1.0,
+        });
+        assert_eq!(m.velocity_mps(), 0.0);
+        assert_eq!(m.position(), Position::ZERO);
+        let mut w = wall_at_zero(-1e-3);
+        w.step(Port {
+            f0_n: f32::INFINITY,
+            z_nspm: 1.0,
+        });
+        assert_eq!(w.position(), Position::from_m(-1e-3).unwrap());
+    }
+
+    #[test]
+    fn constructors_refuse_bad_parameters() {
+        assert_eq!(
+            CursorMass::new(0.0, T, Position::ZERO).unwrap_err().name,
+            "cursor mass (kg)"
+        );
+        assert!(
+            UnilateralWall::new(-1.0, 0.0, Position::ZERO, Solid::Above, T, Position::ZERO)
+                .is_err()
+        );
+    }
+}

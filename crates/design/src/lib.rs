@@ -1,0 +1,2 @@
+//! # twoport-design (in progress)
+#![forbid(unsafe_code)]

@@ -1,0 +1,186 @@
+//! On-target tests of the control laws: the same f32 code the board runs,
+//! checked in QEMU (Cortex-M4F) against its own z-domain forms. Prints one
+//! line per check and `N passed, M failed`; exits through semihosting with
+//! failure on any failed check, panic or HardFault.
+
+#![no_std]
+#![no_main]
+
+use cortex_m_rt::{entry, exception, ExceptionFrame};
+use cortex_m_semihosting::{debug, hprintln};
+use twoport_control::servo::SensorFrame;
+use twoport_control::ve::{
+    BilateralConstraint, CursorMass, Solid, UnilateralWall, VeTransfer, VirtualEnvironment,
+};
+use twoport_control::{
+    AdmittanceCoupling, Complex64, Encoder, Faults, FirstDifference, ImpedanceCoupling,
+    ImpedanceServo, Position, SafetyConfig, SineProbe, ZTransfer,
+};
+
+const T: f32 = 1.0e-3;
+const WINDOW: u32 = 4000;
+const SETTLE: u32 = 3000;
+const BINS: [u32; 4] = [3, 130, 1200, 1990];
+
+struct Tally {
+    passed: u32,
+    failed: u32,
+}
+
+impl Tally {
+    fn check(&mut self, name: &str, ok: bool) {
+        if ok {
+            self.passed += 1;
+            hprintln!("PASS {}", name);
+        } else {
+            self.failed += 1;
+            hprintln!("FAIL {}", name);
+        }
+    }
+}
+
+fn z_of(p: u32) -> Complex64 {
+    let th = 2.0 * core::f64::consts::PI * p as f64 / WINDOW as f64;
+    Complex64::new(libm::cos(th), libm::sin(th))
+}
+
+/// Relative distance between two complex numbers.
+fn rel(got: Complex64, want: Complex64) -> f64 {
+    let d = got - want;
+    libm::sqrt(d.norm_sqr() / want.norm_sqr())
+}
+
+fn measure(p: u32, mut tick: impl FnMut(f64) -> (f64, f64)) -> Complex64 {
+    let z = z_of(p);
+    let mut probe = SineProbe::new(z.re, z.im);
+    for k in 0..SETTLE + WINDOW {
+        let (i, o) = tick(probe.excitation());
+        if k >= SETTLE {
+            probe.record(i, o);
+        } else {
+            probe.skip();
+        }
+    }
+    probe.response()
+}
+
+fn pm(x_m: f64) -> Position {
+    Position::from_pm(libm::round(x_m * 1e12) as i64)
+}
+
+fn ve_tf(t: VeTransfer) -> ZTransfer {
+    match t {
+        VeTransfer::Admittance(t) | VeTransfer::Impedance(t) => t,
+    }
+}
+
+fn impedance_coupling(t: &mut Tally) {
+    let mut worst = 0.0f64;
+    for p in BINS {
+        let mut est = FirstDifference::new(T, Position::ZERO).unwrap();
+        let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T, Position::ZERO).unwrap();
+        let mut ve = BilateralConstraint::new(Position::ZERO);
+        let got = measure(p, |u| {
+            let x = pm(1e-3 * u);
+            let v = est.step(x);
+            (v as f64, c.step(x, v, &mut ve).force_n as f64)
+        });
+        worst = worst.max(rel(got, c.tf().eval(z_of(p))));
+    }
+    hprintln!("  Z_cI worst relative error {:e}", worst);
+    t.check("Z_cI response equals its z-domain form", worst <= 1e-4);
+}
+
+fn admittance_coupling_with_cursor(t: &mut Tally) {
+    let mut worst = 0.0f64;
+    for p in BINS {
+        let mut c = AdmittanceCoupling::new(5.0, 500.0, T).unwrap();
+        let mut ve = CursorMass::new(0.25, T, Position::ZERO).unwrap();
+        let got = measure(p, |u| {
+            let f = (30.0 * u) as f32;
+            (f as f64, c.step(f, &mut ve).velocity_mps as f64)
+        });
+        let z = z_of(p);
+        let want = (c.tf().eval(z) + ve_tf(ve.tf()).eval(z).inv()).inv();
+        worst = worst.max(rel(got, want));
+    }
+    hprintln!("  Z_cA + cursor worst relative error {:e}", worst);
+    t.check("Fig. 7(d) loop solved exactly on target", worst <= 1e-4);
+}
+
+fn frame(tick: u32, raw: u32, load_cell_n: f32) -> SensorFrame {
+    SensorFrame {
+        tick,
+        encoder_raw: raw,
+        load_cell_n,
+        dead_man_closed: true,
+    }
+}
+
+fn servo_wall_and_fault(t: &mut Tally) {
+    let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    let wall = UnilateralWall::new(
+        20_000.0,
+        50.0,
+        Position::ZERO,
+        Solid::Above,
+        T,
+        Position::ZERO,
+    )
+    .unwrap();
+    let mut s = ImpedanceServo::new(51_000.0, 90.0, enc, SafetyConfig::excalibur(), wall).unwrap();
+    let _ = s.enable();
+    let mut f = 0.0;
+    let mut k = 0u32;
+    while k < 3000 {
+        f = s.tick(&frame(k, k.min(1000) * 2, 0.0)).actuator_force_n;
+        k += 1;
+    }
+    let want = 2e-3 / (1.0 / 51_000.0 + 1.0 / 20_000.0);
+    t.check(
+        "wall renders the series stiffness",
+        libm::fabsf(f - want) < 1e-3 * want,
+    );
+    let out = s.tick(&frame(k, 0x1_0000, 0.0));
+    t.check(
+        "invalid encoder value gives zero force in the same tick",
+        out.actuator_force_n == 0.0 && out.faults.contains(Faults::ENCODER_INVALID),
+    );
+}
+
+#[entry]
+fn main() -> ! {
+    let mut t = Tally {
+        passed: 0,
+        failed: 0,
+    };
+    impedance_coupling(&mut t);
+    admittance_coupling_with_cursor(&mut t);
+    servo_wall_and_fault(&mut t);
+    hprintln!("{} passed, {} failed", t.passed, t.failed);
+    debug::exit(if t.failed == 0 {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
+    #[allow(clippy::empty_loop)]
+    loop {}
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    hprintln!("panic: {}", info);
+    debug::exit(debug::EXIT_FAILURE);
+    #[allow(clippy::empty_loop)]
+    loop {}
+}
+
+#[exception]
+// SAFETY: cortex-m-rt requires the HardFault handler to be an `unsafe fn`;
+// it only reads the stacked frame it is handed and exits.
+unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
+    hprintln!("HardFault at pc {:#010x}", ef.pc());
+    debug::exit(debug::EXIT_FAILURE);
+    #[allow(clippy::empty_loop)]
+    loop {}
+}

@@ -1,0 +1,151 @@
+//! `cargo xtask <task>`: the project's build, emulate and check tasks.
+//!
+//! - `ci`: everything CI checks (fmt, clippy, tests, the thumbv7em build of
+//!   the control crate, the firmware's on-target tests in QEMU).
+//! - `thumb`: build `twoport-control` for thumbv7em-none-eabihf.
+//! - `firmware`: build the firmware workspace.
+//! - `qemu`: build and run the on-target tests in QEMU mps2-an386.
+
+mod toolchain;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode, Stdio};
+use std::time::{Duration, Instant};
+use toolchain::{Toolchain, TARGET};
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let result = match args.first().map(String::as_str) {
+        Some("ci") => ci(),
+        Some("thumb") => thumb(),
+        Some("firmware") => firmware().map(|_| ()),
+        Some("qemu") => qemu(),
+        _ => Err(format!(
+            "usage: cargo xtask <ci|thumb|firmware|qemu>\n  got: {}",
+            args.join(" ")
+        )),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("xtask: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives in the workspace root")
+        .to_path_buf()
+}
+
+/// Where cross builds go: beside the host build, in their own folders, so
+/// that two compilers never share a directory.
+fn cross_target_dir(name: &str) -> PathBuf {
+    let base = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target"));
+    base.join(name)
+}
+
+fn run(what: &str, cmd: &mut Command) -> Result<(), String> {
+    eprintln!("xtask: {what}");
+    let status = cmd
+        .status()
+        .map_err(|e| format!("{what}: could not start: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("{what}: failed ({status})"))
+    }
+}
+
+fn cargo() -> Command {
+    let mut c = Command::new(std::env::var("CARGO").unwrap_or("cargo".into()));
+    c.current_dir(root());
+    c
+}
+
+fn ci() -> Result<(), String> {
+    run(
+        "cargo fmt --check",
+        cargo().args(["fmt", "--all", "--", "--check"]),
+    )?;
+    run(
+        "cargo fmt --check (firmware)",
+        cargo().args([
+            "fmt",
+            "--manifest-path",
+            "firmware/Cargo.toml",
+            "--all",
+            "--",
+            "--check",
+        ]),
+    )?;
+    run(
+        "cargo clippy",
+        cargo().args([
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--",
+            "-D",
+            "warnings",
+        ]),
+    )?;
+    thumb()?;
+    qemu()?;
+    // Last, so that its summary is the run's closing test count.
+    run("cargo test", cargo().args(["test", "--workspace"]))
+}
+
+fn thumb() -> Result<(), String> {
+    let tc = Toolchain::detect()?;
+    run(
+        &format!("build twoport-control for {TARGET} ({})", tc.describe()),
+        &mut tc.build(
+            &root(),
+            &cross_target_dir("thumbv7em-control"),
+            &["-p", "twoport-control"],
+        ),
+    )
+}
+
+/// Build the firmware workspace; returns the folder holding the ELF files.
+fn firmware() -> Result<PathBuf, String> {
+    let tc = Toolchain::detect()?;
+    let dir = cross_target_dir("firmware");
+    run(
+        &format!("build firmware ({})", tc.describe()),
+        &mut tc.build(&root().join("firmware"), &dir, &[]),
+    )?;
+    Ok(dir.join(TARGET).join("release"))
+}
+
+fn qemu() -> Result<(), String> {
+    let elf = firmware()?.join("twoport-probe");
+    eprintln!("xtask: run {} in QEMU mps2-an386", elf.display());
+    let mut child = Command::new("qemu-system-arm")
+        .args(["-machine", "mps2-an386", "-cpu", "cortex-m4", "-nographic"])
+        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
+        .arg(&elf)
+        .stdin(Stdio::null())
+        .spawn()
+        .map_err(|e| format!("qemu-system-arm: could not start ({e}); install qemu-system-arm"))?;
+    // A hung target (a lost exit, a fault loop) must not hang CI.
+    let deadline = Instant::now() + Duration::from_secs(300);
+    loop {
+        match child.try_wait() {
+            Ok(Some(status)) if status.success() => return Ok(()),
+            Ok(Some(status)) => return Err(format!("on-target tests failed ({status})")),
+            Ok(None) if Instant::now() > deadline => {
+                let _ = child.kill();
+                return Err("on-target tests timed out after 300 s".into());
+            }
+            Ok(None) => std::thread::sleep(Duration::from_millis(50)),
+            Err(e) => return Err(format!("waiting for qemu: {e}")),
+        }
+    }
+}
