@@ -1,0 +1,436 @@
+//! Coupling synthesis, absolute-stability checks and impedance ranges, on a
+//! frequency grid refined where the device resonates.
+//!
+//! Every coupling and regulator response here is the control crate's own
+//! law, built with the f32 parameters the board would get, through its
+//! `tf()`: the law analysed is the law run.
+
+use crate::twoport::{
+    admittance_display, design_bound, impedance_display, llewellyn_margin,
+    with_admittance_coupling, with_impedance_coupling, HumanBound,
+};
+use crate::{Plant, PlantPoint};
+use num_complex::Complex64;
+use std::f64::consts::PI;
+use twoport_control::{
+    AdmittanceCoupling, ImpedanceCoupling, ParamError, Position, PositionRegulator, ZTransfer,
+};
+
+/// How finely to sample frequency.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridSpec {
+    /// Lowest frequency (Hz).
+    pub f_min_hz: f64,
+    /// Log-spaced points from `f_min_hz` to Nyquist.
+    pub base_points: usize,
+    /// Extra points across each resonance (continuous modes below Nyquist
+    /// and the aliased angles of the discrete poles).
+    pub points_per_mode: usize,
+}
+
+impl GridSpec {
+    /// The default design grid. Doubling both counts moves no design result
+    /// by more than 0.5% (tested).
+    pub const DEFAULT: GridSpec = GridSpec {
+        f_min_hz: 0.05,
+        base_points: 1500,
+        points_per_mode: 300,
+    };
+
+    /// This grid with twice the points.
+    pub fn doubled(self) -> GridSpec {
+        GridSpec {
+            base_points: self.base_points * 2,
+            points_per_mode: self.points_per_mode * 2,
+            ..self
+        }
+    }
+}
+
+/// Angular frequencies (rad/s), increasing, in `(0, π/T]`, ending at `π/T`.
+pub fn grid(plant: &Plant, spec: GridSpec) -> Vec<f64> {
+    let nyq = plant.nyquist();
+    let lo = (2.0 * PI * spec.f_min_hz).min(nyq / 10.0);
+    let n = spec.base_points.max(2);
+    let mut w: Vec<f64> = (0..n)
+        .map(|i| lo * (nyq / lo).powf(i as f64 / (n - 1) as f64))
+        .collect();
+    let mut centres: Vec<(f64, f64)> = plant
+        .modes()
+        .iter()
+        .filter(|m| m.omega_n < nyq)
+        .map(|m| (m.omega_n, m.zeta))
+        .collect();
+    for th in plant.discrete_angles() {
+        centres.push((th / plant.period_s(), 0.0));
+    }
+    for (c, zeta) in centres {
+        // +-20 half-power bandwidths, at least +-2%.
+        let half = (20.0 * zeta.max(0.001)).max(0.02) * c;
+        let k = spec.points_per_mode.max(2);
+        for i in 0..k {
+            let x = c - half + 2.0 * half * i as f64 / (k - 1) as f64;
+            if x > 0.0 && x <= nyq {
+                w.push(x);
+            }
+        }
+    }
+    w.push(nyq);
+    w.sort_by(f64::total_cmp);
+    w.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs());
+    w
+}
+
+/// The device's responses on a grid, ready for design and checks.
+#[derive(Clone, Debug)]
+pub struct Analysis {
+    /// The per-frequency plant terms.
+    pub points: Vec<PlantPoint>,
+    /// The sample period (s).
+    pub period_s: f64,
+}
+
+impl Analysis {
+    /// Evaluate `plant` on the grid `spec`.
+    pub fn new(plant: &Plant, spec: GridSpec) -> Self {
+        Analysis {
+            points: plant.response(&grid(plant, spec)),
+            period_s: plant.period_s(),
+        }
+    }
+
+    /// Evaluate `plant` on the given angular frequencies (rad/s).
+    pub fn on(plant: &Plant, omegas: &[f64]) -> Self {
+        Analysis {
+            points: plant.response(omegas),
+            period_s: plant.period_s(),
+        }
+    }
+
+    /// The impedance-display bound on `Re(1/Z_cI)` at each grid point.
+    pub fn impedance_bound(&self, human: Option<HumanBound>) -> Vec<f64> {
+        self.points
+            .iter()
+            .map(|p| design_bound(&impedance_display(p, human)))
+            .collect()
+    }
+
+    /// The admittance-display bound on `Re Z_cA` at each grid point, for
+    /// the regulator `kp`.
+    pub fn admittance_bound(&self, kp: &ZTransfer, human: Option<HumanBound>) -> Vec<f64> {
+        self.points
+            .iter()
+            .map(|p| design_bound(&admittance_display(p, kp, human)))
+            .collect()
+    }
+}
+
+/// The z-domain form of the impedance coupling the board would run.
+pub fn impedance_coupling_tf(
+    k_npm: f64,
+    b_nspm: f64,
+    period_s: f64,
+) -> Result<ZTransfer, ParamError> {
+    ImpedanceCoupling::new(k_npm as f32, b_nspm as f32, period_s as f32, Position::ZERO)
+        .map(|c| c.tf())
+}
+
+/// The z-domain form of the admittance coupling the board would run.
+pub fn admittance_coupling_tf(
+    m_kg: f64,
+    b_nspm: f64,
+    period_s: f64,
+) -> Result<ZTransfer, ParamError> {
+    AdmittanceCoupling::new(m_kg as f32, b_nspm as f32, period_s as f32).map(|c| c.tf())
+}
+
+/// The z-domain form of the position regulator the board would run.
+pub fn regulator_tf(kp_npm: f64, bp_nspm: f64, period_s: f64) -> Result<ZTransfer, ParamError> {
+    PositionRegulator::new(kp_npm as f32, bp_nspm as f32, period_s as f32).map(|r| r.tf())
+}
+
+/// Smallest `lhs(ω) - bound(ω)` over the grid.
+fn slack(a: &Analysis, bound: &[f64], lhs: impl Fn(Complex64) -> f64) -> f64 {
+    a.points
+        .iter()
+        .zip(bound)
+        .map(|(p, b)| lhs(p.z) - b)
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Largest `x` in `[lo, hi]` with `ok(x)`, assuming `ok` holds below a
+/// threshold and fails above it; `None` if `ok(lo)` fails. Log bisection to
+/// 1e-6 relative.
+fn largest(lo: f64, hi: f64, ok: impl Fn(f64) -> bool) -> Option<f64> {
+    if !ok(lo) {
+        return None;
+    }
+    if ok(hi) {
+        return Some(hi);
+    }
+    let (mut a, mut b) = (lo.ln(), hi.ln());
+    while b - a > 1e-6 {
+        let m = 0.5 * (a + b);
+        if ok(m.exp()) {
+            a = m;
+        } else {
+            b = m;
+        }
+    }
+    Some(a.exp())
+}
+
+/// Search range for the coupling stiffness (N/m).
+pub const K_RANGE: (f64, f64) = (1.0, 1.0e8);
+/// Search range for the coupling mass (kg).
+pub const M_RANGE: (f64, f64) = (1.0e-3, 1.0e4);
+/// Search range for coupling damping in the best-pair search (N s/m).
+pub const B_RANGE: (f64, f64) = (1.0, 1.0e4);
+
+/// The greatest `k_cI` (N/m) that meets the impedance-display bound with
+/// damping `b` (N s/m); `None` if even `k = 1 N/m` does not.
+pub fn max_stiffness(a: &Analysis, bound: &[f64], b_nspm: f64) -> Option<f64> {
+    let t = a.period_s;
+    largest(K_RANGE.0, K_RANGE.1, |k| {
+        impedance_coupling_tf(k, b_nspm, t)
+            .map(|tf| slack(a, bound, |z| tf.eval(z).inv().re) >= 0.0)
+            .unwrap_or(false)
+    })
+}
+
+/// The least `m_cA` (kg) that meets the admittance-display bound with
+/// damping `b` (N s/m); `None` if no mass up to 10^4 kg does.
+pub fn min_mass(a: &Analysis, bound: &[f64], b_nspm: f64) -> Option<f64> {
+    let t = a.period_s;
+    let ok = |m: f64| {
+        admittance_coupling_tf(m, b_nspm, t)
+            .map(|tf| slack(a, bound, |z| tf.eval(z).re) >= 0.0)
+            .unwrap_or(false)
+    };
+    // Heavier is more stable: search 1/m for the largest feasible.
+    largest(1.0 / M_RANGE.1, 1.0 / M_RANGE.0, |inv| ok(1.0 / inv)).map(|inv| 1.0 / inv)
+}
+
+/// Maximise `score(b)` over `B_RANGE` on a log scan refined by golden
+/// section; returns `(b, score)` or `None` if nowhere feasible.
+fn best_over_b(score: impl Fn(f64) -> Option<f64>) -> Option<(f64, f64)> {
+    let n = 33;
+    let (lo, hi) = (B_RANGE.0.ln(), B_RANGE.1.ln());
+    let at = |i: usize| lo + (hi - lo) * i as f64 / (n - 1) as f64;
+    let (mut best_i, mut best) = (None, f64::NEG_INFINITY);
+    for i in 0..n {
+        if let Some(s) = score(at(i).exp()) {
+            if s > best {
+                (best_i, best) = (Some(i), s);
+            }
+        }
+    }
+    let i = best_i?;
+    let (mut a, mut c) = (at(i.saturating_sub(1)), at((i + 1).min(n - 1)));
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let f = |x: f64| score(x.exp()).unwrap_or(f64::NEG_INFINITY);
+    let (mut x1, mut x2) = (c - g * (c - a), a + g * (c - a));
+    let (mut f1, mut f2) = (f(x1), f(x2));
+    while c - a > 1e-4 {
+        if f1 >= f2 {
+            c = x2;
+            (x2, f2) = (x1, f1);
+            x1 = c - g * (c - a);
+            f1 = f(x1);
+        } else {
+            a = x1;
+            (x1, f1) = (x2, f2);
+            x2 = a + g * (c - a);
+            f2 = f(x2);
+        }
+    }
+    let b = (0.5 * (a + c)).exp();
+    score(b).map(|s| (b, s)).or(Some((at(i).exp(), best)))
+}
+
+/// The best impedance coupling: the `(k_cI, b_cI)` with the greatest
+/// stiffness that meets the bound.
+pub fn best_impedance(a: &Analysis, bound: &[f64]) -> Option<(f64, f64)> {
+    best_over_b(|b| max_stiffness(a, bound, b)).map(|(b, k)| (k, b))
+}
+
+/// The best admittance coupling: the `(m_cA, b_cA)` with the least mass
+/// that meets the bound.
+pub fn best_admittance(a: &Analysis, bound: &[f64]) -> Option<(f64, f64)> {
+    best_over_b(|b| min_mass(a, bound, b).map(|m| -m)).map(|(b, m)| (-m, b))
+}
+
+/// Result of an absolute-stability check.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Check {
+    /// Whether Llewellyn's criteria hold at every grid frequency (and, for
+    /// the admittance display, the regulated device is stable).
+    pub absolutely_stable: bool,
+    /// The smallest relative slack of the design inequality over the grid
+    /// (see [`relative_margin`]): >= 0 is absolutely stable.
+    pub min_margin: f64,
+    /// Where it occurs (Hz).
+    pub worst_frequency_hz: f64,
+    /// For the admittance display: the largest pole radius of the regulated
+    /// device (< 1 is stable); 0 for the impedance display.
+    pub regulator_pole_radius: f64,
+}
+
+/// The relative slack `(c - β) / (|c| + |β|)` of a design inequality
+/// `c >= β` (`c` the coupling's term, `β` the bound): +1 far inside, 0 on the
+/// bound, negative where it is violated, -1 where `β` is infinite. Its sign
+/// is that of Llewellyn's `η - 1` at the same frequency (the inequality is
+/// `η >= 1` multiplied by `2 Re p11 > 0`), but unlike `η - 1` it does not
+/// vanish at DC, where every coupling makes the rigid device a lossless link.
+pub fn relative_margin(c: f64, bound: f64) -> f64 {
+    if bound == f64::INFINITY || c.is_nan() || bound.is_nan() {
+        return -1.0;
+    }
+    let den = c.abs() + bound.abs();
+    if den == 0.0 {
+        0.0
+    } else {
+        (c - bound) / den
+    }
+}
+
+fn worst(a: &Analysis, margin: impl Fn(&PlantPoint) -> f64) -> (f64, f64) {
+    a.points
+        .iter()
+        .map(|pt| (margin(pt), pt.omega / (2.0 * PI)))
+        .fold(
+            (f64::INFINITY, 0.0),
+            |acc, x| if x.0 < acc.0 { x } else { acc },
+        )
+}
+
+/// Llewellyn check of the impedance display with coupling `(k, b)`.
+pub fn check_impedance(a: &Analysis, k: f64, b: f64, human: Option<HumanBound>) -> Option<Check> {
+    let tf = impedance_coupling_tf(k, b, a.period_s).ok()?;
+    let (m, f) = worst(a, |p| {
+        relative_margin(
+            tf.eval(p.z).inv().re,
+            design_bound(&impedance_display(p, human)),
+        )
+    });
+    Some(Check {
+        absolutely_stable: m >= 0.0,
+        min_margin: m,
+        worst_frequency_hz: f,
+        regulator_pole_radius: 0.0,
+    })
+}
+
+/// Llewellyn check of the admittance display with regulator `(kp, bp)` and
+/// coupling `(m, b)`.
+pub fn check_admittance(
+    plant: &Plant,
+    a: &Analysis,
+    (kp, bp): (f64, f64),
+    (m, b): (f64, f64),
+    human: Option<HumanBound>,
+) -> Option<Check> {
+    let k = regulator_tf(kp, bp, a.period_s).ok()?;
+    let zc = admittance_coupling_tf(m, b, a.period_s).ok()?;
+    let radius = plant.regulated_pole_radius(&k);
+    let (mg, f) = worst(a, |p| {
+        relative_margin(
+            zc.eval(p.z).re,
+            design_bound(&admittance_display(p, &k, human)),
+        )
+    });
+    Some(Check {
+        absolutely_stable: mg >= 0.0 && radius < 1.0,
+        min_margin: mg,
+        worst_frequency_hz: f,
+        regulator_pole_radius: radius,
+    })
+}
+
+/// Llewellyn's `η - 1` of the full interface at every grid point (for
+/// plots and cross-checks), impedance display.
+pub fn llewellyn_impedance(
+    a: &Analysis,
+    k: f64,
+    b: f64,
+    human: Option<HumanBound>,
+) -> Option<Vec<f64>> {
+    let tf = impedance_coupling_tf(k, b, a.period_s).ok()?;
+    Some(
+        a.points
+            .iter()
+            .map(|p| {
+                llewellyn_margin(&with_impedance_coupling(
+                    &impedance_display(p, human),
+                    tf.eval(p.z),
+                ))
+            })
+            .collect(),
+    )
+}
+
+/// Llewellyn's `η - 1` of the full interface at every grid point,
+/// admittance display.
+pub fn llewellyn_admittance(
+    a: &Analysis,
+    (kp, bp): (f64, f64),
+    (m, b): (f64, f64),
+    human: Option<HumanBound>,
+) -> Option<Vec<f64>> {
+    let k = regulator_tf(kp, bp, a.period_s).ok()?;
+    let zc = admittance_coupling_tf(m, b, a.period_s).ok()?;
+    Some(
+        a.points
+            .iter()
+            .map(|p| {
+                llewellyn_margin(&with_admittance_coupling(
+                    &admittance_display(p, &k, human),
+                    zc.eval(p.z),
+                ))
+            })
+            .collect(),
+    )
+}
+
+/// The impedance range (eqs 32, 33) at each grid point: `(Z_min, Z_max)`
+/// (N s/m), the impedances the human feels with the VE port shorted
+/// (free motion) and open (rigid constraint).
+pub fn impedance_range_impedance(
+    a: &Analysis,
+    k: f64,
+    b: f64,
+) -> Option<Vec<(Complex64, Complex64)>> {
+    let tf = impedance_coupling_tf(k, b, a.period_s).ok()?;
+    Some(
+        a.points
+            .iter()
+            .map(|p| {
+                let y = impedance_display(p, None);
+                let zmin = y[0][0].inv();
+                let zmax = (y[0][0] - y[0][1] * y[1][0] / (y[1][1] + tf.eval(p.z).inv())).inv();
+                (zmin, zmax)
+            })
+            .collect(),
+    )
+}
+
+/// The admittance display's impedance range: `(Z_min, Z_max)` (N s/m).
+pub fn impedance_range_admittance(
+    a: &Analysis,
+    (kp, bp): (f64, f64),
+    (m, b): (f64, f64),
+) -> Option<Vec<(Complex64, Complex64)>> {
+    let k = regulator_tf(kp, bp, a.period_s).ok()?;
+    let zc = admittance_coupling_tf(m, b, a.period_s).ok()?;
+    Some(
+        a.points
+            .iter()
+            .map(|p| {
+                let g = admittance_display(p, &k, None);
+                let zmax = g[0][0].inv();
+                let zmin = (g[0][0] - g[0][1] * g[1][0] / (g[1][1] + zc.eval(p.z))).inv();
+                (zmin, zmax)
+            })
+            .collect(),
+    )
+}

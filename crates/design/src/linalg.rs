@@ -1,0 +1,153 @@
+//! Small allocation-free complex solvers for the per-frequency work: each
+//! frequency point solves one small system, so the solvers reuse buffers.
+
+use num_complex::Complex64;
+
+/// Solve `a x = b` in place by LU with partial pivoting: `a` is n x n
+/// row-major, `b` is n x m row-major; on return `b` holds `x`. Returns
+/// `false` for a singular `a` (a zero pivot).
+pub fn lu_solve(a: &mut [Complex64], n: usize, b: &mut [Complex64], m: usize) -> bool {
+    for k in 0..n {
+        let mut p = k;
+        let mut best = a[k * n + k].norm_sqr();
+        for r in k + 1..n {
+            let v = a[r * n + k].norm_sqr();
+            if v > best {
+                (p, best) = (r, v);
+            }
+        }
+        if best == 0.0 || !best.is_finite() {
+            return false;
+        }
+        if p != k {
+            for c in 0..n {
+                a.swap(k * n + c, p * n + c);
+            }
+            for c in 0..m {
+                b.swap(k * m + c, p * m + c);
+            }
+        }
+        let inv = a[k * n + k].inv();
+        for r in k + 1..n {
+            let f = a[r * n + k] * inv;
+            if f == Complex64::new(0.0, 0.0) {
+                continue;
+            }
+            for c in k + 1..n {
+                let t = a[k * n + c];
+                a[r * n + c] -= f * t;
+            }
+            for c in 0..m {
+                let t = b[k * m + c];
+                b[r * m + c] -= f * t;
+            }
+        }
+    }
+    back_substitute(a, n, b, m);
+    true
+}
+
+fn back_substitute(a: &[Complex64], n: usize, b: &mut [Complex64], m: usize) {
+    for k in (0..n).rev() {
+        let inv = a[k * n + k].inv();
+        for c in 0..m {
+            let mut s = b[k * m + c];
+            for j in k + 1..n {
+                s -= a[k * n + j] * b[j * m + c];
+            }
+            b[k * m + c] = s * inv;
+        }
+    }
+}
+
+/// Solve `(z I - h) y = b` for an upper-Hessenberg `h` (n x n row-major,
+/// real) in O(n^2), using `work` (n x n) as scratch; `b` becomes `y`.
+/// Returns `false` if `z` is an eigenvalue.
+pub fn hessenberg_shift_solve(
+    h: &[f64],
+    n: usize,
+    z: Complex64,
+    work: &mut [Complex64],
+    b: &mut [Complex64],
+) -> bool {
+    for r in 0..n {
+        for c in 0..n {
+            let d = if r == c { z } else { Complex64::new(0.0, 0.0) };
+            work[r * n + c] = d - h[r * n + c];
+        }
+    }
+    // Only the subdiagonal needs eliminating; pivot between rows k, k+1.
+    for k in 0..n.saturating_sub(1) {
+        let (top, below) = (work[k * n + k], work[(k + 1) * n + k]);
+        if below.norm_sqr() > top.norm_sqr() {
+            for c in k..n {
+                work.swap(k * n + c, (k + 1) * n + c);
+            }
+            b.swap(k, k + 1);
+        }
+        let piv = work[k * n + k];
+        if piv.norm_sqr() == 0.0 {
+            return false;
+        }
+        let f = work[(k + 1) * n + k] / piv;
+        for c in k..n {
+            let t = work[k * n + c];
+            work[(k + 1) * n + c] -= f * t;
+        }
+        let t = b[k];
+        b[k + 1] -= f * t;
+    }
+    if work[(n - 1) * n + n - 1].norm_sqr() == 0.0 {
+        return false;
+    }
+    back_substitute(work, n, b, 1);
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn c(re: f64, im: f64) -> Complex64 {
+        Complex64::new(re, im)
+    }
+
+    #[test]
+    fn lu_solves_a_pivoting_system() {
+        // [[0, 1], [2, 3]] x = [[1], [8]] -> x = [2.5, 1]
+        let mut a = vec![c(0.0, 0.0), c(1.0, 0.0), c(2.0, 0.0), c(3.0, 0.0)];
+        let mut b = vec![c(1.0, 0.0), c(8.0, 0.0)];
+        assert!(lu_solve(&mut a, 2, &mut b, 1));
+        assert!((b[0] - c(2.5, 0.0)).norm() < 1e-14 && (b[1] - c(1.0, 0.0)).norm() < 1e-14);
+        let mut s = vec![c(1.0, 0.0), c(2.0, 0.0), c(2.0, 0.0), c(4.0, 0.0)];
+        assert!(!lu_solve(&mut s, 2, &mut b, 1));
+    }
+
+    #[test]
+    fn hessenberg_solve_agrees_with_lu() {
+        let n = 4;
+        let h: Vec<f64> = (0..n * n)
+            .map(|i| {
+                let (r, col) = (i / n, i % n);
+                if r > col + 1 {
+                    0.0
+                } else {
+                    ((i * 7 + 3) % 11) as f64 - 5.0
+                }
+            })
+            .collect();
+        let z = c(0.3, 0.8);
+        let rhs: Vec<Complex64> = (0..n).map(|i| c(i as f64 + 1.0, -(i as f64))).collect();
+        let mut y = rhs.clone();
+        let mut work = vec![c(0.0, 0.0); n * n];
+        assert!(hessenberg_shift_solve(&h, n, z, &mut work, &mut y));
+        let mut a: Vec<Complex64> = (0..n * n)
+            .map(|i| if i / n == i % n { z } else { c(0.0, 0.0) } - h[i])
+            .collect();
+        let mut x = rhs;
+        assert!(lu_solve(&mut a, n, &mut x, 1));
+        for i in 0..n {
+            assert!((x[i] - y[i]).norm() < 1e-12 * x[i].norm().max(1.0));
+        }
+    }
+}

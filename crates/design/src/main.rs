@@ -1,0 +1,481 @@
+//! `twoport`: design and check virtual couplings for a haptic device.
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use serde_json::{json, Value};
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use twoport_design::design::{self, Analysis, GridSpec};
+use twoport_design::twoport::HumanBound;
+use twoport_design::{figures, plot, DeviceModel, Plant};
+
+const DEFAULT_MODEL: &str = "models/excalibur.toml";
+const BUILTIN_EXCALIBUR: &str = include_str!("../../../models/excalibur.toml");
+
+/// Design haptic interfaces that are stable by construction: two-port
+/// analysis, Llewellyn's absolute-stability criteria and virtual-coupling
+/// synthesis after Adams & Hannaford (2002).
+#[derive(Parser)]
+#[command(name = "twoport", version, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Args, Clone)]
+struct Common {
+    /// Device model file (TOML). The default is the paper's Excalibur.
+    #[arg(long, default_value = DEFAULT_MODEL)]
+    model: PathBuf,
+    /// Sample period (s); the model's by default.
+    #[arg(long, allow_negative_numbers = true)]
+    period: Option<f64>,
+    /// Leave out the human bound Z_max = 300 + 1000/s (any passive human).
+    #[arg(long)]
+    no_human: bool,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Synthesise a virtual coupling.
+    #[command(subcommand)]
+    Design(Display<DesignImpedance, DesignAdmittance>),
+    /// Check a coupling for absolute stability (Llewellyn).
+    #[command(subcommand)]
+    Check(Display<ImpedanceGains, AdmittanceGains>),
+    /// Impedance range (Z_min, Z_max) over frequency, 0.1 Hz to Nyquist.
+    #[command(subcommand)]
+    Zrange(Display<ZrangeImpedance, ZrangeAdmittance>),
+    /// Draw one of the paper's figures from this designer's results.
+    Plot(PlotArgs),
+}
+
+#[derive(Subcommand)]
+enum Display<I: Args, A: Args> {
+    /// Impedance display: measure motion, command force.
+    Impedance(I),
+    /// Admittance display: measure force, command motion.
+    Admittance(A),
+}
+
+#[derive(Args)]
+struct DesignImpedance {
+    /// Coupling damping b_cI (N s/m); without it, the best (k, b) pair.
+    #[arg(long, allow_negative_numbers = true)]
+    b: Option<f64>,
+    #[command(flatten)]
+    common: Common,
+}
+
+#[derive(Args)]
+struct DesignAdmittance {
+    /// Regulator stiffness k_p (N/m); with --bp. Default: the impedance design (eq 30).
+    #[arg(long, requires = "bp", allow_negative_numbers = true)]
+    kp: Option<f64>,
+    /// Regulator damping b_p (N s/m); with --kp.
+    #[arg(long, requires = "kp", allow_negative_numbers = true)]
+    bp: Option<f64>,
+    /// Coupling damping b_cA (N s/m); without it, the best (m, b) pair.
+    #[arg(long, allow_negative_numbers = true)]
+    b: Option<f64>,
+    #[command(flatten)]
+    common: Common,
+}
+
+#[derive(Args)]
+struct ImpedanceGains {
+    /// Coupling stiffness k_cI (N/m).
+    #[arg(long, allow_negative_numbers = true)]
+    k: f64,
+    /// Coupling damping b_cI (N s/m).
+    #[arg(long, allow_negative_numbers = true)]
+    b: f64,
+    #[command(flatten)]
+    common: Common,
+}
+
+#[derive(Args)]
+struct AdmittanceGains {
+    /// Regulator stiffness k_p (N/m).
+    #[arg(long, allow_negative_numbers = true)]
+    kp: f64,
+    /// Regulator damping b_p (N s/m).
+    #[arg(long, allow_negative_numbers = true)]
+    bp: f64,
+    /// Coupling mass m_cA (kg).
+    #[arg(long, allow_negative_numbers = true)]
+    m: f64,
+    /// Coupling damping b_cA (N s/m).
+    #[arg(long, allow_negative_numbers = true)]
+    b: f64,
+    #[command(flatten)]
+    common: Common,
+}
+
+#[derive(Args)]
+struct ZrangeImpedance {
+    #[command(flatten)]
+    gains: ImpedanceGains,
+    /// Number of log-spaced frequencies.
+    #[arg(long, default_value_t = 200)]
+    points: usize,
+}
+
+#[derive(Args)]
+struct ZrangeAdmittance {
+    #[command(flatten)]
+    gains: AdmittanceGains,
+    /// Number of log-spaced frequencies.
+    #[arg(long, default_value_t = 200)]
+    points: usize,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Fig {
+    /// Impedance-display design bound and coupling.
+    Fig8,
+    /// Admittance-display design bound and coupling.
+    Fig9,
+    /// Impedance range of both displays.
+    Fig10,
+}
+
+#[derive(Args)]
+struct PlotArgs {
+    /// Which figure.
+    figure: Fig,
+    /// Output file, .png or .svg.
+    #[arg(long)]
+    out: PathBuf,
+    /// Impedance-coupling damping to design at (N s/m).
+    #[arg(long, default_value_t = 90.0)]
+    b_impedance: f64,
+    /// Admittance-coupling damping to design at (N s/m).
+    #[arg(long, default_value_t = 500.0)]
+    b_admittance: f64,
+    #[command(flatten)]
+    common: Common,
+}
+
+/// The model, the plant at the period, and the design grid.
+struct Session {
+    model: DeviceModel,
+    plant: Plant,
+    analysis: Analysis,
+    human: Option<HumanBound>,
+    json: bool,
+}
+
+impl Session {
+    fn open(c: &Common) -> Result<Self, String> {
+        let model = if c.model == Path::new(DEFAULT_MODEL) && !c.model.exists() {
+            DeviceModel::from_toml(BUILTIN_EXCALIBUR, "built-in excalibur.toml")
+        } else {
+            DeviceModel::load(&c.model)
+        }
+        .map_err(|e| e.to_string())?;
+        let period = c.period.unwrap_or(model.period_s);
+        if !(period.is_finite() && period > 0.0) {
+            return Err(format!(
+                "--period {period}: must be a positive number of seconds"
+            ));
+        }
+        let plant =
+            Plant::new(&model, period).map_err(|e| format!("{}: {e}", c.model.display()))?;
+        let analysis = Analysis::new(&plant, GridSpec::DEFAULT);
+        Ok(Session {
+            model,
+            plant,
+            analysis,
+            human: (!c.no_human).then_some(HumanBound::PAPER),
+            json: c.json,
+        })
+    }
+
+    fn period(&self) -> f64 {
+        self.plant.period_s()
+    }
+
+    fn human_text(&self) -> &'static str {
+        if self.human.is_some() {
+            "human bound Z_max = 300 + 1000/s"
+        } else {
+            "no human bound (any passive human)"
+        }
+    }
+
+    fn header(&self, display: &str) {
+        println!(
+            "{display} display, {} at T = {} ms, {}",
+            self.model.name,
+            self.period() * 1e3,
+            self.human_text()
+        );
+    }
+
+    fn emit(&self, v: Value, text: impl FnOnce()) {
+        if self.json {
+            println!("{v}");
+        } else {
+            text();
+        }
+    }
+}
+
+/// Check gains for sign and finiteness before any analysis.
+fn gain(name: &str, v: f64) -> Result<f64, String> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("--{name} {v}: must be a finite number >= 0"))
+    }
+}
+
+fn impedance_design(s: &Session, b: Option<f64>) -> Result<Option<(f64, f64)>, String> {
+    let bound = s.analysis.impedance_bound(s.human);
+    Ok(match b {
+        Some(b) => design::max_stiffness(&s.analysis, &bound, gain("b", b)?).map(|k| (k, b)),
+        None => design::best_impedance(&s.analysis, &bound),
+    })
+}
+
+fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
+    let s = Session::open(&a.common)?;
+    let r = impedance_design(&s, a.b)?;
+    let mut v = json!({"display": "impedance", "feasible": r.is_some(), "period_s": s.period(), "human_model": s.human.is_some()});
+    match r {
+        Some((k, b)) => {
+            v["k_c"] = json!(k);
+            v["b_c"] = json!(b);
+        }
+        None => {
+            v["message"] = json!(format!(
+                "no stiffness from {} to {} N/m meets the bound{}",
+                design::K_RANGE.0,
+                design::K_RANGE.1,
+                a.b.map(|b| format!(" at b_c = {b} N s/m"))
+                    .unwrap_or_default()
+            ))
+        }
+    }
+    s.emit(v.clone(), || {
+        s.header("Impedance");
+        match r {
+            Some((k, b)) if a.b.is_some() => {
+                println!("  greatest k_c at b_c = {b} N s/m: {k:.0} N/m")
+            }
+            Some((k, b)) => println!("  best coupling: k_c = {k:.0} N/m, b_c = {b:.1} N s/m"),
+            None => println!("  infeasible: {}", v["message"].as_str().unwrap_or("")),
+        }
+    });
+    Ok(())
+}
+
+fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
+    let s = Session::open(&a.common)?;
+    let (kp, bp) = match (a.kp, a.bp) {
+        (Some(kp), Some(bp)) => (gain("kp", kp)?, gain("bp", bp)?),
+        _ => impedance_design(&s, None)?
+            .ok_or("no impedance design exists to take K_p from (eq 30); give --kp and --bp")?,
+    };
+    let k = design::regulator_tf(kp, bp, s.period()).map_err(|e| e.to_string())?;
+    let radius = s.plant.regulated_pole_radius(&k);
+    let bound = s.analysis.admittance_bound(&k, s.human);
+    let r = if radius >= 1.0 {
+        None
+    } else {
+        match a.b {
+            Some(b) => design::min_mass(&s.analysis, &bound, gain("b", b)?).map(|m| (m, b)),
+            None => design::best_admittance(&s.analysis, &bound),
+        }
+    };
+    let mut v = json!({"display": "admittance", "feasible": r.is_some(), "kp": kp, "bp": bp,
+        "period_s": s.period(), "human_model": s.human.is_some(), "regulator_pole_radius": radius});
+    match r {
+        Some((m, b)) => {
+            v["m_c"] = json!(m);
+            v["b_c"] = json!(b);
+        }
+        None if radius >= 1.0 => {
+            v["message"] = json!(format!(
+                "the regulator k_p = {kp}, b_p = {bp} does not stabilise the device (pole radius {radius:.4})"
+            ))
+        }
+        None => {
+            v["message"] = json!(format!(
+                "no coupling mass from {} to {} kg meets the bound{}",
+                design::M_RANGE.0,
+                design::M_RANGE.1,
+                a.b.map(|b| format!(" at b_c = {b} N s/m")).unwrap_or_default()
+            ))
+        }
+    }
+    s.emit(v.clone(), || {
+        s.header("Admittance");
+        println!(
+            "  position regulator K_p = {kp:.0} + {bp:.1} (1 - 1/z)/T (pole radius {radius:.4})"
+        );
+        match r {
+            Some((m, b)) if a.b.is_some() => println!("  least m_c at b_c = {b} N s/m: {m:.3} kg"),
+            Some((m, b)) => println!("  best coupling: m_c = {m:.3} kg, b_c = {b:.1} N s/m"),
+            None => println!("  infeasible: {}", v["message"].as_str().unwrap_or("")),
+        }
+    });
+    Ok(())
+}
+
+fn check_json(c: &design::Check) -> Value {
+    json!({"absolutely_stable": c.absolutely_stable, "min_margin": c.min_margin,
+        "worst_frequency_hz": c.worst_frequency_hz})
+}
+
+fn print_check(c: &design::Check) {
+    let verdict = if c.absolutely_stable {
+        "absolutely stable (proven)"
+    } else {
+        "NOT proven absolutely stable"
+    };
+    println!(
+        "  {verdict}: least margin {:.4} at {:.2} Hz",
+        c.min_margin, c.worst_frequency_hz
+    );
+}
+
+fn check(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
+    match d {
+        Display::Impedance(g) => {
+            let s = Session::open(&g.common)?;
+            let (k, b) = (gain("k", g.k)?, gain("b", g.b)?);
+            let c = design::check_impedance(&s.analysis, k, b, s.human).ok_or_else(|| {
+                format!("--k {k} --b {b}: not a valid coupling (k T + b must be > 0)")
+            })?;
+            let mut v = check_json(&c);
+            v["display"] = json!("impedance");
+            s.emit(v, || {
+                s.header("Impedance");
+                println!("  coupling k_c = {k} N/m, b_c = {b} N s/m");
+                print_check(&c);
+            });
+        }
+        Display::Admittance(g) => {
+            let s = Session::open(&g.common)?;
+            let kp = (gain("kp", g.kp)?, gain("bp", g.bp)?);
+            let mb = (g.m, gain("b", g.b)?);
+            if !(g.m.is_finite() && g.m > 0.0) {
+                return Err(format!("--m {}: must be a finite mass > 0 kg", g.m));
+            }
+            let c = design::check_admittance(&s.plant, &s.analysis, kp, mb, s.human)
+                .ok_or("--b must be > 0 for the admittance coupling")?;
+            let mut v = check_json(&c);
+            v["display"] = json!("admittance");
+            v["regulator_pole_radius"] = json!(c.regulator_pole_radius);
+            s.emit(v, || {
+                s.header("Admittance");
+                println!("  regulator k_p = {} N/m, b_p = {} N s/m; coupling m_c = {} kg, b_c = {} N s/m", kp.0, kp.1, mb.0, mb.1);
+                println!("  regulated device pole radius {:.4}", c.regulator_pole_radius);
+                print_check(&c);
+            });
+        }
+    }
+    Ok(())
+}
+
+fn zrange(d: &Display<ZrangeImpedance, ZrangeAdmittance>) -> Result<(), String> {
+    let (common, points) = match d {
+        Display::Impedance(z) => (&z.gains.common, z.points),
+        Display::Admittance(z) => (&z.gains.common, z.points),
+    };
+    if points < 2 {
+        return Err(format!("--points {points}: need at least 2"));
+    }
+    let s = Session::open(common)?;
+    let nyq = s.plant.nyquist();
+    let lo = 2.0 * PI * 0.1;
+    let omegas: Vec<f64> = (0..points)
+        .map(|i| lo * (nyq / lo).powf(i as f64 / (points - 1) as f64))
+        .collect();
+    let a = Analysis::on(&s.plant, &omegas);
+    let range = match d {
+        Display::Impedance(z) => {
+            let (k, b) = (gain("k", z.gains.k)?, gain("b", z.gains.b)?);
+            design::impedance_range_impedance(&a, k, b)
+        }
+        Display::Admittance(z) => {
+            let g = &z.gains;
+            design::impedance_range_admittance(
+                &a,
+                (gain("kp", g.kp)?, gain("bp", g.bp)?),
+                (g.m, gain("b", g.b)?),
+            )
+        }
+    }
+    .ok_or("the gains do not make a valid coupling")?;
+    let freq: Vec<f64> = omegas.iter().map(|w| w / (2.0 * PI)).collect();
+    let pair = |c: num_complex::Complex64| [c.re, c.im];
+    let v = json!({
+        "freq_hz": freq,
+        "z_min": range.iter().map(|r| pair(r.0)).collect::<Vec<_>>(),
+        "z_max": range.iter().map(|r| pair(r.1)).collect::<Vec<_>>(),
+    });
+    s.emit(v, || {
+        println!(
+            "{:>12} {:>14} {:>14}",
+            "freq (Hz)", "|Z_min| N s/m", "|Z_max| N s/m"
+        );
+        for (f, r) in freq.iter().zip(&range) {
+            println!("{f:>12.3} {:>14.4e} {:>14.4e}", r.0.norm(), r.1.norm());
+        }
+    });
+    Ok(())
+}
+
+fn plot_fig(p: &PlotArgs) -> Result<(), String> {
+    let s = Session::open(&p.common)?;
+    let t = s.period();
+    let bi = s.analysis.impedance_bound(Some(HumanBound::PAPER));
+    let (k, b) = design::max_stiffness(&s.analysis, &bi, gain("b-impedance", p.b_impedance)?)
+        .map(|k| (k, p.b_impedance))
+        .ok_or("no impedance coupling meets the bound at --b-impedance")?;
+    let kp = design::regulator_tf(k, b, t).map_err(|e| e.to_string())?;
+    let ba = s.analysis.admittance_bound(&kp, Some(HumanBound::PAPER));
+    let m = design::min_mass(&s.analysis, &ba, gain("b-admittance", p.b_admittance)?)
+        .ok_or("no admittance coupling meets the bound at --b-admittance")?;
+    let fig = match p.figure {
+        Fig::Fig8 => figures::fig8(&s.analysis, k, b),
+        Fig::Fig9 => figures::fig9(&s.analysis, (k, b), (m, p.b_admittance)),
+        Fig::Fig10 => figures::fig10(&s.analysis, (k, b), (k, b), (m, p.b_admittance)),
+    }?;
+    plot::render(&fig, &p.out)?;
+    s.emit(
+        json!({"out": p.out, "k_c": k, "b_c": b, "m_c": m, "b_cA": p.b_admittance}),
+        || {
+            println!(
+                "wrote {} (k_c = {k:.0} N/m, b_c = {b} N s/m, m_c = {m:.3} kg, b_cA = {} N s/m)",
+                p.out.display(),
+                p.b_admittance
+            )
+        },
+    );
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let r = match &cli.cmd {
+        Cmd::Design(Display::Impedance(a)) => design_impedance(a),
+        Cmd::Design(Display::Admittance(a)) => design_admittance(a),
+        Cmd::Check(d) => check(d),
+        Cmd::Zrange(d) => zrange(d),
+        Cmd::Plot(p) => plot_fig(p),
+    };
+    match r {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("twoport: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,268 @@
+//! Device models: the linear lumped-mass description of a haptic device
+//! (paper eqs 3-8), read from TOML and checked before any analysis.
+
+use nalgebra::{DMatrix, SymmetricEigen};
+use serde::Deserialize;
+use std::fmt;
+use std::path::Path;
+
+/// A linear device model `M q'' + D q' + K q = G [f_h, f_a]^T`, with
+/// `[v_h, -v_a]^T = C_v q'`, strain gauge `f_s = C_f q` and load-cell filter
+/// `a(s) = p/(s + p)`. SI units: kg, N s/m, N/m, N, m/s, rad/s, s.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeviceModel {
+    /// A human-readable name.
+    pub name: String,
+    /// Sample period `T` of the controller (s).
+    pub period_s: f64,
+    /// Load-cell filter pole `p` (rad/s).
+    pub load_cell_pole_rad_s: f64,
+    /// Actuator peak force (N).
+    pub peak_force_n: f64,
+    /// Actuator continuous force (N).
+    pub continuous_force_n: f64,
+    /// Mass matrix `M` (n x n, kg), symmetric positive definite.
+    pub m: DMatrix<f64>,
+    /// Damping matrix `D` (n x n, N s/m), symmetric positive semidefinite.
+    pub d: DMatrix<f64>,
+    /// Stiffness matrix `K` (n x n, N/m), symmetric positive semidefinite.
+    pub k: DMatrix<f64>,
+    /// Input matrix `G` (n x 2): columns for `f_h` and `f_a`.
+    pub g: DMatrix<f64>,
+    /// Velocity output matrix `C_v` (2 x n): rows `v_h` and `-v_a`.
+    pub c_v: DMatrix<f64>,
+    /// Strain-gauge output matrix `C_f` (1 x n, N/m).
+    pub c_f: DMatrix<f64>,
+}
+
+/// Why a model file was refused. The message names the file, and the line
+/// or the field and the problem.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelError {
+    /// The file (or `<input>`).
+    pub source: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for ModelError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.source, self.message)
+    }
+}
+
+impl std::error::Error for ModelError {}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawModel {
+    name: Option<String>,
+    period_s: f64,
+    load_cell_pole_rad_s: f64,
+    peak_force_n: f64,
+    continuous_force_n: f64,
+    #[serde(rename = "M")]
+    m: Vec<Vec<f64>>,
+    #[serde(rename = "D")]
+    d: Vec<Vec<f64>>,
+    #[serde(rename = "K")]
+    k: Vec<Vec<f64>>,
+    #[serde(rename = "G")]
+    g: Vec<Vec<f64>>,
+    #[serde(rename = "C_v")]
+    c_v: Vec<Vec<f64>>,
+    #[serde(rename = "C_f")]
+    c_f: Vec<Vec<f64>>,
+}
+
+impl DeviceModel {
+    /// Read and check a model file.
+    pub fn load(path: &Path) -> Result<Self, ModelError> {
+        let source = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| ModelError {
+            source: source.clone(),
+            message: format!("cannot read: {e}"),
+        })?;
+        Self::from_toml(&text, &source)
+    }
+
+    /// Parse and check model text; `source` names it in errors.
+    pub fn from_toml(text: &str, source: &str) -> Result<Self, ModelError> {
+        let err = |message: String| ModelError {
+            source: source.to_string(),
+            message,
+        };
+        let raw: RawModel = toml::from_str(text).map_err(|e| {
+            let at = e
+                .span()
+                .map(|s| {
+                    let line = text[..s.start.min(text.len())].matches('\n').count() + 1;
+                    format!("line {line}: ")
+                })
+                .unwrap_or_default();
+            err(format!("{at}{}", e.message()))
+        })?;
+        let n = raw.m.len();
+        if n == 0 {
+            return Err(err(
+                "M is empty: the model needs at least one coordinate".into()
+            ));
+        }
+        let model = DeviceModel {
+            name: raw.name.unwrap_or_else(|| source.to_string()),
+            period_s: scalar("period_s", raw.period_s).map_err(&err)?,
+            load_cell_pole_rad_s: scalar("load_cell_pole_rad_s", raw.load_cell_pole_rad_s)
+                .map_err(&err)?,
+            peak_force_n: scalar("peak_force_n", raw.peak_force_n).map_err(&err)?,
+            continuous_force_n: scalar("continuous_force_n", raw.continuous_force_n)
+                .map_err(&err)?,
+            m: matrix("M", &raw.m, n, n).map_err(&err)?,
+            d: matrix("D", &raw.d, n, n).map_err(&err)?,
+            k: matrix("K", &raw.k, n, n).map_err(&err)?,
+            g: matrix("G", &raw.g, n, 2).map_err(&err)?,
+            c_v: matrix("C_v", &raw.c_v, 2, n).map_err(&err)?,
+            c_f: matrix("C_f", &raw.c_f, 1, n).map_err(&err)?,
+        };
+        model.check().map_err(err)?;
+        Ok(model)
+    }
+
+    /// Number of coordinates `n`.
+    pub fn dof(&self) -> usize {
+        self.m.nrows()
+    }
+
+    /// The physical checks: symmetry, definiteness, limits.
+    fn check(&self) -> Result<(), String> {
+        if self.continuous_force_n > self.peak_force_n {
+            return Err(format!(
+                "continuous_force_n = {} exceeds peak_force_n = {}",
+                self.continuous_force_n, self.peak_force_n
+            ));
+        }
+        for (name, a) in [("M", &self.m), ("D", &self.d), ("K", &self.k)] {
+            symmetric(name, a)?;
+        }
+        if self.m.clone().cholesky().is_none() {
+            let low = SymmetricEigen::new(self.m.clone()).eigenvalues.min();
+            return Err(format!(
+                "M is not positive definite: smallest eigenvalue {low:e} kg"
+            ));
+        }
+        semidefinite("D", &self.d, "N s/m")?;
+        semidefinite("K", &self.k, "N/m")?;
+        Ok(())
+    }
+}
+
+fn scalar(name: &str, v: f64) -> Result<f64, String> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{name} = {v} must be finite and > 0"))
+    }
+}
+
+fn matrix(name: &str, rows: &[Vec<f64>], r: usize, c: usize) -> Result<DMatrix<f64>, String> {
+    if rows.len() != r {
+        return Err(format!(
+            "{name} must be {r} x {c} (n = {} from M), but has {} rows",
+            if name == "M" { r } else { r.max(c) },
+            rows.len()
+        ));
+    }
+    for (i, row) in rows.iter().enumerate() {
+        if row.len() != c {
+            return Err(format!(
+                "{name} must be {r} x {c}, but row {i} has {} entries",
+                row.len()
+            ));
+        }
+        for (j, v) in row.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(format!("{name}[{i}][{j}] = {v} is not finite"));
+            }
+        }
+    }
+    Ok(DMatrix::from_fn(r, c, |i, j| rows[i][j]))
+}
+
+fn symmetric(name: &str, a: &DMatrix<f64>) -> Result<(), String> {
+    for i in 0..a.nrows() {
+        for j in i + 1..a.ncols() {
+            let (x, y) = (a[(i, j)], a[(j, i)]);
+            if (x - y).abs() > 1e-12 * x.abs().max(y.abs()) {
+                return Err(format!(
+                    "{name} is not symmetric: {name}[{i}][{j}] = {x} but {name}[{j}][{i}] = {y}"
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Positive semidefinite up to the rounding of the printed digits: an
+/// eigenvalue below `-1e-6` times the largest is a real negative one.
+fn semidefinite(name: &str, a: &DMatrix<f64>, unit: &str) -> Result<(), String> {
+    let e = SymmetricEigen::new(a.clone()).eigenvalues;
+    let (low, high) = (e.min(), e.max().abs().max(f64::MIN_POSITIVE));
+    if low < -1e-6 * high {
+        return Err(format!(
+            "{name} is not positive semidefinite: eigenvalue {low:e} {unit} (largest {high:e})"
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const EXCALIBUR: &str = include_str!("../../../models/excalibur.toml");
+
+    #[test]
+    fn excalibur_loads() {
+        let m = DeviceModel::from_toml(EXCALIBUR, "excalibur.toml").unwrap();
+        assert_eq!(m.dof(), 5);
+        assert_eq!(m.m[(2, 3)], 0.2799);
+        assert_eq!(m.k[(2, 2)], 5.3954e7);
+        assert_eq!(m.c_f[(0, 4)], 5.3236e7);
+    }
+
+    fn broken(from: &str, to: &str) -> String {
+        assert!(EXCALIBUR.contains(from), "{from}");
+        DeviceModel::from_toml(&EXCALIBUR.replacen(from, to, 1), "x.toml")
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn errors_name_the_field_and_the_problem() {
+        assert_eq!(
+            broken(
+                "[0.0,    0.0,    0.2799, 0.3343",
+                "[0.0,    0.0,    0.28, 0.3343"
+            ),
+            "x.toml: M is not symmetric: M[2][3] = 0.2799 but M[3][2] = 0.28"
+        );
+        assert!(broken("0.9271", "-0.9271").contains("M is not positive definite"));
+        assert!(broken("5.3236e7, 5.3236e7]", "5.3236e7]")
+            .contains("C_f must be 1 x 5, but row 0 has 4 entries"));
+        assert!(broken("period_s = 0.001", "period_s = -1")
+            .contains("period_s = -1 must be finite and > 0"));
+        assert!(broken("[ 8.5600,", "[ -80.5600,").contains("D is not positive semidefinite"));
+        assert!(broken("period_s = 0.001", "period_s = nan").contains("period_s = NaN"));
+        let e = broken("C_v = [", "C_w = [");
+        assert!(e.contains("line ") && e.contains("C_w"), "{e}");
+        let e = broken(
+            "load_cell_pole_rad_s = 235.0",
+            "load_cell_pole_rad_s = \"fast\"",
+        );
+        let line = EXCALIBUR
+            .lines()
+            .position(|l| l.starts_with("load_cell_pole_rad_s"))
+            .unwrap()
+            + 1;
+        assert!(e.contains(&format!("line {line}: invalid type")), "{e}");
+    }
+}

@@ -1,0 +1,108 @@
+//! The haptic-interface two-ports (note sections 3-6), their design bounds
+//! and Llewellyn's absolute-stability criteria.
+
+use crate::PlantPoint;
+use num_complex::Complex64;
+use twoport_control::ZTransfer;
+
+/// The human operator's bound `Z_max(s) = b + k/s` (N s/m), or none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HumanBound {
+    /// Damping (N s/m).
+    pub damping_nspm: f64,
+    /// Stiffness (N/m).
+    pub stiffness_npm: f64,
+}
+
+impl HumanBound {
+    /// The paper's `Z_max = 300 + 1000/s` (section IV-C-3).
+    pub const PAPER: HumanBound = HumanBound {
+        damping_nspm: 300.0,
+        stiffness_npm: 1000.0,
+    };
+
+    /// `1/Z_max(s)` (m/(N s)).
+    pub fn admittance(&self, s: Complex64) -> Complex64 {
+        (self.damping_nspm + self.stiffness_npm / s).inv()
+    }
+}
+
+/// A two-port immittance matrix `[[p11, p12], [p21, p22]]` at one frequency.
+pub type Matrix2 = [[Complex64; 2]; 2];
+
+/// `Y_hh`, with the human bound folded in as `Y_hh + 1/Z_max`.
+fn y_hh(p: &PlantPoint, human: Option<HumanBound>) -> Complex64 {
+    p.y[0][0] + human.map_or(Complex64::new(0.0, 0.0), |h| h.admittance(p.s))
+}
+
+/// The impedance display's hybrid form without the coupling (section 3):
+/// `[[Y_hh, Y_hc], [Y_ch*, Y_cc*]]`.
+pub fn impedance_display(p: &PlantPoint, human: Option<HumanBound>) -> Matrix2 {
+    [
+        [y_hh(p, human), p.y[0][1] * p.hold],
+        [
+            p.hold * p.y[1][0],
+            (Complex64::new(1.0, 0.0) - p.z.inv()) / p.period_s * p.xaa_d,
+        ],
+    ]
+}
+
+/// The admittance display's alternate hybrid form without the coupling
+/// (section 4), for the position regulator `K_p` (the control crate's law):
+/// `[[G_hh, G_hc], [G_ch*, G_cc*]]`.
+pub fn admittance_display(p: &PlantPoint, kp: &ZTransfer, human: Option<HumanBound>) -> Matrix2 {
+    let one = Complex64::new(1.0, 0.0);
+    let k = kp.eval(p.z);
+    let den = one + p.xaa_d * k;
+    let x_ah = p.y[1][0] / p.s;
+    let integ = p.period_s / (one - p.z.inv());
+    [
+        [
+            y_hh(p, human) - p.y[0][1] * p.hold * k * x_ah / den,
+            p.y[0][1] * p.hold * k / den * integ,
+        ],
+        [p.f[0] - p.fma_d * k * x_ah / den, p.fma_d * k / den * integ],
+    ]
+}
+
+/// The right side of a design inequality: `(|p12 p21| + Re(p12 p21)) /
+/// (2 Re p11) - Re p22`. The coupling term must reach it at every
+/// frequency: `Re(1/Z_cI)` for the impedance display (eq 25 as corrected),
+/// `Re Z_cA` for the admittance display (eq 28). Infinite where
+/// `Re p11 <= 0` (no coupling helps).
+pub fn design_bound(p: &Matrix2) -> f64 {
+    let prod = p[0][1] * p[1][0];
+    let re11 = p[0][0].re;
+    if re11 <= 0.0 {
+        return f64::INFINITY;
+    }
+    (prod.norm() + prod.re) / (2.0 * re11) - p[1][1].re
+}
+
+/// Llewellyn's criteria at one frequency, as a margin: `η - 1` where
+/// `η = (2 Re p11 Re p22 - Re(p12 p21)) / |p12 p21|`, so the two-port is
+/// absolutely stable there iff the margin is >= 0 (with `Re p11`,
+/// `Re p22 >= 0`; a negative real part gives `-∞`). A two-port with no
+/// coupling between its ports (`p12 p21 = 0`) has margin `+∞`.
+pub fn llewellyn_margin(p: &Matrix2) -> f64 {
+    let (r11, r22) = (p[0][0].re, p[1][1].re);
+    if r11 < 0.0 || r22 < 0.0 || r11.is_nan() || r22.is_nan() {
+        return f64::NEG_INFINITY;
+    }
+    let prod = p[0][1] * p[1][0];
+    let mag = prod.norm();
+    if mag == 0.0 {
+        return f64::INFINITY;
+    }
+    (2.0 * r11 * r22 - prod.re) / mag - 1.0
+}
+
+/// The full impedance-display interface `[[Y_hh, Y_hc], [Y_ch, Y_cc + 1/Z_cI]]`.
+pub fn with_impedance_coupling(y: &Matrix2, zc: Complex64) -> Matrix2 {
+    [y[0], [y[1][0], y[1][1] + zc.inv()]]
+}
+
+/// The full admittance-display interface `[[G_hh, G_hc], [G_ch, G_cc + Z_cA]]`.
+pub fn with_admittance_coupling(g: &Matrix2, zc: Complex64) -> Matrix2 {
+    [g[0], [g[1][0], g[1][1] + zc]]
+}

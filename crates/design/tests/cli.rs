@@ -1,0 +1,221 @@
+//! The `twoport` command line as a user runs it: one JSON object per
+//! command, clear errors with exit code 2, figures written to disk.
+
+use serde_json::Value;
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn twoport(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_twoport"))
+        .args(args)
+        // The default model path is relative to the repository root.
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .output()
+        .expect("run twoport")
+}
+
+fn json(args: &[&str]) -> Value {
+    let out = twoport(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(text.trim().lines().count(), 1, "one JSON object: {text}");
+    serde_json::from_str(&text).unwrap()
+}
+
+fn stderr_of_failure(args: &[&str]) -> String {
+    let out = twoport(args);
+    assert_eq!(out.status.code(), Some(2), "{args:?} should fail with 2");
+    assert!(out.stdout.is_empty());
+    String::from_utf8(out.stderr).unwrap()
+}
+
+#[test]
+fn design_impedance_json() {
+    let v = json(&["design", "impedance", "--b", "90", "--json"]);
+    assert_eq!(v["display"], "impedance");
+    assert_eq!(v["feasible"], true);
+    assert_eq!(v["human_model"], true);
+    assert_eq!(v["period_s"], 0.001);
+    let k = v["k_c"].as_f64().unwrap();
+    assert!((k - 51_000.0).abs() < 0.03 * 51_000.0, "{k}");
+    assert_eq!(v["b_c"], 90.0);
+}
+
+#[test]
+fn design_admittance_json_and_infeasible_without_human() {
+    let v = json(&[
+        "design",
+        "admittance",
+        "--kp",
+        "51000",
+        "--bp",
+        "90",
+        "--b",
+        "500",
+        "--json",
+    ]);
+    assert_eq!(v["display"], "admittance");
+    assert_eq!(v["feasible"], true);
+    assert_eq!(v["kp"], 51_000.0);
+    assert_eq!(v["bp"], 90.0);
+    let m = v["m_c"].as_f64().unwrap();
+    assert!((m - 5.0).abs() < 0.15, "{m}");
+    let v = json(&[
+        "design",
+        "admittance",
+        "--kp",
+        "51000",
+        "--bp",
+        "90",
+        "--b",
+        "500",
+        "--no-human",
+        "--json",
+    ]);
+    assert_eq!(v["feasible"], false);
+    assert!(v.get("m_c").is_none(), "no made-up number: {v}");
+    assert!(v["message"].as_str().unwrap().contains("meets the bound"));
+}
+
+#[test]
+fn check_json_both_displays() {
+    let v = json(&["check", "impedance", "--k", "51000", "--b", "90", "--json"]);
+    assert_eq!(v["absolutely_stable"], true);
+    assert!(v["min_margin"].as_f64().unwrap() >= 0.0);
+    let v = json(&["check", "impedance", "--k", "60000", "--b", "90", "--json"]);
+    assert_eq!(v["absolutely_stable"], false);
+    let f = v["worst_frequency_hz"].as_f64().unwrap();
+    assert!(f > 1.0 && f < 500.0, "{f}");
+    let v = json(&[
+        "check",
+        "admittance",
+        "--kp",
+        "51000",
+        "--bp",
+        "90",
+        "--m",
+        "5.1",
+        "--b",
+        "500",
+        "--json",
+    ]);
+    assert_eq!(v["absolutely_stable"], true);
+}
+
+#[test]
+fn zrange_json_runs_from_a_tenth_of_a_hertz_to_nyquist() {
+    let v = json(&[
+        "zrange",
+        "admittance",
+        "--kp",
+        "51000",
+        "--bp",
+        "90",
+        "--m",
+        "5",
+        "--b",
+        "500",
+        "--points",
+        "50",
+        "--json",
+    ]);
+    let f = v["freq_hz"].as_array().unwrap();
+    assert_eq!(f.len(), 50);
+    assert!((f[0].as_f64().unwrap() - 0.1).abs() < 1e-12);
+    assert!((f[49].as_f64().unwrap() - 500.0).abs() < 1e-9);
+    for key in ["z_min", "z_max"] {
+        let z = v[key].as_array().unwrap();
+        assert_eq!(z.len(), 50);
+        assert!(z.iter().all(|p| p[0].is_f64() && p[1].is_f64()), "{key}");
+    }
+}
+
+#[test]
+fn bad_inputs_are_named() {
+    let e = stderr_of_failure(&["check", "impedance", "--k", "-3", "--b", "90"]);
+    assert!(e.contains("--k -3"), "{e}");
+    let e = stderr_of_failure(&[
+        "check",
+        "impedance",
+        "--k",
+        "1e4",
+        "--b",
+        "90",
+        "--model",
+        "no/such.toml",
+    ]);
+    assert!(
+        e.contains("no/such.toml") && e.contains("cannot read"),
+        "{e}"
+    );
+    let dir = std::env::temp_dir().join(format!("twoport-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.toml");
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../models/excalibur.toml"
+    ))
+    .unwrap()
+    .replacen("0.2799, 0.3343", "0.28, 0.3343", 1);
+    std::fs::write(&bad, text).unwrap();
+    let e = stderr_of_failure(&["design", "impedance", "--model", bad.to_str().unwrap()]);
+    assert!(
+        e.contains("M is not symmetric: M[2][3] = 0.2799 but M[3][2] = 0.28"),
+        "{e}"
+    );
+    let e = stderr_of_failure(&[
+        "check",
+        "impedance",
+        "--k",
+        "1",
+        "--b",
+        "1",
+        "--period",
+        "0",
+    ]);
+    assert!(e.contains("--period 0"), "{e}");
+    let e = stderr_of_failure(&["plot", "fig8", "--out", dir.join("x.jpg").to_str().unwrap()]);
+    assert!(e.contains(".png or .svg"), "{e}");
+}
+
+#[test]
+fn plots_are_written_as_png_and_svg() {
+    let dir: PathBuf = std::env::temp_dir().join(format!("twoport-plot-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (fig, ext) in [("fig8", "png"), ("fig9", "svg"), ("fig10", "png")] {
+        let out = dir.join(format!("{fig}.{ext}"));
+        json(&["plot", fig, "--out", out.to_str().unwrap(), "--json"]);
+        let bytes = std::fs::read(&out).unwrap();
+        match ext {
+            "png" => assert_eq!(&bytes[1..4], b"PNG"),
+            _ => assert!(String::from_utf8_lossy(&bytes).contains("frequency (Hz)")),
+        }
+        assert!(bytes.len() > 10_000, "{fig}: {} bytes", bytes.len());
+    }
+}
+
+#[test]
+fn every_subcommand_has_help() {
+    for args in [
+        vec!["--help"],
+        vec!["design", "--help"],
+        vec!["design", "impedance", "--help"],
+        vec!["design", "admittance", "--help"],
+        vec!["check", "impedance", "--help"],
+        vec!["check", "admittance", "--help"],
+        vec!["zrange", "impedance", "--help"],
+        vec!["zrange", "admittance", "--help"],
+        vec!["plot", "--help"],
+    ] {
+        let out = twoport(&args);
+        assert!(out.status.success(), "{args:?}");
+        assert!(
+            String::from_utf8_lossy(&out.stdout).contains("Usage"),
+            "{args:?}"
+        );
+    }
+}
