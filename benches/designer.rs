@@ -16,14 +16,16 @@ fn excalibur() -> Plant {
 
 fn log_grid(n: usize, nyq: f64) -> Vec<f64> {
     let lo = 2.0 * PI * 0.1;
-    (0..n).map(|i| lo * (nyq / lo).powf(i as f64 / (n - 1) as f64)).collect()
+    (0..n)
+        .map(|i| lo * (nyq / lo).powf(i as f64 / (n - 1) as f64))
+        .collect()
 }
 
 fn responses(c: &mut Criterion) {
     let plant = excalibur();
     let w = log_grid(10_000, plant.nyquist());
     let mut scratch = plant.scratch();
-    c.bench_function("Y(s) and F(s), 2x2 continuous, 10,000 points", |b| {
+    c.bench_function("Y(s) and F(s), modal form, 10,000 points", |b| {
         b.iter(|| {
             let mut acc = 0.0;
             for &omega in &w {
@@ -33,24 +35,39 @@ fn responses(c: &mut Criterion) {
             black_box(acc)
         })
     });
-    c.bench_function("all plant terms incl. ZOH-exact X_aa^d, F_ma^d, 10,000 points", |b| {
-        b.iter(|| black_box(plant.response(&w)))
+    c.bench_function("Y(s) and F(s), complex LU per point, 10,000 points", |b| {
+        b.iter(|| {
+            let mut acc = 0.0;
+            for &omega in &w {
+                let (y, f) = plant.continuous_lu(omega, &mut scratch);
+                acc += y[0][0].re + f[1].re;
+            }
+            black_box(acc)
+        })
     });
+    c.bench_function(
+        "all plant terms incl. ZOH-exact X_aa^d, F_ma^d, 10,000 points",
+        |b| b.iter(|| black_box(plant.response(&w))),
+    );
 }
 
 fn designs(c: &mut Criterion) {
-    let model = DeviceModel::from_toml(include_str!("../models/excalibur.toml"), "excalibur").unwrap();
+    let model =
+        DeviceModel::from_toml(include_str!("../models/excalibur.toml"), "excalibur").unwrap();
     let human = Some(HumanBound::PAPER);
-    c.bench_function("full design of both displays (model to k_c at b 90, m_c at b 500)", |b| {
-        b.iter(|| {
-            let plant = Plant::new(&model, 1e-3).unwrap();
-            let a = Analysis::new(&plant, GridSpec::DEFAULT);
-            let k = max_stiffness(&a, &a.impedance_bound(human), 90.0).unwrap();
-            let kp = regulator_tf(k, 90.0, 1e-3).unwrap();
-            let m = min_mass(&a, &a.admittance_bound(&kp, human), 500.0).unwrap();
-            black_box((k, m))
-        })
-    });
+    c.bench_function(
+        "full design of both displays (model to k_c at b 90, m_c at b 500)",
+        |b| {
+            b.iter(|| {
+                let plant = Plant::new(&model, 1e-3).unwrap();
+                let a = Analysis::new(&plant, GridSpec::DEFAULT);
+                let k = max_stiffness(&a, &a.impedance_bound(human), 90.0).unwrap();
+                let kp = regulator_tf(k, 90.0, 1e-3).unwrap();
+                let m = min_mass(&a, &a.admittance_bound(&kp, human), 500.0).unwrap();
+                black_box((k, m))
+            })
+        },
+    );
     let plant = excalibur();
     let a = Analysis::new(&plant, GridSpec::DEFAULT);
     let bi = a.impedance_bound(human);
