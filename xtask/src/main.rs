@@ -97,8 +97,50 @@ fn ci() -> Result<(), String> {
     )?;
     thumb()?;
     qemu()?;
-    // Last, so that its summary is the run's closing test count.
-    run("cargo test", cargo().args(["test", "--workspace"]))
+    // Last, closing on the total so that CI reads the whole count rather
+    // than the last crate's doc-test line.
+    cargo_test_totals()
+}
+
+/// `cargo test --workspace`, passing its output through and ending with
+/// `tests: N passed, M failed`.
+fn cargo_test_totals() -> Result<(), String> {
+    use std::io::{BufRead, BufReader};
+    eprintln!("xtask: cargo test");
+    let mut child = cargo()
+        .args(["test", "--workspace"])
+        .stdout(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("cargo test: could not start: {e}"))?;
+    let (mut passed, mut failed) = (0u64, 0u64);
+    let out = child.stdout.take().expect("stdout is piped");
+    for line in BufReader::new(out).lines() {
+        let line = line.map_err(|e| format!("cargo test output: {e}"))?;
+        println!("{line}");
+        if let Some(rest) = line.strip_prefix("test result: ") {
+            let count = |word: &str| {
+                rest.split(';')
+                    .find_map(|part| {
+                        part.trim()
+                            .strip_suffix(word)?
+                            .split_whitespace()
+                            .last()?
+                            .parse::<u64>()
+                            .ok()
+                    })
+                    .unwrap_or(0)
+            };
+            passed += count(" passed");
+            failed += count(" failed");
+        }
+    }
+    let status = child.wait().map_err(|e| format!("cargo test: {e}"))?;
+    println!("tests: {passed} passed, {failed} failed");
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("cargo test: failed ({status})"))
+    }
 }
 
 fn thumb() -> Result<(), String> {

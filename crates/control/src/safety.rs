@@ -328,7 +328,7 @@ impl SafetyLayer {
                 self.cfg.peak_force_n
             };
             let clipped = command_n.clamp(-limit, limit);
-            self.ramp_done = (self.ramp_done + 1).min(self.cfg.ramp_ticks);
+            self.ramp_done = self.ramp_done.saturating_add(1).min(self.cfg.ramp_ticks);
             let scale = self.ramp_done as f32 / self.cfg.ramp_ticks as f32;
             out.force_n = clipped * scale;
             out.limited = clipped != command_n || scale < 1.0;

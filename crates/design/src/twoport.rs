@@ -106,3 +106,148 @@ pub fn with_impedance_coupling(y: &Matrix2, zc: Complex64) -> Matrix2 {
 pub fn with_admittance_coupling(g: &Matrix2, zc: Complex64) -> Matrix2 {
     [g[0], [g[1][0], g[1][1] + zc]]
 }
+
+/// The four immittance forms of a two-port (paper section II), by which port
+/// variables are the inputs: port 1 `(f_1, v_1)`, port 2 `(f_2, v_2)` with
+/// the paper's signs (`f_e*`, `-v_e*` at the VE port).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Form {
+    /// Impedance: velocities in, forces out.
+    Z,
+    /// Admittance: forces in, velocities out.
+    Y,
+    /// Hybrid: `v_1`, `f_2` in; `f_1`, `v_2` out.
+    H,
+    /// Alternate hybrid: `f_1`, `v_2` in; `v_1`, `f_2` out.
+    G,
+}
+
+impl Form {
+    /// Whether port `k` (0 or 1) takes its velocity as the input.
+    fn velocity_in(self, k: usize) -> bool {
+        match (self, k) {
+            (Form::Z, _) | (Form::H, 0) | (Form::G, 1) => true,
+            (Form::Y, _) | (Form::H, 1) | (Form::G, 0) => false,
+            _ => unreachable!("a two-port has ports 0 and 1"),
+        }
+    }
+}
+
+/// Swap the input and output of port `k` (a principal pivot on `p[k][k]`);
+/// `None` where that entry is zero (the target form does not exist).
+fn pivot(p: &Matrix2, k: usize) -> Option<Matrix2> {
+    let o = 1 - k;
+    let piv = p[k][k];
+    if piv.norm() == 0.0 || !piv.norm().is_finite() {
+        return None;
+    }
+    let inv = piv.inv();
+    let mut q = *p;
+    q[k][k] = inv;
+    q[k][o] = -p[k][o] * inv;
+    q[o][k] = p[o][k] * inv;
+    q[o][o] = p[o][o] - p[o][k] * p[k][o] * inv;
+    Some(q)
+}
+
+/// Convert a two-port matrix from one immittance form to another; `None`
+/// where the target form does not exist.
+pub fn convert(p: &Matrix2, from: Form, to: Form) -> Option<Matrix2> {
+    let mut q = *p;
+    for k in 0..2 {
+        if from.velocity_in(k) != to.velocity_in(k) {
+            q = pivot(&q, k)?;
+        }
+    }
+    Some(q)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn c(re: f64, im: f64) -> Complex64 {
+        Complex64::new(re, im)
+    }
+
+    fn sample(seed: u64) -> Matrix2 {
+        let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+        let mut r = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x % 2001) as f64 / 1000.0 - 1.0
+        };
+        [
+            [c(r() + 1.5, r()), c(r(), r())],
+            [c(r(), r()), c(r() + 1.5, r())],
+        ]
+    }
+
+    fn close(a: &Matrix2, b: &Matrix2) -> bool {
+        (0..4).all(|i| (a[i / 2][i % 2] - b[i / 2][i % 2]).norm() < 1e-9)
+    }
+
+    #[test]
+    fn conversions_match_the_textbook_formulas() {
+        let z = sample(1);
+        let det = z[0][0] * z[1][1] - z[0][1] * z[1][0];
+        let y = convert(&z, Form::Z, Form::Y).unwrap();
+        let want_y = [
+            [z[1][1] / det, -z[0][1] / det],
+            [-z[1][0] / det, z[0][0] / det],
+        ];
+        assert!(close(&y, &want_y));
+        let h = convert(&z, Form::Z, Form::H).unwrap();
+        let want_h = [
+            [det / z[1][1], z[0][1] / z[1][1]],
+            [-z[1][0] / z[1][1], z[1][1].inv()],
+        ];
+        assert!(close(&h, &want_h));
+        let g = convert(&z, Form::Z, Form::G).unwrap();
+        let want_g = [
+            [z[0][0].inv(), -z[0][1] / z[0][0]],
+            [z[1][0] / z[0][0], det / z[0][0]],
+        ];
+        assert!(close(&g, &want_g));
+    }
+
+    /// Every form converts to every other and back, and Llewellyn's `η` is
+    /// the same in all four (absolute stability does not depend on the form).
+    #[test]
+    fn round_trips_and_eta_invariance() {
+        let forms = [Form::Z, Form::Y, Form::H, Form::G];
+        for seed in 1..200 {
+            let z = sample(seed);
+            let eta = llewellyn_margin(&z);
+            for &a in &forms {
+                let pa = convert(&z, Form::Z, a).unwrap();
+                for &b in &forms {
+                    let pb = convert(&pa, a, b).unwrap();
+                    assert!(
+                        close(&convert(&pb, b, a).unwrap(), &pa),
+                        "{a:?} -> {b:?} -> {a:?}"
+                    );
+                }
+                if eta.is_finite() && llewellyn_margin(&pa).is_finite() {
+                    assert!(
+                        (llewellyn_margin(&pa) - eta).abs() < 1e-7 * eta.abs().max(1.0),
+                        "seed {seed} {a:?}"
+                    );
+                } else {
+                    assert_eq!(
+                        llewellyn_margin(&pa) >= 0.0,
+                        eta >= 0.0,
+                        "seed {seed} {a:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_missing_form_is_none() {
+        let z = [[c(0.0, 0.0), c(1.0, 0.0)], [c(1.0, 0.0), c(2.0, 0.0)]];
+        assert!(convert(&z, Form::Z, Form::G).is_none());
+    }
+}
