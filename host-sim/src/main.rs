@@ -1,13 +1,380 @@
-//! The simulator and scope are not built yet. Rather than pretend, this
-//! binary says so and points at what works today.
+//! `host-sim`: run scenes headless, sweep a gain to its stability boundary,
+//! and reproduce the paper's Table I.
 
+use clap::{Args, Parser, Subcommand};
+use host_sim::scene::{Display, Scene};
+use host_sim::{Report, Sample, Simulation};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::json;
+use std::io::Write;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-fn main() -> ExitCode {
-    eprintln!(
-        "host-sim: the simulator is not implemented yet.\n\
-         What runs today is the designer, e.g.:\n  \
-         cargo run --release -p twoport-design -- design impedance"
+/// Simulate a haptic device around the board's own control code.
+#[derive(Parser)]
+#[command(name = "host-sim", version)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Run one scene and judge its stability.
+    Run(RunArgs),
+    /// Find the marginal value of one parameter by bisection.
+    Sweep(SweepArgs),
+    /// Run the paper's Table I matrix and sweep its boundaries.
+    Table1(Table1Args),
+}
+
+#[derive(Args)]
+struct SceneArgs {
+    /// The scene file (TOML).
+    scene: PathBuf,
+    /// Override a scene value, e.g. `--set coupling.k=60000` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    sets: Vec<String>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args)]
+struct RunArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Simulated time (s), instead of the scene's.
+    #[arg(long)]
+    duration: Option<f64>,
+    /// Write every tick to this CSV file.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Draw the run to this PNG file.
+    #[arg(long)]
+    png: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct SweepArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// The parameter, as a `--set` key (e.g. coupling.k).
+    #[arg(long)]
+    param: String,
+    /// One end of the range.
+    #[arg(long, allow_negative_numbers = true)]
+    from: f64,
+    /// The other end; stability must differ between the ends.
+    #[arg(long, allow_negative_numbers = true)]
+    to: f64,
+    /// Relative tolerance of the answer.
+    #[arg(long, default_value_t = 0.005)]
+    tol: f64,
+}
+
+#[derive(Args)]
+struct Table1Args {
+    /// The folder of the Table I scenes.
+    #[arg(long, default_value = "scenes/table1")]
+    scenes: PathBuf,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+fn load(path: &Path, sets: &[String]) -> Result<Scene, String> {
+    Scene::load(path, sets).map_err(|e| e.to_string())
+}
+
+fn run_scene(scene: Scene, mut sink: impl FnMut(&Sample)) -> Result<Report, String> {
+    let mut sim = Simulation::new(scene)?;
+    Ok(sim.run(&mut sink))
+}
+
+fn run(a: &RunArgs) -> Result<(), String> {
+    let mut sets = a.scene.sets.clone();
+    if let Some(d) = a.duration {
+        sets.push(format!("duration_s={d}"));
+    }
+    let scene = load(&a.scene.scene, &sets)?;
+    let name = scene.name.clone();
+    let mut csv = match &a.csv {
+        Some(p) => {
+            let f = std::fs::File::create(p).map_err(|e| format!("{}: {e}", p.display()))?;
+            let mut w = std::io::BufWriter::new(f);
+            writeln!(w, "t_s,handle_position_m,handle_velocity_mps,human_force_n,commanded_force_n,actuator_force_n,ve_position_m,ve_force_n")
+                .map_err(|e| e.to_string())?;
+            Some(w)
+        }
+        None => None,
+    };
+    let mut kept: Vec<Sample> = Vec::new();
+    let mut csv_err = None;
+    let report = run_scene(scene, |s| {
+        if let Some(w) = csv.as_mut() {
+            if let Err(e) = writeln!(
+                w,
+                "{},{},{},{},{},{},{},{}",
+                s.t_s,
+                s.handle_m,
+                s.handle_mps,
+                s.human_n,
+                s.commanded_n,
+                s.actuator_n,
+                s.ve_m,
+                s.ve_n
+            ) {
+                csv_err.get_or_insert(e);
+            }
+        }
+        if a.png.is_some() {
+            kept.push(*s);
+        }
+    })?;
+    if let Some(e) = csv_err {
+        return Err(format!("writing the CSV: {e}"));
+    }
+    if let Some(mut w) = csv {
+        w.flush().map_err(|e| format!("writing the CSV: {e}"))?;
+    }
+    if let Some(p) = &a.png {
+        host_sim::plot::png(&kept, &name, p)?;
+    }
+    if a.scene.json {
+        println!(
+            "{}",
+            serde_json::to_string(&report).map_err(|e| e.to_string())?
+        );
+    } else {
+        print_report(&report);
+    }
+    Ok(())
+}
+
+fn print_report(r: &Report) {
+    let verdict = if r.stable { "stable" } else { "UNSTABLE" };
+    println!("{}: {verdict}", r.scene);
+    if let Some(why) = &r.reason {
+        println!("  {why}");
+    }
+    println!(
+        "  peak force {:.1} N, human energy in {:.3} J, {:.1} s simulated in {:.3} s ({:.0}x real time)",
+        r.peak_force_n, r.energy_in_j, r.sim_seconds, r.wall_seconds, r.realtime_factor
     );
-    ExitCode::from(2)
+    println!("  plant: {} x {} per tick", r.integrator, r.substeps);
+    if let Some(w) = &r.integrator_warning {
+        println!("  warning: {w}");
+    }
+    for e in &r.effects {
+        println!("  effect {:<12} {:>8.1} ns/tick", e.name, e.ns_per_tick);
+    }
+}
+
+/// Stability of `scene` with `param = value`.
+fn stable_at(path: &Path, sets: &[String], param: &str, value: f64) -> Result<bool, String> {
+    let mut s = sets.to_vec();
+    s.push(format!("{param}={value}"));
+    Ok(run_scene(load(path, &s)?, |_| {})?.stable)
+}
+
+/// Bisect between `from` and `to` (geometric when both are positive) for the
+/// value where stability changes; returns the last stable value.
+fn marginal(
+    path: &Path,
+    sets: &[String],
+    param: &str,
+    from: f64,
+    to: f64,
+    tol: f64,
+    bar: &ProgressBar,
+) -> Result<f64, String> {
+    let (s_from, s_to) = (
+        stable_at(path, sets, param, from)?,
+        stable_at(path, sets, param, to)?,
+    );
+    if s_from == s_to {
+        return Err(format!(
+            "{param}: {} at both {from} and {to}; widen the range",
+            if s_from { "stable" } else { "unstable" }
+        ));
+    }
+    let (mut good, mut bad) = if s_from { (from, to) } else { (to, from) };
+    let geometric = good > 0.0 && bad > 0.0;
+    while (good - bad).abs() > tol * good.abs().max(bad.abs()) {
+        let mid = if geometric {
+            (good * bad).sqrt()
+        } else {
+            0.5 * (good + bad)
+        };
+        if stable_at(path, sets, param, mid)? {
+            good = mid;
+        } else {
+            bad = mid;
+        }
+        bar.inc(1);
+    }
+    Ok(good)
+}
+
+fn bar(len: u64, msg: String) -> ProgressBar {
+    let b = ProgressBar::new(len);
+    b.set_style(
+        ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    b.set_message(msg);
+    b
+}
+
+fn steps(from: f64, to: f64, tol: f64) -> u64 {
+    let span = if from > 0.0 && to > 0.0 {
+        (to / from).ln().abs()
+    } else {
+        1.0 / tol
+    };
+    (span / tol).log2().ceil().max(1.0) as u64
+}
+
+fn sweep(a: &SweepArgs) -> Result<(), String> {
+    if !(a.tol > 0.0 && a.tol < 1.0) {
+        return Err(format!("--tol {}: must be between 0 and 1", a.tol));
+    }
+    let b = bar(steps(a.from, a.to, a.tol), format!("sweeping {}", a.param));
+    let m = marginal(
+        &a.scene.scene,
+        &a.scene.sets,
+        &a.param,
+        a.from,
+        a.to,
+        a.tol,
+        &b,
+    )?;
+    b.finish_and_clear();
+    if a.scene.json {
+        println!("{}", json!({"param": a.param, "marginal": m}));
+    } else {
+        println!(
+            "{}: marginal value {m:.6} (the last stable value, within {}%)",
+            a.param,
+            a.tol * 100.0
+        );
+    }
+    Ok(())
+}
+
+/// Table I: every VE state x grasp at the theoretical gains, then the
+/// boundaries swept as the paper did.
+fn table1(a: &Table1Args) -> Result<(), String> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&a.scenes)
+        .map_err(|e| format!("{}: {e}", a.scenes.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        return Err(format!("{}: no scenes", a.scenes.display()));
+    }
+    let b = bar(files.len() as u64, "Table I".into());
+    let mut rows = Vec::new();
+    let (mut k_bound, mut m_bound) = (f64::INFINITY, 0.0f64);
+    for f in &files {
+        let scene = load(f, &[])?;
+        let display = scene.display;
+        let report = run_scene(scene, |_| {})?;
+        let quiet = ProgressBar::hidden();
+        let m = match display {
+            Display::Impedance => {
+                marginal(f, &[], "coupling.k", 51_000.0, 2.0e6, 0.005, &quiet).ok()
+            }
+            Display::Admittance => marginal(f, &[], "coupling.m", 5.0, 0.01, 0.005, &quiet).ok(),
+        };
+        match (display, m) {
+            (Display::Impedance, Some(k)) => k_bound = k_bound.min(k),
+            (Display::Admittance, Some(mm)) => m_bound = m_bound.max(mm),
+            _ => {}
+        }
+        let case = f
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        rows.push(
+            json!({"case": case, "display": format!("{display:?}").to_lowercase(),
+            "stable_at_theoretical_gains": report.stable, "marginal": m}),
+        );
+        b.inc(1);
+    }
+    b.finish_and_clear();
+    let all_stable = rows
+        .iter()
+        .all(|r| r["stable_at_theoretical_gains"] == true);
+    if a.json {
+        println!(
+            "{}",
+            json!({"cases": rows, "all_stable_at_theoretical_gains": all_stable,
+            "impedance_boundary_k": k_bound.is_finite().then_some(k_bound),
+            "admittance_boundary_m": (m_bound > 0.0).then_some(m_bound)})
+        );
+        return Ok(());
+    }
+    println!("Table I  Theoretical versus experimental (paper) and simulated (linear model) stability boundary gains");
+    println!(
+        "{:<26} {:>10} {:>6}   {:>8} {:>6}",
+        "", "k_cI N/m", "b_cI", "m_cA kg", "b_cA"
+    );
+    println!(
+        "{:<26} {:>10} {:>6}   {:>8} {:>6}",
+        "theoretical", "51,000", "90", "5.0", "500"
+    );
+    println!(
+        "{:<26} {:>10} {:>6}   {:>8} {:>6}",
+        "experimental (paper)", "75,000", "90", "4.3", "500"
+    );
+    let fmt_k = if k_bound.is_finite() {
+        format!("{k_bound:.0}")
+    } else {
+        "> 2e6".into()
+    };
+    let fmt_m = if m_bound > 0.0 {
+        format!("{m_bound:.2}")
+    } else {
+        "< 0.01".into()
+    };
+    println!(
+        "{:<26} {:>10} {:>6}   {:>8} {:>6}",
+        "simulated (this model)", fmt_k, "90", fmt_m, "500"
+    );
+    println!();
+    println!(
+        "{:<36} {:>22} {:>14}",
+        "case", "stable at theoretical", "boundary"
+    );
+    for r in &rows {
+        let m = r["marginal"]
+            .as_f64()
+            .map_or("none found".into(), |v| format!("{v:.4}"));
+        println!(
+            "{:<36} {:>22} {:>14}",
+            r["case"].as_str().unwrap_or(""),
+            r["stable_at_theoretical_gains"],
+            m
+        );
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let r = match &cli.cmd {
+        Cmd::Run(a) => run(a),
+        Cmd::Sweep(a) => sweep(a),
+        Cmd::Table1(a) => table1(a),
+    };
+    match r {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("host-sim: {e}");
+            ExitCode::from(2)
+        }
+    }
 }

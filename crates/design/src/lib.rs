@@ -7,7 +7,7 @@
 
 pub mod design;
 pub mod figures;
-mod linalg;
+pub mod linalg;
 pub mod model;
 pub mod plant;
 pub mod plot;

@@ -1,6 +1,7 @@
 //! Small allocation-free complex solvers for the per-frequency work: each
 //! frequency point solves one small system, so the solvers reuse buffers.
 
+use nalgebra::DMatrix;
 use num_complex::Complex64;
 
 /// Solve `a x = b` in place by LU with partial pivoting: `a` is n x n
@@ -102,6 +103,53 @@ pub fn hessenberg_shift_solve(
     }
     back_substitute(work, n, b, 1);
     true
+}
+
+/// Parlett-Reinsch balancing: diagonal `d` (powers of two) such that
+/// `d^-1 a d` has rows and columns of similar norms.
+pub fn balance(a: &DMatrix<f64>) -> Vec<f64> {
+    let n = a.nrows();
+    let mut d = vec![1.0f64; n];
+    for _ in 0..100 {
+        let mut done = true;
+        for i in 0..n {
+            let (mut c, mut r) = (0.0, 0.0);
+            for j in (0..n).filter(|&j| j != i) {
+                c += (a[(j, i)] * d[i] / d[j]).abs();
+                r += (a[(i, j)] * d[j] / d[i]).abs();
+            }
+            if c == 0.0 || r == 0.0 {
+                continue;
+            }
+            let mut f = 1.0;
+            let (mut cc, mut rr) = (c, r);
+            while cc < rr / 2.0 {
+                (f, cc, rr) = (f * 2.0, cc * 2.0, rr / 2.0);
+            }
+            while cc >= rr * 2.0 {
+                (f, cc, rr) = (f / 2.0, cc / 2.0, rr * 2.0);
+            }
+            if (cc + rr) < 0.95 * (c + r) {
+                d[i] *= f;
+                done = false;
+            }
+        }
+        if done {
+            break;
+        }
+    }
+    d
+}
+
+/// `e^a` computed on the balanced matrix, `e^a = d e^(d^-1 a d) d^-1`: a
+/// stiff device model (entries from 1 to 1e10) loses digits in scaling and
+/// squaring otherwise.
+pub fn expm_balanced(a: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = a.nrows();
+    let d = balance(a);
+    let b = DMatrix::from_fn(n, n, |i, j| a[(i, j)] * d[j] / d[i]);
+    let e = b.exp();
+    DMatrix::from_fn(n, n, |i, j| e[(i, j)] * d[i] / d[j])
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! complex LU, and the ZOH-exact discrete `X_aa^d(z)`, `F_ma^d(z)` from the
 //! matrix exponential of the block matrix (note, section 2).
 
-use crate::linalg::{hessenberg_shift_solve, lu_solve};
+use crate::linalg::{balance, expm_balanced, hessenberg_shift_solve, lu_solve};
 use crate::DeviceModel;
 use nalgebra::{Cholesky, DMatrix};
 use num_complex::Complex64;
@@ -160,42 +160,6 @@ impl Modal {
     }
 }
 
-/// Parlett-Reinsch balancing: diagonal `d` (powers of two) such that
-/// `d^-1 a d` has rows and columns of similar norms.
-fn balance(a: &DMatrix<f64>) -> Vec<f64> {
-    let n = a.nrows();
-    let mut d = vec![1.0f64; n];
-    for _ in 0..100 {
-        let mut done = true;
-        for i in 0..n {
-            let (mut c, mut r) = (0.0, 0.0);
-            for j in (0..n).filter(|&j| j != i) {
-                c += (a[(j, i)] * d[i] / d[j]).abs();
-                r += (a[(i, j)] * d[j] / d[i]).abs();
-            }
-            if c == 0.0 || r == 0.0 {
-                continue;
-            }
-            let mut f = 1.0;
-            let (mut cc, mut rr) = (c, r);
-            while cc < rr / 2.0 {
-                (f, cc, rr) = (f * 2.0, cc * 2.0, rr / 2.0);
-            }
-            while cc >= rr * 2.0 {
-                (f, cc, rr) = (f / 2.0, cc / 2.0, rr * 2.0);
-            }
-            if (cc + rr) < 0.95 * (c + r) {
-                d[i] *= f;
-                done = false;
-            }
-        }
-        if done {
-            break;
-        }
-    }
-    d
-}
-
 /// A null vector of `a - shift I` by two steps of inverse iteration.
 fn inverse_iteration(a: &DMatrix<Complex64>, shift: Complex64) -> Option<Vec<Complex64>> {
     let n = a.nrows();
@@ -295,7 +259,7 @@ impl Plant {
         let mut blk = DMatrix::<f64>::zeros(na + 2, na + 2);
         blk.view_mut((0, 0), (na, na)).copy_from(&(&a * period_s));
         blk.view_mut((0, na), (na, 2)).copy_from(&(&b * period_s));
-        let e = blk.exp();
+        let e = expm_balanced(&blk);
         let ad = e.view((0, 0), (na, na)).into_owned();
         let bd_act: Vec<f64> = (0..na).map(|i| e[(i, na + 1)]).collect();
         if !ad.iter().chain(&bd_act).all(|v| v.is_finite()) {

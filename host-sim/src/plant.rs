@@ -1,0 +1,410 @@
+//! The device as a linear state-space model `x' = A x + B u (+ E F_nl)`,
+//! with the human's grasp folded in, and the integrators that advance it.
+//!
+//! State `x = [q, q', w]`: the model's coordinates (m), their velocities
+//! (m/s) and, with the load-cell effect, the filtered strain-gauge force `w`
+//! (N). Inputs `u = [f_ext, f_a]`: the hand's held force term on the handle
+//! (N) and the held actuator force (N, positive resisting actuator motion).
+//! `F_nl` is a force vector on the coordinates from nonlinear effects.
+
+use nalgebra::{Cholesky, DMatrix};
+use twoport_design::DeviceModel;
+
+/// The grasp's impedance `b + k/s` between the handle and the hand.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grasp {
+    /// Damping (N s/m).
+    pub damping_nspm: f64,
+    /// Stiffness (N/m).
+    pub stiffness_npm: f64,
+}
+
+/// How the strain gauge sees the handle force.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Gauge {
+    /// The flexible model's `C_f q`.
+    Model,
+    /// The rigid reduction: the gauge reads the hand force itself.
+    HandForce,
+}
+
+/// A device model ready for simulation.
+#[derive(Clone, Debug)]
+pub struct Device {
+    /// Coordinates.
+    pub n: usize,
+    m: DMatrix<f64>,
+    minv: DMatrix<f64>,
+    d: DMatrix<f64>,
+    k: DMatrix<f64>,
+    g: DMatrix<f64>,
+    /// Handle row of `C_v` (positions and velocities alike).
+    pub handle: Vec<f64>,
+    /// Actuator row: `x_a = actuator . q` (minus `C_v`'s second row).
+    pub actuator: Vec<f64>,
+    c_f: Vec<f64>,
+    gauge: Gauge,
+    pole: f64,
+    /// A human-readable name.
+    pub name: String,
+}
+
+impl Device {
+    /// The flexible model of a designer model file.
+    pub fn flexible(model: &DeviceModel) -> Result<Self, String> {
+        let n = model.dof();
+        let minv = Cholesky::new(model.m.clone())
+            .ok_or("M is not positive definite")?
+            .inverse();
+        Ok(Device {
+            n,
+            m: model.m.clone(),
+            minv,
+            d: model.d.clone(),
+            k: model.k.clone(),
+            g: model.g.clone(),
+            handle: (0..n).map(|j| model.c_v[(0, j)]).collect(),
+            actuator: (0..n).map(|j| -model.c_v[(1, j)]).collect(),
+            c_f: (0..n).map(|j| model.c_f[(0, j)]).collect(),
+            gauge: Gauge::Model,
+            pole: model.load_cell_pole_rad_s,
+            name: model.name.clone(),
+        })
+    }
+
+    /// The rigid one-coordinate reduction: mass `m_kg`, damping `b_nspm`
+    /// to ground, handle and actuator at one point; the gauge reads the hand
+    /// force through the load-cell filter.
+    pub fn rigid(m_kg: f64, b_nspm: f64, load_cell_pole_rad_s: f64) -> Self {
+        Device {
+            n: 1,
+            m: DMatrix::from_element(1, 1, m_kg),
+            minv: DMatrix::from_element(1, 1, 1.0 / m_kg),
+            d: DMatrix::from_element(1, 1, b_nspm),
+            k: DMatrix::zeros(1, 1),
+            g: DMatrix::from_row_slice(1, 2, &[1.0, -1.0]),
+            handle: vec![1.0],
+            actuator: vec![1.0],
+            c_f: vec![0.0],
+            gauge: Gauge::HandForce,
+            pole: load_cell_pole_rad_s,
+            name: format!("rigid {m_kg} kg, {b_nspm} N s/m"),
+        }
+    }
+
+    /// `M[i][j]` (kg).
+    pub fn mass(&self, i: usize, j: usize) -> f64 {
+        self.m[(i, j)]
+    }
+
+    /// `K[i][j]` (N/m).
+    pub fn stiffness(&self, i: usize, j: usize) -> f64 {
+        self.k[(i, j)]
+    }
+
+    /// Set the damping matrix to zero (for energy tests).
+    pub fn without_damping(mut self) -> Self {
+        self.d.fill(0.0);
+        self
+    }
+
+    /// The actuator's column of `G` (force on the coordinates per N of `f_a`).
+    pub fn actuator_input(&self) -> Vec<f64> {
+        (0..self.n).map(|i| self.g[(i, 1)]).collect()
+    }
+
+    /// Kinetic plus elastic energy of the device in state `x` (J).
+    pub fn energy(&self, x: &[f64]) -> f64 {
+        let n = self.n;
+        let (q, v) = (&x[..n], &x[n..2 * n]);
+        let mut e = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                e += 0.5 * (v[i] * self.m[(i, j)] * v[j] + q[i] * self.k[(i, j)] * q[j]);
+            }
+        }
+        e
+    }
+
+    /// The continuous system with the grasp folded in.
+    pub fn system(&self, grasp: Grasp, load_cell: bool) -> System {
+        let n = self.n;
+        let ns = 2 * n + usize::from(load_cell);
+        let h = &self.handle;
+        let mut kt = self.k.clone();
+        let mut dt = self.d.clone();
+        for i in 0..n {
+            for j in 0..n {
+                // f_h = k_h (x_hand - x_h) + b_h (v_hand - v_h) acts on the
+                // handle through G's first column.
+                let gi = self.g[(i, 0)];
+                kt[(i, j)] += gi * grasp.stiffness_npm * h[j];
+                dt[(i, j)] += gi * grasp.damping_nspm * h[j];
+            }
+        }
+        let mk = &self.minv * &kt;
+        let md = &self.minv * &dt;
+        let mg = &self.minv * &self.g;
+        let mut a = DMatrix::<f64>::zeros(ns, ns);
+        let mut b = DMatrix::<f64>::zeros(ns, 2);
+        let mut e = DMatrix::<f64>::zeros(ns, n);
+        for i in 0..n {
+            a[(i, n + i)] = 1.0;
+            for j in 0..n {
+                a[(n + i, j)] = -mk[(i, j)];
+                a[(n + i, n + j)] = -md[(i, j)];
+                e[(n + i, j)] = self.minv[(i, j)];
+            }
+            b[(n + i, 0)] = mg[(i, 0)];
+            b[(n + i, 1)] = mg[(i, 1)];
+        }
+        if load_cell {
+            let p = self.pole;
+            let w = 2 * n;
+            a[(w, w)] = -p;
+            match self.gauge {
+                Gauge::Model => {
+                    for j in 0..n {
+                        a[(w, j)] = p * self.c_f[j];
+                    }
+                }
+                Gauge::HandForce => {
+                    for j in 0..n {
+                        a[(w, j)] = -p * grasp.stiffness_npm * h[j];
+                        a[(w, n + j)] = -p * grasp.damping_nspm * h[j];
+                    }
+                    b[(w, 0)] = p;
+                }
+            }
+        }
+        System { n, a, b, e }
+    }
+}
+
+/// `x' = A x + B u + E F_nl`.
+#[derive(Clone, Debug)]
+pub struct System {
+    /// Coordinates.
+    pub n: usize,
+    /// State matrix.
+    pub a: DMatrix<f64>,
+    /// Input matrix for `[f_ext, f_a]`.
+    pub b: DMatrix<f64>,
+    /// Input matrix for a force vector on the coordinates.
+    pub e: DMatrix<f64>,
+}
+
+impl System {
+    /// State dimension.
+    pub fn states(&self) -> usize {
+        self.a.nrows()
+    }
+
+    /// Eigenvalues of `A` (rad/s).
+    pub fn poles(&self) -> Vec<nalgebra::Complex<f64>> {
+        self.a.complex_eigenvalues().iter().copied().collect()
+    }
+}
+
+/// How the plant is advanced over one sub-step `h`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// Zero-order-hold exact: `x <- e^{Ah} x + (∫e^{At}dt) (B u + E F)`.
+    ExactZoh,
+    /// Explicit (forward) Euler.
+    Euler,
+    /// Semi-implicit (symplectic) Euler: velocities first, then positions.
+    SemiImplicitEuler,
+    /// Classical fourth-order Runge-Kutta.
+    Rk4,
+}
+
+impl Method {
+    /// Name as in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::ExactZoh => "exact_zoh",
+            Method::Euler => "euler",
+            Method::SemiImplicitEuler => "semi_implicit_euler",
+            Method::Rk4 => "rk4",
+        }
+    }
+
+    /// Whether a linear mode at `λ` (rad/s) stays bounded under this method
+    /// at step `h` (s): `|R(hλ)| <= 1` for the method's amplification `R`.
+    /// For semi-implicit Euler on a lightly damped mode, the condition is
+    /// `h ω < 2`. Exact ZOH is exact.
+    pub fn stable_for(self, lambda: nalgebra::Complex<f64>, h: f64) -> bool {
+        let z = lambda * h;
+        let one = nalgebra::Complex::new(1.0, 0.0);
+        match self {
+            Method::ExactZoh => true,
+            Method::Euler => (one + z).norm() <= 1.0 + 1e-12,
+            Method::Rk4 => {
+                (one + z + z * z / 2.0 + z * z * z / 6.0 + z * z * z * z / 24.0).norm()
+                    <= 1.0 + 1e-12
+            }
+            Method::SemiImplicitEuler => lambda.norm() * h < 2.0,
+        }
+    }
+}
+
+/// A discrete stepper for a [`System`] at a fixed sub-step.
+#[derive(Clone, Debug)]
+pub struct Stepper {
+    method: Method,
+    h: f64,
+    ns: usize,
+    n: usize,
+    /// Row-major `A` (continuous) or `A_d` (exact ZOH).
+    a: Vec<f64>,
+    /// Row-major `B` (ns x 2) or `B_d`.
+    b: Vec<f64>,
+    /// Row-major `E` (ns x n) or `E_d`.
+    e: Vec<f64>,
+    k: [Vec<f64>; 4],
+    tmp: Vec<f64>,
+    force: Vec<f64>,
+}
+
+/// A nonlinear force law: fills a force vector on the coordinates (N) for a
+/// state.
+pub type Nonlinear<'a> = &'a mut dyn FnMut(&[f64], &mut [f64]);
+
+fn row_major(m: &DMatrix<f64>) -> Vec<f64> {
+    (0..m.nrows())
+        .flat_map(|r| (0..m.ncols()).map(move |c| (r, c)))
+        .map(|(r, c)| m[(r, c)])
+        .collect()
+}
+
+impl Stepper {
+    /// A stepper for `sys` with method `method` and sub-step `h` (s).
+    pub fn new(sys: &System, method: Method, h: f64) -> Self {
+        let (ns, n) = (sys.states(), sys.n);
+        let (a, b, e) = match method {
+            Method::ExactZoh => {
+                // exp([[A, B, E], [0, 0, 0]] h) = [[A_d, B_d, E_d], [0, I, 0]]
+                let m = 2 + n;
+                let mut blk = DMatrix::<f64>::zeros(ns + m, ns + m);
+                blk.view_mut((0, 0), (ns, ns)).copy_from(&(&sys.a * h));
+                blk.view_mut((0, ns), (ns, 2)).copy_from(&(&sys.b * h));
+                blk.view_mut((0, ns + 2), (ns, n)).copy_from(&(&sys.e * h));
+                let x = twoport_design::linalg::expm_balanced(&blk);
+                (
+                    row_major(&x.view((0, 0), (ns, ns)).into_owned()),
+                    row_major(&x.view((0, ns), (ns, 2)).into_owned()),
+                    row_major(&x.view((0, ns + 2), (ns, n)).into_owned()),
+                )
+            }
+            _ => (row_major(&sys.a), row_major(&sys.b), row_major(&sys.e)),
+        };
+        Stepper {
+            method,
+            h,
+            ns,
+            n,
+            a,
+            b,
+            e,
+            k: std::array::from_fn(|_| vec![0.0; ns]),
+            tmp: vec![0.0; ns],
+            force: vec![0.0; n],
+        }
+    }
+
+    /// The method.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    /// `out = A x + B u + E f` (continuous) or the ZOH map.
+    fn affine(&self, x: &[f64], u: [f64; 2], f: Option<&[f64]>, out: &mut [f64]) {
+        let ns = self.ns;
+        for (r, o) in out.iter_mut().enumerate().take(ns) {
+            let row = &self.a[r * ns..(r + 1) * ns];
+            let mut s = self.b[2 * r] * u[0] + self.b[2 * r + 1] * u[1];
+            for (aij, xj) in row.iter().zip(x) {
+                s += aij * xj;
+            }
+            if let Some(f) = f {
+                let erow = &self.e[r * self.n..(r + 1) * self.n];
+                for (eij, fj) in erow.iter().zip(f) {
+                    s += eij * fj;
+                }
+            }
+            *o = s;
+        }
+    }
+
+    /// `out = f(x)` for the current method's map, with the nonlinear force
+    /// (if any) evaluated at `x` into `force`.
+    fn eval(
+        &self,
+        x: &[f64],
+        u: [f64; 2],
+        nl: &mut Option<Nonlinear<'_>>,
+        force: &mut [f64],
+        out: &mut [f64],
+    ) {
+        match nl {
+            Some(g) => {
+                force.fill(0.0);
+                g(x, force);
+                self.affine(x, u, Some(force), out);
+            }
+            None => self.affine(x, u, None, out),
+        }
+    }
+
+    /// Advance `x` by one sub-step with the inputs `u` held. Nonlinear
+    /// forces come from `nl` (called at every stage of the explicit
+    /// methods, held over the sub-step by exact ZOH); `None` is the linear
+    /// fast path.
+    pub fn step(&mut self, x: &mut [f64], u: [f64; 2], mut nl: Option<Nonlinear<'_>>) {
+        let (ns, n, h) = (self.ns, self.n, self.h);
+        let mut k = std::mem::take(&mut self.k);
+        let mut y = std::mem::take(&mut self.tmp);
+        let mut force = std::mem::take(&mut self.force);
+        match self.method {
+            Method::ExactZoh => {
+                self.eval(x, u, &mut nl, &mut force, &mut y);
+                x.copy_from_slice(&y);
+            }
+            Method::Euler => {
+                self.eval(x, u, &mut nl, &mut force, &mut y);
+                for (xi, di) in x.iter_mut().zip(&y) {
+                    *xi += h * di;
+                }
+            }
+            Method::SemiImplicitEuler => {
+                self.eval(x, u, &mut nl, &mut force, &mut y);
+                // Velocities (and the filter) first, then positions with the
+                // new velocities.
+                for i in n..ns {
+                    x[i] += h * y[i];
+                }
+                for i in 0..n {
+                    x[i] += h * x[n + i];
+                }
+            }
+            Method::Rk4 => {
+                self.eval(x, u, &mut nl, &mut force, &mut k[0]);
+                for (stage, c) in [(1usize, 0.5), (2, 0.5), (3, 1.0)] {
+                    for i in 0..ns {
+                        y[i] = x[i] + c * h * k[stage - 1][i];
+                    }
+                    let (_, rest) = k.split_at_mut(stage);
+                    self.eval(&y, u, &mut nl, &mut force, &mut rest[0]);
+                }
+                for i in 0..ns {
+                    x[i] += h / 6.0 * (k[0][i] + 2.0 * k[1][i] + 2.0 * k[2][i] + k[3][i]);
+                }
+            }
+        }
+        self.k = k;
+        self.tmp = y;
+        self.force = force;
+    }
+}

@@ -1,0 +1,627 @@
+//! Scene files: what to simulate, and only the effects named.
+
+use crate::human::{Event, GraspKind};
+use crate::plant::Method;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// A scene, as read from TOML. Every section but `display`, `coupling` and
+/// `ve` has defaults; unknown keys are errors.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// A name for reports.
+    #[serde(default)]
+    pub name: String,
+    /// Simulated time (s).
+    #[serde(default = "default_duration")]
+    pub duration_s: f64,
+    /// Control period (s); the model's (or 1 ms) by default.
+    pub period_s: Option<f64>,
+    /// The device.
+    #[serde(default)]
+    pub plant: PlantSpec,
+    /// How the plant is advanced.
+    #[serde(default)]
+    pub integrator: IntegratorSpec,
+    /// Impedance or admittance display.
+    pub display: Display,
+    /// Coupling (and regulator) gains.
+    pub coupling: Coupling,
+    /// The virtual environment.
+    pub ve: VeSpec,
+    /// The human operator.
+    #[serde(default)]
+    pub human: HumanSpec,
+    /// Effects to simulate; none by default.
+    #[serde(default)]
+    pub effects: Effects,
+}
+
+fn default_duration() -> f64 {
+    10.0
+}
+
+/// Which device model.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlantSpec {
+    /// Model file for the flexible plant (with the `flexibility` effect).
+    #[serde(default = "default_model")]
+    pub model: PathBuf,
+    /// Rigid reduction's mass (kg).
+    #[serde(default = "default_rigid_mass")]
+    pub rigid_mass_kg: f64,
+    /// Rigid reduction's damping (N s/m).
+    #[serde(default = "default_rigid_damping")]
+    pub rigid_damping_nspm: f64,
+}
+
+fn default_model() -> PathBuf {
+    PathBuf::from("models/excalibur.toml")
+}
+fn default_rigid_mass() -> f64 {
+    3.9
+}
+fn default_rigid_damping() -> f64 {
+    20.0
+}
+
+impl Default for PlantSpec {
+    fn default() -> Self {
+        PlantSpec {
+            model: default_model(),
+            rigid_mass_kg: default_rigid_mass(),
+            rigid_damping_nspm: default_rigid_damping(),
+        }
+    }
+}
+
+/// Integration method and sub-steps per control tick.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorSpec {
+    /// Method (a linear scene always runs exact ZOH in one step).
+    #[serde(default = "default_method")]
+    pub method: Method,
+    /// Sub-steps per control tick when sub-stepping.
+    #[serde(default = "default_substeps")]
+    pub substeps: u32,
+    /// Use this integrator even for a linear scene (to study its accuracy).
+    #[serde(default)]
+    pub on_linear: bool,
+}
+
+fn default_method() -> Method {
+    Method::Rk4
+}
+fn default_substeps() -> u32 {
+    20
+}
+
+impl Default for IntegratorSpec {
+    fn default() -> Self {
+        IntegratorSpec {
+            method: default_method(),
+            substeps: default_substeps(),
+            on_linear: false,
+        }
+    }
+}
+
+/// The display type.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Display {
+    /// Measure motion, command force.
+    Impedance,
+    /// Measure force, command motion.
+    Admittance,
+}
+
+/// Gains. Impedance display: `k`, `b`. Admittance display: `kp`, `bp`, `m`, `b`.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Coupling {
+    /// Impedance coupling stiffness (N/m).
+    pub k: Option<f64>,
+    /// Coupling damping (N s/m), both displays.
+    pub b: f64,
+    /// Admittance coupling mass (kg).
+    pub m: Option<f64>,
+    /// Position regulator stiffness (N/m).
+    pub kp: Option<f64>,
+    /// Position regulator damping (N s/m).
+    pub bp: Option<f64>,
+}
+
+/// Which side of a wall is solid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SolidSide {
+    /// Positions above the surface are inside.
+    Above,
+    /// Positions below the surface are inside.
+    Below,
+}
+
+/// One block of the building-block world.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlockSpec {
+    /// Left edge (m).
+    pub at_m: f64,
+    /// Width (m).
+    pub width_m: f64,
+    /// Mass (kg).
+    pub mass_kg: f64,
+}
+
+/// The virtual environment.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum VeSpec {
+    /// A free cursor mass.
+    Cursor {
+        /// Mass (kg); the paper's minimum is 0.25.
+        mass_kg: f64,
+    },
+    /// A unilateral spring-damper wall.
+    Wall {
+        /// Surface position (m).
+        position_m: f64,
+        /// Stiffness (N/m).
+        stiffness_npm: f64,
+        /// Damping (N s/m).
+        damping_nspm: f64,
+        /// Solid side.
+        #[serde(default = "default_solid")]
+        solid: SolidSide,
+    },
+    /// A fixed point.
+    Bilateral,
+    /// The 1-D building-block world.
+    Blocks {
+        /// Cursor mass (kg).
+        cursor_mass_kg: f64,
+        /// The blocks, left to right, not overlapping.
+        blocks: Vec<BlockSpec>,
+        /// World limits (m): blocks stop at these walls.
+        limits_m: [f64; 2],
+        /// Force that separates two touching blocks (N).
+        stick_force_n: f64,
+        /// Viscous drag of free blocks on the floor (N s/m).
+        #[serde(default = "default_floor")]
+        floor_damping_nspm: f64,
+        /// Grab the block under the cursor at this time (s).
+        grab_at_s: Option<f64>,
+        /// Release it at this time (s).
+        release_at_s: Option<f64>,
+    },
+}
+
+fn default_solid() -> SolidSide {
+    SolidSide::Above
+}
+fn default_floor() -> f64 {
+    5.0
+}
+
+/// The human operator section.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HumanSpec {
+    /// Initial grasp.
+    #[serde(default = "default_grasp")]
+    pub grasp: GraspKind,
+    /// Scripted events.
+    #[serde(default)]
+    pub script: Vec<Event>,
+}
+
+fn default_grasp() -> GraspKind {
+    GraspKind::HandsOff
+}
+
+impl Default for HumanSpec {
+    fn default() -> Self {
+        HumanSpec {
+            grasp: default_grasp(),
+            script: Vec::new(),
+        }
+    }
+}
+
+/// The effects a scene may name. Absent means not simulated at all.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Effects {
+    /// The flexible multi-mass model instead of the rigid reduction.
+    #[serde(default)]
+    pub flexibility: bool,
+    /// The strain gauge and its analog filter (needed by an admittance display).
+    #[serde(default)]
+    pub load_cell: bool,
+    /// Encoder quantisation.
+    pub encoder: Option<EncoderEffect>,
+    /// Load-cell ADC quantisation and noise.
+    pub adc: Option<AdcEffect>,
+    /// Amplifier saturation.
+    pub saturation: Option<SaturationEffect>,
+    /// Coulomb friction at the actuator.
+    pub coulomb: Option<CoulombEffect>,
+    /// Motor cogging.
+    pub cogging: Option<CoggingEffect>,
+    /// Slack in the cable between the actuator and the first link.
+    pub cable_slack: Option<SlackEffect>,
+    /// Sensor delay.
+    pub delay: Option<DelayEffect>,
+}
+
+/// Encoder quantisation.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EncoderEffect {
+    /// Travel per count (m).
+    pub resolution_m: f64,
+    /// Counter width (bits).
+    #[serde(default = "default_bits")]
+    pub bits: u8,
+}
+fn default_bits() -> u8 {
+    16
+}
+
+/// ADC quantisation and seeded Gaussian noise on the load cell.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AdcEffect {
+    /// Force per least significant bit (N).
+    pub lsb_n: f64,
+    /// Noise standard deviation (N).
+    #[serde(default)]
+    pub noise_rms_n: f64,
+    /// Noise seed.
+    #[serde(default)]
+    pub seed: u64,
+}
+
+/// Amplifier force limit.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SaturationEffect {
+    /// Largest force the amplifier delivers (N).
+    pub limit_n: f64,
+}
+
+/// Coulomb friction at the actuator.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoulombEffect {
+    /// Friction force (N).
+    pub force_n: f64,
+    /// Velocity over which it is smoothed (m/s).
+    #[serde(default = "default_smooth")]
+    pub smoothing_mps: f64,
+}
+fn default_smooth() -> f64 {
+    1e-3
+}
+
+/// Motor cogging: `A sin(2π x_a / period)`.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoggingEffect {
+    /// Amplitude (N).
+    pub amplitude_n: f64,
+    /// Spatial period at the actuator (m).
+    pub period_m: f64,
+}
+
+/// A dead band in the cable between the actuator and the first link.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SlackEffect {
+    /// Total free play (m).
+    pub width_m: f64,
+}
+
+/// Sensor delay.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DelayEffect {
+    /// Ticks of delay.
+    pub ticks: u32,
+}
+
+/// Why a scene was refused: the file, and the line or the field.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneError(pub String);
+
+impl std::fmt::Display for SceneError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for SceneError {}
+
+/// Apply `key.path=value` to a TOML tree; the value is read as TOML
+/// (number, boolean, string, array) or else taken as a string.
+pub fn apply_set(root: &mut toml::Table, assignment: &str) -> Result<(), SceneError> {
+    let bad = |m: String| SceneError(format!("--set {assignment}: {m}"));
+    let (path, value) = assignment
+        .split_once('=')
+        .ok_or_else(|| bad("expected key=value".into()))?;
+    let keys: Vec<&str> = path.trim().split('.').collect();
+    if keys.iter().any(|k| k.is_empty()) {
+        return Err(bad("empty key".into()));
+    }
+    let parsed: toml::Value = toml::from_str::<toml::Table>(&format!("v = {}", value.trim()))
+        .ok()
+        .and_then(|mut t| t.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(value.trim().to_string()));
+    let mut table = root;
+    for k in &keys[..keys.len() - 1] {
+        table = table
+            .entry(k.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+            .as_table_mut()
+            .ok_or_else(|| bad(format!("{k} is not a table")))?;
+    }
+    table.insert(keys[keys.len() - 1].to_string(), parsed);
+    Ok(())
+}
+
+/// Where a bad value sits when serde can only name its table (`ve` is an
+/// internally tagged enum, whose fields serde reads from a buffer): the
+/// line in that table holding the value the message quotes, and its key.
+fn locate(text: &str, table: &str, message: &str) -> Option<(usize, String)> {
+    let quoted = message.split('"').nth(1)?;
+    let header = format!("[{table}]");
+    let start = text.lines().position(|l| l.trim() == header)?;
+    text.lines()
+        .enumerate()
+        .skip(start + 1)
+        .take_while(|(_, l)| !l.trim_start().starts_with('['))
+        .find(|(_, l)| l.contains(&format!("\"{quoted}\"")))
+        .and_then(|(i, l)| Some((i + 1, format!("{table}.{}", l.split('=').next()?.trim()))))
+}
+
+impl Scene {
+    /// Read a scene file, apply `--set` overrides, and check it.
+    pub fn load(path: &Path, sets: &[String]) -> Result<Self, SceneError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| SceneError(format!("{}: cannot read: {e}", path.display())))?;
+        Self::parse(&text, &path.display().to_string(), sets)
+    }
+
+    /// Parse scene text; `source` names it in errors.
+    pub fn parse(text: &str, source: &str, sets: &[String]) -> Result<Self, SceneError> {
+        let line_of = |e: &toml::de::Error| {
+            e.span()
+                .map(|s| {
+                    format!(
+                        "line {}: ",
+                        text[..s.start.min(text.len())].matches('\n').count() + 1
+                    )
+                })
+                .unwrap_or_default()
+        };
+        let mut table: toml::Table = toml::from_str(text)
+            .map_err(|e| SceneError(format!("{source}: {}{}", line_of(&e), e.message())))?;
+        let scene: Scene = if sets.is_empty() {
+            // serde_path_to_error names the field; toml's span alone points
+            // at the enclosing table for a bad value inside one.
+            let de = toml::Deserializer::parse(text)
+                .map_err(|e| SceneError(format!("{source}: {}{}", line_of(&e), e.message())))?;
+            serde_path_to_error::deserialize(de).map_err(|e| {
+                let path = e.path().to_string();
+                let inner = e.into_inner();
+                let (line, key) = locate(text, &path, inner.message())
+                    .map(|(l, k)| (format!("line {l}: "), format!("{k}: ")))
+                    .unwrap_or_else(|| {
+                        let field = if path.is_empty() || path == "." {
+                            String::new()
+                        } else {
+                            format!("{path}: ")
+                        };
+                        (line_of(&inner), field)
+                    });
+                SceneError(format!("{source}: {line}{key}{}", inner.message()))
+            })?
+        } else {
+            for s in sets {
+                apply_set(&mut table, s)?;
+            }
+            // The overridden scene has no lines of its own: name the key.
+            let merged =
+                toml::to_string(&table).map_err(|e| SceneError(format!("{source}: {e}")))?;
+            toml::from_str(&merged).map_err(|e| {
+                let key = e
+                    .span()
+                    .and_then(|s| {
+                        merged[..s.start.min(merged.len())]
+                            .lines()
+                            .last()
+                            .map(str::to_string)
+                    })
+                    .unwrap_or_default();
+                let quoted = e.message().split('"').nth(1).unwrap_or("\u{0}");
+                if let Some(set) = sets
+                    .iter()
+                    .find(|s| s.split_once('=').is_some_and(|(_, v)| v.trim() == quoted))
+                {
+                    return SceneError(format!("{source}: --set {set}: {}", e.message()));
+                }
+                let near = if key.trim().is_empty() {
+                    String::new()
+                } else {
+                    format!(" (at `{}`)", key.trim())
+                };
+                SceneError(format!("{source} with --set: {}{near}", e.message()))
+            })?
+        };
+        scene
+            .check()
+            .map_err(|m| SceneError(format!("{source}: {m}")))?;
+        Ok(scene)
+    }
+
+    /// Physical checks beyond the types; the message names the field.
+    fn check(&self) -> Result<(), String> {
+        let pos = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{name} = {v} must be finite and > 0"))
+            }
+        };
+        let nonneg = |name: &str, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{name} = {v} must be finite and >= 0"))
+            }
+        };
+        pos("duration_s", self.duration_s)?;
+        if let Some(t) = self.period_s {
+            pos("period_s", t)?;
+        }
+        pos("plant.rigid_mass_kg", self.plant.rigid_mass_kg)?;
+        nonneg("plant.rigid_damping_nspm", self.plant.rigid_damping_nspm)?;
+        if self.integrator.substeps == 0 || self.integrator.substeps > 100_000 {
+            return Err(format!(
+                "integrator.substeps = {} must be 1..=100000",
+                self.integrator.substeps
+            ));
+        }
+        let c = &self.coupling;
+        match self.display {
+            Display::Impedance => {
+                let k =
+                    c.k.ok_or("coupling.k is required for an impedance display")?;
+                nonneg("coupling.k", k)?;
+                nonneg("coupling.b", c.b)?;
+                for (n, v) in [
+                    ("coupling.m", c.m),
+                    ("coupling.kp", c.kp),
+                    ("coupling.bp", c.bp),
+                ] {
+                    if v.is_some() {
+                        return Err(format!("{n} belongs to an admittance display"));
+                    }
+                }
+            }
+            Display::Admittance => {
+                for (n, v) in [
+                    ("coupling.m", c.m),
+                    ("coupling.kp", c.kp),
+                    ("coupling.bp", c.bp),
+                ] {
+                    let v = v.ok_or(format!("{n} is required for an admittance display"))?;
+                    nonneg(n, v)?;
+                }
+                pos("coupling.m", c.m.unwrap_or(0.0))?;
+                pos("coupling.b", c.b)?;
+                if c.k.is_some() {
+                    return Err("coupling.k belongs to an impedance display (use kp)".into());
+                }
+                if !self.effects.load_cell {
+                    return Err(
+                        "an admittance display measures force: add `load_cell = true` to [effects]"
+                            .into(),
+                    );
+                }
+            }
+        }
+        match &self.ve {
+            VeSpec::Cursor { mass_kg } => pos("ve.mass_kg", *mass_kg)?,
+            VeSpec::Wall {
+                position_m,
+                stiffness_npm,
+                damping_nspm,
+                ..
+            } => {
+                if !position_m.is_finite() {
+                    return Err(format!("ve.position_m = {position_m} must be finite"));
+                }
+                nonneg("ve.stiffness_npm", *stiffness_npm)?;
+                nonneg("ve.damping_nspm", *damping_nspm)?;
+            }
+            VeSpec::Bilateral => {}
+            VeSpec::Blocks {
+                cursor_mass_kg,
+                blocks,
+                limits_m,
+                stick_force_n,
+                floor_damping_nspm,
+                ..
+            } => {
+                pos("ve.cursor_mass_kg", *cursor_mass_kg)?;
+                nonneg("ve.stick_force_n", *stick_force_n)?;
+                nonneg("ve.floor_damping_nspm", *floor_damping_nspm)?;
+                if !(limits_m[0].is_finite()
+                    && limits_m[1].is_finite()
+                    && limits_m[0] < limits_m[1])
+                {
+                    return Err("ve.limits_m must be [low, high] with low < high".into());
+                }
+                let mut edge = limits_m[0];
+                for (i, b) in blocks.iter().enumerate() {
+                    pos(&format!("ve.blocks[{i}].width_m"), b.width_m)?;
+                    pos(&format!("ve.blocks[{i}].mass_kg"), b.mass_kg)?;
+                    if !(b.at_m.is_finite() && b.at_m >= edge - 1e-12) {
+                        return Err(format!(
+                            "ve.blocks[{i}] overlaps the block or limit to its left"
+                        ));
+                    }
+                    edge = b.at_m + b.width_m;
+                }
+                if edge > limits_m[1] + 1e-12 {
+                    return Err("ve.blocks extend past ve.limits_m[1]".into());
+                }
+            }
+        }
+        let e = &self.effects;
+        if let Some(x) = e.encoder {
+            pos("effects.encoder.resolution_m", x.resolution_m)?;
+            if !(2..=32).contains(&x.bits) {
+                return Err(format!("effects.encoder.bits = {} must be 2..=32", x.bits));
+            }
+        }
+        if let Some(x) = e.adc {
+            pos("effects.adc.lsb_n", x.lsb_n)?;
+            nonneg("effects.adc.noise_rms_n", x.noise_rms_n)?;
+        }
+        if let Some(x) = e.saturation {
+            pos("effects.saturation.limit_n", x.limit_n)?;
+        }
+        if let Some(x) = e.coulomb {
+            nonneg("effects.coulomb.force_n", x.force_n)?;
+            pos("effects.coulomb.smoothing_mps", x.smoothing_mps)?;
+        }
+        if let Some(x) = e.cogging {
+            nonneg("effects.cogging.amplitude_n", x.amplitude_n)?;
+            pos("effects.cogging.period_m", x.period_m)?;
+        }
+        if let Some(x) = e.cable_slack {
+            nonneg("effects.cable_slack.width_m", x.width_m)?;
+            if !e.flexibility {
+                return Err("effects.cable_slack needs the flexible model (flexibility = true): the rigid reduction has no cable".into());
+            }
+        }
+        if let Some(x) = e.delay {
+            if x.ticks > 1000 {
+                return Err(format!("effects.delay.ticks = {} must be <= 1000", x.ticks));
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether any effect makes the plant nonlinear (and so sub-stepped).
+    pub fn nonlinear(&self) -> bool {
+        let e = &self.effects;
+        e.coulomb.is_some() || e.cogging.is_some() || e.cable_slack.is_some()
+    }
+}

@@ -1,0 +1,657 @@
+//! One simulation: the plant between the hand and the board's own control
+//! code, ticking at the control period, with only the named effects.
+
+use crate::blocks::{Block, Blocks};
+use crate::human::{GraspKind, Human};
+use crate::plant::{Device, Method, Stepper, System};
+use crate::scene::{Display, Scene, SolidSide, VeSpec};
+use crate::stability::{Detector, Verdict};
+use crate::ve::SceneVe;
+use std::collections::VecDeque;
+use std::time::Instant;
+use twoport_control::servo::{SensorFrame, ServoOutput};
+use twoport_control::ve::{
+    BilateralConstraint, CursorMass, Solid, UnilateralWall, VirtualEnvironment,
+};
+use twoport_control::{AdmittanceServo, Encoder, ImpedanceServo, Position, SafetyConfig};
+use twoport_design::DeviceModel;
+
+const BUILTIN_EXCALIBUR: &str = include_str!("../../models/excalibur.toml");
+
+/// The board's code for the scene's display.
+#[derive(Clone, Debug)]
+pub enum Servo {
+    /// Impedance display.
+    Impedance(Box<ImpedanceServo<SceneVe>>),
+    /// Admittance display.
+    Admittance(Box<AdmittanceServo<SceneVe>>),
+}
+
+impl Servo {
+    fn tick(&mut self, f: &SensorFrame) -> ServoOutput {
+        match self {
+            Servo::Impedance(s) => s.tick(f),
+            Servo::Admittance(s) => s.tick(f),
+        }
+    }
+
+    fn enable(&mut self) -> Result<(), twoport_control::Faults> {
+        match self {
+            Servo::Impedance(s) => s.enable(),
+            Servo::Admittance(s) => s.enable(),
+        }
+    }
+
+    /// The VE.
+    pub fn ve(&self) -> &SceneVe {
+        match self {
+            Servo::Impedance(s) => s.ve(),
+            Servo::Admittance(s) => s.ve(),
+        }
+    }
+
+    /// Change the coupling gains while running (the scope's sliders).
+    /// Impedance: `(k, b)`; admittance: `(m, b)`.
+    pub fn set_coupling(&mut self, a: f64, b: f64) -> Result<(), String> {
+        match self {
+            Servo::Impedance(s) => s.set_gains(a as f32, b as f32),
+            Servo::Admittance(s) => s.set_coupling_gains(a as f32, b as f32),
+        }
+        .map_err(|e| e.to_string())
+    }
+}
+
+/// One tick's record.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Sample {
+    /// Time at the end of the tick (s).
+    pub t_s: f64,
+    /// Handle position (m).
+    pub handle_m: f64,
+    /// Handle velocity (m/s).
+    pub handle_mps: f64,
+    /// Human force on the handle (N).
+    pub human_n: f64,
+    /// Force the law commanded (N).
+    pub commanded_n: f64,
+    /// Force the actuator delivered (N).
+    pub actuator_n: f64,
+    /// VE position (m).
+    pub ve_m: f64,
+    /// VE force (N).
+    pub ve_n: f64,
+    /// Coupling force (N).
+    pub coupling_n: f64,
+    /// Energy the human has put in (J).
+    pub energy_in_j: f64,
+    /// Energy stored in the device (J).
+    pub energy_stored_j: f64,
+}
+
+/// An effect's measured cost.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct EffectCost {
+    /// Effect name.
+    pub name: String,
+    /// Wall time per tick it added, measured around its own code (ns).
+    pub ns_per_tick: f64,
+}
+
+/// What a run found.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Report {
+    /// The scene's name.
+    pub scene: String,
+    /// Stable by the documented criterion (see `stability`).
+    pub stable: bool,
+    /// Why not, when not.
+    pub reason: Option<String>,
+    /// Largest delivered actuator force (N).
+    pub peak_force_n: f64,
+    /// Work done by the human on the handle (J).
+    pub energy_in_j: f64,
+    /// Simulated time (s).
+    pub sim_seconds: f64,
+    /// Wall-clock time (s).
+    pub wall_seconds: f64,
+    /// Simulated over wall-clock time.
+    pub realtime_factor: f64,
+    /// Effects that ran and their cost.
+    pub effects: Vec<EffectCost>,
+    /// How the plant was advanced.
+    pub integrator: String,
+    /// Sub-steps per tick.
+    pub substeps: u32,
+    /// A predicted integrator instability, if any.
+    pub integrator_warning: Option<String>,
+    /// RMS oscillatory force over the final quiet second (N).
+    pub late_rms_n: [f64; 2],
+}
+
+#[derive(Clone, Debug)]
+struct Rng(u64);
+
+impl Rng {
+    fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn gaussian(&mut self) -> f64 {
+        let u = self.uniform().max(1e-300);
+        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * self.uniform()).cos()
+    }
+}
+
+/// A simulation in progress.
+pub struct Simulation {
+    scene: Scene,
+    period: f64,
+    device: Device,
+    load_cell: bool,
+    steppers: Vec<(GraspKind, Stepper)>,
+    method: Method,
+    substeps: u32,
+    /// Plant state `[q, q', w]`.
+    x: Vec<f64>,
+    servo: Servo,
+    human: Human,
+    tick: u64,
+    total_ticks: u64,
+    held_force: f64,
+    encoder_bits: u8,
+    pm_per_count: f64,
+    rng: Rng,
+    delay: VecDeque<SensorFrame>,
+    peak_force: f64,
+    energy_in: f64,
+    last_power: f64,
+    detector: Detector,
+    failure: Option<String>,
+    costs: Vec<(String, f64)>,
+    warning: Option<String>,
+    actuator_dir: Vec<f64>,
+    cable_k: f64,
+}
+
+/// Largest stable sub-step for `method` over `poles` (s), by bisection.
+fn max_stable_step(method: Method, poles: &[nalgebra::Complex<f64>]) -> f64 {
+    poles
+        .iter()
+        .filter(|l| l.norm() > 0.0)
+        .map(|&l| {
+            let (mut lo, mut hi) = (0.0f64, 10.0 / l.norm());
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if method.stable_for(l, mid) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            lo
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The warning for a sub-step `h` that `method` cannot take on `sys`.
+pub fn integrator_warning(sys: &System, method: Method, h: f64) -> Option<String> {
+    let poles = sys.poles();
+    let bad = poles
+        .iter()
+        .filter(|l| !method.stable_for(**l, h))
+        .map(|l| l.im.abs())
+        .fold(0.0, f64::max);
+    if bad == 0.0 && poles.iter().all(|l| method.stable_for(*l, h)) {
+        return None;
+    }
+    let hmax = max_stable_step(method, &poles);
+    Some(format!(
+        "{} at h = {:.3e} s is unstable on the {:.0} Hz mode (needs h < {:.3e} s)",
+        method.name(),
+        h,
+        bad / (2.0 * std::f64::consts::PI),
+        hmax
+    ))
+}
+
+impl Simulation {
+    /// Build a simulation for `scene`.
+    pub fn new(scene: Scene) -> Result<Self, String> {
+        let e = scene.effects.clone();
+        let device = if e.flexibility {
+            let model = if scene.plant.model.exists() {
+                DeviceModel::load(&scene.plant.model).map_err(|e| e.to_string())?
+            } else if scene.plant.model == std::path::Path::new("models/excalibur.toml") {
+                DeviceModel::from_toml(BUILTIN_EXCALIBUR, "built-in excalibur.toml")
+                    .map_err(|e| e.to_string())?
+            } else {
+                return Err(format!(
+                    "plant.model: {}: no such file",
+                    scene.plant.model.display()
+                ));
+            };
+            Device::flexible(&model)?
+        } else {
+            Device::rigid(
+                scene.plant.rigid_mass_kg,
+                scene.plant.rigid_damping_nspm,
+                235.0,
+            )
+        };
+        let period = scene.period_s.unwrap_or(1e-3);
+        let human = Human::new(scene.human.grasp, scene.human.script.clone())?;
+        let nonlinear = scene.nonlinear();
+        let (method, substeps) = if nonlinear || scene.integrator.on_linear {
+            (scene.integrator.method, scene.integrator.substeps)
+        } else {
+            (Method::ExactZoh, 1)
+        };
+        let h = period / substeps as f64;
+        let mut warning = None;
+        let steppers = human
+            .grasps()
+            .into_iter()
+            .map(|g| {
+                let sys = device.system(g.grasp(), e.load_cell);
+                warning = warning
+                    .take()
+                    .or_else(|| integrator_warning(&sys, method, h));
+                (g, Stepper::new(&sys, method, h))
+            })
+            .collect();
+        let (bits, pm_per_count) = match e.encoder {
+            Some(enc) => (enc.bits, (enc.resolution_m * 1e12).round()),
+            None => (32, 1.0),
+        };
+        let encoder = Encoder::new(bits, pm_per_count as i64, 0, Position::ZERO)
+            .map_err(|e| format!("effects.encoder: {e:?}"))?;
+        let t32 = period as f32;
+        let pos =
+            |m: f64| Position::from_m(m as f32).ok_or(format!("position {m} m is out of range"));
+        let ve = match &scene.ve {
+            VeSpec::Cursor { mass_kg } => SceneVe::Cursor(
+                CursorMass::new(*mass_kg as f32, t32, Position::ZERO).map_err(|e| e.to_string())?,
+            ),
+            VeSpec::Wall {
+                position_m,
+                stiffness_npm,
+                damping_nspm,
+                solid,
+            } => {
+                let side = match solid {
+                    SolidSide::Above => Solid::Above,
+                    SolidSide::Below => Solid::Below,
+                };
+                SceneVe::Wall(
+                    UnilateralWall::new(
+                        *stiffness_npm as f32,
+                        *damping_nspm as f32,
+                        pos(*position_m)?,
+                        side,
+                        t32,
+                        Position::ZERO,
+                    )
+                    .map_err(|e| e.to_string())?,
+                )
+            }
+            VeSpec::Bilateral => SceneVe::Bilateral(BilateralConstraint::new(Position::ZERO)),
+            VeSpec::Blocks {
+                cursor_mass_kg,
+                blocks,
+                limits_m,
+                stick_force_n,
+                floor_damping_nspm,
+                grab_at_s,
+                release_at_s,
+            } => {
+                let bs = blocks
+                    .iter()
+                    .map(|b| {
+                        Ok(Block {
+                            left: pos(b.at_m)?,
+                            width_pm: (b.width_m * 1e12).round() as i64,
+                            mass_kg: b.mass_kg as f32,
+                            velocity_mps: 0.0,
+                        })
+                    })
+                    .collect::<Result<Vec<_>, String>>()?;
+                SceneVe::Blocks(Box::new(Blocks::new(
+                    t32,
+                    *cursor_mass_kg as f32,
+                    bs,
+                    [pos(limits_m[0])?, pos(limits_m[1])?],
+                    *stick_force_n as f32,
+                    *floor_damping_nspm as f32,
+                    *grab_at_s,
+                    *release_at_s,
+                )?))
+            }
+        };
+        let safety = SafetyConfig {
+            period_s: t32,
+            ..SafetyConfig::excalibur()
+        };
+        let c = scene.coupling;
+        let mut servo = match scene.display {
+            Display::Impedance => Servo::Impedance(Box::new(
+                ImpedanceServo::new(c.k.unwrap_or(0.0) as f32, c.b as f32, encoder, safety, ve)
+                    .map_err(|e| e.to_string())?,
+            )),
+            Display::Admittance => Servo::Admittance(Box::new(
+                AdmittanceServo::new(
+                    (c.kp.unwrap_or(0.0) as f32, c.bp.unwrap_or(0.0) as f32),
+                    (c.m.unwrap_or(1.0) as f32, c.b as f32),
+                    encoder,
+                    safety,
+                    ve,
+                )
+                .map_err(|e| e.to_string())?,
+            )),
+        };
+        servo
+            .enable()
+            .map_err(|f| format!("the servo would not enable: {f}"))?;
+        let total_ticks = (scene.duration_s / period).round() as u64;
+        let quiet_tick = ((human.last_event_end() / period).ceil() as u64).min(total_ticks);
+        let ns = 2 * device.n + usize::from(e.load_cell);
+        let actuator_dir = device.actuator.clone();
+        // The cable between the actuator (q1) and the first link (q2) is
+        // K's coupling term between them.
+        let cable_k = if device.n > 1 {
+            (-device.stiffness(0, 1)).max(0.0)
+        } else {
+            0.0
+        };
+        let mut sim = Simulation {
+            period,
+            load_cell: e.load_cell,
+            steppers,
+            method,
+            substeps,
+            x: vec![0.0; ns],
+            servo,
+            human,
+            tick: 0,
+            total_ticks,
+            held_force: 0.0,
+            encoder_bits: bits,
+            pm_per_count,
+            rng: Rng(e.adc.map_or(1, |a| a.seed.max(1))),
+            delay: VecDeque::new(),
+            peak_force: 0.0,
+            energy_in: 0.0,
+            last_power: 0.0,
+            detector: Detector::new(total_ticks, quiet_tick, (1.0 / period).round() as u64),
+            failure: None,
+            costs: Vec::new(),
+            warning,
+            actuator_dir,
+            cable_k,
+            device,
+            scene,
+        };
+        sim.costs = sim.effect_names().into_iter().map(|n| (n, 0.0)).collect();
+        Ok(sim)
+    }
+
+    /// Names of the effects this scene simulates.
+    pub fn effect_names(&self) -> Vec<String> {
+        let e = &self.scene.effects;
+        let mut v = Vec::new();
+        let mut add = |on: bool, n: &str| {
+            if on {
+                v.push(n.to_string());
+            }
+        };
+        add(e.flexibility, "flexibility");
+        add(e.load_cell, "load_cell");
+        add(e.encoder.is_some(), "encoder");
+        add(e.adc.is_some(), "adc");
+        add(e.saturation.is_some(), "saturation");
+        add(e.coulomb.is_some(), "coulomb");
+        add(e.cogging.is_some(), "cogging");
+        add(e.cable_slack.is_some(), "cable_slack");
+        add(e.delay.is_some(), "delay");
+        v
+    }
+
+    fn cost(&mut self, name: &str, since: Instant) {
+        let ns = since.elapsed().as_nanos() as f64;
+        if let Some(c) = self.costs.iter_mut().find(|c| c.0 == name) {
+            c.1 += ns;
+        }
+    }
+
+    /// The running servo (gains, VE).
+    pub fn servo(&self) -> &Servo {
+        &self.servo
+    }
+
+    /// The running servo, to change gains between ticks.
+    pub fn servo_mut(&mut self) -> &mut Servo {
+        &mut self.servo
+    }
+
+    /// The control period (s).
+    pub fn period(&self) -> f64 {
+        self.period
+    }
+
+    /// Ticks in the scene's duration.
+    pub fn total_ticks(&self) -> u64 {
+        self.total_ticks
+    }
+
+    /// Why the run failed so far, if it has.
+    pub fn failure(&self) -> Option<&str> {
+        self.failure.as_deref()
+    }
+
+    /// The plant state `[q, q', w]`.
+    pub fn state(&self) -> &[f64] {
+        &self.x
+    }
+
+    /// Set the plant state (tests).
+    pub fn set_state(&mut self, x: &[f64]) {
+        self.x.copy_from_slice(x);
+    }
+
+    fn dot(a: &[f64], b: &[f64]) -> f64 {
+        a.iter().zip(b).map(|(x, y)| x * y).sum()
+    }
+
+    fn sense(&mut self) -> SensorFrame {
+        let n = self.device.n;
+        let x_a = Self::dot(&self.actuator_dir, &self.x[..n]);
+        let t0 = self.scene.effects.encoder.map(|_| Instant::now());
+        let counts = (x_a * 1e12 / self.pm_per_count).round() as i64;
+        let modulus = 1i128 << self.encoder_bits;
+        let raw = (counts as i128).rem_euclid(modulus) as u32;
+        if let Some(t0) = t0 {
+            self.cost("encoder", t0);
+        }
+        let mut f_m = if self.load_cell { self.x[2 * n] } else { 0.0 };
+        if let Some(adc) = self.scene.effects.adc {
+            let t0 = Instant::now();
+            f_m += adc.noise_rms_n * self.rng.gaussian();
+            f_m = (f_m / adc.lsb_n).round() * adc.lsb_n;
+            self.cost("adc", t0);
+        }
+        SensorFrame {
+            tick: self.tick as u32,
+            encoder_raw: raw,
+            load_cell_n: f_m as f32,
+            dead_man_closed: true,
+        }
+    }
+
+    /// Advance one control tick.
+    pub fn step(&mut self) -> Sample {
+        let t = self.tick as f64 * self.period;
+        let n = self.device.n;
+        let hand = self.human.at(t);
+        let mut frame = self.sense();
+        if let Some(d) = self.scene.effects.delay {
+            let t0 = Instant::now();
+            self.delay.push_back(frame);
+            frame = if self.delay.len() > d.ticks as usize {
+                self.delay.pop_front().unwrap_or(frame)
+            } else {
+                *self.delay.front().unwrap_or(&frame)
+            };
+            frame.tick = self.tick as u32;
+            self.cost("delay", t0);
+        }
+        let out = self.servo.tick(&frame);
+        let mut f_a = out.actuator_force_n as f64;
+        if let Some(s) = self.scene.effects.saturation {
+            let t0 = Instant::now();
+            f_a = f_a.clamp(-s.limit_n, s.limit_n);
+            self.cost("saturation", t0);
+        }
+        self.held_force = f_a;
+        if !out.faults.is_empty() && self.failure.is_none() {
+            self.failure = Some(format!("the safety layer tripped: {}", out.faults));
+        }
+        let u = [hand.input_force(), f_a];
+        let stepper = &mut self
+            .steppers
+            .iter_mut()
+            .find(|(g, _)| *g == hand.grasp)
+            .expect("a stepper for every grasp in the script")
+            .1;
+        let e = &self.scene.effects;
+        if self.scene.nonlinear() {
+            let t0 = Instant::now();
+            let dir = &self.actuator_dir;
+            let (coulomb, cogging, slack, kc) = (e.coulomb, e.cogging, e.cable_slack, self.cable_k);
+            let mut nl = |x: &[f64], f: &mut [f64]| {
+                let xa = Self::dot(dir, &x[..n]);
+                let va = Self::dot(dir, &x[n..2 * n]);
+                let mut fa = 0.0;
+                if let Some(c) = coulomb {
+                    fa -= c.force_n * (va / c.smoothing_mps).tanh();
+                }
+                if let Some(c) = cogging {
+                    fa += c.amplitude_n * (2.0 * std::f64::consts::PI * xa / c.period_m).sin();
+                }
+                for (fi, di) in f.iter_mut().zip(dir) {
+                    *fi += di * fa;
+                }
+                if let Some(s) = slack {
+                    // The linear K has the cable as k_c (q1 - q2); with free
+                    // play the cable only pulls past half the play.
+                    let d = x[0] - x[1];
+                    let h = 0.5 * s.width_m;
+                    let dz = d.signum() * (d.abs() - h).max(0.0);
+                    let corr = kc * (d - dz);
+                    f[0] += corr;
+                    f[1] -= corr;
+                }
+            };
+            for _ in 0..self.substeps {
+                stepper.step(&mut self.x, u, Some(&mut nl));
+            }
+            let ns = t0.elapsed().as_nanos() as f64;
+            let names: Vec<String> = ["coulomb", "cogging", "cable_slack"]
+                .iter()
+                .filter(|n| self.costs.iter().any(|c| c.0 == **n))
+                .map(|n| n.to_string())
+                .collect();
+            for name in &names {
+                if let Some(c) = self.costs.iter_mut().find(|c| &c.0 == name) {
+                    c.1 += ns / names.len() as f64;
+                }
+            }
+        } else {
+            for _ in 0..self.substeps {
+                stepper.step(&mut self.x, u, None);
+            }
+        }
+        self.tick += 1;
+        let x_h = Self::dot(&self.device.handle, &self.x[..n]);
+        let v_h = Self::dot(&self.device.handle, &self.x[n..2 * n]);
+        let f_h = hand.force_on(x_h, v_h);
+        let p = f_h * v_h;
+        self.energy_in += 0.5 * (p + self.last_power) * self.period;
+        self.last_power = p;
+        self.peak_force = self.peak_force.max(f_a.abs());
+        self.detector.push(f_a);
+        let stored = self.device.energy(&self.x);
+        if self.failure.is_none() && (!x_h.is_finite() || x_h.abs() > 10.0 || !stored.is_finite()) {
+            self.failure = Some(match &self.warning {
+                Some(w) => format!("diverged: the integrator is unstable ({w})"),
+                None => "diverged: the device ran 10 m away".to_string(),
+            });
+        }
+        Sample {
+            t_s: self.tick as f64 * self.period,
+            handle_m: x_h,
+            handle_mps: v_h,
+            human_n: f_h,
+            commanded_n: out.commanded_force_n as f64,
+            actuator_n: f_a,
+            ve_m: self.servo.ve().position().m() as f64,
+            ve_n: out.ve_force_n as f64,
+            coupling_n: out.coupling_force_n as f64,
+            energy_in_j: self.energy_in,
+            energy_stored_j: stored,
+        }
+    }
+
+    /// Run to the scene's end (or the first failure), passing each sample
+    /// to `sink`.
+    pub fn run(&mut self, mut sink: impl FnMut(&Sample)) -> Report {
+        let start = Instant::now();
+        while self.tick < self.total_ticks && self.failure.is_none() {
+            let s = self.step();
+            sink(&s);
+        }
+        self.report(start.elapsed().as_secs_f64())
+    }
+
+    /// The report so far, given the wall time spent.
+    pub fn report(&self, wall: f64) -> Report {
+        let Verdict {
+            stable,
+            reason,
+            late_rms_n,
+        } = self.detector.verdict();
+        let ticks = self.tick.max(1) as f64;
+        let sim_seconds = self.tick as f64 * self.period;
+        let (stable, reason) = match &self.failure {
+            Some(f) => (false, Some(f.clone())),
+            None => (stable, reason),
+        };
+        Report {
+            scene: self.scene.name.clone(),
+            stable,
+            reason,
+            peak_force_n: self.peak_force,
+            energy_in_j: self.energy_in,
+            sim_seconds,
+            wall_seconds: wall,
+            realtime_factor: if wall > 0.0 {
+                sim_seconds / wall
+            } else {
+                f64::INFINITY
+            },
+            effects: self
+                .costs
+                .iter()
+                .map(|(n, ns)| EffectCost {
+                    name: n.clone(),
+                    ns_per_tick: ns / ticks,
+                })
+                .collect(),
+            integrator: self.method.name().to_string(),
+            substeps: self.substeps,
+            integrator_warning: self.warning.clone(),
+            late_rms_n,
+        }
+    }
+}
