@@ -117,13 +117,15 @@ impl Device {
     pub fn energy(&self, x: &[f64]) -> f64 {
         let n = self.n;
         let (q, v) = (&x[..n], &x[n..2 * n]);
-        let mut e = 0.0;
-        for i in 0..n {
-            for j in 0..n {
-                e += 0.5 * (v[i] * self.m[(i, j)] * v[j] + q[i] * self.k[(i, j)] * q[j]);
-            }
-        }
-        e
+        // M and K are symmetric: column-major slices read as rows.
+        let quad = |m: &DMatrix<f64>, y: &[f64]| -> f64 {
+            m.as_slice()
+                .chunks_exact(n)
+                .zip(y)
+                .map(|(row, yi)| yi * row.iter().zip(y).map(|(a, b)| a * b).sum::<f64>())
+                .sum()
+        };
+        0.5 * (quad(&self.m, v) + quad(&self.k, q))
     }
 
     /// The continuous system with the grasp folded in.
@@ -257,11 +259,11 @@ pub struct Stepper {
     h: f64,
     ns: usize,
     n: usize,
-    /// Row-major `A` (continuous) or `A_d` (exact ZOH).
+    /// Column-major `A` (continuous) or `A_d` (exact ZOH).
     a: Vec<f64>,
-    /// Row-major `B` (ns x 2) or `B_d`.
+    /// Column-major `B` (ns x 2) or `B_d`.
     b: Vec<f64>,
-    /// Row-major `E` (ns x n) or `E_d`.
+    /// Column-major `E` (ns x n) or `E_d`.
     e: Vec<f64>,
     k: [Vec<f64>; 4],
     tmp: Vec<f64>,
@@ -272,11 +274,27 @@ pub struct Stepper {
 /// state.
 pub type Nonlinear<'a> = &'a mut dyn FnMut(&[f64], &mut [f64]);
 
-fn row_major(m: &DMatrix<f64>) -> Vec<f64> {
-    (0..m.nrows())
-        .flat_map(|r| (0..m.ncols()).map(move |c| (r, c)))
-        .map(|(r, c)| m[(r, c)])
-        .collect()
+/// `out = A x + B u` for `N` states, column-major `A` (N x N) and `B`
+/// (N x 2).
+fn affine_fixed<const N: usize>(a: &[f64], b: &[f64], x: &[f64], u: [f64; 2], out: &mut [f64]) {
+    let mut acc = [0.0f64; N];
+    let (b0, b1) = b.split_at(N);
+    for ((o, p), q) in acc.iter_mut().zip(b0).zip(b1) {
+        *o = p * u[0] + q * u[1];
+    }
+    for (col, xj) in a.chunks_exact(N).zip(x) {
+        let Ok(col) = <&[f64; N]>::try_from(col) else {
+            continue;
+        };
+        for (o, c) in acc.iter_mut().zip(col) {
+            *o += c * xj;
+        }
+    }
+    out[..N].copy_from_slice(&acc);
+}
+
+fn column_major(m: &DMatrix<f64>) -> Vec<f64> {
+    m.as_slice().to_vec()
 }
 
 impl Stepper {
@@ -293,12 +311,16 @@ impl Stepper {
                 blk.view_mut((0, ns + 2), (ns, n)).copy_from(&(&sys.e * h));
                 let x = twoport_design::linalg::expm_balanced(&blk);
                 (
-                    row_major(&x.view((0, 0), (ns, ns)).into_owned()),
-                    row_major(&x.view((0, ns), (ns, 2)).into_owned()),
-                    row_major(&x.view((0, ns + 2), (ns, n)).into_owned()),
+                    column_major(&x.view((0, 0), (ns, ns)).into_owned()),
+                    column_major(&x.view((0, ns), (ns, 2)).into_owned()),
+                    column_major(&x.view((0, ns + 2), (ns, n)).into_owned()),
                 )
             }
-            _ => (row_major(&sys.a), row_major(&sys.b), row_major(&sys.e)),
+            _ => (
+                column_major(&sys.a),
+                column_major(&sys.b),
+                column_major(&sys.e),
+            ),
         };
         Stepper {
             method,
@@ -319,22 +341,38 @@ impl Stepper {
         self.method
     }
 
-    /// `out = A x + B u + E f` (continuous) or the ZOH map.
+    /// `out = A x + B u + E f` (continuous) or the ZOH map, as a sum of
+    /// columns (axpy form, which vectorises; the matrices are stored
+    /// column-major).
     fn affine(&self, x: &[f64], u: [f64; 2], f: Option<&[f64]>, out: &mut [f64]) {
-        let ns = self.ns;
-        for (r, o) in out.iter_mut().enumerate().take(ns) {
-            let row = &self.a[r * ns..(r + 1) * ns];
-            let mut s = self.b[2 * r] * u[0] + self.b[2 * r + 1] * u[1];
-            for (aij, xj) in row.iter().zip(x) {
-                s += aij * xj;
+        // The common sizes (rigid 2-3 states, the 5-DOF Excalibur 10-11)
+        // get fixed-size loops the compiler unrolls and vectorises.
+        if f.is_none() {
+            match self.ns {
+                2 => return affine_fixed::<2>(&self.a, &self.b, x, u, out),
+                3 => return affine_fixed::<3>(&self.a, &self.b, x, u, out),
+                10 => return affine_fixed::<10>(&self.a, &self.b, x, u, out),
+                11 => return affine_fixed::<11>(&self.a, &self.b, x, u, out),
+                _ => {}
             }
-            if let Some(f) = f {
-                let erow = &self.e[r * self.n..(r + 1) * self.n];
-                for (eij, fj) in erow.iter().zip(f) {
-                    s += eij * fj;
+        }
+        let ns = self.ns;
+        let out = &mut out[..ns];
+        let (b0, b1) = self.b.split_at(ns);
+        for ((o, p), q) in out.iter_mut().zip(b0).zip(b1) {
+            *o = p * u[0] + q * u[1];
+        }
+        for (col, xj) in self.a.chunks_exact(ns).zip(x) {
+            for (o, c) in out.iter_mut().zip(col) {
+                *o += c * xj;
+            }
+        }
+        if let Some(f) = f {
+            for (col, fj) in self.e.chunks_exact(ns).zip(f) {
+                for (o, c) in out.iter_mut().zip(col) {
+                    *o += c * fj;
                 }
             }
-            *o = s;
         }
     }
 
@@ -364,6 +402,14 @@ impl Stepper {
     /// fast path.
     pub fn step(&mut self, x: &mut [f64], u: [f64; 2], mut nl: Option<Nonlinear<'_>>) {
         let (ns, n, h) = (self.ns, self.n, self.h);
+        if self.method == Method::ExactZoh && nl.is_none() {
+            // The linear scene's whole update: one affine map.
+            let mut y = std::mem::take(&mut self.tmp);
+            self.affine(x, u, None, &mut y);
+            x[..ns].copy_from_slice(&y[..ns]);
+            self.tmp = y;
+            return;
+        }
         let mut k = std::mem::take(&mut self.k);
         let mut y = std::mem::take(&mut self.tmp);
         let mut force = std::mem::take(&mut self.force);

@@ -16,6 +16,9 @@ use twoport_control::ve::{
 use twoport_control::{AdmittanceServo, Encoder, ImpedanceServo, Position, SafetyConfig};
 use twoport_design::DeviceModel;
 
+/// One tick in this many is timed for the effects' cost.
+const TIMING_STRIDE: u64 = 64;
+
 const BUILTIN_EXCALIBUR: &str = include_str!("../../models/excalibur.toml");
 
 /// The board's code for the scene's display.
@@ -84,7 +87,8 @@ pub struct Sample {
     pub coupling_n: f64,
     /// Energy the human has put in (J).
     pub energy_in_j: f64,
-    /// Energy stored in the device (J).
+    /// Energy stored in the device (J); NaN unless energy tracking is on
+    /// (see [`Simulation::track_energy`]).
     pub energy_stored_j: f64,
 }
 
@@ -161,8 +165,8 @@ pub struct Simulation {
     tick: u64,
     total_ticks: u64,
     held_force: f64,
-    encoder_bits: u8,
-    pm_per_count: f64,
+    encoder_mask: u32,
+    counts_per_m: f64,
     rng: Rng,
     delay: VecDeque<SensorFrame>,
     peak_force: f64,
@@ -174,6 +178,9 @@ pub struct Simulation {
     warning: Option<String>,
     actuator_dir: Vec<f64>,
     cable_k: f64,
+    track_energy: bool,
+    /// What reading the clock twice costs (ns), subtracted from timings.
+    clock_ns: f64,
 }
 
 /// Largest stable sub-step for `method` over `poles` (s), by bisection.
@@ -377,8 +384,12 @@ impl Simulation {
             tick: 0,
             total_ticks,
             held_force: 0.0,
-            encoder_bits: bits,
-            pm_per_count,
+            encoder_mask: if bits >= 32 {
+                u32::MAX
+            } else {
+                (1u32 << bits) - 1
+            },
+            counts_per_m: 1e12 / pm_per_count,
             rng: Rng(e.adc.map_or(1, |a| a.seed.max(1))),
             delay: VecDeque::new(),
             peak_force: 0.0,
@@ -390,6 +401,13 @@ impl Simulation {
             warning,
             actuator_dir,
             cable_k,
+            track_energy: false,
+            clock_ns: (0..32)
+                .map(|_| {
+                    let t = Instant::now();
+                    t.elapsed().as_nanos() as f64
+                })
+                .fold(f64::INFINITY, f64::min),
             device,
             scene,
         };
@@ -418,11 +436,25 @@ impl Simulation {
         v
     }
 
-    fn cost(&mut self, name: &str, since: Instant) {
-        let ns = since.elapsed().as_nanos() as f64;
+    /// Effects are timed on one tick in [`TIMING_STRIDE`] and the time is
+    /// scaled up: a clock read costs more than most effects do.
+    fn timing(&self) -> bool {
+        self.tick % TIMING_STRIDE == 0
+    }
+
+    fn cost(&mut self, name: &str, since: Option<Instant>) {
+        let Some(since) = since else { return };
+        let raw = since.elapsed().as_nanos() as f64 - self.clock_ns;
+        let ns = raw.max(0.0) * TIMING_STRIDE as f64;
         if let Some(c) = self.costs.iter_mut().find(|c| c.0 == name) {
             c.1 += ns;
         }
+    }
+
+    /// Compute the device's stored energy every tick (for a passivity view;
+    /// off by default, it costs about a fifth of a tick).
+    pub fn track_energy(&mut self, on: bool) {
+        self.track_energy = on;
     }
 
     /// The running servo (gains, VE).
@@ -467,16 +499,18 @@ impl Simulation {
     fn sense(&mut self) -> SensorFrame {
         let n = self.device.n;
         let x_a = Self::dot(&self.actuator_dir, &self.x[..n]);
-        let t0 = self.scene.effects.encoder.map(|_| Instant::now());
-        let counts = (x_a * 1e12 / self.pm_per_count).round() as i64;
-        let modulus = 1i128 << self.encoder_bits;
-        let raw = (counts as i128).rem_euclid(modulus) as u32;
-        if let Some(t0) = t0 {
-            self.cost("encoder", t0);
-        }
+        let timing = self.timing();
+        let t0 = self.scene.effects.encoder.and(timing.then(Instant::now));
+        // Round half away from zero without a libm call.
+        let c = x_a * self.counts_per_m;
+        let counts = (c + 0.5f64.copysign(c)) as i64;
+        // The counter keeps the low `bits` of the count: for a power-of-two
+        // modulus that is a mask of the two's-complement value.
+        let raw = (counts as u32) & self.encoder_mask;
+        self.cost("encoder", t0);
         let mut f_m = if self.load_cell { self.x[2 * n] } else { 0.0 };
         if let Some(adc) = self.scene.effects.adc {
-            let t0 = Instant::now();
+            let t0 = timing.then(Instant::now);
             f_m += adc.noise_rms_n * self.rng.gaussian();
             f_m = (f_m / adc.lsb_n).round() * adc.lsb_n;
             self.cost("adc", t0);
@@ -495,8 +529,9 @@ impl Simulation {
         let n = self.device.n;
         let hand = self.human.at(t);
         let mut frame = self.sense();
+        let timing = self.timing();
         if let Some(d) = self.scene.effects.delay {
-            let t0 = Instant::now();
+            let t0 = timing.then(Instant::now);
             self.delay.push_back(frame);
             frame = if self.delay.len() > d.ticks as usize {
                 self.delay.pop_front().unwrap_or(frame)
@@ -509,7 +544,7 @@ impl Simulation {
         let out = self.servo.tick(&frame);
         let mut f_a = out.actuator_force_n as f64;
         if let Some(s) = self.scene.effects.saturation {
-            let t0 = Instant::now();
+            let t0 = timing.then(Instant::now);
             f_a = f_a.clamp(-s.limit_n, s.limit_n);
             self.cost("saturation", t0);
         }
@@ -526,7 +561,7 @@ impl Simulation {
             .1;
         let e = &self.scene.effects;
         if self.scene.nonlinear() {
-            let t0 = Instant::now();
+            let t0 = timing.then(Instant::now);
             let dir = &self.actuator_dir;
             let (coulomb, cogging, slack, kc) = (e.coulomb, e.cogging, e.cable_slack, self.cable_k);
             let mut nl = |x: &[f64], f: &mut [f64]| {
@@ -556,7 +591,9 @@ impl Simulation {
             for _ in 0..self.substeps {
                 stepper.step(&mut self.x, u, Some(&mut nl));
             }
-            let ns = t0.elapsed().as_nanos() as f64;
+            let ns = t0.map_or(0.0, |t| {
+                (t.elapsed().as_nanos() as f64 - self.clock_ns).max(0.0) * TIMING_STRIDE as f64
+            });
             let names: Vec<String> = ["coulomb", "cogging", "cable_slack"]
                 .iter()
                 .filter(|n| self.costs.iter().any(|c| c.0 == **n))
@@ -581,8 +618,12 @@ impl Simulation {
         self.last_power = p;
         self.peak_force = self.peak_force.max(f_a.abs());
         self.detector.push(f_a);
-        let stored = self.device.energy(&self.x);
-        if self.failure.is_none() && (!x_h.is_finite() || x_h.abs() > 10.0 || !stored.is_finite()) {
+        let stored = if self.track_energy {
+            self.device.energy(&self.x)
+        } else {
+            f64::NAN
+        };
+        if self.failure.is_none() && (!x_h.is_finite() || x_h.abs() > 10.0 || !v_h.is_finite()) {
             self.failure = Some(match &self.warning {
                 Some(w) => format!("diverged: the integrator is unstable ({w})"),
                 None => "diverged: the device ran 10 m away".to_string(),

@@ -76,7 +76,10 @@ impl Detector {
         let n = self.window.len();
         self.sum += force_n - self.window[self.next];
         self.window[self.next] = force_n;
-        self.next = (self.next + 1) % n;
+        self.next += 1;
+        if self.next == n {
+            self.next = 0;
+        }
         self.filled = (self.filled + 1).min(n);
         let osc = force_n - self.sum / self.filled as f64;
         if self.tick >= self.quiet_from_tick && self.tick < self.total_ticks {

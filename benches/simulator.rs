@@ -1,0 +1,84 @@
+//! Simulator speed: one simulated second (1,000 ticks) of the linear 5-DOF
+//! Excalibur scene with exact ZOH (goal: 20,000x real time, i.e. 50 us per
+//! simulated second), and the added cost of each effect, all measured in
+//! one run so they compare as ratios.
+
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use host_sim::{Scene, Simulation};
+use std::hint::black_box;
+use std::path::Path;
+
+const SCENE: &str = "scenes/table1/impedance_bilateral_maximum.toml";
+
+fn scene(sets: &[&str]) -> Scene {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sets: Vec<String> = sets
+        .iter()
+        .map(|s| s.to_string())
+        .chain(["duration_s=1000".to_string()])
+        .collect();
+    let mut s = Scene::load(&root.join(SCENE), &sets).unwrap();
+    s.plant.model = root.join("models/excalibur.toml");
+    s
+}
+
+fn one_second(c: &mut Criterion, name: &str, sets: &[&str]) {
+    let s = scene(sets);
+    c.bench_function(name, |b| {
+        b.iter_batched_ref(
+            || Simulation::new(s.clone()).unwrap(),
+            |sim| {
+                for _ in 0..1000 {
+                    black_box(sim.step());
+                }
+            },
+            BatchSize::LargeInput,
+        )
+    });
+}
+
+fn effects(c: &mut Criterion) {
+    one_second(c, "1 s of the linear 5-DOF scene, exact ZOH", &[]);
+    one_second(c, "1 s, rigid 1-DOF plant", &["effects.flexibility=false"]);
+    one_second(
+        c,
+        "1 s + encoder quantisation",
+        &["effects.encoder.resolution_m=1e-6"],
+    );
+    one_second(
+        c,
+        "1 s + load cell and ADC noise",
+        &[
+            "effects.load_cell=true",
+            "effects.adc.lsb_n=0.01",
+            "effects.adc.noise_rms_n=0.05",
+        ],
+    );
+    one_second(c, "1 s + saturation", &["effects.saturation.limit_n=200.0"]);
+    one_second(c, "1 s + 2-tick delay", &["effects.delay.ticks=2"]);
+    one_second(
+        c,
+        "1 s + Coulomb friction (RK4 x 20)",
+        &["effects.coulomb.force_n=2.0"],
+    );
+    one_second(
+        c,
+        "1 s + cogging (RK4 x 20)",
+        &[
+            "effects.cogging.amplitude_n=0.5",
+            "effects.cogging.period_m=0.002",
+        ],
+    );
+    one_second(
+        c,
+        "1 s + cable slack (RK4 x 20)",
+        &["effects.cable_slack.width_m=1e-5"],
+    );
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(20);
+    targets = effects
+}
+criterion_main!(benches);

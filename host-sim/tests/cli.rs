@@ -1,0 +1,184 @@
+//! `host-sim` as a user runs it: JSON on stdout, CSV columns, sweeps, the
+//! Table I command, and errors with exit code 2.
+
+use serde_json::Value;
+use std::process::{Command, Output};
+
+fn host_sim(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(args)
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
+        .output()
+        .expect("run host-sim")
+}
+
+fn json(args: &[&str]) -> Value {
+    let out = host_sim(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(text.trim().lines().count(), 1, "one JSON object: {text}");
+    serde_json::from_str(&text).unwrap()
+}
+
+#[test]
+fn run_json_has_the_documented_fields() {
+    let v = json(&["run", "scenes/stiff_wall.toml", "--duration", "3", "--json"]);
+    for key in [
+        "stable",
+        "peak_force_n",
+        "energy_in_j",
+        "sim_seconds",
+        "wall_seconds",
+        "realtime_factor",
+        "effects",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}: {v}");
+    }
+    assert_eq!(v["stable"], true);
+    assert!((v["sim_seconds"].as_f64().unwrap() - 3.0).abs() < 1e-9);
+    let names: Vec<&str> = v["effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["flexibility", "encoder", "saturation"]);
+    let peak = v["peak_force_n"].as_f64().unwrap();
+    assert!(peak > 5.0 && peak <= 200.0, "{peak}");
+}
+
+#[test]
+fn set_overrides_any_value_and_a_big_gain_is_unstable() {
+    let v = json(&[
+        "run",
+        "scenes/table1/impedance_bilateral_hands_off.toml",
+        "--set",
+        "coupling.k=1e6",
+        "--json",
+    ]);
+    assert_eq!(v["stable"], false);
+    assert!(v["reason"].as_str().unwrap().len() > 5);
+}
+
+#[test]
+fn csv_has_one_row_per_tick_and_the_documented_columns() {
+    let path = std::env::temp_dir().join(format!("host-sim-{}.csv", std::process::id()));
+    let png = path.with_extension("png");
+    json(&[
+        "run",
+        "scenes/vbb_blocks.toml",
+        "--duration",
+        "2",
+        "--csv",
+        path.to_str().unwrap(),
+        "--png",
+        png.to_str().unwrap(),
+        "--json",
+    ]);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "t_s,handle_position_m,handle_velocity_mps,human_force_n,commanded_force_n,actuator_force_n,ve_position_m,ve_force_n"
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 2000);
+    assert!(rows
+        .iter()
+        .all(|r| r.len() == 8 && r.iter().all(|x| x.is_finite())));
+    // The hand moves the handle; the VE (the grabbed block) follows it.
+    let last = rows.last().unwrap();
+    assert!(
+        last[1] > 0.02 && (last[1] - last[6]).abs() < 0.005,
+        "{last:?}"
+    );
+    assert_eq!(&std::fs::read(&png).unwrap()[1..4], b"PNG");
+}
+
+#[test]
+fn sweep_finds_a_marginal_gain_between_stable_and_unstable() {
+    let v = json(&[
+        "sweep",
+        "scenes/table1/impedance_bilateral_hands_off.toml",
+        "--param",
+        "coupling.k",
+        "--from",
+        "51000",
+        "--to",
+        "1000000",
+        "--tol",
+        "0.02",
+        "--json",
+    ]);
+    assert_eq!(v["param"], "coupling.k");
+    let k = v["marginal"].as_f64().unwrap();
+    assert!(k > 51_000.0 && k < 1_000_000.0, "{k}");
+    let stable = json(&[
+        "run",
+        "scenes/table1/impedance_bilateral_hands_off.toml",
+        "--set",
+        &format!("coupling.k={k}"),
+        "--json",
+    ]);
+    assert_eq!(stable["stable"], true);
+    let past = json(&[
+        "run",
+        "scenes/table1/impedance_bilateral_hands_off.toml",
+        "--set",
+        &format!("coupling.k={}", k * 1.05),
+        "--json",
+    ]);
+    assert_eq!(past["stable"], false);
+}
+
+#[test]
+fn table1_runs_every_case_stable_at_the_theoretical_gains() {
+    let v = json(&["table1", "--json"]);
+    assert_eq!(v["cases"].as_array().unwrap().len(), 18);
+    assert_eq!(v["all_stable_at_theoretical_gains"], true);
+    assert!(v["impedance_boundary_k"].as_f64().unwrap() > 51_000.0);
+    let m = v["admittance_boundary_m"].as_f64().unwrap();
+    assert!(m > 0.0 && m < 5.0, "{m}");
+}
+
+#[test]
+fn errors_name_the_problem_and_exit_2() {
+    for (args, want) in [
+        (
+            vec!["run", "no/such/scene.toml"],
+            "no/such/scene.toml: cannot read",
+        ),
+        (
+            vec!["run", "scenes/stiff_wall.toml", "--set", "coupling.b=-1"],
+            "coupling.b = -1",
+        ),
+        (
+            vec!["run", "scenes/stiff_wall.toml", "--set", "nonsense"],
+            "expected key=value",
+        ),
+        (
+            vec![
+                "sweep",
+                "scenes/stiff_wall.toml",
+                "--param",
+                "coupling.k",
+                "--from",
+                "1000",
+                "--to",
+                "2000",
+            ],
+            "stable at both",
+        ),
+    ] {
+        let out = host_sim(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert!(e.contains(want), "{args:?}: {e}");
+    }
+}
