@@ -1,0 +1,134 @@
+//! The board's code on the host: each law's `step` and a whole servo tick
+//! (goal: 20 ns or less). Inputs vary every iteration so nothing folds away.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use std::hint::black_box;
+use twoport_control::servo::SensorFrame;
+use twoport_control::ve::{
+    BilateralConstraint, CursorMass, Port, Solid, UnilateralWall, VirtualEnvironment,
+};
+use twoport_control::{
+    AdmittanceCoupling, AdmittanceServo, Encoder, FirstDifference, ImpedanceCoupling,
+    ImpedanceServo, Integrator, Position, PositionRegulator, SafetyConfig,
+};
+
+const T: f32 = 1e-3;
+
+/// A wobbling position in picometres, different every tick.
+fn wobble(k: u32) -> Position {
+    Position::from_pm(((k as i64 * 7919) % 2_000_001 - 1_000_000) * 1000)
+}
+
+fn laws(c: &mut Criterion) {
+    let mut k = 0u32;
+    let mut est = FirstDifference::new(T, Position::ZERO).unwrap();
+    c.bench_function("first-difference estimator step", |b| {
+        b.iter(|| {
+            k = k.wrapping_add(1);
+            black_box(est.step(black_box(wobble(k))))
+        })
+    });
+    let mut x = Integrator::new(T, Position::ZERO);
+    c.bench_function("velocity integrator step", |b| {
+        b.iter(|| {
+            k = k.wrapping_add(1);
+            black_box(x.step(black_box((k % 100) as f32 * 1e-3)))
+        })
+    });
+    let mut reg = PositionRegulator::new(51_000.0, 90.0, T).unwrap();
+    c.bench_function("position regulator K_p step", |b| {
+        b.iter(|| {
+            k = k.wrapping_add(1);
+            black_box(reg.step(black_box(wobble(k)), Position::ZERO))
+        })
+    });
+    let mut zc = ImpedanceCoupling::new(51_000.0, 90.0, T, Position::ZERO).unwrap();
+    let mut fixed = BilateralConstraint::new(Position::ZERO);
+    c.bench_function("impedance coupling Z_cI step, bilateral VE", |b| {
+        b.iter(|| {
+            k = k.wrapping_add(1);
+            black_box(zc.step(black_box(wobble(k)), 0.01, &mut fixed))
+        })
+    });
+    let mut wall =
+        UnilateralWall::new(1e5, 50.0, Position::ZERO, Solid::Above, T, Position::ZERO).unwrap();
+    c.bench_function("unilateral wall VE step (exact loop solve)", |b| {
+        b.iter(|| {
+            k = k.wrapping_add(1);
+            black_box(wall.step(Port {
+                f0_n: black_box((k % 50) as f32 - 25.0),
+                z_nspm: 141.0,
+            }))
+        })
+    });
+    let mut za = AdmittanceCoupling::new(5.0, 500.0, T).unwrap();
+    let mut cursor = CursorMass::new(0.25, T, Position::ZERO).unwrap();
+    c.bench_function("admittance coupling Z_cA step, cursor VE", |b| {
+        b.iter(|| {
+            k = k.wrapping_add(1);
+            black_box(za.step(black_box((k % 20) as f32 - 10.0), &mut cursor))
+        })
+    });
+}
+
+fn frame(k: u32, raw: u32, f: f32) -> SensorFrame {
+    SensorFrame {
+        tick: k,
+        encoder_raw: raw,
+        load_cell_n: f,
+        dead_man_closed: true,
+    }
+}
+
+fn servos(c: &mut Criterion) {
+    let enc = || Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    let wall = UnilateralWall::new(
+        1e5,
+        50.0,
+        Position::from_pm(500_000_000),
+        Solid::Above,
+        T,
+        Position::ZERO,
+    )
+    .unwrap();
+    let mut s =
+        ImpedanceServo::new(51_000.0, 90.0, enc(), SafetyConfig::excalibur(), wall).unwrap();
+    s.enable().unwrap();
+    let mut k = 0u32;
+    c.bench_function(
+        "impedance servo tick: encoder, estimator, Z_cI, wall, safety",
+        |b| {
+            b.iter(|| {
+                k = k.wrapping_add(1);
+                black_box(s.tick(&frame(k, black_box(k % 1000), 0.0)))
+            })
+        },
+    );
+    let cursor = CursorMass::new(0.25, T, Position::ZERO).unwrap();
+    let mut a = AdmittanceServo::new(
+        (51_000.0, 90.0),
+        (5.0, 500.0),
+        enc(),
+        SafetyConfig::excalibur(),
+        cursor,
+    )
+    .unwrap();
+    a.enable().unwrap();
+    let mut k = 0u32;
+    c.bench_function(
+        "admittance servo tick: load cell, Z_cA, cursor, T/(1-1/z), K_p, safety",
+        |b| {
+            b.iter(|| {
+                k = k.wrapping_add(1);
+                black_box(a.tick(&frame(k, 0, black_box(((k % 40) as f32 - 20.0) * 0.1))))
+            })
+        },
+    );
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(30);
+    targets = laws, servos
+}
+criterion_main!(benches);
