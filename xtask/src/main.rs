@@ -146,11 +146,14 @@ fn cargo_test_totals() -> Result<(), String> {
 fn thumb() -> Result<(), String> {
     let tc = Toolchain::detect()?;
     run(
-        &format!("build twoport-control for {TARGET} ({})", tc.describe()),
+        &format!(
+            "build twoport-control and twoport-link for {TARGET} ({})",
+            tc.describe()
+        ),
         &mut tc.build(
             &root(),
             &cross_target_dir("thumbv7em-control"),
-            &["-p", "twoport-control"],
+            &["-p", "twoport-control", "-p", "twoport-link"],
         ),
     )
 }

@@ -1,0 +1,179 @@
+//! What the board and the host say to each other. Units are SI; positions
+//! are integer picometres as in `twoport-control`.
+
+use serde::{Deserialize, Serialize};
+
+/// The protocol version both ends must share (checked by the handshake).
+pub const PROTOCOL_VERSION: u16 = 1;
+
+/// Which end is speaking in a handshake.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Role {
+    /// The motor-controller board.
+    Board,
+    /// The host (simulator, scope).
+    Host,
+}
+
+/// The board's state each telemetry period.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Telemetry {
+    /// Control tick.
+    pub tick: u32,
+    /// Actuator position (pm).
+    pub position_pm: i64,
+    /// Actuator velocity (m/s).
+    pub velocity_mps: f32,
+    /// Load-cell force (N).
+    pub load_cell_n: f32,
+    /// Force the law commanded (N).
+    pub commanded_n: f32,
+    /// Force sent to the amplifier after the safety layer (N).
+    pub actuator_n: f32,
+    /// VE position (pm).
+    pub ve_position_pm: i64,
+    /// Latched fault bits (`twoport_control::Faults`).
+    pub faults: u16,
+    /// Cycles (or instructions, in QEMU) the last tick took.
+    pub loop_cycles: u32,
+}
+
+/// Coupling (and regulator) gains.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Gains {
+    /// Impedance display: `Z_cI` stiffness (N/m) and damping (N s/m).
+    Impedance {
+        /// Stiffness (N/m).
+        k_npm: f32,
+        /// Damping (N s/m).
+        b_nspm: f32,
+    },
+    /// Admittance display: regulator `K_p` and coupling `Z_cA`.
+    Admittance {
+        /// Regulator stiffness (N/m).
+        kp_npm: f32,
+        /// Regulator damping (N s/m).
+        bp_nspm: f32,
+        /// Coupling mass (kg).
+        m_kg: f32,
+        /// Coupling damping (N s/m).
+        b_nspm: f32,
+    },
+}
+
+/// Why the board refused gains.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Refusal {
+    /// A gain is NaN or infinite.
+    NotFinite,
+    /// A gain is negative (or zero where it must be positive).
+    OutOfRange,
+    /// Outside the region the designer proved absolutely stable; the bound
+    /// at the asked damping is given (N/m for a stiffness, kg for a mass).
+    NotProvenStable {
+        /// The proven limit.
+        limit: f32,
+    },
+    /// Gains for the other display type.
+    WrongDisplay,
+}
+
+/// The board's answer to `SetGains`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum GainsReply {
+    /// In force from the next tick.
+    Accepted(Gains),
+    /// Not applied; the old gains stay.
+    Refused(Refusal),
+}
+
+/// Processor-in-the-loop: the simulated sensors for one tick (host to board).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SensorFrame {
+    /// Tick this frame is for.
+    pub tick: u32,
+    /// Raw encoder counter.
+    pub encoder_raw: u32,
+    /// Raw load-cell ADC reading (counts).
+    pub load_cell_raw: i32,
+    /// Dead-man switch closed.
+    pub dead_man_closed: bool,
+}
+
+/// Processor-in-the-loop: the actuator command for one tick (board to host).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ActuatorFrame {
+    /// Tick this command answers.
+    pub tick: u32,
+    /// Signed PWM duty, full scale ±32767 = ± peak force.
+    pub duty: i16,
+}
+
+/// Every message.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Message {
+    /// Handshake request with the sender's protocol version.
+    Hello {
+        /// Sender's version.
+        version: u16,
+        /// Sender's role.
+        role: Role,
+    },
+    /// Handshake answer.
+    HelloAck {
+        /// Answerer's version.
+        version: u16,
+        /// Whether the versions match.
+        accepted: bool,
+    },
+    /// The host is alive (feeds the board's link watchdog).
+    Heartbeat,
+    /// Board state.
+    Telemetry(Telemetry),
+    /// Ask for the gains in force.
+    GetGains,
+    /// The gains in force.
+    Gains(Gains),
+    /// Ask for new gains.
+    SetGains(Gains),
+    /// Answer to `SetGains`.
+    GainsReply(GainsReply),
+    /// Latched faults (and the first one).
+    FaultReport {
+        /// All latched fault bits.
+        faults: u16,
+        /// The first fault's bit.
+        first: u16,
+    },
+    /// Clear latched faults.
+    ClearFaults,
+    /// Enable force output.
+    Enable,
+    /// Disable force output.
+    Disable,
+    /// PIL sensors in.
+    Sensors(SensorFrame),
+    /// PIL actuator out.
+    Actuator(ActuatorFrame),
+}
+
+impl Message {
+    /// This side's handshake opener.
+    pub const fn hello(role: Role) -> Message {
+        Message::Hello {
+            version: PROTOCOL_VERSION,
+            role,
+        }
+    }
+
+    /// The answer to a `Hello`; `None` for any other message.
+    pub fn answer(&self) -> Option<Message> {
+        match *self {
+            Message::Hello { version, .. } => Some(Message::HelloAck {
+                version: PROTOCOL_VERSION,
+                accepted: version == PROTOCOL_VERSION,
+            }),
+            _ => None,
+        }
+    }
+}
