@@ -43,6 +43,12 @@ struct Siso {
 impl Siso {
     fn new(a: DMatrix<f64>, b: Vec<f64>, c: Vec<f64>) -> Self {
         let n = a.nrows();
+        // Balance first (d^-1 a d, d^-1 b, c d): the load-cell row makes A_d
+        // span ten orders of magnitude, which costs the reduction digits.
+        let d = balance(&a);
+        let a = DMatrix::from_fn(n, n, |i, j| a[(i, j)] * d[j] / d[i]);
+        let b: Vec<f64> = b.iter().zip(&d).map(|(x, di)| x / di).collect();
+        let c: Vec<f64> = c.iter().zip(&d).map(|(x, di)| x * di).collect();
         let (q, h) = a.hessenberg().unpack();
         // a = q h q^T: c (zI - a)^-1 b = (c q) (zI - h)^-1 (q^T b).
         let qb: Vec<f64> = (0..n)
@@ -212,6 +218,9 @@ pub struct Plant {
     c_f: Vec<f64>,
     xaa: Siso,
     fma: Siso,
+    /// The augmented `A_d` (row-major), the actuator column of `B_d`, and
+    /// the output rows for `-x_a` and `f_m`: kept for a second method.
+    zoh: (usize, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>),
     modal: Option<Modal>,
     modes: Vec<Mode>,
     discrete_angles: Vec<f64>,
@@ -274,6 +283,13 @@ impl Plant {
         c_fm[2 * n] = 1.0;
         let ad_q = ad.view((0, 0), (2 * n, 2 * n)).into_owned();
         let xaa = Siso::new(ad_q, bd_act[..2 * n].to_vec(), c_xa[..2 * n].to_vec());
+        let zoh = (
+            na,
+            row_major(&ad),
+            bd_act.clone(),
+            c_xa.clone(),
+            c_fm.clone(),
+        );
         let fma = Siso::new(ad.clone(), bd_act, c_fm);
 
         let a_q = a.view((0, 0), (2 * n, 2 * n)).into_owned();
@@ -312,6 +328,7 @@ impl Plant {
             c_f: row_major(&model.c_f),
             xaa,
             fma,
+            zoh,
             modal,
             modes,
             discrete_angles,
@@ -486,6 +503,34 @@ impl Plant {
             .iter()
             .map(|l| l.norm())
             .fold(0.0, f64::max)
+    }
+
+    /// `X_aa^d` and `F_ma^d` at `ω` by a plain complex LU of `(zI - A_d)`
+    /// on the augmented model: a second method for the Hessenberg path.
+    pub fn sampled_by_lu(&self, omega: f64) -> (Complex64, Complex64) {
+        let (na, ad, b, c_xa, c_fm) = &self.zoh;
+        let na = *na;
+        // The same balancing as the fast path: it is the data, not the
+        // solver, that the two methods share.
+        let dm = DMatrix::from_row_slice(na, na, ad);
+        let d = balance(&dm);
+        let ad: Vec<f64> = (0..na * na)
+            .map(|i| ad[i] * d[i % na] / d[i / na])
+            .collect();
+        let b: Vec<f64> = b.iter().zip(&d).map(|(x, di)| x / di).collect();
+        let c_xa: Vec<f64> = c_xa.iter().zip(&d).map(|(x, di)| x * di).collect();
+        let c_fm: Vec<f64> = c_fm.iter().zip(&d).map(|(x, di)| x * di).collect();
+        let z = Complex64::from_polar(1.0, omega * self.period_s);
+        let mut m: Vec<Complex64> = (0..na * na)
+            .map(|i| if i / na == i % na { z } else { Complex64::new(0.0, 0.0) } - ad[i])
+            .collect();
+        let mut x: Vec<Complex64> = b.iter().map(|v| Complex64::new(*v, 0.0)).collect();
+        if !lu_solve(&mut m, na, &mut x, 1) {
+            let inf = Complex64::new(f64::INFINITY, 0.0);
+            return (inf, inf);
+        }
+        let dot = |c: &[f64]| x.iter().zip(c).map(|(a, b)| a * b).sum();
+        (dot(&c_xa), dot(&c_fm))
     }
 
     /// All terms on a grid of angular frequencies (rad/s).
