@@ -1,7 +1,7 @@
 //! The human operator: a grasp impedance `b + k/s` between the handle and
 //! a hand whose motion (and grip) follows a script.
 
-use crate::plant::Grasp;
+use crate::plant::{Arm, Grasp};
 use serde::Deserialize;
 
 /// Grasp presets. The paper bounds the human by `Z_max = 300 + 1000/s`
@@ -19,7 +19,7 @@ pub enum GraspKind {
 }
 
 impl GraspKind {
-    /// The impedance.
+    /// The impedance (with no arm behind it).
     pub fn grasp(self) -> Grasp {
         let (b, k) = match self {
             GraspKind::HandsOff => (0.0, 0.0),
@@ -29,6 +29,7 @@ impl GraspKind {
         Grasp {
             damping_nspm: b,
             stiffness_npm: k,
+            arm: None,
         }
     }
 
@@ -128,6 +129,7 @@ impl HandState {
 pub struct Human {
     grasp: GraspKind,
     events: Vec<Event>,
+    arm: Option<Arm>,
 }
 
 impl Human {
@@ -187,7 +189,52 @@ impl Human {
             }
         }
         events.sort_by(|a, b| a.at().total_cmp(&b.at()));
-        Ok(Human { grasp, events })
+        Ok(Human {
+            grasp,
+            events,
+            arm: None,
+        })
+    }
+
+    /// Put a passive arm behind every grasp but hands-off; the hand then
+    /// stays still and only `force` events act (on the handle).
+    pub fn with_arm(mut self, arm: Option<Arm>) -> Result<Self, String> {
+        if let Some(a) = arm {
+            let ok = |v: f64| v.is_finite() && v >= 0.0;
+            if !(a.mass_kg.is_finite()
+                && a.mass_kg > 0.0
+                && ok(a.damping_nspm)
+                && ok(a.stiffness_npm))
+            {
+                return Err(
+                    "human.arm needs mass_kg > 0 and finite damping_nspm, stiffness_npm >= 0"
+                        .into(),
+                );
+            }
+            if self
+                .events
+                .iter()
+                .any(|e| matches!(e, Event::Move { .. } | Event::Shake { .. }))
+            {
+                return Err("human.arm: the hand is still behind an arm; use force events, not move or shake".into());
+            }
+        }
+        self.arm = arm;
+        Ok(self)
+    }
+
+    /// The plant's grasp for `kind`, with the arm when there is one.
+    pub fn grasp_of(&self, kind: GraspKind) -> Grasp {
+        let g = kind.grasp();
+        match (kind, self.arm) {
+            (GraspKind::HandsOff, _) | (_, None) => g,
+            (_, arm) => Grasp { arm, ..g },
+        }
+    }
+
+    /// Whether an arm is behind the grasp.
+    pub fn has_arm(&self) -> bool {
+        self.arm.is_some()
     }
 
     /// Every grasp the script uses (to prepare the plant for each).

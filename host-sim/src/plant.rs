@@ -10,12 +10,30 @@
 use nalgebra::{Cholesky, DMatrix};
 use twoport_design::DeviceModel;
 
-/// The grasp's impedance `b + k/s` between the handle and the hand.
+/// The grasp's impedance `b + k/s` between the handle and the hand, and
+/// optionally a passive arm behind it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Grasp {
     /// Damping (N s/m).
     pub damping_nspm: f64,
     /// Stiffness (N/m).
+    pub stiffness_npm: f64,
+    /// The arm `Z_p` behind the grasp (paper Fig. 3): without it the grasp
+    /// ends at the moving hand; with it the grasp ends at a node of mass
+    /// `m` held to the (still) hand by its own spring and damper, so the
+    /// human is `Z_max` in series with an arbitrary passive `Z_p`.
+    pub arm: Option<Arm>,
+}
+
+/// A passive mass-spring-damper arm behind the grasp.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Arm {
+    /// Node mass (kg), > 0.
+    pub mass_kg: f64,
+    /// Damping to the hand (N s/m).
+    pub damping_nspm: f64,
+    /// Stiffness to the hand (N/m).
     pub stiffness_npm: f64,
 }
 
@@ -131,7 +149,8 @@ impl Device {
     /// The continuous system with the grasp folded in.
     pub fn system(&self, grasp: Grasp, load_cell: bool) -> System {
         let n = self.n;
-        let ns = 2 * n + usize::from(load_cell);
+        let arm_at = 2 * n + usize::from(load_cell);
+        let ns = arm_at + if grasp.arm.is_some() { 2 } else { 0 };
         let h = &self.handle;
         let mut kt = self.k.clone();
         let mut dt = self.d.clone();
@@ -160,6 +179,24 @@ impl Device {
             b[(n + i, 0)] = mg[(i, 0)];
             b[(n + i, 1)] = mg[(i, 1)];
         }
+        let (kg, bg) = (grasp.stiffness_npm, grasp.damping_nspm);
+        if let Some(arm) = grasp.arm {
+            // The grasp pulls the handle toward the node, not the hand:
+            // f_h = k_g (x_n - x_h) + b_g (v_n - v_h).
+            let (xn, vn) = (arm_at, arm_at + 1);
+            for i in 0..n {
+                a[(n + i, xn)] += mg[(i, 0)] * kg;
+                a[(n + i, vn)] += mg[(i, 0)] * bg;
+            }
+            let m = arm.mass_kg;
+            a[(xn, vn)] = 1.0;
+            for j in 0..n {
+                a[(vn, j)] = kg * h[j] / m;
+                a[(vn, n + j)] = bg * h[j] / m;
+            }
+            a[(vn, xn)] = -(kg + arm.stiffness_npm) / m;
+            a[(vn, vn)] = -(bg + arm.damping_nspm) / m;
+        }
         if load_cell {
             let p = self.pole;
             let w = 2 * n;
@@ -172,8 +209,12 @@ impl Device {
                 }
                 Gauge::HandForce => {
                     for j in 0..n {
-                        a[(w, j)] = -p * grasp.stiffness_npm * h[j];
-                        a[(w, n + j)] = -p * grasp.damping_nspm * h[j];
+                        a[(w, j)] = -p * kg * h[j];
+                        a[(w, n + j)] = -p * bg * h[j];
+                    }
+                    if grasp.arm.is_some() {
+                        a[(w, arm_at)] = p * kg;
+                        a[(w, arm_at + 1)] = p * bg;
                     }
                     b[(w, 0)] = p;
                 }
@@ -353,6 +394,8 @@ impl Stepper {
                 3 => return affine_fixed::<3>(&self.a, &self.b, x, u, out),
                 10 => return affine_fixed::<10>(&self.a, &self.b, x, u, out),
                 11 => return affine_fixed::<11>(&self.a, &self.b, x, u, out),
+                12 => return affine_fixed::<12>(&self.a, &self.b, x, u, out),
+                13 => return affine_fixed::<13>(&self.a, &self.b, x, u, out),
                 _ => {}
             }
         }

@@ -180,6 +180,16 @@ pub enum VeSpec {
     },
     /// A fixed point.
     Bilateral,
+    /// A spring-damper to an anchor, pulling and pushing (the wall in
+    /// permanent contact): a linear passive VE.
+    Spring {
+        /// Anchor position (m).
+        anchor_m: f64,
+        /// Stiffness (N/m).
+        stiffness_npm: f64,
+        /// Damping (N s/m).
+        damping_nspm: f64,
+    },
     /// The 1-D building-block world.
     Blocks {
         /// Cursor mass (kg).
@@ -217,6 +227,8 @@ pub struct HumanSpec {
     /// Scripted events.
     #[serde(default)]
     pub script: Vec<Event>,
+    /// A passive arm behind the grasp (paper Fig. 3's `Z_p`).
+    pub arm: Option<crate::plant::Arm>,
 }
 
 fn default_grasp() -> GraspKind {
@@ -228,6 +240,7 @@ impl Default for HumanSpec {
         HumanSpec {
             grasp: default_grasp(),
             script: Vec::new(),
+            arm: None,
         }
     }
 }
@@ -550,6 +563,17 @@ impl Scene {
                 nonneg("ve.damping_nspm", *damping_nspm)?;
             }
             VeSpec::Bilateral => {}
+            VeSpec::Spring {
+                anchor_m,
+                stiffness_npm,
+                damping_nspm,
+            } => {
+                if !anchor_m.is_finite() {
+                    return Err(format!("ve.anchor_m = {anchor_m} must be finite"));
+                }
+                nonneg("ve.stiffness_npm", *stiffness_npm)?;
+                nonneg("ve.damping_nspm", *damping_nspm)?;
+            }
             VeSpec::Blocks {
                 cursor_mass_kg,
                 blocks,

@@ -11,7 +11,7 @@ use std::collections::VecDeque;
 use std::time::Instant;
 use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::ve::{
-    BilateralConstraint, CursorMass, Solid, UnilateralWall, VirtualEnvironment,
+    BilateralConstraint, CursorMass, Solid, Spring, UnilateralWall, VirtualEnvironment,
 };
 use twoport_control::{AdmittanceServo, Encoder, ImpedanceServo, Position, SafetyConfig};
 use twoport_design::DeviceModel;
@@ -249,7 +249,8 @@ impl Simulation {
             )
         };
         let period = scene.period_s.unwrap_or(1e-3);
-        let human = Human::new(scene.human.grasp, scene.human.script.clone())?;
+        let human =
+            Human::new(scene.human.grasp, scene.human.script.clone())?.with_arm(scene.human.arm)?;
         let nonlinear = scene.nonlinear();
         let (method, substeps) = if nonlinear || scene.integrator.on_linear {
             (scene.integrator.method, scene.integrator.substeps)
@@ -262,7 +263,7 @@ impl Simulation {
             .grasps()
             .into_iter()
             .map(|g| {
-                let sys = device.system(g.grasp(), e.load_cell);
+                let sys = device.system(human.grasp_of(g), e.load_cell);
                 warning = warning
                     .take()
                     .or_else(|| integrator_warning(&sys, method, h));
@@ -305,6 +306,20 @@ impl Simulation {
                 )
             }
             VeSpec::Bilateral => SceneVe::Bilateral(BilateralConstraint::new(Position::ZERO)),
+            VeSpec::Spring {
+                anchor_m,
+                stiffness_npm,
+                damping_nspm,
+            } => SceneVe::Spring(
+                Spring::new(
+                    *stiffness_npm as f32,
+                    *damping_nspm as f32,
+                    pos(*anchor_m)?,
+                    t32,
+                    Position::ZERO,
+                )
+                .map_err(|e| e.to_string())?,
+            ),
             VeSpec::Blocks {
                 cursor_mass_kg,
                 blocks,
@@ -363,7 +378,7 @@ impl Simulation {
             .map_err(|f| format!("the servo would not enable: {f}"))?;
         let total_ticks = (scene.duration_s / period).round() as u64;
         let quiet_tick = ((human.last_event_end() / period).ceil() as u64).min(total_ticks);
-        let ns = 2 * device.n + usize::from(e.load_cell);
+        let ns = 2 * device.n + usize::from(e.load_cell) + if human.has_arm() { 2 } else { 0 };
         let actuator_dir = device.actuator.clone();
         // The cable between the actuator (q1) and the first link (q2) is
         // K's coupling term between them.
@@ -552,7 +567,15 @@ impl Simulation {
         if !out.faults.is_empty() && self.failure.is_none() {
             self.failure = Some(format!("the safety layer tripped: {}", out.faults));
         }
-        let u = [hand.input_force(), f_a];
+        // Behind an arm the hand is still: only pushes reach the handle.
+        let u = [
+            if self.human.has_arm() {
+                hand.push_n
+            } else {
+                hand.input_force()
+            },
+            f_a,
+        ];
         let stepper = &mut self
             .steppers
             .iter_mut()
@@ -612,7 +635,16 @@ impl Simulation {
         self.tick += 1;
         let x_h = Self::dot(&self.device.handle, &self.x[..n]);
         let v_h = Self::dot(&self.device.handle, &self.x[n..2 * n]);
-        let f_h = hand.force_on(x_h, v_h);
+        let f_h = match self.human.grasp_of(hand.grasp).arm {
+            Some(_) => {
+                let g = hand.grasp.grasp();
+                let at = 2 * n + usize::from(self.load_cell);
+                g.stiffness_npm * (self.x[at] - x_h)
+                    + g.damping_nspm * (self.x[at + 1] - v_h)
+                    + hand.push_n
+            }
+            None => hand.force_on(x_h, v_h),
+        };
         let p = f_h * v_h;
         self.energy_in += 0.5 * (p + self.last_power) * self.period;
         self.last_power = p;

@@ -9,10 +9,11 @@
 //! 3. **Undamped oscillation**: the oscillatory part of the force (the
 //!    force minus its 50 ms trailing mean) is measured as an RMS over the
 //!    two halves of the final quiet second, after the script's last event.
-//!    If the second half is above 0.5 N and has not decayed below 70% of
-//!    the first half, the oscillation is undamped or growing: unstable. A
-//!    damped mode of the device (ζω above about 0.7 rad/s) decays faster
-//!    than that over half a second.
+//!    If the second half is above 0.5 N and has not decayed below 98% of
+//!    the first half, the oscillation is sustained (a limit cycle) or
+//!    growing: unstable. Any mode with ζω above 0.04 rad/s decays faster
+//!    than that over half a second, so lightly damped passive terminations
+//!    (a stiff arm, a high-Q spring VE) are not mistaken for instability.
 //!
 //! Scenes end with at least a second of constant human input so that a
 //! forced motion is never mistaken for a self-sustained one.
@@ -47,7 +48,7 @@ pub struct Verdict {
 /// Oscillation below this RMS is noise, not instability (N).
 pub const FLOOR_N: f64 = 0.5;
 /// A late half above this fraction of the early half has not decayed.
-pub const DECAY: f64 = 0.7;
+pub const DECAY: f64 = 0.98;
 
 impl Detector {
     /// For a run of `total_ticks` whose script is quiet from `quiet_tick`;

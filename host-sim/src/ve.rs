@@ -2,7 +2,7 @@
 
 use crate::blocks::Blocks;
 use twoport_control::ve::{
-    BilateralConstraint, Causality, CursorMass, Port, UnilateralWall, VeOutput, VeTransfer,
+    BilateralConstraint, Causality, CursorMass, Port, Spring, UnilateralWall, VeOutput, VeTransfer,
     VirtualEnvironment,
 };
 use twoport_control::Position;
@@ -16,6 +16,8 @@ pub enum SceneVe {
     Wall(UnilateralWall),
     /// A fixed point.
     Bilateral(BilateralConstraint),
+    /// A spring-damper to an anchor.
+    Spring(Spring),
     /// The building-block world.
     Blocks(Box<Blocks>),
 }
@@ -26,6 +28,7 @@ macro_rules! each {
             SceneVe::Cursor($v) => $e,
             SceneVe::Wall($v) => $e,
             SceneVe::Bilateral($v) => $e,
+            SceneVe::Spring($v) => $e,
             SceneVe::Blocks($v) => $e,
         }
     };

@@ -106,6 +106,7 @@ fn exact_zoh_conserves_energy_without_damping() {
         Grasp {
             damping_nspm: 0.0,
             stiffness_npm: 0.0,
+            arm: None,
         },
         false,
     );
@@ -148,6 +149,7 @@ fn exact_zoh_conserves_energy_without_damping() {
         Grasp {
             damping_nspm: 0.0,
             stiffness_npm: 0.0,
+            arm: None,
         },
         false,
     );

@@ -8,8 +8,8 @@
 extern crate std;
 
 use crate::ve::{
-    BilateralConstraint, Causality, CursorMass, Port, Solid, UnilateralWall, VeOutput, VeTransfer,
-    VirtualEnvironment,
+    BilateralConstraint, Causality, CursorMass, Port, Solid, Spring, UnilateralWall, VeOutput,
+    VeTransfer, VirtualEnvironment,
 };
 use crate::*;
 use std::f64::consts::PI;
@@ -196,6 +196,16 @@ fn wall_ve_in_contact() {
         let got = ve_response(p, &mut ve, 100.0, 30.0);
         assert!(ve.in_contact());
         assert_close("wall b + kT/(1 - z^-1)", p, got, ve_tf(&ve).eval(z_of(p)));
+    }
+}
+
+#[test]
+fn spring_ve_pulls_and_pushes_linearly() {
+    for p in BINS {
+        let mut ve = Spring::new(20_000.0, 50.0, Position::ZERO, T, Position::ZERO).unwrap();
+        // Zero-mean force: the spring is linear on both sides.
+        let got = ve_response(p, &mut ve, 0.0, 30.0);
+        assert_close("spring b + kT/(1 - z^-1)", p, got, ve_tf(&ve).eval(z_of(p)));
     }
 }
 

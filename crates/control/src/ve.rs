@@ -292,6 +292,72 @@ impl VirtualEnvironment for UnilateralWall {
     }
 }
 
+/// A spring-damper to a fixed anchor, pulling as well as pushing: the
+/// unilateral wall in permanent contact, and the simplest linear passive
+/// impedance VE. `f = k (x - anchor) + b v`, so
+/// `Z_e(z) = b + kT/(1 - z^-1)`.
+#[derive(Clone, Copy, Debug)]
+pub struct Spring {
+    k: f32,
+    b: f32,
+    kt: f32,
+    anchor: Position,
+    probe: Integrator,
+}
+
+impl Spring {
+    /// A spring of `k_npm` (N/m) and damper `b_nspm` (N s/m) to `anchor`;
+    /// the probe starts at rest at `probe`.
+    pub fn new(
+        k_npm: f32,
+        b_nspm: f32,
+        anchor: Position,
+        period_s: f32,
+        probe: Position,
+    ) -> Result<Self, ParamError> {
+        let k = param::non_negative("spring stiffness (N/m)", k_npm)?;
+        let b = param::non_negative("spring damping (N s/m)", b_nspm)?;
+        let t = param::positive("T (s)", period_s)?;
+        Ok(Spring {
+            k,
+            b,
+            kt: k * t,
+            anchor,
+            probe: Integrator::new(t, probe),
+        })
+    }
+}
+
+impl VirtualEnvironment for Spring {
+    fn causality(&self) -> Causality {
+        Causality::Impedance
+    }
+
+    fn step(&mut self, port: Port) -> VeOutput {
+        let d = self.probe.position().minus_m(self.anchor);
+        let out = port.solve_impedance(self.k * d, self.kt + self.b);
+        if out.velocity_mps.is_finite() {
+            self.probe.step(out.velocity_mps);
+        }
+        out
+    }
+
+    /// Moves the probe; the anchor stays.
+    fn reset(&mut self, x: Position) {
+        self.probe.reset(x);
+    }
+
+    fn position(&self) -> Position {
+        self.probe.position()
+    }
+
+    /// `F/V = b + kT/(1 - z^-1)`.
+    fn tf(&self) -> VeTransfer {
+        let (b, kt) = (self.b as f64, self.kt as f64);
+        VeTransfer::Impedance(ZTransfer::first_order([b + kt, -b], -1.0))
+    }
+}
+
 /// A bilateral constraint: the VE point is fixed, `v_e = 0`, whatever the
 /// force (admittance zero). The paper's "bilaterally constrained block".
 #[derive(Clone, Copy, Debug)]
