@@ -7,6 +7,7 @@
 //! exact discrete update with no sub-steps.
 #![forbid(unsafe_code)]
 
+pub mod accuracy;
 pub mod blocks;
 pub mod human;
 pub mod plant;

@@ -26,6 +26,15 @@ enum Cmd {
     Sweep(SweepArgs),
     /// Run the paper's Table I matrix and sweep its boundaries.
     Table1(Table1Args),
+    /// Measure what accuracy costs: every integrator x sub-step count.
+    Accuracy(AccuracyArgs),
+}
+
+#[derive(Args)]
+struct AccuracyArgs {
+    /// Folder for accuracy.md, accuracy.json and accuracy.png.
+    #[arg(long, default_value = "docs")]
+    out: PathBuf,
 }
 
 #[derive(Args)]
@@ -363,12 +372,48 @@ fn table1(a: &Table1Args) -> Result<(), String> {
     Ok(())
 }
 
+fn accuracy(a: &AccuracyArgs) -> Result<(), String> {
+    std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
+    let scenes = host_sim::accuracy::scenes(Path::new("."))?;
+    let b = bar(scenes.len() as u64, "accuracy study".into());
+    let mut cells = Vec::new();
+    for (label, scene, reference) in &scenes {
+        cells.extend(host_sim::accuracy::study(label, scene, *reference)?);
+        b.inc(1);
+    }
+    b.finish_and_clear();
+    let md = format!(
+        "# What accuracy costs in time\n\nRegenerate with `cargo xtask accuracy`. Error: the largest handle-position \
+         difference from the reference over the run, relative to the reference's peak displacement. Cost: wall time \
+         per simulated millisecond (1 control tick), best of three, on the machine that ran it. References: exact \
+         ZOH for the linear scene (exact there), RK4 at 1,000 sub-steps (1 us) for the nonlinear one. The controller \
+         is the board's f32 code in every run.\n\n![accuracy](accuracy.png)\n\n{}",
+        host_sim::accuracy::markdown(&cells)
+    );
+    let write = |name: &str, text: String| {
+        std::fs::write(a.out.join(name), text).map_err(|e| format!("{name}: {e}"))
+    };
+    write("accuracy.md", md)?;
+    write(
+        "accuracy.json",
+        serde_json::to_string_pretty(&cells).map_err(|e| e.to_string())?,
+    )?;
+    host_sim::plot::accuracy_png(&cells, &a.out.join("accuracy.png"))?;
+    println!(
+        "wrote {}/accuracy.md, accuracy.json, accuracy.png ({} runs)",
+        a.out.display(),
+        cells.len()
+    );
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let r = match &cli.cmd {
         Cmd::Run(a) => run(a),
         Cmd::Sweep(a) => sweep(a),
         Cmd::Table1(a) => table1(a),
+        Cmd::Accuracy(a) => accuracy(a),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,

@@ -92,3 +92,92 @@ pub fn png(samples: &[Sample], title: &str, out: &Path) -> Result<(), String> {
     )?;
     root.present().map_err(e)
 }
+
+/// The accuracy study as a PNG: error against cost, one line per method,
+/// a panel per scene.
+pub fn accuracy_png(cells: &[crate::accuracy::Cell], out: &Path) -> Result<(), String> {
+    let _ =
+        plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
+    let root = BitMapBackend::new(out, (1200, 560)).into_drawing_area();
+    let e = |e: DrawingAreaErrorKind<_>| format!("{}: {e}", out.display());
+    root.fill(&WHITE).map_err(e)?;
+    let root = root
+        .titled(
+            "What accuracy costs: max handle error vs wall time, per integrator",
+            ("sans-serif", 20),
+        )
+        .map_err(e)?;
+    let mut scenes: Vec<&str> = cells.iter().map(|c| c.scene.as_str()).collect();
+    scenes.dedup();
+    let panels = root.split_evenly((1, scenes.len().max(1)));
+    let colors = [
+        RGBColor(31, 90, 180),
+        RGBColor(190, 40, 40),
+        RGBColor(20, 140, 60),
+        RGBColor(150, 90, 20),
+    ];
+    for (panel, scene) in panels.iter().zip(&scenes) {
+        let mine: Vec<_> = cells
+            .iter()
+            .filter(|c| c.scene == *scene && c.error.is_some_and(|x| x > 0.0))
+            .collect();
+        if mine.is_empty() {
+            continue;
+        }
+        let (x0, x1) = mine.iter().fold((f64::INFINITY, 0.0f64), |(a, b), c| {
+            (a.min(c.ns_per_sim_ms), b.max(c.ns_per_sim_ms))
+        });
+        let (y0, y1) = mine
+            .iter()
+            .filter_map(|c| c.error)
+            .fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+        let mut chart = ChartBuilder::on(panel)
+            .caption(*scene, ("sans-serif", 14))
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(70)
+            .build_cartesian_2d(
+                (x0 / 1.5..x1 * 1.5).log_scale(),
+                (y0 / 3.0..y1 * 3.0).log_scale(),
+            )
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_desc("ns per simulated ms")
+            .y_desc("max error / peak")
+            .x_label_formatter(&|v| format!("{v:.0e}"))
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .label_style(("sans-serif", 12))
+            .draw()
+            .map_err(e)?;
+        let mut methods: Vec<&str> = mine.iter().map(|c| c.method.as_str()).collect();
+        methods.dedup();
+        for (i, m) in methods.iter().enumerate() {
+            let color = colors[i % colors.len()];
+            let pts: Vec<(f64, f64)> = mine
+                .iter()
+                .filter(|c| c.method == *m)
+                .filter_map(|c| Some((c.ns_per_sim_ms, c.error?)))
+                .collect();
+            chart
+                .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
+                .map_err(e)?
+                .label(*m)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                });
+            chart
+                .draw_series(pts.iter().map(|p| Circle::new(*p, 3, color.filled())))
+                .map_err(e)?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 12))
+            .draw()
+            .map_err(e)?;
+    }
+    root.present().map_err(e)
+}

@@ -5,6 +5,7 @@
 //! - `thumb`: build `twoport-control` for thumbv7em-none-eabihf.
 //! - `firmware`: build the firmware workspace.
 //! - `qemu`: build and run the on-target tests in QEMU mps2-an386.
+//! - `accuracy`: regenerate docs/accuracy.md and docs/accuracy.png.
 
 mod toolchain;
 
@@ -20,8 +21,21 @@ fn main() -> ExitCode {
         Some("thumb") => thumb(),
         Some("firmware") => firmware().map(|_| ()),
         Some("qemu") => qemu(),
+        Some("accuracy") => run(
+            "host-sim accuracy (docs/accuracy.md, docs/accuracy.png)",
+            cargo().args([
+                "run",
+                "--release",
+                "-p",
+                "host-sim",
+                "--",
+                "accuracy",
+                "--out",
+                "docs",
+            ]),
+        ),
         _ => Err(format!(
-            "usage: cargo xtask <ci|thumb|firmware|qemu>\n  got: {}",
+            "usage: cargo xtask <ci|thumb|firmware|qemu|accuracy>\n  got: {}",
             args.join(" ")
         )),
     };
@@ -99,13 +113,16 @@ fn ci() -> Result<(), String> {
     qemu()?;
     // Last, closing on the total so that CI reads the whole count rather
     // than the last crate's doc-test line. The long hard cases (24 h of
-    // ticks) are ignored in debug builds and run here in release.
+    // ticks, 2 x 10^4 random terminations) are ignored in debug builds and
+    // run here in release.
     let runs: [&[&str]; 2] = [
         &[
             "test",
             "--release",
             "--test",
             "hard_cases",
+            "--test",
+            "terminations",
             "--",
             "--ignored",
         ],

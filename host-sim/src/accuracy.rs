@@ -1,0 +1,138 @@
+//! What accuracy costs in time: every integrator at every sub-step count on
+//! a linear scene (reference: exact ZOH, which is exact there) and on a
+//! nonlinear one (reference: RK4 at a 1 us step), error against cost.
+
+use crate::plant::Method;
+use crate::{Scene, Simulation};
+use std::path::Path;
+use std::time::Instant;
+
+/// One cell of the study.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Cell {
+    /// Scene label.
+    pub scene: String,
+    /// Integrator.
+    pub method: String,
+    /// Sub-steps per 1 ms tick.
+    pub substeps: u32,
+    /// Max handle-position error over the run, relative to the reference's
+    /// peak displacement; `None` when the run did not finish.
+    pub error: Option<f64>,
+    /// Wall time per simulated millisecond (ns), best of three.
+    pub ns_per_sim_ms: f64,
+    /// Why the run failed, or the integrator's stability warning.
+    pub note: Option<String>,
+}
+
+/// Sub-step counts studied.
+pub const SUBSTEPS: [u32; 9] = [1, 2, 4, 8, 16, 32, 64, 128, 256];
+/// Methods studied.
+pub const METHODS: [Method; 4] = [
+    Method::ExactZoh,
+    Method::SemiImplicitEuler,
+    Method::Rk4,
+    Method::Euler,
+];
+
+fn with(scene: &Scene, method: Method, substeps: u32) -> Scene {
+    let mut s = scene.clone();
+    s.integrator.method = method;
+    s.integrator.substeps = substeps;
+    s.integrator.on_linear = true;
+    s
+}
+
+/// Handle path and the best wall time of three runs.
+fn path(scene: &Scene) -> Result<(Vec<f64>, f64, Option<String>), String> {
+    let mut best = f64::INFINITY;
+    let mut out = (Vec::new(), None);
+    for _ in 0..3 {
+        let mut sim = Simulation::new(scene.clone())?;
+        let mut xs = Vec::with_capacity(sim.total_ticks() as usize);
+        let t0 = Instant::now();
+        let r = sim.run(|s| xs.push(s.handle_m));
+        best = best.min(t0.elapsed().as_secs_f64());
+        let note = r.reason.clone().or(r.integrator_warning.clone());
+        out = (xs, note);
+        if r.reason.is_some() {
+            break; // a failed run is not timed further
+        }
+    }
+    Ok((out.0, best, out.1))
+}
+
+/// Run the study on one scene against `reference`.
+pub fn study(label: &str, scene: &Scene, reference: (Method, u32)) -> Result<Vec<Cell>, String> {
+    let (want, _, _) = path(&with(scene, reference.0, reference.1))?;
+    let peak = want.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-12);
+    let sim_ms = scene.duration_s * 1e3;
+    let mut cells = Vec::new();
+    for method in METHODS {
+        for n in SUBSTEPS {
+            if method == Method::ExactZoh && n > 16 {
+                continue; // exact already; more sub-steps only cost
+            }
+            let (got, wall, note) = path(&with(scene, method, n))?;
+            let error = (got.len() == want.len())
+                .then(|| {
+                    got.iter()
+                        .zip(&want)
+                        .map(|(a, b)| (a - b).abs())
+                        .fold(0.0, f64::max)
+                        / peak
+                })
+                .filter(|e| e.is_finite());
+            cells.push(Cell {
+                scene: label.to_string(),
+                method: method.name().to_string(),
+                substeps: n,
+                error,
+                ns_per_sim_ms: wall * 1e9 / sim_ms,
+                note,
+            });
+        }
+    }
+    Ok(cells)
+}
+
+/// The two scenes of the study, from the repository root.
+pub fn scenes(root: &Path) -> Result<Vec<(String, Scene, (Method, u32))>, String> {
+    let load = |f: &str, sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let mut s = Scene::load(&root.join(f), &sets).map_err(|e| e.to_string())?;
+        s.plant.model = root.join("models/excalibur.toml");
+        Ok::<Scene, String>(s)
+    };
+    Ok(vec![
+        (
+            "linear: table1/impedance_bilateral_maximum (5-DOF, 5.5 s)".into(),
+            load("scenes/table1/impedance_bilateral_maximum.toml", &[])?,
+            (Method::ExactZoh, 1),
+        ),
+        (
+            "nonlinear: stiff_wall + 2 N Coulomb friction (3 s)".into(),
+            load(
+                "scenes/stiff_wall.toml",
+                &["duration_s=3", "effects.coulomb.force_n=2.0"],
+            )?,
+            (Method::Rk4, 1000),
+        ),
+    ])
+}
+
+/// The study as a markdown table.
+pub fn markdown(cells: &[Cell]) -> String {
+    let mut s = String::from(
+        "| scene | method | sub-steps | max error / peak | ns per simulated ms | note |\n| --- | --- | --- | --- | --- | --- |\n",
+    );
+    for c in cells {
+        let err = c.error.map_or("diverged".into(), |e| format!("{e:.2e}"));
+        let note = c.note.clone().unwrap_or_default().replace('|', "/");
+        s += &format!(
+            "| {} | {} | {} | {} | {:.0} | {} |\n",
+            c.scene, c.method, c.substeps, err, c.ns_per_sim_ms, note
+        );
+    }
+    s
+}
