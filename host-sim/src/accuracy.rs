@@ -96,8 +96,18 @@ pub fn study(label: &str, scene: &Scene, reference: (Method, u32)) -> Result<Vec
     Ok(cells)
 }
 
+/// A scene of the study and its converged reference.
+pub struct StudyScene {
+    /// Label for the table.
+    pub label: String,
+    /// The scene.
+    pub scene: Scene,
+    /// Reference method and sub-steps.
+    pub reference: (Method, u32),
+}
+
 /// The two scenes of the study, from the repository root.
-pub fn scenes(root: &Path) -> Result<Vec<(String, Scene, (Method, u32))>, String> {
+pub fn scenes(root: &Path) -> Result<Vec<StudyScene>, String> {
     let load = |f: &str, sets: &[&str]| {
         let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
         let mut s = Scene::load(&root.join(f), &sets).map_err(|e| e.to_string())?;
@@ -105,19 +115,19 @@ pub fn scenes(root: &Path) -> Result<Vec<(String, Scene, (Method, u32))>, String
         Ok::<Scene, String>(s)
     };
     Ok(vec![
-        (
-            "linear: table1/impedance_bilateral_maximum (5-DOF, 5.5 s)".into(),
-            load("scenes/table1/impedance_bilateral_maximum.toml", &[])?,
-            (Method::ExactZoh, 1),
-        ),
-        (
-            "nonlinear: stiff_wall + 2 N Coulomb friction (3 s)".into(),
-            load(
+        StudyScene {
+            label: "linear: table1/impedance_bilateral_maximum (5-DOF, 5.5 s)".into(),
+            scene: load("scenes/table1/impedance_bilateral_maximum.toml", &[])?,
+            reference: (Method::ExactZoh, 1),
+        },
+        StudyScene {
+            label: "nonlinear: stiff_wall + 2 N Coulomb friction (3 s)".into(),
+            scene: load(
                 "scenes/stiff_wall.toml",
                 &["duration_s=3", "effects.coulomb.force_n=2.0"],
             )?,
-            (Method::Rk4, 1000),
-        ),
+            reference: (Method::Rk4, 1000),
+        },
     ])
 }
 

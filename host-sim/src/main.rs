@@ -377,8 +377,8 @@ fn accuracy(a: &AccuracyArgs) -> Result<(), String> {
     let scenes = host_sim::accuracy::scenes(Path::new("."))?;
     let b = bar(scenes.len() as u64, "accuracy study".into());
     let mut cells = Vec::new();
-    for (label, scene, reference) in &scenes {
-        cells.extend(host_sim::accuracy::study(label, scene, *reference)?);
+    for s in &scenes {
+        cells.extend(host_sim::accuracy::study(&s.label, &s.scene, s.reference)?);
         b.inc(1);
     }
     b.finish_and_clear();
