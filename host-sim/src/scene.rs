@@ -499,7 +499,9 @@ impl Scene {
         };
         pos("duration_s", self.duration_s)?;
         if let Some(t) = self.period_s {
-            pos("period_s", t)?;
+            if !(t.is_finite() && (1e-6..=0.1).contains(&t)) {
+                return Err(format!("period_s = {t} must be between 1e-6 and 0.1 s"));
+            }
         }
         pos("plant.rigid_mass_kg", self.plant.rigid_mass_kg)?;
         nonneg("plant.rigid_damping_nspm", self.plant.rigid_damping_nspm)?;

@@ -5,6 +5,7 @@
 //! - `thumb`: build `twoport-control` for thumbv7em-none-eabihf.
 //! - `firmware`: build the firmware workspace.
 //! - `qemu`: build and run the on-target tests in QEMU mps2-an386.
+//! - `fuzz [seconds]`: run each cargo-fuzz target (default 60 s each).
 //! - `accuracy`: regenerate docs/accuracy.md and docs/accuracy.png.
 
 mod toolchain;
@@ -21,6 +22,12 @@ fn main() -> ExitCode {
         Some("thumb") => thumb(),
         Some("firmware") => firmware().map(|_| ()),
         Some("qemu") => qemu(),
+        Some("fuzz") => {
+            let secs = args.get(1).map_or(Ok(60), |s| {
+                s.parse::<u32>().map_err(|e| format!("seconds: {e}"))
+            });
+            secs.and_then(fuzz)
+        }
         Some("accuracy") => run(
             "host-sim accuracy (docs/accuracy.md, docs/accuracy.png)",
             cargo().args([
@@ -35,7 +42,7 @@ fn main() -> ExitCode {
             ]),
         ),
         _ => Err(format!(
-            "usage: cargo xtask <ci|thumb|firmware|qemu|accuracy>\n  got: {}",
+            "usage: cargo xtask <ci|thumb|firmware|qemu|fuzz [seconds]|accuracy>\n  got: {}",
             args.join(" ")
         )),
     };
@@ -99,6 +106,17 @@ fn ci() -> Result<(), String> {
         ]),
     )?;
     run(
+        "cargo fmt --check (fuzz)",
+        cargo().args([
+            "fmt",
+            "--manifest-path",
+            "fuzz/Cargo.toml",
+            "--all",
+            "--",
+            "--check",
+        ]),
+    )?;
+    run(
         "cargo clippy",
         cargo().args([
             "clippy",
@@ -111,6 +129,7 @@ fn ci() -> Result<(), String> {
     )?;
     thumb()?;
     qemu()?;
+    fuzz(60)?;
     // Last, closing on the total so that CI reads the whole count rather
     // than the last crate's doc-test line. The long hard cases (24 h of
     // ticks, 2 x 10^4 random terminations) are ignored in debug builds and
@@ -201,6 +220,47 @@ fn firmware() -> Result<PathBuf, String> {
         &mut tc.build(&root().join("firmware"), &dir, &[]),
     )?;
     Ok(dir.join(TARGET).join("release"))
+}
+
+/// The cargo-fuzz targets in fuzz/.
+const FUZZ_TARGETS: [&str; 3] = ["link_decoder", "model_parser", "scene_parser"];
+
+/// Run each fuzz target for `secs` seconds on a scratch copy of its seed
+/// corpus. On a stable toolchain cargo-fuzz needs RUSTC_BOOTSTRAP=1 for its
+/// sanitizer flags.
+fn fuzz(secs: u32) -> Result<(), String> {
+    let has = Command::new(std::env::var("CARGO").unwrap_or("cargo".into()))
+        .args(["fuzz", "--version"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !has {
+        return Err("cargo-fuzz is not installed: cargo install cargo-fuzz --locked".into());
+    }
+    for t in FUZZ_TARGETS {
+        let work = cross_target_dir("fuzz-corpus").join(t);
+        std::fs::create_dir_all(&work).map_err(|e| format!("{}: {e}", work.display()))?;
+        let seeds = root().join("fuzz/corpus").join(t);
+        for f in std::fs::read_dir(&seeds)
+            .map_err(|e| format!("{}: {e}", seeds.display()))?
+            .flatten()
+        {
+            let _ = std::fs::copy(f.path(), work.join(f.file_name()));
+        }
+        run(
+            &format!("fuzz {t} for {secs} s"),
+            cargo()
+                .env("RUSTC_BOOTSTRAP", "1")
+                .args(["fuzz", "run", t])
+                .arg(&work)
+                .args([
+                    "--",
+                    &format!("-max_total_time={secs}"),
+                    "-max_len=4096",
+                    "-print_final_stats=1",
+                ]),
+        )?;
+    }
+    Ok(())
 }
 
 fn qemu() -> Result<(), String> {
