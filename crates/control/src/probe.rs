@@ -50,4 +50,26 @@ impl SineProbe {
     pub fn response(&self) -> Complex64 {
         self.output / self.input
     }
+
+    /// The whole measurement: drive `tick` with `cos(θk)` for `settle`
+    /// ticks unrecorded, then `window` ticks recorded (make it a whole number
+    /// of periods); `tick` returns the (input, output) it really had.
+    pub fn measure(
+        cos_theta: f64,
+        sin_theta: f64,
+        settle: u32,
+        window: u32,
+        mut tick: impl FnMut(f64) -> (f64, f64),
+    ) -> Complex64 {
+        let mut probe = SineProbe::new(cos_theta, sin_theta);
+        for k in 0..settle + window {
+            let (i, o) = tick(probe.excitation());
+            if k >= settle {
+                probe.record(i, o);
+            } else {
+                probe.skip();
+            }
+        }
+        probe.response()
+    }
 }

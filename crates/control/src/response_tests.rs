@@ -31,18 +31,9 @@ fn z_of(p: usize) -> Complex64 {
 
 /// Drive `tick` with `cos(θk)` for SETTLE + WINDOW ticks; it returns the
 /// (input, output) it really had; the response is their DFT-bin ratio.
-fn measure(p: usize, mut tick: impl FnMut(f64) -> (f64, f64)) -> Complex64 {
+fn measure(p: usize, tick: impl FnMut(f64) -> (f64, f64)) -> Complex64 {
     let z = z_of(p);
-    let mut probe = SineProbe::new(z.re, z.im);
-    for k in 0..SETTLE + WINDOW {
-        let (i, o) = tick(probe.excitation());
-        if k >= SETTLE {
-            probe.record(i, o);
-        } else {
-            probe.skip();
-        }
-    }
-    probe.response()
+    SineProbe::measure(z.re, z.im, SETTLE as u32, WINDOW as u32, tick)
 }
 
 fn assert_close(what: &str, p: usize, got: Complex64, want: Complex64) {

@@ -168,139 +168,17 @@ pub enum Solid {
     Below,
 }
 
-/// A one-sided spring-damper wall touched by a massless probe. Impedance
-/// causality: in contact the force needed to hold the probe at penetration
-/// `p` moving inward at `p'` is `k p + b p'`, never pulling (`>= 0`); out of
-/// contact it is zero. Penetration is summed from velocities like the
-/// coupling's spring (`p[k] = p[k-1] + T p'[k]`), so in contact the law is
-/// exactly `Z_e(z) = b + kT/(1 - z^-1)`.
-#[derive(Clone, Copy, Debug)]
-pub struct UnilateralWall {
-    k: f32,
-    b: f32,
-    kt: f32,
-    period_s: f32,
-    surface: Position,
-    solid: Solid,
-    probe: Integrator,
-}
-
-impl UnilateralWall {
-    /// A wall of stiffness `k_npm` (N/m) and damping `b_nspm` (N s/m) whose
-    /// surface is at `surface`, solid on the `solid` side; the probe starts
-    /// at rest at `probe`.
-    pub fn new(
-        k_npm: f32,
-        b_nspm: f32,
-        surface: Position,
-        solid: Solid,
-        period_s: f32,
-        probe: Position,
-    ) -> Result<Self, ParamError> {
-        let k = param::non_negative("wall stiffness (N/m)", k_npm)?;
-        let b = param::non_negative("wall damping (N s/m)", b_nspm)?;
-        let t = param::positive("T (s)", period_s)?;
-        Ok(UnilateralWall {
-            k,
-            b,
-            kt: k * t,
-            period_s: t,
-            surface,
-            solid,
-            probe: Integrator::new(t, probe),
-        })
-    }
-
-    /// Move the surface (the probe stays where it is).
-    pub fn set_surface(&mut self, surface: Position) {
-        self.surface = surface;
-    }
-
-    /// Change stiffness and damping.
-    pub fn set_gains(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
-        self.k = param::non_negative("wall stiffness (N/m)", k_npm)?;
-        self.b = param::non_negative("wall damping (N s/m)", b_nspm)?;
-        self.kt = self.k * self.period_s;
-        Ok(())
-    }
-
-    /// +1 when solid above, -1 when below.
-    fn sign(&self) -> f32 {
-        match self.solid {
-            Solid::Above => 1.0,
-            Solid::Below => -1.0,
-        }
-    }
-
-    /// Penetration (m, > 0 inside) and inward push (N, before clamping) of
-    /// the probe at velocity `v` this tick.
-    fn contact(&self, d_m: f32, v: f32) -> (f32, f32) {
-        let s = self.sign();
-        let pen = s * (d_m + self.period_s * v);
-        (pen, self.k * pen + self.b * s * v)
-    }
-
-    /// Whether the probe is in the wall.
-    pub fn in_contact(&self) -> bool {
-        let d = self.probe.position().minus_m(self.surface);
-        self.sign() * d > 0.0
-    }
-}
-
-impl VirtualEnvironment for UnilateralWall {
-    fn causality(&self) -> Causality {
-        Causality::Impedance
-    }
-
-    fn step(&mut self, port: Port) -> VeOutput {
-        let d = self.probe.position().minus_m(self.surface);
-        // The force needed is non-decreasing in v, so exactly one of three
-        // cases holds: free, pushed by the wall, or stopped at the surface
-        // (the damper's jump on first touch).
-        let free = port.at(port.f0_n / port.z_nspm);
-        let (pen, push) = self.contact(d, free.velocity_mps);
-        let out = if pen <= 0.0 || push <= 0.0 {
-            free
-        } else {
-            // f = k (x - surface) + (kT + b) v, the same for both sides.
-            let touched = port.solve_impedance(self.k * d, self.kt + self.b);
-            let (pen, push) = self.contact(d, touched.velocity_mps);
-            if pen > 0.0 && push >= 0.0 {
-                touched
-            } else {
-                port.at(-d / self.period_s)
-            }
-        };
-        if out.velocity_mps.is_finite() {
-            self.probe.step(out.velocity_mps);
-        }
-        out
-    }
-
-    fn reset(&mut self, x: Position) {
-        self.probe.reset(x);
-    }
-
-    fn position(&self) -> Position {
-        self.probe.position()
-    }
-
-    /// In contact: `F/V = b + kT/(1 - z^-1)`.
-    fn tf(&self) -> VeTransfer {
-        let (b, kt) = (self.b as f64, self.kt as f64);
-        VeTransfer::Impedance(ZTransfer::first_order([b + kt, -b], -1.0))
-    }
-}
-
 /// A spring-damper to a fixed anchor, pulling as well as pushing: the
-/// unilateral wall in permanent contact, and the simplest linear passive
-/// impedance VE. `f = k (x - anchor) + b v`, so
-/// `Z_e(z) = b + kT/(1 - z^-1)`.
+/// simplest linear passive impedance VE, and the law of a wall in contact.
+/// The probe's position is summed from velocities like the coupling's
+/// spring (`x[k] = x[k-1] + T v[k]`), so `f = k (x - anchor) + b v` is
+/// exactly `Z_e(z) = b + kT/(1 - z^-1)`.
 #[derive(Clone, Copy, Debug)]
 pub struct Spring {
     k: f32,
     b: f32,
     kt: f32,
+    period_s: f32,
     anchor: Position,
     probe: Integrator,
 }
@@ -315,16 +193,48 @@ impl Spring {
         period_s: f32,
         probe: Position,
     ) -> Result<Self, ParamError> {
-        let k = param::non_negative("spring stiffness (N/m)", k_npm)?;
-        let b = param::non_negative("spring damping (N s/m)", b_nspm)?;
         let t = param::positive("T (s)", period_s)?;
-        Ok(Spring {
-            k,
-            b,
-            kt: k * t,
+        let mut s = Spring {
+            k: 0.0,
+            b: 0.0,
+            kt: 0.0,
+            period_s: t,
             anchor,
             probe: Integrator::new(t, probe),
-        })
+        };
+        s.set_gains(k_npm, b_nspm)?;
+        Ok(s)
+    }
+
+    /// Change stiffness (N/m) and damping (N s/m).
+    pub fn set_gains(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
+        self.k = param::non_negative("stiffness (N/m)", k_npm)?;
+        self.b = param::non_negative("damping (N s/m)", b_nspm)?;
+        self.kt = self.k * self.period_s;
+        Ok(())
+    }
+
+    /// Move the anchor (the probe stays where it is).
+    pub fn set_anchor(&mut self, anchor: Position) {
+        self.anchor = anchor;
+    }
+
+    /// The probe's offset from the anchor now (m).
+    fn stretch_m(&self) -> f32 {
+        self.probe.position().minus_m(self.anchor)
+    }
+
+    /// This tick's law `f = g + h v` for the probe velocity `v`, given its
+    /// offset `d_m` from the anchor: `g = k d`, `h = kT + b`.
+    fn affine(&self, d_m: f32) -> (f32, f32) {
+        (self.k * d_m, self.kt + self.b)
+    }
+
+    /// Move the probe at `v` for this tick (ignored if not finite).
+    fn commit(&mut self, v_mps: f32) {
+        if v_mps.is_finite() {
+            self.probe.step(v_mps);
+        }
     }
 }
 
@@ -334,11 +244,9 @@ impl VirtualEnvironment for Spring {
     }
 
     fn step(&mut self, port: Port) -> VeOutput {
-        let d = self.probe.position().minus_m(self.anchor);
-        let out = port.solve_impedance(self.k * d, self.kt + self.b);
-        if out.velocity_mps.is_finite() {
-            self.probe.step(out.velocity_mps);
-        }
+        let (g, h) = self.affine(self.stretch_m());
+        let out = port.solve_impedance(g, h);
+        self.commit(out.velocity_mps);
         out
     }
 
@@ -355,6 +263,110 @@ impl VirtualEnvironment for Spring {
     fn tf(&self) -> VeTransfer {
         let (b, kt) = (self.b as f64, self.kt as f64);
         VeTransfer::Impedance(ZTransfer::first_order([b + kt, -b], -1.0))
+    }
+}
+
+/// A one-sided wall touched by a massless probe: a [`Spring`] anchored at
+/// the surface that only pushes. Impedance causality: in contact the force
+/// needed to hold the probe at penetration `p` moving inward at `p'` is
+/// `k p + b p'`, never pulling (`>= 0`); out of contact it is zero. In
+/// contact the law is exactly the spring's, `Z_e(z) = b + kT/(1 - z^-1)`.
+#[derive(Clone, Copy, Debug)]
+pub struct UnilateralWall {
+    spring: Spring,
+    solid: Solid,
+}
+
+impl UnilateralWall {
+    /// A wall of stiffness `k_npm` (N/m) and damping `b_nspm` (N s/m) whose
+    /// surface is at `surface`, solid on the `solid` side; the probe starts
+    /// at rest at `probe`.
+    pub fn new(
+        k_npm: f32,
+        b_nspm: f32,
+        surface: Position,
+        solid: Solid,
+        period_s: f32,
+        probe: Position,
+    ) -> Result<Self, ParamError> {
+        Ok(UnilateralWall {
+            spring: Spring::new(k_npm, b_nspm, surface, period_s, probe)?,
+            solid,
+        })
+    }
+
+    /// Move the surface (the probe stays where it is).
+    pub fn set_surface(&mut self, surface: Position) {
+        self.spring.set_anchor(surface);
+    }
+
+    /// Change stiffness and damping.
+    pub fn set_gains(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
+        self.spring.set_gains(k_npm, b_nspm)
+    }
+
+    /// +1 when solid above, -1 when below.
+    fn sign(&self) -> f32 {
+        match self.solid {
+            Solid::Above => 1.0,
+            Solid::Below => -1.0,
+        }
+    }
+
+    /// Penetration (m, > 0 inside) and inward push (N, before clamping) of
+    /// the probe at velocity `v` this tick.
+    fn contact(&self, d_m: f32, v: f32) -> (f32, f32) {
+        let s = self.sign();
+        let pen = s * (d_m + self.spring.period_s * v);
+        (pen, self.spring.k * pen + self.spring.b * s * v)
+    }
+
+    /// Whether the probe is in the wall.
+    pub fn in_contact(&self) -> bool {
+        self.sign() * self.spring.stretch_m() > 0.0
+    }
+}
+
+impl VirtualEnvironment for UnilateralWall {
+    fn causality(&self) -> Causality {
+        Causality::Impedance
+    }
+
+    fn step(&mut self, port: Port) -> VeOutput {
+        let d = self.spring.stretch_m();
+        // The force needed is non-decreasing in v, so exactly one of three
+        // cases holds: free, pushed by the wall, or stopped at the surface
+        // (the damper's jump on first touch).
+        let free = port.at(port.f0_n / port.z_nspm);
+        let (pen, push) = self.contact(d, free.velocity_mps);
+        let out = if pen <= 0.0 || push <= 0.0 {
+            free
+        } else {
+            // In contact the spring's own law, the same for both sides.
+            let (g, h) = self.spring.affine(d);
+            let touched = port.solve_impedance(g, h);
+            let (pen, push) = self.contact(d, touched.velocity_mps);
+            if pen > 0.0 && push >= 0.0 {
+                touched
+            } else {
+                port.at(-d / self.spring.period_s)
+            }
+        };
+        self.spring.commit(out.velocity_mps);
+        out
+    }
+
+    fn reset(&mut self, x: Position) {
+        self.spring.reset(x);
+    }
+
+    fn position(&self) -> Position {
+        self.spring.position()
+    }
+
+    /// In contact: the spring's `F/V = b + kT/(1 - z^-1)`.
+    fn tf(&self) -> VeTransfer {
+        self.spring.tf()
     }
 }
 

@@ -50,18 +50,9 @@ fn rel(got: Complex64, want: Complex64) -> f64 {
     libm::sqrt(d.norm_sqr() / want.norm_sqr())
 }
 
-fn measure(p: u32, mut tick: impl FnMut(f64) -> (f64, f64)) -> Complex64 {
+fn measure(p: u32, tick: impl FnMut(f64) -> (f64, f64)) -> Complex64 {
     let z = z_of(p);
-    let mut probe = SineProbe::new(z.re, z.im);
-    for k in 0..SETTLE + WINDOW {
-        let (i, o) = tick(probe.excitation());
-        if k >= SETTLE {
-            probe.record(i, o);
-        } else {
-            probe.skip();
-        }
-    }
-    probe.response()
+    SineProbe::measure(z.re, z.im, SETTLE, WINDOW, tick)
 }
 
 fn pm(x_m: f64) -> Position {
