@@ -200,13 +200,20 @@ fn thumb() -> Result<(), String> {
     let tc = Toolchain::detect()?;
     run(
         &format!(
-            "build twoport-control and twoport-link for {TARGET} ({})",
+            "build twoport-control, -link and -board for {TARGET} ({})",
             tc.describe()
         ),
         &mut tc.build(
             &root(),
             &cross_target_dir("thumbv7em-control"),
-            &["-p", "twoport-control", "-p", "twoport-link"],
+            &[
+                "-p",
+                "twoport-control",
+                "-p",
+                "twoport-link",
+                "-p",
+                "twoport-board",
+            ],
         ),
     )
 }

@@ -1,0 +1,326 @@
+//! The portable firmware loop driven over the wire, as a host drives it.
+
+use twoport_board::{Board, Bound, Law, Region};
+use twoport_control::servo::SensorFrame;
+use twoport_control::ve::BilateralConstraint;
+use twoport_control::{AdmittanceServo, Encoder, Faults, ImpedanceServo, Position, SafetyConfig};
+use twoport_link::{
+    encode, Decoder, Gains, GainsReply, Message, Refusal, Role, MAX_FRAME, PROTOCOL_VERSION,
+};
+
+fn region() -> Region<3> {
+    Region::new(
+        Bound::MaxStiffness,
+        [30.0, 60.0, 90.0],
+        [46_000.0, 51_400.0, 51_000.0],
+        None,
+    )
+    .unwrap()
+}
+
+fn safety() -> SafetyConfig {
+    SafetyConfig {
+        heartbeat_timeout_ticks: 50,
+        ..SafetyConfig::excalibur()
+    }
+}
+
+fn board() -> Board<BilateralConstraint, 3> {
+    let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    let s = ImpedanceServo::new(
+        51_000.0,
+        90.0,
+        enc,
+        safety(),
+        BilateralConstraint::new(Position::ZERO),
+    )
+    .unwrap();
+    Board::new(Law::Impedance(s), region(), 10)
+}
+
+fn send(b: &mut Board<BilateralConstraint, 3>, seq: u16, m: Message) {
+    let mut buf = [0u8; MAX_FRAME];
+    let n = encode(seq, &m, &mut buf).unwrap();
+    b.on_bytes(&buf[..n]);
+}
+
+fn replies(b: &mut Board<BilateralConstraint, 3>) -> Vec<Message> {
+    let mut d = Decoder::new();
+    let mut out = Vec::new();
+    while let Some(f) = b.pop_tx() {
+        d.feed(&f, |e| out.push(e.msg));
+    }
+    out
+}
+
+fn frame(tick: u32, raw: u32) -> SensorFrame {
+    SensorFrame {
+        tick,
+        encoder_raw: raw,
+        load_cell_n: 0.0,
+        dead_man_closed: true,
+    }
+}
+
+#[test]
+fn handshake_and_gain_queries() {
+    let mut b = board();
+    send(&mut b, 0, Message::hello(Role::Host));
+    send(&mut b, 1, Message::GetGains);
+    assert_eq!(
+        replies(&mut b),
+        vec![
+            Message::HelloAck {
+                version: PROTOCOL_VERSION,
+                accepted: true
+            },
+            Message::Gains(Gains::Impedance {
+                k_npm: 51_000.0,
+                b_nspm: 90.0
+            }),
+        ]
+    );
+}
+
+/// Only gains inside the proven region are accepted; everything else is
+/// refused with the reason, and the gains in force do not change.
+#[test]
+fn gains_outside_the_proven_region_are_refused() {
+    let mut b = board();
+    let cases = [
+        (
+            Gains::Impedance {
+                k_npm: 50_000.0,
+                b_nspm: 90.0,
+            },
+            None,
+        ),
+        (
+            Gains::Impedance {
+                k_npm: 51_001.0,
+                b_nspm: 90.0,
+            },
+            Some(Refusal::NotProvenStable { limit: 51_000.0 }),
+        ),
+        (
+            Gains::Impedance {
+                k_npm: 50_600.0,
+                b_nspm: 75.0,
+            },
+            Some(Refusal::NotProvenStable {
+                limit: 51_000.0 * 0.99,
+            }),
+        ),
+        (
+            Gains::Impedance {
+                k_npm: 1_000.0,
+                b_nspm: 10.0,
+            },
+            Some(Refusal::NotProvenStable { limit: 0.0 }),
+        ),
+        (
+            Gains::Impedance {
+                k_npm: f32::NAN,
+                b_nspm: 90.0,
+            },
+            Some(Refusal::NotFinite),
+        ),
+        (
+            Gains::Impedance {
+                k_npm: -1.0,
+                b_nspm: 90.0,
+            },
+            Some(Refusal::OutOfRange),
+        ),
+        (
+            Gains::Admittance {
+                kp_npm: 1.0,
+                bp_nspm: 1.0,
+                m_kg: 5.0,
+                b_nspm: 500.0,
+            },
+            Some(Refusal::WrongDisplay),
+        ),
+    ];
+    for (i, (g, refusal)) in cases.iter().enumerate() {
+        send(&mut b, i as u16, Message::SetGains(*g));
+        let r = replies(&mut b);
+        match refusal {
+            None => assert_eq!(r, vec![Message::GainsReply(GainsReply::Accepted(*g))]),
+            Some(why) => assert_eq!(
+                r,
+                vec![Message::GainsReply(GainsReply::Refused(*why))],
+                "{g:?}"
+            ),
+        }
+    }
+    // The one accepted change is in force; the refusals changed nothing.
+    send(&mut b, 99, Message::GetGains);
+    assert_eq!(
+        replies(&mut b),
+        vec![Message::Gains(Gains::Impedance {
+            k_npm: 50_000.0,
+            b_nspm: 90.0
+        })]
+    );
+}
+
+/// With heartbeats the loop runs; when they stop, force is zero within the
+/// watchdog's 50 ticks, a fault report goes out, and it stays latched until
+/// the host clears it.
+#[test]
+fn link_loss_gives_zero_force_within_the_watchdog_deadline() {
+    let mut b = board();
+    send(&mut b, 0, Message::Enable);
+    let mut seq = 1;
+    for k in 0..500u32 {
+        if k % 10 == 0 {
+            send(&mut b, seq, Message::Heartbeat);
+            seq += 1;
+        }
+        let out = b.tick(&frame(k, 100));
+        assert!(out.faults.is_empty(), "tick {k}: {}", out.faults);
+    }
+    assert!(
+        b.tick(&frame(500, 100)).actuator_force_n.abs() > 1.0,
+        "the coupling pulls"
+    );
+    let mut zero_at = None;
+    for k in 501..600u32 {
+        let out = b.tick(&frame(k, 100));
+        if out.actuator_force_n == 0.0 && zero_at.is_none() {
+            zero_at = Some(k);
+            assert!(out.faults.contains(Faults::HEARTBEAT_LOST));
+        }
+    }
+    let zero_at = zero_at.expect("zero force after link loss");
+    assert!(
+        zero_at - 491 <= 51,
+        "zero at tick {zero_at}, last heartbeat at 490"
+    );
+    assert!(replies(&mut b).iter().any(|m| matches!(m, Message::FaultReport { faults, .. } if faults & Faults::HEARTBEAT_LOST.0 != 0)));
+    send(&mut b, seq, Message::ClearFaults);
+    send(&mut b, seq + 1, Message::Heartbeat);
+    assert!(b.tick(&frame(600, 100)).faults.is_empty());
+}
+
+/// Garbage and corrupted frames between good ones: the loop keeps ticking,
+/// the good commands still act, the bad ones are counted.
+#[test]
+fn corrupted_frames_do_not_stop_the_loop() {
+    let mut b = board();
+    let mut good = [0u8; MAX_FRAME];
+    let n = encode(
+        7,
+        &Message::SetGains(Gains::Impedance {
+            k_npm: 40_000.0,
+            b_nspm: 60.0,
+        }),
+        &mut good,
+    )
+    .unwrap();
+    let mut bad = good;
+    bad[3] ^= 0x40;
+    for k in 0..1000u32 {
+        match k % 100 {
+            10 => b.on_bytes(&[0xde, 0xad, 0xbe, 0xef, 0x00, 0x13]),
+            20 => b.on_bytes(&bad[..n]),
+            _ => {}
+        }
+        if k == 555 {
+            b.on_bytes(&good[..n]);
+        }
+        b.tick(&frame(k, k % 300));
+    }
+    let s = b.link_stats();
+    assert!(s.dropped() >= 20, "{s:?}");
+    assert_eq!(s.frames, 1);
+    let msgs = replies(&mut b);
+    assert!(msgs.contains(&Message::GainsReply(GainsReply::Accepted(
+        Gains::Impedance {
+            k_npm: 40_000.0,
+            b_nspm: 60.0
+        }
+    ))));
+}
+
+/// A host that never reads cannot grow the board's memory: telemetry keeps
+/// the newest frames and counts the dropped ones, and an answer queued
+/// behind the flood is still delivered first.
+#[test]
+fn the_outgoing_queue_is_bounded() {
+    let mut b = board();
+    for k in 0..10_000u32 {
+        b.tick(&frame(k, 0));
+        if k == 5_000 {
+            send(&mut b, 0, Message::GetGains);
+        }
+    }
+    assert!(b.tx_dropped() > 900);
+    let msgs = replies(&mut b);
+    assert_eq!(msgs.len(), 1 + twoport_board::TX_FRAMES);
+    assert!(
+        matches!(msgs[0], Message::Gains(_)),
+        "the answer first: {:?}",
+        msgs[0]
+    );
+    assert!(matches!(msgs.last(), Some(Message::Telemetry(t)) if t.tick == 9_999));
+}
+
+#[test]
+fn admittance_gains_need_the_proven_regulator() {
+    let region = Region::new(
+        Bound::MinMass,
+        [300.0, 500.0],
+        [5.5, 5.0],
+        Some((51_000.0, 90.0)),
+    )
+    .unwrap();
+    let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    let s = AdmittanceServo::new(
+        (51_000.0, 90.0),
+        (5.0, 500.0),
+        enc,
+        safety(),
+        BilateralConstraint::new(Position::ZERO),
+    )
+    .unwrap();
+    let mut b = Board::new(Law::Admittance(s), region, 0);
+    let ok = Gains::Admittance {
+        kp_npm: 51_000.0,
+        bp_nspm: 90.0,
+        m_kg: 5.2,
+        b_nspm: 500.0,
+    };
+    let stiffer = Gains::Admittance {
+        kp_npm: 60_000.0,
+        bp_nspm: 90.0,
+        m_kg: 5.2,
+        b_nspm: 500.0,
+    };
+    let lighter = Gains::Admittance {
+        kp_npm: 51_000.0,
+        bp_nspm: 90.0,
+        m_kg: 4.9,
+        b_nspm: 500.0,
+    };
+    for (g, want) in [
+        (ok, GainsReply::Accepted(ok)),
+        (
+            stiffer,
+            GainsReply::Refused(Refusal::NotProvenStable { limit: 51_000.0 }),
+        ),
+        (
+            lighter,
+            GainsReply::Refused(Refusal::NotProvenStable { limit: 5.0 }),
+        ),
+    ] {
+        let mut buf = [0u8; MAX_FRAME];
+        let n = encode(0, &Message::SetGains(g), &mut buf).unwrap();
+        b.on_bytes(&buf[..n]);
+        let f = b.pop_tx().unwrap();
+        let mut got = None;
+        Decoder::new().feed(&f, |e| got = Some(e.msg));
+        assert_eq!(got, Some(Message::GainsReply(want)));
+    }
+}
