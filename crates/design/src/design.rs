@@ -434,3 +434,40 @@ pub fn impedance_range_admittance(
             .collect(),
     )
 }
+
+/// The proven region for a board: for each damping on a log grid from
+/// `b_lo` to `b_hi` (N s/m, `points` of them), the greatest coupling
+/// stiffness (impedance display). Dampings where nothing is stable are left
+/// out.
+pub fn region_impedance(
+    a: &Analysis,
+    bound: &[f64],
+    (b_lo, b_hi): (f64, f64),
+    points: usize,
+) -> Vec<(f64, f64)> {
+    log_grid(b_lo, b_hi, points)
+        .into_iter()
+        .filter_map(|b| max_stiffness(a, bound, b).map(|k| (b, k)))
+        .collect()
+}
+
+/// The proven region for a board's admittance display (one regulator):
+/// the least coupling mass for each damping on a log grid.
+pub fn region_admittance(
+    a: &Analysis,
+    bound: &[f64],
+    (b_lo, b_hi): (f64, f64),
+    points: usize,
+) -> Vec<(f64, f64)> {
+    log_grid(b_lo, b_hi, points)
+        .into_iter()
+        .filter_map(|b| min_mass(a, bound, b).map(|m| (b, m)))
+        .collect()
+}
+
+fn log_grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {
+    let n = n.max(2);
+    (0..n)
+        .map(|i| lo * (hi / lo).powf(i as f64 / (n - 1) as f64))
+        .collect()
+}

@@ -51,6 +51,44 @@ enum Cmd {
     Zrange(Display<ZrangeImpedance, ZrangeAdmittance>),
     /// Draw one of the paper's figures from this designer's results.
     Plot(PlotArgs),
+    /// The proven region a board ships with: the limit for each damping.
+    #[command(subcommand)]
+    Region(Display<RegionImpedance, RegionAdmittance>),
+}
+
+#[derive(Args)]
+struct RegionGrid {
+    /// Smallest coupling damping (N s/m).
+    #[arg(long, default_value_t = 10.0)]
+    b_from: f64,
+    /// Largest coupling damping (N s/m).
+    #[arg(long, default_value_t = 1000.0)]
+    b_to: f64,
+    /// Grid points (log-spaced).
+    #[arg(long, default_value_t = 32)]
+    points: usize,
+}
+
+#[derive(Args)]
+struct RegionImpedance {
+    #[command(flatten)]
+    grid: RegionGrid,
+    #[command(flatten)]
+    common: Common,
+}
+
+#[derive(Args)]
+struct RegionAdmittance {
+    /// Regulator stiffness k_p (N/m) the region is proven for.
+    #[arg(long, allow_negative_numbers = true)]
+    kp: f64,
+    /// Regulator damping b_p (N s/m).
+    #[arg(long, allow_negative_numbers = true)]
+    bp: f64,
+    #[command(flatten)]
+    grid: RegionGrid,
+    #[command(flatten)]
+    common: Common,
 }
 
 #[derive(Subcommand)]
@@ -462,6 +500,48 @@ fn plot_fig(p: &PlotArgs) -> Result<(), String> {
     Ok(())
 }
 
+fn region(d: &Display<RegionImpedance, RegionAdmittance>) -> Result<(), String> {
+    let (grid, common) = match d {
+        Display::Impedance(r) => (&r.grid, &r.common),
+        Display::Admittance(r) => (&r.grid, &r.common),
+    };
+    let (lo, hi) = (gain("b-from", grid.b_from)?, gain("b-to", grid.b_to)?);
+    if !(lo > 0.0 && hi > lo && (2..=1000).contains(&grid.points)) {
+        return Err("need 0 < --b-from < --b-to and 2..=1000 --points".into());
+    }
+    let s = Session::open(common)?;
+    let (bound, rows, regulator) = match d {
+        Display::Impedance(_) => {
+            let b = s.analysis.impedance_bound(s.human);
+            (
+                "max_stiffness_npm",
+                design::region_impedance(&s.analysis, &b, (lo, hi), grid.points),
+                None,
+            )
+        }
+        Display::Admittance(r) => {
+            let (kp, bp) = (gain("kp", r.kp)?, gain("bp", r.bp)?);
+            let k = design::regulator_tf(kp, bp, s.period()).map_err(|e| e.to_string())?;
+            let b = s.analysis.admittance_bound(&k, s.human);
+            (
+                "min_mass_kg",
+                design::region_admittance(&s.analysis, &b, (lo, hi), grid.points),
+                Some((kp, bp)),
+            )
+        }
+    };
+    let v = json!({"bound": bound, "damping_nspm": rows.iter().map(|r| r.0).collect::<Vec<_>>(),
+        "limit": rows.iter().map(|r| r.1).collect::<Vec<_>>(), "regulator": regulator,
+        "period_s": s.period(), "human_model": s.human.is_some()});
+    s.emit(v, || {
+        println!("{:>14} {:>16}", "b (N s/m)", bound);
+        for (b, l) in &rows {
+            println!("{b:>14.3} {l:>16.4}");
+        }
+    });
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let r = match &cli.cmd {
@@ -470,6 +550,7 @@ fn main() -> ExitCode {
         Cmd::Check(d) => check(d),
         Cmd::Zrange(d) => zrange(d),
         Cmd::Plot(p) => plot_fig(p),
+        Cmd::Region(d) => region(d),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,

@@ -219,3 +219,49 @@ fn every_subcommand_has_help() {
         );
     }
 }
+
+#[test]
+fn region_tables_for_a_board() {
+    let v = json(&[
+        "region",
+        "impedance",
+        "--b-from",
+        "20",
+        "--b-to",
+        "120",
+        "--points",
+        "6",
+        "--json",
+    ]);
+    assert_eq!(v["bound"], "max_stiffness_npm");
+    let (b, k) = (
+        v["damping_nspm"].as_array().unwrap(),
+        v["limit"].as_array().unwrap(),
+    );
+    assert_eq!((b.len(), k.len()), (6, 6));
+    assert!(k.iter().all(|x| x.as_f64().unwrap() > 1e4));
+    let v = json(&[
+        "region",
+        "admittance",
+        "--kp",
+        "51000",
+        "--bp",
+        "90",
+        "--b-from",
+        "400",
+        "--b-to",
+        "1000",
+        "--points",
+        "4",
+        "--json",
+    ]);
+    assert_eq!(v["bound"], "min_mass_kg");
+    assert_eq!(v["regulator"], serde_json::json!([51000.0, 90.0]));
+    let m: Vec<f64> = v["limit"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert!(m.iter().all(|x| (4.0..6.0).contains(x)), "{m:?}");
+}
