@@ -442,13 +442,10 @@ pub fn impedance_range_admittance(
 pub fn region_impedance(
     a: &Analysis,
     bound: &[f64],
-    (b_lo, b_hi): (f64, f64),
+    range: (f64, f64),
     points: usize,
 ) -> Vec<(f64, f64)> {
-    log_grid(b_lo, b_hi, points)
-        .into_iter()
-        .filter_map(|b| max_stiffness(a, bound, b).map(|k| (b, k)))
-        .collect()
+    region(range, points, |b| max_stiffness(a, bound, b))
 }
 
 /// The proven region for a board's admittance display (one regulator):
@@ -456,12 +453,20 @@ pub fn region_impedance(
 pub fn region_admittance(
     a: &Analysis,
     bound: &[f64],
-    (b_lo, b_hi): (f64, f64),
+    range: (f64, f64),
     points: usize,
 ) -> Vec<(f64, f64)> {
-    log_grid(b_lo, b_hi, points)
+    region(range, points, |b| min_mass(a, bound, b))
+}
+
+fn region(
+    (lo, hi): (f64, f64),
+    points: usize,
+    limit: impl Fn(f64) -> Option<f64>,
+) -> Vec<(f64, f64)> {
+    log_grid(lo, hi, points)
         .into_iter()
-        .filter_map(|b| min_mass(a, bound, b).map(|m| (b, m)))
+        .filter_map(|b| limit(b).map(|l| (b, l)))
         .collect()
 }
 
