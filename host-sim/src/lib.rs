@@ -13,6 +13,7 @@ pub mod human;
 pub mod plant;
 pub mod plot;
 pub mod scene;
+pub mod scope;
 pub mod sim;
 pub mod stability;
 pub mod ve;
