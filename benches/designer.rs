@@ -14,16 +14,9 @@ fn excalibur() -> Plant {
     Plant::new(&m, 1e-3).unwrap()
 }
 
-fn log_grid(n: usize, nyq: f64) -> Vec<f64> {
-    let lo = 2.0 * PI * 0.1;
-    (0..n)
-        .map(|i| lo * (nyq / lo).powf(i as f64 / (n - 1) as f64))
-        .collect()
-}
-
 fn responses(c: &mut Criterion) {
     let plant = excalibur();
-    let w = log_grid(10_000, plant.nyquist());
+    let w = log_grid(2.0 * PI * 0.1, plant.nyquist(), 10_000);
     let mut scratch = plant.scratch();
     c.bench_function("Y(s) and F(s), modal form, 10,000 points", |b| {
         b.iter(|| {

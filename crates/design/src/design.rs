@@ -51,10 +51,7 @@ impl GridSpec {
 pub fn grid(plant: &Plant, spec: GridSpec) -> Vec<f64> {
     let nyq = plant.nyquist();
     let lo = (2.0 * PI * spec.f_min_hz).min(nyq / 10.0);
-    let n = spec.base_points.max(2);
-    let mut w: Vec<f64> = (0..n)
-        .map(|i| lo * (nyq / lo).powf(i as f64 / (n - 1) as f64))
-        .collect();
+    let mut w = log_grid(lo, nyq, spec.base_points);
     let mut centres: Vec<(f64, f64)> = plant
         .modes()
         .iter()
@@ -470,7 +467,8 @@ fn region(
         .collect()
 }
 
-fn log_grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {
+/// `n` (at least 2) log-spaced values from `lo` to `hi`, both included.
+pub fn log_grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {
     let n = n.max(2);
     (0..n)
         .map(|i| lo * (hi / lo).powf(i as f64 / (n - 1) as f64))

@@ -432,9 +432,7 @@ fn zrange(d: &Display<ZrangeImpedance, ZrangeAdmittance>) -> Result<(), String> 
     let s = Session::open(common)?;
     let nyq = s.plant.nyquist();
     let lo = 2.0 * PI * 0.1;
-    let omegas: Vec<f64> = (0..points)
-        .map(|i| lo * (nyq / lo).powf(i as f64 / (points - 1) as f64))
-        .collect();
+    let omegas = design::log_grid(lo, nyq, points);
     let a = Analysis::on(&s.plant, &omegas);
     let range = match d {
         Display::Impedance(z) => {

@@ -345,9 +345,7 @@ impl Plant {
     fn keep_modal_if_exact(&mut self) {
         let Some(modal) = &self.modal else { return };
         let nyq = self.nyquist();
-        let mut checks: Vec<f64> = (0..40)
-            .map(|i| 0.1 * (nyq / 0.1f64).powf(i as f64 / 39.0))
-            .collect();
+        let mut checks = crate::design::log_grid(0.1, nyq, 40);
         checks.extend(self.modes.iter().map(|m| m.omega_n).filter(|w| *w < nyq));
         let mut work = self.scratch();
         let exact = checks.iter().all(|&w| {
