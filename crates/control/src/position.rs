@@ -54,7 +54,7 @@ impl Position {
     /// `self - other` in metres, computed exactly in integers first, so a
     /// small difference of two large positions keeps full f32 precision.
     pub fn minus_m(self, other: Position) -> f32 {
-        self.0.saturating_sub(other.0) as f32 * M_PER_PM
+        pm_to_f32(self.0.saturating_sub(other.0)) * M_PER_PM
     }
 
     /// This position moved by `delta_pm` picometres, saturating at the ends
@@ -76,6 +76,28 @@ impl Add<i64> for Position {
     type Output = Position;
     fn add(self, rhs_pm: i64) -> Position {
         self.offset_pm(rhs_pm)
+    }
+}
+
+/// `pm as f32`, exactly. Differences within ±2.1 mm fit an `i32`, which a
+/// 32-bit FPU converts in one instruction; an `i64` conversion is a library
+/// call of dozens. Both round the same integer to the same `f32`.
+#[inline]
+pub(crate) fn pm_to_f32(pm: i64) -> f32 {
+    match i32::try_from(pm) {
+        Ok(small) => small as f32,
+        Err(_) => pm as f32,
+    }
+}
+
+/// `x as i64` (toward zero, saturating) for a finite `x`, through `i32`
+/// when it fits, for the same reason as [`pm_to_f32`].
+#[inline]
+fn f32_to_pm(x: f32) -> i64 {
+    if x.abs() < 2.0e9 {
+        x as i32 as i64
+    } else {
+        x as i64
     }
 }
 
@@ -135,8 +157,8 @@ impl Integrator {
         if !d.is_finite() || d.abs() >= 9.2e18 {
             return self.position;
         }
-        let whole = d as i64; // toward zero, exact for |d| < 2^63
-        self.remainder_pm = d - whole as f32;
+        let whole = f32_to_pm(d); // toward zero
+        self.remainder_pm = d - pm_to_f32(whole);
         self.position = self.position.offset_pm(whole);
         self.position
     }

@@ -58,7 +58,11 @@ impl PositionRegulator {
         let de = e.saturating_sub(self.prev_error_pm);
         self.prev_error_pm = e;
         const M_PER_PM: f32 = 1.0e-12;
-        self.kp * (e as f32 * M_PER_PM) + self.bp_over_t * (de as f32 * M_PER_PM)
+        let (e, de) = (
+            crate::position::pm_to_f32(e),
+            crate::position::pm_to_f32(de),
+        );
+        self.kp * (e * M_PER_PM) + self.bp_over_t * (de * M_PER_PM)
     }
 
     /// `K_p(z) = (k_p + b_p/T) - (b_p/T) z^-1`: force (N) per error (m).

@@ -139,6 +139,55 @@ fn servo_wall_and_fault(t: &mut Tally) {
     );
 }
 
+/// The servo tick's cost in QEMU: SysTick counts the 25 MHz system clock, and
+/// with `-icount shift=6` each instruction takes 64 ns of virtual time, so
+/// one instruction is 1.6 counts (deterministic, unlike wall time).
+fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
+    use cortex_m::peripheral::{syst::SystClkSource, SYST};
+    let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    let wall = UnilateralWall::new(
+        1e5,
+        50.0,
+        Position::from_pm(500_000_000),
+        Solid::Above,
+        T,
+        Position::ZERO,
+    )
+    .unwrap();
+    let mut s = ImpedanceServo::new(51_000.0, 90.0, enc, SafetyConfig::excalibur(), wall).unwrap();
+    let _ = s.enable();
+    syst.set_clock_source(SystClkSource::Core);
+    syst.set_reload(0x00FF_FFFF);
+    syst.clear_current();
+    syst.enable_counter();
+    let ticks = 1000u32;
+    let mut sink = 0.0f32;
+    // The loop with an empty body first, to subtract its own cost.
+    let empty_start = SYST::get_current();
+    for k in 0..ticks {
+        sink += core::hint::black_box(k as f32);
+    }
+    let empty = empty_start.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF;
+    let start = SYST::get_current();
+    for k in 0..ticks {
+        let f = frame(k, core::hint::black_box(k % 1000 * 2), 0.0);
+        sink += s.tick(&f).actuator_force_n;
+    }
+    let counts = start.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF;
+    core::hint::black_box(sink);
+    let per_tick = counts.saturating_sub(empty) as f32 / ticks as f32;
+    hprintln!(
+        "  empty loop: {} instructions per iteration",
+        empty as f32 / ticks as f32 / 1.6
+    );
+    hprintln!(
+        "  impedance servo tick (encoder, estimator, Z_cI, wall, safety): {} SysTick counts = {} instructions",
+        per_tick,
+        per_tick / 1.6
+    );
+    t.check("servo tick measured", per_tick > 0.0);
+}
+
 #[entry]
 fn main() -> ! {
     let mut t = Tally {
@@ -148,6 +197,9 @@ fn main() -> ! {
     impedance_coupling(&mut t);
     admittance_coupling_with_cursor(&mut t);
     servo_wall_and_fault(&mut t);
+    if let Some(mut p) = cortex_m::Peripherals::take() {
+        tick_cost(&mut t, &mut p.SYST);
+    }
     hprintln!("{} passed, {} failed", t.passed, t.failed);
     debug::exit(if t.failed == 0 {
         debug::EXIT_SUCCESS
