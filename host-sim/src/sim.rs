@@ -614,17 +614,15 @@ impl Simulation {
             for _ in 0..self.substeps {
                 stepper.step(&mut self.x, u, Some(&mut nl));
             }
-            let ns = t0.map_or(0.0, |t| {
-                (t.elapsed().as_nanos() as f64 - self.clock_ns).max(0.0) * TIMING_STRIDE as f64
-            });
-            let names: Vec<String> = ["coulomb", "cogging", "cable_slack"]
-                .iter()
-                .filter(|n| self.costs.iter().any(|c| c.0 == **n))
-                .map(|n| n.to_string())
-                .collect();
-            for name in &names {
-                if let Some(c) = self.costs.iter_mut().find(|c| &c.0 == name) {
-                    c.1 += ns / names.len() as f64;
+            // On a timed tick, the sub-stepping's cost is shared among the
+            // nonlinear effects that ran (they are evaluated together).
+            if let Some(t) = t0 {
+                let ns =
+                    (t.elapsed().as_nanos() as f64 - self.clock_ns).max(0.0) * TIMING_STRIDE as f64;
+                let is_nl = |n: &str| matches!(n, "coulomb" | "cogging" | "cable_slack");
+                let count = self.costs.iter().filter(|c| is_nl(&c.0)).count().max(1);
+                for c in self.costs.iter_mut().filter(|c| is_nl(&c.0)) {
+                    c.1 += ns / count as f64;
                 }
             }
         } else {
