@@ -10,6 +10,7 @@
 pub mod accuracy;
 pub mod blocks;
 pub mod human;
+pub mod pil;
 pub mod plant;
 pub mod plot;
 pub mod scene;

@@ -28,6 +28,39 @@ enum Cmd {
     Table1(Table1Args),
     /// Measure what accuracy costs: every integrator x sub-step count.
     Accuracy(AccuracyArgs),
+    /// Processor-in-the-loop: this plant against a board over a serial port
+    /// (the firmware in QEMU, or a real board), compared with the same
+    /// board loop run in-process.
+    Pil(PilArgs),
+}
+
+#[derive(Args)]
+struct PilArgs {
+    /// The board's serial port (QEMU prints its pty at start). Without it,
+    /// only the in-process board loop runs.
+    #[arg(long)]
+    port: Option<String>,
+    /// The scene: plant, hand and effects; the board brings its own law.
+    #[arg(default_value = "scenes/stiff_wall.toml")]
+    scene: PathBuf,
+    /// Simulated time (s).
+    #[arg(long, default_value_t = 10.0)]
+    seconds: f64,
+    /// Every this many ticks, inject a corrupted frame and garbage (0: never).
+    #[arg(long, default_value_t = 100)]
+    corrupt_every: u64,
+    /// Stop sending heartbeats at this time (s) and check the board goes to
+    /// zero force within its watchdog deadline.
+    #[arg(long)]
+    link_loss_at_s: Option<f64>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Fail unless the board matched the in-process loop bit for bit,
+    /// dropped every corrupted frame and, after a link loss, held zero force
+    /// within its watchdog deadline.
+    #[arg(long)]
+    check: bool,
 }
 
 #[derive(Args)]
@@ -407,6 +440,116 @@ fn accuracy(a: &AccuracyArgs) -> Result<(), String> {
     Ok(())
 }
 
+fn pil(a: &PilArgs) -> Result<(), String> {
+    use host_sim::pil;
+    if !(a.seconds.is_finite() && a.seconds > 0.0 && a.seconds <= 3600.0) {
+        return Err(format!("--seconds {}: must be in (0, 3600]", a.seconds));
+    }
+    let scene = load(&a.scene, &[])?;
+    let period = scene.period_s.unwrap_or(1e-3);
+    let ticks = (a.seconds / period).round() as u64;
+    let link_loss_at = match a.link_loss_at_s {
+        Some(t) if t.is_finite() && t >= 0.0 && t < a.seconds => Some((t / period).round() as u64),
+        Some(t) => return Err(format!("--link-loss-at-s {t}: must be in [0, --seconds)")),
+        None => None,
+    };
+    let faults = pil::Faults {
+        corrupt_every: a.corrupt_every,
+        link_loss_at,
+    };
+    let start = std::time::Instant::now();
+    let reference = pil::run(
+        scene.clone(),
+        ticks,
+        &mut pil::LocalBoard::excalibur()?,
+        faults,
+    )?;
+    let local_s = start.elapsed().as_secs_f64();
+    let (run, remote_s) = match &a.port {
+        Some(p) => {
+            let mut port = pil::SerialBoard::open(p)?;
+            let start = std::time::Instant::now();
+            let r = pil::run(scene, ticks, &mut port, faults)?;
+            (r, start.elapsed().as_secs_f64())
+        }
+        None => (reference.clone(), local_s),
+    };
+    let c = pil::compare(&run, &reference);
+    let frames_dropped = run.board_stats.rx.dropped() + run.host_dropped;
+    let loop_cycles = run.telemetry.last().map(|t| t.loop_cycles);
+    let v = json!({
+        "ticks": c.ticks,
+        "max_position_error_m": c.max_position_error_m,
+        "max_force_error_n": c.max_force_error_n,
+        "duty_mismatches": c.duty_mismatches,
+        "frames_dropped": frames_dropped,
+        "corrupted_sent": run.corrupted_sent,
+        "board_frames_received": run.board_stats.rx.frames,
+        "zero_force_after_link_loss_ticks": run.zero_after_loss_ticks,
+        "watchdog_deadline_ticks": twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS,
+        "telemetry_frames": run.telemetry.len(),
+        "peak_force_n": run.samples.iter().map(|s| s.actuator_n.abs()).fold(0.0, f64::max),
+        "last_loop_cycles": loop_cycles,
+        "board": if a.port.is_some() { "serial" } else { "in-process" },
+        "wall_s": remote_s,
+    });
+    if a.json {
+        println!("{v}");
+    } else {
+        println!(
+            "PIL ({}): {} ticks in {remote_s:.2} s; position error {:.3e} m, force error {:.3e} N, \
+             {} duty mismatches; {} corrupted frames sent, {frames_dropped} dropped",
+            v["board"], c.ticks, c.max_position_error_m, c.max_force_error_n, c.duty_mismatches,
+            run.corrupted_sent
+        );
+        if let Some(z) = run.zero_after_loss_ticks {
+            println!(
+                "  link loss: zero force after {z} ticks (watchdog deadline {})",
+                twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS
+            );
+        }
+    }
+    if a.check {
+        let mut bad = Vec::new();
+        if c.duty_mismatches > 0 || c.max_position_error_m > 0.0 || c.max_force_error_n > 0.0 {
+            bad.push(format!(
+                "the board differs from the in-process loop ({} duties, {:.3e} m, {:.3e} N)",
+                c.duty_mismatches, c.max_position_error_m, c.max_force_error_n
+            ));
+        }
+        if c.ticks != ticks {
+            bad.push(format!("{} of {ticks} ticks ran", c.ticks));
+        }
+        if u64::from(run.board_stats.rx.dropped()) < run.corrupted_sent {
+            bad.push(format!(
+                "{} corrupted frames sent, the board dropped {}",
+                run.corrupted_sent,
+                run.board_stats.rx.dropped()
+            ));
+        }
+        let deadline = u64::from(twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS);
+        if let (Some(t0), Some(z)) = (link_loss_at, run.zero_after_loss_ticks) {
+            let pushing = run.duties[..t0 as usize]
+                .iter()
+                .rev()
+                .take(10)
+                .any(|d| *d != 0);
+            if !pushing {
+                bad.push("no force before the link loss: the check would prove nothing".into());
+            }
+            if z > deadline {
+                bad.push(format!(
+                    "zero force {z} ticks after the link loss (deadline {deadline})"
+                ));
+            }
+        }
+        if !bad.is_empty() {
+            return Err(format!("PIL check failed: {}", bad.join("; ")));
+        }
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let r = match &cli.cmd {
@@ -414,6 +557,7 @@ fn main() -> ExitCode {
         Cmd::Sweep(a) => sweep(a),
         Cmd::Table1(a) => table1(a),
         Cmd::Accuracy(a) => accuracy(a),
+        Cmd::Pil(a) => pil(a),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,

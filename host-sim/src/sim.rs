@@ -454,7 +454,7 @@ impl Simulation {
     /// Effects are timed on one tick in [`TIMING_STRIDE`] and the time is
     /// scaled up: a clock read costs more than most effects do.
     fn timing(&self) -> bool {
-        self.tick % TIMING_STRIDE == 0
+        self.tick.is_multiple_of(TIMING_STRIDE)
     }
 
     fn cost(&mut self, name: &str, since: Option<Instant>) {
@@ -538,8 +538,27 @@ impl Simulation {
         }
     }
 
-    /// Advance one control tick.
+    /// Advance one control tick with the scene's own servo.
     pub fn step(&mut self) -> Sample {
+        self.step_inner(None)
+    }
+
+    /// Advance one control tick with the controller outside this process
+    /// (a board over a serial link, or the board loop in-process): it gets
+    /// the tick's sensor frame and answers with the force to hold. Only its
+    /// `actuator_force_n` drives the plant; the VE position shown is its
+    /// `reference`.
+    pub fn step_external(
+        &mut self,
+        controller: &mut dyn FnMut(&SensorFrame) -> ServoOutput,
+    ) -> Sample {
+        self.step_inner(Some(controller))
+    }
+
+    fn step_inner(
+        &mut self,
+        external: Option<&mut dyn FnMut(&SensorFrame) -> ServoOutput>,
+    ) -> Sample {
         let t = self.tick as f64 * self.period;
         let n = self.device.n;
         let hand = self.human.at(t);
@@ -556,7 +575,11 @@ impl Simulation {
             frame.tick = self.tick as u32;
             self.cost("delay", t0);
         }
-        let out = self.servo.tick(&frame);
+        let is_external = external.is_some();
+        let out = match external {
+            Some(c) => c(&frame),
+            None => self.servo.tick(&frame),
+        };
         let mut f_a = out.actuator_force_n as f64;
         if let Some(s) = self.scene.effects.saturation {
             let t0 = timing.then(Instant::now);
@@ -666,7 +689,11 @@ impl Simulation {
             human_n: f_h,
             commanded_n: out.commanded_force_n as f64,
             actuator_n: f_a,
-            ve_m: self.servo.ve().position().m() as f64,
+            ve_m: if is_external {
+                out.reference.m() as f64
+            } else {
+                self.servo.ve().position().m() as f64
+            },
             ve_n: out.ve_force_n as f64,
             coupling_n: out.coupling_force_n as f64,
             energy_in_j: self.energy_in,

@@ -5,6 +5,9 @@
 //! - `thumb`: build `twoport-control` for thumbv7em-none-eabihf.
 //! - `firmware`: build the firmware workspace.
 //! - `qemu`: build and run the on-target tests in QEMU mps2-an386.
+//! - `pil [host-sim pil options]`: processor-in-the-loop, the firmware in
+//!   QEMU against host-sim's plant over `-serial pty` (e.g. `--json`,
+//!   `--seconds 4`, `--link-loss-at-s 3`, `--check`).
 //! - `fuzz [seconds]`: run each cargo-fuzz target (default 60 s each).
 //! - `accuracy`: regenerate docs/accuracy.md and docs/accuracy.png.
 
@@ -22,6 +25,7 @@ fn main() -> ExitCode {
         Some("thumb") => thumb(),
         Some("firmware") => firmware().map(|_| ()),
         Some("qemu") => qemu(),
+        Some("pil") => pil(&args[1..]),
         Some("fuzz") => {
             let secs = args.get(1).map_or(Ok(60), |s| {
                 s.parse::<u32>().map_err(|e| format!("seconds: {e}"))
@@ -42,7 +46,7 @@ fn main() -> ExitCode {
             ]),
         ),
         _ => Err(format!(
-            "usage: cargo xtask <ci|thumb|firmware|qemu|fuzz [seconds]|accuracy>\n  got: {}",
+            "usage: cargo xtask <ci|thumb|firmware|qemu|pil [options]|fuzz [seconds]|accuracy>\n  got: {}",
             args.join(" ")
         )),
     };
@@ -106,6 +110,17 @@ fn ci() -> Result<(), String> {
         ]),
     )?;
     run(
+        "cargo fmt --check (firmware/stm32f405)",
+        cargo().args([
+            "fmt",
+            "--manifest-path",
+            "firmware/stm32f405/Cargo.toml",
+            "--all",
+            "--",
+            "--check",
+        ]),
+    )?;
+    run(
         "cargo fmt --check (fuzz)",
         cargo().args([
             "fmt",
@@ -129,6 +144,15 @@ fn ci() -> Result<(), String> {
     )?;
     thumb()?;
     qemu()?;
+    // Processor-in-the-loop: bit for bit against the in-process loop, with
+    // corrupted frames and a link loss.
+    pil(&[
+        "--seconds".into(),
+        "4".into(),
+        "--link-loss-at-s".into(),
+        "3".into(),
+        "--check".into(),
+    ])?;
     fuzz(60)?;
     // Last, closing on the total so that CI reads the whole count rather
     // than the last crate's doc-test line. The long hard cases (24 h of
@@ -223,10 +247,101 @@ fn firmware() -> Result<PathBuf, String> {
     let tc = Toolchain::detect()?;
     let dir = cross_target_dir("firmware");
     run(
-        &format!("build firmware ({})", tc.describe()),
+        &format!("build firmware: QEMU images ({})", tc.describe()),
         &mut tc.build(&root().join("firmware"), &dir, &[]),
     )?;
-    Ok(dir.join(TARGET).join("release"))
+    run(
+        &format!("build firmware: STM32F405 image ({})", tc.describe()),
+        &mut tc.build(&root().join("firmware/stm32f405"), &dir, &[]),
+    )?;
+    let out = dir.join(TARGET).join("release");
+    // Flash and RAM of each image (text + data in flash; data + bss in RAM).
+    let size = Command::new("arm-none-eabi-size")
+        .args(["twoport-stm32f405", "twoport-an386", "twoport-probe"])
+        .current_dir(&out)
+        .output();
+    if let Ok(o) = size {
+        eprint!("{}", String::from_utf8_lossy(&o.stdout));
+    }
+    Ok(out)
+}
+
+/// Processor-in-the-loop: start the an386 image in QEMU with its UART on a
+/// pty, point `host-sim pil` at it, and fail if either side fails.
+fn pil(extra: &[String]) -> Result<(), String> {
+    use std::io::{BufRead, BufReader, Read};
+    let elf = firmware()?.join("twoport-an386");
+    run(
+        "build host-sim",
+        cargo().args(["build", "--release", "-q", "-p", "host-sim"]),
+    )?;
+    let mut qemu = Command::new("qemu-system-arm")
+        .args(["-machine", "mps2-an386", "-cpu", "cortex-m4"])
+        .args(["-display", "none", "-monitor", "none", "-serial", "pty"])
+        // Deterministic virtual time: the board's SysTick loop timing in
+        // its telemetry is then a function of the instructions it ran.
+        .args(["-icount", "shift=6"])
+        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
+        .arg(&elf)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("qemu-system-arm: could not start ({e}); install qemu-system-arm"))?;
+    // QEMU names the pty on stdout, where the board's semihosting prints go
+    // too; both are kept to show if the run fails.
+    let stdout = qemu.stdout.take().ok_or("qemu's stdout")?;
+    let mut lines = BufReader::new(stdout).lines();
+    let pty = loop {
+        match lines.next() {
+            Some(Ok(l)) => {
+                if let Some(rest) = l.strip_prefix("char device redirected to ") {
+                    break rest.split_whitespace().next().unwrap_or("").to_string();
+                }
+            }
+            _ => {
+                let _ = qemu.kill();
+                return Err("qemu did not say where its serial pty is".into());
+            }
+        }
+    };
+    let board_out = std::thread::spawn(move || lines.map_while(Result::ok).collect::<Vec<_>>());
+    let mut stderr = qemu.stderr.take().ok_or("qemu's stderr")?;
+    std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = stderr.read_to_string(&mut s);
+    });
+    eprintln!("xtask: firmware in QEMU on {pty}");
+    let host = cargo()
+        .args([
+            "run",
+            "--release",
+            "-q",
+            "-p",
+            "host-sim",
+            "--",
+            "pil",
+            "--port",
+        ])
+        .arg(&pty)
+        .args(extra)
+        .status();
+    let early_exit = qemu.try_wait().ok().flatten();
+    let _ = qemu.kill();
+    let _ = qemu.wait();
+    let printed = board_out.join().unwrap_or_default().join("\n");
+    if let Some(st) = early_exit {
+        return Err(format!(
+            "the firmware stopped during the run ({st}):\n{printed}"
+        ));
+    }
+    match host {
+        Ok(st) if st.success() => Ok(()),
+        Ok(st) => Err(format!(
+            "host-sim pil failed ({st}); the board printed:\n{printed}"
+        )),
+        Err(e) => Err(format!("host-sim pil: {e}")),
+    }
 }
 
 /// The cargo-fuzz targets in fuzz/.

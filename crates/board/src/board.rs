@@ -1,12 +1,14 @@
 //! The loop: servo tick, link in, frames out.
 
+use crate::io::IoScale;
 use crate::region::{Bound, Region};
 use heapless::{Deque, Vec};
 use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::ve::VirtualEnvironment;
 use twoport_control::{AdmittanceServo, Faults, ImpedanceServo};
 use twoport_link::{
-    encode, Decoder, Gains, GainsReply, Message, Refusal, Stats, Telemetry, MAX_FRAME,
+    encode, ActuatorFrame, Decoder, Gains, GainsReply, LinkStats, Message, Refusal, Stats,
+    Telemetry, MAX_FRAME,
 };
 
 /// One encoded frame, delimiter included.
@@ -82,6 +84,8 @@ pub struct Board<V, const R: usize> {
     reported: Faults,
     loop_cycles: u32,
     tx_dropped: u32,
+    io: IoScale,
+    last: ServoOutput,
 }
 
 fn all_finite(g: &Gains) -> bool {
@@ -112,7 +116,31 @@ impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
             reported: Faults::NONE,
             loop_cycles: 0,
             tx_dropped: 0,
+            io: IoScale::EXCALIBUR,
+            last: ServoOutput::default(),
         }
+    }
+
+    /// The same board with `io` scaling its peripherals (default:
+    /// [`IoScale::EXCALIBUR`]).
+    pub fn with_io(mut self, io: IoScale) -> Self {
+        self.io = io;
+        self
+    }
+
+    /// How the peripherals scale.
+    pub fn io(&self) -> IoScale {
+        self.io
+    }
+
+    /// The last tick's output.
+    pub fn last_output(&self) -> &ServoOutput {
+        &self.last
+    }
+
+    /// The signed PWM duty for the held actuator force.
+    pub fn duty(&self) -> i16 {
+        self.io.duty(self.last.actuator_force_n)
     }
 
     /// The law (gains, safety state).
@@ -201,6 +229,23 @@ impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
                 }
             }
             Message::Disable => both!(&mut self.law, s => s.disable()),
+            Message::GetStats => self.queue(Message::Stats(LinkStats {
+                rx: self.decoder.stats(),
+                tx_dropped: self.tx_dropped,
+            })),
+            // Processor-in-the-loop: the host's sensors drive one tick, the
+            // duty goes straight back.
+            Message::Sensors(s) => {
+                let frame = SensorFrame {
+                    tick: s.tick,
+                    encoder_raw: s.encoder_raw,
+                    load_cell_n: self.io.load_cell_n(s.load_cell_raw),
+                    dead_man_closed: s.dead_man_closed,
+                };
+                self.tick(&frame);
+                let duty = self.duty();
+                self.queue(Message::Actuator(ActuatorFrame { tick: s.tick, duty }));
+            }
             _ => {}
         }
     }
@@ -278,6 +323,7 @@ impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
     /// telemetry on schedule. Returns the held actuator command.
     pub fn tick(&mut self, frame: &SensorFrame) -> ServoOutput {
         let out = self.law.tick(frame);
+        self.last = out;
         if !out.faults.is_empty() && out.faults != self.reported {
             self.reported = out.faults;
             self.queue(Message::FaultReport {

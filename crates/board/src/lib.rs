@@ -13,7 +13,10 @@
 #![warn(missing_docs)]
 
 mod board;
+pub mod excalibur;
+mod io;
 mod region;
 
 pub use board::{Board, Frame, Law, TX_FRAMES};
+pub use io::{IoScale, DUTY_FULL_SCALE};
 pub use region::{Bound, Region, RegionError};

@@ -474,3 +474,73 @@ pub fn log_grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {
         .map(|i| lo * (hi / lo).powf(i as f64 / (n - 1) as f64))
         .collect()
 }
+
+/// A proven region as Rust source for a board image (`twoport-board`'s
+/// `Region`): the damping grid, the limits (rounded *toward safety*: a
+/// stiffness down, a mass up, so that the f32 copy never proves more than
+/// the f64 analysis did), and the regulator for an admittance region.
+/// `how` is the command that made it, quoted in the header.
+pub fn region_rust_source(
+    rows: &[(f64, f64)],
+    max_stiffness: bool,
+    regulator: Option<(f64, f64)>,
+    how: &str,
+) -> String {
+    use std::fmt::Write;
+    let toward_safety = |l: f64| {
+        let f = l as f32;
+        let over = (f as f64) > l;
+        match (max_stiffness, over) {
+            (true, true) => f.next_down(),
+            (false, false) if (f as f64) < l => f.next_up(),
+            _ => f,
+        }
+    };
+    let n = rows.len();
+    let mut s = String::new();
+    let _ = writeln!(s, "// Made by the designer: `{how}`. Do not edit;");
+    let _ = writeln!(
+        s,
+        "// tests/shipped_region.rs checks it against the designer."
+    );
+    let bound = if max_stiffness {
+        "MaxStiffness"
+    } else {
+        "MinMass"
+    };
+    let _ = writeln!(s, "/// What the region bounds.");
+    let _ = writeln!(s, "pub const BOUND: Bound = Bound::{bound};");
+    let _ = writeln!(s, "/// Coupling damping grid (N s/m).");
+    let list = |v: &mut dyn Iterator<Item = f32>| {
+        v.map(|x| format!("{x:?}")).collect::<Vec<_>>().join(", ")
+    };
+    let _ = writeln!(
+        s,
+        "pub const DAMPING_NSPM: [f32; {n}] = [{}];",
+        list(&mut rows.iter().map(|r| r.0 as f32))
+    );
+    let unit = if max_stiffness { "N/m" } else { "kg" };
+    let _ = writeln!(s, "/// The proven limit at each damping ({unit}).");
+    let _ = writeln!(
+        s,
+        "pub const LIMIT: [f32; {n}] = [{}];",
+        list(&mut rows.iter().map(|r| toward_safety(r.1)))
+    );
+    let _ = writeln!(
+        s,
+        "/// The regulator (k_p N/m, b_p N s/m) an admittance region holds for."
+    );
+    match regulator {
+        Some((k, b)) => {
+            let _ = writeln!(
+                s,
+                "pub const REGULATOR: Option<(f32, f32)> = Some(({:?}, {:?}));",
+                k as f32, b as f32
+            );
+        }
+        None => {
+            let _ = writeln!(s, "pub const REGULATOR: Option<(f32, f32)> = None;");
+        }
+    }
+    s
+}

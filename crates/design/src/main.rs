@@ -67,6 +67,10 @@ struct RegionGrid {
     /// Grid points (log-spaced).
     #[arg(long, default_value_t = 32)]
     points: usize,
+    /// Print Rust source for a board image (twoport-board's `Region`)
+    /// instead of a table.
+    #[arg(long, conflicts_with = "json")]
+    rust: bool,
 }
 
 #[derive(Args)]
@@ -528,6 +532,19 @@ fn region(d: &Display<RegionImpedance, RegionAdmittance>) -> Result<(), String> 
             )
         }
     };
+    if grid.rust {
+        let how = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
+        print!(
+            "{}",
+            design::region_rust_source(
+                &rows,
+                bound == "max_stiffness_npm",
+                regulator,
+                &format!("twoport {how}")
+            )
+        );
+        return Ok(());
+    }
     let v = json!({"bound": bound, "damping_nspm": rows.iter().map(|r| r.0).collect::<Vec<_>>(),
         "limit": rows.iter().map(|r| r.1).collect::<Vec<_>>(), "regulator": regulator,
         "period_s": s.period(), "human_model": s.human.is_some()});

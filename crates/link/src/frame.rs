@@ -51,7 +51,7 @@ pub fn encode(seq: u16, msg: &Message, out: &mut [u8]) -> Result<usize, FrameErr
 }
 
 /// What the decoder has seen.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Stats {
     /// Good frames.
     pub frames: u32,

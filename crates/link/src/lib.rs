@@ -20,6 +20,6 @@ mod message;
 pub use crc::crc16;
 pub use frame::{encode, Decoder, Envelope, FrameError, Stats, MAX_FRAME, MAX_PAYLOAD};
 pub use message::{
-    ActuatorFrame, Gains, GainsReply, Message, Refusal, Role, SensorFrame, Telemetry,
+    ActuatorFrame, Gains, GainsReply, LinkStats, Message, Refusal, Role, SensorFrame, Telemetry,
     PROTOCOL_VERSION,
 };

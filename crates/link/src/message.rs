@@ -1,10 +1,11 @@
 //! What the board and the host say to each other. Units are SI; positions
 //! are integer picometres as in `twoport-control`.
 
+use crate::frame::Stats;
 use serde::{Deserialize, Serialize};
 
 /// The protocol version both ends must share (checked by the handshake).
-pub const PROTOCOL_VERSION: u16 = 1;
+pub const PROTOCOL_VERSION: u16 = 2;
 
 /// Which end is speaking in a handshake.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -155,6 +156,19 @@ pub enum Message {
     Sensors(SensorFrame),
     /// PIL actuator out.
     Actuator(ActuatorFrame),
+    /// Ask for the board's link counters (protocol 2).
+    GetStats,
+    /// The board's link counters (protocol 2).
+    Stats(LinkStats),
+}
+
+/// The board's view of the link.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LinkStats {
+    /// What the board's decoder received and dropped.
+    pub rx: Stats,
+    /// Outgoing frames the board dropped because its queue was full.
+    pub tx_dropped: u32,
 }
 
 impl Message {

@@ -1,0 +1,114 @@
+//! The Excalibur board image: what the firmware ships with and what the
+//! host's processor-in-the-loop reference builds, from one place. The
+//! impedance display at the paper's coupling (51,000 N/m, 90 N s/m) holding
+//! the stiff wall of the default scene (`scenes/stiff_wall.toml`), and the
+//! region of gains the designer proved absolutely stable.
+
+use crate::io::IoScale;
+use crate::region::{Bound, Region, RegionError};
+use crate::{Board, Law};
+use twoport_control::ve::{Solid, UnilateralWall};
+use twoport_control::{Encoder, EncoderError, ImpedanceServo, ParamError, Position, SafetyConfig};
+
+/// Why the board image could not be built (a constant here is wrong).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BuildError {
+    /// A law's parameter.
+    Param(ParamError),
+    /// The encoder's.
+    Encoder(EncoderError),
+    /// The shipped region table.
+    Region(RegionError),
+}
+
+impl From<ParamError> for BuildError {
+    fn from(e: ParamError) -> Self {
+        BuildError::Param(e)
+    }
+}
+impl From<EncoderError> for BuildError {
+    fn from(e: EncoderError) -> Self {
+        BuildError::Encoder(e)
+    }
+}
+impl From<RegionError> for BuildError {
+    fn from(e: RegionError) -> Self {
+        BuildError::Region(e)
+    }
+}
+
+/// The proven region (impedance display, paper human bound, T = 1 ms).
+pub mod region {
+    use super::Bound;
+    include!("excalibur_region.rs");
+}
+
+/// Control period (s).
+pub const PERIOD_S: f32 = 1.0e-3;
+/// Encoder counter width (bits) and resolution (pm per count): 1 um.
+pub const ENCODER: (u8, i64) = (16, 1_000_000);
+/// Coupling stiffness (N/m) and damping (N s/m): the paper's design.
+pub const COUPLING: (f32, f32) = (51_000.0, 90.0);
+/// The wall: surface (pm, 1 cm), stiffness (N/m), damping (N s/m); solid
+/// above.
+pub const WALL: (i64, f32, f32) = (10_000_000_000, 5.0e6, 200.0);
+/// Ticks without a host heartbeat before the board forces zero (50 ms).
+pub const HEARTBEAT_TIMEOUT_TICKS: u32 = 50;
+/// Telemetry every this many ticks (100 Hz).
+pub const TELEMETRY_EVERY: u32 = 10;
+
+/// Grid points of [`region`].
+pub const REGION_POINTS: usize = region::DAMPING_NSPM.len();
+
+/// The axis limits: Excalibur's, with the link watchdog and the dead-man
+/// switch on.
+pub const fn safety() -> SafetyConfig {
+    SafetyConfig {
+        period_s: PERIOD_S,
+        heartbeat_timeout_ticks: HEARTBEAT_TIMEOUT_TICKS,
+        require_dead_man: true,
+        ..SafetyConfig::excalibur()
+    }
+}
+
+/// The shipped region as a `Region`.
+pub fn proven_region() -> Result<Region<REGION_POINTS>, RegionError> {
+    Region::new(
+        region::BOUND,
+        region::DAMPING_NSPM,
+        region::LIMIT,
+        region::REGULATOR,
+    )
+}
+
+/// The board's law: the impedance display on the wall, disabled until the
+/// host enables it.
+pub fn stiff_wall_law() -> Result<Law<UnilateralWall>, BuildError> {
+    let (bits, pm) = ENCODER;
+    let enc = Encoder::new(bits, pm, 0, Position::ZERO)?;
+    let (x, k, b) = WALL;
+    let ve = UnilateralWall::new(
+        k,
+        b,
+        Position::from_pm(x),
+        Solid::Above,
+        PERIOD_S,
+        Position::ZERO,
+    )?;
+    let (kc, bc) = COUPLING;
+    Ok(Law::Impedance(ImpedanceServo::new(
+        kc,
+        bc,
+        enc,
+        safety(),
+        ve,
+    )?))
+}
+
+/// The whole board: law, region, telemetry rate, I/O scaling.
+pub fn stiff_wall_board() -> Result<Board<UnilateralWall, REGION_POINTS>, BuildError> {
+    Ok(
+        Board::new(stiff_wall_law()?, proven_region()?, TELEMETRY_EVERY)
+            .with_io(IoScale::EXCALIBUR),
+    )
+}

@@ -1,0 +1,73 @@
+//! Scaling between the raw peripherals and SI units: the PWM duty that
+//! commands the amplifier, the load-cell ADC counts. The same functions run
+//! on the board and in the host's processor-in-the-loop reference, so both
+//! quantise a force identically.
+
+/// Full-scale signed PWM duty: ±`DUTY_FULL_SCALE` commands ± the
+/// amplifier's full-scale force.
+pub const DUTY_FULL_SCALE: i16 = i16::MAX;
+
+/// How the board's peripherals map to SI units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IoScale {
+    /// Actuator force at full-scale duty (N).
+    pub force_full_scale_n: f32,
+    /// Load-cell force per ADC count (N).
+    pub load_cell_n_per_count: f32,
+}
+
+impl IoScale {
+    /// The Excalibur's amplifier (200 N peak, the safety layer's limit) and
+    /// a 1 mN-per-count load-cell front end.
+    pub const EXCALIBUR: IoScale = IoScale {
+        force_full_scale_n: 200.0,
+        load_cell_n_per_count: 1.0e-3,
+    };
+
+    /// The signed duty for `force_n`, rounded to the nearest step and
+    /// clamped to full scale; a non-finite force gives zero duty.
+    pub fn duty(&self, force_n: f32) -> i16 {
+        let d = force_n / self.force_full_scale_n * DUTY_FULL_SCALE as f32;
+        if !d.is_finite() {
+            return 0;
+        }
+        let full = DUTY_FULL_SCALE as f32;
+        let r = d.clamp(-full, full);
+        // Round half away from zero without libm.
+        (r + 0.5f32.copysign(r)) as i16
+    }
+
+    /// The force a duty commands (N).
+    pub fn force_n(&self, duty: i16) -> f32 {
+        duty.max(-DUTY_FULL_SCALE) as f32 * (self.force_full_scale_n / DUTY_FULL_SCALE as f32)
+    }
+
+    /// The load-cell force for an ADC reading (N).
+    pub fn load_cell_n(&self, counts: i32) -> f32 {
+        counts as f32 * self.load_cell_n_per_count
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn duty_round_trips_within_half_a_step_and_clamps() {
+        let s = IoScale::EXCALIBUR;
+        let step = s.force_full_scale_n / DUTY_FULL_SCALE as f32;
+        for i in -2000..=2000 {
+            let f = i as f32 * 0.0937;
+            let back = s.force_n(s.duty(f));
+            // Half a step, plus f32 rounding of the product at 100 N.
+            assert!((back - f).abs() <= 0.5 * step * 1.01, "{f} -> {back}");
+        }
+        assert_eq!(s.duty(1e9), DUTY_FULL_SCALE);
+        assert_eq!(s.duty(-1e9), -DUTY_FULL_SCALE);
+        assert_eq!(s.duty(f32::NAN), 0);
+        assert_eq!(s.duty(f32::INFINITY), 0);
+        assert_eq!(s.force_n(i16::MIN), -s.force_full_scale_n);
+        assert_eq!(s.duty(0.0), 0);
+        assert_eq!(s.duty(-0.5 * step * 0.99), 0);
+    }
+}

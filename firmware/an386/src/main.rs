@@ -1,0 +1,68 @@
+//! The board loop on QEMU mps2-an386 (Cortex-M4F) for processor-in-the-loop
+//! runs: the same `twoport-board` loop as the STM32F405 image, with its
+//! sensors arriving and its PWM duty leaving as link frames on UART0, one
+//! tick per sensor frame (lockstep with host-sim). Started by
+//! `cargo xtask pil`; a panic or HardFault ends QEMU with a failure code.
+
+#![no_std]
+#![no_main]
+
+mod uart;
+
+use cortex_m::peripheral::{syst::SystClkSource, SYST};
+use cortex_m_rt::{entry, exception, ExceptionFrame};
+use cortex_m_semihosting::{debug, hprintln};
+use twoport_board::excalibur;
+
+#[entry]
+fn main() -> ! {
+    let Ok(mut board) = excalibur::stiff_wall_board() else {
+        hprintln!("the Excalibur board image would not build");
+        debug::exit(debug::EXIT_FAILURE);
+        #[allow(clippy::empty_loop)]
+        loop {}
+    };
+    let mut uart = uart::Uart::take();
+    // SysTick measures each frame's handling; with `-icount shift=N` it is
+    // a deterministic function of the instructions executed.
+    if let Some(mut p) = cortex_m::Peripherals::take() {
+        p.SYST.set_clock_source(SystClkSource::Core);
+        p.SYST.set_reload(0x00FF_FFFF);
+        p.SYST.clear_current();
+        p.SYST.enable_counter();
+    }
+    hprintln!("twoport-an386: board loop up, waiting on UART0");
+    loop {
+        if let Some(b) = uart.read() {
+            let start = SYST::get_current();
+            board.on_bytes(&[b]);
+            if b == 0 {
+                // A frame ended here: what handling it (and any tick it
+                // drove) cost.
+                let used = start.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF;
+                board.set_loop_cycles(used);
+            }
+        }
+        while let Some(frame) = board.pop_tx() {
+            uart.write(&frame);
+        }
+    }
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    hprintln!("panic: {}", info);
+    debug::exit(debug::EXIT_FAILURE);
+    #[allow(clippy::empty_loop)]
+    loop {}
+}
+
+#[exception]
+// SAFETY: cortex-m-rt requires the HardFault handler to be an `unsafe fn`;
+// it only reads the stacked frame it is handed and exits.
+unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
+    hprintln!("HardFault at pc {:#010x}", ef.pc());
+    debug::exit(debug::EXIT_FAILURE);
+    #[allow(clippy::empty_loop)]
+    loop {}
+}
