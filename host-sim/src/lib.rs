@@ -8,6 +8,7 @@
 #![forbid(unsafe_code)]
 
 pub mod accuracy;
+pub mod app;
 pub mod blocks;
 pub mod human;
 pub mod pil;
@@ -17,7 +18,9 @@ pub mod scene;
 pub mod scope;
 pub mod sim;
 pub mod stability;
+pub mod ui;
 pub mod ve;
+pub mod window;
 
 pub use scene::Scene;
 pub use sim::{Report, Sample, Simulation};

@@ -1,5 +1,5 @@
-//! `host-sim`: run scenes headless, sweep a gain to its stability boundary,
-//! and reproduce the paper's Table I.
+//! `host-sim`: the scope (no subcommand), headless scene runs, sweeps to a
+//! stability boundary, the paper's Table I, and processor-in-the-loop.
 
 use clap::{Args, Parser, Subcommand};
 use host_sim::scene::{Display, Scene};
@@ -12,14 +12,36 @@ use std::process::ExitCode;
 
 /// Simulate a haptic device around the board's own control code.
 #[derive(Parser)]
-#[command(name = "host-sim", version)]
+#[command(name = "host-sim", version, args_conflicts_with_subcommands = true)]
 struct Cli {
     #[command(subcommand)]
-    cmd: Cmd,
+    cmd: Option<Cmd>,
+    #[command(flatten)]
+    scope: ScopeArgs,
+}
+
+/// The scope: the default when no subcommand is given.
+#[derive(Args, Clone)]
+struct ScopeArgs {
+    /// The scene to open.
+    #[arg(long, default_value = "scenes/stiff_wall.toml")]
+    scene: PathBuf,
+    /// Save the window to this PNG at --exit-after (and at half that time
+    /// to NAME.first.png), then close.
+    #[arg(long, requires = "exit_after")]
+    screenshot: Option<PathBuf>,
+    /// Close after this many seconds.
+    #[arg(long)]
+    exit_after: Option<f64>,
+    /// Run the scene headless even where a display exists.
+    #[arg(long)]
+    headless: bool,
 }
 
 #[derive(Subcommand)]
 enum Cmd {
+    /// The scope window (the same as no subcommand).
+    Scope(ScopeArgs),
     /// Run one scene and judge its stability.
     Run(RunArgs),
     /// Find the marginal value of one parameter by bisection.
@@ -458,18 +480,13 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         link_loss_at,
     };
     let start = std::time::Instant::now();
-    let reference = pil::run(
-        scene.clone(),
-        ticks,
-        &mut pil::LocalBoard::excalibur()?,
-        faults,
-    )?;
+    let reference = pil::run(scene.clone(), ticks, pil::LocalBoard::excalibur()?, faults)?;
     let local_s = start.elapsed().as_secs_f64();
     let (run, remote_s) = match &a.port {
         Some(p) => {
-            let mut port = pil::SerialBoard::open(p)?;
+            let port = pil::SerialBoard::open(p)?;
             let start = std::time::Instant::now();
-            let r = pil::run(scene, ticks, &mut port, faults)?;
+            let r = pil::run(scene, ticks, port, faults)?;
             (r, start.elapsed().as_secs_f64())
         }
         None => (reference.clone(), local_s),
@@ -553,11 +570,9 @@ fn pil(a: &PilArgs) -> Result<(), String> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let r = match &cli.cmd {
-        Cmd::Run(a) => run(a),
-        Cmd::Sweep(a) => sweep(a),
-        Cmd::Table1(a) => table1(a),
-        Cmd::Accuracy(a) => accuracy(a),
-        Cmd::Pil(a) => pil(a),
+        None => scope(&cli.scope),
+        Some(Cmd::Scope(a)) => scope(a),
+        Some(c) => subcommand(c),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,
@@ -565,5 +580,68 @@ fn main() -> ExitCode {
             eprintln!("host-sim: {e}");
             ExitCode::from(2)
         }
+    }
+}
+
+/// The scope, or where no window can open, a headless run of its scene.
+fn scope(a: &ScopeArgs) -> Result<(), String> {
+    if let Some(t) = a.exit_after {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(format!(
+                "--exit-after {t}: must be a positive number of seconds"
+            ));
+        }
+    }
+    let why_headless = if a.headless {
+        Some("--headless".to_string())
+    } else if !host_sim::window::display_available() {
+        Some("no display (DISPLAY and WAYLAND_DISPLAY are unset)".to_string())
+    } else {
+        let script = host_sim::window::Script {
+            screenshot: a.screenshot.clone(),
+            exit_after_s: a.exit_after,
+        };
+        match host_sim::window::run(&a.scene, script) {
+            Ok(shots) => {
+                for p in shots {
+                    eprintln!("host-sim: saved {}", p.display());
+                }
+                return Ok(());
+            }
+            Err(e) if e.starts_with("the window would not open") => Some(e),
+            Err(e) => return Err(e),
+        }
+    };
+    if a.screenshot.is_some() {
+        return Err(format!(
+            "--screenshot needs a window: {}",
+            why_headless.unwrap_or_default()
+        ));
+    }
+    eprintln!(
+        "host-sim: {}; running {} headless instead",
+        why_headless.unwrap_or_default(),
+        a.scene.display()
+    );
+    run(&RunArgs {
+        scene: SceneArgs {
+            scene: a.scene.clone(),
+            sets: Vec::new(),
+            json: false,
+        },
+        duration: None,
+        csv: None,
+        png: None,
+    })
+}
+
+fn subcommand(c: &Cmd) -> Result<(), String> {
+    match c {
+        Cmd::Scope(a) => scope(a),
+        Cmd::Run(a) => run(a),
+        Cmd::Sweep(a) => sweep(a),
+        Cmd::Table1(a) => table1(a),
+        Cmd::Accuracy(a) => accuracy(a),
+        Cmd::Pil(a) => pil(a),
     }
 }

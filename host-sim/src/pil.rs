@@ -126,15 +126,39 @@ pub struct Run {
     pub zero_after_loss_ticks: Option<u64>,
 }
 
-/// The host side of the link.
-struct Host<'a, P: BoardPort> {
-    port: &'a mut P,
+/// The host side of a lockstep link to a board: handshake, heartbeats,
+/// one sensor frame out and one actuator frame back per tick, and whatever
+/// else the board says kept for the caller.
+pub struct Session<P: BoardPort> {
+    port: P,
     seq: u16,
     decoder: Decoder,
     inbox: Vec<Message>,
+    io: twoport_board::IoScale,
+    faults: Faults,
+    tick: u64,
+    /// Frames the host injected corrupted.
+    pub corrupted_sent: u64,
 }
 
-impl<P: BoardPort> Host<'_, P> {
+impl<P: BoardPort> Session<P> {
+    /// Shake hands with the board at `port` and enable it.
+    pub fn open(port: P, faults: Faults) -> Result<Self, String> {
+        let mut s = Session {
+            port,
+            seq: 0,
+            decoder: Decoder::new(),
+            inbox: Vec::new(),
+            io: twoport_board::IoScale::EXCALIBUR,
+            faults,
+            tick: 0,
+            corrupted_sent: 0,
+        };
+        s.handshake()?;
+        s.send(&Message::Enable)?;
+        Ok(s)
+    }
+
     fn frame(&mut self, msg: &Message) -> Result<Vec<u8>, String> {
         let mut buf = [0u8; MAX_FRAME];
         let n = encode(self.seq, msg, &mut buf).map_err(|e| format!("encode: {e:?}"))?;
@@ -142,22 +166,36 @@ impl<P: BoardPort> Host<'_, P> {
         Ok(buf[..n].to_vec())
     }
 
-    fn send(&mut self, msg: &Message) -> Result<(), String> {
+    /// Send one message.
+    pub fn send(&mut self, msg: &Message) -> Result<(), String> {
         let f = self.frame(msg)?;
         self.port.send(&f)
     }
 
+    fn pump(&mut self, timeout: Duration) -> Result<(), String> {
+        let mut buf = [0u8; 256];
+        let n = self.port.recv(&mut buf, timeout)?;
+        let inbox = &mut self.inbox;
+        self.decoder.feed(&buf[..n], |env| inbox.push(env.msg));
+        Ok(())
+    }
+
     /// Read until `want` picks a message out, or time out.
-    fn wait<T>(
+    pub fn wait<T>(
         &mut self,
         what: &str,
         mut want: impl FnMut(&Message) -> Option<T>,
     ) -> Result<T, String> {
         let deadline = Instant::now() + ANSWER_TIMEOUT;
         loop {
-            if let Some(i) = self.inbox.iter().position(|m| want(m).is_some()) {
-                let m = self.inbox.remove(i);
-                return want(&m).ok_or_else(|| "unreachable".to_string());
+            if let Some((i, v)) = self
+                .inbox
+                .iter()
+                .enumerate()
+                .find_map(|(i, m)| want(m).map(|v| (i, v)))
+            {
+                self.inbox.remove(i);
+                return Ok(v);
             }
             let now = Instant::now();
             if now > deadline {
@@ -166,12 +204,7 @@ impl<P: BoardPort> Host<'_, P> {
                     ANSWER_TIMEOUT.as_secs()
                 ));
             }
-            let mut buf = [0u8; 256];
-            let n = self
-                .port
-                .recv(&mut buf, (deadline - now).min(Duration::from_millis(50)))?;
-            let inbox = &mut self.inbox;
-            self.decoder.feed(&buf[..n], |env| inbox.push(env.msg));
+            self.pump((deadline - now).min(Duration::from_millis(50)))?;
         }
     }
 
@@ -181,10 +214,7 @@ impl<P: BoardPort> Host<'_, P> {
         let deadline = Instant::now() + ANSWER_TIMEOUT;
         loop {
             self.send(&Message::hello(Role::Host))?;
-            let mut buf = [0u8; 256];
-            let n = self.port.recv(&mut buf, Duration::from_millis(100))?;
-            let inbox = &mut self.inbox;
-            self.decoder.feed(&buf[..n], |env| inbox.push(env.msg));
+            self.pump(Duration::from_millis(100))?;
             if let Some(i) = self
                 .inbox
                 .iter()
@@ -204,6 +234,79 @@ impl<P: BoardPort> Host<'_, P> {
             }
         }
     }
+
+    /// Messages the board sent that no one waited for (telemetry, fault
+    /// reports, gain replies), oldest first.
+    pub fn take_messages(&mut self) -> Vec<Message> {
+        std::mem::take(&mut self.inbox)
+    }
+
+    /// The board's link counters.
+    pub fn board_stats(&mut self) -> Result<LinkStats, String> {
+        self.send(&Message::GetStats)?;
+        self.wait("GetStats", |m| match m {
+            Message::Stats(s) => Some(*s),
+            _ => None,
+        })
+    }
+
+    /// Frames from the board this host dropped.
+    pub fn host_dropped(&self) -> u32 {
+        self.decoder.stats().dropped()
+    }
+
+    /// One tick of `sim` with the board as its controller; returns the
+    /// sample and the duty the board answered.
+    pub fn step(&mut self, sim: &mut Simulation) -> Result<(Sample, i16), String> {
+        let tick = self.tick;
+        self.tick += 1;
+        let lost = self.faults.link_loss_at.is_some_and(|t| tick >= t);
+        if tick.is_multiple_of(HEARTBEAT_EVERY) && !lost {
+            self.send(&Message::Heartbeat)?;
+        }
+        let mut answer: Result<i16, String> = Ok(0);
+        let io = self.io;
+        let mut ctl = |f: &SensorFrame| -> ServoOutput {
+            answer = self.exchange(tick, f);
+            let force = io.force_n(*answer.as_ref().unwrap_or(&0));
+            ServoOutput {
+                actuator_force_n: force,
+                commanded_force_n: force,
+                position: Position::ZERO,
+                ..ServoOutput::default()
+            }
+        };
+        let sample = sim.step_external(&mut ctl);
+        Ok((sample, answer?))
+    }
+
+    fn exchange(&mut self, tick: u64, f: &SensorFrame) -> Result<i16, String> {
+        let sensors = Message::Sensors(LinkSensors {
+            tick: f.tick,
+            encoder_raw: f.encoder_raw,
+            load_cell_raw: (f.load_cell_n / self.io.load_cell_n_per_count).round() as i32,
+            dead_man_closed: f.dead_man_closed,
+        });
+        let good = self.frame(&sensors)?;
+        let every = self.faults.corrupt_every;
+        if every > 0 && tick % every == every / 2 {
+            let mut bad = good.clone();
+            let i = bad.len() / 2;
+            bad[i] ^= 0x5A;
+            if bad[i] == 0 {
+                bad[i] = 0x33;
+            }
+            self.port.send(&[0x17, 0xFF, 0x42, 0x00])?;
+            self.port.send(&bad)?;
+            self.corrupted_sent += 2;
+        }
+        self.port.send(&good)?;
+        let want = f.tick;
+        self.wait(&format!("tick {want}"), |m| match m {
+            Message::Actuator(a) if a.tick == want => Some(a.duty),
+            _ => None,
+        })
+    }
 }
 
 /// The scene's sensors must be the board's: the same encoder.
@@ -221,93 +324,24 @@ pub fn check_scene(scene: &Scene) -> Result<(), String> {
 }
 
 /// Run `scene` for `ticks` against the board at `port`.
-pub fn run<P: BoardPort>(
-    scene: Scene,
-    ticks: u64,
-    port: &mut P,
-    faults: Faults,
-) -> Result<Run, String> {
+pub fn run<P: BoardPort>(scene: Scene, ticks: u64, port: P, faults: Faults) -> Result<Run, String> {
     check_scene(&scene)?;
     let mut sim = Simulation::new(scene)?;
-    let mut host = Host {
-        port,
-        seq: 0,
-        decoder: Decoder::new(),
-        inbox: Vec::new(),
-    };
-    host.handshake()?;
-    host.send(&Message::Enable)?;
+    let mut session = Session::open(port, faults)?;
     let mut r = Run::default();
-    let io = twoport_board::IoScale::EXCALIBUR;
-    let mut error = None;
-    for tick in 0..ticks {
-        let lost = faults.link_loss_at.is_some_and(|t| tick >= t);
-        if tick % HEARTBEAT_EVERY == 0 && !lost {
-            host.send(&Message::Heartbeat)?;
-        }
-        let mut duty_seen = 0i16;
-        let mut ctl = |f: &SensorFrame| -> ServoOutput {
-            let sensors = Message::Sensors(LinkSensors {
-                tick: f.tick,
-                encoder_raw: f.encoder_raw,
-                load_cell_raw: (f.load_cell_n / io.load_cell_n_per_count).round() as i32,
-                dead_man_closed: f.dead_man_closed,
-            });
-            let answer = (|| {
-                let good = host.frame(&sensors)?;
-                if faults.corrupt_every > 0
-                    && tick % faults.corrupt_every == faults.corrupt_every / 2
-                {
-                    let mut bad = good.clone();
-                    let i = bad.len() / 2;
-                    bad[i] ^= 0x5A;
-                    if bad[i] == 0 {
-                        bad[i] = 0x33;
-                    }
-                    host.port.send(&[0x17, 0xFF, 0x42, 0x00])?;
-                    host.port.send(&bad)?;
-                    r.corrupted_sent += 2;
-                }
-                host.port.send(&good)?;
-                let want = f.tick;
-                host.wait(&format!("tick {want}"), |m| match m {
-                    Message::Actuator(a) if a.tick == want => Some(a.duty),
-                    _ => None,
-                })
-            })();
-            let duty = match answer {
-                Ok(d) => d,
-                Err(e) => {
-                    error = Some(e);
-                    0
-                }
-            };
-            duty_seen = duty;
-            ServoOutput {
-                actuator_force_n: io.force_n(duty),
-                commanded_force_n: io.force_n(duty),
-                position: Position::ZERO,
-                ..ServoOutput::default()
-            }
-        };
-        let s = sim.step_external(&mut ctl);
-        if let Some(e) = error.take() {
-            return Err(e);
-        }
+    for _ in 0..ticks {
+        let (s, duty) = session.step(&mut sim)?;
         r.samples.push(s);
-        r.duties.push(duty_seen);
-        for m in host.inbox.drain(..) {
+        r.duties.push(duty);
+        for m in session.take_messages() {
             if let Message::Telemetry(t) = m {
                 r.telemetry.push(t);
             }
         }
     }
-    host.send(&Message::GetStats)?;
-    r.board_stats = host.wait("GetStats", |m| match m {
-        Message::Stats(s) => Some(*s),
-        _ => None,
-    })?;
-    r.host_dropped = host.decoder.stats().dropped();
+    r.board_stats = session.board_stats()?;
+    r.host_dropped = session.host_dropped();
+    r.corrupted_sent = session.corrupted_sent;
     if let Some(t0) = faults.link_loss_at {
         // The last tick with a non-zero duty after the loss, plus one.
         let after = r.duties.iter().skip(t0 as usize);

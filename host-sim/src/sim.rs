@@ -53,6 +53,36 @@ impl Servo {
         }
     }
 
+    /// Change the admittance display's regulator `K_p` (N/m, N s/m); an
+    /// error on an impedance display.
+    pub fn set_regulator(&mut self, kp: f64, bp: f64) -> Result<(), String> {
+        match self {
+            Servo::Impedance(_) => Err("an impedance display has no regulator".into()),
+            Servo::Admittance(s) => s
+                .set_regulator_gains(kp as f32, bp as f32)
+                .map_err(|e| e.to_string()),
+        }
+    }
+
+    /// Move the wall and change its stiffness while running (the scope's
+    /// controls); an error if the scene's VE is not a wall.
+    pub fn set_wall(&mut self, surface_m: f64, stiffness_npm: f64) -> Result<(), String> {
+        let ve = match self {
+            Servo::Impedance(s) => s.ve_mut(),
+            Servo::Admittance(s) => s.ve_mut(),
+        };
+        let SceneVe::Wall(w) = ve else {
+            return Err("the scene's VE is not a wall".into());
+        };
+        let x = Position::from_m(surface_m as f32)
+            .ok_or(format!("wall position {surface_m} m is out of range"))?;
+        let (_, b) = w.gains();
+        w.set_gains(stiffness_npm as f32, b)
+            .map_err(|e| e.to_string())?;
+        w.set_surface(x);
+        Ok(())
+    }
+
     /// Change the coupling gains while running (the scope's sliders).
     /// Impedance: `(k, b)`; admittance: `(m, b)`.
     pub fn set_coupling(&mut self, a: f64, b: f64) -> Result<(), String> {
@@ -181,6 +211,10 @@ pub struct Simulation {
     track_energy: bool,
     /// What reading the clock twice costs (ns), subtracted from timings.
     clock_ns: f64,
+    /// The scope's grasp, instead of the script's.
+    grasp_override: Option<GraspKind>,
+    /// The scope's mouse push, added to the script's (N).
+    extra_push_n: f64,
 }
 
 /// Largest stable sub-step for `method` over `poles` (s), by bisection.
@@ -425,6 +459,8 @@ impl Simulation {
                 .fold(f64::INFINITY, f64::min),
             device,
             scene,
+            grasp_override: None,
+            extra_push_n: 0.0,
         };
         sim.costs = sim.effect_names().into_iter().map(|n| (n, 0.0)).collect();
         Ok(sim)
@@ -470,6 +506,24 @@ impl Simulation {
     /// off by default, it costs about a fifth of a tick).
     pub fn track_energy(&mut self, on: bool) {
         self.track_energy = on;
+    }
+
+    /// Hold the hand in `grasp` (the scope's grasp control), or give it
+    /// back to the script with `None`.
+    pub fn set_grasp(&mut self, grasp: Option<GraspKind>) {
+        if let Some(g) = grasp {
+            if !self.steppers.iter().any(|(k, _)| *k == g) {
+                let sys = self.device.system(self.human.grasp_of(g), self.load_cell);
+                let h = self.period / self.substeps as f64;
+                self.steppers.push((g, Stepper::new(&sys, self.method, h)));
+            }
+        }
+        self.grasp_override = grasp;
+    }
+
+    /// A hand force added to the script's (N): the scope's mouse push.
+    pub fn set_push(&mut self, force_n: f64) {
+        self.extra_push_n = if force_n.is_finite() { force_n } else { 0.0 };
     }
 
     /// The running servo (gains, VE).
@@ -561,7 +615,11 @@ impl Simulation {
     ) -> Sample {
         let t = self.tick as f64 * self.period;
         let n = self.device.n;
-        let hand = self.human.at(t);
+        let mut hand = self.human.at(t);
+        if let Some(g) = self.grasp_override {
+            hand.grasp = g;
+        }
+        hand.push_n += self.extra_push_n;
         let mut frame = self.sense();
         let timing = self.timing();
         if let Some(d) = self.scene.effects.delay {

@@ -182,3 +182,36 @@ fn errors_name_the_problem_and_exit_2() {
         assert!(e.contains(want), "{args:?}: {e}");
     }
 }
+
+#[test]
+fn with_no_display_the_scope_says_so_and_runs_headless() {
+    let out = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .expect("run host-sim");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("no display"), "{err}");
+    assert!(err.contains("headless"), "{err}");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("Stiff wall") && text.contains("stable"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_screenshot_without_a_display_is_a_clear_error() {
+    let out = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(["--screenshot", "/tmp/never.png", "--exit-after", "1"])
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .expect("run host-sim");
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--screenshot needs a window"), "{err}");
+}

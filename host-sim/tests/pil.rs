@@ -14,7 +14,7 @@ fn corrupted_frames_are_dropped_and_the_loop_goes_on() {
     let clean = pil::run(
         scene(),
         3000,
-        &mut LocalBoard::excalibur().unwrap(),
+        LocalBoard::excalibur().unwrap(),
         Faults::default(),
     )
     .unwrap();
@@ -22,7 +22,7 @@ fn corrupted_frames_are_dropped_and_the_loop_goes_on() {
         corrupt_every: 7,
         link_loss_at: None,
     };
-    let noisy = pil::run(scene(), 3000, &mut LocalBoard::excalibur().unwrap(), faults).unwrap();
+    let noisy = pil::run(scene(), 3000, LocalBoard::excalibur().unwrap(), faults).unwrap();
     assert!(noisy.corrupted_sent > 800);
     assert_eq!(
         u64::from(noisy.board_stats.rx.dropped()),
@@ -48,7 +48,7 @@ fn link_loss_gives_zero_force_within_the_watchdog_deadline() {
             corrupt_every: 0,
             link_loss_at: Some(t0),
         };
-        let r = pil::run(scene(), 4500, &mut LocalBoard::excalibur().unwrap(), faults).unwrap();
+        let r = pil::run(scene(), 4500, LocalBoard::excalibur().unwrap(), faults).unwrap();
         assert!(r.duties[t0 as usize - 1] != 0, "force before the loss");
         let z = r.zero_after_loss_ticks.unwrap();
         assert!(z <= deadline, "zero after {z} ticks, deadline {deadline}");
@@ -65,7 +65,7 @@ fn the_board_loop_matches_the_scenes_own_servo_within_pwm_resolution() {
     let r = pil::run(
         scene(),
         6000,
-        &mut LocalBoard::excalibur().unwrap(),
+        LocalBoard::excalibur().unwrap(),
         Faults::default(),
     )
     .unwrap();
@@ -87,13 +87,8 @@ fn a_scene_with_another_encoder_is_refused_by_name() {
         &["effects.encoder.bits=32".to_string()],
     )
     .unwrap();
-    let e = pil::run(
-        s,
-        10,
-        &mut LocalBoard::excalibur().unwrap(),
-        Faults::default(),
-    )
-    .err()
-    .unwrap();
+    let e = pil::run(s, 10, LocalBoard::excalibur().unwrap(), Faults::default())
+        .err()
+        .unwrap();
     assert!(e.contains("effects.encoder"), "{e}");
 }

@@ -8,6 +8,7 @@
 //! - `pil [host-sim pil options]`: processor-in-the-loop, the firmware in
 //!   QEMU against host-sim's plant over `-serial pty` (e.g. `--json`,
 //!   `--seconds 4`, `--link-loss-at-s 3`, `--check`).
+//! - `scope-board`: the scope's board mode against the firmware in QEMU.
 //! - `fuzz [seconds]`: run each cargo-fuzz target (default 60 s each).
 //! - `accuracy`: regenerate docs/accuracy.md and docs/accuracy.png.
 
@@ -26,6 +27,7 @@ fn main() -> ExitCode {
         Some("firmware") => firmware().map(|_| ()),
         Some("qemu") => qemu(),
         Some("pil") => pil(&args[1..]),
+        Some("scope-board") => scope_board(),
         Some("fuzz") => {
             let secs = args.get(1).map_or(Ok(60), |s| {
                 s.parse::<u32>().map_err(|e| format!("seconds: {e}"))
@@ -46,7 +48,7 @@ fn main() -> ExitCode {
             ]),
         ),
         _ => Err(format!(
-            "usage: cargo xtask <ci|thumb|firmware|qemu|pil [options]|fuzz [seconds]|accuracy>\n  got: {}",
+            "usage: cargo xtask <ci|thumb|firmware|qemu|pil [options]|scope-board|fuzz [seconds]|accuracy>\n  got: {}",
             args.join(" ")
         )),
     };
@@ -153,12 +155,13 @@ fn ci() -> Result<(), String> {
         "3".into(),
         "--check".into(),
     ])?;
+    scope_board()?;
     fuzz(60)?;
     // Last, closing on the total so that CI reads the whole count rather
     // than the last crate's doc-test line. The long hard cases (24 h of
     // ticks, 2 x 10^4 random terminations) are ignored in debug builds and
     // run here in release.
-    let runs: [&[&str]; 2] = [
+    let runs: [&[&str]; 3] = [
         &[
             "test",
             "--release",
@@ -168,6 +171,22 @@ fn ci() -> Result<(), String> {
             "terminations",
             "--",
             "--ignored",
+        ],
+        // The scope in a real window under Xvfb (screenshots) and an hour of
+        // scope buffers.
+        &[
+            "test",
+            "--release",
+            "-p",
+            "host-sim",
+            "--test",
+            "screenshot",
+            "--test",
+            "scope",
+            "--",
+            "--ignored",
+            "--skip",
+            "board_mode",
         ],
         &["test", "--workspace"],
     ];
@@ -269,12 +288,54 @@ fn firmware() -> Result<PathBuf, String> {
 /// Processor-in-the-loop: start the an386 image in QEMU with its UART on a
 /// pty, point `host-sim pil` at it, and fail if either side fails.
 fn pil(extra: &[String]) -> Result<(), String> {
-    use std::io::{BufRead, BufReader, Read};
-    let elf = firmware()?.join("twoport-an386");
     run(
         "build host-sim",
         cargo().args(["build", "--release", "-q", "-p", "host-sim"]),
     )?;
+    with_board_in_qemu(|pty| {
+        let st = cargo()
+            .args([
+                "run",
+                "--release",
+                "-q",
+                "-p",
+                "host-sim",
+                "--",
+                "pil",
+                "--port",
+            ])
+            .arg(pty)
+            .args(extra)
+            .status()
+            .map_err(|e| format!("host-sim pil: {e}"))?;
+        if st.success() {
+            Ok(())
+        } else {
+            Err(format!("host-sim pil failed ({st})"))
+        }
+    })
+}
+
+/// The scope's board mode against the firmware in QEMU.
+fn scope_board() -> Result<(), String> {
+    with_board_in_qemu(|pty| {
+        run(
+            "scope board mode against QEMU",
+            cargo()
+                .env("TWOPORT_PTY", pty)
+                .args(["test", "--release", "-p", "host-sim", "--test", "scope"])
+                .args(["--", "--ignored", "--exact"])
+                .arg("board_mode_shows_telemetry_and_the_boards_gain_answers"),
+        )
+    })
+}
+
+/// Run `f` with the an386 image in QEMU, its UART on the pty `f` gets;
+/// fails if the firmware stops (a panic or HardFault exits QEMU) or `f`
+/// fails.
+fn with_board_in_qemu(f: impl FnOnce(&str) -> Result<(), String>) -> Result<(), String> {
+    use std::io::{BufRead, BufReader, Read};
+    let elf = firmware()?.join("twoport-an386");
     let mut qemu = Command::new("qemu-system-arm")
         .args(["-machine", "mps2-an386", "-cpu", "cortex-m4"])
         .args(["-display", "none", "-monitor", "none", "-serial", "pty"])
@@ -312,20 +373,7 @@ fn pil(extra: &[String]) -> Result<(), String> {
         let _ = stderr.read_to_string(&mut s);
     });
     eprintln!("xtask: firmware in QEMU on {pty}");
-    let host = cargo()
-        .args([
-            "run",
-            "--release",
-            "-q",
-            "-p",
-            "host-sim",
-            "--",
-            "pil",
-            "--port",
-        ])
-        .arg(&pty)
-        .args(extra)
-        .status();
+    let host = f(&pty);
     let early_exit = qemu.try_wait().ok().flatten();
     let _ = qemu.kill();
     let _ = qemu.wait();
@@ -335,13 +383,7 @@ fn pil(extra: &[String]) -> Result<(), String> {
             "the firmware stopped during the run ({st}):\n{printed}"
         ));
     }
-    match host {
-        Ok(st) if st.success() => Ok(()),
-        Ok(st) => Err(format!(
-            "host-sim pil failed ({st}); the board printed:\n{printed}"
-        )),
-        Err(e) => Err(format!("host-sim pil: {e}")),
-    }
+    host.map_err(|e| format!("{e}; the board printed:\n{printed}"))
 }
 
 /// The cargo-fuzz targets in fuzz/.

@@ -214,6 +214,11 @@ impl Spring {
         Ok(())
     }
 
+    /// Stiffness (N/m) and damping (N s/m).
+    pub fn gains(&self) -> (f32, f32) {
+        (self.k, self.b)
+    }
+
     /// Move the anchor (the probe stays where it is).
     pub fn set_anchor(&mut self, anchor: Position) {
         self.anchor = anchor;
@@ -303,6 +308,16 @@ impl UnilateralWall {
     /// Change stiffness and damping.
     pub fn set_gains(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
         self.spring.set_gains(k_npm, b_nspm)
+    }
+
+    /// Stiffness (N/m) and damping (N s/m).
+    pub fn gains(&self) -> (f32, f32) {
+        self.spring.gains()
+    }
+
+    /// Where the surface is.
+    pub fn surface(&self) -> Position {
+        self.spring.anchor
     }
 
     /// +1 when solid above, -1 when below.

@@ -1,0 +1,667 @@
+//! The scope's state, apart from any drawing: the running simulation, its
+//! signals in bounded rings, the transport (play, pause, step, speed), the
+//! trigger and freeze, the gains with the designer's live verdict, the hand
+//! and wall controls, and the link to a board. `ui.rs` draws it.
+
+use crate::human::GraspKind;
+use crate::pil::{SerialBoard, Session};
+use crate::scene::{Display, Scene, VeSpec};
+use crate::scope::{last_trigger, Edge, Ring};
+use crate::{Sample, Simulation};
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+use twoport_design::design::{self, Analysis, Check, GridSpec};
+use twoport_design::plot::Figure;
+use twoport_design::twoport::HumanBound;
+use twoport_design::{DeviceModel, Plant};
+use twoport_link::{Gains, GainsReply, Message, Telemetry};
+
+/// Samples each signal's ring holds: 20 s at 1 kHz.
+pub const RING_SAMPLES: usize = 20_000;
+/// The rings' memory bound (bytes): every signal, simulation and board.
+pub const RING_BYTES: usize =
+    (Signal::ALL.len() + BoardSignal::ALL.len()) * RING_SAMPLES * std::mem::size_of::<(f64, f64)>();
+/// Wall time the simulation may take per frame, so the window stays live.
+const FRAME_BUDGET: Duration = Duration::from_millis(25);
+
+const BUILTIN_EXCALIBUR: &str = include_str!("../../models/excalibur.toml");
+
+/// A simulated signal the scope records.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Signal {
+    /// Handle position (m).
+    HandlePosition,
+    /// Handle velocity (m/s).
+    HandleVelocity,
+    /// Human force on the handle (N).
+    HumanForce,
+    /// Force the law commanded (N).
+    CommandedForce,
+    /// Force the actuator delivered (N).
+    ActuatorForce,
+    /// VE position (m).
+    VePosition,
+    /// VE force (N).
+    VeForce,
+    /// Coupling force (N).
+    CouplingForce,
+    /// Energy the human put in (J).
+    EnergyIn,
+    /// Energy stored in the device (J).
+    EnergyStored,
+}
+
+impl Signal {
+    /// Every signal, in ring order.
+    pub const ALL: [Signal; 10] = [
+        Signal::HandlePosition,
+        Signal::HandleVelocity,
+        Signal::HumanForce,
+        Signal::CommandedForce,
+        Signal::ActuatorForce,
+        Signal::VePosition,
+        Signal::VeForce,
+        Signal::CouplingForce,
+        Signal::EnergyIn,
+        Signal::EnergyStored,
+    ];
+
+    /// Legend text with unit.
+    pub fn name(self) -> &'static str {
+        match self {
+            Signal::HandlePosition => "handle position (m)",
+            Signal::HandleVelocity => "handle velocity (m/s)",
+            Signal::HumanForce => "human force (N)",
+            Signal::CommandedForce => "commanded force (N)",
+            Signal::ActuatorForce => "actuator force (N)",
+            Signal::VePosition => "VE position (m)",
+            Signal::VeForce => "VE force (N)",
+            Signal::CouplingForce => "coupling force (N)",
+            Signal::EnergyIn => "energy in from the human (J)",
+            Signal::EnergyStored => "energy stored in the device (J)",
+        }
+    }
+
+    fn of(self, s: &Sample) -> f64 {
+        match self {
+            Signal::HandlePosition => s.handle_m,
+            Signal::HandleVelocity => s.handle_mps,
+            Signal::HumanForce => s.human_n,
+            Signal::CommandedForce => s.commanded_n,
+            Signal::ActuatorForce => s.actuator_n,
+            Signal::VePosition => s.ve_m,
+            Signal::VeForce => s.ve_n,
+            Signal::CouplingForce => s.coupling_n,
+            Signal::EnergyIn => s.energy_in_j,
+            Signal::EnergyStored => s.energy_stored_j,
+        }
+    }
+
+    fn index(self) -> usize {
+        Signal::ALL.iter().position(|s| *s == self).unwrap_or(0)
+    }
+}
+
+/// A signal from the board's telemetry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BoardSignal {
+    /// Actuator position from the encoder (m).
+    Position,
+    /// Force the board's law commanded (N).
+    Commanded,
+    /// Force sent to the amplifier (N).
+    Actuator,
+    /// The board's VE position (m).
+    VePosition,
+}
+
+impl BoardSignal {
+    /// Every board signal, in ring order.
+    pub const ALL: [BoardSignal; 4] = [
+        BoardSignal::Position,
+        BoardSignal::Commanded,
+        BoardSignal::Actuator,
+        BoardSignal::VePosition,
+    ];
+
+    /// Legend text with unit.
+    pub fn name(self) -> &'static str {
+        match self {
+            BoardSignal::Position => "board: position (m)",
+            BoardSignal::Commanded => "board: commanded force (N)",
+            BoardSignal::Actuator => "board: actuator force (N)",
+            BoardSignal::VePosition => "board: VE position (m)",
+        }
+    }
+
+    fn of(self, t: &Telemetry) -> f64 {
+        match self {
+            BoardSignal::Position => t.position_pm as f64 * 1e-12,
+            BoardSignal::Commanded => t.commanded_n as f64,
+            BoardSignal::Actuator => t.actuator_n as f64,
+            BoardSignal::VePosition => t.ve_position_pm as f64 * 1e-12,
+        }
+    }
+}
+
+/// How fast simulated time runs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Speed {
+    /// Simulated time follows wall time times this factor.
+    Times(f64),
+    /// As many ticks as the frame budget allows.
+    Fastest,
+}
+
+/// The oscilloscope trigger.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Trigger {
+    /// Whether sweeps start at a crossing.
+    pub enabled: bool,
+    /// The signal watched.
+    pub signal: Signal,
+    /// The level crossed (the signal's unit).
+    pub level: f64,
+    /// Which crossing.
+    pub edge: Edge,
+}
+
+/// The coupling (and regulator) gains as the sliders hold them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SliderGains {
+    /// Impedance display: `k_c` (N/m), `b_c` (N s/m).
+    Impedance {
+        /// Stiffness (N/m).
+        k: f64,
+        /// Damping (N s/m).
+        b: f64,
+    },
+    /// Admittance display: `K_p` (N/m, N s/m), `m_c` (kg), `b_c` (N s/m).
+    Admittance {
+        /// Regulator stiffness (N/m).
+        kp: f64,
+        /// Regulator damping (N s/m).
+        bp: f64,
+        /// Coupling mass (kg).
+        m: f64,
+        /// Coupling damping (N s/m).
+        b: f64,
+    },
+}
+
+/// The designer's verdict on the gains in force.
+pub struct Light {
+    /// Proven absolutely stable.
+    pub proven: bool,
+    /// Least relative margin and where (Hz).
+    pub margin: f64,
+    /// Worst frequency (Hz).
+    pub worst_hz: f64,
+    /// The design bound and the coupling's response (Fig. 8 or 9).
+    pub figure: Option<Figure>,
+}
+
+/// A connected board.
+pub struct BoardLink {
+    session: Session<SerialBoard>,
+    /// Port path.
+    pub port: String,
+    /// The last telemetry.
+    pub telemetry: Option<Telemetry>,
+    /// The board's last answer to a gain request.
+    pub reply: Option<String>,
+    /// Latched faults the board reported.
+    pub faults: Option<u16>,
+}
+
+/// Everything the scope shows and controls.
+pub struct ScopeState {
+    /// Scene files found in the scenes folder.
+    pub scenes: Vec<PathBuf>,
+    /// The scene running.
+    pub scene_path: PathBuf,
+    scene: Scene,
+    sim: Simulation,
+    /// The designer's view of the scene's device (the model file's).
+    design: Option<(Plant, Analysis)>,
+    /// Running or paused.
+    pub running: bool,
+    /// How fast.
+    pub speed: Speed,
+    rings: Vec<Ring>,
+    board_rings: Vec<Ring>,
+    /// Signals drawn.
+    pub shown: Vec<Signal>,
+    /// The visible time span (s).
+    pub window_s: f64,
+    /// The trigger.
+    pub trigger: Trigger,
+    /// A frozen copy of the rings, drawn instead of the live ones.
+    frozen: Option<(Vec<Ring>, Vec<Ring>, f64)>,
+    /// The gains in force.
+    pub gains: SliderGains,
+    /// The designer's verdict on them.
+    pub light: Option<Light>,
+    /// The grasp override (None: the scene's script).
+    pub grasp: Option<GraspKind>,
+    /// The mouse push (N).
+    pub push_n: f64,
+    /// Wall surface (m) and stiffness (N/m), when the VE is a wall.
+    pub wall: Option<(f64, f64)>,
+    /// The board, in board mode.
+    pub board: Option<BoardLink>,
+    /// The last problem to show (a refused gain, a lost link, a bad scene).
+    pub message: Option<String>,
+    /// Simulated seconds owed to real time (real-time speeds).
+    debt_s: f64,
+    last: Option<Sample>,
+}
+
+fn gains_of(scene: &Scene) -> SliderGains {
+    let c = scene.coupling;
+    match scene.display {
+        Display::Impedance => SliderGains::Impedance {
+            k: c.k.unwrap_or(0.0),
+            b: c.b,
+        },
+        Display::Admittance => SliderGains::Admittance {
+            kp: c.kp.unwrap_or(0.0),
+            bp: c.bp.unwrap_or(0.0),
+            m: c.m.unwrap_or(1.0),
+            b: c.b,
+        },
+    }
+}
+
+/// The scene files in `dir`, sorted.
+pub fn list_scenes(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|d| {
+            d.filter_map(Result::ok)
+                .map(|e| e.path())
+                .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+impl ScopeState {
+    /// The scope on `scene_path`, listing the scenes beside it.
+    pub fn open(scene_path: &Path) -> Result<Self, String> {
+        let scene = Scene::load(scene_path, &[]).map_err(|e| e.to_string())?;
+        let sim = Simulation::new(scene.clone())?;
+        let dir = scene_path.parent().unwrap_or(Path::new("."));
+        let mut s = ScopeState {
+            scenes: list_scenes(dir),
+            scene_path: scene_path.to_path_buf(),
+            design: analysis_plant(&scene).map(|p| {
+                let a = Analysis::new(&p, GridSpec::DEFAULT);
+                (p, a)
+            }),
+            gains: gains_of(&scene),
+            wall: wall_of(&scene),
+            scene,
+            sim,
+            running: true,
+            speed: Speed::Times(1.0),
+            rings: Signal::ALL
+                .iter()
+                .map(|_| Ring::new(RING_SAMPLES))
+                .collect(),
+            board_rings: BoardSignal::ALL
+                .iter()
+                .map(|_| Ring::new(RING_SAMPLES))
+                .collect(),
+            shown: Signal::ALL.to_vec(),
+            window_s: 5.0,
+            trigger: Trigger {
+                enabled: false,
+                signal: Signal::ActuatorForce,
+                level: 1.0,
+                edge: Edge::Rising,
+            },
+            frozen: None,
+            light: None,
+            grasp: None,
+            push_n: 0.0,
+            board: None,
+            message: None,
+            debt_s: 0.0,
+            last: None,
+        };
+        s.sim.track_energy(true);
+        s.update_light();
+        Ok(s)
+    }
+
+    /// Switch to another scene (keeps the board link).
+    pub fn load_scene(&mut self, path: &Path) {
+        match ScopeState::open(path) {
+            Ok(mut n) => {
+                n.scenes = std::mem::take(&mut self.scenes);
+                n.board = self.board.take();
+                n.speed = self.speed;
+                *self = n;
+            }
+            Err(e) => self.message = Some(format!("{}: {e}", path.display())),
+        }
+    }
+
+    /// Start the scene again (the gains and controls stay as set).
+    pub fn reset(&mut self) {
+        let path = self.scene_path.clone();
+        let (gains, grasp, push, wall, speed) =
+            (self.gains, self.grasp, self.push_n, self.wall, self.speed);
+        self.load_scene(&path);
+        self.speed = speed;
+        self.set_gains(gains);
+        self.set_grasp(grasp);
+        self.set_push(push);
+        if let Some((x, k)) = wall {
+            self.set_wall(x, k);
+        }
+    }
+
+    /// The coupling gains the running simulation uses: `(k, b)` on an
+    /// impedance display, `(m, b)` on an admittance display.
+    pub fn running_coupling(&self) -> (f64, f64) {
+        let (a, b) = match self.sim.servo() {
+            crate::sim::Servo::Impedance(s) => s.coupling().gains(),
+            crate::sim::Servo::Admittance(s) => s.coupling().gains(),
+        };
+        (a as f64, b as f64)
+    }
+
+    /// The scene in force.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// Simulated time (s).
+    pub fn time_s(&self) -> f64 {
+        self.last.map_or(0.0, |s| s.t_s)
+    }
+
+    /// The last sample.
+    pub fn last(&self) -> Option<&Sample> {
+        self.last.as_ref()
+    }
+
+    /// Why the simulation stopped, if it did.
+    pub fn failure(&self) -> Option<&str> {
+        self.sim.failure()
+    }
+
+    /// The ring of `s` (live or frozen).
+    pub fn ring(&self, s: Signal) -> &Ring {
+        match &self.frozen {
+            Some((r, _, _)) => &r[s.index()],
+            None => &self.rings[s.index()],
+        }
+    }
+
+    /// The ring of a board signal (live or frozen).
+    pub fn board_ring(&self, s: BoardSignal) -> &Ring {
+        let i = BoardSignal::ALL.iter().position(|x| *x == s).unwrap_or(0);
+        match &self.frozen {
+            Some((_, r, _)) => &r[i],
+            None => &self.board_rings[i],
+        }
+    }
+
+    /// Whether the display is frozen.
+    pub fn is_frozen(&self) -> bool {
+        self.frozen.is_some()
+    }
+
+    /// Freeze the display (a copy of the rings) or let it run again.
+    pub fn set_frozen(&mut self, on: bool) {
+        self.frozen = on.then(|| (self.rings.clone(), self.board_rings.clone(), self.time_s()));
+    }
+
+    /// The time span to draw: the last `window_s`, or from the last
+    /// trigger crossing that still has a full window after it.
+    pub fn view(&self) -> (f64, f64) {
+        let end = match &self.frozen {
+            Some((_, _, t)) => *t,
+            None => self.time_s(),
+        };
+        if self.trigger.enabled {
+            let ring = self.ring(self.trigger.signal);
+            let early = ring.iter().filter(|(t, _)| *t <= end - 0.8 * self.window_s);
+            if let Some(t) = last_trigger(early, self.trigger.level, self.trigger.edge) {
+                let start = t - 0.2 * self.window_s;
+                return (start, start + self.window_s);
+            }
+        }
+        (end - self.window_s, end)
+    }
+
+    /// Advance by one frame of `wall_s` wall time at the set speed.
+    pub fn advance(&mut self, wall_s: f64) {
+        if !self.running {
+            return;
+        }
+        let start = std::time::Instant::now();
+        let period = self.sim.period();
+        let ticks = match self.speed {
+            Speed::Times(f) => {
+                self.debt_s = (self.debt_s + wall_s * f).min(1.0);
+                (self.debt_s / period).floor() as u64
+            }
+            Speed::Fastest => u64::MAX,
+        };
+        for _ in 0..ticks {
+            if !self.tick() || start.elapsed() > FRAME_BUDGET {
+                break;
+            }
+        }
+    }
+
+    /// One tick (the step button); false if the simulation cannot go on.
+    pub fn tick(&mut self) -> bool {
+        if self.sim.failure().is_some() {
+            self.running = false;
+            return false;
+        }
+        let s = match self.board.as_mut() {
+            Some(b) => match b.session.step(&mut self.sim) {
+                Ok((s, _)) => s,
+                Err(e) => {
+                    self.message = Some(format!("board link lost: {e}"));
+                    self.board = None;
+                    self.running = false;
+                    return false;
+                }
+            },
+            None => self.sim.step(),
+        };
+        self.debt_s -= self.sim.period();
+        for (sig, ring) in Signal::ALL.iter().zip(&mut self.rings) {
+            ring.push(s.t_s, sig.of(&s));
+        }
+        self.last = Some(s);
+        self.board_messages();
+        true
+    }
+
+    fn board_messages(&mut self) {
+        let Some(b) = self.board.as_mut() else {
+            return;
+        };
+        for m in b.session.take_messages() {
+            match m {
+                Message::Telemetry(t) => {
+                    let ts = t.tick as f64 * self.sim.period();
+                    for (sig, ring) in BoardSignal::ALL.iter().zip(&mut self.board_rings) {
+                        ring.push(ts, sig.of(&t));
+                    }
+                    b.telemetry = Some(t);
+                }
+                Message::GainsReply(GainsReply::Accepted(_)) => {
+                    b.reply = Some("accepted".into());
+                }
+                Message::GainsReply(GainsReply::Refused(why)) => {
+                    b.reply = Some(format!("refused: {why:?}"));
+                }
+                Message::FaultReport { faults, .. } => b.faults = Some(faults),
+                _ => {}
+            }
+        }
+    }
+
+    /// New gains for the running simulation (and the board, which may
+    /// refuse them); the light follows.
+    pub fn set_gains(&mut self, g: SliderGains) {
+        let r = match g {
+            SliderGains::Impedance { k, b } => self.sim.servo_mut().set_coupling(k, b),
+            SliderGains::Admittance { kp, bp, m, b } => self
+                .sim
+                .servo_mut()
+                .set_regulator(kp, bp)
+                .and_then(|_| self.sim.servo_mut().set_coupling(m, b)),
+        };
+        if let Err(e) = r {
+            self.message = Some(format!("gains not applied: {e}"));
+            return;
+        }
+        self.gains = g;
+        if let Some(b) = self.board.as_mut() {
+            let msg = Message::SetGains(match g {
+                SliderGains::Impedance { k, b } => Gains::Impedance {
+                    k_npm: k as f32,
+                    b_nspm: b as f32,
+                },
+                SliderGains::Admittance { kp, bp, m, b } => Gains::Admittance {
+                    kp_npm: kp as f32,
+                    bp_nspm: bp as f32,
+                    m_kg: m as f32,
+                    b_nspm: b as f32,
+                },
+            });
+            if let Err(e) = b.session.send(&msg) {
+                self.message = Some(format!("board: {e}"));
+            }
+        }
+        self.update_light();
+    }
+
+    fn update_light(&mut self) {
+        let Some((plant, a)) = &self.design else {
+            self.light = None;
+            return;
+        };
+        let h = Some(HumanBound::PAPER);
+        let (check, figure): (Option<Check>, _) = match self.gains {
+            SliderGains::Impedance { k, b } => (
+                design::check_impedance(a, k, b, h),
+                twoport_design::figures::fig8(a, k, b).ok(),
+            ),
+            SliderGains::Admittance { kp, bp, m, b } => (
+                design::check_admittance(plant, a, (kp, bp), (m, b), h),
+                twoport_design::figures::fig9(a, (kp, bp), (m, b)).ok(),
+            ),
+        };
+        self.light = Some(match check {
+            Some(c) => Light {
+                proven: c.absolutely_stable,
+                margin: c.min_margin,
+                worst_hz: c.worst_frequency_hz,
+                figure,
+            },
+            None => Light {
+                proven: false,
+                margin: f64::NEG_INFINITY,
+                worst_hz: 0.0,
+                figure,
+            },
+        });
+    }
+
+    /// Hold the hand in a grasp, or give it back to the script.
+    pub fn set_grasp(&mut self, g: Option<GraspKind>) {
+        self.grasp = g;
+        self.sim.set_grasp(g);
+    }
+
+    /// The mouse push (N).
+    pub fn set_push(&mut self, f: f64) {
+        self.push_n = f;
+        self.sim.set_push(f);
+    }
+
+    /// Move the wall and set its stiffness.
+    pub fn set_wall(&mut self, x_m: f64, k_npm: f64) {
+        match self.sim.servo_mut().set_wall(x_m, k_npm) {
+            Ok(()) => self.wall = Some((x_m, k_npm)),
+            Err(e) => self.message = Some(e),
+        }
+    }
+
+    /// Board mode: connect to the board at `port` (lockstep: this
+    /// simulation is its plant).
+    pub fn connect(&mut self, port: &str) {
+        let r = crate::pil::check_scene(&self.scene)
+            .and_then(|_| SerialBoard::open(port))
+            .and_then(|p| Session::open(p, crate::pil::Faults::default()));
+        match r {
+            Ok(session) => {
+                self.board = Some(BoardLink {
+                    session,
+                    port: port.to_string(),
+                    telemetry: None,
+                    reply: None,
+                    faults: None,
+                });
+                self.message = None;
+            }
+            Err(e) => self.message = Some(format!("board at {port}: {e}")),
+        }
+    }
+
+    /// Leave board mode.
+    pub fn disconnect(&mut self) {
+        if let Some(mut b) = self.board.take() {
+            let _ = b.session.send(&Message::Disable);
+        }
+    }
+
+    /// Clear the board's latched faults.
+    pub fn clear_board_faults(&mut self) {
+        if let Some(b) = self.board.as_mut() {
+            let _ = b.session.send(&Message::ClearFaults);
+            let _ = b.session.send(&Message::Enable);
+            b.faults = None;
+        }
+    }
+}
+
+fn wall_of(scene: &Scene) -> Option<(f64, f64)> {
+    match scene.ve {
+        VeSpec::Wall {
+            position_m,
+            stiffness_npm,
+            ..
+        } => Some((position_m, stiffness_npm)),
+        _ => None,
+    }
+}
+
+fn analysis_plant(scene: &Scene) -> Option<Plant> {
+    let model = if scene.plant.model.exists() {
+        DeviceModel::load(&scene.plant.model).ok()?
+    } else {
+        DeviceModel::from_toml(BUILTIN_EXCALIBUR, "built-in excalibur.toml").ok()?
+    };
+    Plant::new(&model, scene.period_s.unwrap_or(model.period_s)).ok()
+}
+
+/// Serial ports the system lists (a pty from QEMU is not listed; type its
+/// path).
+pub fn list_ports() -> Vec<String> {
+    serialport::available_ports()
+        .map(|v| v.into_iter().map(|p| p.port_name).collect())
+        .unwrap_or_default()
+}

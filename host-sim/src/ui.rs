@@ -1,0 +1,437 @@
+//! The scope's drawing: small functions, one per panel, over `ScopeState`.
+//! Nothing here owns simulation state.
+
+use crate::app::{list_ports, BoardSignal, ScopeState, Signal, SliderGains, Speed};
+use crate::human::GraspKind;
+use crate::scope::{minmax, Edge, Ring};
+use eframe::egui::{self, Color32, RichText, Ui};
+use egui_plot::{Legend, Line, Plot, PlotPoints};
+
+/// Per-pixel min/max columns of `ring` over `[t0, t1)`, as a polyline that
+/// runs down each column: every peak drawn, none aliased away.
+fn envelope(ring: &Ring, t0: f64, t1: f64, pixels: usize) -> Vec<[f64; 2]> {
+    let cols = minmax(ring.iter(), t0, t1, pixels.max(1));
+    let dt = (t1 - t0) / cols.len() as f64;
+    let mut pts = Vec::with_capacity(2 * cols.len());
+    for (i, c) in cols.iter().enumerate() {
+        if let Some((lo, hi)) = c {
+            let t = t0 + (i as f64 + 0.5) * dt;
+            pts.push([t, *lo]);
+            if hi != lo {
+                pts.push([t, *hi]);
+            }
+        }
+    }
+    pts
+}
+
+const COLORS: [Color32; 6] = [
+    Color32::from_rgb(31, 119, 180),
+    Color32::from_rgb(214, 39, 40),
+    Color32::from_rgb(44, 160, 44),
+    Color32::from_rgb(255, 127, 14),
+    Color32::from_rgb(148, 103, 189),
+    Color32::from_rgb(140, 86, 75),
+];
+
+/// One plot of the stack: the named signals on the shared time axis.
+fn signal_plot(
+    ui: &mut Ui,
+    s: &ScopeState,
+    id: &str,
+    height: f32,
+    signals: &[Signal],
+    board: &[BoardSignal],
+) {
+    let (t0, t1) = s.view();
+    let px = ui.available_width().max(1.0) as usize;
+    Plot::new(id)
+        .height(height)
+        .legend(Legend::default())
+        .link_axis(egui::Id::unique("scope-time"), [true, false])
+        .allow_drag(false)
+        .allow_zoom(false)
+        .allow_scroll(false)
+        .show(ui, |p| {
+            p.set_plot_bounds_x(t0..=t1);
+            p.set_auto_bounds([false, true]);
+            for (i, sig) in signals.iter().filter(|x| s.shown.contains(x)).enumerate() {
+                let pts = envelope(s.ring(*sig), t0, t1, px);
+                p.line(Line::new(sig.name(), PlotPoints::from(pts)).color(COLORS[i % 6]));
+            }
+            if s.board.is_some() {
+                for b in board {
+                    let pts = envelope(s.board_ring(*b), t0, t1, px);
+                    p.line(Line::new(b.name(), PlotPoints::from(pts)).width(2.0));
+                }
+            }
+        });
+}
+
+/// The four plots on one time axis.
+pub fn plots(ui: &mut Ui, s: &ScopeState) {
+    let h = ((ui.available_height() - 24.0) / 4.0).max(80.0);
+    signal_plot(
+        ui,
+        s,
+        "positions",
+        h,
+        &[Signal::HandlePosition, Signal::VePosition],
+        &[BoardSignal::Position, BoardSignal::VePosition],
+    );
+    signal_plot(ui, s, "velocity", h, &[Signal::HandleVelocity], &[]);
+    signal_plot(
+        ui,
+        s,
+        "forces",
+        h,
+        &[
+            Signal::HumanForce,
+            Signal::CommandedForce,
+            Signal::ActuatorForce,
+            Signal::VeForce,
+            Signal::CouplingForce,
+        ],
+        &[BoardSignal::Commanded, BoardSignal::Actuator],
+    );
+    signal_plot(
+        ui,
+        s,
+        "energy",
+        h,
+        &[Signal::EnergyIn, Signal::EnergyStored],
+        &[],
+    );
+}
+
+/// Scene picker, play/pause/step/reset, speed, time and status.
+pub fn transport(ui: &mut Ui, s: &mut ScopeState) {
+    ui.horizontal_wrapped(|ui| {
+        let current = s.scene_path.display().to_string();
+        let mut pick = None;
+        egui::ComboBox::from_label("scene")
+            .selected_text(
+                s.scene_path
+                    .file_name()
+                    .map(|f| f.to_string_lossy().to_string())
+                    .unwrap_or(current.clone()),
+            )
+            .show_ui(ui, |ui| {
+                for p in &s.scenes {
+                    let name = p.file_name().map(|f| f.to_string_lossy().to_string());
+                    let name = name.unwrap_or_default();
+                    if ui.selectable_label(*p == s.scene_path, name).clicked() {
+                        pick = Some(p.clone());
+                    }
+                }
+            });
+        if let Some(p) = pick {
+            s.load_scene(&p);
+        }
+        let play = if s.running { "pause" } else { "play" };
+        if ui.button(play).clicked() {
+            s.running = !s.running;
+        }
+        if ui.button("step").clicked() {
+            s.running = false;
+            s.tick();
+        }
+        if ui.button("reset").clicked() {
+            s.reset();
+        }
+        speed(ui, s);
+        ui.label(format!("t = {:.3} s", s.time_s()));
+        if let Some(f) = s.failure() {
+            ui.colored_label(Color32::RED, f.to_string());
+        }
+        if let Some(m) = &s.message {
+            ui.colored_label(Color32::from_rgb(200, 120, 0), m.clone());
+        }
+    });
+}
+
+fn speed(ui: &mut Ui, s: &mut ScopeState) {
+    let label = match s.speed {
+        Speed::Times(1.0) => "real time".to_string(),
+        Speed::Times(f) => format!("x {f}"),
+        Speed::Fastest => "as fast as possible".to_string(),
+    };
+    egui::ComboBox::from_label("speed")
+        .selected_text(label)
+        .show_ui(ui, |ui| {
+            for f in [0.1, 0.25, 1.0, 2.0, 5.0] {
+                let text = if f == 1.0 {
+                    "real time".to_string()
+                } else {
+                    format!("x {f}")
+                };
+                ui.selectable_value(&mut s.speed, Speed::Times(f), text);
+            }
+            ui.selectable_value(&mut s.speed, Speed::Fastest, "as fast as possible");
+        });
+}
+
+/// The gain sliders and the designer's light.
+pub fn gains(ui: &mut Ui, s: &mut ScopeState) {
+    ui.heading("Coupling");
+    let mut g = s.gains;
+    let changed = match &mut g {
+        SliderGains::Impedance { k, b } => {
+            let a = ui
+                .add(egui::Slider::new(k, 0.0..=150_000.0).text("k_c (N/m)"))
+                .changed();
+            let c = ui
+                .add(egui::Slider::new(b, 0.0..=500.0).text("b_c (N s/m)"))
+                .changed();
+            a || c
+        }
+        SliderGains::Admittance { kp, bp, m, b } => {
+            let a = ui
+                .add(egui::Slider::new(kp, 0.0..=150_000.0).text("K_p stiffness (N/m)"))
+                .changed();
+            let c = ui
+                .add(egui::Slider::new(bp, 0.0..=1000.0).text("K_p damping (N s/m)"))
+                .changed();
+            let d = ui
+                .add(
+                    egui::Slider::new(m, 0.05..=50.0)
+                        .logarithmic(true)
+                        .text("m_c (kg)"),
+                )
+                .changed();
+            let e = ui
+                .add(egui::Slider::new(b, 1.0..=2000.0).text("b_c (N s/m)"))
+                .changed();
+            a || c || d || e
+        }
+    };
+    if changed {
+        s.set_gains(g);
+    }
+    light(ui, s);
+}
+
+fn light(ui: &mut Ui, s: &ScopeState) {
+    let Some(l) = &s.light else {
+        ui.label("no designer model for this scene");
+        return;
+    };
+    ui.horizontal(|ui| {
+        let (color, text) = if l.proven {
+            (
+                Color32::from_rgb(30, 170, 60),
+                format!(
+                    "proven absolutely stable (least margin {:.3} at {:.1} Hz)",
+                    l.margin, l.worst_hz
+                ),
+            )
+        } else {
+            (
+                Color32::from_rgb(210, 40, 40),
+                format!("NOT proven stable: worst at {:.1} Hz", l.worst_hz),
+            )
+        };
+        let (rect, _) = ui.allocate_exact_size(egui::vec2(16.0, 16.0), egui::Sense::hover());
+        ui.painter().circle_filled(rect.center(), 7.0, color);
+        ui.label(RichText::new(text).color(color));
+    });
+}
+
+/// The design bound and the coupling's response (Fig. 8 or 9), live.
+pub fn design_panel(ui: &mut Ui, s: &ScopeState) {
+    let Some(fig) = s.light.as_ref().and_then(|l| l.figure.as_ref()) else {
+        return;
+    };
+    ui.label(RichText::new(&fig.y_label).small());
+    // The bound dives at the resonances; frame the plot on the coupling's
+    // own scale, as the paper's figures do.
+    let scale = fig
+        .curves
+        .last()
+        .map(|c| c.points.iter().map(|p| p.1.abs()).fold(0.0, f64::max))
+        .filter(|m| *m > 0.0 && m.is_finite())
+        .unwrap_or(1.0);
+    Plot::new("design-bound")
+        .height(150.0)
+        .include_y(-1.5 * scale)
+        .include_y(1.5 * scale)
+        .auto_bounds([true, false])
+        .legend(Legend::default())
+        .x_axis_label("log10 frequency (Hz)")
+        .show(ui, |p| {
+            for (i, c) in fig.curves.iter().enumerate() {
+                let pts: Vec<[f64; 2]> = c
+                    .points
+                    .iter()
+                    .filter(|(f, v)| *f > 0.0 && v.is_finite())
+                    .map(|(f, v)| [f.log10(), *v])
+                    .collect();
+                let color = Color32::from_rgb(c.color.0, c.color.1, c.color.2);
+                p.line(
+                    Line::new(c.label.clone(), PlotPoints::from(pts))
+                        .color(color)
+                        .width(c.width as f32)
+                        .id(("design", i)),
+                );
+            }
+        });
+}
+
+/// Grasp and the mouse push.
+pub fn hand(ui: &mut Ui, s: &mut ScopeState) {
+    ui.heading("Hand");
+    let mut g = s.grasp;
+    ui.horizontal(|ui| {
+        ui.selectable_value(&mut g, None, "script");
+        ui.selectable_value(&mut g, Some(GraspKind::HandsOff), "hands off");
+        ui.selectable_value(&mut g, Some(GraspKind::Relaxed), "relaxed");
+        ui.selectable_value(&mut g, Some(GraspKind::Maximum), "maximum");
+    });
+    if g != s.grasp {
+        s.set_grasp(g);
+    }
+    // Drag sideways in the box: 0.2 N per point, released is zero.
+    let (rect, resp) =
+        ui.allocate_exact_size(egui::vec2(ui.available_width(), 36.0), egui::Sense::drag());
+    let push = if resp.dragged() {
+        (s.push_n + resp.drag_delta().x as f64 * 0.2).clamp(-60.0, 60.0)
+    } else {
+        0.0
+    };
+    if push != s.push_n {
+        s.set_push(push);
+    }
+    ui.painter().rect_filled(
+        rect,
+        4.0,
+        Color32::from_gray(if resp.dragged() { 70 } else { 45 }),
+    );
+    ui.painter().text(
+        rect.center(),
+        egui::Align2::CENTER_CENTER,
+        format!("drag to push the handle: {:+.1} N", s.push_n),
+        egui::FontId::proportional(13.0),
+        Color32::WHITE,
+    );
+}
+
+/// Wall position and stiffness, when the VE is a wall.
+pub fn wall(ui: &mut Ui, s: &mut ScopeState) {
+    let Some((mut x, mut k)) = s.wall else {
+        return;
+    };
+    ui.heading("Wall");
+    let a = ui
+        .add(egui::Slider::new(&mut x, -0.05..=0.05).text("surface (m)"))
+        .changed();
+    let b = ui
+        .add(
+            egui::Slider::new(&mut k, 1e3..=1e7)
+                .logarithmic(true)
+                .text("stiffness (N/m)"),
+        )
+        .changed();
+    if a || b {
+        s.set_wall(x, k);
+    }
+}
+
+/// Trigger, freeze and the visible span.
+pub fn trigger(ui: &mut Ui, s: &mut ScopeState) {
+    ui.heading("Trigger");
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut s.trigger.enabled, "on");
+        egui::ComboBox::from_label("signal")
+            .selected_text(s.trigger.signal.name())
+            .show_ui(ui, |ui| {
+                for sig in Signal::ALL {
+                    ui.selectable_value(&mut s.trigger.signal, sig, sig.name());
+                }
+            });
+    });
+    ui.horizontal(|ui| {
+        ui.add(egui::DragValue::new(&mut s.trigger.level).speed(0.01))
+            .on_hover_text("level, in the signal's unit");
+        ui.selectable_value(&mut s.trigger.edge, Edge::Rising, "rising");
+        ui.selectable_value(&mut s.trigger.edge, Edge::Falling, "falling");
+    });
+    ui.horizontal(|ui| {
+        let mut frozen = s.is_frozen();
+        if ui.checkbox(&mut frozen, "freeze").changed() {
+            s.set_frozen(frozen);
+        }
+        ui.add(
+            egui::Slider::new(&mut s.window_s, 0.05..=20.0)
+                .logarithmic(true)
+                .text("span (s)"),
+        );
+    });
+}
+
+/// Board mode: port, connect, and what the board says.
+pub fn board(ui: &mut Ui, s: &mut ScopeState, port: &mut String) {
+    ui.heading("Board");
+    if let Some(b) = &s.board {
+        ui.label(format!("connected: {} (lockstep, this plant)", b.port));
+        if let Some(t) = &b.telemetry {
+            ui.label(format!(
+                "tick {}  loop {} cycles  faults {:#06x}",
+                t.tick, t.loop_cycles, t.faults
+            ));
+        }
+        if let Some(r) = &b.reply {
+            ui.label(format!("last gain request: {r}"));
+        }
+        let faults = b.faults;
+        if let Some(f) = faults {
+            ui.colored_label(Color32::RED, format!("fault latched: {f:#06x}"));
+            if ui.button("clear faults").clicked() {
+                s.clear_board_faults();
+            }
+        }
+        if ui.button("disconnect").clicked() {
+            s.disconnect();
+        }
+        return;
+    }
+    ui.horizontal(|ui| {
+        egui::ComboBox::from_label("serial port")
+            .selected_text(if port.is_empty() {
+                "port"
+            } else {
+                port.as_str()
+            })
+            .show_ui(ui, |ui| {
+                for p in list_ports() {
+                    ui.selectable_value(port, p.clone(), p);
+                }
+            });
+        ui.text_edit_singleline(port)
+            .on_hover_text("or a path, e.g. the pty QEMU prints");
+    });
+    if ui.button("connect").clicked() && !port.is_empty() {
+        let p = port.clone();
+        s.connect(&p);
+    }
+}
+
+/// The whole window.
+pub fn scope(ui: &mut Ui, s: &mut ScopeState, port: &mut String) {
+    egui::Panel::top("transport").show(ui, |ui| transport(ui, s));
+    egui::Panel::right("controls")
+        .min_size(330.0)
+        .show(ui, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                gains(ui, s);
+                design_panel(ui, s);
+                ui.separator();
+                hand(ui, s);
+                wall(ui, s);
+                ui.separator();
+                trigger(ui, s);
+                ui.separator();
+                board(ui, s, port);
+            });
+        });
+    egui::CentralPanel::default().show(ui, |ui| plots(ui, s));
+}

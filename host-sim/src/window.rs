@@ -1,0 +1,126 @@
+//! The scope's window (eframe): a frame advances the simulation by the wall
+//! time since the last one, then draws. With `--screenshot` it saves the
+//! window twice (half-way and at `--exit-after`) and closes.
+
+use crate::app::ScopeState;
+use eframe::egui;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+/// What a scripted run does (CI, documentation).
+#[derive(Clone, Debug, Default)]
+pub struct Script {
+    /// Save the window here at the end, and at half-time beside it with
+    /// `.first` before the extension.
+    pub screenshot: Option<PathBuf>,
+    /// Close after this many seconds of wall time.
+    pub exit_after_s: Option<f64>,
+}
+
+/// The first screenshot's path: `out.png` -> `out.first.png`.
+pub fn first_shot_path(p: &Path) -> PathBuf {
+    let stem = p.file_stem().map(|s| s.to_string_lossy().to_string());
+    let ext = p.extension().map(|s| s.to_string_lossy().to_string());
+    p.with_file_name(format!(
+        "{}.first.{}",
+        stem.unwrap_or_else(|| "screenshot".into()),
+        ext.unwrap_or_else(|| "png".into())
+    ))
+}
+
+struct ScopeApp {
+    state: ScopeState,
+    port: String,
+    script: Script,
+    started: Instant,
+    last_frame: Instant,
+    shots: u32,
+    saved: Arc<Mutex<Vec<Result<PathBuf, String>>>>,
+}
+
+fn save_png(img: &egui::ColorImage, path: &Path) -> Result<PathBuf, String> {
+    let [w, h] = img.size;
+    let bytes: Vec<u8> = img.pixels.iter().flat_map(|c| c.to_array()).collect();
+    image::save_buffer(path, &bytes, w as u32, h as u32, image::ColorType::Rgba8)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(path.to_path_buf())
+}
+
+impl ScopeApp {
+    fn shoot(&mut self, ctx: &egui::Context, path: PathBuf) {
+        let saved = self.saved.clone();
+        ctx.request_screenshot(move |img| {
+            let r = save_png(&img, &path);
+            if let Ok(mut v) = saved.lock() {
+                v.push(r);
+            }
+        });
+        self.shots += 1;
+    }
+
+    fn scripted(&mut self, ctx: &egui::Context) {
+        let Some(exit) = self.script.exit_after_s else {
+            return;
+        };
+        let t = self.started.elapsed().as_secs_f64();
+        if let Some(out) = self.script.screenshot.clone() {
+            if self.shots == 0 && t >= 0.5 * exit {
+                self.shoot(ctx, first_shot_path(&out));
+            } else if self.shots == 1 && t >= exit {
+                self.shoot(ctx, out);
+            }
+            let done = self.saved.lock().map(|v| v.len()).unwrap_or(0);
+            if done >= 2 {
+                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            }
+        } else if t >= exit {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
+    }
+}
+
+impl eframe::App for ScopeApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        let now = Instant::now();
+        let dt = (now - self.last_frame).as_secs_f64();
+        self.last_frame = now;
+        self.state.advance(dt);
+        crate::ui::scope(ui, &mut self.state, &mut self.port);
+        self.scripted(&ctx);
+        ctx.request_repaint();
+    }
+}
+
+/// Whether a window can open here: an X11 or Wayland display is named.
+pub fn display_available() -> bool {
+    ["DISPLAY", "WAYLAND_DISPLAY"]
+        .iter()
+        .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()))
+}
+
+/// Open the scope on `scene`; returns the screenshots saved.
+pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, String> {
+    let state = ScopeState::open(scene)?;
+    let saved = Arc::new(Mutex::new(Vec::new()));
+    let app = ScopeApp {
+        state,
+        port: String::new(),
+        script,
+        started: Instant::now(),
+        last_frame: Instant::now(),
+        shots: 0,
+        saved: saved.clone(),
+    };
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_inner_size([1280.0, 860.0])
+            .with_title("twoport scope"),
+        ..Default::default()
+    };
+    eframe::run_native("twoport scope", options, Box::new(|_cc| Ok(Box::new(app))))
+        .map_err(|e| format!("the window would not open: {e}"))?;
+    let v = saved.lock().map(|v| v.clone()).unwrap_or_default();
+    v.into_iter().collect()
+}

@@ -1,0 +1,173 @@
+//! The scope as a person uses it: its controls drive the running simulation
+//! (egui_kittest, no window needed), and its memory stays bounded.
+
+use eframe::egui::accesskit::Role;
+use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
+use host_sim::app::Signal;
+use host_sim::app::{ScopeState, SliderGains, Speed, RING_SAMPLES};
+use std::path::Path;
+
+fn harness() -> Harness<'static, (ScopeState, String)> {
+    let state = ScopeState::open(Path::new("../scenes/stiff_wall.toml")).unwrap();
+    let mut h = Harness::new_ui_state(
+        |ui, s: &mut (ScopeState, String)| {
+            let (state, port) = s;
+            host_sim::ui::scope(ui, state, port)
+        },
+        (state, String::new()),
+    );
+    h.set_size(eframe::egui::vec2(1280.0, 860.0));
+    h.run();
+    h
+}
+
+#[test]
+fn the_stiffness_slider_changes_the_running_simulations_gain() {
+    let mut h = harness();
+    assert_eq!(h.state().0.running_coupling(), (51_000.0, 90.0));
+    h.get_by_role_and_label(Role::Slider, "k_c (N/m)")
+        .set_value_accesskit(30_000.0);
+    h.run();
+    let (k, b) = h.state().0.running_coupling();
+    assert_eq!((k, b), (30_000.0, 90.0));
+    assert_eq!(
+        h.state().0.gains,
+        SliderGains::Impedance {
+            k: 30_000.0,
+            b: 90.0
+        }
+    );
+}
+
+#[test]
+fn the_light_turns_red_past_the_bound() {
+    let mut h = harness();
+    assert!(h
+        .query_by_label_contains("proven absolutely stable")
+        .is_some());
+    // The designer's bound at b = 90 N s/m is 51,074 N/m.
+    h.get_by_role_and_label(Role::Slider, "k_c (N/m)")
+        .set_value_accesskit(60_000.0);
+    h.run();
+    assert!(h
+        .query_by_label_contains("proven absolutely stable")
+        .is_none());
+    let _red = h.get_by_label_contains("NOT proven stable: worst at");
+    let light = h.state().0.light.as_ref().unwrap();
+    assert!(!light.proven);
+    assert!(
+        light.margin < 0.0 && light.worst_hz > 1.0,
+        "{} at {} Hz",
+        light.margin,
+        light.worst_hz
+    );
+    // And back inside it turns green again.
+    h.get_by_role_and_label(Role::Slider, "k_c (N/m)")
+        .set_value_accesskit(50_000.0);
+    h.run();
+    assert!(h.state().0.light.as_ref().unwrap().proven);
+}
+
+#[test]
+fn the_grasp_buttons_and_the_wall_act_on_the_simulation() {
+    let mut h = harness();
+    h.get_by_label("hands off").click();
+    h.run();
+    assert_eq!(
+        h.state().0.grasp,
+        Some(host_sim::human::GraspKind::HandsOff)
+    );
+    h.get_by_role_and_label(Role::Slider, "surface (m)")
+        .set_value_accesskit(0.02);
+    h.run();
+    assert_eq!(h.state().0.wall.map(|w| w.0), Some(0.02));
+}
+
+#[test]
+fn pause_and_step_advance_one_tick() {
+    let mut h = harness();
+    h.get_by_label("pause").click();
+    h.run();
+    let t = h.state().0.time_s();
+    h.get_by_label("step").click();
+    h.run();
+    assert!((h.state().0.time_s() - t - 1e-3).abs() < 1e-9);
+}
+
+#[test]
+fn the_scope_memory_is_bounded() {
+    let mut s = ScopeState::open(Path::new("../scenes/stiff_wall.toml")).unwrap();
+    s.speed = Speed::Fastest;
+    for _ in 0..3 * RING_SAMPLES {
+        assert!(s.tick());
+    }
+    for sig in Signal::ALL {
+        assert_eq!(s.ring(sig).len(), RING_SAMPLES);
+        assert_eq!(s.ring(sig).capacity(), RING_SAMPLES);
+    }
+}
+
+/// An hour at 1 kHz: the buffers hold their bound (release, CI).
+#[test]
+#[ignore = "3.6e6 ticks; CI runs it in release"]
+fn an_hour_of_running_does_not_grow_the_buffers() {
+    let mut s = ScopeState::open(Path::new("../scenes/stiff_wall.toml")).unwrap();
+    let ticks = 3_600_000u64;
+    let mut done = 0;
+    while done < ticks {
+        // The scene ends at 10 s: start it again as a person would.
+        if !s.tick() {
+            s.reset();
+        }
+        done += 1;
+        if done % 600_000 == 0 {
+            for sig in Signal::ALL {
+                assert!(s.ring(sig).len() <= RING_SAMPLES);
+            }
+        }
+    }
+}
+
+/// Board mode against the firmware in QEMU: `cargo xtask scope-board`
+/// starts QEMU and passes its pty in `TWOPORT_PTY`.
+#[test]
+#[ignore = "needs the firmware in QEMU; run by `cargo xtask scope-board`"]
+fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
+    let pty = std::env::var("TWOPORT_PTY").expect("TWOPORT_PTY names the board's pty");
+    let mut s = ScopeState::open(Path::new("../scenes/stiff_wall.toml")).unwrap();
+    s.connect(&pty);
+    assert!(s.board.is_some(), "{:?}", s.message);
+    for _ in 0..2000 {
+        assert!(s.tick(), "{:?}", s.message);
+    }
+    let b = s.board.as_ref().unwrap();
+    let t = b.telemetry.expect("telemetry from the board");
+    assert!(t.tick >= 1900, "tick {}", t.tick);
+    assert!(s.board_ring(host_sim::app::BoardSignal::Actuator).len() >= 150);
+    // The board's position agrees with the simulated handle's encoder.
+    let x_board = t.position_pm as f64 * 1e-12;
+    assert!(
+        x_board > 0.005,
+        "the hand has pushed into the wall: {x_board} m"
+    );
+    // Inside the proven region: accepted; outside: refused with the reason.
+    s.set_gains(SliderGains::Impedance {
+        k: 40_000.0,
+        b: 90.0,
+    });
+    for _ in 0..5 {
+        s.tick();
+    }
+    assert_eq!(s.board.as_ref().unwrap().reply.as_deref(), Some("accepted"));
+    s.set_gains(SliderGains::Impedance {
+        k: 60_000.0,
+        b: 90.0,
+    });
+    for _ in 0..5 {
+        s.tick();
+    }
+    let r = s.board.as_ref().unwrap().reply.clone().unwrap();
+    assert!(r.starts_with("refused: NotProvenStable"), "{r}");
+    s.disconnect();
+}

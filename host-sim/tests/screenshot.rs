@@ -1,0 +1,66 @@
+//! The scope in a real window, as CI sees it: under Xvfb, the default scene
+//! for three seconds, two screenshots. The window must not be blank and the
+//! plots must have moved between the shots while the controls did not.
+
+use image::RgbaImage;
+use std::path::Path;
+use std::process::Command;
+
+fn load(p: &Path) -> RgbaImage {
+    image::open(p)
+        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+        .to_rgba8()
+}
+
+/// Fraction of pixels in `[x0, x1) x [y0, y1)` that differ.
+fn changed(a: &RgbaImage, b: &RgbaImage, (x0, x1): (u32, u32), (y0, y1): (u32, u32)) -> f64 {
+    let mut n = 0u64;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            if a.get_pixel(x, y) != b.get_pixel(x, y) {
+                n += 1;
+            }
+        }
+    }
+    n as f64 / ((x1 - x0) as f64 * (y1 - y0) as f64)
+}
+
+#[test]
+#[ignore = "needs xvfb-run (CI installs xvfb); run with --ignored"]
+fn the_scope_draws_and_its_plots_move() {
+    let dir = std::env::temp_dir().join(format!("twoport-shot-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("scope.png");
+    let status = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1400x900x24"])
+        .arg(env!("CARGO_BIN_EXE_host-sim"))
+        .arg("--scene")
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/stiff_wall.toml"))
+        .arg("--screenshot")
+        .arg(&out)
+        .args(["--exit-after", "3"])
+        .status()
+        .expect("xvfb-run runs (install xvfb)");
+    assert!(status.success(), "host-sim under Xvfb: {status}");
+    let last = load(&out);
+    let first = load(&host_sim::window::first_shot_path(&out));
+    assert_eq!(first.dimensions(), last.dimensions());
+    let (w, h) = last.dimensions();
+    assert!(w >= 800 && h >= 600, "{w} x {h}");
+    // Not blank: many distinct colours (text, traces, light, grid).
+    let mut colours: Vec<[u8; 4]> = last.pixels().map(|p| p.0).collect();
+    colours.sort_unstable();
+    colours.dedup();
+    assert!(colours.len() > 50, "{} colours", colours.len());
+    // The plot area (left of the 330-pt control panel, below the transport
+    // bar) moved; the control panel's lower half (hand, wall, trigger,
+    // board) did not.
+    let plots = changed(&first, &last, (40, w - 400), (40, h - 20));
+    assert!(plots > 0.01, "plot area changed by {:.4}", plots);
+    let controls = changed(&first, &last, (w - 340, w), (h / 2, h));
+    assert!(
+        controls < plots,
+        "controls {controls:.4} vs plots {plots:.4}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
