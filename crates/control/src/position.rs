@@ -79,14 +79,23 @@ impl Add<i64> for Position {
     }
 }
 
-/// `pm as f32`, exactly. Differences within ±2.1 mm fit an `i32`, which a
-/// 32-bit FPU converts in one instruction; an `i64` conversion is a library
-/// call of dozens. Both round the same integer to the same `f32`.
+/// `pm as f32`, exactly, without the `i64` conversion a 32-bit core makes a
+/// library call of ~37 instructions. Split `pm = hi 2^24 + lo` with
+/// `0 <= lo < 2^24`: both halves convert exactly (one instruction each on
+/// the FPU), `hi 2^24` is exact, and the one rounding of the sum is IEEE
+/// round-to-nearest-even of the exact value, which is what `as` does.
+/// (A `try_from::<i32>` fast path does not survive LLVM, which sees both
+/// branches compute the same value and keeps the library call.)
 #[inline]
 pub(crate) fn pm_to_f32(pm: i64) -> f32 {
-    match i32::try_from(pm) {
-        Ok(small) => small as f32,
-        Err(_) => pm as f32,
+    const TWO_24: f32 = 16_777_216.0;
+    let hi = pm >> 24;
+    if (-(1 << 23)..(1 << 23)).contains(&hi) {
+        let lo = (pm & 0x00FF_FFFF) as i32;
+        hi as i32 as f32 * TWO_24 + lo as f32
+    } else {
+        // Beyond 140 m: the library conversion.
+        pm as f32
     }
 }
 
@@ -192,6 +201,36 @@ mod tests {
         assert!(Position::from_m(f32::NAN).is_none());
         assert!(Position::from_m(f32::INFINITY).is_none());
         assert!(Position::from_m(1.0e7).is_none());
+    }
+
+    #[test]
+    fn the_split_conversion_equals_as_f32_bit_for_bit() {
+        // Ties, carries across the split, both signs, every magnitude.
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut check = |pm: i64| {
+            assert_eq!(pm_to_f32(pm).to_bits(), (pm as f32).to_bits(), "{pm}");
+        };
+        for e in 0..63 {
+            for d in [-2i64, -1, 0, 1, 2] {
+                let v = (1i64 << e).saturating_add(d);
+                check(v);
+                check(-v);
+                check(v | 0x80_0000);
+            }
+        }
+        for _ in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let shift = (x % 64) as u32;
+            check((x as i64) >> shift);
+        }
+        check(i64::MIN);
+        check(i64::MAX);
+        // Exact ties at 2^24 + 1 and its multiples round to even.
+        check((1 << 24) + 1);
+        check((1 << 25) + 2);
+        check((3 << 40) + (1 << 16));
     }
 
     #[test]

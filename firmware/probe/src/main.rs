@@ -14,7 +14,7 @@ use twoport_control::ve::{
 };
 use twoport_control::{
     AdmittanceCoupling, Complex64, Encoder, Faults, FirstDifference, ImpedanceCoupling,
-    ImpedanceServo, Position, SafetyConfig, SineProbe, ZTransfer,
+    ImpedanceServo, Position, SafetyConfig, SafetyLayer, SineProbe, ZTransfer,
 };
 
 const T: f32 = 1.0e-3;
@@ -188,6 +188,68 @@ fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
     t.check("servo tick measured", per_tick > 0.0);
 }
 
+/// SysTick counts per call of `f` over `n` calls, less the loop's own cost.
+fn counts_per_call(n: u32, mut f: impl FnMut(u32) -> f32) -> f32 {
+    use cortex_m::peripheral::SYST;
+    let mut sink = 0.0f32;
+    let start = SYST::get_current();
+    for k in 0..n {
+        sink += core::hint::black_box(k as f32);
+    }
+    let empty = start.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF;
+    let start = SYST::get_current();
+    for k in 0..n {
+        sink += f(core::hint::black_box(k));
+    }
+    let used = start.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF;
+    core::hint::black_box(sink);
+    used.saturating_sub(empty) as f32 / n as f32
+}
+
+/// Where a tick's instructions go: each stage of the impedance-display
+/// tick alone (SysTick is already running; 1.6 counts per instruction).
+fn cost_breakdown() {
+    use twoport_control::safety::SafetyInputs;
+    let n = 1000;
+    let mut enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    let mut est = FirstDifference::new(T, Position::ZERO).unwrap();
+    let sense = counts_per_call(n, |k| {
+        let p = enc.update(k % 1000 * 2).unwrap_or(Position::ZERO);
+        est.step(p)
+    });
+    let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T, Position::ZERO).unwrap();
+    let mut wall = UnilateralWall::new(
+        1e5,
+        50.0,
+        Position::from_pm(500_000_000),
+        Solid::Above,
+        T,
+        Position::ZERO,
+    )
+    .unwrap();
+    let law = counts_per_call(n, |k| {
+        let x = Position::from_pm((k % 1000 * 2) as i64 * 1_000_000);
+        c.step(x, 0.01, &mut wall).force_n
+    });
+    let mut safety = SafetyLayer::new(SafetyConfig::excalibur()).unwrap();
+    let _ = safety.enable();
+    let safe = counts_per_call(n, |k| {
+        let i = SafetyInputs {
+            tick: k,
+            dead_man_closed: true,
+            velocity_mps: 0.01,
+            sensor_faults: Faults::NONE,
+        };
+        safety.step(&i, (k % 7) as f32).force_n
+    });
+    hprintln!(
+        "  per stage: encoder + estimator {} , coupling + wall {} , safety {} instructions",
+        sense / 1.6,
+        law / 1.6,
+        safe / 1.6
+    );
+}
+
 #[entry]
 fn main() -> ! {
     let mut t = Tally {
@@ -199,6 +261,7 @@ fn main() -> ! {
     servo_wall_and_fault(&mut t);
     if let Some(mut p) = cortex_m::Peripherals::take() {
         tick_cost(&mut t, &mut p.SYST);
+        cost_breakdown();
     }
     hprintln!("{} passed, {} failed", t.passed, t.failed);
     debug::exit(if t.failed == 0 {
