@@ -46,6 +46,7 @@ fn ve() -> impl Strategy<Value = VeSpec> {
             anchor_m: -0.001,
             stiffness_npm: k,
             damping_nspm: b,
+            discretization: Default::default(),
         }),
         Just(VeSpec::Bilateral),
     ]
@@ -72,6 +73,7 @@ fn tuned_case(f_hz: f64) -> impl Strategy<Value = Case> {
             anchor_m: -0.001,
             stiffness_npm: k,
             damping_nspm: b,
+            discretization: Default::default(),
         }),
         Just(VeSpec::Bilateral),
     ];
@@ -201,11 +203,9 @@ fn find_unstable(
 /// finds one for the admittance display with the coupling mass 20% below
 /// the least stable one (4.998 kg / 1.2).
 ///
-/// For the impedance display neither 2 x 10^4 random nor 2 x 10^4 aimed
-/// draws from this family find one even 50% past the bound (the bound is
-/// conservative for these terminations; Table I's simple ones hold to
-/// ~150,000 N/m). Constructing the violating pair from the two-port itself
-/// is open work.
+/// For the impedance display no draw from this family (whose spring VEs are
+/// backward-Euler, and so damped at high frequency) finds one even 50% past
+/// the bound; see the next test for the lossless termination that does.
 #[test]
 fn admittance_gains_past_the_bound_meet_an_unstable_termination() {
     let found = find_unstable(
@@ -220,4 +220,59 @@ fn admittance_gains_past_the_bound_meet_an_unstable_termination() {
         why.contains("oscillation") || why.contains("tripped"),
         "{why}: {c:?}"
     );
+}
+
+/// The impedance display past its bound, against the termination the
+/// two-port points to. Past the bound the interface's `p22 = Y_cc + 1/Z_cI`
+/// has a negative real part near 82 Hz, so with the hand off a nearly
+/// lossless spring VE tuned there should destabilise the loop. The board's
+/// backward-Euler spring cannot be that VE (its spring part alone damps
+/// `kT/2`, 17-28 N s/m at 82 Hz for these stiffnesses); the trapezoidal
+/// spring is lossless and can.
+///
+/// Found in the time domain with the board's code: a 56,000 N/m trapezoidal
+/// spring with the hand off is unstable at 70,000 N/m (1.37 k_max), and
+/// stable at the designed 51,074 N/m. At 1.2 k_max it still decays (late
+/// RMS ratio about 0.5; the marginal coupling is about 66,000 N/m): the
+/// simulated loop is better damped near 82 Hz than the designer's two-port
+/// by roughly 8 N s/m, which is why the 20%-past search of issue 7 is not
+/// met for this display yet.
+#[test]
+fn impedance_gains_past_the_bound_meet_a_lossless_termination() {
+    let run = |k_c: f64| {
+        let mut s = base(Display::Impedance);
+        s.coupling.k = Some(k_c);
+        s.duration_s = 2.5;
+        s.ve = VeSpec::Spring {
+            anchor_m: 0.0,
+            stiffness_npm: 56_000.0,
+            damping_nspm: 0.0,
+            discretization: host_sim::scene::Discretization::Trapezoidal,
+        };
+        s.human.grasp = host_sim::human::GraspKind::HandsOff;
+        s.human.script = vec![host_sim::human::Event::Force {
+            at_s: 0.1,
+            force_n: 5.0,
+            for_s: 0.02,
+        }];
+        Simulation::new(s).unwrap().run(|_| {})
+    };
+    let past = run(70_000.0);
+    assert!(!past.stable, "70,000 N/m should be unstable: {past:?}");
+    let at = run(51_074.0);
+    assert!(at.stable, "the designed gain: {at:?}");
+    // The same VE discretised by backward Euler damps itself: stable even
+    // at 70,000 N/m.
+    let mut s = base(Display::Impedance);
+    s.coupling.k = Some(70_000.0);
+    s.duration_s = 2.5;
+    s.ve = VeSpec::Spring {
+        anchor_m: 0.0,
+        stiffness_npm: 56_000.0,
+        damping_nspm: 0.0,
+        discretization: host_sim::scene::Discretization::BackwardEuler,
+    };
+    s.human.grasp = host_sim::human::GraspKind::HandsOff;
+    let be = Simulation::new(s).unwrap().run(|_| {});
+    assert!(be.stable, "backward Euler: {be:?}");
 }

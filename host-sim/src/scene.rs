@@ -157,6 +157,17 @@ pub struct BlockSpec {
     pub mass_kg: f64,
 }
 
+/// How a spring VE's probe position is integrated on the board.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Discretization {
+    /// `x[k] = x[k-1] + T v[k]`: adds damping `kT/2` at high frequency.
+    #[default]
+    BackwardEuler,
+    /// `x[k] = x[k-1] + T (v[k] + v[k-1])/2`: lossless.
+    Trapezoidal,
+}
+
 /// The virtual environment.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
@@ -189,6 +200,10 @@ pub enum VeSpec {
         stiffness_npm: f64,
         /// Damping (N s/m).
         damping_nspm: f64,
+        /// How the board integrates the probe: `backward_euler` (the
+        /// default, like the wall) or `trapezoidal` (a lossless spring).
+        #[serde(default)]
+        discretization: Discretization,
     },
     /// The 1-D building-block world.
     Blocks {
@@ -569,6 +584,7 @@ impl Scene {
                 anchor_m,
                 stiffness_npm,
                 damping_nspm,
+                ..
             } => {
                 if !anchor_m.is_finite() {
                     return Err(format!("ve.anchor_m = {anchor_m} must be finite"));

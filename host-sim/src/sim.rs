@@ -4,14 +4,15 @@
 use crate::blocks::{Block, Blocks};
 use crate::human::{GraspKind, Human};
 use crate::plant::{Device, Method, Stepper, System};
-use crate::scene::{Display, Scene, SolidSide, VeSpec};
+use crate::scene::{Discretization, Display, Scene, SolidSide, VeSpec};
 use crate::stability::{Detector, Verdict};
 use crate::ve::SceneVe;
 use std::collections::VecDeque;
 use std::time::Instant;
 use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::ve::{
-    BilateralConstraint, CursorMass, Solid, Spring, UnilateralWall, VirtualEnvironment,
+    BilateralConstraint, CursorMass, Solid, Spring, TrapezoidalSpring, UnilateralWall,
+    VirtualEnvironment,
 };
 use twoport_control::{AdmittanceServo, Encoder, ImpedanceServo, Position, SafetyConfig};
 use twoport_design::DeviceModel;
@@ -344,16 +345,19 @@ impl Simulation {
                 anchor_m,
                 stiffness_npm,
                 damping_nspm,
-            } => SceneVe::Spring(
-                Spring::new(
-                    *stiffness_npm as f32,
-                    *damping_nspm as f32,
-                    pos(*anchor_m)?,
-                    t32,
-                    Position::ZERO,
-                )
-                .map_err(|e| e.to_string())?,
-            ),
+                discretization,
+            } => {
+                let (k, b, a) = (*stiffness_npm as f32, *damping_nspm as f32, pos(*anchor_m)?);
+                match discretization {
+                    Discretization::BackwardEuler => SceneVe::Spring(
+                        Spring::new(k, b, a, t32, Position::ZERO).map_err(|e| e.to_string())?,
+                    ),
+                    Discretization::Trapezoidal => SceneVe::TrapezoidalSpring(
+                        TrapezoidalSpring::new(k, b, a, t32, Position::ZERO)
+                            .map_err(|e| e.to_string())?,
+                    ),
+                }
+            }
             VeSpec::Blocks {
                 cursor_mass_kg,
                 blocks,

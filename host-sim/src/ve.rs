@@ -2,8 +2,8 @@
 
 use crate::blocks::Blocks;
 use twoport_control::ve::{
-    BilateralConstraint, Causality, CursorMass, Port, Spring, UnilateralWall, VeOutput, VeTransfer,
-    VirtualEnvironment,
+    BilateralConstraint, Causality, CursorMass, Port, Spring, TrapezoidalSpring, UnilateralWall,
+    VeOutput, VeTransfer, VirtualEnvironment,
 };
 use twoport_control::Position;
 
@@ -18,6 +18,8 @@ pub enum SceneVe {
     Bilateral(BilateralConstraint),
     /// A spring-damper to an anchor.
     Spring(Spring),
+    /// A lossless (trapezoidal) spring-damper to an anchor.
+    TrapezoidalSpring(TrapezoidalSpring),
     /// The building-block world.
     Blocks(Box<Blocks>),
 }
@@ -29,6 +31,7 @@ macro_rules! each {
             SceneVe::Wall($v) => $e,
             SceneVe::Bilateral($v) => $e,
             SceneVe::Spring($v) => $e,
+            SceneVe::TrapezoidalSpring($v) => $e,
             SceneVe::Blocks($v) => $e,
         }
     };

@@ -207,7 +207,7 @@ mod tests {
     fn the_split_conversion_equals_as_f32_bit_for_bit() {
         // Ties, carries across the split, both signs, every magnitude.
         let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
-        let mut check = |pm: i64| {
+        let check = |pm: i64| {
             assert_eq!(pm_to_f32(pm).to_bits(), (pm as f32).to_bits(), "{pm}");
         };
         for e in 0..63 {

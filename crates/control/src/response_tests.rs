@@ -8,8 +8,8 @@
 extern crate std;
 
 use crate::ve::{
-    BilateralConstraint, Causality, CursorMass, Port, Solid, Spring, UnilateralWall, VeOutput,
-    VeTransfer, VirtualEnvironment,
+    BilateralConstraint, Causality, CursorMass, Port, Solid, Spring, TrapezoidalSpring,
+    UnilateralWall, VeOutput, VeTransfer, VirtualEnvironment,
 };
 use crate::*;
 use std::f64::consts::PI;
@@ -197,6 +197,27 @@ fn spring_ve_pulls_and_pushes_linearly() {
         // Zero-mean force: the spring is linear on both sides.
         let got = ve_response(p, &mut ve, 0.0, 30.0);
         assert_close("spring b + kT/(1 - z^-1)", p, got, ve_tf(&ve).eval(z_of(p)));
+    }
+}
+
+#[test]
+fn trapezoidal_spring_ve_matches_its_z_form_and_is_lossless() {
+    // (At Nyquist a lossless trapezoidal spring has impedance exactly 0:
+    // the damped case below covers that bin.)
+    for p in BINS.into_iter().filter(|p| 2 * *p != WINDOW) {
+        let mut ve =
+            TrapezoidalSpring::new(20_000.0, 0.0, Position::ZERO, T, Position::ZERO).unwrap();
+        let got = ve_response(p, &mut ve, 0.0, 30.0);
+        let want = ve_tf(&ve).eval(z_of(p));
+        assert_close("spring b + (kT/2)(1 + z^-1)/(1 - z^-1)", p, got, want);
+        // No damping of its own: the real part vanishes on the unit circle.
+        assert!(want.re.abs() < 1e-9 * want.norm(), "{want}");
+    }
+    for p in BINS {
+        let mut ve =
+            TrapezoidalSpring::new(20_000.0, 50.0, Position::ZERO, T, Position::ZERO).unwrap();
+        let got = ve_response(p, &mut ve, 0.0, 30.0);
+        assert_close("with damping", p, got, ve_tf(&ve).eval(z_of(p)));
     }
 }
 
