@@ -284,11 +284,8 @@ impl VirtualEnvironment for Spring {
 /// is the passive termination that shows the bound is not conservative.
 #[derive(Clone, Copy, Debug)]
 pub struct TrapezoidalSpring {
-    k: f32,
-    b: f32,
-    half_t: f32,
-    anchor: Position,
-    probe: Integrator,
+    /// Gains, anchor and the probe's integer position.
+    spring: Spring,
     /// Last tick's probe velocity (m/s).
     v_prev: f32,
 }
@@ -303,24 +300,15 @@ impl TrapezoidalSpring {
         period_s: f32,
         probe: Position,
     ) -> Result<Self, ParamError> {
-        let t = param::positive("T (s)", period_s)?;
-        let mut s = TrapezoidalSpring {
-            k: 0.0,
-            b: 0.0,
-            half_t: 0.5 * t,
-            anchor,
-            probe: Integrator::new(t, probe),
+        Ok(TrapezoidalSpring {
+            spring: Spring::new(k_npm, b_nspm, anchor, period_s, probe)?,
             v_prev: 0.0,
-        };
-        s.set_gains(k_npm, b_nspm)?;
-        Ok(s)
+        })
     }
 
     /// Change stiffness (N/m) and damping (N s/m).
     pub fn set_gains(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
-        self.k = param::non_negative("stiffness (N/m)", k_npm)?;
-        self.b = param::non_negative("damping (N s/m)", b_nspm)?;
-        Ok(())
+        self.spring.set_gains(k_npm, b_nspm)
     }
 }
 
@@ -331,27 +319,29 @@ impl VirtualEnvironment for TrapezoidalSpring {
 
     fn step(&mut self, port: Port) -> VeOutput {
         // f = k (x[k-1] - a + T/2 v[k-1]) + (k T/2 + b) v[k]
-        let d = self.probe.position().minus_m(self.anchor) + self.half_t * self.v_prev;
-        let out = port.solve_impedance(self.k * d, self.k * self.half_t + self.b);
+        let s = &self.spring;
+        let half_kt = 0.5 * s.kt;
+        let g = s.k * s.stretch_m() + half_kt * self.v_prev;
+        let out = port.solve_impedance(g, half_kt + s.b);
         if out.velocity_mps.is_finite() {
-            self.probe.step(0.5 * (out.velocity_mps + self.v_prev));
+            self.spring.commit(0.5 * (out.velocity_mps + self.v_prev));
             self.v_prev = out.velocity_mps;
         }
         out
     }
 
     fn reset(&mut self, x: Position) {
-        self.probe.reset(x);
+        self.spring.reset(x);
         self.v_prev = 0.0;
     }
 
     fn position(&self) -> Position {
-        self.probe.position()
+        self.spring.position()
     }
 
     /// `F/V = ((b + kT/2) + (kT/2 - b) z^-1) / (1 - z^-1)`.
     fn tf(&self) -> VeTransfer {
-        let (b, hkt) = (self.b as f64, self.k as f64 * self.half_t as f64);
+        let (b, hkt) = (self.spring.b as f64, 0.5 * self.spring.kt as f64);
         VeTransfer::Impedance(ZTransfer::first_order([b + hkt, hkt - b], -1.0))
     }
 }

@@ -10,17 +10,16 @@
 mod uart;
 
 use cortex_m::peripheral::{syst::SystClkSource, SYST};
-use cortex_m_rt::{entry, exception, ExceptionFrame};
-use cortex_m_semihosting::{debug, hprintln};
+use cortex_m_rt::entry;
+use cortex_m_semihosting::hprintln;
 use twoport_board::excalibur;
+use twoport_qemu_exit::exit;
 
 #[entry]
 fn main() -> ! {
     let Ok(mut board) = excalibur::stiff_wall_board() else {
         hprintln!("the Excalibur board image would not build");
-        debug::exit(debug::EXIT_FAILURE);
-        #[allow(clippy::empty_loop)]
-        loop {}
+        exit(false)
     };
     let mut uart = uart::Uart::take();
     // SysTick measures each frame's handling; with `-icount shift=N` it is
@@ -47,22 +46,4 @@ fn main() -> ! {
             uart.write(&frame);
         }
     }
-}
-
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    hprintln!("panic: {}", info);
-    debug::exit(debug::EXIT_FAILURE);
-    #[allow(clippy::empty_loop)]
-    loop {}
-}
-
-#[exception]
-// SAFETY: cortex-m-rt requires the HardFault handler to be an `unsafe fn`;
-// it only reads the stacked frame it is handed and exits.
-unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
-    hprintln!("HardFault at pc {:#010x}", ef.pc());
-    debug::exit(debug::EXIT_FAILURE);
-    #[allow(clippy::empty_loop)]
-    loop {}
 }

@@ -6,8 +6,8 @@
 #![no_std]
 #![no_main]
 
-use cortex_m_rt::{entry, exception, ExceptionFrame};
-use cortex_m_semihosting::{debug, hprintln};
+use cortex_m_rt::entry;
+use cortex_m_semihosting::hprintln;
 use twoport_control::servo::SensorFrame;
 use twoport_control::ve::{
     BilateralConstraint, CursorMass, Solid, UnilateralWall, VeTransfer, VirtualEnvironment,
@@ -16,6 +16,7 @@ use twoport_control::{
     AdmittanceCoupling, Complex64, Encoder, Faults, FirstDifference, ImpedanceCoupling,
     ImpedanceServo, Position, SafetyConfig, SafetyLayer, SineProbe, ZTransfer,
 };
+use twoport_qemu_exit::exit;
 
 const T: f32 = 1.0e-3;
 const WINDOW: u32 = 4000;
@@ -143,7 +144,7 @@ fn servo_wall_and_fault(t: &mut Tally) {
 /// with `-icount shift=6` each instruction takes 64 ns of virtual time, so
 /// one instruction is 1.6 counts (deterministic, unlike wall time).
 fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
-    use cortex_m::peripheral::{syst::SystClkSource, SYST};
+    use cortex_m::peripheral::syst::SystClkSource;
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let wall = UnilateralWall::new(
         1e5,
@@ -160,26 +161,11 @@ fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
     syst.set_reload(0x00FF_FFFF);
     syst.clear_current();
     syst.enable_counter();
-    let ticks = 1000u32;
-    let mut sink = 0.0f32;
-    // The loop with an empty body first, to subtract its own cost.
-    let empty_start = SYST::get_current();
-    for k in 0..ticks {
-        sink += core::hint::black_box(k as f32);
-    }
-    let empty = empty_start.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF;
-    let start = SYST::get_current();
-    for k in 0..ticks {
+    let (per_tick, empty) = counts_per_call(1000, |k| {
         let f = frame(k, core::hint::black_box(k % 1000 * 2), 0.0);
-        sink += s.tick(&f).actuator_force_n;
-    }
-    let counts = start.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF;
-    core::hint::black_box(sink);
-    let per_tick = counts.saturating_sub(empty) as f32 / ticks as f32;
-    hprintln!(
-        "  empty loop: {} instructions per iteration",
-        empty as f32 / ticks as f32 / 1.6
-    );
+        s.tick(&f).actuator_force_n
+    });
+    hprintln!("  empty loop: {} instructions per iteration", empty / 1.6);
     hprintln!(
         "  impedance servo tick (encoder, estimator, Z_cI, wall, safety): {} SysTick counts = {} instructions",
         per_tick,
@@ -188,8 +174,9 @@ fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
     t.check("servo tick measured", per_tick > 0.0);
 }
 
-/// SysTick counts per call of `f` over `n` calls, less the loop's own cost.
-fn counts_per_call(n: u32, mut f: impl FnMut(u32) -> f32) -> f32 {
+/// SysTick counts per call of `f` over `n` calls, less the loop's own
+/// cost; and that cost, per iteration of an empty loop.
+fn counts_per_call(n: u32, mut f: impl FnMut(u32) -> f32) -> (f32, f32) {
     use cortex_m::peripheral::SYST;
     let mut sink = 0.0f32;
     let start = SYST::get_current();
@@ -203,7 +190,10 @@ fn counts_per_call(n: u32, mut f: impl FnMut(u32) -> f32) -> f32 {
     }
     let used = start.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF;
     core::hint::black_box(sink);
-    used.saturating_sub(empty) as f32 / n as f32
+    (
+        used.saturating_sub(empty) as f32 / n as f32,
+        empty as f32 / n as f32,
+    )
 }
 
 /// Where a tick's instructions go: each stage of the impedance-display
@@ -213,7 +203,7 @@ fn cost_breakdown() {
     let n = 1000;
     let mut enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let mut est = FirstDifference::new(T, Position::ZERO).unwrap();
-    let sense = counts_per_call(n, |k| {
+    let (sense, _) = counts_per_call(n, |k| {
         let p = enc.update(k % 1000 * 2).unwrap_or(Position::ZERO);
         est.step(p)
     });
@@ -227,13 +217,13 @@ fn cost_breakdown() {
         Position::ZERO,
     )
     .unwrap();
-    let law = counts_per_call(n, |k| {
+    let (law, _) = counts_per_call(n, |k| {
         let x = Position::from_pm((k % 1000 * 2) as i64 * 1_000_000);
         c.step(x, 0.01, &mut wall).force_n
     });
     let mut safety = SafetyLayer::new(SafetyConfig::excalibur()).unwrap();
     let _ = safety.enable();
-    let safe = counts_per_call(n, |k| {
+    let (safe, _) = counts_per_call(n, |k| {
         let i = SafetyInputs {
             tick: k,
             dead_man_closed: true,
@@ -264,29 +254,5 @@ fn main() -> ! {
         cost_breakdown();
     }
     hprintln!("{} passed, {} failed", t.passed, t.failed);
-    debug::exit(if t.failed == 0 {
-        debug::EXIT_SUCCESS
-    } else {
-        debug::EXIT_FAILURE
-    });
-    #[allow(clippy::empty_loop)]
-    loop {}
-}
-
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    hprintln!("panic: {}", info);
-    debug::exit(debug::EXIT_FAILURE);
-    #[allow(clippy::empty_loop)]
-    loop {}
-}
-
-#[exception]
-// SAFETY: cortex-m-rt requires the HardFault handler to be an `unsafe fn`;
-// it only reads the stacked frame it is handed and exits.
-unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
-    hprintln!("HardFault at pc {:#010x}", ef.pc());
-    debug::exit(debug::EXIT_FAILURE);
-    #[allow(clippy::empty_loop)]
-    loop {}
+    exit(t.failed == 0)
 }
