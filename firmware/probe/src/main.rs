@@ -140,13 +140,10 @@ fn servo_wall_and_fault(t: &mut Tally) {
     );
 }
 
-/// The servo tick's cost in QEMU: SysTick counts the 25 MHz system clock, and
-/// with `-icount shift=6` each instruction takes 64 ns of virtual time, so
-/// one instruction is 1.6 counts (deterministic, unlike wall time).
-fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
-    use cortex_m::peripheral::syst::SystClkSource;
-    let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
-    let wall = UnilateralWall::new(
+/// The wall the cost measurements push into: 0.5 mm from the start, so the
+/// encoder sweep (0 to 2 mm) is in contact three quarters of the time.
+fn timing_wall() -> UnilateralWall {
+    UnilateralWall::new(
         1e5,
         50.0,
         Position::from_pm(500_000_000),
@@ -154,7 +151,16 @@ fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
         T,
         Position::ZERO,
     )
-    .unwrap();
+    .unwrap()
+}
+
+/// The servo tick's cost in QEMU: SysTick counts the 25 MHz system clock, and
+/// with `-icount shift=6` each instruction takes 64 ns of virtual time, so
+/// one instruction is 1.6 counts (deterministic, unlike wall time).
+fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
+    use cortex_m::peripheral::syst::SystClkSource;
+    let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    let wall = timing_wall();
     let mut s = ImpedanceServo::new(51_000.0, 90.0, enc, SafetyConfig::excalibur(), wall).unwrap();
     let _ = s.enable();
     syst.set_clock_source(SystClkSource::Core);
@@ -208,15 +214,7 @@ fn cost_breakdown() {
         est.step(p)
     });
     let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T, Position::ZERO).unwrap();
-    let mut wall = UnilateralWall::new(
-        1e5,
-        50.0,
-        Position::from_pm(500_000_000),
-        Solid::Above,
-        T,
-        Position::ZERO,
-    )
-    .unwrap();
+    let mut wall = timing_wall();
     let (law, _) = counts_per_call(n, |k| {
         let x = Position::from_pm((k % 1000 * 2) as i64 * 1_000_000);
         c.step(x, 0.01, &mut wall).force_n
