@@ -49,6 +49,8 @@ fn signal_plot(
         .height(height)
         .legend(Legend::default())
         .link_axis(egui::Id::unique("scope-time"), [true, false])
+        // One y-axis width for all four, so their time axes line up.
+        .y_axis_min_width(48.0)
         .allow_drag(false)
         .allow_zoom(false)
         .allow_scroll(false)
