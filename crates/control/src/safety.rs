@@ -290,14 +290,10 @@ impl SafetyLayer {
     /// One tick: check, latch, limit, ramp. Call exactly once per tick.
     pub fn step(&mut self, inputs: &SafetyInputs, command_n: f32) -> SafeForce {
         let mut new = inputs.sensor_faults;
-        let v = inputs.velocity_mps;
-        // One comparison in the common case: NaN fails `<=` too.
-        if !(v.abs() <= self.cfg.max_velocity_mps) {
-            new = new.with(if v.is_finite() {
-                Faults::VELOCITY_LIMIT
-            } else {
-                Faults::SENSOR_NOT_FINITE
-            });
+        if !inputs.velocity_mps.is_finite() {
+            new = new.with(Faults::SENSOR_NOT_FINITE);
+        } else if inputs.velocity_mps.abs() > self.cfg.max_velocity_mps {
+            new = new.with(Faults::VELOCITY_LIMIT);
         }
         if let Some(last) = self.last_tick {
             if inputs.tick != last.wrapping_add(1) {
@@ -331,8 +327,15 @@ impl SafetyLayer {
             } else {
                 self.cfg.peak_force_n
             };
-            // (`clamp` would assert on its bounds; these are positive.)
-            let clipped = command_n.max(-limit).min(limit);
+            // (Not `clamp`, which carries an assertion on its bounds; the
+            // command is finite here, or a fault would have latched.)
+            let clipped = if command_n > limit {
+                limit
+            } else if command_n < -limit {
+                -limit
+            } else {
+                command_n
+            };
             self.ramp_done = self.ramp_done.saturating_add(1).min(self.cfg.ramp_ticks);
             let scale = self.ramp_done as f32 / self.cfg.ramp_ticks as f32;
             out.force_n = clipped * scale;
