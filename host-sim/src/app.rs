@@ -206,6 +206,10 @@ pub struct BoardLink {
     session: Session<SerialBoard>,
     /// Port path.
     pub port: String,
+    /// Lockstep: this simulation is the board's plant (processor in the
+    /// loop, the QEMU image). Otherwise the board runs on its own sensors
+    /// and clock and the scope only watches and talks to it.
+    pub lockstep: bool,
     /// The last telemetry.
     pub telemetry: Option<Telemetry>,
     /// The board's last answer to a gain request.
@@ -441,6 +445,7 @@ impl ScopeState {
 
     /// Advance by one frame of `wall_s` wall time at the set speed.
     pub fn advance(&mut self, wall_s: f64) {
+        self.watch_board();
         if !self.running {
             return;
         }
@@ -466,7 +471,7 @@ impl ScopeState {
             self.running = false;
             return false;
         }
-        let s = match self.board.as_mut() {
+        let s = match self.board.as_mut().filter(|b| b.lockstep) {
             Some(b) => match b.session.step(&mut self.sim) {
                 Ok((s, _)) => s,
                 Err(e) => {
@@ -487,6 +492,24 @@ impl ScopeState {
         true
     }
 
+    /// A free-running board: keep its link watchdog fed and read what it
+    /// sent. (A lockstep board is fed and read every tick.)
+    fn watch_board(&mut self) {
+        let Some(b) = self.board.as_mut().filter(|b| !b.lockstep) else {
+            return;
+        };
+        let r = b
+            .session
+            .send(&Message::Heartbeat)
+            .and_then(|_| b.session.poll());
+        if let Err(e) = r {
+            self.message = Some(format!("board link lost: {e}"));
+            self.board = None;
+            return;
+        }
+        self.board_messages();
+    }
+
     fn board_messages(&mut self) {
         let Some(b) = self.board.as_mut() else {
             return;
@@ -494,7 +517,13 @@ impl ScopeState {
         for m in b.session.take_messages() {
             match m {
                 Message::Telemetry(t) => {
-                    let ts = t.tick as f64 * self.sim.period();
+                    // Lockstep: the board's tick is the simulation's. Free
+                    // running: shown when it arrives.
+                    let ts = if b.lockstep {
+                        t.tick as f64 * self.sim.period()
+                    } else {
+                        self.last.map_or(0.0, |s| s.t_s)
+                    };
                     for (sig, ring) in BoardSignal::ALL.iter().zip(&mut self.board_rings) {
                         ring.push(ts, sig.of(&t));
                     }
@@ -600,10 +629,16 @@ impl ScopeState {
         }
     }
 
-    /// Board mode: connect to the board at `port` (lockstep: this
-    /// simulation is its plant).
-    pub fn connect(&mut self, port: &str) {
-        let r = crate::pil::check_scene(&self.scene)
+    /// Board mode: connect to the board at `port`; with `lockstep` this
+    /// simulation is its plant (processor in the loop), without it the
+    /// board runs on its own sensors and the scope watches.
+    pub fn connect(&mut self, port: &str, lockstep: bool) {
+        let scene_ok = if lockstep {
+            crate::pil::check_scene(&self.scene)
+        } else {
+            Ok(())
+        };
+        let r = scene_ok
             .and_then(|_| SerialBoard::open(port))
             .and_then(|p| Session::open(p, crate::pil::Faults::default()));
         match r {
@@ -611,6 +646,7 @@ impl ScopeState {
                 self.board = Some(BoardLink {
                     session,
                     port: port.to_string(),
+                    lockstep,
                     telemetry: None,
                     reply: None,
                     faults: None,

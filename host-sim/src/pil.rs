@@ -72,7 +72,8 @@ impl LocalBoard {
     pub fn excalibur() -> Result<Self, String> {
         Ok(LocalBoard {
             board: excalibur::stiff_wall_board()
-                .map_err(|e| format!("the Excalibur board image: {e:?}"))?,
+                .map_err(|e| format!("the Excalibur board image: {e:?}"))?
+                .with_pil(true),
             out: Vec::new(),
         })
     }
@@ -233,6 +234,12 @@ impl<P: BoardPort> Session<P> {
                 return Err("no handshake answer from the board".into());
             }
         }
+    }
+
+    /// Read whatever the board has sent, waiting at most a millisecond
+    /// (a free-running board: telemetry, replies, fault reports).
+    pub fn poll(&mut self) -> Result<(), String> {
+        self.pump(Duration::from_millis(1))
     }
 
     /// Messages the board sent that no one waited for (telemetry, fault

@@ -371,10 +371,15 @@ pub fn trigger(ui: &mut Ui, s: &mut ScopeState) {
 }
 
 /// Board mode: port, connect, and what the board says.
-pub fn board(ui: &mut Ui, s: &mut ScopeState, port: &mut String) {
+pub fn board(ui: &mut Ui, s: &mut ScopeState, link: &mut BoardChoice) {
     ui.heading("Board");
     if let Some(b) = &s.board {
-        ui.label(format!("connected: {} (lockstep, this plant)", b.port));
+        let how = if b.lockstep {
+            "lockstep: this simulation is its plant"
+        } else {
+            "free running on its own sensors"
+        };
+        ui.label(format!("connected: {} ({how})", b.port));
         if let Some(t) = &b.telemetry {
             ui.label(format!(
                 "tick {}  loop {} cycles  faults {:#06x}",
@@ -396,6 +401,7 @@ pub fn board(ui: &mut Ui, s: &mut ScopeState, port: &mut String) {
         }
         return;
     }
+    let port = &mut link.port;
     ui.horizontal(|ui| {
         egui::ComboBox::from_label("serial port")
             .selected_text(if port.is_empty() {
@@ -411,14 +417,36 @@ pub fn board(ui: &mut Ui, s: &mut ScopeState, port: &mut String) {
         ui.text_edit_singleline(port)
             .on_hover_text("or a path, e.g. the pty QEMU prints");
     });
-    if ui.button("connect").clicked() && !port.is_empty() {
-        let p = port.clone();
-        s.connect(&p);
+    ui.checkbox(&mut link.lockstep, "lockstep (processor in the loop)")
+        .on_hover_text(
+            "the board takes its sensors from this simulation; off for a board on a real device",
+        );
+    if ui.button("connect").clicked() && !link.port.is_empty() {
+        let p = link.port.clone();
+        s.connect(&p, link.lockstep);
+    }
+}
+
+/// What the board panel's connect controls hold.
+#[derive(Clone, Debug)]
+pub struct BoardChoice {
+    /// Serial port path.
+    pub port: String,
+    /// Lockstep (processor in the loop) or free running.
+    pub lockstep: bool,
+}
+
+impl Default for BoardChoice {
+    fn default() -> Self {
+        BoardChoice {
+            port: String::new(),
+            lockstep: true,
+        }
     }
 }
 
 /// The whole window.
-pub fn scope(ui: &mut Ui, s: &mut ScopeState, port: &mut String) {
+pub fn scope(ui: &mut Ui, s: &mut ScopeState, link: &mut BoardChoice) {
     egui::Panel::top("transport").show(ui, |ui| transport(ui, s));
     egui::Panel::right("controls")
         .min_size(330.0)
@@ -432,7 +460,7 @@ pub fn scope(ui: &mut Ui, s: &mut ScopeState, port: &mut String) {
                 ui.separator();
                 trigger(ui, s);
                 ui.separator();
-                board(ui, s, port);
+                board(ui, s, link);
             });
         });
     egui::CentralPanel::default().show(ui, |ui| plots(ui, s));

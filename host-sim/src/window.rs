@@ -31,7 +31,7 @@ pub fn first_shot_path(p: &Path) -> PathBuf {
 
 struct ScopeApp {
     state: ScopeState,
-    port: String,
+    link: crate::ui::BoardChoice,
     script: Script,
     started: Instant,
     last_frame: Instant,
@@ -87,7 +87,7 @@ impl eframe::App for ScopeApp {
         let dt = (now - self.last_frame).as_secs_f64();
         self.last_frame = now;
         self.state.advance(dt);
-        crate::ui::scope(ui, &mut self.state, &mut self.port);
+        crate::ui::scope(ui, &mut self.state, &mut self.link);
         self.scripted(&ctx);
         ctx.request_repaint();
     }
@@ -106,7 +106,7 @@ pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, String> {
     let saved = Arc::new(Mutex::new(Vec::new()));
     let app = ScopeApp {
         state,
-        port: String::new(),
+        link: crate::ui::BoardChoice::default(),
         script,
         started: Instant::now(),
         last_frame: Instant::now(),

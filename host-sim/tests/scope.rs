@@ -6,16 +6,17 @@ use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use host_sim::app::Signal;
 use host_sim::app::{ScopeState, SliderGains, Speed, RING_SAMPLES};
+use host_sim::ui::BoardChoice;
 use std::path::Path;
 
-fn harness() -> Harness<'static, (ScopeState, String)> {
+fn harness() -> Harness<'static, (ScopeState, BoardChoice)> {
     let state = ScopeState::open(Path::new("../scenes/stiff_wall.toml")).unwrap();
     let mut h = Harness::new_ui_state(
-        |ui, s: &mut (ScopeState, String)| {
-            let (state, port) = s;
-            host_sim::ui::scope(ui, state, port)
+        |ui, s: &mut (ScopeState, BoardChoice)| {
+            let (state, link) = s;
+            host_sim::ui::scope(ui, state, link)
         },
-        (state, String::new()),
+        (state, BoardChoice::default()),
     );
     h.set_size(eframe::egui::vec2(1280.0, 860.0));
     h.run();
@@ -136,7 +137,7 @@ fn an_hour_of_running_does_not_grow_the_buffers() {
 fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
     let pty = std::env::var("TWOPORT_PTY").expect("TWOPORT_PTY names the board's pty");
     let mut s = ScopeState::open(Path::new("../scenes/stiff_wall.toml")).unwrap();
-    s.connect(&pty);
+    s.connect(&pty, true);
     assert!(s.board.is_some(), "{:?}", s.message);
     for _ in 0..2000 {
         assert!(s.tick(), "{:?}", s.message);
@@ -169,5 +170,25 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
     }
     let r = s.board.as_ref().unwrap().reply.clone().unwrap();
     assert!(r.starts_with("refused: NotProvenStable"), "{r}");
+    s.disconnect();
+    // Free running (a board on its own sensors): the scope only feeds the
+    // watchdog and talks; the gain answers still come back.
+    s.connect(&pty, false);
+    assert!(
+        s.board.as_ref().is_some_and(|b| !b.lockstep),
+        "{:?}",
+        s.message
+    );
+    s.set_gains(SliderGains::Impedance {
+        k: 45_000.0,
+        b: 90.0,
+    });
+    for _ in 0..200 {
+        s.advance(0.001);
+        if s.board.as_ref().unwrap().reply.is_some() {
+            break;
+        }
+    }
+    assert_eq!(s.board.as_ref().unwrap().reply.as_deref(), Some("accepted"));
     s.disconnect();
 }

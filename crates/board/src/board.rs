@@ -86,6 +86,10 @@ pub struct Board<V, const R: usize> {
     tx_dropped: u32,
     io: IoScale,
     last: ServoOutput,
+    /// Whether sensor frames from the link drive ticks (processor in the
+    /// loop). A board with real sensors must never let the host move it.
+    pil: bool,
+    pil_refused: u32,
 }
 
 fn all_finite(g: &Gains) -> bool {
@@ -118,7 +122,22 @@ impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
             tx_dropped: 0,
             io: IoScale::EXCALIBUR,
             last: ServoOutput::default(),
+            pil: false,
+            pil_refused: 0,
         }
+    }
+
+    /// The same board driven by sensor frames from the link (processor in
+    /// the loop: the QEMU image, the host's reference). Off by default: a
+    /// board with real sensors ignores sensor frames and counts them.
+    pub fn with_pil(mut self, on: bool) -> Self {
+        self.pil = on;
+        self
+    }
+
+    /// Sensor frames ignored because this board reads its own sensors.
+    pub fn pil_refused(&self) -> u32 {
+        self.pil_refused
     }
 
     /// The same board with `io` scaling its peripherals (default:
@@ -235,6 +254,9 @@ impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
             })),
             // Processor-in-the-loop: the host's sensors drive one tick, the
             // duty goes straight back.
+            Message::Sensors(_) if !self.pil => {
+                self.pil_refused = self.pil_refused.saturating_add(1);
+            }
             Message::Sensors(s) => {
                 let frame = SensorFrame {
                     tick: s.tick,

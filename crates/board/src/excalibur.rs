@@ -105,7 +105,8 @@ pub fn stiff_wall_law() -> Result<Law<UnilateralWall>, BuildError> {
     )?))
 }
 
-/// The whole board: law, region, telemetry rate, I/O scaling.
+/// The whole board: law, region, telemetry rate, I/O scaling. It reads its
+/// own sensors; the processor-in-the-loop images add `.with_pil(true)`.
 pub fn stiff_wall_board() -> Result<Board<UnilateralWall, REGION_POINTS>, BuildError> {
     Ok(
         Board::new(stiff_wall_law()?, proven_region()?, TELEMETRY_EVERY)

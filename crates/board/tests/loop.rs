@@ -324,3 +324,53 @@ fn admittance_gains_need_the_proven_regulator() {
         assert_eq!(got, Some(Message::GainsReply(want)));
     }
 }
+
+fn sensors(tick: u32, raw: u32) -> Message {
+    Message::Sensors(twoport_link::SensorFrame {
+        tick,
+        encoder_raw: raw,
+        load_cell_raw: 0,
+        dead_man_closed: true,
+    })
+}
+
+#[test]
+fn a_board_with_real_sensors_ignores_sensor_frames_from_the_link() {
+    let mut b = board();
+    send(&mut b, 0, Message::Enable);
+    for k in 0..20u32 {
+        b.tick(&frame(k, k));
+    }
+    let before = b.last_output().position;
+    for k in 0..5u16 {
+        send(&mut b, 1 + k, sensors(20 + u32::from(k), 5000));
+    }
+    assert_eq!(b.pil_refused(), 5);
+    // No tick ran from the link, and nothing answered.
+    assert_eq!(b.last_output().position, before);
+    assert!(replies(&mut b)
+        .iter()
+        .all(|m| !matches!(m, Message::Actuator(_))));
+}
+
+#[test]
+fn a_pil_board_ticks_once_per_sensor_frame_and_answers_with_the_duty() {
+    let mut b = board().with_pil(true);
+    send(&mut b, 0, Message::Enable);
+    for k in 0..30u16 {
+        send(&mut b, 1 + k, sensors(u32::from(k), u32::from(k) * 10));
+    }
+    let acts: Vec<_> = replies(&mut b)
+        .into_iter()
+        .filter_map(|m| match m {
+            Message::Actuator(a) => Some(a),
+            _ => None,
+        })
+        .collect();
+    // The queue holds the newest replies; each answers its own tick with
+    // the duty of the force that tick held.
+    assert!(!acts.is_empty());
+    assert_eq!(acts.last().unwrap().tick, 29);
+    assert_eq!(acts.last().unwrap().duty, b.duty());
+    assert_eq!(b.pil_refused(), 0);
+}

@@ -17,7 +17,7 @@ use twoport_qemu_exit::exit;
 
 #[entry]
 fn main() -> ! {
-    let Ok(mut board) = excalibur::stiff_wall_board() else {
+    let Ok(mut board) = excalibur::stiff_wall_board().map(|b| b.with_pil(true)) else {
         hprintln!("the Excalibur board image would not build");
         exit(false)
     };
