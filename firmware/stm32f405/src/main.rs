@@ -8,7 +8,7 @@
 //! | load cell         | ADC1 channel 0, 12 bit        | PA0               |
 //! | dead-man switch   | input, pull-up, closed = low  | PC0               |
 //! | link              | USART2, 115200 8N1            | PA2, PA3 (AF7)    |
-//! | control loop      | TIM2 update interrupt, 1 kHz  |                   |
+//! | control loop      | TIM2 update interrupt, 1/T (1 kHz shipped) |      |
 //!
 //! Clocks: 8 MHz crystal, PLL to 168 MHz (APB1 42 MHz, APB2 84 MHz).
 //! Zero duty is 50 % in locked antiphase, i.e. zero average voltage; the
@@ -155,10 +155,17 @@ fn usart(u: &pac::USART2) {
         .write(|w| w.ue().set_bit().te().set_bit().re().set_bit());
 }
 
+/// Control-loop timer counts (1 us each) per tick: the image's period, so
+/// the interrupt rate and the laws' `T` cannot disagree. 1 kHz as shipped;
+/// 100 to 1000 counts give the 1-10 kHz range (a new `T` needs its own
+/// proven region: `twoport region impedance --period T --rust`).
+const LOOP_COUNTS: u32 = (excalibur::PERIOD_S * 1.0e6 + 0.5) as u32;
+const _: () = assert!(LOOP_COUNTS >= 100 && LOOP_COUNTS <= 1000);
+
 fn control_timer(t: &pac::TIM2) {
-    // 84 MHz timer clock / 84 = 1 MHz; 1000 counts = 1 kHz.
+    // 84 MHz timer clock / 84 = 1 MHz.
     t.psc().write(|w| w.psc().set(83));
-    t.arr().write(|w| w.set(999));
+    t.arr().write(|w| w.set(LOOP_COUNTS - 1));
     t.dier().write(|w| w.uie().set_bit());
     t.cr1().write(|w| w.cen().set_bit());
 }
