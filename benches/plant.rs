@@ -19,7 +19,7 @@ fn plant(c: &mut Criterion) {
         (Method::Euler, &[64][..]),
     ] {
         for &n in subs {
-            let mut st = Stepper::new(&sys, method, 1e-3 / n as f64);
+            let mut st = Stepper::new(&sys, method, 1e-3 / n as f64).unwrap();
             let mut x = vec![0.0; sys.states()];
             c.bench_function(&format!("plant tick: {} x {n}", method.name()), |b| {
                 b.iter(|| {

@@ -174,6 +174,15 @@ fn ill_conditioned_models_answer_or_refuse_clearly() {
             "[0.0,    0.0,    2.4489, 0.2799, 0.0]",
             "[0.0,    0.0,    0.3343, 0.2799, 0.0]",
         ),
+        // M^-1 K overflows to infinity: the matrix exponential's scaling
+        // and squaring once looped forever here (found by the fuzzer).
+        ("stiffness 1e300", "5.3954e7", "5.3954e300"),
+        ("handle mass 1e-300", "0.1600]", "1.0e-300]"),
+        (
+            "stiffness 1e15 (norm far past the step)",
+            "5.3954e7",
+            "5.3954e15",
+        ),
     ];
     for (what, from, to) in cases {
         match scaled(from, to) {
@@ -196,11 +205,33 @@ fn ill_conditioned_models_answer_or_refuse_clearly() {
                 }
             }
             Err(e) => assert!(
-                e.contains("M ") || e.contains("positive definite") || e.contains("not finite"),
+                e.contains("M ")
+                    || e.contains("positive definite")
+                    || e.contains("not finite")
+                    || e.contains("far faster than the sample period"),
                 "{what}: unclear error {e}"
             ),
         }
     }
+}
+
+/// A model whose `M^-1 K` overflows to infinity (a 1e-300 kg coordinate
+/// on a 5e7 N/m spring scaled to 5e300): refused with a clear error at once.
+/// The matrix exponential's scaling and squaring once spun forever on such
+/// an argument (the model-file fuzzer found it).
+#[test]
+fn a_model_whose_dynamics_overflow_is_refused() {
+    let text = EXCALIBUR
+        .replacen("0.1600]", "1.0e-300]", 1)
+        .replacen("5.3236e7", "5.3236e300", 1);
+    let m = DeviceModel::from_toml(&text, "overflow").unwrap();
+    let Err(e) = Plant::new(&m, 1e-3) else {
+        panic!("a model whose dynamics overflow must be refused");
+    };
+    assert!(
+        e.contains("not finite") || e.contains("far faster than the sample period"),
+        "{e}"
+    );
 }
 
 /// At Nyquist and at every resonance (aliased ones included) the sampled

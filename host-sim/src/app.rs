@@ -611,8 +611,10 @@ impl ScopeState {
 
     /// Hold the hand in a grasp, or give it back to the script.
     pub fn set_grasp(&mut self, g: Option<GraspKind>) {
-        self.grasp = g;
-        self.sim.set_grasp(g);
+        match self.sim.set_grasp(g) {
+            Ok(()) => self.grasp = g,
+            Err(e) => self.message = Some(format!("grasp not changed: {e}")),
+        }
     }
 
     /// The mouse push (N).

@@ -340,7 +340,7 @@ fn column_major(m: &DMatrix<f64>) -> Vec<f64> {
 
 impl Stepper {
     /// A stepper for `sys` with method `method` and sub-step `h` (s).
-    pub fn new(sys: &System, method: Method, h: f64) -> Self {
+    pub fn new(sys: &System, method: Method, h: f64) -> Result<Self, String> {
         let (ns, n) = (sys.states(), sys.n);
         let (a, b, e) = match method {
             Method::ExactZoh => {
@@ -350,7 +350,7 @@ impl Stepper {
                 blk.view_mut((0, 0), (ns, ns)).copy_from(&(&sys.a * h));
                 blk.view_mut((0, ns), (ns, 2)).copy_from(&(&sys.b * h));
                 blk.view_mut((0, ns + 2), (ns, n)).copy_from(&(&sys.e * h));
-                let x = twoport_design::linalg::expm_balanced(&blk);
+                let x = twoport_design::linalg::expm_balanced(&blk)?;
                 (
                     column_major(&x.view((0, 0), (ns, ns)).into_owned()),
                     column_major(&x.view((0, ns), (ns, 2)).into_owned()),
@@ -363,7 +363,7 @@ impl Stepper {
                 column_major(&sys.e),
             ),
         };
-        Stepper {
+        Ok(Stepper {
             method,
             h,
             ns,
@@ -374,7 +374,7 @@ impl Stepper {
             k: std::array::from_fn(|_| vec![0.0; ns]),
             tmp: vec![0.0; ns],
             force: vec![0.0; n],
-        }
+        })
     }
 
     /// The method.

@@ -302,9 +302,9 @@ impl Simulation {
                 warning = warning
                     .take()
                     .or_else(|| integrator_warning(&sys, method, h));
-                (g, Stepper::new(&sys, method, h))
+                Ok((g, Stepper::new(&sys, method, h)?))
             })
-            .collect();
+            .collect::<Result<_, String>>()?;
         let (bits, pm_per_count) = match e.encoder {
             Some(enc) => (enc.bits, (enc.resolution_m * 1e12).round()),
             None => (32, 1.0),
@@ -514,15 +514,16 @@ impl Simulation {
 
     /// Hold the hand in `grasp` (the scope's grasp control), or give it
     /// back to the script with `None`.
-    pub fn set_grasp(&mut self, grasp: Option<GraspKind>) {
+    pub fn set_grasp(&mut self, grasp: Option<GraspKind>) -> Result<(), String> {
         if let Some(g) = grasp {
             if !self.steppers.iter().any(|(k, _)| *k == g) {
                 let sys = self.device.system(self.human.grasp_of(g), self.load_cell);
                 let h = self.period / self.substeps as f64;
-                self.steppers.push((g, Stepper::new(&sys, self.method, h)));
+                self.steppers.push((g, Stepper::new(&sys, self.method, h)?));
             }
         }
         self.grasp_override = grasp;
+        Ok(())
     }
 
     /// A hand force added to the script's (N): the scope's mouse push.

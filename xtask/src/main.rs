@@ -419,6 +419,9 @@ fn fuzz(secs: u32) -> Result<(), String> {
                 .args([
                     "--",
                     &format!("-max_total_time={secs}"),
+                    // A slow input is a finding (a model once spun the
+                    // matrix exponential forever), not a 20-minute stall.
+                    "-timeout=10",
                     "-max_len=4096",
                     "-print_final_stats=1",
                 ]),

@@ -144,13 +144,38 @@ pub fn balance(a: &DMatrix<f64>) -> Vec<f64> {
 /// `e^a` computed on the balanced matrix, `e^a = d e^(d^-1 a d) d^-1`: a
 /// stiff device model (entries from 1 to 1e10) loses digits in scaling and
 /// squaring otherwise.
-pub fn expm_balanced(a: &DMatrix<f64>) -> DMatrix<f64> {
+///
+/// An error for a non-finite entry or a norm beyond [`EXPM_MAX_NORM`]:
+/// scaling and squaring takes `log2 |a|` squarings, so an infinite norm
+/// would never finish (the model-file fuzzer found one), and a norm that
+/// large means time constants a million million times shorter than the
+/// step, which no sampled model of a device has.
+pub fn expm_balanced(a: &DMatrix<f64>) -> Result<DMatrix<f64>, String> {
     let n = a.nrows();
+    if a.iter().any(|v| !v.is_finite()) {
+        return Err("the matrix exponential's argument is not finite".into());
+    }
+    let norm = (0..n)
+        .map(|j| a.column(j).iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0, f64::max);
+    if norm > EXPM_MAX_NORM {
+        return Err(format!(
+            "the matrix exponential's argument has norm {norm:.3e} (> {EXPM_MAX_NORM:e}): \
+             the model's dynamics are far faster than the sample period"
+        ));
+    }
     let d = balance(a);
     let b = DMatrix::from_fn(n, n, |i, j| a[(i, j)] * d[j] / d[i]);
     let e = b.exp();
-    DMatrix::from_fn(n, n, |i, j| e[(i, j)] * d[i] / d[j])
+    let out = DMatrix::from_fn(n, n, |i, j| e[(i, j)] * d[i] / d[j]);
+    if out.iter().any(|v| !v.is_finite()) {
+        return Err("the matrix exponential is not finite".into());
+    }
+    Ok(out)
 }
+
+/// The largest 1-norm [`expm_balanced`] accepts.
+pub const EXPM_MAX_NORM: f64 = 1.0e15;
 
 #[cfg(test)]
 mod tests {
