@@ -18,8 +18,10 @@ pub mod scene;
 pub mod scope;
 pub mod sim;
 pub mod stability;
+#[cfg(feature = "gui")]
 pub mod ui;
 pub mod ve;
+#[cfg(feature = "gui")]
 pub mod window;
 
 pub use scene::Scene;

@@ -594,33 +594,17 @@ fn scope(a: &ScopeArgs) -> Result<(), String> {
     }
     let why_headless = if a.headless {
         Some("--headless".to_string())
-    } else if !host_sim::window::display_available() {
-        Some("no display (DISPLAY and WAYLAND_DISPLAY are unset)".to_string())
     } else {
-        let script = host_sim::window::Script {
-            screenshot: a.screenshot.clone(),
-            exit_after_s: a.exit_after,
-        };
-        match host_sim::window::run(&a.scene, script) {
-            Ok(shots) => {
-                for p in shots {
-                    eprintln!("host-sim: saved {}", p.display());
-                }
-                return Ok(());
-            }
-            Err(e) if e.starts_with("the window would not open") => Some(e),
-            Err(e) => return Err(e),
-        }
+        open_window(a)?
+    };
+    let Some(why_headless) = why_headless else {
+        return Ok(()); // the window ran and closed
     };
     if a.screenshot.is_some() {
-        return Err(format!(
-            "--screenshot needs a window: {}",
-            why_headless.unwrap_or_default()
-        ));
+        return Err(format!("--screenshot needs a window: {why_headless}"));
     }
     eprintln!(
-        "host-sim: {}; running {} headless instead",
-        why_headless.unwrap_or_default(),
+        "host-sim: {why_headless}; running {} headless instead",
         a.scene.display()
     );
     run(&RunArgs {
@@ -633,6 +617,36 @@ fn scope(a: &ScopeArgs) -> Result<(), String> {
         csv: None,
         png: None,
     })
+}
+
+/// The scope window; `Ok(Some(why))` where none can open.
+#[cfg(feature = "gui")]
+fn open_window(a: &ScopeArgs) -> Result<Option<String>, String> {
+    if !host_sim::window::display_available() {
+        return Ok(Some(
+            "no display (DISPLAY and WAYLAND_DISPLAY are unset)".to_string(),
+        ));
+    }
+    let script = host_sim::window::Script {
+        screenshot: a.screenshot.clone(),
+        exit_after_s: a.exit_after,
+    };
+    match host_sim::window::run(&a.scene, script) {
+        Ok(shots) => {
+            for p in shots {
+                eprintln!("host-sim: saved {}", p.display());
+            }
+            Ok(None)
+        }
+        Err(e) if e.starts_with("the window would not open") => Ok(Some(e)),
+        Err(e) => Err(e),
+    }
+}
+
+/// Built without the `gui` feature: there is no window to open.
+#[cfg(not(feature = "gui"))]
+fn open_window(_: &ScopeArgs) -> Result<Option<String>, String> {
+    Ok(Some("built without the `gui` feature".to_string()))
 }
 
 fn subcommand(c: &Cmd) -> Result<(), String> {

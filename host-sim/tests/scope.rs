@@ -1,5 +1,6 @@
 //! The scope as a person uses it: its controls drive the running simulation
 //! (egui_kittest, no window needed), and its memory stays bounded.
+#![cfg(feature = "gui")]
 
 use eframe::egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;

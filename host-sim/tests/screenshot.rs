@@ -1,6 +1,7 @@
 //! The scope in a real window, as CI sees it: under Xvfb, the default scene
 //! for three seconds, two screenshots. The window must not be blank and the
 //! plots must have moved between the shots while the controls did not.
+#![cfg(feature = "gui")]
 
 use image::RgbaImage;
 use std::path::Path;
