@@ -222,6 +222,8 @@ pub struct BoardLink {
 pub struct ScopeState {
     /// Scene files found in the scenes folder.
     pub scenes: Vec<PathBuf>,
+    /// The folder they were listed from.
+    pub scenes_root: PathBuf,
     /// The scene running.
     pub scene_path: PathBuf,
     scene: Scene,
@@ -277,16 +279,23 @@ fn gains_of(scene: &Scene) -> SliderGains {
     }
 }
 
-/// The scene files in `dir`, sorted.
+/// The scene files in `dir` and its sub-folders one level down (the
+/// Table I set lives in `scenes/table1/`), sorted.
 pub fn list_scenes(dir: &Path) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map(|d| {
-            d.filter_map(Result::ok)
-                .map(|e| e.path())
-                .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-                .collect()
-        })
-        .unwrap_or_default();
+    let entries = |d: &Path| -> Vec<PathBuf> {
+        std::fs::read_dir(d)
+            .map(|it| it.filter_map(Result::ok).map(|e| e.path()).collect())
+            .unwrap_or_default()
+    };
+    let is_scene = |p: &PathBuf| p.extension().is_some_and(|x| x == "toml");
+    let mut v: Vec<PathBuf> = Vec::new();
+    for p in entries(dir) {
+        if p.is_dir() {
+            v.extend(entries(&p).into_iter().filter(is_scene));
+        } else if is_scene(&p) {
+            v.push(p);
+        }
+    }
     v.sort();
     v
 }
@@ -299,6 +308,7 @@ impl ScopeState {
         let dir = scene_path.parent().unwrap_or(Path::new("."));
         let mut s = ScopeState {
             scenes: list_scenes(dir),
+            scenes_root: dir.to_path_buf(),
             scene_path: scene_path.to_path_buf(),
             design: analysis_plant(&scene).map(|p| {
                 let a = Analysis::new(&p, GridSpec::DEFAULT);
@@ -345,6 +355,7 @@ impl ScopeState {
         match ScopeState::open(path) {
             Ok(mut n) => {
                 n.scenes = std::mem::take(&mut self.scenes);
+                n.scenes_root = std::mem::take(&mut self.scenes_root);
                 n.board = self.board.take();
                 n.speed = self.speed;
                 *self = n;

@@ -109,20 +109,18 @@ pub fn plots(ui: &mut Ui, s: &ScopeState) {
 /// Scene picker, play/pause/step/reset, speed, time and status.
 pub fn transport(ui: &mut Ui, s: &mut ScopeState) {
     ui.horizontal_wrapped(|ui| {
-        let current = s.scene_path.display().to_string();
+        let name = |p: &std::path::Path| {
+            p.strip_prefix(&s.scenes_root)
+                .unwrap_or(p)
+                .display()
+                .to_string()
+        };
         let mut pick = None;
         egui::ComboBox::from_label("scene")
-            .selected_text(
-                s.scene_path
-                    .file_name()
-                    .map(|f| f.to_string_lossy().to_string())
-                    .unwrap_or(current.clone()),
-            )
+            .selected_text(name(&s.scene_path))
             .show_ui(ui, |ui| {
                 for p in &s.scenes {
-                    let name = p.file_name().map(|f| f.to_string_lossy().to_string());
-                    let name = name.unwrap_or_default();
-                    if ui.selectable_label(*p == s.scene_path, name).clicked() {
+                    if ui.selectable_label(*p == s.scene_path, name(p)).clicked() {
                         pick = Some(p.clone());
                     }
                 }

@@ -193,3 +193,24 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
     assert_eq!(s.board.as_ref().unwrap().reply.as_deref(), Some("accepted"));
     s.disconnect();
 }
+
+#[test]
+fn the_scene_picker_lists_the_scenes_and_the_table_i_folder() {
+    let s = ScopeState::open(Path::new("../scenes/stiff_wall.toml")).unwrap();
+    let names: Vec<String> = s
+        .scenes
+        .iter()
+        .map(|p| {
+            p.strip_prefix(&s.scenes_root)
+                .unwrap()
+                .display()
+                .to_string()
+        })
+        .collect();
+    assert!(names.contains(&"stiff_wall.toml".to_string()), "{names:?}");
+    assert!(names.contains(&"vbb_blocks.toml".to_string()), "{names:?}");
+    assert_eq!(
+        names.iter().filter(|n| n.starts_with("table1/")).count(),
+        18
+    );
+}
