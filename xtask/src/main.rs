@@ -62,8 +62,14 @@ fn main() -> ExitCode {
 }
 
 fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
+    // `cargo run` names the checkout it ran from; the path compiled in is
+    // only the fallback. (Two checkouts sharing one CARGO_TARGET_DIR share
+    // the xtask binary too, and a compiled-in path made one checkout's
+    // `cargo xtask` quietly build the other's sources.)
+    let dir = std::env::var_os("CARGO_MANIFEST_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")));
+    dir.parent()
         .expect("xtask lives in the workspace root")
         .to_path_buf()
 }
