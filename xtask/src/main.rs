@@ -14,7 +14,7 @@
 
 mod toolchain;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::{Command, ExitCode, Stdio};
 use std::time::{Duration, Instant};
 use toolchain::{Toolchain, TARGET};
