@@ -13,7 +13,7 @@ use std::time::Duration;
 use twoport_design::design::{self, Analysis, Check, GridSpec};
 use twoport_design::plot::Figure;
 use twoport_design::twoport::HumanBound;
-use twoport_design::{DeviceModel, Plant};
+use twoport_design::Plant;
 use twoport_link::{Gains, GainsReply, Message, Telemetry};
 
 /// Samples each signal's ring holds: 20 s at 1 kHz.
@@ -23,8 +23,6 @@ pub const RING_BYTES: usize =
     (Signal::ALL.len() + BoardSignal::ALL.len()) * RING_SAMPLES * std::mem::size_of::<(f64, f64)>();
 /// Wall time the simulation may take per frame, so the window stays live.
 const FRAME_BUDGET: Duration = Duration::from_millis(25);
-
-const BUILTIN_EXCALIBUR: &str = include_str!("../../models/excalibur.toml");
 
 /// A simulated signal the scope records.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -698,13 +696,10 @@ fn wall_of(scene: &Scene) -> Option<(f64, f64)> {
     }
 }
 
+/// The designer's plant for the scene's device, at the period the
+/// simulation runs.
 fn analysis_plant(scene: &Scene) -> Option<Plant> {
-    let model = if scene.plant.model.exists() {
-        DeviceModel::load(&scene.plant.model).ok()?
-    } else {
-        DeviceModel::from_toml(BUILTIN_EXCALIBUR, "built-in excalibur.toml").ok()?
-    };
-    Plant::new(&model, scene.period_s.unwrap_or(model.period_s)).ok()
+    Plant::new(&scene.device_model().ok()?, scene.period()).ok()
 }
 
 /// Serial ports the system lists (a pty from QEMU is not listed; type its

@@ -468,7 +468,7 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         return Err(format!("--seconds {}: must be in (0, 3600]", a.seconds));
     }
     let scene = load(&a.scene, &[])?;
-    let period = scene.period_s.unwrap_or(1e-3);
+    let period = scene.period();
     let ticks = (a.seconds / period).round() as u64;
     let link_loss_at = match a.link_loss_at_s {
         Some(t) if t.is_finite() && t >= 0.0 && t < a.seconds => Some((t / period).round() as u64),

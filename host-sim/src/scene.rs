@@ -16,7 +16,7 @@ pub struct Scene {
     /// Simulated time (s).
     #[serde(default = "default_duration")]
     pub duration_s: f64,
-    /// Control period (s); the model's (or 1 ms) by default.
+    /// Control period (s); 1 ms by default (see [`Scene::period`]).
     pub period_s: Option<f64>,
     /// The device.
     #[serde(default)]
@@ -417,6 +417,18 @@ fn locate(text: &str, table: &str, message: &str) -> Option<(usize, String)> {
 }
 
 impl Scene {
+    /// The control period the scene runs at (s).
+    pub fn period(&self) -> f64 {
+        self.period_s.unwrap_or(1e-3)
+    }
+
+    /// The scene's device model, [`DeviceModel::load_or_excalibur`]; the
+    /// error names `plant.model`.
+    pub fn device_model(&self) -> Result<twoport_design::DeviceModel, String> {
+        twoport_design::DeviceModel::load_or_excalibur(&self.plant.model)
+            .map_err(|e| format!("plant.model: {e}"))
+    }
+
     /// Read a scene file, apply `--set` overrides, and check it.
     pub fn load(path: &Path, sets: &[String]) -> Result<Self, SceneError> {
         let text = std::fs::read_to_string(path)

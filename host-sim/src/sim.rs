@@ -15,12 +15,9 @@ use twoport_control::ve::{
     VirtualEnvironment,
 };
 use twoport_control::{AdmittanceServo, Encoder, ImpedanceServo, Position, SafetyConfig};
-use twoport_design::DeviceModel;
 
 /// One tick in this many is timed for the effects' cost.
 const TIMING_STRIDE: u64 = 64;
-
-const BUILTIN_EXCALIBUR: &str = include_str!("../../models/excalibur.toml");
 
 /// The board's code for the scene's display.
 #[derive(Clone, Debug)]
@@ -264,18 +261,7 @@ impl Simulation {
     pub fn new(scene: Scene) -> Result<Self, String> {
         let e = scene.effects.clone();
         let device = if e.flexibility {
-            let model = if scene.plant.model.exists() {
-                DeviceModel::load(&scene.plant.model).map_err(|e| e.to_string())?
-            } else if scene.plant.model == std::path::Path::new("models/excalibur.toml") {
-                DeviceModel::from_toml(BUILTIN_EXCALIBUR, "built-in excalibur.toml")
-                    .map_err(|e| e.to_string())?
-            } else {
-                return Err(format!(
-                    "plant.model: {}: no such file",
-                    scene.plant.model.display()
-                ));
-            };
-            Device::flexible(&model)?
+            Device::flexible(&scene.device_model()?)?
         } else {
             Device::rigid(
                 scene.plant.rigid_mass_kg,
@@ -283,7 +269,7 @@ impl Simulation {
                 235.0,
             )
         };
-        let period = scene.period_s.unwrap_or(1e-3);
+        let period = scene.period();
         let human =
             Human::new(scene.human.grasp, scene.human.script.clone())?.with_arm(scene.human.arm)?;
         let nonlinear = scene.nonlinear();

@@ -3,14 +3,13 @@
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use serde_json::{json, Value};
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use twoport_design::design::{self, Analysis, GridSpec};
 use twoport_design::twoport::HumanBound;
 use twoport_design::{figures, plot, DeviceModel, Plant};
 
-const DEFAULT_MODEL: &str = "models/excalibur.toml";
-const BUILTIN_EXCALIBUR: &str = include_str!("../../../models/excalibur.toml");
+const DEFAULT_MODEL: &str = twoport_design::model::EXCALIBUR_PATH;
 
 /// Design haptic interfaces that are stable by construction: two-port
 /// analysis, Llewellyn's absolute-stability criteria and virtual-coupling
@@ -213,12 +212,7 @@ struct Session {
 
 impl Session {
     fn open(c: &Common) -> Result<Self, String> {
-        let model = if c.model == Path::new(DEFAULT_MODEL) && !c.model.exists() {
-            DeviceModel::from_toml(BUILTIN_EXCALIBUR, "built-in excalibur.toml")
-        } else {
-            DeviceModel::load(&c.model)
-        }
-        .map_err(|e| e.to_string())?;
+        let model = DeviceModel::load_or_excalibur(&c.model).map_err(|e| e.to_string())?;
         let period = c.period.unwrap_or(model.period_s);
         if !(period.is_finite() && period > 0.0) {
             return Err(format!(

@@ -75,7 +75,29 @@ struct RawModel {
     c_f: Vec<Vec<f64>>,
 }
 
+/// Where the paper's Excalibur model lives in this repository.
+pub const EXCALIBUR_PATH: &str = "models/excalibur.toml";
+
+/// The same model built into the tools, for a run outside the repository.
+const EXCALIBUR_TOML: &str = include_str!("../../../models/excalibur.toml");
+
 impl DeviceModel {
+    /// The paper's Excalibur model (the copy built into the tools).
+    pub fn excalibur() -> Result<Self, ModelError> {
+        Self::from_toml(EXCALIBUR_TOML, "built-in excalibur.toml")
+    }
+
+    /// Read and check `path`; the default path [`EXCALIBUR_PATH`], when the
+    /// file is not there (a tool run outside the repository), gives the
+    /// built-in Excalibur model.
+    pub fn load_or_excalibur(path: &Path) -> Result<Self, ModelError> {
+        if path == Path::new(EXCALIBUR_PATH) && !path.exists() {
+            Self::excalibur()
+        } else {
+            Self::load(path)
+        }
+    }
+
     /// Read and check a model file.
     pub fn load(path: &Path) -> Result<Self, ModelError> {
         let source = path.display().to_string();
