@@ -234,8 +234,6 @@ pub struct ScopeState {
     pub speed: Speed,
     rings: Vec<Ring>,
     board_rings: Vec<Ring>,
-    /// Signals drawn.
-    pub shown: Vec<Signal>,
     /// The visible time span (s).
     pub window_s: f64,
     /// The trigger.
@@ -326,7 +324,6 @@ impl ScopeState {
                 .iter()
                 .map(|_| Ring::new(RING_SAMPLES))
                 .collect(),
-            shown: Signal::ALL.to_vec(),
             window_s: 5.0,
             trigger: Trigger {
                 enabled: false,

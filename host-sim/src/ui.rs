@@ -34,16 +34,16 @@ const COLORS: [Color32; 6] = [
     Color32::from_rgb(140, 86, 75),
 ];
 
-/// One plot of the stack: the named signals on the shared time axis.
+/// One plot of the stack: the named signals over `[t0, t1)`.
 fn signal_plot(
     ui: &mut Ui,
     s: &ScopeState,
+    (t0, t1): (f64, f64),
     id: &str,
     height: f32,
     signals: &[Signal],
     board: &[BoardSignal],
 ) {
-    let (t0, t1) = s.view();
     let px = ui.available_width().max(1.0) as usize;
     Plot::new(id)
         .height(height)
@@ -57,7 +57,7 @@ fn signal_plot(
         .show(ui, |p| {
             p.set_plot_bounds_x(t0..=t1);
             p.set_auto_bounds([false, true]);
-            for (i, sig) in signals.iter().filter(|x| s.shown.contains(x)).enumerate() {
+            for (i, sig) in signals.iter().enumerate() {
                 let pts = envelope(s.ring(*sig), t0, t1, px);
                 p.line(Line::new(sig.name(), PlotPoints::from(pts)).color(COLORS[i % 6]));
             }
@@ -70,21 +70,25 @@ fn signal_plot(
         });
 }
 
-/// The four plots on one time axis.
+/// The four plots on one time axis. The span is found once a frame (a
+/// triggered one scans the trigger signal's ring).
 pub fn plots(ui: &mut Ui, s: &ScopeState) {
     let h = ((ui.available_height() - 24.0) / 4.0).max(80.0);
+    let span = s.view();
     signal_plot(
         ui,
         s,
+        span,
         "positions",
         h,
         &[Signal::HandlePosition, Signal::VePosition],
         &[BoardSignal::Position, BoardSignal::VePosition],
     );
-    signal_plot(ui, s, "velocity", h, &[Signal::HandleVelocity], &[]);
+    signal_plot(ui, s, span, "velocity", h, &[Signal::HandleVelocity], &[]);
     signal_plot(
         ui,
         s,
+        span,
         "forces",
         h,
         &[
@@ -99,6 +103,7 @@ pub fn plots(ui: &mut Ui, s: &ScopeState) {
     signal_plot(
         ui,
         s,
+        span,
         "energy",
         h,
         &[Signal::EnergyIn, Signal::EnergyStored],
