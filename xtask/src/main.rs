@@ -14,7 +14,7 @@
 
 mod toolchain;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 use std::time::{Duration, Instant};
 use toolchain::{Toolchain, TARGET};
@@ -299,26 +299,13 @@ fn pil(extra: &[String]) -> Result<(), String> {
         cargo().args(["build", "--release", "-q", "-p", "host-sim"]),
     )?;
     with_board_in_qemu(|pty| {
-        let st = cargo()
-            .args([
-                "run",
-                "--release",
-                "-q",
-                "-p",
-                "host-sim",
-                "--",
-                "pil",
-                "--port",
-            ])
-            .arg(pty)
-            .args(extra)
-            .status()
-            .map_err(|e| format!("host-sim pil: {e}"))?;
-        if st.success() {
-            Ok(())
-        } else {
-            Err(format!("host-sim pil failed ({st})"))
-        }
+        run(
+            "host-sim pil",
+            cargo()
+                .args(["run", "--release", "-q", "-p", "host-sim", "--"])
+                .args(["pil", "--port", pty])
+                .args(extra),
+        )
     })
 }
 
@@ -342,15 +329,8 @@ fn scope_board() -> Result<(), String> {
 fn with_board_in_qemu(f: impl FnOnce(&str) -> Result<(), String>) -> Result<(), String> {
     use std::io::{BufRead, BufReader, Read};
     let elf = firmware()?.join("twoport-an386");
-    let mut qemu = Command::new("qemu-system-arm")
-        .args(["-machine", "mps2-an386", "-cpu", "cortex-m4"])
+    let mut qemu = qemu_an386(&elf)
         .args(["-display", "none", "-monitor", "none", "-serial", "pty"])
-        // Deterministic virtual time: the board's SysTick loop timing in
-        // its telemetry is then a function of the instructions it ran.
-        .args(["-icount", "shift=6"])
-        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
-        .arg(&elf)
-        .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -436,17 +416,24 @@ fn fuzz(secs: u32) -> Result<(), String> {
     Ok(())
 }
 
+/// QEMU's Cortex-M4F board running `elf`, with semihosting (prints and
+/// exit codes) and virtual time from the instruction count, so that the
+/// images' SysTick measurements are deterministic.
+fn qemu_an386(elf: &Path) -> Command {
+    let mut c = Command::new("qemu-system-arm");
+    c.args(["-machine", "mps2-an386", "-cpu", "cortex-m4"])
+        .args(["-icount", "shift=6"])
+        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
+        .arg(elf)
+        .stdin(Stdio::null());
+    c
+}
+
 fn qemu() -> Result<(), String> {
     let elf = firmware()?.join("twoport-probe");
     eprintln!("xtask: run {} in QEMU mps2-an386", elf.display());
-    let mut child = Command::new("qemu-system-arm")
-        .args(["-machine", "mps2-an386", "-cpu", "cortex-m4", "-nographic"])
-        // Virtual time from the instruction count: the probe's per-tick
-        // cost is then deterministic.
-        .args(["-icount", "shift=6"])
-        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
-        .arg(&elf)
-        .stdin(Stdio::null())
+    let mut child = qemu_an386(&elf)
+        .arg("-nographic")
         .spawn()
         .map_err(|e| format!("qemu-system-arm: could not start ({e}); install qemu-system-arm"))?;
     // A hung target (a lost exit, a fault loop) must not hang CI.
