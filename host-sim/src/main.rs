@@ -494,6 +494,11 @@ fn pil(a: &PilArgs) -> Result<(), String> {
     let c = pil::compare(&run, &reference);
     let frames_dropped = run.board_stats.rx.dropped() + run.host_dropped;
     let loop_cycles = run.telemetry.last().map(|t| t.loop_cycles);
+    let board = if a.port.is_some() {
+        "serial"
+    } else {
+        "in-process"
+    };
     let v = json!({
         "ticks": c.ticks,
         "max_position_error_m": c.max_position_error_m,
@@ -507,16 +512,16 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         "telemetry_frames": run.telemetry.len(),
         "peak_force_n": run.samples.iter().map(|s| s.actuator_n.abs()).fold(0.0, f64::max),
         "last_loop_cycles": loop_cycles,
-        "board": if a.port.is_some() { "serial" } else { "in-process" },
+        "board": board,
         "wall_s": remote_s,
     });
     if a.json {
         println!("{v}");
     } else {
         println!(
-            "PIL ({}): {} ticks in {remote_s:.2} s; position error {:.3e} m, force error {:.3e} N, \
+            "PIL ({board}): {} ticks in {remote_s:.2} s; position error {:.3e} m, force error {:.3e} N, \
              {} duty mismatches; {} corrupted frames sent, {frames_dropped} dropped",
-            v["board"], c.ticks, c.max_position_error_m, c.max_force_error_n, c.duty_mismatches,
+            c.ticks, c.max_position_error_m, c.max_force_error_n, c.duty_mismatches,
             run.corrupted_sent
         );
         if let Some(z) = run.zero_after_loss_ticks {

@@ -14,7 +14,6 @@ use twoport_board::excalibur::{self, REGION_POINTS};
 use twoport_board::Board;
 use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::ve::UnilateralWall;
-use twoport_control::Position;
 use twoport_link::{
     encode, Decoder, LinkStats, Message, Role, SensorFrame as LinkSensors, Telemetry, MAX_FRAME,
 };
@@ -279,7 +278,6 @@ impl<P: BoardPort> Session<P> {
             ServoOutput {
                 actuator_force_n: force,
                 commanded_force_n: force,
-                position: Position::ZERO,
                 ..ServoOutput::default()
             }
         };
@@ -291,7 +289,7 @@ impl<P: BoardPort> Session<P> {
         let sensors = Message::Sensors(LinkSensors {
             tick: f.tick,
             encoder_raw: f.encoder_raw,
-            load_cell_raw: (f.load_cell_n / self.io.load_cell_n_per_count).round() as i32,
+            load_cell_raw: self.io.load_cell_counts(f.load_cell_n),
             dead_man_closed: f.dead_man_closed,
         });
         let good = self.frame(&sensors)?;
@@ -351,8 +349,7 @@ pub fn run<P: BoardPort>(scene: Scene, ticks: u64, port: P, faults: Faults) -> R
     r.corrupted_sent = session.corrupted_sent;
     if let Some(t0) = faults.link_loss_at {
         // The last tick with a non-zero duty after the loss, plus one.
-        let after = r.duties.iter().skip(t0 as usize);
-        let last_nonzero = after.clone().rposition(|d| *d != 0);
+        let last_nonzero = r.duties.iter().skip(t0 as usize).rposition(|d| *d != 0);
         r.zero_after_loss_ticks = Some(last_nonzero.map_or(0, |i| i as u64 + 1));
     }
     Ok(r)

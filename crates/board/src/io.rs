@@ -46,6 +46,14 @@ impl IoScale {
     pub fn load_cell_n(&self, counts: i32) -> f32 {
         counts as f32 * self.load_cell_n_per_count
     }
+
+    /// The ADC reading (counts, nearest, half away from zero; saturating,
+    /// NaN gives 0) a load-cell force gives: what a processor-in-the-loop
+    /// host sends for a simulated force.
+    pub fn load_cell_counts(&self, force_n: f32) -> i32 {
+        let c = force_n / self.load_cell_n_per_count;
+        (c + 0.5f32.copysign(c)) as i32
+    }
 }
 
 #[cfg(test)]
@@ -69,5 +77,16 @@ mod tests {
         assert_eq!(s.force_n(i16::MIN), -s.force_full_scale_n);
         assert_eq!(s.duty(0.0), 0);
         assert_eq!(s.duty(-0.5 * step * 0.99), 0);
+    }
+
+    #[test]
+    fn load_cell_counts_invert_load_cell_n() {
+        let s = IoScale::EXCALIBUR;
+        for c in [-250_000, -1001, -1, 0, 1, 999, 250_000] {
+            assert_eq!(s.load_cell_counts(s.load_cell_n(c)), c);
+        }
+        assert_eq!(s.load_cell_counts(0.0014), 1);
+        assert_eq!(s.load_cell_counts(-0.0016), -2);
+        assert_eq!(s.load_cell_counts(f32::NAN), 0);
     }
 }
