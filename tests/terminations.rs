@@ -222,19 +222,33 @@ fn admittance_gains_past_the_bound_meet_an_unstable_termination() {
     );
 }
 
+/// The designer's Excalibur at T = 1 ms.
+fn excalibur_plant() -> twoport_design::Plant {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let model = twoport_design::DeviceModel::load(&root.join("models/excalibur.toml")).unwrap();
+    twoport_design::Plant::new(&model, 1e-3).unwrap()
+}
+
 /// The designer's view of the impedance display at the VE port, hand off:
-/// `p22 = Y_cc + 1/Z_cI` at `f_hz` for coupling stiffness `k` (b = 90).
-fn designer_p22(k: f64, f_hz: f64) -> num_complex::Complex64 {
+/// `p22 = Y_cc + 1/Z_cI` at each of `f_hz` for coupling stiffness `k`
+/// (b = 90).
+fn designer_p22(
+    plant: &twoport_design::Plant,
+    k: f64,
+    f_hz: &[f64],
+) -> Vec<num_complex::Complex64> {
     use twoport_design::design::*;
     use twoport_design::twoport::*;
-    use twoport_design::{DeviceModel, Plant};
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let model = DeviceModel::load(&root.join("models/excalibur.toml")).unwrap();
-    let plant = Plant::new(&model, 1e-3).unwrap();
-    let pa = Analysis::on(&plant, &[2.0 * std::f64::consts::PI * f_hz]);
-    let p = &pa.points[0];
-    let zc = impedance_coupling_tf(k, 90.0, 1e-3).unwrap().eval(p.z);
-    with_impedance_coupling(&impedance_display(p, None), zc)[1][1]
+    let omegas: Vec<f64> = f_hz
+        .iter()
+        .map(|f| 2.0 * std::f64::consts::PI * f)
+        .collect();
+    let zc = impedance_coupling_tf(k, 90.0, plant.period_s()).unwrap();
+    Analysis::on(plant, &omegas)
+        .points
+        .iter()
+        .map(|p| with_impedance_coupling(&impedance_display(p, None), zc.eval(p.z))[1][1])
+        .collect()
 }
 
 /// The impedance display past its bound, against the termination the
@@ -254,11 +268,9 @@ fn designer_p22(k: f64, f_hz: f64) -> num_complex::Complex64 {
 fn impedance_gains_past_the_bound_meet_the_termination_the_two_port_names() {
     use twoport_design::design::*;
     use twoport_design::twoport::HumanBound;
-    use twoport_design::{DeviceModel, Plant};
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let model = DeviceModel::load(&root.join("models/excalibur.toml")).unwrap();
-    let t = 1e-3;
-    let a = Analysis::new(&Plant::new(&model, t).unwrap(), GridSpec::DEFAULT);
+    let plant = excalibur_plant();
+    let t = plant.period_s();
+    let a = Analysis::new(&plant, GridSpec::DEFAULT);
     let human = Some(HumanBound::PAPER);
     let k_max = max_stiffness(&a, &a.impedance_bound(human), 90.0).unwrap();
     let k = 1.2 * k_max;
@@ -266,9 +278,11 @@ fn impedance_gains_past_the_bound_meet_the_termination_the_two_port_names() {
         .unwrap()
         .worst_frequency_hz;
     // The most negative Re p22 near the worst frequency.
-    let (f, p) = (0..=400)
-        .map(|i| worst - 4.0 + 0.02 * i as f64)
-        .map(|f| (f, designer_p22(k, f)))
+    let fs: Vec<f64> = (0..=400).map(|i| worst - 4.0 + 0.02 * i as f64).collect();
+    let (f, p) = fs
+        .iter()
+        .copied()
+        .zip(designer_p22(&plant, k, &fs))
         .min_by(|x, y| x.1.re.total_cmp(&y.1.re))
         .unwrap();
     assert!(
@@ -349,6 +363,7 @@ fn the_simulated_ve_port_impedance_is_the_designers() {
             VeTransfer::Admittance(ZTransfer::first_order([0.0, 0.0], 0.0))
         }
     }
+    let plant = excalibur_plant();
     for k in [51_074.0, 61_289.0] {
         for bin in [320u32, 329, 337] {
             let f_hz = bin as f64 / 4.0;
@@ -371,7 +386,7 @@ fn the_simulated_ve_port_impedance_is_the_designers() {
                 sim.step_external(&mut |frame| servo.tick(frame));
                 (1e-3 * u, -servo.ve().f as f64)
             });
-            let want = designer_p22(k, f_hz).inv();
+            let want = designer_p22(&plant, k, &[f_hz])[0].inv();
             let err = (z_net - want).norm() / want.norm();
             assert!(
                 err < 1e-3,
