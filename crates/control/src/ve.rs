@@ -390,10 +390,6 @@ impl UnilateralWall {
         self.spring.gains()
     }
 
-    /// Where the surface is.
-    pub fn surface(&self) -> Position {
-        self.spring.anchor
-    }
 
     /// +1 when solid above, -1 when below.
     fn sign(&self) -> f32 {
