@@ -390,7 +390,6 @@ impl UnilateralWall {
         self.spring.gains()
     }
 
-
     /// +1 when solid above, -1 when below.
     fn sign(&self) -> f32 {
         match self.solid {
