@@ -14,9 +14,9 @@ use twoport_control::{
 
 const T: f32 = 1e-3;
 
-/// A wobbling position in picometres, different every tick.
+/// A wobbling position (±1 mm), different every tick.
 fn wobble(k: u32) -> Position {
-    Position::from_pm(((k as i64 * 7919) % 2_000_001 - 1_000_000) * 1000)
+    Position::from_nm(((k as i64 * 7919) % 2_000_001 - 1_000_000) as i32)
 }
 
 fn laws(c: &mut Criterion) {
@@ -36,10 +36,11 @@ fn laws(c: &mut Criterion) {
         })
     });
     let mut reg = PositionRegulator::new(51_000.0, 90.0, T).unwrap();
+    let held = Integrator::new(T, Position::ZERO);
     c.bench_function("position regulator K_p step", |b| {
         b.iter(|| {
             k = k.wrapping_add(1);
-            black_box(reg.step(black_box(wobble(k)), Position::ZERO))
+            black_box(reg.step(black_box(wobble(k)), &held))
         })
     });
     let mut zc = ImpedanceCoupling::new(51_000.0, 90.0, T, Position::ZERO).unwrap();
@@ -85,7 +86,7 @@ fn servos(c: &mut Criterion) {
     let wall = UnilateralWall::new(
         1e5,
         50.0,
-        Position::from_pm(500_000_000),
+        Position::from_nm(500_000),
         Solid::Above,
         T,
         Position::ZERO,

@@ -12,15 +12,15 @@ const T: f32 = 1.0e-3;
 const TICKS: usize = 1_000_000;
 
 /// A device path with large slow motion, fast vibration and a pseudo-random
-/// walk, in integer picometres (an encoder's exact position).
+/// walk, in integer nanometres (an encoder's exact position).
 fn path(k: usize) -> Position {
     let t = k as f64 * T as f64;
     let mut h: u64 = (k as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
     h ^= h >> 29;
-    let jitter = (h % 2001) as f64 - 1000.0; // +-1 nm
+    let jitter = (h % 2001) as i32 - 1000; // +-1 um
     let x = 0.05 * (2.0 * std::f64::consts::PI * 0.7 * t).sin()
         + 0.002 * (2.0 * std::f64::consts::PI * 37.0 * t).sin();
-    Position::from_pm((x * 1e12).round() as i64 + jitter as i64 * 1000)
+    Position::from_nm((x * 1e9).round() as i32 + jitter)
 }
 
 #[test]
@@ -38,7 +38,7 @@ fn spring_on_positions_matches_the_formula_for_a_million_ticks_without_drift() {
         let x = path(i);
         let v = est.step(x);
         let f = c.step(x, v, &mut ve).force_n as f64;
-        let e = (x.pm() - origin.pm()) as f64 * 1e-12;
+        let e = (x.nm() - origin.nm()) as f64 * 1e-9;
         let f_ref = k * e + b * (e - e_prev) / t;
         // f32 rounding of the two terms (a few ulp of each).
         let scale = (k * e).abs() + (b * (e - e_prev) / t).abs() + 1e-3;

@@ -21,8 +21,8 @@ const EXCALIBUR: &str = include_str!("../models/excalibur.toml");
 #[test]
 #[ignore = "8.64e7 ticks: run with --release --ignored (CI does)"]
 fn admittance_display_does_not_creep_in_24_hours() {
-    let count_pm = 1_000_000;
-    let enc = Encoder::new(16, count_pm, 0, Position::ZERO).unwrap();
+    let count_nm = 1000;
+    let enc = Encoder::new(16, count_nm as i64 * 1000, 0, Position::ZERO).unwrap();
     let wall =
         UnilateralWall::new(2e4, 50.0, Position::ZERO, Solid::Above, T, Position::ZERO).unwrap();
     let mut s = AdmittanceServo::new(
@@ -56,8 +56,8 @@ fn admittance_display_does_not_creep_in_24_hours() {
         }
     }
     let drift = (last - at_1h.unwrap()).abs();
-    eprintln!("position command drift from hour 1 to hour 24: {drift} pm");
-    assert!(drift <= count_pm, "drifted {drift} pm > one count");
+    eprintln!("position command drift from hour 1 to hour 24: {drift} nm");
+    assert!(drift <= count_nm, "drifted {drift} nm > one count");
     // And it sits where the wall puts it: 10 N mean into 2e4 N/m is 0.5 mm
     // (the wave's phase adds its own offset, well under 0.3 mm).
     assert!((last.m() - 0.5e-3).abs() < 0.3e-3, "{} m", last.m());

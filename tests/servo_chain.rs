@@ -162,5 +162,5 @@ fn impedance_display_renders_the_series_of_coupling_and_wall() {
         "{} N vs {want} N",
         out.actuator_force_n
     );
-    assert!(s.ve().position().pm() > 0);
+    assert!(s.ve().position().nm() > 0);
 }

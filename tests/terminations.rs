@@ -376,7 +376,7 @@ fn the_simulated_ve_port_impedance_is_the_designers() {
                 max_velocity_mps: 100.0,
                 ..SafetyConfig::excalibur()
             };
-            let enc = Encoder::new(32, 1, 0, Position::ZERO).unwrap();
+            let enc = Encoder::new(32, 1000, 0, Position::ZERO).unwrap(); // the sim's ideal 1 nm counts
             let ve = VelocitySource { v: 0.0, f: 0.0 };
             let mut servo = ImpedanceServo::new(k as f32, 90.0, enc, safety, ve).unwrap();
             servo.enable().unwrap();

@@ -10,8 +10,8 @@ use twoport_control::{Position, ZTransfer};
 pub struct Block {
     /// Left edge.
     pub left: Position,
-    /// Width (pm).
-    pub width_pm: i64,
+    /// Width (nm).
+    pub width_nm: i32,
     /// Mass (kg).
     pub mass_kg: f32,
     /// Velocity (m/s).
@@ -20,7 +20,7 @@ pub struct Block {
 
 impl Block {
     fn right(&self) -> Position {
-        self.left + self.width_pm
+        self.left + self.width_nm
     }
 }
 
@@ -35,15 +35,15 @@ pub struct Blocks {
     stick_n: f32,
     floor_nspm: f32,
     grabbed: Option<usize>,
-    /// Cursor position minus the grabbed block's left edge (pm).
-    offset_pm: i64,
+    /// Cursor position minus the grabbed block's left edge (nm).
+    offset_nm: i32,
     ticks: u64,
     grab_tick: Option<u64>,
     release_tick: Option<u64>,
 }
 
 /// Touching within 1 nm.
-const TOUCH_PM: i64 = 1_000;
+const TOUCH_NM: i32 = 1;
 
 impl Blocks {
     /// A world; `grab_at_s`/`release_at_s` script the mouse button.
@@ -69,7 +69,7 @@ impl Blocks {
             stick_n,
             floor_nspm,
             grabbed: None,
-            offset_pm: 0,
+            offset_nm: 0,
             ticks: 0,
             grab_tick: grab_at_s.map(tick),
             release_tick: release_at_s.map(tick),
@@ -93,7 +93,7 @@ impl Blocks {
             .blocks
             .iter()
             .position(|b| b.left <= x && x <= b.right())?;
-        self.offset_pm = x - self.blocks[i].left;
+        self.offset_nm = x - self.blocks[i].left;
         self.grabbed = Some(i);
         Some(i)
     }
@@ -102,18 +102,18 @@ impl Blocks {
     pub fn release(&mut self) {
         if let Some(i) = self.grabbed.take() {
             let b = self.blocks[i];
-            self.cursor.reset(b.left + self.offset_pm);
+            self.cursor.reset(b.left + self.offset_nm);
         }
     }
 
     /// The contiguous touching chain around block `g`: indices `lo..=hi`.
     fn chain(&self, g: usize) -> (usize, usize) {
         let (mut lo, mut hi) = (g, g);
-        while lo > 0 && self.blocks[lo].left - self.blocks[lo - 1].right() <= TOUCH_PM {
+        while lo > 0 && self.blocks[lo].left - self.blocks[lo - 1].right() <= TOUCH_NM {
             lo -= 1;
         }
         while hi + 1 < self.blocks.len()
-            && self.blocks[hi + 1].left - self.blocks[hi].right() <= TOUCH_PM
+            && self.blocks[hi + 1].left - self.blocks[hi].right() <= TOUCH_NM
         {
             hi += 1;
         }
@@ -152,12 +152,12 @@ impl Blocks {
             out = self.group_solve(port, lo, hi).1;
         }
         // The leading face stops exactly at the next obstacle this tick: the
-        // move is clamped in integer picometres, and the velocity follows
+        // move is clamped in integer nanometres, and the velocity follows
         // from it, so nothing ever overlaps.
         if !out.velocity_mps.is_finite() {
             return out;
         }
-        let want = (out.velocity_mps as f64 * t as f64 * 1e12).round() as i64;
+        let want = (out.velocity_mps as f64 * t as f64 * 1e9).round() as i32;
         let d = if want > 0 {
             let front = self.blocks[hi].right();
             let wall = self.blocks.get(hi + 1).map_or(self.limits[1], |b| b.left);
@@ -174,7 +174,7 @@ impl Blocks {
             0
         };
         if d != want {
-            out = port.at((d as f64 * 1e-12 / t as f64) as f32);
+            out = port.at((d as f64 * 1e-9 / t as f64) as f32);
         }
         for b in &mut self.blocks[lo..=hi] {
             b.velocity_mps = out.velocity_mps;
@@ -190,7 +190,7 @@ impl Blocks {
         for i in (0..self.blocks.len()).filter(|i| *i < lo || *i > hi) {
             let b = self.blocks[i];
             let v = b.velocity_mps / (1.0 + t * self.floor_nspm / b.mass_kg);
-            let mut d = (v as f64 * t as f64 * 1e12) as i64;
+            let mut d = (v as f64 * t as f64 * 1e9) as i32;
             let left_wall = if i > 0 {
                 self.blocks[i - 1].right()
             } else {
@@ -241,7 +241,7 @@ impl VirtualEnvironment for Blocks {
 
     fn position(&self) -> Position {
         match self.grabbed {
-            Some(g) => self.blocks[g].left + self.offset_pm,
+            Some(g) => self.blocks[g].left + self.offset_nm,
             None => self.cursor.position(),
         }
     }
@@ -265,14 +265,14 @@ mod tests {
 
     const T: f32 = 1e-3;
 
-    fn pm(m: f64) -> Position {
-        Position::from_pm((m * 1e12).round() as i64)
+    fn at(m: f64) -> Position {
+        Position::from_m_f64(m).unwrap()
     }
 
     fn world(stick: f32) -> Blocks {
-        let b = |at: f64| Block {
-            left: pm(at),
-            width_pm: 20_000_000_000,
+        let b = |left_m: f64| Block {
+            left: at(left_m),
+            width_nm: 20_000_000,
             mass_kg: 0.5,
             velocity_mps: 0.0,
         };
@@ -280,7 +280,7 @@ mod tests {
             T,
             0.25,
             vec![b(-0.01), b(0.01), b(0.1)],
-            [pm(-0.1), pm(0.2)],
+            [at(-0.1), at(0.2)],
             stick,
             5.0,
             None,
@@ -307,14 +307,14 @@ mod tests {
                 let right_limit = if i + 1 < b.len() {
                     b[i + 1].left
                 } else {
-                    pm(0.2)
+                    at(0.2)
                 };
                 assert!(b[i].right() <= right_limit, "overlap at block {i}");
             }
         }
         let b = w.blocks();
         assert!(
-            (b[2].right() - pm(0.2)).abs() <= TOUCH_PM,
+            (b[2].right() - at(0.2)).abs() <= TOUCH_NM,
             "pushed to the wall"
         );
         assert!(
@@ -344,7 +344,7 @@ mod tests {
                 });
             }
             let gap = w.blocks()[1].left - w.blocks()[0].right();
-            assert_eq!(gap <= TOUCH_PM, follows, "stick {stick}: gap {gap} pm");
+            assert_eq!(gap <= TOUCH_NM, follows, "stick {stick}: gap {gap} nm");
         }
     }
 }

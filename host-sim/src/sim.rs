@@ -72,8 +72,9 @@ impl Servo {
         let SceneVe::Wall(w) = ve else {
             return Err("the scene's VE is not a wall".into());
         };
-        let x = Position::from_m(surface_m as f32)
-            .ok_or(format!("wall position {surface_m} m is out of range"))?;
+        let x = Position::from_m_f64(surface_m).ok_or(format!(
+            "wall position {surface_m} m is out of range (±2.147 m)"
+        ))?;
         let (_, b) = w.gains();
         w.set_gains(stiffness_npm as f32, b)
             .map_err(|e| e.to_string())?;
@@ -293,13 +294,15 @@ impl Simulation {
             .collect::<Result<_, String>>()?;
         let (bits, pm_per_count) = match e.encoder {
             Some(enc) => (enc.bits, (enc.resolution_m * 1e12).round()),
-            None => (32, 1.0),
+            // Ideal sensing: 1 nm counts, the resolution of a Position.
+            None => (32, 1000.0),
         };
         let encoder = Encoder::new(bits, pm_per_count as i64, 0, Position::ZERO)
             .map_err(|e| format!("effects.encoder: {e:?}"))?;
         let t32 = period as f32;
-        let pos =
-            |m: f64| Position::from_m(m as f32).ok_or(format!("position {m} m is out of range"));
+        let pos = |m: f64| {
+            Position::from_m_f64(m).ok_or(format!("position {m} m is out of range (±2.147 m)"))
+        };
         let ve = match &scene.ve {
             VeSpec::Cursor { mass_kg } => SceneVe::Cursor(
                 CursorMass::new(*mass_kg as f32, t32, Position::ZERO).map_err(|e| e.to_string())?,
@@ -358,7 +361,7 @@ impl Simulation {
                     .map(|b| {
                         Ok(Block {
                             left: pos(b.at_m)?,
-                            width_pm: (b.width_m * 1e12).round() as i64,
+                            width_nm: pos(b.width_m)?.nm(),
                             mass_kg: b.mass_kg as f32,
                             velocity_mps: 0.0,
                         })

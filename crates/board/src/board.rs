@@ -64,7 +64,7 @@ impl<V: VirtualEnvironment> Law<V> {
 
     /// The VE position (pm).
     fn ve_position_pm(&self) -> i64 {
-        both!(self, s => s.ve().position().pm())
+        both!(self, s => s.ve().position().nm() as i64 * 1000)
     }
 }
 
@@ -359,7 +359,7 @@ impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
                 self.since_telemetry = 0;
                 self.queue(Message::Telemetry(Telemetry {
                     tick: frame.tick,
-                    position_pm: out.position.pm(),
+                    position_pm: out.position.nm() as i64 * 1000,
                     velocity_mps: out.velocity_mps,
                     load_cell_n: frame.load_cell_n,
                     commanded_n: out.commanded_force_n,

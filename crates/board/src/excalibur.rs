@@ -49,9 +49,9 @@ pub const PERIOD_S: f32 = 1.0e-3;
 pub const ENCODER: (u8, i64) = (16, 1_000_000);
 /// Coupling stiffness (N/m) and damping (N s/m): the paper's design.
 pub const COUPLING: (f32, f32) = (51_000.0, 90.0);
-/// The wall: surface (pm, 1 cm), stiffness (N/m), damping (N s/m); solid
+/// The wall: surface (nm, 1 cm), stiffness (N/m), damping (N s/m); solid
 /// above.
-pub const WALL: (i64, f32, f32) = (10_000_000_000, 5.0e6, 200.0);
+pub const WALL: (i32, f32, f32) = (10_000_000, 5.0e6, 200.0);
 /// Ticks without a host heartbeat before the board forces zero (50 ms).
 pub const HEARTBEAT_TIMEOUT_TICKS: u32 = 50;
 /// Telemetry every this many ticks (100 Hz).
@@ -90,7 +90,7 @@ pub fn stiff_wall_law() -> Result<Law<UnilateralWall>, BuildError> {
     let ve = UnilateralWall::new(
         k,
         b,
-        Position::from_pm(x),
+        Position::from_nm(x),
         Solid::Above,
         PERIOD_S,
         Position::ZERO,

@@ -8,7 +8,7 @@ use crate::Position;
 pub enum EncoderError {
     /// The counter width is not between 2 and 32 bits.
     BadWidth(u8),
-    /// The resolution is not a positive number of picometres per count.
+    /// The resolution is not between 1 pm and 2.097 mm per count.
     BadResolution(i64),
     /// A raw reading has bits set above the counter width: the value did not
     /// come from a counter of this width (bus glitch or wrong register).
@@ -16,25 +16,39 @@ pub enum EncoderError {
 }
 
 /// Unwraps a free-running `bits`-wide hardware counter (16 or 32 bits on
-/// common timers) into an unbounded `i64` count and a [`Position`].
+/// common timers) into an unwrapped `i32` count and a [`Position`].
 ///
 /// Between two reads the shaft must move less than half the counter range
 /// (`2^(bits-1)` counts); the safety layer's velocity limit is what enforces
 /// that, so set it below `2^(bits-1) * resolution / T`.
+///
+/// The resolution is configured in integer picometres per count and kept as
+/// a fixed-point number of 2^-10 nm (0.98 pm) per count, so that a count
+/// becomes a position with one 32 x 32-bit multiply: the scale is exact to
+/// 0.49 pm per count (5e-7 of a 1 µm count). The unwrapped count saturates
+/// at ±2^31 counts and the position at the ends of its range.
 #[derive(Clone, Copy, Debug)]
 pub struct Encoder {
     bits: u8,
+    /// `32 - bits`: shifting a difference up by this and back down
+    /// (arithmetically) sign-extends it.
+    shift: u32,
     mask: u32,
     pm_per_count: i64,
+    /// The resolution in 2^-10 nm per count.
+    q10_per_count: i32,
     last_raw: u32,
-    count: i64,
+    count: i32,
     origin: Position,
 }
 
+/// The largest resolution: `i32::MAX` units of 2^-10 nm, 2.097 mm per count.
+const MAX_PM_PER_COUNT: i64 = 2_097_151_999;
+
 impl Encoder {
     /// A counter `bits` wide (2..=32) whose one count is `pm_per_count`
-    /// picometres of travel at the actuator. `first_raw` is the counter's
-    /// value that maps to `origin`.
+    /// picometres (1 ..= 2.097e9) of travel at the actuator. `first_raw` is
+    /// the counter's value that maps to `origin`.
     pub fn new(
         bits: u8,
         pm_per_count: i64,
@@ -44,7 +58,7 @@ impl Encoder {
         if !(2..=32).contains(&bits) {
             return Err(EncoderError::BadWidth(bits));
         }
-        if pm_per_count <= 0 {
+        if !(1..=MAX_PM_PER_COUNT).contains(&pm_per_count) {
             return Err(EncoderError::BadResolution(pm_per_count));
         }
         let mask = if bits == 32 {
@@ -55,10 +69,14 @@ impl Encoder {
         if first_raw & !mask != 0 {
             return Err(EncoderError::RawOutOfRange(first_raw));
         }
+        // pm * 1024 / 1000, rounded half up; >= 1 for pm >= 1.
+        let q10 = (pm_per_count * 128 + 62) / 125;
         Ok(Encoder {
             bits,
+            shift: 32 - bits as u32,
             mask,
             pm_per_count,
+            q10_per_count: q10 as i32,
             last_raw: first_raw,
             count: 0,
             origin,
@@ -70,39 +88,38 @@ impl Encoder {
         (1u32 << (self.bits - 1)) - 1
     }
 
-    /// Travel per count (pm).
+    /// Travel per count as configured (pm).
     pub fn pm_per_count(&self) -> i64 {
         self.pm_per_count
     }
 
     /// Take a new raw counter value; returns the unwrapped position. A raw
     /// value wider than the counter is refused and the state is unchanged.
+    #[inline]
     pub fn update(&mut self, raw: u32) -> Result<Position, EncoderError> {
         if raw & !self.mask != 0 {
             return Err(EncoderError::RawOutOfRange(raw));
         }
-        let diff = raw.wrapping_sub(self.last_raw) & self.mask;
-        // Sign-extend the `bits`-wide difference.
-        let half = 1u32 << (self.bits - 1);
-        let delta = if diff >= half {
-            diff as i64 - (self.mask as i64 + 1)
-        } else {
-            diff as i64
-        };
+        // The `bits`-wide difference, sign-extended: bits above the
+        // counter's width leave through the top.
+        let delta = ((raw.wrapping_sub(self.last_raw) << self.shift) as i32) >> self.shift;
         self.last_raw = raw;
         self.count = self.count.saturating_add(delta);
         Ok(self.position())
     }
 
     /// Unwrapped counts since construction.
-    pub fn count(&self) -> i64 {
+    pub fn count(&self) -> i32 {
         self.count
     }
 
-    /// The current position: `origin + count * resolution`.
+    /// The current position: `origin + count * resolution`, to the nearest
+    /// nanometre.
+    #[inline]
     pub fn position(&self) -> Position {
-        self.origin
-            .offset_pm(self.count.saturating_mul(self.pm_per_count))
+        let nm = (self.count as i64 * self.q10_per_count as i64 + 512) >> 10;
+        let nm = nm.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+        self.origin.offset_nm(nm)
     }
 }
 
@@ -138,33 +155,66 @@ mod tests {
     #[test]
     fn unwraps_exactly_at_maximum_speed_for_a_million_reads() {
         for bits in [16u8, 32] {
-            let mut e = Encoder::new(bits, 1, 0, Position::ZERO).unwrap();
+            let mut e = Encoder::new(bits, 1000, 0, Position::ZERO).unwrap();
             let vmax = e.max_counts_per_read() as i64;
             let modulus: i128 = 1i128 << bits;
             let mut truth: i64 = 0;
+            // Full speed forward until half the count range, then a
+            // pattern that reverses at full speed every read.
+            let forward = (i32::MAX as i64 / 2 / vmax).min(600_000);
             for k in 0..1_000_000i64 {
-                // Full speed forward for the first 600k reads, then a
-                // pattern that reverses at full speed.
-                let step = if k < 600_000 {
+                let step = if k < forward {
                     vmax
-                } else if (k / 7) % 2 == 0 {
-                    -vmax
+                } else if k % 2 == 0 {
+                    -vmax + (k % 13)
                 } else {
-                    vmax - (k % 13)
+                    vmax
                 };
                 truth += step;
                 let raw = (truth as i128).rem_euclid(modulus) as u32;
                 e.update(raw).unwrap();
-                assert_eq!(e.count(), truth, "bits {bits}, read {k}");
+                assert_eq!(e.count() as i64, truth, "bits {bits}, read {k}");
             }
-            assert_eq!(e.position().pm(), truth);
+            assert_eq!(e.position().nm() as i64, truth);
         }
     }
 
     #[test]
     fn position_uses_origin_and_resolution() {
-        let mut e = Encoder::new(16, 2_500_000, 65_535, Position::from_pm(7)).unwrap();
+        let mut e = Encoder::new(16, 2_500_000, 65_535, Position::from_nm(7)).unwrap();
         e.update(1).unwrap(); // wrapped forward by 2 counts
-        assert_eq!(e.position().pm(), 7 + 2 * 2_500_000);
+        assert_eq!(e.position().nm(), 7 + 2 * 2_500);
+        // A resolution that is not a whole number of nanometres: 1.5 µm
+        // over a 2π·10 mm / 4096 count wheel is 15,339,807.88 pm.
+        let mut e = Encoder::new(32, 15_339_808, 0, Position::ZERO).unwrap();
+        e.update(100_000).unwrap();
+        let want_nm = 100_000.0 * 15_339_807.878_856 / 1000.0;
+        assert!((e.position().nm() as f64 - want_nm).abs() < 60.0);
+    }
+
+    #[test]
+    fn count_and_position_saturate_instead_of_wrapping() {
+        let mut e = Encoder::new(32, 1_000_000, 0, Position::ZERO).unwrap();
+        let step = e.max_counts_per_read();
+        let mut raw = 0u32;
+        for _ in 0..4 {
+            raw = raw.wrapping_add(step);
+            e.update(raw).unwrap();
+        }
+        assert_eq!(e.count(), i32::MAX);
+        assert_eq!(e.position(), Position::MAX);
+        // Back the other way: it moves again, from the saturated count.
+        e.update(raw.wrapping_sub(10)).unwrap();
+        assert_eq!(e.count(), i32::MAX - 10);
+    }
+
+    #[test]
+    fn resolution_limits() {
+        assert!(Encoder::new(16, 1, 0, Position::ZERO).is_ok());
+        assert!(Encoder::new(16, MAX_PM_PER_COUNT, 0, Position::ZERO).is_ok());
+        assert_eq!(
+            Encoder::new(16, MAX_PM_PER_COUNT + 1, 0, Position::ZERO).unwrap_err(),
+            EncoderError::BadResolution(MAX_PM_PER_COUNT + 1)
+        );
     }
 }

@@ -24,7 +24,7 @@
 //! `tf()` method) so the designer evaluates exactly what runs here; the unit
 //! tests drive each law with sinusoids and match that form.
 //!
-//! Units are SI throughout (N, m, s, kg); positions are integer picometres
+//! Units are SI throughout (N, m, s, kg); positions are integer nanometres
 //! ([`Position`]) so that no position ever accumulates f32 rounding.
 //! Sign convention (the paper's, see `shared/design/two-port-equations.md`):
 //! the actuator force is positive when it resists positive actuator motion;
@@ -57,7 +57,7 @@ pub use encoder::{Encoder, EncoderError};
 pub use estimator::FirstDifference;
 pub use num_complex::Complex64;
 pub use param::ParamError;
-pub use position::{Integrator, Position, PM_PER_M};
+pub use position::{Integrator, Position, NM_PER_M};
 pub use probe::SineProbe;
 pub use regulator::PositionRegulator;
 pub use safety::{Faults, SafetyConfig, SafetyLayer};

@@ -45,8 +45,8 @@ fn assert_close(what: &str, p: usize, got: Complex64, want: Complex64) {
     );
 }
 
-fn pm(x_m: f64) -> Position {
-    Position::from_pm((x_m * 1e12).round() as i64)
+fn pos(x_m: f64) -> Position {
+    Position::from_m_f64(x_m).unwrap()
 }
 
 /// A test VE that imposes a velocity whatever the force (admittance 0 plus a
@@ -74,7 +74,7 @@ fn first_difference_estimator() {
     for p in BINS {
         let mut est = FirstDifference::new(T, Position::ZERO).unwrap();
         let got = measure(p, |c| {
-            let x = pm(1e-3 * c);
+            let x = pos(1e-3 * c);
             (x.m() as f64, est.step(x) as f64)
         });
         assert_close("(1 - z^-1)/T", p, got, est.tf().eval(z_of(p)));
@@ -87,7 +87,7 @@ fn velocity_integrator() {
         let mut x = Integrator::new(T, Position::ZERO);
         let got = measure(p, |c| {
             let v = (0.2 * c) as f32;
-            (v as f64, x.step(v).pm() as f64 * 1e-12)
+            (v as f64, x.step(v).nm() as f64 * 1e-9)
         });
         assert_close("T/(1 - z^-1)", p, got, x.tf().eval(z_of(p)));
     }
@@ -97,9 +97,10 @@ fn velocity_integrator() {
 fn position_regulator() {
     for p in BINS {
         let mut r = PositionRegulator::new(51_000.0, 90.0, T).unwrap();
+        let held = Integrator::new(T, Position::ZERO);
         let got = measure(p, |c| {
-            let x = pm(1e-3 * c);
-            (x.m() as f64, r.step(x, Position::ZERO) as f64)
+            let x = pos(1e-3 * c);
+            (x.m() as f64, r.step(x, &held) as f64)
         });
         assert_close("K_p", p, got, r.tf().eval(z_of(p)));
     }
@@ -112,7 +113,7 @@ fn impedance_coupling_against_a_fixed_ve() {
         let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T, Position::ZERO).unwrap();
         let mut ve = BilateralConstraint::new(Position::ZERO);
         let got = measure(p, |u| {
-            let x = pm(1e-3 * u);
+            let x = pos(1e-3 * u);
             let v = est.step(x);
             (v as f64, c.step(x, v, &mut ve).force_n as f64)
         });
@@ -233,11 +234,11 @@ fn fig7a_impedance_coupling_with_impedance_ve() {
         let x0 = Position::ZERO;
         let mut est = FirstDifference::new(T, x0).unwrap();
         let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T, x0).unwrap();
-        let mut ve = UnilateralWall::new(20_000.0, 50.0, pm(-5e-3), Solid::Above, T, x0).unwrap();
+        let mut ve = UnilateralWall::new(20_000.0, 50.0, pos(-5e-3), Solid::Above, T, x0).unwrap();
         // 0.1 mm keeps the wall's damper from ever wanting to pull at 500 Hz,
         // so the wall stays on its linear (contact) piece.
         let got = measure(p, |u| {
-            let x = pm(1e-4 * u);
+            let x = pos(1e-4 * u);
             let v = est.step(x);
             (v as f64, c.step(x, v, &mut ve).force_n as f64)
         });
@@ -261,7 +262,7 @@ fn fig7b_impedance_coupling_with_admittance_ve() {
         let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T, x0).unwrap();
         let mut ve = CursorMass::new(0.25, T, x0).unwrap();
         let got = measure(p, |u| {
-            let x = pm(1e-3 * u);
+            let x = pos(1e-3 * u);
             let v = est.step(x);
             (v as f64, c.step(x, v, &mut ve).force_n as f64)
         });

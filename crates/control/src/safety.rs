@@ -288,12 +288,18 @@ impl SafetyLayer {
     }
 
     /// One tick: check, latch, limit, ramp. Call exactly once per tick.
+    #[inline]
     pub fn step(&mut self, inputs: &SafetyInputs, command_n: f32) -> SafeForce {
         let mut new = inputs.sensor_faults;
-        if !inputs.velocity_mps.is_finite() {
-            new = new.with(Faults::SENSOR_NOT_FINITE);
-        } else if inputs.velocity_mps.abs() > self.cfg.max_velocity_mps {
-            new = new.with(Faults::VELOCITY_LIMIT);
+        let v = inputs.velocity_mps;
+        // One comparison passes every good tick; NaN fails it too.
+        let speed_ok = v.abs() <= self.cfg.max_velocity_mps;
+        if !speed_ok {
+            new = new.with(if v.is_finite() {
+                Faults::VELOCITY_LIMIT
+            } else {
+                Faults::SENSOR_NOT_FINITE
+            });
         }
         if let Some(last) = self.last_tick {
             if inputs.tick != last.wrapping_add(1) {
@@ -336,8 +342,13 @@ impl SafetyLayer {
             } else {
                 command_n
             };
-            self.ramp_done = self.ramp_done.saturating_add(1).min(self.cfg.ramp_ticks);
-            let scale = self.ramp_done as f32 / self.cfg.ramp_ticks as f32;
+            // (ramp_done <= ramp_ticks always; once ramped in, no division.)
+            let scale = if self.ramp_done < self.cfg.ramp_ticks {
+                self.ramp_done += 1;
+                self.ramp_done as f32 / self.cfg.ramp_ticks as f32
+            } else {
+                1.0
+            };
             out.force_n = clipped * scale;
             out.limited = clipped != command_n || scale < 1.0;
         } else {
@@ -345,7 +356,9 @@ impl SafetyLayer {
         }
         let c = self.cfg.continuous_force_n;
         let f = out.force_n;
-        self.heat = (self.heat + (f * f - c * c) * self.cfg.period_s).max(0.0);
+        let heat = self.heat + (f * f - c * c) * self.cfg.period_s;
+        // (`f` is finite: a comparison, not `max`'s NaN handling.)
+        self.heat = if heat > 0.0 { heat } else { 0.0 };
         out
     }
 }

@@ -302,8 +302,8 @@ impl<V: VirtualEnvironment> AdmittanceServo<V> {
         let mut out = ServoOutput::default();
         if self.front.runnable(faults) {
             let s = self.coupling.step(f_c, &mut self.ve);
-            let x_cmd = self.command.step(s.velocity_mps);
-            out.commanded_force_n = self.regulator.step(self.front.position, x_cmd);
+            self.command.step(s.velocity_mps);
+            out.commanded_force_n = self.regulator.step(self.front.position, &self.command);
             out.coupling_force_n = s.coupling_force_n;
             out.ve_force_n = s.ve_force_n;
             out.ve_velocity_mps = s.velocity_mps;

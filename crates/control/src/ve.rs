@@ -226,7 +226,7 @@ impl Spring {
 
     /// The probe's offset from the anchor now (m).
     fn stretch_m(&self) -> f32 {
-        self.probe.position().minus_m(self.anchor)
+        self.probe.offset_m(self.anchor)
     }
 
     /// This tick's law `f = g + h v` for the probe velocity `v`, given its
@@ -535,7 +535,7 @@ mod tests {
         });
         assert!((out.velocity_mps - 0.1).abs() < 1e-5, "{out:?}");
         assert!(out.force_n >= 0.0);
-        assert!(w.position().pm().abs() < 1_000, "{:?}", w.position());
+        assert!(w.position().nm().abs() <= 1, "{:?}", w.position());
         // Inside but pulled out fast: the wall lets go (force 0, not < 0).
         let mut w = wall_at_zero(1e-4);
         let out = w.step(Port {

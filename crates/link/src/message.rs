@@ -1,5 +1,6 @@
 //! What the board and the host say to each other. Units are SI; positions
-//! are integer picometres as in `twoport-control`.
+//! are integer picometres on the wire (`twoport-control` keeps nanometres,
+//! so today's boards send multiples of 1000; the wire has room for finer).
 
 use crate::frame::Stats;
 use serde::{Deserialize, Serialize};

@@ -57,7 +57,7 @@ fn measure(p: u32, tick: impl FnMut(f64) -> (f64, f64)) -> Complex64 {
 }
 
 fn pm(x_m: f64) -> Position {
-    Position::from_pm(libm::round(x_m * 1e12) as i64)
+    Position::from_m_f64(x_m).unwrap_or(Position::ZERO)
 }
 
 fn ve_tf(t: VeTransfer) -> ZTransfer {
@@ -146,7 +146,7 @@ fn timing_wall() -> UnilateralWall {
     UnilateralWall::new(
         1e5,
         50.0,
-        Position::from_pm(500_000_000),
+        Position::from_nm(500_000),
         Solid::Above,
         T,
         Position::ZERO,
@@ -216,7 +216,7 @@ fn cost_breakdown() {
     let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T, Position::ZERO).unwrap();
     let mut wall = timing_wall();
     let (law, _) = counts_per_call(n, |k| {
-        let x = Position::from_pm((k % 1000 * 2) as i64 * 1_000_000);
+        let x = Position::from_nm((k % 1000 * 2) as i32 * 1000);
         c.step(x, 0.01, &mut wall).force_n
     });
     let mut safety = SafetyLayer::new(SafetyConfig::excalibur()).unwrap();

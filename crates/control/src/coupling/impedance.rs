@@ -79,16 +79,16 @@ impl ImpedanceCoupling {
         v_c_mps: f32,
         ve: &mut V,
     ) -> ImpedanceStep {
-        let stretch_prev = x_c.minus_m(self.ve_side.position());
+        let stretch_prev = -self.ve_side.offset_m(x_c);
         // f = k (x_c - x_e[k-1] - T v_e) + b (v_c - v_e) = f0 - (kT + b) v_e
         let port = Port {
             f0_n: self.k * stretch_prev + self.b * v_c_mps,
             z_nspm: self.z_direct,
         };
         let v_e = ve.step(port).velocity_mps;
-        let x_e = self.ve_side.step(v_e);
+        self.ve_side.step(v_e);
         ImpedanceStep {
-            force_n: self.k * x_c.minus_m(x_e) + self.b * (v_c_mps - v_e),
+            force_n: self.b * (v_c_mps - v_e) - self.k * self.ve_side.offset_m(x_c),
             ve_velocity_mps: v_e,
         }
     }
