@@ -1,8 +1,12 @@
-//! What accuracy costs in time: every integrator at every sub-step count on
-//! a linear scene (reference: exact ZOH, which is exact there) and on a
-//! nonlinear one (reference: RK4 at a 1 us step), error against cost.
+//! What accuracy costs in time: every integrator at every sub-step count,
+//! with the board's f32 controller and with the same laws in f64, on a
+//! linear scene (reference: exact ZOH, which is exact there) and on a
+//! nonlinear one (reference: RK4 at a 1 us step), error against cost. The
+//! references run the f64 controller, so the f32 rows show the board's
+//! rounding as an error floor.
 
 use crate::plant::Method;
+use crate::scene::Precision;
 use crate::{Scene, Simulation};
 use std::path::Path;
 use std::time::Instant;
@@ -16,6 +20,8 @@ pub struct Cell {
     pub method: String,
     /// Sub-steps per 1 ms tick.
     pub substeps: u32,
+    /// The controller's float type, `"f32"` (the board's) or `"f64"`.
+    pub controller: String,
     /// Max handle-position error over the run, relative to the reference's
     /// peak displacement; `None` when the run did not finish.
     pub error: Option<f64>,
@@ -35,11 +41,15 @@ pub const METHODS: [Method; 4] = [
     Method::Euler,
 ];
 
-fn with(scene: &Scene, method: Method, substeps: u32) -> Scene {
+/// Controller float types studied.
+pub const CONTROLLERS: [Precision; 2] = [Precision::F32, Precision::F64];
+
+fn with(scene: &Scene, method: Method, substeps: u32, controller: Precision) -> Scene {
     let mut s = scene.clone();
     s.integrator.method = method;
     s.integrator.substeps = substeps;
     s.integrator.on_linear = true;
+    s.integrator.controller = controller;
     s
 }
 
@@ -64,7 +74,7 @@ fn path(scene: &Scene) -> Result<(Vec<f64>, f64, Option<String>), String> {
 
 /// Run the study on one scene against `reference`.
 pub fn study(label: &str, scene: &Scene, reference: (Method, u32)) -> Result<Vec<Cell>, String> {
-    let (want, _, _) = path(&with(scene, reference.0, reference.1))?;
+    let (want, _, _) = path(&with(scene, reference.0, reference.1, Precision::F64))?;
     let peak = want.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-12);
     let sim_ms = scene.duration_s * 1e3;
     let mut cells = Vec::new();
@@ -73,24 +83,27 @@ pub fn study(label: &str, scene: &Scene, reference: (Method, u32)) -> Result<Vec
             if method == Method::ExactZoh && n > 16 {
                 continue; // exact already; more sub-steps only cost
             }
-            let (got, wall, note) = path(&with(scene, method, n))?;
-            let error = (got.len() == want.len())
-                .then(|| {
-                    got.iter()
-                        .zip(&want)
-                        .map(|(a, b)| (a - b).abs())
-                        .fold(0.0, f64::max)
-                        / peak
-                })
-                .filter(|e| e.is_finite());
-            cells.push(Cell {
-                scene: label.to_string(),
-                method: method.name().to_string(),
-                substeps: n,
-                error,
-                ns_per_sim_ms: wall * 1e9 / sim_ms,
-                note,
-            });
+            for controller in CONTROLLERS {
+                let (got, wall, note) = path(&with(scene, method, n, controller))?;
+                let error = (got.len() == want.len())
+                    .then(|| {
+                        got.iter()
+                            .zip(&want)
+                            .map(|(a, b)| (a - b).abs())
+                            .fold(0.0, f64::max)
+                            / peak
+                    })
+                    .filter(|e| e.is_finite());
+                cells.push(Cell {
+                    scene: label.to_string(),
+                    method: method.name().to_string(),
+                    substeps: n,
+                    controller: controller.name().to_string(),
+                    error,
+                    ns_per_sim_ms: wall * 1e9 / sim_ms,
+                    note,
+                });
+            }
         }
     }
     Ok(cells)
@@ -134,14 +147,14 @@ pub fn scenes(root: &Path) -> Result<Vec<StudyScene>, String> {
 /// The study as a markdown table.
 pub fn markdown(cells: &[Cell]) -> String {
     let mut s = String::from(
-        "| scene | method | sub-steps | max error / peak | ns per simulated ms | note |\n| --- | --- | --- | --- | --- | --- |\n",
+        "| scene | method | sub-steps | controller | max error / peak | ns per simulated ms | note |\n| --- | --- | --- | --- | --- | --- | --- |\n",
     );
     for c in cells {
         let err = c.error.map_or("diverged".into(), |e| format!("{e:.2e}"));
         let note = c.note.clone().unwrap_or_default().replace('|', "/");
         s += &format!(
-            "| {} | {} | {} | {} | {:.0} | {} |\n",
-            c.scene, c.method, c.substeps, err, c.ns_per_sim_ms, note
+            "| {} | {} | {} | {} | {} | {:.0} | {} |\n",
+            c.scene, c.method, c.substeps, c.controller, err, c.ns_per_sim_ms, note
         );
     }
     s

@@ -377,10 +377,7 @@ impl ScopeState {
     /// The coupling gains the running simulation uses: `(k, b)` on an
     /// impedance display, `(m, b)` on an admittance display.
     pub fn running_coupling(&self) -> (f64, f64) {
-        let (a, b) = match self.sim.servo() {
-            crate::sim::Servo::Impedance(s) => s.coupling().gains(),
-            crate::sim::Servo::Admittance(s) => s.coupling().gains(),
-        };
+        let (a, b) = self.sim.servo().coupling_gains();
         (a as f64, b as f64)
     }
 

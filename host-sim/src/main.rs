@@ -441,8 +441,9 @@ fn accuracy(a: &AccuracyArgs) -> Result<(), String> {
         "# What accuracy costs in time\n\nRegenerate with `cargo xtask accuracy`. Error: the largest handle-position \
          difference from the reference over the run, relative to the reference's peak displacement. Cost: wall time \
          per simulated millisecond (1 control tick), best of three, on the machine that ran it. References: exact \
-         ZOH for the linear scene (exact there), RK4 at 1,000 sub-steps (1 us) for the nonlinear one. The controller \
-         is the board's f32 code in every run.\n\n![accuracy](accuracy.png)\n\n{}",
+         ZOH for the linear scene (exact there), RK4 at 1,000 sub-steps (1 us) for the nonlinear one, both with the \
+         f64 controller. Controller: the board's f32 laws, or the same laws computing in f64 (`integrator.controller`); \
+         the f32 rows' error cannot fall below what the board's rounding does to the trajectory.\n\n![accuracy](accuracy.png)\n\n{}",
         host_sim::accuracy::markdown(&cells)
     );
     let write = |name: &str, text: String| {

@@ -151,24 +151,31 @@ pub fn accuracy_png(cells: &[crate::accuracy::Cell], out: &Path) -> Result<(), S
             .draw()
             .map_err(e)?;
         let mut methods: Vec<&str> = mine.iter().map(|c| c.method.as_str()).collect();
+        methods.sort();
         methods.dedup();
+        // One colour per method; the f32 controller solid, f64 thin.
         for (i, m) in methods.iter().enumerate() {
-            let color = colors[i % colors.len()];
-            let pts: Vec<(f64, f64)> = mine
-                .iter()
-                .filter(|c| c.method == *m)
-                .filter_map(|c| Some((c.ns_per_sim_ms, c.error?)))
-                .collect();
-            chart
-                .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
-                .map_err(e)?
-                .label(*m)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
-            chart
-                .draw_series(pts.iter().map(|p| Circle::new(*p, 3, color.filled())))
-                .map_err(e)?;
+            for (controller, width) in [("f32", 2), ("f64", 1)] {
+                let color = colors[i % colors.len()];
+                let pts: Vec<(f64, f64)> = mine
+                    .iter()
+                    .filter(|c| c.method == *m && c.controller == controller)
+                    .filter_map(|c| Some((c.ns_per_sim_ms, c.error?)))
+                    .collect();
+                if pts.is_empty() {
+                    continue;
+                }
+                chart
+                    .draw_series(LineSeries::new(pts.clone(), color.stroke_width(width)))
+                    .map_err(e)?
+                    .label(format!("{m} ({controller})"))
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(width))
+                    });
+                chart
+                    .draw_series(pts.iter().map(|p| Circle::new(*p, 3, color.filled())))
+                    .map_err(e)?;
+            }
         }
         chart
             .configure_series_labels()

@@ -90,6 +90,31 @@ pub struct IntegratorSpec {
     /// Use this integrator even for a linear scene (to study its accuracy).
     #[serde(default)]
     pub on_linear: bool,
+    /// The controller's float type: `"f32"` (the board's, the default) or
+    /// `"f64"` (the same laws, to see what the board's rounding costs).
+    #[serde(default)]
+    pub controller: Precision,
+}
+
+/// A float type for the controller.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum Precision {
+    /// `f32`, as on the board.
+    #[default]
+    F32,
+    /// `f64`.
+    F64,
+}
+
+impl Precision {
+    /// `"f32"` or `"f64"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+        }
+    }
 }
 
 fn default_method() -> Method {
@@ -105,6 +130,7 @@ impl Default for IntegratorSpec {
             method: default_method(),
             substeps: default_substeps(),
             on_linear: false,
+            controller: Precision::F32,
         }
     }
 }

@@ -4,7 +4,7 @@
 use crate::blocks::{Block, Blocks};
 use crate::human::{GraspKind, Human};
 use crate::plant::{Device, Method, Stepper, System};
-use crate::scene::{Discretization, Display, Scene, SolidSide, VeSpec};
+use crate::scene::{Discretization, Display, Precision, Scene, SolidSide, VeSpec};
 use crate::stability::{Detector, Verdict};
 use crate::ve::SceneVe;
 use std::collections::VecDeque;
@@ -14,83 +14,224 @@ use twoport_control::ve::{
     BilateralConstraint, CursorMass, Solid, Spring, TrapezoidalSpring, UnilateralWall,
     VirtualEnvironment,
 };
-use twoport_control::{AdmittanceServo, Encoder, ImpedanceServo, Position, SafetyConfig};
+use twoport_control::{AdmittanceServo, Encoder, ImpedanceServo, Position, Real, SafetyConfig};
 
 /// One tick in this many is timed for the effects' cost.
 const TIMING_STRIDE: u64 = 64;
 
-/// The board's code for the scene's display.
+/// The board's code for the scene's display: the board's f32 laws, or the
+/// same laws computing in f64 (`integrator.controller = "f64"`).
 #[derive(Clone, Debug)]
 pub enum Servo {
     /// Impedance display.
     Impedance(Box<ImpedanceServo<SceneVe>>),
     /// Admittance display.
     Admittance(Box<AdmittanceServo<SceneVe>>),
+    /// Impedance display computing in f64.
+    Impedance64(Box<ImpedanceServo<SceneVe<f64>, f64>>),
+    /// Admittance display computing in f64.
+    Admittance64(Box<AdmittanceServo<SceneVe<f64>, f64>>),
+}
+
+/// `$e` on the servo whatever its display and float type.
+macro_rules! each_servo {
+    ($self:expr, $s:ident => $e:expr) => {
+        match $self {
+            Servo::Impedance($s) => $e,
+            Servo::Admittance($s) => $e,
+            Servo::Impedance64($s) => $e,
+            Servo::Admittance64($s) => $e,
+        }
+    };
+}
+
+/// The sensors as the f32 board reads them.
+fn frame_f32(f: &SensorFrame<f64>) -> SensorFrame {
+    SensorFrame {
+        tick: f.tick,
+        encoder_raw: f.encoder_raw,
+        load_cell_n: f.load_cell_n as f32,
+        dead_man_closed: f.dead_man_closed,
+    }
+}
+
+/// An f32 servo's output, widened.
+fn output_f64(o: ServoOutput) -> ServoOutput<f64> {
+    ServoOutput {
+        actuator_force_n: o.actuator_force_n as f64,
+        commanded_force_n: o.commanded_force_n as f64,
+        position: o.position,
+        velocity_mps: o.velocity_mps as f64,
+        ve_velocity_mps: o.ve_velocity_mps as f64,
+        ve_force_n: o.ve_force_n as f64,
+        coupling_force_n: o.coupling_force_n as f64,
+        reference: o.reference,
+        faults: o.faults,
+        limited: o.limited,
+    }
+}
+
+/// Move a wall VE's surface and stiffness, in either float type.
+fn set_wall<R: Real>(ve: &mut SceneVe<R>, surface: Position, k_npm: f64) -> Result<(), String> {
+    let SceneVe::Wall(w) = ve else {
+        return Err("the scene's VE is not a wall".into());
+    };
+    let (_, b) = w.gains();
+    w.set_gains(k_npm as f32, b).map_err(|e| e.to_string())?;
+    w.set_surface(surface);
+    Ok(())
 }
 
 impl Servo {
-    fn tick(&mut self, f: &SensorFrame) -> ServoOutput {
+    fn tick(&mut self, f: &SensorFrame<f64>) -> ServoOutput<f64> {
         match self {
-            Servo::Impedance(s) => s.tick(f),
-            Servo::Admittance(s) => s.tick(f),
+            Servo::Impedance(s) => output_f64(s.tick(&frame_f32(f))),
+            Servo::Admittance(s) => output_f64(s.tick(&frame_f32(f))),
+            Servo::Impedance64(s) => s.tick(f),
+            Servo::Admittance64(s) => s.tick(f),
         }
     }
 
     fn enable(&mut self) -> Result<(), twoport_control::Faults> {
-        match self {
-            Servo::Impedance(s) => s.enable(),
-            Servo::Admittance(s) => s.enable(),
-        }
+        each_servo!(self, s => s.enable())
     }
 
-    /// The VE.
-    pub fn ve(&self) -> &SceneVe {
+    /// The VE's position.
+    pub fn ve_position(&self) -> Position {
+        each_servo!(self, s => s.ve().position())
+    }
+
+    /// The coupling gains: `(k, b)` on an impedance display, `(m, b)` on an
+    /// admittance display.
+    pub fn coupling_gains(&self) -> (f32, f32) {
+        each_servo!(self, s => s.coupling().gains())
+    }
+
+    /// The controller's float type.
+    pub fn precision(&self) -> Precision {
         match self {
-            Servo::Impedance(s) => s.ve(),
-            Servo::Admittance(s) => s.ve(),
+            Servo::Impedance(_) | Servo::Admittance(_) => Precision::F32,
+            Servo::Impedance64(_) | Servo::Admittance64(_) => Precision::F64,
         }
     }
 
     /// Change the admittance display's regulator `K_p` (N/m, N s/m); an
     /// error on an impedance display.
     pub fn set_regulator(&mut self, kp: f64, bp: f64) -> Result<(), String> {
+        let (kp, bp) = (kp as f32, bp as f32);
         match self {
-            Servo::Impedance(_) => Err("an impedance display has no regulator".into()),
-            Servo::Admittance(s) => s
-                .set_regulator_gains(kp as f32, bp as f32)
-                .map_err(|e| e.to_string()),
+            Servo::Impedance(_) | Servo::Impedance64(_) => {
+                Err("an impedance display has no regulator".into())
+            }
+            Servo::Admittance(s) => s.set_regulator_gains(kp, bp).map_err(|e| e.to_string()),
+            Servo::Admittance64(s) => s.set_regulator_gains(kp, bp).map_err(|e| e.to_string()),
         }
     }
 
     /// Move the wall and change its stiffness while running (the scope's
     /// controls); an error if the scene's VE is not a wall.
     pub fn set_wall(&mut self, surface_m: f64, stiffness_npm: f64) -> Result<(), String> {
-        let ve = match self {
-            Servo::Impedance(s) => s.ve_mut(),
-            Servo::Admittance(s) => s.ve_mut(),
-        };
-        let SceneVe::Wall(w) = ve else {
-            return Err("the scene's VE is not a wall".into());
-        };
         let x = Position::from_m_f64(surface_m).ok_or(format!(
             "wall position {surface_m} m is out of range (±2.147 m)"
         ))?;
-        let (_, b) = w.gains();
-        w.set_gains(stiffness_npm as f32, b)
-            .map_err(|e| e.to_string())?;
-        w.set_surface(x);
-        Ok(())
+        each_servo!(self, s => set_wall(s.ve_mut(), x, stiffness_npm))
     }
 
     /// Change the coupling gains while running (the scope's sliders).
     /// Impedance: `(k, b)`; admittance: `(m, b)`.
     pub fn set_coupling(&mut self, a: f64, b: f64) -> Result<(), String> {
+        let (a, b) = (a as f32, b as f32);
         match self {
-            Servo::Impedance(s) => s.set_gains(a as f32, b as f32),
-            Servo::Admittance(s) => s.set_coupling_gains(a as f32, b as f32),
+            Servo::Impedance(s) => s.set_gains(a, b),
+            Servo::Admittance(s) => s.set_coupling_gains(a, b),
+            Servo::Impedance64(s) => s.set_gains(a, b),
+            Servo::Admittance64(s) => s.set_coupling_gains(a, b),
         }
         .map_err(|e| e.to_string())
     }
+}
+
+/// The scene's VE, computing in `R`.
+fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, String> {
+    let pos = |m: f64| {
+        Position::from_m_f64(m).ok_or(format!("position {m} m is out of range (±2.147 m)"))
+    };
+    Ok(match &scene.ve {
+        VeSpec::Cursor { mass_kg } => SceneVe::Cursor(
+            CursorMass::new_in(*mass_kg as f32, t32, Position::ZERO).map_err(|e| e.to_string())?,
+        ),
+        VeSpec::Wall {
+            position_m,
+            stiffness_npm,
+            damping_nspm,
+            solid,
+        } => {
+            let side = match solid {
+                SolidSide::Above => Solid::Above,
+                SolidSide::Below => Solid::Below,
+            };
+            SceneVe::Wall(
+                UnilateralWall::new_in(
+                    *stiffness_npm as f32,
+                    *damping_nspm as f32,
+                    pos(*position_m)?,
+                    side,
+                    t32,
+                    Position::ZERO,
+                )
+                .map_err(|e| e.to_string())?,
+            )
+        }
+        VeSpec::Bilateral => SceneVe::Bilateral(BilateralConstraint::new(Position::ZERO)),
+        VeSpec::Spring {
+            anchor_m,
+            stiffness_npm,
+            damping_nspm,
+            discretization,
+        } => {
+            let (k, b, a) = (*stiffness_npm as f32, *damping_nspm as f32, pos(*anchor_m)?);
+            match discretization {
+                Discretization::BackwardEuler => SceneVe::Spring(
+                    Spring::new_in(k, b, a, t32, Position::ZERO).map_err(|e| e.to_string())?,
+                ),
+                Discretization::Trapezoidal => SceneVe::TrapezoidalSpring(
+                    TrapezoidalSpring::new_in(k, b, a, t32, Position::ZERO)
+                        .map_err(|e| e.to_string())?,
+                ),
+            }
+        }
+        VeSpec::Blocks {
+            cursor_mass_kg,
+            blocks,
+            limits_m,
+            stick_force_n,
+            floor_damping_nspm,
+            grab_at_s,
+            release_at_s,
+        } => {
+            let bs = blocks
+                .iter()
+                .map(|b| {
+                    Ok(Block {
+                        left: pos(b.at_m)?,
+                        width_nm: pos(b.width_m)?.nm(),
+                        mass_kg: b.mass_kg as f32,
+                        velocity_mps: 0.0,
+                    })
+                })
+                .collect::<Result<Vec<_>, String>>()?;
+            SceneVe::Blocks(Box::new(Blocks::new(
+                t32,
+                *cursor_mass_kg as f32,
+                bs,
+                [pos(limits_m[0])?, pos(limits_m[1])?],
+                *stick_force_n as f32,
+                *floor_damping_nspm as f32,
+                *grab_at_s,
+                *release_at_s,
+            )?))
+        }
+    })
 }
 
 /// One tick's record.
@@ -197,7 +338,7 @@ pub struct Simulation {
     encoder_mask: u32,
     counts_per_m: f64,
     rng: Rng,
-    delay: VecDeque<SensorFrame>,
+    delay: VecDeque<SensorFrame<f64>>,
     peak_force: f64,
     energy_in: f64,
     last_power: f64,
@@ -300,104 +441,43 @@ impl Simulation {
         let encoder = Encoder::new(bits, pm_per_count as i64, 0, Position::ZERO)
             .map_err(|e| format!("effects.encoder: {e:?}"))?;
         let t32 = period as f32;
-        let pos = |m: f64| {
-            Position::from_m_f64(m).ok_or(format!("position {m} m is out of range (±2.147 m)"))
-        };
-        let ve = match &scene.ve {
-            VeSpec::Cursor { mass_kg } => SceneVe::Cursor(
-                CursorMass::new(*mass_kg as f32, t32, Position::ZERO).map_err(|e| e.to_string())?,
-            ),
-            VeSpec::Wall {
-                position_m,
-                stiffness_npm,
-                damping_nspm,
-                solid,
-            } => {
-                let side = match solid {
-                    SolidSide::Above => Solid::Above,
-                    SolidSide::Below => Solid::Below,
-                };
-                SceneVe::Wall(
-                    UnilateralWall::new(
-                        *stiffness_npm as f32,
-                        *damping_nspm as f32,
-                        pos(*position_m)?,
-                        side,
-                        t32,
-                        Position::ZERO,
-                    )
-                    .map_err(|e| e.to_string())?,
-                )
-            }
-            VeSpec::Bilateral => SceneVe::Bilateral(BilateralConstraint::new(Position::ZERO)),
-            VeSpec::Spring {
-                anchor_m,
-                stiffness_npm,
-                damping_nspm,
-                discretization,
-            } => {
-                let (k, b, a) = (*stiffness_npm as f32, *damping_nspm as f32, pos(*anchor_m)?);
-                match discretization {
-                    Discretization::BackwardEuler => SceneVe::Spring(
-                        Spring::new(k, b, a, t32, Position::ZERO).map_err(|e| e.to_string())?,
-                    ),
-                    Discretization::Trapezoidal => SceneVe::TrapezoidalSpring(
-                        TrapezoidalSpring::new(k, b, a, t32, Position::ZERO)
-                            .map_err(|e| e.to_string())?,
-                    ),
-                }
-            }
-            VeSpec::Blocks {
-                cursor_mass_kg,
-                blocks,
-                limits_m,
-                stick_force_n,
-                floor_damping_nspm,
-                grab_at_s,
-                release_at_s,
-            } => {
-                let bs = blocks
-                    .iter()
-                    .map(|b| {
-                        Ok(Block {
-                            left: pos(b.at_m)?,
-                            width_nm: pos(b.width_m)?.nm(),
-                            mass_kg: b.mass_kg as f32,
-                            velocity_mps: 0.0,
-                        })
-                    })
-                    .collect::<Result<Vec<_>, String>>()?;
-                SceneVe::Blocks(Box::new(Blocks::new(
-                    t32,
-                    *cursor_mass_kg as f32,
-                    bs,
-                    [pos(limits_m[0])?, pos(limits_m[1])?],
-                    *stick_force_n as f32,
-                    *floor_damping_nspm as f32,
-                    *grab_at_s,
-                    *release_at_s,
-                )?))
-            }
-        };
         let safety = SafetyConfig {
             period_s: t32,
             ..SafetyConfig::excalibur()
         };
         let c = scene.coupling;
-        let mut servo = match scene.display {
-            Display::Impedance => Servo::Impedance(Box::new(
-                ImpedanceServo::new(c.k.unwrap_or(0.0) as f32, c.b as f32, encoder, safety, ve)
-                    .map_err(|e| e.to_string())?,
+        let (k, b) = (c.k.unwrap_or(0.0) as f32, c.b as f32);
+        let regulator = (c.kp.unwrap_or(0.0) as f32, c.bp.unwrap_or(0.0) as f32);
+        let coupling = (c.m.unwrap_or(1.0) as f32, c.b as f32);
+        let err = |e: twoport_control::ParamError| e.to_string();
+        let mut servo = match (scene.display, scene.integrator.controller) {
+            (Display::Impedance, Precision::F32) => Servo::Impedance(Box::new(
+                ImpedanceServo::new_in(k, b, encoder, safety, scene_ve(&scene, t32)?)
+                    .map_err(err)?,
             )),
-            Display::Admittance => Servo::Admittance(Box::new(
-                AdmittanceServo::new(
-                    (c.kp.unwrap_or(0.0) as f32, c.bp.unwrap_or(0.0) as f32),
-                    (c.m.unwrap_or(1.0) as f32, c.b as f32),
+            (Display::Admittance, Precision::F32) => Servo::Admittance(Box::new(
+                AdmittanceServo::new_in(
+                    regulator,
+                    coupling,
                     encoder,
                     safety,
-                    ve,
+                    scene_ve(&scene, t32)?,
                 )
-                .map_err(|e| e.to_string())?,
+                .map_err(err)?,
+            )),
+            (Display::Impedance, Precision::F64) => Servo::Impedance64(Box::new(
+                ImpedanceServo::new_in(k, b, encoder, safety, scene_ve(&scene, t32)?)
+                    .map_err(err)?,
+            )),
+            (Display::Admittance, Precision::F64) => Servo::Admittance64(Box::new(
+                AdmittanceServo::new_in(
+                    regulator,
+                    coupling,
+                    encoder,
+                    safety,
+                    scene_ve(&scene, t32)?,
+                )
+                .map_err(err)?,
             )),
         };
         servo
@@ -559,7 +639,7 @@ impl Simulation {
         a.iter().zip(b).map(|(x, y)| x * y).sum()
     }
 
-    fn sense(&mut self) -> SensorFrame {
+    fn sense(&mut self) -> SensorFrame<f64> {
         let n = self.device.n;
         let x_a = Self::dot(&self.actuator_dir, &self.x[..n]);
         let timing = self.timing();
@@ -581,7 +661,7 @@ impl Simulation {
         SensorFrame {
             tick: self.tick as u32,
             encoder_raw: raw,
-            load_cell_n: f_m as f32,
+            load_cell_n: f_m,
             dead_man_closed: true,
         }
     }
@@ -629,10 +709,10 @@ impl Simulation {
         }
         let is_external = external.is_some();
         let out = match external {
-            Some(c) => c(&frame),
+            Some(c) => output_f64(c(&frame_f32(&frame))),
             None => self.servo.tick(&frame),
         };
-        let mut f_a = out.actuator_force_n as f64;
+        let mut f_a = out.actuator_force_n;
         if let Some(s) = self.scene.effects.saturation {
             let t0 = timing.then(Instant::now);
             f_a = f_a.clamp(-s.limit_n, s.limit_n);
@@ -739,15 +819,15 @@ impl Simulation {
             handle_m: x_h,
             handle_mps: v_h,
             human_n: f_h,
-            commanded_n: out.commanded_force_n as f64,
+            commanded_n: out.commanded_force_n,
             actuator_n: f_a,
             ve_m: if is_external {
                 out.reference.m() as f64
             } else {
-                self.servo.ve().position().m() as f64
+                self.servo.ve_position().m() as f64
             },
-            ve_n: out.ve_force_n as f64,
-            coupling_n: out.coupling_force_n as f64,
+            ve_n: out.ve_force_n,
+            coupling_n: out.coupling_force_n,
             energy_in_j: self.energy_in,
             energy_stored_j: stored,
         }

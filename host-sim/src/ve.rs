@@ -5,52 +5,64 @@ use twoport_control::ve::{
     BilateralConstraint, Causality, CursorMass, Port, Spring, TrapezoidalSpring, UnilateralWall,
     VeOutput, VeTransfer, VirtualEnvironment,
 };
-use twoport_control::Position;
+use twoport_control::{Position, Real};
 
-/// One of the VEs a scene can name.
+/// One of the VEs a scene can name, computing in `R` (the controller's
+/// float type).
 #[derive(Clone, Debug)]
-pub enum SceneVe {
+pub enum SceneVe<R: Real = f32> {
     /// A free cursor mass.
-    Cursor(CursorMass),
+    Cursor(CursorMass<R>),
     /// A unilateral wall.
-    Wall(UnilateralWall),
+    Wall(UnilateralWall<R>),
     /// A fixed point.
     Bilateral(BilateralConstraint),
     /// A spring-damper to an anchor.
-    Spring(Spring),
+    Spring(Spring<R>),
     /// A lossless (trapezoidal) spring-damper to an anchor.
-    TrapezoidalSpring(TrapezoidalSpring),
-    /// The building-block world.
+    TrapezoidalSpring(TrapezoidalSpring<R>),
+    /// The building-block world (host-only, computing in f32 whatever the
+    /// controller's type: an f64 controller's port is rounded to it).
     Blocks(Box<Blocks>),
 }
 
+/// `$e` on the VE in any variant but the blocks, `$blocks` on those.
 macro_rules! each {
-    ($self:expr, $v:ident => $e:expr) => {
+    ($self:expr, $v:ident => $e:expr, $b:ident => $blocks:expr) => {
         match $self {
             SceneVe::Cursor($v) => $e,
             SceneVe::Wall($v) => $e,
             SceneVe::Bilateral($v) => $e,
             SceneVe::Spring($v) => $e,
             SceneVe::TrapezoidalSpring($v) => $e,
-            SceneVe::Blocks($v) => $e,
+            SceneVe::Blocks($b) => $blocks,
         }
     };
 }
 
-impl VirtualEnvironment for SceneVe {
+impl<R: Real> VirtualEnvironment<R> for SceneVe<R> {
     fn causality(&self) -> Causality {
-        each!(self, v => v.causality())
+        each!(self, v => VirtualEnvironment::<R>::causality(v), b => b.causality())
     }
-    fn step(&mut self, port: Port) -> VeOutput {
-        each!(self, v => v.step(port))
+    fn step(&mut self, port: Port<R>) -> VeOutput<R> {
+        each!(self, v => v.step(port), b => {
+            let o = b.step(Port {
+                f0_n: port.f0_n.to_f32(),
+                z_nspm: port.z_nspm.to_f32(),
+            });
+            VeOutput {
+                velocity_mps: R::of(o.velocity_mps),
+                force_n: R::of(o.force_n),
+            }
+        })
     }
     fn reset(&mut self, x: Position) {
-        each!(self, v => v.reset(x))
+        each!(self, v => VirtualEnvironment::<R>::reset(v, x), b => b.reset(x))
     }
     fn position(&self) -> Position {
-        each!(self, v => v.position())
+        each!(self, v => VirtualEnvironment::<R>::position(v), b => b.position())
     }
     fn tf(&self) -> VeTransfer {
-        each!(self, v => v.tf())
+        each!(self, v => VirtualEnvironment::<R>::tf(v), b => b.tf())
     }
 }

@@ -184,11 +184,15 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
         k: 45_000.0,
         b: 90.0,
     });
-    for _ in 0..200 {
+    // The answer comes when QEMU gets to it: wait in wall time (10 s at
+    // most), not in a count of frames, which a loaded machine outruns.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    while std::time::Instant::now() < deadline {
         s.advance(0.001);
         if s.board.as_ref().unwrap().reply.is_some() {
             break;
         }
+        std::thread::sleep(std::time::Duration::from_millis(1));
     }
     assert_eq!(s.board.as_ref().unwrap().reply.as_deref(), Some("accepted"));
     s.disconnect();

@@ -1,22 +1,30 @@
 //! Velocity from sampled positions.
 
-use crate::{param, ParamError, Position, ZTransfer};
+use crate::{param, ParamError, Position, Real, ZTransfer};
 
 /// First-difference velocity estimate `v[k] = (x[k] - x[k-1]) / T` (m/s),
 /// computed from integer positions so that it has no cancellation error.
 /// This is the estimator of the paper's impedance display (Fig. 5).
 #[derive(Clone, Copy, Debug)]
-pub struct FirstDifference {
-    inv_t: f32,
+pub struct FirstDifference<R = f32> {
+    inv_t: R,
     prev: Position,
 }
 
 impl FirstDifference {
     /// An estimator for sample period `period_s` (s), at rest at `x`.
     pub fn new(period_s: f32, x: Position) -> Result<Self, ParamError> {
+        Self::new_in(period_s, x)
+    }
+}
+
+impl<R: Real> FirstDifference<R> {
+    /// [`FirstDifference::new`] computing in `R`.
+    pub fn new_in(period_s: f32, x: Position) -> Result<Self, ParamError> {
         let t = param::positive("T (s)", period_s)?;
         Ok(FirstDifference {
-            inv_t: 1.0 / t,
+            // Divided in R: an f64 law's 1/T is the f64 reciprocal.
+            inv_t: R::ONE / R::of(t),
             prev: x,
         })
     }
@@ -27,15 +35,15 @@ impl FirstDifference {
     }
 
     /// The estimate for the new sample `x[k]` (m/s).
-    pub fn step(&mut self, x: Position) -> f32 {
-        let v = x.minus_m(self.prev) * self.inv_t;
+    pub fn step(&mut self, x: Position) -> R {
+        let v = x.minus::<R>(self.prev) * self.inv_t;
         self.prev = x;
         v
     }
 
     /// `V(z)/X(z) = (1 - z^-1) / T` ((m/s) per m).
     pub fn tf(&self) -> ZTransfer {
-        let g = self.inv_t as f64;
+        let g = self.inv_t.to_f64();
         ZTransfer::first_order([g, -g], 0.0)
     }
 }

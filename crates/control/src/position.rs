@@ -18,11 +18,11 @@
 //! spare; a VE point driven past it stops at the end of the range
 //! (saturation) instead of wrapping.
 
+use crate::Real;
 use core::ops::{Add, Sub};
 
 /// Nanometres per metre.
 pub const NM_PER_M: f32 = 1.0e9;
-const M_PER_NM: f32 = 1.0e-9;
 
 /// An absolute position along one device axis, in integer nanometres
 /// (1 nm = 1e-9 m). Range ±2.147 m (`i32`); arithmetic saturates at the
@@ -67,7 +67,7 @@ impl Position {
 
     /// This position in metres (f32: relative precision 6e-8 of the value).
     pub fn m(self) -> f32 {
-        self.0 as f32 * M_PER_NM
+        self.0 as f32 * 1.0e-9
     }
 
     /// `self - other` in metres, computed in integers first, so a small
@@ -75,7 +75,13 @@ impl Position {
     /// below 2^24 nm = 16.7 mm, one rounding beyond).
     #[inline]
     pub fn minus_m(self, other: Position) -> f32 {
-        self.0.saturating_sub(other.0) as f32 * M_PER_NM
+        self.minus(other)
+    }
+
+    /// [`Position::minus_m`] in the float type `R` (m).
+    #[inline]
+    pub fn minus<R: Real>(self, other: Position) -> R {
+        R::from_i32(self.0.saturating_sub(other.0)) * R::M_PER_NM
     }
 
     /// This position moved by `delta_nm` nanometres, saturating at the ends
@@ -123,22 +129,29 @@ fn round_half_away(x: f64) -> f64 {
 /// This is the velocity-to-position step of the admittance display's position
 /// command and of the virtual couplings' VE side.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Integrator {
+pub struct Integrator<R = f32> {
     position: Position,
     /// Remainder below one nanometre, in nanometres, |r| < 1.
-    remainder_nm: f32,
+    remainder_nm: R,
     /// `T` in nanometres per (m/s): `v [m/s] * nm_per_mps` is the step in nm.
-    nm_per_mps: f32,
+    nm_per_mps: R,
     period_s: f32,
 }
 
 impl Integrator {
     /// An integrator at `start` for sample period `period_s` (s).
     pub fn new(period_s: f32, start: Position) -> Self {
+        Self::new_in(period_s, start)
+    }
+}
+
+impl<R: Real> Integrator<R> {
+    /// [`Integrator::new`] computing in `R`.
+    pub fn new_in(period_s: f32, start: Position) -> Self {
         Integrator {
             position: start,
-            remainder_nm: 0.0,
-            nm_per_mps: period_s * NM_PER_M,
+            remainder_nm: R::ZERO,
+            nm_per_mps: R::of(period_s) * R::NM_PER_M,
             period_s,
         }
     }
@@ -146,7 +159,7 @@ impl Integrator {
     /// Move to `x` and forget the remainder.
     pub fn reset(&mut self, x: Position) {
         self.position = x;
-        self.remainder_nm = 0.0;
+        self.remainder_nm = R::ZERO;
     }
 
     /// `x[k] = x[k-1] + T v[k]`; returns `x[k]`. A non-finite `v` (or a step
@@ -154,12 +167,12 @@ impl Integrator {
     /// can never become poisoned; the safety layer reports the fault that
     /// produced it.
     #[inline]
-    pub fn step(&mut self, velocity_mps: f32) -> Position {
+    pub fn step(&mut self, velocity_mps: R) -> Position {
         let d = velocity_mps * self.nm_per_mps + self.remainder_nm;
         // One comparison rejects NaN, infinities and steps beyond i32.
-        if d.abs() < 2.0e9 {
-            let whole = d as i32; // toward zero: one `vcvt`
-            self.remainder_nm = d - whole as f32;
+        if d.abs() < R::of(2.0e9) {
+            let whole = d.trunc_i32(); // toward zero: one `vcvt`
+            self.remainder_nm = d - R::from_i32(whole);
             self.position = self.position.offset_nm(whole);
         }
         self.position
@@ -174,7 +187,7 @@ impl Integrator {
     /// The exact state: the position and the remainder (nm, |r| < 1) that
     /// the integer position leaves out.
     #[inline]
-    pub fn exact(&self) -> (Position, f32) {
+    pub fn exact(&self) -> (Position, R) {
         (self.position, self.remainder_nm)
     }
 
@@ -182,8 +195,8 @@ impl Integrator {
     /// integrator state, for laws whose force depends on it (a 5e6 N/m spring
     /// would otherwise see the 1 nm steps as 5 mN of force ripple).
     #[inline]
-    pub fn offset_m(&self, from: Position) -> f32 {
-        self.position.minus_m(from) + self.remainder_nm * M_PER_NM
+    pub fn offset_m(&self, from: Position) -> R {
+        self.position.minus::<R>(from) + self.remainder_nm * R::M_PER_NM
     }
 
     /// The sample period `T` (s).
@@ -194,7 +207,7 @@ impl Integrator {
     /// `X(z)/V(z) = T / (1 - z^-1)` (m per m/s), with the `T` this
     /// integrator really adds per (m/s) (the f32 product `T * 1e9`).
     pub fn tf(&self) -> crate::ZTransfer {
-        let t = self.nm_per_mps as f64 * 1.0e-9;
+        let t = self.nm_per_mps.to_f64() * 1.0e-9;
         crate::ZTransfer::first_order([t, 0.0], -1.0)
     }
 }

@@ -304,3 +304,50 @@ fn fig7d_admittance_coupling_with_admittance_ve() {
         assert_close("1/(Z_cA + 1/Y_cursor)", p, got, want);
     }
 }
+
+/// Worst relative error of `Z_cI` (against a fixed VE) and of the Fig. 7(d)
+/// loop (`Z_cA` with a cursor) over all bins, computing in `R`.
+fn worst_errors<R: Real>() -> (f64, f64) {
+    let (mut zci, mut loop_d) = (0.0f64, 0.0f64);
+    for p in BINS {
+        let mut est = FirstDifference::<R>::new_in(T, Position::ZERO).unwrap();
+        let mut c = ImpedanceCoupling::<R>::new_in(51_000.0, 90.0, T, Position::ZERO).unwrap();
+        let mut ve = BilateralConstraint::new(Position::ZERO);
+        let got = measure(p, |u| {
+            let x = pos(1e-3 * u);
+            let v = est.step(x);
+            (v.to_f64(), c.step(x, v, &mut ve).force_n.to_f64())
+        });
+        let want = c.tf().eval(z_of(p));
+        zci = zci.max((got - want).norm() / want.norm());
+
+        let mut c = AdmittanceCoupling::<R>::new_in(5.0, 500.0, T).unwrap();
+        let mut cursor = CursorMass::<R>::new_in(0.25, T, Position::ZERO).unwrap();
+        let got = measure(p, |u| {
+            let f = R::of((30.0 * u) as f32);
+            (f.to_f64(), c.step(f, &mut cursor).velocity_mps.to_f64())
+        });
+        let z = z_of(p);
+        let cursor_z = match VirtualEnvironment::<R>::tf(&cursor) {
+            VeTransfer::Admittance(t) | VeTransfer::Impedance(t) => t.eval(z).inv(),
+        };
+        let want = (c.tf().eval(z) + cursor_z).inv();
+        loop_d = loop_d.max((got - want).norm() / want.norm());
+    }
+    (zci, loop_d)
+}
+
+/// The same laws in f64 (`new_in::<f64>`): the response equals the z-form
+/// to double precision, where the board's f32 shows its rounding. The f64
+/// law is the f32 law, only wider.
+#[test]
+fn f64_laws_match_their_z_forms_to_double_precision() {
+    let (zci32, d32) = worst_errors::<f32>();
+    let (zci64, d64) = worst_errors::<f64>();
+    std::eprintln!(
+        "Z_cI: f32 {zci32:.1e}, f64 {zci64:.1e}; Fig. 7(d): f32 {d32:.1e}, f64 {d64:.1e}"
+    );
+    assert!(zci64 < 1e-10 && d64 < 1e-10, "{zci64:e} {d64:e}");
+    assert!(zci32 > 100.0 * zci64 && d32 > 100.0 * d64);
+    assert!(zci32 < 1e-4 && d32 < 1e-4);
+}

@@ -2,7 +2,7 @@
 //! for, the actuator gets at most this layer's answer; any fault gives zero
 //! force in the same tick, latches, and is reported until explicitly cleared.
 
-use crate::{param, ParamError};
+use crate::{param, ParamError, Real};
 use core::fmt;
 
 /// A set of fault reasons (bit flags).
@@ -159,22 +159,22 @@ impl SafetyConfig {
 
 /// What the safety layer needs to know besides the force command.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SafetyInputs {
+pub struct SafetyInputs<R = f32> {
     /// The control tick number from the timer (wraps).
     pub tick: u32,
     /// Whether the dead-man switch is closed (operator present).
     pub dead_man_closed: bool,
     /// Handle or actuator velocity estimate (m/s).
-    pub velocity_mps: f32,
+    pub velocity_mps: R,
     /// Faults the sensor checks found this tick.
     pub sensor_faults: Faults,
 }
 
 /// The actuator command after the safety layer.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SafeForce {
+pub struct SafeForce<R = f32> {
     /// The force to hold on the actuator this tick (N).
-    pub force_n: f32,
+    pub force_n: R,
     /// Every latched fault (empty when running).
     pub faults: Faults,
     /// Whether the force was clipped (peak, thermal fold-back or ramp).
@@ -183,15 +183,20 @@ pub struct SafeForce {
 
 /// Limits, guards, watchdogs, the fault latch and the ramp-in.
 #[derive(Clone, Copy, Debug)]
-pub struct SafetyLayer {
+pub struct SafetyLayer<R = f32> {
     cfg: SafetyConfig,
-    budget: f32,
+    /// The limits of `cfg` in `R`.
+    max_velocity: R,
+    peak: R,
+    continuous: R,
+    period: R,
+    budget: R,
     enabled: bool,
     latched: Faults,
     first: Faults,
     ramp_done: u32,
     /// I^2 t state above the continuous rating (N^2 s), >= 0.
-    heat: f32,
+    heat: R,
     last_tick: Option<u32>,
     heartbeat_age: u32,
 }
@@ -199,15 +204,26 @@ pub struct SafetyLayer {
 impl SafetyLayer {
     /// A disabled layer with the given limits.
     pub fn new(cfg: SafetyConfig) -> Result<Self, ParamError> {
+        Self::new_in(cfg)
+    }
+}
+
+impl<R: Real> SafetyLayer<R> {
+    /// [`SafetyLayer::new`] computing in `R`.
+    pub fn new_in(cfg: SafetyConfig) -> Result<Self, ParamError> {
         cfg.validate()?;
         Ok(SafetyLayer {
-            budget: cfg.thermal_budget(),
+            max_velocity: R::of(cfg.max_velocity_mps),
+            peak: R::of(cfg.peak_force_n),
+            continuous: R::of(cfg.continuous_force_n),
+            period: R::of(cfg.period_s),
+            budget: R::of(cfg.thermal_budget()),
             cfg,
             enabled: false,
             latched: Faults::NONE,
             first: Faults::NONE,
             ramp_done: 0,
-            heat: 0.0,
+            heat: R::ZERO,
             last_tick: None,
             heartbeat_age: 0,
         })
@@ -267,9 +283,10 @@ impl SafetyLayer {
 
     /// The thermal state as a fraction of the I^2 t budget (1 = folded back).
     pub fn thermal_load(&self) -> f32 {
-        if self.budget > 0.0 {
-            self.heat / self.budget
-        } else if self.heat > 0.0 {
+        let (heat, budget) = (self.heat.to_f32(), self.budget.to_f32());
+        if budget > 0.0 {
+            heat / budget
+        } else if heat > 0.0 {
             1.0
         } else {
             0.0
@@ -288,12 +305,14 @@ impl SafetyLayer {
     }
 
     /// One tick: check, latch, limit, ramp. Call exactly once per tick.
-    #[inline]
-    pub fn step(&mut self, inputs: &SafetyInputs, command_n: f32) -> SafeForce {
+    // (Always inlined: called once per tick, and a call would pass its
+    // inputs and answer through memory, 30 of the board tick's instructions.)
+    #[inline(always)]
+    pub fn step(&mut self, inputs: &SafetyInputs<R>, command_n: R) -> SafeForce<R> {
         let mut new = inputs.sensor_faults;
         let v = inputs.velocity_mps;
         // One comparison passes every good tick; NaN fails it too.
-        let speed_ok = v.abs() <= self.cfg.max_velocity_mps;
+        let speed_ok = v.abs() <= self.max_velocity;
         if !speed_ok {
             new = new.with(if v.is_finite() {
                 Faults::VELOCITY_LIMIT
@@ -323,15 +342,15 @@ impl SafetyLayer {
         self.trip(new);
 
         let mut out = SafeForce {
-            force_n: 0.0,
+            force_n: R::ZERO,
             faults: self.latched,
             limited: false,
         };
         if self.enabled && self.latched.is_empty() {
             let limit = if self.heat >= self.budget {
-                self.cfg.continuous_force_n
+                self.continuous
             } else {
-                self.cfg.peak_force_n
+                self.peak
             };
             // (Not `clamp`, which carries an assertion on its bounds; the
             // command is finite here, or a fault would have latched.)
@@ -345,20 +364,20 @@ impl SafetyLayer {
             // (ramp_done <= ramp_ticks always; once ramped in, no division.)
             let scale = if self.ramp_done < self.cfg.ramp_ticks {
                 self.ramp_done += 1;
-                self.ramp_done as f32 / self.cfg.ramp_ticks as f32
+                R::of(self.ramp_done as f32 / self.cfg.ramp_ticks as f32)
             } else {
-                1.0
+                R::ONE
             };
             out.force_n = clipped * scale;
-            out.limited = clipped != command_n || scale < 1.0;
+            out.limited = clipped != command_n || scale < R::ONE;
         } else {
             self.ramp_done = 0;
         }
-        let c = self.cfg.continuous_force_n;
+        let c = self.continuous;
         let f = out.force_n;
-        let heat = self.heat + (f * f - c * c) * self.cfg.period_s;
+        let heat = self.heat + (f * f - c * c) * self.period;
         // (`f` is finite: a comparison, not `max`'s NaN handling.)
-        self.heat = if heat > 0.0 { heat } else { 0.0 };
+        self.heat = if heat > R::ZERO { heat } else { R::ZERO };
         out
     }
 }

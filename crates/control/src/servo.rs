@@ -6,40 +6,40 @@ use crate::estimator::FirstDifference;
 use crate::regulator::PositionRegulator;
 use crate::safety::{Faults, SafetyConfig, SafetyInputs, SafetyLayer};
 use crate::ve::VirtualEnvironment;
-use crate::{Encoder, Integrator, ParamError, Position};
+use crate::{Encoder, Integrator, ParamError, Position, Real};
 
 /// The sensors of one tick.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SensorFrame {
+pub struct SensorFrame<R = f32> {
     /// Timer tick number (must increase by one every tick).
     pub tick: u32,
     /// Raw hardware encoder counter.
     pub encoder_raw: u32,
     /// Load-cell force on the handle along +x (N); only the admittance
     /// display reads it.
-    pub load_cell_n: f32,
+    pub load_cell_n: R,
     /// Dead-man switch closed (operator present).
     pub dead_man_closed: bool,
 }
 
 /// The result of one tick.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ServoOutput {
+pub struct ServoOutput<R = f32> {
     /// Force to hold on the actuator (N), after the safety layer; positive
     /// resists positive actuator motion (the paper's `f_a`).
-    pub actuator_force_n: f32,
+    pub actuator_force_n: R,
     /// What the law asked for before the safety layer (N).
-    pub commanded_force_n: f32,
+    pub commanded_force_n: R,
     /// Actuator position from the encoder.
     pub position: Position,
     /// First-difference actuator velocity (m/s).
-    pub velocity_mps: f32,
+    pub velocity_mps: R,
     /// VE velocity `v_e` (m/s).
-    pub ve_velocity_mps: f32,
+    pub ve_velocity_mps: R,
     /// Force on the VE `f_e` (N).
-    pub ve_force_n: f32,
+    pub ve_force_n: R,
     /// Force in the virtual coupling (N).
-    pub coupling_force_n: f32,
+    pub coupling_force_n: R,
     /// Impedance display: the coupling's VE-side position; admittance
     /// display: the position command `x_cmd`.
     pub reference: Position,
@@ -51,26 +51,26 @@ pub struct ServoOutput {
 
 /// Encoder, velocity estimate and safety layer: the part both displays share.
 #[derive(Clone, Copy, Debug)]
-struct Frontend {
+struct Frontend<R> {
     encoder: Encoder,
-    estimator: FirstDifference,
-    safety: SafetyLayer,
+    estimator: FirstDifference<R>,
+    safety: SafetyLayer<R>,
     position: Position,
 }
 
-impl Frontend {
+impl<R: Real> Frontend<R> {
     fn new(encoder: Encoder, safety: SafetyConfig) -> Result<Self, ParamError> {
         let position = encoder.position();
         Ok(Frontend {
-            estimator: FirstDifference::new(safety.period_s, position)?,
-            safety: SafetyLayer::new(safety)?,
+            estimator: FirstDifference::new_in(safety.period_s, position)?,
+            safety: SafetyLayer::new_in(safety)?,
             encoder,
             position,
         })
     }
 
     /// Read the encoder; returns the velocity and the sensor faults.
-    fn sense(&mut self, frame: &SensorFrame) -> (f32, Faults) {
+    fn sense(&mut self, frame: &SensorFrame<R>) -> (R, Faults) {
         let mut faults = Faults::NONE;
         match self.encoder.update(frame.encoder_raw) {
             Ok(p) => self.position = p,
@@ -84,7 +84,7 @@ impl Frontend {
         sensor_faults.is_empty() && self.safety.faults().is_empty()
     }
 
-    fn finish(&mut self, frame: &SensorFrame, v: f32, faults: Faults, out: &mut ServoOutput) {
+    fn finish(&mut self, frame: &SensorFrame<R>, v: R, faults: Faults, out: &mut ServoOutput<R>) {
         let safe = self.safety.step(
             &SafetyInputs {
                 tick: frame.tick,
@@ -138,7 +138,7 @@ macro_rules! servo_controls {
         }
 
         /// The safety layer (limits, latched faults, thermal state).
-        pub fn safety(&self) -> &SafetyLayer {
+        pub fn safety(&self) -> &SafetyLayer<R> {
             &self.front.safety
         }
 
@@ -162,9 +162,9 @@ macro_rules! servo_controls {
 /// The impedance display (paper Fig. 5): measure motion, command force,
 /// through the spring-damper coupling `Z_cI` to the VE.
 #[derive(Clone, Copy, Debug)]
-pub struct ImpedanceServo<V> {
-    front: Frontend,
-    coupling: ImpedanceCoupling,
+pub struct ImpedanceServo<V, R = f32> {
+    front: Frontend<R>,
+    coupling: ImpedanceCoupling<R>,
     ve: V,
 }
 
@@ -177,8 +177,21 @@ impl<V: VirtualEnvironment> ImpedanceServo<V> {
         safety: SafetyConfig,
         ve: V,
     ) -> Result<Self, ParamError> {
+        Self::new_in(k_npm, b_nspm, encoder, safety, ve)
+    }
+}
+
+impl<V: VirtualEnvironment<R>, R: Real> ImpedanceServo<V, R> {
+    /// [`ImpedanceServo::new`] computing in `R`.
+    pub fn new_in(
+        k_npm: f32,
+        b_nspm: f32,
+        encoder: Encoder,
+        safety: SafetyConfig,
+        ve: V,
+    ) -> Result<Self, ParamError> {
         let front = Frontend::new(encoder, safety)?;
-        let coupling = ImpedanceCoupling::new(k_npm, b_nspm, safety.period_s, front.position)?;
+        let coupling = ImpedanceCoupling::new_in(k_npm, b_nspm, safety.period_s, front.position)?;
         let mut s = ImpedanceServo {
             front,
             coupling,
@@ -191,7 +204,7 @@ impl<V: VirtualEnvironment> ImpedanceServo<V> {
     servo_controls!();
 
     /// The coupling (gains, z-domain form).
-    pub fn coupling(&self) -> &ImpedanceCoupling {
+    pub fn coupling(&self) -> &ImpedanceCoupling<R> {
         &self.coupling
     }
 
@@ -208,7 +221,7 @@ impl<V: VirtualEnvironment> ImpedanceServo<V> {
     }
 
     /// One control tick.
-    pub fn tick(&mut self, frame: &SensorFrame) -> ServoOutput {
+    pub fn tick(&mut self, frame: &SensorFrame<R>) -> ServoOutput<R> {
         let (v, faults) = self.front.sense(frame);
         let mut out = ServoOutput::default();
         if self.front.runnable(faults) {
@@ -228,11 +241,11 @@ impl<V: VirtualEnvironment> ImpedanceServo<V> {
 /// through the mass-damper coupling `Z_cA`, the velocity integrated to a
 /// position command and the regulator `K_p`.
 #[derive(Clone, Copy, Debug)]
-pub struct AdmittanceServo<V> {
-    front: Frontend,
-    coupling: AdmittanceCoupling,
-    command: Integrator,
-    regulator: PositionRegulator,
+pub struct AdmittanceServo<V, R = f32> {
+    front: Frontend<R>,
+    coupling: AdmittanceCoupling<R>,
+    command: Integrator<R>,
+    regulator: PositionRegulator<R>,
     ve: V,
 }
 
@@ -240,6 +253,19 @@ impl<V: VirtualEnvironment> AdmittanceServo<V> {
     /// A disabled servo with regulator `kp_npm`, `bp_nspm` and coupling
     /// `m_kg`, `b_nspm`.
     pub fn new(
+        regulator: (f32, f32),
+        coupling: (f32, f32),
+        encoder: Encoder,
+        safety: SafetyConfig,
+        ve: V,
+    ) -> Result<Self, ParamError> {
+        Self::new_in(regulator, coupling, encoder, safety, ve)
+    }
+}
+
+impl<V: VirtualEnvironment<R>, R: Real> AdmittanceServo<V, R> {
+    /// [`AdmittanceServo::new`] computing in `R`.
+    pub fn new_in(
         (kp_npm, bp_nspm): (f32, f32),
         (m_kg, b_nspm): (f32, f32),
         encoder: Encoder,
@@ -249,9 +275,9 @@ impl<V: VirtualEnvironment> AdmittanceServo<V> {
         let t = safety.period_s;
         let front = Frontend::new(encoder, safety)?;
         let mut s = AdmittanceServo {
-            command: Integrator::new(t, front.position),
-            coupling: AdmittanceCoupling::new(m_kg, b_nspm, t)?,
-            regulator: PositionRegulator::new(kp_npm, bp_nspm, t)?,
+            command: Integrator::new_in(t, front.position),
+            coupling: AdmittanceCoupling::new_in(m_kg, b_nspm, t)?,
+            regulator: PositionRegulator::new_in(kp_npm, bp_nspm, t)?,
             front,
             ve,
         };
@@ -262,12 +288,12 @@ impl<V: VirtualEnvironment> AdmittanceServo<V> {
     servo_controls!();
 
     /// The coupling (gains, z-domain form).
-    pub fn coupling(&self) -> &AdmittanceCoupling {
+    pub fn coupling(&self) -> &AdmittanceCoupling<R> {
         &self.coupling
     }
 
     /// The position regulator (gains, z-domain form).
-    pub fn regulator(&self) -> &PositionRegulator {
+    pub fn regulator(&self) -> &PositionRegulator<R> {
         &self.regulator
     }
 
@@ -291,12 +317,12 @@ impl<V: VirtualEnvironment> AdmittanceServo<V> {
     }
 
     /// One control tick.
-    pub fn tick(&mut self, frame: &SensorFrame) -> ServoOutput {
+    pub fn tick(&mut self, frame: &SensorFrame<R>) -> ServoOutput<R> {
         let (v, mut faults) = self.front.sense(frame);
         let f_c = frame.load_cell_n;
         if !f_c.is_finite() {
             faults = faults.with(Faults::SENSOR_NOT_FINITE);
-        } else if f_c.abs() > self.front.safety.config().max_sensor_force_n {
+        } else if f_c.abs() > R::of(self.front.safety.config().max_sensor_force_n) {
             faults = faults.with(Faults::SENSOR_OUT_OF_RANGE);
         }
         let mut out = ServoOutput::default();

@@ -12,7 +12,7 @@
 //! Sign convention: `f` is the force applied *to* the VE along +x (N), `v`
 //! is the VE velocity along +x (m/s), and positions are [`Position`]s.
 
-use crate::{param, Integrator, ParamError, Position, ZTransfer};
+use crate::{param, Integrator, ParamError, Position, Real, ZTransfer};
 
 /// The paper's Fig. 7 causality of a VE's own law.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -27,37 +27,37 @@ pub enum Causality {
 /// `f0_n - z_nspm * v` (N) to the VE for a VE velocity `v` (m/s).
 /// `z_nspm > 0` (N s/m) always: it is the coupling's direct feedthrough.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Port {
+pub struct Port<R = f32> {
     /// Force at zero VE velocity (N).
-    pub f0_n: f32,
+    pub f0_n: R,
     /// Direct-feedthrough impedance (N s/m), > 0.
-    pub z_nspm: f32,
+    pub z_nspm: R,
 }
 
 /// What a VE settled on this tick.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct VeOutput {
+pub struct VeOutput<R = f32> {
     /// VE velocity `v_e` (m/s).
-    pub velocity_mps: f32,
+    pub velocity_mps: R,
     /// Force applied to the VE along +x, `f_e` (N).
-    pub force_n: f32,
+    pub force_n: R,
 }
 
-impl Port {
+impl<R: Real> Port<R> {
     /// Intersect with an admittance law `v = v0 + y f` (y >= 0, m/(N s)).
-    pub fn solve_admittance(self, v0_mps: f32, y: f32) -> VeOutput {
-        let v = (v0_mps + y * self.f0_n) / (1.0 + y * self.z_nspm);
+    pub fn solve_admittance(self, v0_mps: R, y: R) -> VeOutput<R> {
+        let v = (v0_mps + y * self.f0_n) / (R::ONE + y * self.z_nspm);
         self.at(v)
     }
 
     /// Intersect with an impedance law `f = g + h v` (h >= 0, N s/m).
-    pub fn solve_impedance(self, g_n: f32, h: f32) -> VeOutput {
+    pub fn solve_impedance(self, g_n: R, h: R) -> VeOutput<R> {
         let v = (self.f0_n - g_n) / (self.z_nspm + h);
         self.at(v)
     }
 
     /// The port's force at VE velocity `v`.
-    pub fn at(self, v_mps: f32) -> VeOutput {
+    pub fn at(self, v_mps: R) -> VeOutput<R> {
         VeOutput {
             velocity_mps: v_mps,
             force_n: self.f0_n - self.z_nspm * v_mps,
@@ -76,12 +76,13 @@ pub enum VeTransfer {
 
 /// A virtual environment stepped once per tick against a coupling's [`Port`].
 /// `step` must not allocate, panic or loop without bound, and must leave its
-/// state unchanged when the port holds a non-finite number.
-pub trait VirtualEnvironment {
+/// state unchanged when the port holds a non-finite number. `R` is the float
+/// it computes in (see [`Real`]).
+pub trait VirtualEnvironment<R: Real = f32> {
     /// The causality of this VE's own law.
     fn causality(&self) -> Causality;
     /// Solve this tick exactly against the coupling's law and commit.
-    fn step(&mut self, port: Port) -> VeOutput;
+    fn step(&mut self, port: Port<R>) -> VeOutput<R>;
     /// Put the VE at rest at `x`.
     fn reset(&mut self, x: Position);
     /// The VE's current position.
@@ -96,11 +97,11 @@ pub trait VirtualEnvironment {
 /// Admittance causality. The paper's VBB needed `m >= 0.25 kg` with its
 /// explicit integrator ([`PAPER_MIN_CURSOR_MASS_KG`]).
 #[derive(Clone, Copy, Debug)]
-pub struct CursorMass {
+pub struct CursorMass<R = f32> {
     mass_kg: f32,
-    t_over_m: f32,
-    velocity_mps: f32,
-    x: Integrator,
+    t_over_m: R,
+    velocity_mps: R,
+    x: Integrator<R>,
 }
 
 /// The smallest cursor mass the paper's experiments ran stably (kg).
@@ -109,13 +110,20 @@ pub const PAPER_MIN_CURSOR_MASS_KG: f32 = 0.25;
 impl CursorMass {
     /// A mass of `mass_kg` (kg) at rest at `x`, period `period_s` (s).
     pub fn new(mass_kg: f32, period_s: f32, x: Position) -> Result<Self, ParamError> {
+        Self::new_in(mass_kg, period_s, x)
+    }
+}
+
+impl<R: Real> CursorMass<R> {
+    /// [`CursorMass::new`] computing in `R`.
+    pub fn new_in(mass_kg: f32, period_s: f32, x: Position) -> Result<Self, ParamError> {
         let m = param::positive("cursor mass (kg)", mass_kg)?;
         let t = param::positive("T (s)", period_s)?;
         Ok(CursorMass {
             mass_kg: m,
-            t_over_m: t / m,
-            velocity_mps: 0.0,
-            x: Integrator::new(t, x),
+            t_over_m: R::of(t) / R::of(m),
+            velocity_mps: R::ZERO,
+            x: Integrator::new_in(t, x),
         })
     }
 
@@ -125,17 +133,17 @@ impl CursorMass {
     }
 
     /// The current velocity (m/s).
-    pub fn velocity_mps(&self) -> f32 {
+    pub fn velocity_mps(&self) -> R {
         self.velocity_mps
     }
 }
 
-impl VirtualEnvironment for CursorMass {
+impl<R: Real> VirtualEnvironment<R> for CursorMass<R> {
     fn causality(&self) -> Causality {
         Causality::Admittance
     }
 
-    fn step(&mut self, port: Port) -> VeOutput {
+    fn step(&mut self, port: Port<R>) -> VeOutput<R> {
         let out = port.solve_admittance(self.velocity_mps, self.t_over_m);
         if out.velocity_mps.is_finite() {
             self.velocity_mps = out.velocity_mps;
@@ -145,7 +153,7 @@ impl VirtualEnvironment for CursorMass {
     }
 
     fn reset(&mut self, x: Position) {
-        self.velocity_mps = 0.0;
+        self.velocity_mps = R::ZERO;
         self.x.reset(x);
     }
 
@@ -155,7 +163,7 @@ impl VirtualEnvironment for CursorMass {
 
     /// `V/F = (T/m) / (1 - z^-1)`.
     fn tf(&self) -> VeTransfer {
-        VeTransfer::Admittance(ZTransfer::first_order([self.t_over_m as f64, 0.0], -1.0))
+        VeTransfer::Admittance(ZTransfer::first_order([self.t_over_m.to_f64(), 0.0], -1.0))
     }
 }
 
@@ -174,13 +182,13 @@ pub enum Solid {
 /// spring (`x[k] = x[k-1] + T v[k]`), so `f = k (x - anchor) + b v` is
 /// exactly `Z_e(z) = b + kT/(1 - z^-1)`.
 #[derive(Clone, Copy, Debug)]
-pub struct Spring {
-    k: f32,
-    b: f32,
-    kt: f32,
-    period_s: f32,
+pub struct Spring<R = f32> {
+    k: R,
+    b: R,
+    kt: R,
+    period: R,
     anchor: Position,
-    probe: Integrator,
+    probe: Integrator<R>,
 }
 
 impl Spring {
@@ -193,14 +201,27 @@ impl Spring {
         period_s: f32,
         probe: Position,
     ) -> Result<Self, ParamError> {
+        Self::new_in(k_npm, b_nspm, anchor, period_s, probe)
+    }
+}
+
+impl<R: Real> Spring<R> {
+    /// [`Spring::new`] computing in `R`.
+    pub fn new_in(
+        k_npm: f32,
+        b_nspm: f32,
+        anchor: Position,
+        period_s: f32,
+        probe: Position,
+    ) -> Result<Self, ParamError> {
         let t = param::positive("T (s)", period_s)?;
         let mut s = Spring {
-            k: 0.0,
-            b: 0.0,
-            kt: 0.0,
-            period_s: t,
+            k: R::ZERO,
+            b: R::ZERO,
+            kt: R::ZERO,
+            period: R::of(t),
             anchor,
-            probe: Integrator::new(t, probe),
+            probe: Integrator::new_in(t, probe),
         };
         s.set_gains(k_npm, b_nspm)?;
         Ok(s)
@@ -208,15 +229,16 @@ impl Spring {
 
     /// Change stiffness (N/m) and damping (N s/m).
     pub fn set_gains(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
-        self.k = param::non_negative("stiffness (N/m)", k_npm)?;
-        self.b = param::non_negative("damping (N s/m)", b_nspm)?;
-        self.kt = self.k * self.period_s;
+        let k = param::non_negative("stiffness (N/m)", k_npm)?;
+        let b = param::non_negative("damping (N s/m)", b_nspm)?;
+        let (k, b) = (R::of(k), R::of(b));
+        (self.k, self.b, self.kt) = (k, b, k * self.period);
         Ok(())
     }
 
     /// Stiffness (N/m) and damping (N s/m).
     pub fn gains(&self) -> (f32, f32) {
-        (self.k, self.b)
+        (self.k.to_f32(), self.b.to_f32())
     }
 
     /// Move the anchor (the probe stays where it is).
@@ -225,30 +247,30 @@ impl Spring {
     }
 
     /// The probe's offset from the anchor now (m).
-    fn stretch_m(&self) -> f32 {
+    fn stretch_m(&self) -> R {
         self.probe.offset_m(self.anchor)
     }
 
     /// This tick's law `f = g + h v` for the probe velocity `v`, given its
     /// offset `d_m` from the anchor: `g = k d`, `h = kT + b`.
-    fn affine(&self, d_m: f32) -> (f32, f32) {
+    fn affine(&self, d_m: R) -> (R, R) {
         (self.k * d_m, self.kt + self.b)
     }
 
     /// Move the probe at `v` for this tick (ignored if not finite).
-    fn commit(&mut self, v_mps: f32) {
+    fn commit(&mut self, v_mps: R) {
         if v_mps.is_finite() {
             self.probe.step(v_mps);
         }
     }
 }
 
-impl VirtualEnvironment for Spring {
+impl<R: Real> VirtualEnvironment<R> for Spring<R> {
     fn causality(&self) -> Causality {
         Causality::Impedance
     }
 
-    fn step(&mut self, port: Port) -> VeOutput {
+    fn step(&mut self, port: Port<R>) -> VeOutput<R> {
         let (g, h) = self.affine(self.stretch_m());
         let out = port.solve_impedance(g, h);
         self.commit(out.velocity_mps);
@@ -266,7 +288,7 @@ impl VirtualEnvironment for Spring {
 
     /// `F/V = b + kT/(1 - z^-1)`.
     fn tf(&self) -> VeTransfer {
-        let (b, kt) = (self.b as f64, self.kt as f64);
+        let (b, kt) = (self.b.to_f64(), self.kt.to_f64());
         VeTransfer::Impedance(ZTransfer::first_order([b + kt, -b], -1.0))
     }
 }
@@ -283,11 +305,11 @@ impl VirtualEnvironment for Spring {
 /// energy-conserving spring), and to meet the designer's bound exactly: it
 /// is the passive termination that shows the bound is not conservative.
 #[derive(Clone, Copy, Debug)]
-pub struct TrapezoidalSpring {
+pub struct TrapezoidalSpring<R = f32> {
     /// Gains, anchor and the probe's integer position.
-    spring: Spring,
+    spring: Spring<R>,
     /// Last tick's probe velocity (m/s).
-    v_prev: f32,
+    v_prev: R,
 }
 
 impl TrapezoidalSpring {
@@ -300,9 +322,22 @@ impl TrapezoidalSpring {
         period_s: f32,
         probe: Position,
     ) -> Result<Self, ParamError> {
+        Self::new_in(k_npm, b_nspm, anchor, period_s, probe)
+    }
+}
+
+impl<R: Real> TrapezoidalSpring<R> {
+    /// [`TrapezoidalSpring::new`] computing in `R`.
+    pub fn new_in(
+        k_npm: f32,
+        b_nspm: f32,
+        anchor: Position,
+        period_s: f32,
+        probe: Position,
+    ) -> Result<Self, ParamError> {
         Ok(TrapezoidalSpring {
-            spring: Spring::new(k_npm, b_nspm, anchor, period_s, probe)?,
-            v_prev: 0.0,
+            spring: Spring::new_in(k_npm, b_nspm, anchor, period_s, probe)?,
+            v_prev: R::ZERO,
         })
     }
 
@@ -312,19 +347,20 @@ impl TrapezoidalSpring {
     }
 }
 
-impl VirtualEnvironment for TrapezoidalSpring {
+impl<R: Real> VirtualEnvironment<R> for TrapezoidalSpring<R> {
     fn causality(&self) -> Causality {
         Causality::Impedance
     }
 
-    fn step(&mut self, port: Port) -> VeOutput {
+    fn step(&mut self, port: Port<R>) -> VeOutput<R> {
         // f = k (x[k-1] - a + T/2 v[k-1]) + (k T/2 + b) v[k]
         let s = &self.spring;
-        let half_kt = 0.5 * s.kt;
+        let half_kt = R::HALF * s.kt;
         let g = s.k * s.stretch_m() + half_kt * self.v_prev;
         let out = port.solve_impedance(g, half_kt + s.b);
         if out.velocity_mps.is_finite() {
-            self.spring.commit(0.5 * (out.velocity_mps + self.v_prev));
+            self.spring
+                .commit(R::HALF * (out.velocity_mps + self.v_prev));
             self.v_prev = out.velocity_mps;
         }
         out
@@ -332,7 +368,7 @@ impl VirtualEnvironment for TrapezoidalSpring {
 
     fn reset(&mut self, x: Position) {
         self.spring.reset(x);
-        self.v_prev = 0.0;
+        self.v_prev = R::ZERO;
     }
 
     fn position(&self) -> Position {
@@ -341,7 +377,7 @@ impl VirtualEnvironment for TrapezoidalSpring {
 
     /// `F/V = ((b + kT/2) + (kT/2 - b) z^-1) / (1 - z^-1)`.
     fn tf(&self) -> VeTransfer {
-        let (b, hkt) = (self.spring.b as f64, 0.5 * self.spring.kt as f64);
+        let (b, hkt) = (self.spring.b.to_f64(), 0.5 * self.spring.kt.to_f64());
         VeTransfer::Impedance(ZTransfer::first_order([b + hkt, hkt - b], -1.0))
     }
 }
@@ -352,8 +388,8 @@ impl VirtualEnvironment for TrapezoidalSpring {
 /// `k p + b p'`, never pulling (`>= 0`); out of contact it is zero. In
 /// contact the law is exactly the spring's, `Z_e(z) = b + kT/(1 - z^-1)`.
 #[derive(Clone, Copy, Debug)]
-pub struct UnilateralWall {
-    spring: Spring,
+pub struct UnilateralWall<R = f32> {
+    spring: Spring<R>,
     solid: Solid,
 }
 
@@ -369,8 +405,22 @@ impl UnilateralWall {
         period_s: f32,
         probe: Position,
     ) -> Result<Self, ParamError> {
+        Self::new_in(k_npm, b_nspm, surface, solid, period_s, probe)
+    }
+}
+
+impl<R: Real> UnilateralWall<R> {
+    /// [`UnilateralWall::new`] computing in `R`.
+    pub fn new_in(
+        k_npm: f32,
+        b_nspm: f32,
+        surface: Position,
+        solid: Solid,
+        period_s: f32,
+        probe: Position,
+    ) -> Result<Self, ParamError> {
         Ok(UnilateralWall {
-            spring: Spring::new(k_npm, b_nspm, surface, period_s, probe)?,
+            spring: Spring::new_in(k_npm, b_nspm, surface, period_s, probe)?,
             solid,
         })
     }
@@ -391,50 +441,50 @@ impl UnilateralWall {
     }
 
     /// +1 when solid above, -1 when below.
-    fn sign(&self) -> f32 {
+    fn sign(&self) -> R {
         match self.solid {
-            Solid::Above => 1.0,
-            Solid::Below => -1.0,
+            Solid::Above => R::ONE,
+            Solid::Below => -R::ONE,
         }
     }
 
     /// Penetration (m, > 0 inside) and inward push (N, before clamping) of
     /// the probe at velocity `v` this tick.
-    fn contact(&self, d_m: f32, v: f32) -> (f32, f32) {
+    fn contact(&self, d_m: R, v: R) -> (R, R) {
         let s = self.sign();
-        let pen = s * (d_m + self.spring.period_s * v);
+        let pen = s * (d_m + self.spring.period * v);
         (pen, self.spring.k * pen + self.spring.b * s * v)
     }
 
     /// Whether the probe is in the wall.
     pub fn in_contact(&self) -> bool {
-        self.sign() * self.spring.stretch_m() > 0.0
+        self.sign() * self.spring.stretch_m() > R::ZERO
     }
 }
 
-impl VirtualEnvironment for UnilateralWall {
+impl<R: Real> VirtualEnvironment<R> for UnilateralWall<R> {
     fn causality(&self) -> Causality {
         Causality::Impedance
     }
 
-    fn step(&mut self, port: Port) -> VeOutput {
+    fn step(&mut self, port: Port<R>) -> VeOutput<R> {
         let d = self.spring.stretch_m();
         // The force needed is non-decreasing in v, so exactly one of three
         // cases holds: free, pushed by the wall, or stopped at the surface
         // (the damper's jump on first touch).
         let free = port.at(port.f0_n / port.z_nspm);
         let (pen, push) = self.contact(d, free.velocity_mps);
-        let out = if pen <= 0.0 || push <= 0.0 {
+        let out = if pen <= R::ZERO || push <= R::ZERO {
             free
         } else {
             // In contact the spring's own law, the same for both sides.
             let (g, h) = self.spring.affine(d);
             let touched = port.solve_impedance(g, h);
             let (pen, push) = self.contact(d, touched.velocity_mps);
-            if pen > 0.0 && push >= 0.0 {
+            if pen > R::ZERO && push >= R::ZERO {
                 touched
             } else {
-                port.at(-d / self.spring.period_s)
+                port.at(-d / self.spring.period)
             }
         };
         self.spring.commit(out.velocity_mps);
@@ -469,13 +519,13 @@ impl BilateralConstraint {
     }
 }
 
-impl VirtualEnvironment for BilateralConstraint {
+impl<R: Real> VirtualEnvironment<R> for BilateralConstraint {
     fn causality(&self) -> Causality {
         Causality::Admittance
     }
 
-    fn step(&mut self, port: Port) -> VeOutput {
-        port.at(0.0)
+    fn step(&mut self, port: Port<R>) -> VeOutput<R> {
+        port.at(R::ZERO)
     }
 
     fn reset(&mut self, x: Position) {

@@ -2,7 +2,7 @@
 //! admittances add (eq 21).
 
 use crate::ve::{Port, VirtualEnvironment};
-use crate::{param, ParamError, ZTransfer};
+use crate::{param, ParamError, Real, ZTransfer};
 
 /// `Z_cA(z) = m b (z - 1) / ((m + bT) z - m)` (paper eq 21), i.e.
 /// `1/Z_cA = 1/b + Tz/(m(z - 1))`: a damper `b` in series with a mass `m`.
@@ -13,38 +13,45 @@ use crate::{param, ParamError, ZTransfer};
 /// direct feedthrough `m b / (m + bT)` closes an algebraic loop with an
 /// admittance VE; it is solved exactly through [`Port`].
 #[derive(Clone, Copy, Debug)]
-pub struct AdmittanceCoupling {
+pub struct AdmittanceCoupling<R = f32> {
     m: f32,
     b: f32,
     period_s: f32,
-    t_over_m: f32,
-    z_direct: f32,
+    t_over_m: R,
+    z_direct: R,
     /// Velocity of the coupling's mass (m/s).
-    mass_velocity_mps: f32,
+    mass_velocity_mps: R,
 }
 
 /// One tick of the admittance coupling.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct AdmittanceStep {
+pub struct AdmittanceStep<R = f32> {
     /// Velocity command to the display, `v_c = v_e` (m/s).
-    pub velocity_mps: f32,
+    pub velocity_mps: R,
     /// Force on the VE, `f_e` (N).
-    pub ve_force_n: f32,
+    pub ve_force_n: R,
     /// Force taken by the coupling, `f_c - f_e = Z_cA v_e` (N).
-    pub coupling_force_n: f32,
+    pub coupling_force_n: R,
 }
 
 impl AdmittanceCoupling {
     /// A coupling of mass `m_kg` (kg) and damping `b_nspm` (N s/m), at rest.
     pub fn new(m_kg: f32, b_nspm: f32, period_s: f32) -> Result<Self, ParamError> {
+        Self::new_in(m_kg, b_nspm, period_s)
+    }
+}
+
+impl<R: Real> AdmittanceCoupling<R> {
+    /// [`AdmittanceCoupling::new`] computing in `R`.
+    pub fn new_in(m_kg: f32, b_nspm: f32, period_s: f32) -> Result<Self, ParamError> {
         let t = param::positive("T (s)", period_s)?;
         let mut c = AdmittanceCoupling {
             m: 1.0,
             b: 1.0,
             period_s: t,
-            t_over_m: 0.0,
-            z_direct: 0.0,
-            mass_velocity_mps: 0.0,
+            t_over_m: R::ZERO,
+            z_direct: R::ZERO,
+            mass_velocity_mps: R::ZERO,
         };
         c.set_gains(m_kg, b_nspm)?;
         Ok(c)
@@ -54,11 +61,15 @@ impl AdmittanceCoupling {
     pub fn set_gains(&mut self, m_kg: f32, b_nspm: f32) -> Result<(), ParamError> {
         let m = param::positive("m_c (kg)", m_kg)?;
         let b = param::positive("b_c (N s/m)", b_nspm)?;
-        let z = param::positive(
+        param::positive(
             "m_c b_c / (m_c + b_c T) (N s/m)",
             m * b / (m + b * self.period_s),
         )?;
-        (self.m, self.b, self.t_over_m, self.z_direct) = (m, b, self.period_s / m, z);
+        (self.m, self.b) = (m, b);
+        // Derived in R (the same operations as the f32 check above), so an
+        // f64 law's constants are the f64 values of its z-form.
+        let (m, b, t) = (R::of(m), R::of(b), R::of(self.period_s));
+        (self.t_over_m, self.z_direct) = (t / m, m * b / (m + b * t));
         Ok(())
     }
 
@@ -69,16 +80,16 @@ impl AdmittanceCoupling {
 
     /// Bring the coupling's mass to rest.
     pub fn reset(&mut self) {
-        self.mass_velocity_mps = 0.0;
+        self.mass_velocity_mps = R::ZERO;
     }
 
     /// One tick: the measured handle force `f_c` (N) in, the VE solved
     /// exactly against the coupling, the display's velocity command out.
-    pub fn step<V: VirtualEnvironment + ?Sized>(
+    pub fn step<V: VirtualEnvironment<R> + ?Sized>(
         &mut self,
-        f_c_n: f32,
+        f_c_n: R,
         ve: &mut V,
-    ) -> AdmittanceStep {
+    ) -> AdmittanceStep<R> {
         // Coupling force Z_cA v = z (v - v_mass[k-1]); the VE gets the rest.
         let port = Port {
             f0_n: f_c_n + self.z_direct * self.mass_velocity_mps,

@@ -1,7 +1,7 @@
 //! The impedance-display virtual coupling, a shunt spring-damper (eq 20).
 
 use crate::ve::{Port, VirtualEnvironment};
-use crate::{param, Integrator, ParamError, Position, ZTransfer};
+use crate::{param, Integrator, ParamError, Position, Real, ZTransfer};
 
 /// `Z_cI(z) = b + kTz/(z - 1)` between the device and the VE (paper eq 20).
 ///
@@ -14,34 +14,41 @@ use crate::{param, Integrator, ParamError, Position, ZTransfer};
 /// paper's actuator force `f_a`, which enters the device through `G` with a
 /// minus sign), and pulls the VE along +x.
 #[derive(Clone, Copy, Debug)]
-pub struct ImpedanceCoupling {
-    k: f32,
-    b: f32,
+pub struct ImpedanceCoupling<R = f32> {
+    k: R,
+    b: R,
     period_s: f32,
-    z_direct: f32,
-    ve_side: Integrator,
+    z_direct: R,
+    ve_side: Integrator<R>,
 }
 
 /// One tick of the impedance coupling.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ImpedanceStep {
+pub struct ImpedanceStep<R = f32> {
     /// Device force command `f_c` (N), equal to the VE force `f_e`.
-    pub force_n: f32,
+    pub force_n: R,
     /// VE velocity `v_e` (m/s).
-    pub ve_velocity_mps: f32,
+    pub ve_velocity_mps: R,
 }
 
 impl ImpedanceCoupling {
     /// A coupling of stiffness `k_npm` (N/m) and damping `b_nspm` (N s/m) at
     /// period `period_s` (s), with the VE side at `x`. `kT + b` must be > 0.
     pub fn new(k_npm: f32, b_nspm: f32, period_s: f32, x: Position) -> Result<Self, ParamError> {
+        Self::new_in(k_npm, b_nspm, period_s, x)
+    }
+}
+
+impl<R: Real> ImpedanceCoupling<R> {
+    /// [`ImpedanceCoupling::new`] computing in `R`.
+    pub fn new_in(k_npm: f32, b_nspm: f32, period_s: f32, x: Position) -> Result<Self, ParamError> {
         let t = param::positive("T (s)", period_s)?;
         let mut c = ImpedanceCoupling {
-            k: 0.0,
-            b: 0.0,
+            k: R::ZERO,
+            b: R::ZERO,
             period_s: t,
-            z_direct: 0.0,
-            ve_side: Integrator::new(t, x),
+            z_direct: R::ZERO,
+            ve_side: Integrator::new_in(t, x),
         };
         c.set_gains(k_npm, b_nspm)?;
         Ok(c)
@@ -51,14 +58,16 @@ impl ImpedanceCoupling {
     pub fn set_gains(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
         let k = param::non_negative("k_c (N/m)", k_npm)?;
         let b = param::non_negative("b_c (N s/m)", b_nspm)?;
-        let z = param::positive("k_c T + b_c (N s/m)", k * self.period_s + b)?;
-        (self.k, self.b, self.z_direct) = (k, b, z);
+        param::positive("k_c T + b_c (N s/m)", k * self.period_s + b)?;
+        // Checked in f32 above; derived in R like the z-form.
+        let (k, b) = (R::of(k), R::of(b));
+        (self.k, self.b, self.z_direct) = (k, b, k * R::of(self.period_s) + b);
         Ok(())
     }
 
     /// Stiffness (N/m) and damping (N s/m).
     pub fn gains(&self) -> (f32, f32) {
-        (self.k, self.b)
+        (self.k.to_f32(), self.b.to_f32())
     }
 
     /// Put the VE side at `x` (no stretch if `x` is the device position).
@@ -73,12 +82,12 @@ impl ImpedanceCoupling {
 
     /// One tick: device position `x_c` and its velocity estimate `v_c`
     /// (m/s) in, the VE solved exactly against the coupling, force out.
-    pub fn step<V: VirtualEnvironment + ?Sized>(
+    pub fn step<V: VirtualEnvironment<R> + ?Sized>(
         &mut self,
         x_c: Position,
-        v_c_mps: f32,
+        v_c_mps: R,
         ve: &mut V,
-    ) -> ImpedanceStep {
+    ) -> ImpedanceStep<R> {
         let stretch_prev = -self.ve_side.offset_m(x_c);
         // f = k (x_c - x_e[k-1] - T v_e) + b (v_c - v_e) = f0 - (kT + b) v_e
         let port = Port {
@@ -96,7 +105,7 @@ impl ImpedanceCoupling {
     /// `Z_cI(z) = ((b + kT) - b z^-1) / (1 - z^-1)`: force (N) per velocity
     /// difference `v_c - v_e` (m/s).
     pub fn tf(&self) -> ZTransfer {
-        let (b, kt) = (self.b as f64, self.k as f64 * self.period_s as f64);
+        let (b, kt) = (self.b.to_f64(), self.k.to_f64() * self.period_s as f64);
         ZTransfer::first_order([b + kt, -b], -1.0)
     }
 }

@@ -1,0 +1,101 @@
+//! The float type a law computes in: `f32` on the board, `f64` where a
+//! simulation wants to see what the board's rounding costs.
+//!
+//! Every law is written once, generic over [`Real`], and its plain name is
+//! the `f32` law the board runs (`ImpedanceCoupling` is
+//! `ImpedanceCoupling<f32>`). Parameters (gains, periods, limits) are `f32`
+//! in both, so an `f64` law runs exactly the gains the designer checked and
+//! differs from the board's only in the arithmetic of its signals and state.
+
+use core::fmt::Debug;
+use core::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
+
+/// `f32` or `f64`: what the laws need of a float.
+pub trait Real:
+    Copy
+    + Default
+    + Debug
+    + PartialEq
+    + PartialOrd
+    + Add<Output = Self>
+    + AddAssign
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + Send
+    + Sync
+    + 'static
+{
+    /// 0.
+    const ZERO: Self;
+    /// 1.
+    const ONE: Self;
+    /// 1/2.
+    const HALF: Self;
+    /// Metres per nanometre (1e-9).
+    const M_PER_NM: Self;
+    /// Nanometres per metre (1e9).
+    const NM_PER_M: Self;
+    /// The type's name, `"f32"` or `"f64"`.
+    const NAME: &'static str;
+
+    /// A parameter or reading given in `f32`, exactly.
+    fn of(x: f32) -> Self;
+    /// Rounded to `f32` (exact for `f32`).
+    fn to_f32(self) -> f32;
+    /// Widened to `f64`, exactly.
+    fn to_f64(self) -> f64;
+    /// An integer, rounded to nearest (exact below 2^24 for `f32`).
+    fn from_i32(i: i32) -> Self;
+    /// Toward zero, saturating, NaN to 0 (one `vcvt` on the M4F).
+    fn trunc_i32(self) -> i32;
+    /// `|self|`.
+    fn abs(self) -> Self;
+    /// Neither NaN nor infinite.
+    fn is_finite(self) -> bool;
+}
+
+macro_rules! real {
+    ($t:ty, $name:literal) => {
+        impl Real for $t {
+            const ZERO: Self = 0.0;
+            const ONE: Self = 1.0;
+            const HALF: Self = 0.5;
+            const M_PER_NM: Self = 1.0e-9;
+            const NM_PER_M: Self = 1.0e9;
+            const NAME: &'static str = $name;
+            #[inline]
+            fn of(x: f32) -> Self {
+                x as $t
+            }
+            #[inline]
+            fn to_f32(self) -> f32 {
+                self as f32
+            }
+            #[inline]
+            fn to_f64(self) -> f64 {
+                self as f64
+            }
+            #[inline]
+            fn from_i32(i: i32) -> Self {
+                i as $t
+            }
+            #[inline]
+            fn trunc_i32(self) -> i32 {
+                self as i32
+            }
+            #[inline]
+            fn abs(self) -> Self {
+                <$t>::abs(self)
+            }
+            #[inline]
+            fn is_finite(self) -> bool {
+                <$t>::is_finite(self)
+            }
+        }
+    };
+}
+
+real!(f32, "f32");
+real!(f64, "f64");
