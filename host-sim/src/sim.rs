@@ -19,28 +19,108 @@ use twoport_control::{AdmittanceServo, Encoder, ImpedanceServo, Position, Real, 
 /// One tick in this many is timed for the effects' cost.
 const TIMING_STRIDE: u64 = 64;
 
+/// One display's laws and VE, computing in `R`.
+#[derive(Clone, Debug)]
+pub enum Law<R: Real> {
+    /// Impedance display.
+    Impedance(Box<ImpedanceServo<SceneVe<R>, R>>),
+    /// Admittance display.
+    Admittance(Box<AdmittanceServo<SceneVe<R>, R>>),
+}
+
+/// `$e` on the servo of either display.
+macro_rules! each_display {
+    ($self:expr, $s:ident => $e:expr) => {
+        match $self {
+            Law::Impedance($s) => $e,
+            Law::Admittance($s) => $e,
+        }
+    };
+}
+
+impl<R: Real> Law<R> {
+    /// The scene's display with its coupling, regulator and VE, enabled.
+    fn new(scene: &Scene, encoder: Encoder, safety: SafetyConfig) -> Result<Self, String> {
+        let c = scene.coupling;
+        let ve = scene_ve(scene, safety.period_s)?;
+        let err = |e: twoport_control::ParamError| e.to_string();
+        let mut law = match scene.display {
+            Display::Impedance => Law::Impedance(Box::new(
+                ImpedanceServo::new_in(c.k.unwrap_or(0.0) as f32, c.b as f32, encoder, safety, ve)
+                    .map_err(err)?,
+            )),
+            Display::Admittance => Law::Admittance(Box::new(
+                AdmittanceServo::new_in(
+                    (c.kp.unwrap_or(0.0) as f32, c.bp.unwrap_or(0.0) as f32),
+                    (c.m.unwrap_or(1.0) as f32, c.b as f32),
+                    encoder,
+                    safety,
+                    ve,
+                )
+                .map_err(err)?,
+            )),
+        };
+        each_display!(&mut law, s => s.enable())
+            .map_err(|f| format!("the servo would not enable: {f}"))?;
+        Ok(law)
+    }
+
+    fn tick(&mut self, f: &SensorFrame<R>) -> ServoOutput<R> {
+        each_display!(self, s => s.tick(f))
+    }
+
+    fn set_regulator(&mut self, kp: f32, bp: f32) -> Result<(), String> {
+        match self {
+            Law::Impedance(_) => Err("an impedance display has no regulator".into()),
+            Law::Admittance(s) => s.set_regulator_gains(kp, bp).map_err(|e| e.to_string()),
+        }
+    }
+
+    fn set_wall(&mut self, surface: Position, k_npm: f32) -> Result<(), String> {
+        let SceneVe::Wall(w) = each_display!(self, s => s.ve_mut()) else {
+            return Err("the scene's VE is not a wall".into());
+        };
+        let (_, b) = w.gains();
+        w.set_gains(k_npm, b).map_err(|e| e.to_string())?;
+        w.set_surface(surface);
+        Ok(())
+    }
+
+    fn set_coupling(&mut self, a: f32, b: f32) -> Result<(), String> {
+        match self {
+            Law::Impedance(s) => s.set_gains(a, b),
+            Law::Admittance(s) => s.set_coupling_gains(a, b),
+        }
+        .map_err(|e| e.to_string())
+    }
+}
+
 /// The board's code for the scene's display: the board's f32 laws, or the
 /// same laws computing in f64 (`integrator.controller = "f64"`).
 #[derive(Clone, Debug)]
 pub enum Servo {
-    /// Impedance display.
-    Impedance(Box<ImpedanceServo<SceneVe>>),
-    /// Admittance display.
-    Admittance(Box<AdmittanceServo<SceneVe>>),
-    /// Impedance display computing in f64.
-    Impedance64(Box<ImpedanceServo<SceneVe<f64>, f64>>),
-    /// Admittance display computing in f64.
-    Admittance64(Box<AdmittanceServo<SceneVe<f64>, f64>>),
+    /// The board's f32 laws.
+    F32(Law<f32>),
+    /// The same laws computing in f64.
+    F64(Law<f64>),
 }
 
-/// `$e` on the servo whatever its display and float type.
+/// `$e` on the laws of the servo of either float type and display.
 macro_rules! each_servo {
     ($self:expr, $s:ident => $e:expr) => {
         match $self {
-            Servo::Impedance($s) => $e,
-            Servo::Admittance($s) => $e,
-            Servo::Impedance64($s) => $e,
-            Servo::Admittance64($s) => $e,
+            Servo::F32(l) => each_display!(l, $s => $e),
+            Servo::F64(l) => each_display!(l, $s => $e),
+        }
+    };
+}
+
+/// `$e` on the [`Law`] of either float type.
+macro_rules! each_law {
+    ($self:expr, $l:ident => $e:expr) => {
+        match $self {
+            Servo::F32($l) => $e,
+            Servo::F64($l) => $e,
         }
     };
 }
@@ -71,29 +151,19 @@ fn output_f64(o: ServoOutput) -> ServoOutput<f64> {
     }
 }
 
-/// Move a wall VE's surface and stiffness, in either float type.
-fn set_wall<R: Real>(ve: &mut SceneVe<R>, surface: Position, k_npm: f64) -> Result<(), String> {
-    let SceneVe::Wall(w) = ve else {
-        return Err("the scene's VE is not a wall".into());
-    };
-    let (_, b) = w.gains();
-    w.set_gains(k_npm as f32, b).map_err(|e| e.to_string())?;
-    w.set_surface(surface);
-    Ok(())
-}
-
 impl Servo {
-    fn tick(&mut self, f: &SensorFrame<f64>) -> ServoOutput<f64> {
-        match self {
-            Servo::Impedance(s) => output_f64(s.tick(&frame_f32(f))),
-            Servo::Admittance(s) => output_f64(s.tick(&frame_f32(f))),
-            Servo::Impedance64(s) => s.tick(f),
-            Servo::Admittance64(s) => s.tick(f),
-        }
+    fn new(scene: &Scene, encoder: Encoder, safety: SafetyConfig) -> Result<Self, String> {
+        Ok(match scene.integrator.controller {
+            Precision::F32 => Servo::F32(Law::new(scene, encoder, safety)?),
+            Precision::F64 => Servo::F64(Law::new(scene, encoder, safety)?),
+        })
     }
 
-    fn enable(&mut self) -> Result<(), twoport_control::Faults> {
-        each_servo!(self, s => s.enable())
+    fn tick(&mut self, f: &SensorFrame<f64>) -> ServoOutput<f64> {
+        match self {
+            Servo::F32(l) => output_f64(l.tick(&frame_f32(f))),
+            Servo::F64(l) => l.tick(f),
+        }
     }
 
     /// The VE's position.
@@ -107,25 +177,10 @@ impl Servo {
         each_servo!(self, s => s.coupling().gains())
     }
 
-    /// The controller's float type.
-    pub fn precision(&self) -> Precision {
-        match self {
-            Servo::Impedance(_) | Servo::Admittance(_) => Precision::F32,
-            Servo::Impedance64(_) | Servo::Admittance64(_) => Precision::F64,
-        }
-    }
-
     /// Change the admittance display's regulator `K_p` (N/m, N s/m); an
     /// error on an impedance display.
     pub fn set_regulator(&mut self, kp: f64, bp: f64) -> Result<(), String> {
-        let (kp, bp) = (kp as f32, bp as f32);
-        match self {
-            Servo::Impedance(_) | Servo::Impedance64(_) => {
-                Err("an impedance display has no regulator".into())
-            }
-            Servo::Admittance(s) => s.set_regulator_gains(kp, bp).map_err(|e| e.to_string()),
-            Servo::Admittance64(s) => s.set_regulator_gains(kp, bp).map_err(|e| e.to_string()),
-        }
+        each_law!(self, l => l.set_regulator(kp as f32, bp as f32))
     }
 
     /// Move the wall and change its stiffness while running (the scope's
@@ -134,20 +189,13 @@ impl Servo {
         let x = Position::from_m_f64(surface_m).ok_or(format!(
             "wall position {surface_m} m is out of range (±2.147 m)"
         ))?;
-        each_servo!(self, s => set_wall(s.ve_mut(), x, stiffness_npm))
+        each_law!(self, l => l.set_wall(x, stiffness_npm as f32))
     }
 
     /// Change the coupling gains while running (the scope's sliders).
     /// Impedance: `(k, b)`; admittance: `(m, b)`.
     pub fn set_coupling(&mut self, a: f64, b: f64) -> Result<(), String> {
-        let (a, b) = (a as f32, b as f32);
-        match self {
-            Servo::Impedance(s) => s.set_gains(a, b),
-            Servo::Admittance(s) => s.set_coupling_gains(a, b),
-            Servo::Impedance64(s) => s.set_gains(a, b),
-            Servo::Admittance64(s) => s.set_coupling_gains(a, b),
-        }
-        .map_err(|e| e.to_string())
+        each_law!(self, l => l.set_coupling(a as f32, b as f32))
     }
 }
 
@@ -445,44 +493,7 @@ impl Simulation {
             period_s: t32,
             ..SafetyConfig::excalibur()
         };
-        let c = scene.coupling;
-        let (k, b) = (c.k.unwrap_or(0.0) as f32, c.b as f32);
-        let regulator = (c.kp.unwrap_or(0.0) as f32, c.bp.unwrap_or(0.0) as f32);
-        let coupling = (c.m.unwrap_or(1.0) as f32, c.b as f32);
-        let err = |e: twoport_control::ParamError| e.to_string();
-        let mut servo = match (scene.display, scene.integrator.controller) {
-            (Display::Impedance, Precision::F32) => Servo::Impedance(Box::new(
-                ImpedanceServo::new_in(k, b, encoder, safety, scene_ve(&scene, t32)?)
-                    .map_err(err)?,
-            )),
-            (Display::Admittance, Precision::F32) => Servo::Admittance(Box::new(
-                AdmittanceServo::new_in(
-                    regulator,
-                    coupling,
-                    encoder,
-                    safety,
-                    scene_ve(&scene, t32)?,
-                )
-                .map_err(err)?,
-            )),
-            (Display::Impedance, Precision::F64) => Servo::Impedance64(Box::new(
-                ImpedanceServo::new_in(k, b, encoder, safety, scene_ve(&scene, t32)?)
-                    .map_err(err)?,
-            )),
-            (Display::Admittance, Precision::F64) => Servo::Admittance64(Box::new(
-                AdmittanceServo::new_in(
-                    regulator,
-                    coupling,
-                    encoder,
-                    safety,
-                    scene_ve(&scene, t32)?,
-                )
-                .map_err(err)?,
-            )),
-        };
-        servo
-            .enable()
-            .map_err(|f| format!("the servo would not enable: {f}"))?;
+        let servo = Servo::new(&scene, encoder, safety)?;
         let total_ticks = (scene.duration_s / period).round() as u64;
         let quiet_tick = ((human.last_event_end() / period).ceil() as u64).min(total_ticks);
         let ns = 2 * device.n + usize::from(e.load_cell) + if human.has_arm() { 2 } else { 0 };
