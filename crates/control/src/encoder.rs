@@ -29,10 +29,10 @@ pub enum EncoderError {
 /// at ±2^31 counts and the position at the ends of its range.
 #[derive(Clone, Copy, Debug)]
 pub struct Encoder {
-    bits: u8,
     /// `32 - bits`: shifting a difference up by this and back down
     /// (arithmetically) sign-extends it.
     shift: u32,
+    /// `2^bits - 1`: the bits the counter has.
     mask: u32,
     pm_per_count: i64,
     /// The resolution in 2^-10 nm per count.
@@ -72,7 +72,6 @@ impl Encoder {
         // pm * 1024 / 1000, rounded half up; >= 1 for pm >= 1.
         let q10 = (pm_per_count * 128 + 62) / 125;
         Ok(Encoder {
-            bits,
             shift: 32 - bits as u32,
             mask,
             pm_per_count,
@@ -85,7 +84,7 @@ impl Encoder {
 
     /// Largest movement between two reads that unwraps unambiguously (counts).
     pub fn max_counts_per_read(&self) -> u32 {
-        (1u32 << (self.bits - 1)) - 1
+        self.mask >> 1 // 2^(bits-1) - 1
     }
 
     /// Travel per count as configured (pm).

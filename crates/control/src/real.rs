@@ -37,8 +37,6 @@ pub trait Real:
     const M_PER_NM: Self;
     /// Nanometres per metre (1e9).
     const NM_PER_M: Self;
-    /// The type's name, `"f32"` or `"f64"`.
-    const NAME: &'static str;
 
     /// A parameter or reading given in `f32`, exactly.
     fn of(x: f32) -> Self;
@@ -57,14 +55,13 @@ pub trait Real:
 }
 
 macro_rules! real {
-    ($t:ty, $name:literal) => {
+    ($t:ty) => {
         impl Real for $t {
             const ZERO: Self = 0.0;
             const ONE: Self = 1.0;
             const HALF: Self = 0.5;
             const M_PER_NM: Self = 1.0e-9;
             const NM_PER_M: Self = 1.0e9;
-            const NAME: &'static str = $name;
             #[inline]
             fn of(x: f32) -> Self {
                 x as $t
@@ -97,5 +94,5 @@ macro_rules! real {
     };
 }
 
-real!(f32, "f32");
-real!(f64, "f64");
+real!(f32);
+real!(f64);

@@ -14,10 +14,9 @@ use crate::{param, Integrator, ParamError, Position, Real, ZTransfer};
 /// at Nyquist, 1e-4 of the response there).
 #[derive(Clone, Copy, Debug)]
 pub struct PositionRegulator<R = f32> {
-    kp: f32,
+    kp: R,
     bp: f32,
     period_s: f32,
-    kp_r: R,
     bp_over_t: R,
     prev_error_nm: i32,
     /// The previous error's fraction of a nanometre.
@@ -37,10 +36,9 @@ impl<R: Real> PositionRegulator<R> {
     pub fn new_in(kp_npm: f32, bp_nspm: f32, period_s: f32) -> Result<Self, ParamError> {
         let t = param::positive("T (s)", period_s)?;
         let mut r = PositionRegulator {
-            kp: 0.0,
+            kp: R::ZERO,
             bp: 0.0,
             period_s: t,
-            kp_r: R::ZERO,
             bp_over_t: R::ZERO,
             prev_error_nm: 0,
             prev_fraction_nm: R::ZERO,
@@ -51,16 +49,15 @@ impl<R: Real> PositionRegulator<R> {
 
     /// Change the gains; the error history is kept.
     pub fn set_gains(&mut self, kp_npm: f32, bp_nspm: f32) -> Result<(), ParamError> {
-        self.kp = param::non_negative("k_p (N/m)", kp_npm)?;
+        self.kp = R::of(param::non_negative("k_p (N/m)", kp_npm)?);
         self.bp = param::non_negative("b_p (N s/m)", bp_nspm)?;
-        self.kp_r = R::of(self.kp);
         self.bp_over_t = R::of(self.bp) / R::of(self.period_s);
         Ok(())
     }
 
     /// Stiffness (N/m) and damping (N s/m).
     pub fn gains(&self) -> (f32, f32) {
-        (self.kp, self.bp)
+        (self.kp.to_f32(), self.bp)
     }
 
     /// Set the remembered previous error to zero.
@@ -80,13 +77,12 @@ impl<R: Real> PositionRegulator<R> {
             R::from_i32(e.saturating_sub(self.prev_error_nm)) + (fraction - self.prev_fraction_nm);
         self.prev_error_nm = e;
         self.prev_fraction_nm = fraction;
-        self.kp_r * ((R::from_i32(e) + fraction) * R::M_PER_NM)
-            + self.bp_over_t * (de * R::M_PER_NM)
+        self.kp * ((R::from_i32(e) + fraction) * R::M_PER_NM) + self.bp_over_t * (de * R::M_PER_NM)
     }
 
     /// `K_p(z) = (k_p + b_p/T) - (b_p/T) z^-1`: force (N) per error (m).
     pub fn tf(&self) -> ZTransfer {
-        let (kp, bt) = (self.kp as f64, self.bp_over_t.to_f64());
+        let (kp, bt) = (self.kp.to_f64(), self.bp_over_t.to_f64());
         ZTransfer::first_order([kp + bt, -bt], 0.0)
     }
 }

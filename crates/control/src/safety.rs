@@ -185,12 +185,7 @@ pub struct SafeForce<R = f32> {
 #[derive(Clone, Copy, Debug)]
 pub struct SafetyLayer<R = f32> {
     cfg: SafetyConfig,
-    /// The limits of `cfg` in `R`.
-    max_velocity: R,
-    peak: R,
-    continuous: R,
-    period: R,
-    budget: R,
+    budget: f32,
     enabled: bool,
     latched: Faults,
     first: Faults,
@@ -213,11 +208,7 @@ impl<R: Real> SafetyLayer<R> {
     pub fn new_in(cfg: SafetyConfig) -> Result<Self, ParamError> {
         cfg.validate()?;
         Ok(SafetyLayer {
-            max_velocity: R::of(cfg.max_velocity_mps),
-            peak: R::of(cfg.peak_force_n),
-            continuous: R::of(cfg.continuous_force_n),
-            period: R::of(cfg.period_s),
-            budget: R::of(cfg.thermal_budget()),
+            budget: cfg.thermal_budget(),
             cfg,
             enabled: false,
             latched: Faults::NONE,
@@ -283,7 +274,7 @@ impl<R: Real> SafetyLayer<R> {
 
     /// The thermal state as a fraction of the I^2 t budget (1 = folded back).
     pub fn thermal_load(&self) -> f32 {
-        let (heat, budget) = (self.heat.to_f32(), self.budget.to_f32());
+        let (heat, budget) = (self.heat.to_f32(), self.budget);
         if budget > 0.0 {
             heat / budget
         } else if heat > 0.0 {
@@ -312,7 +303,7 @@ impl<R: Real> SafetyLayer<R> {
         let mut new = inputs.sensor_faults;
         let v = inputs.velocity_mps;
         // One comparison passes every good tick; NaN fails it too.
-        let speed_ok = v.abs() <= self.max_velocity;
+        let speed_ok = v.abs() <= R::of(self.cfg.max_velocity_mps);
         if !speed_ok {
             new = new.with(if v.is_finite() {
                 Faults::VELOCITY_LIMIT
@@ -347,11 +338,11 @@ impl<R: Real> SafetyLayer<R> {
             limited: false,
         };
         if self.enabled && self.latched.is_empty() {
-            let limit = if self.heat >= self.budget {
-                self.continuous
+            let limit = R::of(if self.heat >= R::of(self.budget) {
+                self.cfg.continuous_force_n
             } else {
-                self.peak
-            };
+                self.cfg.peak_force_n
+            });
             // (Not `clamp`, which carries an assertion on its bounds; the
             // command is finite here, or a fault would have latched.)
             let clipped = if command_n > limit {
@@ -373,9 +364,9 @@ impl<R: Real> SafetyLayer<R> {
         } else {
             self.ramp_done = 0;
         }
-        let c = self.continuous;
+        let c = R::of(self.cfg.continuous_force_n);
         let f = out.force_n;
-        let heat = self.heat + (f * f - c * c) * self.period;
+        let heat = self.heat + (f * f - c * c) * R::of(self.cfg.period_s);
         // (`f` is finite: a comparison, not `max`'s NaN handling.)
         self.heat = if heat > R::ZERO { heat } else { R::ZERO };
         out

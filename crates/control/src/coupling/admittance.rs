@@ -61,15 +61,13 @@ impl<R: Real> AdmittanceCoupling<R> {
     pub fn set_gains(&mut self, m_kg: f32, b_nspm: f32) -> Result<(), ParamError> {
         let m = param::positive("m_c (kg)", m_kg)?;
         let b = param::positive("b_c (N s/m)", b_nspm)?;
-        param::positive(
-            "m_c b_c / (m_c + b_c T) (N s/m)",
-            m * b / (m + b * self.period_s),
-        )?;
+        // Derived in R, so an f64 law's constants are the f64 values of its
+        // z-form; checked as the f32 the error reports.
+        let (mr, br, t) = (R::of(m), R::of(b), R::of(self.period_s));
+        let z = mr * br / (mr + br * t);
+        param::positive("m_c b_c / (m_c + b_c T) (N s/m)", z.to_f32())?;
         (self.m, self.b) = (m, b);
-        // Derived in R (the same operations as the f32 check above), so an
-        // f64 law's constants are the f64 values of its z-form.
-        let (m, b, t) = (R::of(m), R::of(b), R::of(self.period_s));
-        (self.t_over_m, self.z_direct) = (t / m, m * b / (m + b * t));
+        (self.t_over_m, self.z_direct) = (t / mr, z);
         Ok(())
     }
 

@@ -58,10 +58,12 @@ impl<R: Real> ImpedanceCoupling<R> {
     pub fn set_gains(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
         let k = param::non_negative("k_c (N/m)", k_npm)?;
         let b = param::non_negative("b_c (N s/m)", b_nspm)?;
-        param::positive("k_c T + b_c (N s/m)", k * self.period_s + b)?;
-        // Checked in f32 above; derived in R like the z-form.
+        // Derived in R, so an f64 law's constant is the f64 value of its
+        // z-form; checked as the f32 the error reports.
         let (k, b) = (R::of(k), R::of(b));
-        (self.k, self.b, self.z_direct) = (k, b, k * R::of(self.period_s) + b);
+        let z = k * R::of(self.period_s) + b;
+        param::positive("k_c T + b_c (N s/m)", z.to_f32())?;
+        (self.k, self.b, self.z_direct) = (k, b, z);
         Ok(())
     }
 
