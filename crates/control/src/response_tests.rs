@@ -106,18 +106,25 @@ fn position_regulator() {
     }
 }
 
+/// `Z_cI` against a fixed VE at bin `p`, computing in `R`: (measured,
+/// z-domain form).
+fn zci_fixed_ve<R: Real>(p: usize) -> (Complex64, Complex64) {
+    let mut est = FirstDifference::<R>::new_in(T, Position::ZERO).unwrap();
+    let mut c = ImpedanceCoupling::<R>::new_in(51_000.0, 90.0, T, Position::ZERO).unwrap();
+    let mut ve = BilateralConstraint::new(Position::ZERO);
+    let got = measure(p, |u| {
+        let x = pos(1e-3 * u);
+        let v = est.step(x);
+        (v.to_f64(), c.step(x, v, &mut ve).force_n.to_f64())
+    });
+    (got, c.tf().eval(z_of(p)))
+}
+
 #[test]
 fn impedance_coupling_against_a_fixed_ve() {
     for p in BINS {
-        let mut est = FirstDifference::new(T, Position::ZERO).unwrap();
-        let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T, Position::ZERO).unwrap();
-        let mut ve = BilateralConstraint::new(Position::ZERO);
-        let got = measure(p, |u| {
-            let x = pos(1e-3 * u);
-            let v = est.step(x);
-            (v as f64, c.step(x, v, &mut ve).force_n as f64)
-        });
-        assert_close("Z_cI", p, got, c.tf().eval(z_of(p)));
+        let (got, want) = zci_fixed_ve::<f32>(p);
+        assert_close("Z_cI", p, got, want);
     }
 }
 
@@ -289,18 +296,26 @@ fn fig7c_admittance_coupling_with_impedance_ve() {
     }
 }
 
+/// Fig. 7(d) at bin `p`, computing in `R`: (measured, composed z-forms).
+fn fig7d<R: Real>(p: usize) -> (Complex64, Complex64) {
+    let mut c = AdmittanceCoupling::<R>::new_in(5.0, 500.0, T).unwrap();
+    let mut ve = CursorMass::<R>::new_in(0.25, T, Position::ZERO).unwrap();
+    let got = measure(p, |u| {
+        let f = R::of((30.0 * u) as f32);
+        (f.to_f64(), c.step(f, &mut ve).velocity_mps.to_f64())
+    });
+    let z = z_of(p);
+    let cursor = match VirtualEnvironment::<R>::tf(&ve) {
+        VeTransfer::Admittance(t) | VeTransfer::Impedance(t) => t.eval(z),
+    };
+    (got, (c.tf().eval(z) + cursor.inv()).inv())
+}
+
 /// Fig. 7(d): admittance display, admittance VE (a 0.25 kg cursor).
 #[test]
 fn fig7d_admittance_coupling_with_admittance_ve() {
     for p in BINS {
-        let mut c = AdmittanceCoupling::new(5.0, 500.0, T).unwrap();
-        let mut ve = CursorMass::new(0.25, T, Position::ZERO).unwrap();
-        let got = measure(p, |u| {
-            let f = (30.0 * u) as f32;
-            (f as f64, c.step(f, &mut ve).velocity_mps as f64)
-        });
-        let z = z_of(p);
-        let want = (c.tf().eval(z) + ve_tf(&ve).eval(z).inv()).inv();
+        let (got, want) = fig7d::<f32>(p);
         assert_close("1/(Z_cA + 1/Y_cursor)", p, got, want);
     }
 }
@@ -308,33 +323,13 @@ fn fig7d_admittance_coupling_with_admittance_ve() {
 /// Worst relative error of `Z_cI` (against a fixed VE) and of the Fig. 7(d)
 /// loop (`Z_cA` with a cursor) over all bins, computing in `R`.
 fn worst_errors<R: Real>() -> (f64, f64) {
-    let (mut zci, mut loop_d) = (0.0f64, 0.0f64);
-    for p in BINS {
-        let mut est = FirstDifference::<R>::new_in(T, Position::ZERO).unwrap();
-        let mut c = ImpedanceCoupling::<R>::new_in(51_000.0, 90.0, T, Position::ZERO).unwrap();
-        let mut ve = BilateralConstraint::new(Position::ZERO);
-        let got = measure(p, |u| {
-            let x = pos(1e-3 * u);
-            let v = est.step(x);
-            (v.to_f64(), c.step(x, v, &mut ve).force_n.to_f64())
-        });
-        let want = c.tf().eval(z_of(p));
-        zci = zci.max((got - want).norm() / want.norm());
-
-        let mut c = AdmittanceCoupling::<R>::new_in(5.0, 500.0, T).unwrap();
-        let mut cursor = CursorMass::<R>::new_in(0.25, T, Position::ZERO).unwrap();
-        let got = measure(p, |u| {
-            let f = R::of((30.0 * u) as f32);
-            (f.to_f64(), c.step(f, &mut cursor).velocity_mps.to_f64())
-        });
-        let z = z_of(p);
-        let cursor_z = match VirtualEnvironment::<R>::tf(&cursor) {
-            VeTransfer::Admittance(t) | VeTransfer::Impedance(t) => t.eval(z).inv(),
-        };
-        let want = (c.tf().eval(z) + cursor_z).inv();
-        loop_d = loop_d.max((got - want).norm() / want.norm());
-    }
-    (zci, loop_d)
+    let rel = |(got, want): (Complex64, Complex64)| (got - want).norm() / want.norm();
+    BINS.into_iter().fold((0.0f64, 0.0f64), |(zci, loop_d), p| {
+        (
+            zci.max(rel(zci_fixed_ve::<R>(p))),
+            loop_d.max(rel(fig7d::<R>(p))),
+        )
+    })
 }
 
 /// The same laws in f64 (`new_in::<f64>`): the response equals the z-form
