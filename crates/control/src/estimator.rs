@@ -7,7 +7,8 @@ use crate::{param, ParamError, Position, Real, ZTransfer};
 /// This is the estimator of the paper's impedance display (Fig. 5).
 #[derive(Clone, Copy, Debug)]
 pub struct FirstDifference<R = f32> {
-    inv_t: R,
+    /// `1e-9 / T`: (m/s) per nanometre moved in one tick.
+    mps_per_nm: R,
     prev: Position,
 }
 
@@ -23,8 +24,10 @@ impl<R: Real> FirstDifference<R> {
     pub fn new_in(period_s: f32, x: Position) -> Result<Self, ParamError> {
         let t = param::positive("T (s)", period_s)?;
         Ok(FirstDifference {
-            // Divided in R: an f64 law's 1/T is the f64 reciprocal.
-            inv_t: R::ONE / R::of(t),
+            // Divided in R: an f64 law's constant is the f64 quotient. One
+            // constant, so the tick multiplies once between the encoder
+            // and the coupling (the start of the tick's longest chain).
+            mps_per_nm: R::M_PER_NM / R::of(t),
             prev: x,
         })
     }
@@ -36,14 +39,14 @@ impl<R: Real> FirstDifference<R> {
 
     /// The estimate for the new sample `x[k]` (m/s).
     pub fn step(&mut self, x: Position) -> R {
-        let v = x.minus::<R>(self.prev) * self.inv_t;
+        let v = R::from_i32(x - self.prev) * self.mps_per_nm;
         self.prev = x;
         v
     }
 
     /// `V(z)/X(z) = (1 - z^-1) / T` ((m/s) per m).
     pub fn tf(&self) -> ZTransfer {
-        let g = self.inv_t.to_f64();
+        let g = self.mps_per_nm.to_f64() * 1.0e9;
         ZTransfer::first_order([g, -g], 0.0)
     }
 }

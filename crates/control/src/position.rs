@@ -196,7 +196,7 @@ impl<R: Real> Integrator<R> {
     /// would otherwise see the 1 nm steps as 5 mN of force ripple).
     #[inline]
     pub fn offset_m(&self, from: Position) -> R {
-        self.position.minus::<R>(from) + self.remainder_nm * R::M_PER_NM
+        (R::from_i32(self.position - from) + self.remainder_nm) * R::M_PER_NM
     }
 
     /// The sample period `T` (s).

@@ -352,15 +352,16 @@ impl<R: Real> SafetyLayer<R> {
             } else {
                 command_n
             };
-            // (ramp_done <= ramp_ticks always; once ramped in, no division.)
-            let scale = if self.ramp_done < self.cfg.ramp_ticks {
+            // (ramp_done <= ramp_ticks always; once ramped in, the force
+            // passes with neither a division nor a multiplication.)
+            out.force_n = if self.ramp_done < self.cfg.ramp_ticks {
                 self.ramp_done += 1;
-                R::of(self.ramp_done as f32 / self.cfg.ramp_ticks as f32)
+                out.limited = self.ramp_done < self.cfg.ramp_ticks;
+                clipped * R::of(self.ramp_done as f32 / self.cfg.ramp_ticks as f32)
             } else {
-                R::ONE
+                clipped
             };
-            out.force_n = clipped * scale;
-            out.limited = clipped != command_n || scale < R::ONE;
+            out.limited |= clipped != command_n;
         } else {
             self.ramp_done = 0;
         }

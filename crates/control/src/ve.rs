@@ -448,12 +448,14 @@ impl<R: Real> UnilateralWall<R> {
         }
     }
 
-    /// Penetration (m, > 0 inside) and inward push (N, before clamping) of
-    /// the probe at velocity `v` this tick.
-    fn contact(&self, d_m: R, v: R) -> (R, R) {
+    /// Penetration (> 0 inside) and inward push (before clamping) of the
+    /// probe if it moves at `v = n / m` (m/s) this tick, both multiplied by
+    /// `m > 0`: the signs decide contact, and multiplying through lets the
+    /// tests run beside the division instead of after it.
+    fn contact(&self, d_m: R, n: R, m: R) -> (R, R) {
         let s = self.sign();
-        let pen = s * (d_m + self.spring.period * v);
-        (pen, self.spring.k * pen + self.spring.b * s * v)
+        let pen = s * (d_m * m + self.spring.period * n);
+        (pen, self.spring.k * pen + self.spring.b * s * n)
     }
 
     /// Whether the probe is in the wall.
@@ -471,22 +473,26 @@ impl<R: Real> VirtualEnvironment<R> for UnilateralWall<R> {
         let d = self.spring.stretch_m();
         // The force needed is non-decreasing in v, so exactly one of three
         // cases holds: free, pushed by the wall, or stopped at the surface
-        // (the damper's jump on first touch).
-        let free = port.at(port.f0_n / port.z_nspm);
-        let (pen, push) = self.contact(d, free.velocity_mps);
-        let out = if pen <= R::ZERO || push <= R::ZERO {
-            free
+        // (the damper's jump on first touch). Each case's velocity is a
+        // quotient n / m, and only the chosen one is divided. A non-finite
+        // port fails the first test and goes free with a non-finite
+        // velocity, which `commit` ignores.
+        let (f0, z) = (port.f0_n, port.z_nspm);
+        let (pen, push) = self.contact(d, f0, z);
+        let (n, m) = if !(pen > R::ZERO && push > R::ZERO) {
+            (f0, z)
         } else {
             // In contact the spring's own law, the same for both sides.
             let (g, h) = self.spring.affine(d);
-            let touched = port.solve_impedance(g, h);
-            let (pen, push) = self.contact(d, touched.velocity_mps);
+            let (n, m) = (f0 - g, z + h);
+            let (pen, push) = self.contact(d, n, m);
             if pen > R::ZERO && push >= R::ZERO {
-                touched
+                (n, m)
             } else {
-                port.at(-d / self.spring.period)
+                (-d, self.spring.period)
             }
         };
+        let out = port.at(n / m);
         self.spring.commit(out.velocity_mps);
         out
     }
@@ -620,12 +626,22 @@ mod tests {
         });
         assert_eq!(m.velocity_mps(), 0.0);
         assert_eq!(m.position(), Position::ZERO);
-        let mut w = wall_at_zero(-1e-3);
-        w.step(Port {
-            f0_n: f32::INFINITY,
-            z_nspm: 1.0,
-        });
-        assert_eq!(w.position(), Position::from_m(-1e-3).unwrap());
+        // Outside, inside, solid on either side: no non-finite port moves
+        // the probe (a NaN once reached the surface case and moved it there).
+        for (probe_m, solid) in [
+            (-1e-3, Solid::Above),
+            (1e-3, Solid::Above),
+            (1e-3, Solid::Below),
+        ] {
+            for f0_n in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+                let probe = Position::from_m(probe_m).unwrap();
+                let mut w =
+                    UnilateralWall::new(10_000.0, 20.0, Position::ZERO, solid, T, probe).unwrap();
+                let out = w.step(Port { f0_n, z_nspm: 1.0 });
+                assert_eq!(w.position(), probe, "{f0_n} at {probe_m} m, {solid:?}");
+                assert!(!out.velocity_mps.is_finite() || !out.force_n.is_finite());
+            }
+        }
     }
 
     #[test]

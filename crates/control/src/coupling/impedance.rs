@@ -96,11 +96,14 @@ impl<R: Real> ImpedanceCoupling<R> {
             f0_n: self.k * stretch_prev + self.b * v_c_mps,
             z_nspm: self.z_direct,
         };
-        let v_e = ve.step(port).velocity_mps;
-        self.ve_side.step(v_e);
+        // The VE's answer is on the port's line, so its force is this
+        // tick's coupling force: f_c and f_e are one number, and the force
+        // does not wait for the integrator below.
+        let out = ve.step(port);
+        self.ve_side.step(out.velocity_mps);
         ImpedanceStep {
-            force_n: self.b * (v_c_mps - v_e) - self.k * self.ve_side.offset_m(x_c),
-            ve_velocity_mps: v_e,
+            force_n: out.force_n,
+            ve_velocity_mps: out.velocity_mps,
         }
     }
 
