@@ -105,6 +105,26 @@ fn servos(c: &mut Criterion) {
             })
         },
     );
+    // The same tick with the simplest VE: what the wall's contact solve
+    // and its own integrator add to the tick.
+    let mut s = ImpedanceServo::new(
+        51_000.0,
+        90.0,
+        enc(),
+        SafetyConfig::excalibur(),
+        BilateralConstraint::new(Position::ZERO),
+    )
+    .unwrap();
+    s.enable().unwrap();
+    c.bench_function(
+        "impedance servo tick: encoder, estimator, Z_cI, bilateral VE, safety",
+        |b| {
+            b.iter(|| {
+                k = k.wrapping_add(1);
+                black_box(s.tick(&frame(k, black_box(k % 1000), 0.0)))
+            })
+        },
+    );
     let cursor = CursorMass::new(0.25, T, Position::ZERO).unwrap();
     let mut a = AdmittanceServo::new(
         (51_000.0, 90.0),
