@@ -81,8 +81,28 @@ fn frame(k: u32, raw: u32, f: f32) -> SensorFrame {
     }
 }
 
+fn encoder() -> Encoder {
+    Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap()
+}
+
+/// The impedance display's whole tick with the VE `ve`.
+fn impedance_tick<V: VirtualEnvironment>(c: &mut Criterion, ve_name: &str, ve: V) {
+    let mut s =
+        ImpedanceServo::new(51_000.0, 90.0, encoder(), SafetyConfig::excalibur(), ve).unwrap();
+    s.enable().unwrap();
+    let mut k = 0u32;
+    c.bench_function(
+        &format!("impedance servo tick: encoder, estimator, Z_cI, {ve_name}, safety"),
+        |b| {
+            b.iter(|| {
+                k = k.wrapping_add(1);
+                black_box(s.tick(&frame(k, black_box(k % 1000), 0.0)))
+            })
+        },
+    );
+}
+
 fn servos(c: &mut Criterion) {
-    let enc = || Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let wall = UnilateralWall::new(
         1e5,
         50.0,
@@ -92,44 +112,15 @@ fn servos(c: &mut Criterion) {
         Position::ZERO,
     )
     .unwrap();
-    let mut s =
-        ImpedanceServo::new(51_000.0, 90.0, enc(), SafetyConfig::excalibur(), wall).unwrap();
-    s.enable().unwrap();
-    let mut k = 0u32;
-    c.bench_function(
-        "impedance servo tick: encoder, estimator, Z_cI, wall, safety",
-        |b| {
-            b.iter(|| {
-                k = k.wrapping_add(1);
-                black_box(s.tick(&frame(k, black_box(k % 1000), 0.0)))
-            })
-        },
-    );
+    impedance_tick(c, "wall", wall);
     // The same tick with the simplest VE: what the wall's contact solve
     // and its own integrator add to the tick.
-    let mut s = ImpedanceServo::new(
-        51_000.0,
-        90.0,
-        enc(),
-        SafetyConfig::excalibur(),
-        BilateralConstraint::new(Position::ZERO),
-    )
-    .unwrap();
-    s.enable().unwrap();
-    c.bench_function(
-        "impedance servo tick: encoder, estimator, Z_cI, bilateral VE, safety",
-        |b| {
-            b.iter(|| {
-                k = k.wrapping_add(1);
-                black_box(s.tick(&frame(k, black_box(k % 1000), 0.0)))
-            })
-        },
-    );
+    impedance_tick(c, "bilateral VE", BilateralConstraint::new(Position::ZERO));
     let cursor = CursorMass::new(0.25, T, Position::ZERO).unwrap();
     let mut a = AdmittanceServo::new(
         (51_000.0, 90.0),
         (5.0, 500.0),
-        enc(),
+        encoder(),
         SafetyConfig::excalibur(),
         cursor,
     )

@@ -75,13 +75,7 @@ impl Position {
     /// below 2^24 nm = 16.7 mm, one rounding beyond).
     #[inline]
     pub fn minus_m(self, other: Position) -> f32 {
-        self.minus(other)
-    }
-
-    /// [`Position::minus_m`] in the float type `R` (m).
-    #[inline]
-    pub fn minus<R: Real>(self, other: Position) -> R {
-        R::from_i32(self.0.saturating_sub(other.0)) * R::M_PER_NM
+        (self - other) as f32 * 1.0e-9
     }
 
     /// This position moved by `delta_nm` nanometres, saturating at the ends
@@ -95,6 +89,7 @@ impl Position {
 impl Sub for Position {
     /// The difference in nanometres (saturating).
     type Output = i32;
+    #[inline]
     fn sub(self, rhs: Position) -> i32 {
         self.0.saturating_sub(rhs.0)
     }

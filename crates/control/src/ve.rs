@@ -52,8 +52,14 @@ impl<R: Real> Port<R> {
 
     /// Intersect with an impedance law `f = g + h v` (h >= 0, N s/m).
     pub fn solve_impedance(self, g_n: R, h: R) -> VeOutput<R> {
-        let v = (self.f0_n - g_n) / (self.z_nspm + h);
-        self.at(v)
+        let (n, m) = self.impedance_quotient(g_n, h);
+        self.at(n / m)
+    }
+
+    /// The intersection's velocity with `f = g + h v` as the quotient
+    /// `n / m` (m > 0), for a VE that must test it before it divides.
+    pub fn impedance_quotient(self, g_n: R, h: R) -> (R, R) {
+        (self.f0_n - g_n, self.z_nspm + h)
     }
 
     /// The port's force at VE velocity `v`.
@@ -484,7 +490,7 @@ impl<R: Real> VirtualEnvironment<R> for UnilateralWall<R> {
         } else {
             // In contact the spring's own law, the same for both sides.
             let (g, h) = self.spring.affine(d);
-            let (n, m) = (f0 - g, z + h);
+            let (n, m) = port.impedance_quotient(g, h);
             let (pen, push) = self.contact(d, n, m);
             if pen > R::ZERO && push >= R::ZERO {
                 (n, m)
