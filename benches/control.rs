@@ -43,7 +43,7 @@ fn laws(c: &mut Criterion) {
             black_box(reg.step(black_box(wobble(k)), &held))
         })
     });
-    let mut zc = ImpedanceCoupling::new(51_000.0, 90.0, T, Position::ZERO).unwrap();
+    let mut zc = ImpedanceCoupling::new(51_000.0, 90.0, T).unwrap();
     let mut fixed = BilateralConstraint::new(Position::ZERO);
     c.bench_function("impedance coupling Z_cI step, bilateral VE", |b| {
         b.iter(|| {

@@ -27,7 +27,7 @@ fn path(k: usize) -> Position {
 fn spring_on_positions_matches_the_formula_for_a_million_ticks_without_drift() {
     let origin = Position::ZERO;
     let mut est = FirstDifference::new(T, path(0)).unwrap();
-    let mut c = ImpedanceCoupling::new(K, B, T, origin).unwrap();
+    let mut c = ImpedanceCoupling::new(K, B, T).unwrap();
     let mut ve = BilateralConstraint::new(origin);
     let (k, b, t) = (K as f64, B as f64, T as f64);
     let mut e_prev = path(0).minus_m(origin) as f64;

@@ -340,11 +340,15 @@ fn impedance_gains_past_the_bound_meet_the_termination_the_two_port_names() {
 #[test]
 fn the_simulated_ve_port_impedance_is_the_designers() {
     use twoport_control::ve::{Causality, Port, VeOutput, VeTransfer, VirtualEnvironment};
-    use twoport_control::{Encoder, ImpedanceServo, Position, SafetyConfig, SineProbe, ZTransfer};
-    /// A VE that is a velocity source and records the force it meets.
+    use twoport_control::{
+        Encoder, ImpedanceServo, Integrator, Position, SafetyConfig, SineProbe, ZTransfer,
+    };
+    /// A VE that is a velocity source, moves as it says, and records the
+    /// force it meets.
     struct VelocitySource {
         v: f32,
         f: f32,
+        x: Integrator,
     }
     impl VirtualEnvironment for VelocitySource {
         fn causality(&self) -> Causality {
@@ -353,11 +357,17 @@ fn the_simulated_ve_port_impedance_is_the_designers() {
         fn step(&mut self, port: Port) -> VeOutput {
             let o = port.at(self.v);
             self.f = o.force_n;
+            self.x.step(self.v);
             o
         }
-        fn reset(&mut self, _: Position) {}
+        fn reset(&mut self, x: Position) {
+            self.x.reset(x);
+        }
         fn position(&self) -> Position {
-            Position::ZERO
+            self.x.position()
+        }
+        fn offset_m(&self, from: Position) -> f32 {
+            self.x.offset_m(from)
         }
         fn tf(&self) -> VeTransfer {
             VeTransfer::Admittance(ZTransfer::first_order([0.0, 0.0], 0.0))
@@ -377,7 +387,11 @@ fn the_simulated_ve_port_impedance_is_the_designers() {
                 ..SafetyConfig::excalibur()
             };
             let enc = Encoder::new(32, 1000, 0, Position::ZERO).unwrap(); // the sim's ideal 1 nm counts
-            let ve = VelocitySource { v: 0.0, f: 0.0 };
+            let ve = VelocitySource {
+                v: 0.0,
+                f: 0.0,
+                x: Integrator::new(1e-3, Position::ZERO),
+            };
             let mut servo = ImpedanceServo::new(k as f32, 90.0, enc, safety, ve).unwrap();
             servo.enable().unwrap();
             let th = 2.0 * std::f64::consts::PI * bin as f64 / 4000.0;

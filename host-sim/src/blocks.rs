@@ -246,6 +246,15 @@ impl VirtualEnvironment for Blocks {
         }
     }
 
+    /// A grabbed block sits on whole nanometres; the free cursor carries its
+    /// integrator's remainder.
+    fn offset_m(&self, from: Position) -> f32 {
+        match self.grabbed {
+            Some(_) => self.position().minus_m(from),
+            None => self.cursor.offset_m(from),
+        }
+    }
+
     /// The coupled body's mass admittance `(T/m)/(1 - z^-1)`.
     fn tf(&self) -> VeTransfer {
         let m = match self.grabbed {

@@ -62,6 +62,9 @@ impl<R: Real> VirtualEnvironment<R> for SceneVe<R> {
     fn position(&self) -> Position {
         each!(self, v => VirtualEnvironment::<R>::position(v), b => b.position())
     }
+    fn offset_m(&self, from: Position) -> R {
+        each!(self, v => VirtualEnvironment::<R>::offset_m(v, from), b => R::of(b.offset_m(from)))
+    }
     fn tf(&self) -> VeTransfer {
         each!(self, v => VirtualEnvironment::<R>::tf(v), b => b.tf())
     }

@@ -1,10 +1,10 @@
 //! One control tick of each display, as the board runs it and the simulator
 //! runs it: sensors in, law, VE, safety layer, held actuator force out.
 
-use crate::coupling::{AdmittanceCoupling, ImpedanceCoupling};
+use crate::coupling::{AdmittanceCoupling, AdmittanceStep, ImpedanceCoupling, ImpedanceStep};
 use crate::estimator::FirstDifference;
 use crate::regulator::PositionRegulator;
-use crate::safety::{Faults, SafetyConfig, SafetyInputs, SafetyLayer};
+use crate::safety::{Faults, SafeForce, SafetyConfig, SafetyInputs, SafetyLayer};
 use crate::ve::VirtualEnvironment;
 use crate::{Encoder, Integrator, ParamError, Position, Real};
 
@@ -40,7 +40,7 @@ pub struct ServoOutput<R = f32> {
     pub ve_force_n: R,
     /// Force in the virtual coupling (N).
     pub coupling_force_n: R,
-    /// Impedance display: the coupling's VE-side position; admittance
+    /// Impedance display: the VE point the coupling holds; admittance
     /// display: the position command `x_cmd`.
     pub reference: Position,
     /// Latched faults.
@@ -84,21 +84,23 @@ impl<R: Real> Frontend<R> {
         sensor_faults.is_empty() && self.safety.faults().is_empty()
     }
 
-    fn finish(&mut self, frame: &SensorFrame<R>, v: R, faults: Faults, out: &mut ServoOutput<R>) {
-        let safe = self.safety.step(
+    /// The safety layer's answer to the law's `command_n` (N).
+    fn limit(
+        &mut self,
+        frame: &SensorFrame<R>,
+        v: R,
+        faults: Faults,
+        command_n: R,
+    ) -> SafeForce<R> {
+        self.safety.step(
             &SafetyInputs {
                 tick: frame.tick,
                 dead_man_closed: frame.dead_man_closed,
                 velocity_mps: v,
                 sensor_faults: faults,
             },
-            out.commanded_force_n,
-        );
-        out.actuator_force_n = safe.force_n;
-        out.faults = safe.faults;
-        out.limited = safe.limited;
-        out.position = self.position;
-        out.velocity_mps = v;
+            command_n,
+        )
     }
 }
 
@@ -191,7 +193,7 @@ impl<V: VirtualEnvironment<R>, R: Real> ImpedanceServo<V, R> {
         ve: V,
     ) -> Result<Self, ParamError> {
         let front = Frontend::new(encoder, safety)?;
-        let coupling = ImpedanceCoupling::new_in(k_npm, b_nspm, safety.period_s, front.position)?;
+        let coupling = ImpedanceCoupling::new_in(k_npm, b_nspm, safety.period_s)?;
         let mut s = ImpedanceServo {
             front,
             coupling,
@@ -216,24 +218,30 @@ impl<V: VirtualEnvironment<R>, R: Real> ImpedanceServo<V, R> {
     fn realign(&mut self) {
         let x = self.front.position;
         self.front.estimator.reset(x);
-        self.coupling.reset(x);
         self.ve.reset(x);
     }
 
     /// One control tick.
     pub fn tick(&mut self, frame: &SensorFrame<R>) -> ServoOutput<R> {
         let (v, faults) = self.front.sense(frame);
-        let mut out = ServoOutput::default();
-        if self.front.runnable(faults) {
-            let s = self.coupling.step(self.front.position, v, &mut self.ve);
-            out.commanded_force_n = s.force_n;
-            out.coupling_force_n = s.force_n;
-            out.ve_force_n = s.force_n;
-            out.ve_velocity_mps = s.ve_velocity_mps;
+        let s = if self.front.runnable(faults) {
+            self.coupling.step(self.front.position, v, &mut self.ve)
+        } else {
+            ImpedanceStep::default()
+        };
+        let safe = self.front.limit(frame, v, faults, s.force_n);
+        ServoOutput {
+            actuator_force_n: safe.force_n,
+            commanded_force_n: s.force_n,
+            position: self.front.position,
+            velocity_mps: v,
+            ve_velocity_mps: s.ve_velocity_mps,
+            ve_force_n: s.force_n,
+            coupling_force_n: s.force_n,
+            reference: self.ve.position(),
+            faults: safe.faults,
+            limited: safe.limited,
         }
-        out.reference = self.coupling.ve_side();
-        self.front.finish(frame, v, faults, &mut out);
-        out
     }
 }
 
@@ -325,17 +333,25 @@ impl<V: VirtualEnvironment<R>, R: Real> AdmittanceServo<V, R> {
         } else if f_c.abs() > R::of(self.front.safety.config().max_sensor_force_n) {
             faults = faults.with(Faults::SENSOR_OUT_OF_RANGE);
         }
-        let mut out = ServoOutput::default();
-        if self.front.runnable(faults) {
+        let (s, command_n) = if self.front.runnable(faults) {
             let s = self.coupling.step(f_c, &mut self.ve);
             self.command.step(s.velocity_mps);
-            out.commanded_force_n = self.regulator.step(self.front.position, &self.command);
-            out.coupling_force_n = s.coupling_force_n;
-            out.ve_force_n = s.ve_force_n;
-            out.ve_velocity_mps = s.velocity_mps;
+            (s, self.regulator.step(self.front.position, &self.command))
+        } else {
+            (AdmittanceStep::default(), R::ZERO)
+        };
+        let safe = self.front.limit(frame, v, faults, command_n);
+        ServoOutput {
+            actuator_force_n: safe.force_n,
+            commanded_force_n: command_n,
+            position: self.front.position,
+            velocity_mps: v,
+            ve_velocity_mps: s.velocity_mps,
+            ve_force_n: s.ve_force_n,
+            coupling_force_n: s.coupling_force_n,
+            reference: self.command.position(),
+            faults: safe.faults,
+            limited: safe.limited,
         }
-        out.reference = self.command.position();
-        self.front.finish(frame, v, faults, &mut out);
-        out
     }
 }

@@ -91,8 +91,21 @@ pub trait VirtualEnvironment<R: Real = f32> {
     fn step(&mut self, port: Port<R>) -> VeOutput<R>;
     /// Put the VE at rest at `x`.
     fn reset(&mut self, x: Position);
-    /// The VE's current position.
+    /// The VE point the coupling holds: where the velocities `step` returned
+    /// have taken it, `x[k] = x[k-1] + T v[k]` (to the nanometre below; see
+    /// [`offset_m`](Self::offset_m)). The impedance coupling's spring acts on
+    /// it, so a VE whose own law integrates otherwise (the trapezoidal
+    /// spring) keeps this sum apart; a body stopped by an obstacle reports
+    /// where it stopped.
     fn position(&self) -> Position;
+    /// [`position`](Self::position) minus `from`, in metres, with the
+    /// sub-nanometre part the VE's integrator carries: a stiff coupling
+    /// spring would otherwise see the 1 nm steps as force ripple. The
+    /// default has no such part.
+    #[inline]
+    fn offset_m(&self, from: Position) -> R {
+        R::from_i32(self.position() - from) * R::M_PER_NM
+    }
     /// The VE's law in the z-domain (for a piecewise law: the piece named in
     /// its documentation, e.g. a wall in contact).
     fn tf(&self) -> VeTransfer;
@@ -165,6 +178,11 @@ impl<R: Real> VirtualEnvironment<R> for CursorMass<R> {
 
     fn position(&self) -> Position {
         self.x.position()
+    }
+
+    #[inline]
+    fn offset_m(&self, from: Position) -> R {
+        self.x.offset_m(from)
     }
 
     /// `V/F = (T/m) / (1 - z^-1)`.
@@ -292,6 +310,11 @@ impl<R: Real> VirtualEnvironment<R> for Spring<R> {
         self.probe.position()
     }
 
+    #[inline]
+    fn offset_m(&self, from: Position) -> R {
+        self.probe.offset_m(from)
+    }
+
     /// `F/V = b + kT/(1 - z^-1)`.
     fn tf(&self) -> VeTransfer {
         let (b, kt) = (self.b.to_f64(), self.kt.to_f64());
@@ -316,6 +339,10 @@ pub struct TrapezoidalSpring<R = f32> {
     spring: Spring<R>,
     /// Last tick's probe velocity (m/s).
     v_prev: R,
+    /// The probe's velocities summed by the rectangle rule: the point the
+    /// coupling holds (its spring integrates that way, see
+    /// [`VirtualEnvironment::position`]).
+    held: Integrator<R>,
 }
 
 impl TrapezoidalSpring {
@@ -341,8 +368,10 @@ impl<R: Real> TrapezoidalSpring<R> {
         period_s: f32,
         probe: Position,
     ) -> Result<Self, ParamError> {
+        let spring = Spring::new_in(k_npm, b_nspm, anchor, period_s, probe)?;
         Ok(TrapezoidalSpring {
-            spring: Spring::new_in(k_npm, b_nspm, anchor, period_s, probe)?,
+            held: Integrator::new_in(period_s, probe),
+            spring,
             v_prev: R::ZERO,
         })
     }
@@ -368,6 +397,7 @@ impl<R: Real> VirtualEnvironment<R> for TrapezoidalSpring<R> {
             self.spring
                 .commit(R::HALF * (out.velocity_mps + self.v_prev));
             self.v_prev = out.velocity_mps;
+            self.held.step(out.velocity_mps);
         }
         out
     }
@@ -375,10 +405,15 @@ impl<R: Real> VirtualEnvironment<R> for TrapezoidalSpring<R> {
     fn reset(&mut self, x: Position) {
         self.spring.reset(x);
         self.v_prev = R::ZERO;
+        self.held.reset(x);
     }
 
     fn position(&self) -> Position {
-        self.spring.position()
+        self.held.position()
+    }
+
+    fn offset_m(&self, from: Position) -> R {
+        self.held.offset_m(from)
     }
 
     /// `F/V = ((b + kT/2) + (kT/2 - b) z^-1) / (1 - z^-1)`.
@@ -509,6 +544,11 @@ impl<R: Real> VirtualEnvironment<R> for UnilateralWall<R> {
 
     fn position(&self) -> Position {
         self.spring.position()
+    }
+
+    #[inline]
+    fn offset_m(&self, from: Position) -> R {
+        self.spring.probe.offset_m(from)
     }
 
     /// In contact: the spring's `F/V = b + kT/(1 - z^-1)`.

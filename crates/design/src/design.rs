@@ -13,7 +13,7 @@ use crate::{Plant, PlantPoint};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 use twoport_control::{
-    AdmittanceCoupling, ImpedanceCoupling, ParamError, Position, PositionRegulator, ZTransfer,
+    AdmittanceCoupling, ImpedanceCoupling, ParamError, PositionRegulator, ZTransfer,
 };
 
 /// How finely to sample frequency.
@@ -128,8 +128,7 @@ pub fn impedance_coupling_tf(
     b_nspm: f64,
     period_s: f64,
 ) -> Result<ZTransfer, ParamError> {
-    ImpedanceCoupling::new(k_npm as f32, b_nspm as f32, period_s as f32, Position::ZERO)
-        .map(|c| c.tf())
+    ImpedanceCoupling::new(k_npm as f32, b_nspm as f32, period_s as f32).map(|c| c.tf())
 }
 
 /// The z-domain form of the admittance coupling the board would run.

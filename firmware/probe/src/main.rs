@@ -70,7 +70,7 @@ fn impedance_coupling(t: &mut Tally) {
     let mut worst = 0.0f64;
     for p in BINS {
         let mut est = FirstDifference::new(T, Position::ZERO).unwrap();
-        let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T, Position::ZERO).unwrap();
+        let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T).unwrap();
         let mut ve = BilateralConstraint::new(Position::ZERO);
         let got = measure(p, |u| {
             let x = pm(1e-3 * u);
@@ -213,7 +213,7 @@ fn cost_breakdown() {
         let p = enc.update(k % 1000 * 2).unwrap_or(Position::ZERO);
         est.step(p)
     });
-    let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T, Position::ZERO).unwrap();
+    let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T).unwrap();
     let mut wall = timing_wall();
     let (law, _) = counts_per_call(n, |k| {
         let x = Position::from_nm((k % 1000 * 2) as i32 * 1000);

@@ -1,14 +1,18 @@
 //! The impedance-display virtual coupling, a shunt spring-damper (eq 20).
 
 use crate::ve::{Port, VirtualEnvironment};
-use crate::{param, Integrator, ParamError, Position, Real, ZTransfer};
+use crate::{param, ParamError, Position, Real, ZTransfer};
 
 /// `Z_cI(z) = b + kTz/(z - 1)` between the device and the VE (paper eq 20).
 ///
 /// The device force command and the VE force are both `Z_cI (v_c - v_e)`.
 /// The spring acts on the position error `x_c - x_e` (integer positions), so
 /// it is the sum of velocities exactly and does not drift; with a fixed VE
-/// the force is `k e + b (e - e_prev) / T` on the error `e`.
+/// the force is `k e + b (e - e_prev) / T` on the error `e`. The coupling
+/// holds no position of its own: `x_e` is the VE's
+/// ([`VirtualEnvironment::offset_m`]), the sum of the velocities the VE
+/// returned, so the VE and the coupling can never disagree on where the VE
+/// point is (and the tick integrates it once).
 ///
 /// Sign: a positive force resists positive device motion (it is the
 /// paper's actuator force `f_a`, which enters the device through `G` with a
@@ -19,7 +23,6 @@ pub struct ImpedanceCoupling<R = f32> {
     b: R,
     period_s: f32,
     z_direct: R,
-    ve_side: Integrator<R>,
 }
 
 /// One tick of the impedance coupling.
@@ -33,22 +36,21 @@ pub struct ImpedanceStep<R = f32> {
 
 impl ImpedanceCoupling {
     /// A coupling of stiffness `k_npm` (N/m) and damping `b_nspm` (N s/m) at
-    /// period `period_s` (s), with the VE side at `x`. `kT + b` must be > 0.
-    pub fn new(k_npm: f32, b_nspm: f32, period_s: f32, x: Position) -> Result<Self, ParamError> {
-        Self::new_in(k_npm, b_nspm, period_s, x)
+    /// period `period_s` (s). `kT + b` must be > 0.
+    pub fn new(k_npm: f32, b_nspm: f32, period_s: f32) -> Result<Self, ParamError> {
+        Self::new_in(k_npm, b_nspm, period_s)
     }
 }
 
 impl<R: Real> ImpedanceCoupling<R> {
     /// [`ImpedanceCoupling::new`] computing in `R`.
-    pub fn new_in(k_npm: f32, b_nspm: f32, period_s: f32, x: Position) -> Result<Self, ParamError> {
+    pub fn new_in(k_npm: f32, b_nspm: f32, period_s: f32) -> Result<Self, ParamError> {
         let t = param::positive("T (s)", period_s)?;
         let mut c = ImpedanceCoupling {
             k: R::ZERO,
             b: R::ZERO,
             period_s: t,
             z_direct: R::ZERO,
-            ve_side: Integrator::new_in(t, x),
         };
         c.set_gains(k_npm, b_nspm)?;
         Ok(c)
@@ -72,16 +74,6 @@ impl<R: Real> ImpedanceCoupling<R> {
         (self.k.to_f32(), self.b.to_f32())
     }
 
-    /// Put the VE side at `x` (no stretch if `x` is the device position).
-    pub fn reset(&mut self, x: Position) {
-        self.ve_side.reset(x);
-    }
-
-    /// The VE-side position `x_e`.
-    pub fn ve_side(&self) -> Position {
-        self.ve_side.position()
-    }
-
     /// One tick: device position `x_c` and its velocity estimate `v_c`
     /// (m/s) in, the VE solved exactly against the coupling, force out.
     pub fn step<V: VirtualEnvironment<R> + ?Sized>(
@@ -90,17 +82,15 @@ impl<R: Real> ImpedanceCoupling<R> {
         v_c_mps: R,
         ve: &mut V,
     ) -> ImpedanceStep<R> {
-        let stretch_prev = -self.ve_side.offset_m(x_c);
+        let stretch_prev = -ve.offset_m(x_c);
         // f = k (x_c - x_e[k-1] - T v_e) + b (v_c - v_e) = f0 - (kT + b) v_e
         let port = Port {
             f0_n: self.k * stretch_prev + self.b * v_c_mps,
             z_nspm: self.z_direct,
         };
         // The VE's answer is on the port's line, so its force is this
-        // tick's coupling force: f_c and f_e are one number, and the force
-        // does not wait for the integrator below.
+        // tick's coupling force: f_c and f_e are one number.
         let out = ve.step(port);
-        self.ve_side.step(out.velocity_mps);
         ImpedanceStep {
             force_n: out.force_n,
             ve_velocity_mps: out.velocity_mps,
