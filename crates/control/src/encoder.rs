@@ -26,7 +26,8 @@ pub enum EncoderError {
 /// a fixed-point number of 2^-10 nm (0.98 pm) per count, so that a count
 /// becomes a position with one 32 x 32-bit multiply: the scale is exact to
 /// 0.49 pm per count (5e-7 of a 1 µm count). The unwrapped count saturates
-/// at ±2^31 counts and the position at the ends of its range.
+/// where the position reaches an end of its range (±2.147 m), so a shaft
+/// driven past it moves the position again as soon as it turns back.
 #[derive(Clone, Copy, Debug)]
 pub struct Encoder {
     /// `32 - bits`: shifting a difference up by this and back down
@@ -39,6 +40,9 @@ pub struct Encoder {
     q10_per_count: i32,
     last_raw: u32,
     count: i32,
+    /// The counts whose positions are the ends of the range.
+    count_min: i32,
+    count_max: i32,
     origin: Position,
 }
 
@@ -71,6 +75,12 @@ impl Encoder {
         }
         // pm * 1024 / 1000, rounded half up; >= 1 for pm >= 1.
         let q10 = (pm_per_count * 128 + 62) / 125;
+        // The position of count c is origin + floor((c q10 + 512) / 1024);
+        // these are the extreme counts that keep it within i32.
+        let room_up = i32::MAX as i64 - origin.nm() as i64;
+        let room_down = origin.nm() as i64 - i32::MIN as i64;
+        let count_max = ((room_up + 1) * 1024 - 513) / q10;
+        let count_min = -((room_down * 1024 + 512) / q10);
         Ok(Encoder {
             shift: 32 - bits as u32,
             mask,
@@ -78,6 +88,8 @@ impl Encoder {
             q10_per_count: q10 as i32,
             last_raw: first_raw,
             count: 0,
+            count_min: count_min.max(i32::MIN as i64) as i32,
+            count_max: count_max.min(i32::MAX as i64) as i32,
             origin,
         })
     }
@@ -103,7 +115,11 @@ impl Encoder {
         // counter's width leave through the top.
         let delta = ((raw.wrapping_sub(self.last_raw) << self.shift) as i32) >> self.shift;
         self.last_raw = raw;
-        self.count = self.count.saturating_add(delta);
+        self.count = self
+            .count
+            .saturating_add(delta)
+            .max(self.count_min)
+            .min(self.count_max);
         Ok(self.position())
     }
 
@@ -117,8 +133,9 @@ impl Encoder {
     #[inline]
     pub fn position(&self) -> Position {
         let nm = (self.count as i64 * self.q10_per_count as i64 + 512) >> 10;
-        let nm = nm.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
-        self.origin.offset_nm(nm)
+        // The count's limits keep the sum within i32, so it is exact modulo
+        // 2^32 and exact: no clamp, no saturation.
+        Position(self.origin.nm().wrapping_add(nm as i32))
     }
 }
 
@@ -193,18 +210,39 @@ mod tests {
 
     #[test]
     fn count_and_position_saturate_instead_of_wrapping() {
-        let mut e = Encoder::new(32, 1_000_000, 0, Position::ZERO).unwrap();
+        // 1 mm per count from 2 m: the end of the range is 147 counts away.
+        let mut e = Encoder::new(32, 1_000_000_000, 0, Position::from_nm(2_000_000_000)).unwrap();
         let step = e.max_counts_per_read();
         let mut raw = 0u32;
         for _ in 0..4 {
             raw = raw.wrapping_add(step);
             e.update(raw).unwrap();
         }
-        assert_eq!(e.count(), i32::MAX);
-        assert_eq!(e.position(), Position::MAX);
-        // Back the other way: it moves again, from the saturated count.
+        assert_eq!(e.count(), 147);
+        assert_eq!(e.position().nm(), 2_147_000_000);
+        // Back the other way: it moves at once, from the end of the range.
         e.update(raw.wrapping_sub(10)).unwrap();
-        assert_eq!(e.count(), i32::MAX - 10);
+        assert_eq!(e.count(), 137);
+        assert_eq!(e.position().nm(), 2_137_000_000);
+    }
+
+    /// At every resolution and origin, the count stops exactly where the
+    /// next count's position would leave the range, at both ends.
+    #[test]
+    fn count_limits_are_the_ends_of_the_range() {
+        let exact = |e: &Encoder, c: i64| -> i64 {
+            e.origin.nm() as i64 + ((c * e.q10_per_count as i64 + 512) >> 10)
+        };
+        for pm in [1, 999, 1_000, 15_339_808, 1_000_000_000, MAX_PM_PER_COUNT] {
+            for origin in [i32::MIN, -1_000_000_007, 0, 123_456_789, i32::MAX] {
+                let e = Encoder::new(32, pm, 0, Position::from_nm(origin)).unwrap();
+                let (lo, hi) = (e.count_min as i64, e.count_max as i64);
+                let range = i32::MIN as i64..=i32::MAX as i64;
+                assert!(range.contains(&exact(&e, lo)) && range.contains(&exact(&e, hi)));
+                assert!(hi == i32::MAX as i64 || exact(&e, hi + 1) > i32::MAX as i64);
+                assert!(lo == i32::MIN as i64 || exact(&e, lo - 1) < i32::MIN as i64);
+            }
+        }
     }
 
     #[test]

@@ -163,14 +163,29 @@ impl<R: Real> Integrator<R> {
     /// produced it.
     #[inline]
     pub fn step(&mut self, velocity_mps: R) -> Position {
+        self.step_unsplit(velocity_mps);
+        self.position
+    }
+
+    /// [`step`](Self::step), answering with the new state before it is
+    /// split into whole and sub-nanometre parts: the position before this
+    /// step and the step plus the carried remainder (nm), whose sum is
+    /// `x[k]`. A law that reads `x[k]` in the same tick can start from it
+    /// at once instead of waiting for the split (the admittance display's
+    /// regulator). An ignored step answers with [`exact`](Self::exact).
+    #[inline]
+    pub fn step_unsplit(&mut self, velocity_mps: R) -> (Position, R) {
+        let start = self.position;
         let d = velocity_mps * self.nm_per_mps + self.remainder_nm;
         // One comparison rejects NaN, infinities and steps beyond i32.
         if d.abs() < R::of(2.0e9) {
             let whole = d.trunc_i32(); // toward zero: one `vcvt`
             self.remainder_nm = d - R::from_i32(whole);
             self.position = self.position.offset_nm(whole);
+            (start, d)
+        } else {
+            self.exact()
         }
-        self.position
     }
 
     /// The current position `x[k]`, to the nanometre below the exact sum
@@ -254,6 +269,29 @@ mod tests {
             "{:?}",
             x.position()
         );
+    }
+
+    /// The unsplit answer is the same point as the split state: the start
+    /// plus the step equals the new position plus its remainder, in f64,
+    /// to the f32 rounding of the step; an ignored step answers with the
+    /// state it kept.
+    #[test]
+    fn unsplit_step_is_the_same_point_as_the_split_state() {
+        let mut x = Integrator::new(1.0e-3, Position::from_nm(-7));
+        for k in 0..10_000 {
+            let v = 0.37 * ((k as f32) * 0.01).sin() + 1e-7;
+            let (start, d) = x.step_unsplit(v);
+            let (p, r) = x.exact();
+            let (a, b) = (start.nm() as f64 + d as f64, p.nm() as f64 + r as f64);
+            assert!(
+                (a - b).abs() <= d.abs() as f64 * 1.2e-7 + 1e-9,
+                "{a} vs {b}"
+            );
+            assert!(r.abs() < 1.0);
+        }
+        let kept = x.exact();
+        assert_eq!(x.step_unsplit(f32::NAN), kept);
+        assert_eq!(x.exact(), kept);
     }
 
     #[test]

@@ -100,7 +100,7 @@ fn position_regulator() {
         let held = Integrator::new(T, Position::ZERO);
         let got = measure(p, |c| {
             let x = pos(1e-3 * c);
-            (x.m() as f64, r.step(x, &held) as f64)
+            (x.m() as f64, r.step(x, held.exact()) as f64)
         });
         assert_close("K_p", p, got, r.tf().eval(z_of(p)));
     }

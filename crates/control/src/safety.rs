@@ -194,6 +194,12 @@ pub struct SafetyLayer<R = f32> {
     heat: R,
     last_tick: Option<u32>,
     heartbeat_age: u32,
+    /// Largest heartbeat age that is not a fault (`u32::MAX`: unchecked).
+    heartbeat_limit: u32,
+    /// `continuous_force_n^2` (N^2), the heat the actuator sheds per second.
+    continuous_sq_n2: R,
+    /// `T` (s).
+    period: R,
 }
 
 impl SafetyLayer {
@@ -217,6 +223,12 @@ impl<R: Real> SafetyLayer<R> {
             heat: R::ZERO,
             last_tick: None,
             heartbeat_age: 0,
+            heartbeat_limit: match cfg.heartbeat_timeout_ticks {
+                0 => u32::MAX,
+                t => t,
+            },
+            continuous_sq_n2: R::of(cfg.continuous_force_n) * R::of(cfg.continuous_force_n),
+            period: R::of(cfg.period_s),
         })
     }
 
@@ -284,6 +296,37 @@ impl<R: Real> SafetyLayer<R> {
         }
     }
 
+    /// The faults behind a tick whose checks did not all pass.
+    #[cold]
+    fn found(
+        inputs: &SafetyInputs<R>,
+        speed_ok: bool,
+        tick_ok: bool,
+        dead_man_open: bool,
+        heartbeat_lost: bool,
+        command_ok: bool,
+    ) -> Faults {
+        let mut f = inputs.sensor_faults;
+        if !speed_ok {
+            f = f.with(if inputs.velocity_mps.is_finite() {
+                Faults::VELOCITY_LIMIT
+            } else {
+                Faults::SENSOR_NOT_FINITE
+            });
+        }
+        for (bad, fault) in [
+            (!tick_ok, Faults::MISSED_TICK),
+            (dead_man_open, Faults::DEAD_MAN),
+            (heartbeat_lost, Faults::HEARTBEAT_LOST),
+            (!command_ok, Faults::COMMAND_NOT_FINITE),
+        ] {
+            if bad {
+                f = f.with(fault);
+            }
+        }
+        f
+    }
+
     /// Latch `f` now (faults found outside `step`, e.g. by the link).
     pub fn trip(&mut self, f: Faults) {
         if f.is_empty() {
@@ -300,37 +343,32 @@ impl<R: Real> SafetyLayer<R> {
     // inputs and answer through memory, 30 of the board tick's instructions.)
     #[inline(always)]
     pub fn step(&mut self, inputs: &SafetyInputs<R>, command_n: R) -> SafeForce<R> {
-        let mut new = inputs.sensor_faults;
         let v = inputs.velocity_mps;
-        // One comparison passes every good tick; NaN fails it too.
+        // Every check a good tick passes, as flags joined into one branch;
+        // the cold path works out which faults they were.
+        // (One comparison for the speed: NaN fails it too.)
         let speed_ok = v.abs() <= R::of(self.cfg.max_velocity_mps);
-        if !speed_ok {
-            new = new.with(if v.is_finite() {
-                Faults::VELOCITY_LIMIT
-            } else {
-                Faults::SENSOR_NOT_FINITE
-            });
-        }
-        if let Some(last) = self.last_tick {
-            if inputs.tick != last.wrapping_add(1) {
-                new = new.with(Faults::MISSED_TICK);
-            }
-        }
+        let tick_ok = match self.last_tick {
+            Some(last) => inputs.tick == last.wrapping_add(1),
+            None => true,
+        };
         self.last_tick = Some(inputs.tick);
-        if self.enabled {
-            if self.cfg.require_dead_man && !inputs.dead_man_closed {
-                new = new.with(Faults::DEAD_MAN);
-            }
-            self.heartbeat_age = self.heartbeat_age.saturating_add(1);
-            let timeout = self.cfg.heartbeat_timeout_ticks;
-            if timeout > 0 && self.heartbeat_age > timeout {
-                new = new.with(Faults::HEARTBEAT_LOST);
-            }
+        let enabled = self.enabled;
+        self.heartbeat_age = self.heartbeat_age.saturating_add(enabled as u32);
+        let dead_man_open = enabled & self.cfg.require_dead_man & !inputs.dead_man_closed;
+        let heartbeat_lost = enabled & (self.heartbeat_age > self.heartbeat_limit);
+        let command_ok = command_n.is_finite();
+        let sensors_ok = inputs.sensor_faults.is_empty();
+        if !(speed_ok & tick_ok & !dead_man_open & !heartbeat_lost & command_ok & sensors_ok) {
+            self.trip(Self::found(
+                inputs,
+                speed_ok,
+                tick_ok,
+                dead_man_open,
+                heartbeat_lost,
+                command_ok,
+            ));
         }
-        if !command_n.is_finite() {
-            new = new.with(Faults::COMMAND_NOT_FINITE);
-        }
-        self.trip(new);
 
         let mut out = SafeForce {
             force_n: R::ZERO,
@@ -365,9 +403,8 @@ impl<R: Real> SafetyLayer<R> {
         } else {
             self.ramp_done = 0;
         }
-        let c = R::of(self.cfg.continuous_force_n);
         let f = out.force_n;
-        let heat = self.heat + (f * f - c * c) * R::of(self.cfg.period_s);
+        let heat = self.heat + (f * f - self.continuous_sq_n2) * self.period;
         // (`f` is finite: a comparison, not `max`'s NaN handling.)
         self.heat = if heat > R::ZERO { heat } else { R::ZERO };
         out

@@ -335,8 +335,8 @@ impl<V: VirtualEnvironment<R>, R: Real> AdmittanceServo<V, R> {
         }
         let (s, command_n) = if self.front.runnable(faults) {
             let s = self.coupling.step(f_c, &mut self.ve);
-            self.command.step(s.velocity_mps);
-            (s, self.regulator.step(self.front.position, &self.command))
+            let x_cmd = self.command.step_unsplit(s.velocity_mps);
+            (s, self.regulator.step(self.front.position, x_cmd))
         } else {
             (AdmittanceStep::default(), R::ZERO)
         };

@@ -121,6 +121,12 @@ pub struct CursorMass<R = f32> {
     t_over_m: R,
     velocity_mps: R,
     x: Integrator<R>,
+    /// The port feedthrough `z` last met and `1 / (1 + (T/m) z)`: a
+    /// coupling's `z` changes only with its gains, so the loop solve
+    /// multiplies instead of dividing (the division's latency sat on the
+    /// admittance display's sensor-to-force chain).
+    port_z: R,
+    inv_den: R,
 }
 
 /// The smallest cursor mass the paper's experiments ran stably (kg).
@@ -143,6 +149,8 @@ impl<R: Real> CursorMass<R> {
             t_over_m: R::of(t) / R::of(m),
             velocity_mps: R::ZERO,
             x: Integrator::new_in(t, x),
+            port_z: R::ZERO,
+            inv_den: R::ONE,
         })
     }
 
@@ -163,7 +171,13 @@ impl<R: Real> VirtualEnvironment<R> for CursorMass<R> {
     }
 
     fn step(&mut self, port: Port<R>) -> VeOutput<R> {
-        let out = port.solve_admittance(self.velocity_mps, self.t_over_m);
+        // (A NaN z never equals the one kept, so it gives a NaN answer,
+        // which is not committed, and the next good z recomputes.)
+        if port.z_nspm != self.port_z {
+            self.port_z = port.z_nspm;
+            self.inv_den = R::ONE / (R::ONE + self.t_over_m * port.z_nspm);
+        }
+        let out = port.at((self.velocity_mps + self.t_over_m * port.f0_n) * self.inv_den);
         if out.velocity_mps.is_finite() {
             self.velocity_mps = out.velocity_mps;
             self.x.step(out.velocity_mps);
@@ -687,6 +701,37 @@ mod tests {
                 assert_eq!(w.position(), probe, "{f0_n} at {probe_m} m, {solid:?}");
                 assert!(!out.velocity_mps.is_finite() || !out.force_n.is_finite());
             }
+        }
+    }
+
+    /// The cursor keeps `1/(1 + (T/m) z)` for the port's `z`: when a
+    /// coupling's gains change `z` (or a NaN passes), its answer is still the
+    /// loop solve's, to f32 rounding, tick after tick.
+    #[test]
+    fn cursor_follows_a_changing_port_feedthrough() {
+        let mut m = CursorMass::new(0.25, T, Position::ZERO).unwrap();
+        let mut twin_v = 0.0f32; // the same mass by the divided formula
+        for (k, z) in [100.0, 100.0, 250.0, f32::NAN, 250.0, 40.0, 40.0]
+            .into_iter()
+            .enumerate()
+        {
+            let port = Port {
+                f0_n: 3.0 - k as f32,
+                z_nspm: z,
+            };
+            let want = port.solve_admittance(twin_v, T / 0.25);
+            let got = m.step(port);
+            if z.is_nan() {
+                assert!(got.velocity_mps.is_nan());
+                continue;
+            }
+            let tol = 3e-7 * want.velocity_mps.abs();
+            assert!(
+                (got.velocity_mps - want.velocity_mps).abs() <= tol,
+                "tick {k}, z {z}: {got:?} vs {want:?}"
+            );
+            twin_v = want.velocity_mps;
+            assert!((m.velocity_mps() - twin_v).abs() <= tol);
         }
     }
 
