@@ -39,7 +39,7 @@ impl<R: Real> FirstDifference<R> {
 
     /// The estimate for the new sample `x[k]` (m/s).
     pub fn step(&mut self, x: Position) -> R {
-        let v = R::from_i32(x - self.prev) * self.mps_per_nm;
+        let v = x.nm_from::<R>(self.prev) * self.mps_per_nm;
         self.prev = x;
         v
     }

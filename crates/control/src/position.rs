@@ -78,6 +78,21 @@ impl Position {
         (self - other) as f32 * 1.0e-9
     }
 
+    /// `self - from` in nanometres as an `R`, rounded once: the exact
+    /// difference converted. On a 64-bit machine the difference of two
+    /// `i32`s is exact in an `i64` and converts in one instruction; on a
+    /// 32-bit core it saturates to `i32` first (one `qsub`), which changes
+    /// nothing closer than 2.147 m. The tick's position differences (the
+    /// velocity estimate, the springs' stretches) all go through here.
+    #[inline]
+    pub fn nm_from<R: Real>(self, from: Position) -> R {
+        #[cfg(target_pointer_width = "64")]
+        let d = R::from_i64(self.0 as i64 - from.0 as i64);
+        #[cfg(not(target_pointer_width = "64"))]
+        let d = R::from_i32(self - from);
+        d
+    }
+
     /// This position moved by `delta_nm` nanometres, saturating at the ends
     /// of the range instead of wrapping.
     #[inline]
@@ -206,7 +221,7 @@ impl<R: Real> Integrator<R> {
     /// would otherwise see the 1 nm steps as 5 mN of force ripple).
     #[inline]
     pub fn offset_m(&self, from: Position) -> R {
-        (R::from_i32(self.position - from) + self.remainder_nm) * R::M_PER_NM
+        (self.position.nm_from::<R>(from) + self.remainder_nm) * R::M_PER_NM
     }
 
     /// The sample period `T` (s).
@@ -245,6 +260,20 @@ mod tests {
         assert_eq!(Position::MIN + -1, Position::MIN);
         assert_eq!(Position::MAX - Position::MIN, i32::MAX);
         assert_eq!(Position::MIN.minus_m(Position::MAX), i32::MIN as f32 * 1e-9);
+    }
+
+    #[test]
+    fn nm_from_is_the_difference_rounded_once() {
+        let (a, b) = (Position::from_nm(1_234_567_891), Position::from_nm(-7));
+        assert_eq!(a.nm_from::<f64>(b), 1_234_567_898.0);
+        assert_eq!(a.nm_from::<f32>(b), 1_234_567_898.0f64 as f32);
+        assert_eq!(b.nm_from::<f32>(a), -1_234_567_898.0f64 as f32);
+        // Beyond i32: exact on a 64-bit host, saturated on a 32-bit core.
+        let far = Position::MAX.nm_from::<f64>(Position::MIN);
+        #[cfg(target_pointer_width = "64")]
+        assert_eq!(far, 4_294_967_295.0);
+        #[cfg(not(target_pointer_width = "64"))]
+        assert_eq!(far, i32::MAX as f64);
     }
 
     #[test]

@@ -46,6 +46,9 @@ pub trait Real:
     fn to_f64(self) -> f64;
     /// An integer, rounded to nearest (exact below 2^24 for `f32`).
     fn from_i32(i: i32) -> Self;
+    /// `i` rounded to the nearest value (one conversion on a 64-bit host;
+    /// a library call on a 32-bit core, where nothing in the tick uses it).
+    fn from_i64(i: i64) -> Self;
     /// Toward zero, saturating, NaN to 0 (one `vcvt` on the M4F).
     fn trunc_i32(self) -> i32;
     /// `|self|`.
@@ -76,6 +79,10 @@ macro_rules! real {
             }
             #[inline]
             fn from_i32(i: i32) -> Self {
+                i as $t
+            }
+            #[inline]
+            fn from_i64(i: i64) -> Self {
                 i as $t
             }
             #[inline]

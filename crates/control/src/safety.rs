@@ -192,7 +192,10 @@ pub struct SafetyLayer<R = f32> {
     ramp_done: u32,
     /// I^2 t state above the continuous rating (N^2 s), >= 0.
     heat: R,
-    last_tick: Option<u32>,
+    /// The tick number the next step must bring.
+    next_tick: u32,
+    /// Whether a tick has been seen (the first may bring any number).
+    ticking: bool,
     heartbeat_age: u32,
     /// Largest heartbeat age that is not a fault (`u32::MAX`: unchecked).
     heartbeat_limit: u32,
@@ -221,7 +224,8 @@ impl<R: Real> SafetyLayer<R> {
             first: Faults::NONE,
             ramp_done: 0,
             heat: R::ZERO,
-            last_tick: None,
+            next_tick: 0,
+            ticking: false,
             heartbeat_age: 0,
             heartbeat_limit: match cfg.heartbeat_timeout_ticks {
                 0 => u32::MAX,
@@ -348,11 +352,9 @@ impl<R: Real> SafetyLayer<R> {
         // the cold path works out which faults they were.
         // (One comparison for the speed: NaN fails it too.)
         let speed_ok = v.abs() <= R::of(self.cfg.max_velocity_mps);
-        let tick_ok = match self.last_tick {
-            Some(last) => inputs.tick == last.wrapping_add(1),
-            None => true,
-        };
-        self.last_tick = Some(inputs.tick);
+        let tick_ok = (inputs.tick == self.next_tick) | !self.ticking;
+        self.next_tick = inputs.tick.wrapping_add(1);
+        self.ticking = true;
         let enabled = self.enabled;
         self.heartbeat_age = self.heartbeat_age.saturating_add(enabled as u32);
         let dead_man_open = enabled & self.cfg.require_dead_man & !inputs.dead_man_closed;

@@ -104,7 +104,7 @@ pub trait VirtualEnvironment<R: Real = f32> {
     /// default has no such part.
     #[inline]
     fn offset_m(&self, from: Position) -> R {
-        R::from_i32(self.position() - from) * R::M_PER_NM
+        self.position().nm_from::<R>(from) * R::M_PER_NM
     }
     /// The VE's law in the z-domain (for a piecewise law: the piece named in
     /// its documentation, e.g. a wall in contact).
@@ -295,11 +295,10 @@ impl<R: Real> Spring<R> {
         (self.k * d_m, self.kt + self.b)
     }
 
-    /// Move the probe at `v` for this tick (ignored if not finite).
+    /// Move the probe at `v` for this tick (the integrator ignores a
+    /// non-finite `v`).
     fn commit(&mut self, v_mps: R) {
-        if v_mps.is_finite() {
-            self.probe.step(v_mps);
-        }
+        self.probe.step(v_mps);
     }
 }
 
