@@ -1,11 +1,11 @@
 //! The board's code on the host: each law's `step` and a whole servo tick
 //! (goal: 20 ns or less). Inputs vary every iteration so nothing folds away.
 //!
-//! A servo tick's 44-byte output is made observable by reference
+//! A law's or tick's output struct is made observable by reference
 //! (`black_box(&out)`), as a caller reads it in place. Returning it by value
-//! from the timed closure copies it, and that copy's 16-byte loads of fields
-//! just stored 4 bytes at a time defeat store forwarding: 5-8 ns a tick
-//! that belong to the harness, not to the tick.
+//! from the timed closure copies it, and that copy's wide loads of fields
+//! just stored 4 bytes at a time defeat store forwarding: 5-8 ns a call
+//! that belong to the harness, not to the law.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
@@ -54,7 +54,8 @@ fn laws(c: &mut Criterion) {
     c.bench_function("impedance coupling Z_cI step, bilateral VE", |b| {
         b.iter(|| {
             k = k.wrapping_add(1);
-            black_box(zc.step(black_box(wobble(k)), 0.01, &mut fixed))
+            let out = zc.step(black_box(wobble(k)), 0.01, &mut fixed);
+            black_box(&out);
         })
     });
     let mut wall =
@@ -62,10 +63,11 @@ fn laws(c: &mut Criterion) {
     c.bench_function("unilateral wall VE step (exact loop solve)", |b| {
         b.iter(|| {
             k = k.wrapping_add(1);
-            black_box(wall.step(Port {
+            let out = wall.step(Port {
                 f0_n: black_box((k % 50) as f32 - 25.0),
                 z_nspm: 141.0,
-            }))
+            });
+            black_box(&out);
         })
     });
     let mut za = AdmittanceCoupling::new(5.0, 500.0, T).unwrap();
@@ -73,7 +75,8 @@ fn laws(c: &mut Criterion) {
     c.bench_function("admittance coupling Z_cA step, cursor VE", |b| {
         b.iter(|| {
             k = k.wrapping_add(1);
-            black_box(za.step(black_box((k % 20) as f32 - 10.0), &mut cursor))
+            let out = za.step(black_box((k % 20) as f32 - 10.0), &mut cursor);
+            black_box(&out);
         })
     });
 }
