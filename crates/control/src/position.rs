@@ -137,7 +137,8 @@ fn round_half_away(x: f64) -> f64 {
 /// the f32 rounding of each `v T` product itself.
 ///
 /// This is the velocity-to-position step of the admittance display's position
-/// command and of the virtual couplings' VE side.
+/// command and of every VE point (the impedance coupling's spring acts on
+/// the VE's).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Integrator<R = f32> {
     position: Position,

@@ -46,8 +46,16 @@ pub struct VeOutput<R = f32> {
 impl<R: Real> Port<R> {
     /// Intersect with an admittance law `v = v0 + y f` (y >= 0, m/(N s)).
     pub fn solve_admittance(self, v0_mps: R, y: R) -> VeOutput<R> {
-        let v = (v0_mps + y * self.f0_n) / (R::ONE + y * self.z_nspm);
-        self.at(v)
+        let (n, m) = self.admittance_quotient(v0_mps, y);
+        self.at(n / m)
+    }
+
+    /// The intersection's velocity with `v = v0 + y f` as the quotient
+    /// `n / m` (m >= 1), for a VE that keeps `1 / m` (it depends on the
+    /// port's `z` alone) and multiplies.
+    #[inline]
+    pub fn admittance_quotient(self, v0_mps: R, y: R) -> (R, R) {
+        (v0_mps + y * self.f0_n, R::ONE + y * self.z_nspm)
     }
 
     /// Intersect with an impedance law `f = g + h v` (h >= 0, N s/m).
@@ -173,11 +181,12 @@ impl<R: Real> VirtualEnvironment<R> for CursorMass<R> {
     fn step(&mut self, port: Port<R>) -> VeOutput<R> {
         // (A NaN z never equals the one kept, so it gives a NaN answer,
         // which is not committed, and the next good z recomputes.)
+        let (n, m) = port.admittance_quotient(self.velocity_mps, self.t_over_m);
         if port.z_nspm != self.port_z {
             self.port_z = port.z_nspm;
-            self.inv_den = R::ONE / (R::ONE + self.t_over_m * port.z_nspm);
+            self.inv_den = R::ONE / m;
         }
-        let out = port.at((self.velocity_mps + self.t_over_m * port.f0_n) * self.inv_den);
+        let out = port.at(n * self.inv_den);
         if out.velocity_mps.is_finite() {
             self.velocity_mps = out.velocity_mps;
             self.x.step(out.velocity_mps);
@@ -561,7 +570,7 @@ impl<R: Real> VirtualEnvironment<R> for UnilateralWall<R> {
 
     #[inline]
     fn offset_m(&self, from: Position) -> R {
-        self.spring.probe.offset_m(from)
+        self.spring.offset_m(from)
     }
 
     /// In contact: the spring's `F/V = b + kT/(1 - z^-1)`.
