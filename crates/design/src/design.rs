@@ -9,7 +9,7 @@ use crate::twoport::{
     admittance_display, design_bound, impedance_display, llewellyn_margin,
     with_admittance_coupling, with_impedance_coupling, HumanBound,
 };
-use crate::{Plant, PlantPoint};
+use crate::{sampled, Plant, PlantPoint};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 use twoport_control::{
@@ -85,6 +85,8 @@ pub struct Analysis {
     pub points: Vec<PlantPoint>,
     /// The sample period (s).
     pub period_s: f64,
+    /// The device, for the alias sums of the sampled-data bounds.
+    plant: Plant,
 }
 
 impl Analysis {
@@ -93,6 +95,7 @@ impl Analysis {
         Analysis {
             points: plant.response(&grid(plant, spec)),
             period_s: plant.period_s(),
+            plant: plant.clone(),
         }
     }
 
@@ -101,20 +104,36 @@ impl Analysis {
         Analysis {
             points: plant.response(omegas),
             period_s: plant.period_s(),
+            plant: plant.clone(),
         }
     }
 
-    /// The impedance-display bound on `Re(1/Z_cI)` at each grid point.
+    /// The impedance-display bound on `Re(1/Z_cI)` at each grid point,
+    /// sound for the sampled-data loop (aliasing at the handle port
+    /// included, see [`crate::sampled`]): what designs and checks use.
     pub fn impedance_bound(&self, human: Option<HumanBound>) -> Vec<f64> {
+        sampled::impedance_bound(&self.plant, &self.points, human)
+    }
+
+    /// The admittance-display bound on `Re Z_cA` at each grid point, for
+    /// the regulator `kp`, sound for the sampled-data loop.
+    pub fn admittance_bound(&self, kp: &ZTransfer, human: Option<HumanBound>) -> Vec<f64> {
+        sampled::admittance_bound(&self.plant, &self.points, kp, human)
+    }
+
+    /// The paper's impedance-display bound (eq 25 as corrected): the handle
+    /// port's cross terms as continuous transfer functions times the hold,
+    /// aliasing neglected. Reported beside the sound one, never used alone
+    /// to prove.
+    pub fn paper_impedance_bound(&self, human: Option<HumanBound>) -> Vec<f64> {
         self.points
             .iter()
             .map(|p| design_bound(&impedance_display(p, human)))
             .collect()
     }
 
-    /// The admittance-display bound on `Re Z_cA` at each grid point, for
-    /// the regulator `kp`.
-    pub fn admittance_bound(&self, kp: &ZTransfer, human: Option<HumanBound>) -> Vec<f64> {
+    /// The paper's admittance-display bound (eq 28), aliasing neglected.
+    pub fn paper_admittance_bound(&self, kp: &ZTransfer, human: Option<HumanBound>) -> Vec<f64> {
         self.points
             .iter()
             .map(|p| design_bound(&admittance_display(p, kp, human)))
@@ -259,17 +278,32 @@ pub fn best_admittance(a: &Analysis, bound: &[f64]) -> Option<(f64, f64)> {
 /// Result of an absolute-stability check.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Check {
-    /// Whether Llewellyn's criteria hold at every grid frequency (and, for
-    /// the admittance display, the regulated device is stable).
+    /// Whether the sound (sampled-data) design inequality holds at every
+    /// grid frequency (and, for the admittance display, the regulated
+    /// device is stable): absolutely stable for every passive hand and VE.
     pub absolutely_stable: bool,
-    /// The smallest relative slack of the design inequality over the grid
-    /// (see [`relative_margin`]): >= 0 is absolutely stable.
+    /// The smallest relative slack of the sound design inequality over the
+    /// grid (see [`relative_margin`]): >= 0 is absolutely stable.
     pub min_margin: f64,
     /// Where it occurs (Hz).
     pub worst_frequency_hz: f64,
     /// For the admittance display: the largest pole radius of the regulated
     /// device (< 1 is stable); 0 for the impedance display.
     pub regulator_pole_radius: f64,
+    /// The same check on the paper's approximation (aliasing at the handle
+    /// port neglected), for comparison.
+    pub paper: PaperCheck,
+}
+
+/// The paper's approximate check beside the sound one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PaperCheck {
+    /// Whether the paper's inequality holds everywhere.
+    pub absolutely_stable: bool,
+    /// Its least relative slack.
+    pub min_margin: f64,
+    /// Where (Hz).
+    pub worst_frequency_hz: f64,
 }
 
 /// The relative slack `(c - β) / (|c| + |β|)` of a design inequality
@@ -290,35 +324,42 @@ pub fn relative_margin(c: f64, bound: f64) -> f64 {
     }
 }
 
-fn worst(a: &Analysis, margin: impl Fn(&PlantPoint) -> f64) -> (f64, f64) {
+/// The least relative slack of `lhs(z) >= bound` over the grid, and where.
+fn worst(a: &Analysis, bound: &[f64], lhs: impl Fn(Complex64) -> f64) -> (f64, f64) {
     a.points
         .iter()
-        .map(|pt| (margin(pt), pt.omega / (2.0 * PI)))
+        .zip(bound)
+        .map(|(pt, b)| (relative_margin(lhs(pt.z), *b), pt.omega / (2.0 * PI)))
         .fold(
             (f64::INFINITY, 0.0),
             |acc, x| if x.0 < acc.0 { x } else { acc },
         )
 }
 
-/// Llewellyn check of the impedance display with coupling `(k, b)`.
+fn paper_check((m, f): (f64, f64), extra: bool) -> PaperCheck {
+    PaperCheck {
+        absolutely_stable: m >= 0.0 && extra,
+        min_margin: m,
+        worst_frequency_hz: f,
+    }
+}
+
+/// Absolute-stability check of the impedance display with coupling `(k, b)`.
 pub fn check_impedance(a: &Analysis, k: f64, b: f64, human: Option<HumanBound>) -> Option<Check> {
     let tf = impedance_coupling_tf(k, b, a.period_s).ok()?;
-    let (m, f) = worst(a, |p| {
-        relative_margin(
-            tf.eval(p.z).inv().re,
-            design_bound(&impedance_display(p, human)),
-        )
-    });
+    let lhs = |z: Complex64| tf.eval(z).inv().re;
+    let (m, f) = worst(a, &a.impedance_bound(human), lhs);
     Some(Check {
         absolutely_stable: m >= 0.0,
         min_margin: m,
         worst_frequency_hz: f,
         regulator_pole_radius: 0.0,
+        paper: paper_check(worst(a, &a.paper_impedance_bound(human), lhs), true),
     })
 }
 
-/// Llewellyn check of the admittance display with regulator `(kp, bp)` and
-/// coupling `(m, b)`.
+/// Absolute-stability check of the admittance display with regulator
+/// `(kp, bp)` and coupling `(m, b)`.
 pub fn check_admittance(
     plant: &Plant,
     a: &Analysis,
@@ -329,17 +370,17 @@ pub fn check_admittance(
     let k = regulator_tf(kp, bp, a.period_s).ok()?;
     let zc = admittance_coupling_tf(m, b, a.period_s).ok()?;
     let radius = plant.regulated_pole_radius(&k);
-    let (mg, f) = worst(a, |p| {
-        relative_margin(
-            zc.eval(p.z).re,
-            design_bound(&admittance_display(p, &k, human)),
-        )
-    });
+    let lhs = |z: Complex64| zc.eval(z).re;
+    let (mg, f) = worst(a, &a.admittance_bound(&k, human), lhs);
     Some(Check {
         absolutely_stable: mg >= 0.0 && radius < 1.0,
         min_margin: mg,
         worst_frequency_hz: f,
         regulator_pole_radius: radius,
+        paper: paper_check(
+            worst(a, &a.paper_admittance_bound(&k, human), lhs),
+            radius < 1.0,
+        ),
     })
 }
 

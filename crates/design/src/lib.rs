@@ -11,6 +11,7 @@ pub mod linalg;
 pub mod model;
 pub mod plant;
 pub mod plot;
+pub mod sampled;
 pub mod twoport;
 
 pub use model::{DeviceModel, ModelError};

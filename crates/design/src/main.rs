@@ -270,18 +270,67 @@ fn gain(name: &str, v: f64) -> Result<f64, String> {
     }
 }
 
-fn impedance_design(s: &Session, b: Option<f64>) -> Result<Option<(f64, f64)>, String> {
-    let bound = s.analysis.impedance_bound(s.human);
+fn impedance_design_on(
+    s: &Session,
+    bound: &[f64],
+    b: Option<f64>,
+) -> Result<Option<(f64, f64)>, String> {
     Ok(match b {
-        Some(b) => design::max_stiffness(&s.analysis, &bound, gain("b", b)?).map(|k| (k, b)),
-        None => design::best_impedance(&s.analysis, &bound),
+        Some(b) => design::max_stiffness(&s.analysis, bound, gain("b", b)?).map(|k| (k, b)),
+        None => design::best_impedance(&s.analysis, bound),
     })
+}
+
+fn impedance_design(s: &Session, b: Option<f64>) -> Result<Option<(f64, f64)>, String> {
+    impedance_design_on(s, &s.analysis.impedance_bound(s.human), b)
+}
+
+/// Which bound set a design, and by how much the paper's approximation
+/// (aliasing at the handle port neglected) would have claimed more. `sound`
+/// and `paper` are the designed limits; `more_is_bolder` says whether a
+/// larger limit claims more (a stiffness) or less (a mass).
+fn binding(v: &mut Value, sound: Option<f64>, paper: Option<f64>, more_is_bolder: bool) {
+    let (text, by) = match (sound, paper) {
+        (Some(s), Some(p)) => {
+            let by = if more_is_bolder {
+                (p - s) / p
+            } else {
+                (s - p) / p
+            };
+            if by > 1e-5 {
+                ("sampled-data", by)
+            } else {
+                ("both", by.max(0.0))
+            }
+        }
+        (None, Some(_)) => ("sampled-data", 1.0),
+        _ => ("both", 0.0),
+    };
+    v["binding_bound"] = json!(text);
+    v["aliasing_effect"] = json!(by);
+}
+
+fn binding_text(v: &Value, what: &str, paper: &str, unit: &str) -> String {
+    let by = 100.0 * v["aliasing_effect"].as_f64().unwrap_or(0.0);
+    match v[paper].as_f64() {
+        Some(p) if v["binding_bound"] == "sampled-data" => format!(
+            "  the sampled-data analysis binds: the paper's approximation (aliasing at the handle neglected) gives {p:.4} {unit}; the proven {what} is {by:.1}% {}", if unit == "kg" { "higher" } else { "lower" }
+        ),
+        Some(_) => format!("  the paper's approximation gives the same {what} (aliasing moves it by {by:.4}%)"),
+        None => "  the paper's approximation finds no design either".into(),
+    }
 }
 
 fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
     let s = Session::open(&a.common)?;
     let r = impedance_design(&s, a.b)?;
+    let paper = impedance_design_on(&s, &s.analysis.paper_impedance_bound(s.human), a.b)?;
     let mut v = json!({"display": "impedance", "feasible": r.is_some(), "period_s": s.period(), "human_model": s.human.is_some()});
+    if let Some((k, b)) = paper {
+        v["paper_k_c"] = json!(k);
+        v["paper_b_c"] = json!(b);
+    }
+    binding(&mut v, r.map(|r| r.0), paper.map(|p| p.0), true);
     match r {
         Some((k, b)) => {
             v["k_c"] = json!(k);
@@ -306,6 +355,7 @@ fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
             Some((k, b)) => println!("  best coupling: k_c = {k:.0} N/m, b_c = {b:.1} N s/m"),
             None => println!("  infeasible: {}", v["message"].as_str().unwrap_or("")),
         }
+        println!("{}", binding_text(&v, "stiffness", "paper_k_c", "N/m"));
     });
     Ok(())
 }
@@ -319,17 +369,25 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
     };
     let k = design::regulator_tf(kp, bp, s.period()).map_err(|e| e.to_string())?;
     let radius = s.plant.regulated_pole_radius(&k);
-    let bound = s.analysis.admittance_bound(&k, s.human);
-    let r = if radius >= 1.0 {
-        None
-    } else {
-        match a.b {
-            Some(b) => design::min_mass(&s.analysis, &bound, gain("b", b)?).map(|m| (m, b)),
-            None => design::best_admittance(&s.analysis, &bound),
-        }
+    let design_on = |bound: &[f64]| -> Result<Option<(f64, f64)>, String> {
+        Ok(if radius >= 1.0 {
+            None
+        } else {
+            match a.b {
+                Some(b) => design::min_mass(&s.analysis, bound, gain("b", b)?).map(|m| (m, b)),
+                None => design::best_admittance(&s.analysis, bound),
+            }
+        })
     };
+    let r = design_on(&s.analysis.admittance_bound(&k, s.human))?;
+    let paper = design_on(&s.analysis.paper_admittance_bound(&k, s.human))?;
     let mut v = json!({"display": "admittance", "feasible": r.is_some(), "kp": kp, "bp": bp,
         "period_s": s.period(), "human_model": s.human.is_some(), "regulator_pole_radius": radius});
+    if let Some((m, b)) = paper {
+        v["paper_m_c"] = json!(m);
+        v["paper_b_c"] = json!(b);
+    }
+    binding(&mut v, r.map(|r| r.0), paper.map(|p| p.0), false);
     match r {
         Some((m, b)) => {
             v["m_c"] = json!(m);
@@ -359,25 +417,48 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
             Some((m, b)) => println!("  best coupling: m_c = {m:.3} kg, b_c = {b:.1} N s/m"),
             None => println!("  infeasible: {}", v["message"].as_str().unwrap_or("")),
         }
+        println!("{}", binding_text(&v, "mass", "paper_m_c", "kg"));
     });
     Ok(())
 }
 
 fn check_json(c: &design::Check) -> Value {
+    let p = &c.paper;
+    let binding =
+        if c.absolutely_stable != p.absolutely_stable || (p.min_margin - c.min_margin) > 1e-6 {
+            "sampled-data"
+        } else {
+            "both"
+        };
     json!({"absolutely_stable": c.absolutely_stable, "min_margin": c.min_margin,
-        "worst_frequency_hz": c.worst_frequency_hz})
+        "worst_frequency_hz": c.worst_frequency_hz, "binding_bound": binding,
+        "paper_absolutely_stable": p.absolutely_stable, "paper_min_margin": p.min_margin,
+        "paper_worst_frequency_hz": p.worst_frequency_hz})
 }
 
 fn print_check(c: &design::Check) {
-    let verdict = if c.absolutely_stable {
-        "absolutely stable (proven)"
-    } else {
-        "NOT proven absolutely stable"
+    let verdict = |ok| {
+        if ok {
+            "absolutely stable (proven)"
+        } else {
+            "NOT proven absolutely stable"
+        }
     };
     println!(
-        "  {verdict}: least margin {:.4} at {:.2} Hz",
-        c.min_margin, c.worst_frequency_hz
+        "  {}: least margin {:.4} at {:.2} Hz (sampled-data analysis)",
+        verdict(c.absolutely_stable),
+        c.min_margin,
+        c.worst_frequency_hz
     );
+    let p = &c.paper;
+    if p.absolutely_stable != c.absolutely_stable || (p.min_margin - c.min_margin) > 1e-6 {
+        println!(
+            "  the paper's approximation (aliasing at the handle neglected) would say {}: margin {:.4} at {:.2} Hz",
+            verdict(p.absolutely_stable),
+            p.min_margin,
+            p.worst_frequency_hz
+        );
+    }
 }
 
 fn check(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {

@@ -1,0 +1,265 @@
+//! The handle port without the paper's approximation: design bounds that
+//! hold for the exact sampled-data loop.
+//!
+//! The paper's hybrid two-port treats the handle port with continuous
+//! transfer functions times the hold, which neglects aliasing: a hand force
+//! at `ω + 2πk/T` also reaches the sampled actuator signals. Here the hand is
+//! a passive impedance whose value at every alias frequency is free (a
+//! superset of the real hands, so the bound stays sufficient), and the hand
+//! enters the discrete loop through the exact alias sums. `docs/soundness.md`
+//! has the derivation; in short, with `P = Y_ah Y_ha`, `θ = ωT`,
+//! `ω_k = ω + 2πk/T` and `R_k = Re Y_hh(jω_k)` (the human bound folded in):
+//!
+//! * **impedance display**, exact for any passive hand and VE:
+//!   `Re(1/Z_cI) >= -Re Y_cc* + Σ_k 4 sin²(θ/2) / (T ω_k)² (|P_k| + Re(e^{-jθ} P_k)) / (2 R_k)`.
+//!   The `k = 0` term is the paper's; on a rigid device the sum is exactly
+//!   Colgate's passivity bound `(1 - cos θ)/(2 b)`, i.e. `b > K T/2 + |B|`.
+//! * **admittance display**, a sufficient condition: the paper's bound plus
+//!   the worst change the aliased hand terms can make to `G_cc*` (a bound on
+//!   the perturbation of a ratio), infinite where the aliased hand could
+//!   destabilise the regulated device.
+//!
+//! Aliases are summed to `N` (the device's highest mode times 8, at least
+//! 16 either side); the rest is bounded by the last alias's ratio and the
+//! exact tail `Σ_{|k|>N} 1/(θ + 2πk)² <= 2/(4π² (N - 1/2))`, which assumes the
+//! ratios decay no slower beyond `N` (true above the device's modes, where
+//! the handle's inertia dominates).
+
+use crate::twoport::{admittance_display, design_bound, impedance_display, HumanBound};
+use crate::{Plant, PlantPoint};
+use num_complex::Complex64;
+use std::f64::consts::PI;
+use twoport_control::ZTransfer;
+
+/// How many aliases either side of the base band the sums take for `plant`.
+pub fn alias_count(plant: &Plant) -> usize {
+    let ws = 2.0 * PI / plant.period_s();
+    let top = plant.modes().iter().map(|m| m.omega_n).fold(0.0, f64::max);
+    ((8.0 * top / ws).ceil() as usize).clamp(256, 4096)
+}
+
+/// The device's hand-side terms at one alias frequency `ω_k` (rad/s, any
+/// sign): `Y_hh` with the human bound, `P = Y_ah Y_ha`, and `F_mh Y_ha`.
+struct Alias {
+    omega: f64,
+    re_yhh: f64,
+    p: Complex64,
+    fy: Complex64,
+}
+
+fn aliases(plant: &Plant, p: &PlantPoint, human: Option<HumanBound>, n: usize) -> Vec<Alias> {
+    let mut work = plant.scratch();
+    let ws = 2.0 * PI / p.period_s;
+    let n = n as i64;
+    (-n..=n)
+        .filter(|k| *k != 0)
+        .map(|k| {
+            let omega = p.omega + ws * k as f64;
+            let (mut y, mut f) = plant.continuous(omega.abs(), &mut work);
+            if omega < 0.0 {
+                y = y.map(|r| r.map(|v| v.conj()));
+                f = f.map(|v| v.conj());
+            }
+            let h = human.map_or(Complex64::new(0.0, 0.0), |h| {
+                h.admittance(Complex64::new(0.0, omega))
+            });
+            Alias {
+                omega,
+                re_yhh: (y[0][0] + h).re,
+                p: y[1][0] * y[0][1],
+                fy: f[0] * y[0][1],
+            }
+        })
+        .collect()
+}
+
+/// `Σ_{|k|>N} 1/(θ + 2πk)²` is at most this (for `0 <= θ <= π`).
+fn tail_sum(n: usize) -> f64 {
+    2.0 / (4.0 * PI * PI * (n as f64 - 0.5))
+}
+
+/// The alias terms of the impedance display at one point: what the
+/// aliased hand adds to the paper's bound on `Re(1/Z_cI)`.
+fn impedance_alias_terms(al: &[Alias], p: &PlantPoint, n: usize) -> f64 {
+    let t = p.period_s;
+    let th = p.omega * t;
+    let s2 = 4.0 * (0.5 * th).sin().powi(2);
+    let rot = Complex64::from_polar(1.0, -th);
+    let mut sum = 0.0;
+    let mut tail_ratio = 0.0f64;
+    for a in al {
+        if a.re_yhh.is_nan() || a.re_yhh <= 0.0 {
+            return f64::INFINITY;
+        }
+        let wt = a.omega * t;
+        sum += s2 / (wt * wt) * (a.p.norm() + (rot * a.p).re) / (2.0 * a.re_yhh);
+        if (a.omega.abs() * t / (2.0 * PI)).round() as usize >= n {
+            tail_ratio = tail_ratio.max(a.p.norm() / a.re_yhh);
+        }
+    }
+    sum + tail_ratio * s2 * tail_sum(n)
+}
+
+/// The impedance-display bound on `Re(1/Z_cI)` at each point, exact for the
+/// sampled loop (see the module docs). It is never below the paper's.
+pub fn impedance_bound(
+    plant: &Plant,
+    points: &[PlantPoint],
+    human: Option<HumanBound>,
+) -> Vec<f64> {
+    let n = alias_count(plant);
+    points
+        .iter()
+        .map(|p| {
+            let paper = design_bound(&impedance_display(p, human));
+            paper + impedance_alias_terms(&aliases(plant, p, human, n), p, n)
+        })
+        .collect()
+}
+
+/// The admittance-display bound on `Re Z_cA` at each point for the
+/// regulator `kp`, sufficient for the sampled loop (see the module docs).
+/// It is never below the paper's.
+pub fn admittance_bound(
+    plant: &Plant,
+    points: &[PlantPoint],
+    kp: &ZTransfer,
+    human: Option<HumanBound>,
+) -> Vec<f64> {
+    let n = alias_count(plant);
+    points
+        .iter()
+        .map(|p| admittance_point(p, &aliases(plant, p, human, n), kp, human, n))
+        .collect()
+}
+
+fn admittance_point(
+    p: &PlantPoint,
+    al: &[Alias],
+    kp: &ZTransfer,
+    human: Option<HumanBound>,
+    n: usize,
+) -> f64 {
+    let g = admittance_display(p, kp, human);
+    let paper = design_bound(&g);
+    let g_hh = g[0][0].re;
+    if !paper.is_finite() || g_hh <= 0.0 {
+        return f64::INFINITY;
+    }
+    let t = p.period_s;
+    let one = Complex64::new(1.0, 0.0);
+    let diff = (one - p.z.inv()).norm();
+    let k = kp.eval(p.z);
+    // Σ |α_k| |w_k| / |1 - z^-1| and Σ |φ_k| |w_k| / |1 - z^-1|, with
+    // |w_k| <= 1/R_k: the aliased hand's reach into -x_a* and f_m* per unit
+    // held force.
+    let (mut rx, mut rf) = (0.0, 0.0);
+    let (mut tail_x, mut tail_f) = (0.0f64, 0.0f64);
+    for a in al {
+        if a.re_yhh.is_nan() || a.re_yhh <= 0.0 {
+            return f64::INFINITY;
+        }
+        let w2 = a.omega * a.omega;
+        rx += a.p.norm() / (t * w2 * a.re_yhh);
+        rf += a.fy.norm() / (t * a.omega.abs() * a.re_yhh);
+        if (a.omega.abs() * t / (2.0 * PI)).round() as usize >= n {
+            tail_x = tail_x.max(a.p.norm() / a.re_yhh);
+            tail_f = tail_f.max(a.fy.norm() * a.omega.abs() / a.re_yhh);
+        }
+    }
+    // Σ_{|k|>N} 1/(T ω_k²) = T Σ 1/(θ + 2πk)².
+    rx += tail_x * t * tail_sum(n);
+    rf += tail_f * t * tail_sum(n);
+    let rho_d = k.norm() * diff * rx;
+    // |c| ρ_F with c = K T/(1 - z^-1): the factors |1 - z^-1| cancel.
+    let c_rho_f = k.norm() * t * rf;
+    // The base-band hand's reach into the regulator loop's denominator
+    // D = 1 + K X_aa^d - K α_0 w_0, w_0 in the disk of diameter 1/R_0.
+    let y0 = p.y[0][0] + human.map_or(Complex64::new(0.0, 0.0), |h| h.admittance(p.s));
+    if y0.re <= 0.0 {
+        return f64::INFINITY;
+    }
+    let r0 = 0.5 / y0.re;
+    let p0 = p.y[1][0] * p.y[0][1];
+    let alpha0 = -(one - p.z.inv()) * p0 / (t * p.omega * p.omega);
+    let den = one + k * p.xaa_d;
+    let ka = k * alpha0;
+    let d_min = (den - ka * r0).norm() - ka.norm() * r0;
+    if d_min <= rho_d {
+        return f64::INFINITY;
+    }
+    let q = -(g[0][1] * g[1][0]);
+    let g_max = g[1][1].norm() + q.norm() / g_hh;
+    paper + (c_rho_f + g_max * rho_d) / (d_min - rho_d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::DeviceModel;
+
+    fn rigid(m: f64, b: f64) -> Plant {
+        let text = format!(
+            "name = \"rigid\"\nperiod_s = 0.001\nload_cell_pole_rad_s = 235.0\npeak_force_n = 50.0\ncontinuous_force_n = 20.0\nM = [[{m}]]\nD = [[{b}]]\nK = [[0.0]]\n\
+             G = [[1.0, -1.0]]\nC_v = [[1.0], [-1.0]]\nC_f = [[0.0]]\n"
+        );
+        let model = DeviceModel::from_toml(&text, "rigid").unwrap();
+        Plant::new(&model, 1e-3).unwrap()
+    }
+
+    /// On a rigid device the exact bound is Colgate & Schenkel's passivity
+    /// condition `(1 - cos θ)/(2 b)` for every mass, and never below it:
+    /// the alias sums are what the paper's approximation leaves out.
+    #[test]
+    fn rigid_device_bound_is_colgates() {
+        for (m, b) in [(1.0, 20.0), (0.1, 5.0), (10.0, 200.0)] {
+            let plant = rigid(m, b);
+            let omegas = crate::design::log_grid(1.0, plant.nyquist(), 60);
+            let pts = plant.response(&omegas);
+            let exact = impedance_bound(&plant, &pts, None);
+            let paper: Vec<f64> = pts
+                .iter()
+                .map(|p| design_bound(&impedance_display(p, None)))
+                .collect();
+            for ((p, e), pa) in pts.iter().zip(&exact).zip(&paper) {
+                let colgate = (1.0 - (p.omega * 1e-3).cos()) / (2.0 * b);
+                assert!(
+                    *e >= colgate * (1.0 - 1e-9),
+                    "m {m} at {}: {e} < {colgate}",
+                    p.omega
+                );
+                assert!(
+                    *e <= colgate * 1.01,
+                    "m {m} at {}: {e} vs {colgate}",
+                    p.omega
+                );
+                assert!(pa <= e);
+            }
+            // At Nyquist the paper's approximation misses a good part of it.
+            let last = pts.len() - 1;
+            assert!(
+                paper[last] < 0.8 * exact[last],
+                "{} {}",
+                paper[last],
+                exact[last]
+            );
+        }
+    }
+
+    /// With no alias terms the admittance bound is the paper's.
+    #[test]
+    fn admittance_bound_without_aliases_is_the_papers() {
+        let model = DeviceModel::excalibur().unwrap();
+        let plant = Plant::new(&model, 1e-3).unwrap();
+        let kp = crate::design::regulator_tf(51_000.0, 90.0, 1e-3).unwrap();
+        let pts = plant.response(&crate::design::log_grid(1.0, plant.nyquist(), 40));
+        for p in &pts {
+            let h = Some(HumanBound::PAPER);
+            let paper = design_bound(&admittance_display(p, &kp, h));
+            let none = admittance_point(p, &[], &kp, h, 16);
+            assert!((none - paper).abs() <= 1e-12 * paper.abs().max(1.0));
+            let with = admittance_point(p, &aliases(&plant, p, h, 16), &kp, h, 16);
+            assert!(with >= paper);
+        }
+    }
+}
