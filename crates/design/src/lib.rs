@@ -11,8 +11,10 @@ pub mod linalg;
 pub mod model;
 pub mod plant;
 pub mod plot;
+pub mod rational;
 pub mod sampled;
 pub mod twoport;
+pub mod verify;
 
 pub use model::{DeviceModel, ModelError};
 pub use plant::{Plant, PlantPoint};

@@ -53,6 +53,10 @@ enum Cmd {
     /// The proven region a board ships with: the limit for each damping.
     #[command(subcommand)]
     Region(Display<RegionImpedance, RegionAdmittance>),
+    /// Search for a passive hand and VE that make the exact sampled loop
+    /// unstable at these gains (independent of the two-port proof).
+    #[command(subcommand)]
+    Verify(Display<ImpedanceGains, AdmittanceGains>),
 }
 
 #[derive(Args)]
@@ -360,8 +364,19 @@ fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
     Ok(())
 }
 
+/// Why an admittance display cannot be built for `model`.
+fn no_force_sensor(model: &DeviceModel) -> String {
+    format!(
+        "{}: the model has no force sensor (no C_f), and an admittance display needs one to measure the hand's force; design an impedance display instead",
+        model.name
+    )
+}
+
 fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
     let s = Session::open(&a.common)?;
+    if !s.model.force_sensor {
+        return Err(no_force_sensor(&s.model));
+    }
     let (kp, bp) = match (a.kp, a.bp) {
         (Some(kp), Some(bp)) => (gain("kp", kp)?, gain("bp", bp)?),
         _ => impedance_design(&s, None)?
@@ -479,6 +494,9 @@ fn check(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
         }
         Display::Admittance(g) => {
             let s = Session::open(&g.common)?;
+            if !s.model.force_sensor {
+                return Err(no_force_sensor(&s.model));
+            }
             let kp = (gain("kp", g.kp)?, gain("bp", g.bp)?);
             let mb = (g.m, gain("b", g.b)?);
             if !(g.m.is_finite() && g.m > 0.0) {
@@ -597,6 +615,9 @@ fn region(d: &Display<RegionImpedance, RegionAdmittance>) -> Result<(), String> 
             )
         }
         Display::Admittance(r) => {
+            if !s.model.force_sensor {
+                return Err(no_force_sensor(&s.model));
+            }
             let (kp, bp) = (gain("kp", r.kp)?, gain("bp", r.bp)?);
             let k = design::regulator_tf(kp, bp, s.period()).map_err(|e| e.to_string())?;
             let b = s.analysis.admittance_bound(&k, s.human);
@@ -632,6 +653,73 @@ fn region(d: &Display<RegionImpedance, RegionAdmittance>) -> Result<(), String> 
     Ok(())
 }
 
+fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
+    use twoport_design::verify::{self, Gains};
+    let (common, gains) = match d {
+        Display::Impedance(g) => (
+            &g.common,
+            Gains::Impedance {
+                k_npm: gain("k", g.k)?,
+                b_nspm: gain("b", g.b)?,
+            },
+        ),
+        Display::Admittance(g) => {
+            if !(g.m.is_finite() && g.m > 0.0) {
+                return Err(format!("--m {}: must be a finite mass > 0 kg", g.m));
+            }
+            (
+                &g.common,
+                Gains::Admittance {
+                    kp_npm: gain("kp", g.kp)?,
+                    bp_nspm: gain("bp", g.bp)?,
+                    m_kg: g.m,
+                    b_nspm: gain("b", g.b)?,
+                },
+            )
+        }
+    };
+    let model = DeviceModel::load_or_excalibur(&common.model).map_err(|e| e.to_string())?;
+    let period = common.period.unwrap_or(model.period_s);
+    let human = (!common.no_human).then_some(HumanBound::PAPER);
+    if matches!(gains, Gains::Admittance { .. }) && !model.force_sensor {
+        return Err(no_force_sensor(&model));
+    }
+    let v = verify::verify(&model, period, &gains, human, model.delay_samples as usize)
+        .map_err(|e| format!("{}: {e}", common.model.display()))?;
+    let display = match d {
+        Display::Impedance(_) => "impedance",
+        Display::Admittance(_) => "admittance",
+    };
+    let mut out = serde_json::to_value(v).map_err(|e| e.to_string())?;
+    out["display"] = json!(display);
+    out["human_model"] = json!(human.is_some());
+    out["period_s"] = json!(period);
+    if common.json {
+        println!("{out}");
+    } else {
+        println!(
+            "{display} display, {} at T = {} ms: {} closed loops searched",
+            model.name,
+            period * 1e3,
+            v.evaluations
+        );
+        let verdict = if v.unstable {
+            "UNSTABLE: a passive termination breaks these gains"
+        } else {
+            "no counterexample found"
+        };
+        println!(
+            "  {verdict}; worst spectral radius {:.6} at {:.2} Hz",
+            v.spectral_radius, v.frequency_hz
+        );
+        println!(
+            "  worst termination: {}",
+            serde_json::to_string(&v.termination).unwrap_or_default()
+        );
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let r = match &cli.cmd {
@@ -641,6 +729,7 @@ fn main() -> ExitCode {
         Cmd::Zrange(d) => zrange(d),
         Cmd::Plot(p) => plot_fig(p),
         Cmd::Region(d) => region(d),
+        Cmd::Verify(d) => verify(d),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,

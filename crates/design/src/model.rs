@@ -15,7 +15,8 @@ pub struct DeviceModel {
     pub name: String,
     /// Sample period `T` of the controller (s).
     pub period_s: f64,
-    /// Load-cell filter pole `p` (rad/s).
+    /// Load-cell filter pole `p` (rad/s); 235 where the device has no
+    /// force sensor (unused then).
     pub load_cell_pole_rad_s: f64,
     /// Actuator peak force (N).
     pub peak_force_n: f64,
@@ -31,8 +32,15 @@ pub struct DeviceModel {
     pub g: DMatrix<f64>,
     /// Velocity output matrix `C_v` (2 x n): rows `v_h` and `-v_a`.
     pub c_v: DMatrix<f64>,
-    /// Strain-gauge output matrix `C_f` (1 x n, N/m).
+    /// Strain-gauge output matrix `C_f` (1 x n, N/m); zeros where the
+    /// device has no force sensor.
     pub c_f: DMatrix<f64>,
+    /// Whether the device has a force sensor (`C_f` given). Without one an
+    /// admittance display cannot be built.
+    pub force_sensor: bool,
+    /// Measurement-to-actuation delay in whole ticks (0: the force is held
+    /// from the tick that sampled the sensors).
+    pub delay_samples: u32,
 }
 
 /// Why a model file was refused. The message names the file, and the line
@@ -58,7 +66,7 @@ impl std::error::Error for ModelError {}
 struct RawModel {
     name: Option<String>,
     period_s: f64,
-    load_cell_pole_rad_s: f64,
+    load_cell_pole_rad_s: Option<f64>,
     peak_force_n: f64,
     continuous_force_n: f64,
     #[serde(rename = "M")]
@@ -72,8 +80,15 @@ struct RawModel {
     #[serde(rename = "C_v")]
     c_v: Vec<Vec<f64>>,
     #[serde(rename = "C_f")]
-    c_f: Vec<Vec<f64>>,
+    c_f: Option<Vec<Vec<f64>>>,
+    delay_samples: Option<u32>,
 }
+
+/// The filter pole a model without a force sensor is given (rad/s).
+pub const DEFAULT_LOAD_CELL_POLE_RAD_S: f64 = 235.0;
+
+/// The longest measurement-to-actuation delay a model may declare (ticks).
+pub const MAX_DELAY_SAMPLES: u32 = 64;
 
 /// Where the paper's Excalibur model lives in this repository.
 pub const EXCALIBUR_PATH: &str = "models/excalibur.toml";
@@ -130,20 +145,42 @@ impl DeviceModel {
                 "M is empty: the model needs at least one coordinate".into()
             ));
         }
+        let pole = match (&raw.c_f, raw.load_cell_pole_rad_s) {
+            (Some(_), None) => {
+                return Err(err(
+                    "C_f is given but load_cell_pole_rad_s is not: a force sensor needs its filter pole"
+                        .into(),
+                ))
+            }
+            (_, Some(p)) => scalar("load_cell_pole_rad_s", p).map_err(&err)?,
+            (None, None) => DEFAULT_LOAD_CELL_POLE_RAD_S,
+        };
+        let c_f = match &raw.c_f {
+            Some(rows) => matrix("C_f", rows, 1, n, n).map_err(&err)?,
+            None => DMatrix::zeros(1, n),
+        };
         let model = DeviceModel {
             name: raw.name.unwrap_or_else(|| source.to_string()),
             period_s: scalar("period_s", raw.period_s).map_err(&err)?,
-            load_cell_pole_rad_s: scalar("load_cell_pole_rad_s", raw.load_cell_pole_rad_s)
-                .map_err(&err)?,
+            load_cell_pole_rad_s: pole,
             peak_force_n: scalar("peak_force_n", raw.peak_force_n).map_err(&err)?,
             continuous_force_n: scalar("continuous_force_n", raw.continuous_force_n)
                 .map_err(&err)?,
-            m: matrix("M", &raw.m, n, n).map_err(&err)?,
-            d: matrix("D", &raw.d, n, n).map_err(&err)?,
-            k: matrix("K", &raw.k, n, n).map_err(&err)?,
-            g: matrix("G", &raw.g, n, 2).map_err(&err)?,
-            c_v: matrix("C_v", &raw.c_v, 2, n).map_err(&err)?,
-            c_f: matrix("C_f", &raw.c_f, 1, n).map_err(&err)?,
+            m: matrix("M", &raw.m, n, n, n).map_err(&err)?,
+            d: matrix("D", &raw.d, n, n, n).map_err(&err)?,
+            k: matrix("K", &raw.k, n, n, n).map_err(&err)?,
+            g: matrix("G", &raw.g, n, 2, n).map_err(&err)?,
+            c_v: matrix("C_v", &raw.c_v, 2, n, n).map_err(&err)?,
+            c_f,
+            force_sensor: raw.c_f.is_some(),
+            delay_samples: match raw.delay_samples {
+                Some(d) if d > MAX_DELAY_SAMPLES => {
+                    return Err(err(format!(
+                        "delay_samples = {d}: at most {MAX_DELAY_SAMPLES} ticks"
+                    )))
+                }
+                d => d.unwrap_or(0),
+            },
         };
         model.check().map_err(err)?;
         Ok(model)
@@ -185,11 +222,18 @@ fn scalar(name: &str, v: f64) -> Result<f64, String> {
     }
 }
 
-fn matrix(name: &str, rows: &[Vec<f64>], r: usize, c: usize) -> Result<DMatrix<f64>, String> {
+/// `name` as an `r x c` matrix; `n` is the model's coordinate count (from
+/// `M`), named in the error.
+fn matrix(
+    name: &str,
+    rows: &[Vec<f64>],
+    r: usize,
+    c: usize,
+    n: usize,
+) -> Result<DMatrix<f64>, String> {
     if rows.len() != r {
         return Err(format!(
-            "{name} must be {r} x {c} (n = {} from M), but has {} rows",
-            if name == "M" { r } else { r.max(c) },
+            "{name} must be {r} x {c} (n = {n} from M), but has {} rows",
             rows.len()
         ));
     }
@@ -286,5 +330,36 @@ mod tests {
             .unwrap()
             + 1;
         assert!(e.contains(&format!("line {line}: invalid type")), "{e}");
+        let e = broken("C_f = [", "delay_samples = -1\nC_f = [");
+        assert!(
+            e.contains("delay_samples") || e.contains("invalid value"),
+            "{e}"
+        );
+        assert!(broken("C_f = [", "delay_samples = 65\nC_f = [").contains("at most 64"));
+        let e = broken("load_cell_pole_rad_s = 235.0\n", "");
+        assert!(e.contains("needs its filter pole"), "{e}");
+    }
+
+    /// A model without `C_f` has no force sensor; `delay_samples` defaults
+    /// to 0; a one-coordinate model's shape errors name n = 1.
+    #[test]
+    fn optional_force_sensor_and_delay() {
+        let rigid = "period_s = 0.001\npeak_force_n = 5.0\ncontinuous_force_n = 2.0\n\
+                     M = [[0.01]]\nD = [[0.5]]\nK = [[0.0]]\nG = [[1.0, -1.0]]\n\
+                     C_v = [[1.0], [-1.0]]\n";
+        let m = DeviceModel::from_toml(rigid, "r").unwrap();
+        assert!(!m.force_sensor);
+        assert_eq!(m.delay_samples, 0);
+        assert_eq!(m.c_f, DMatrix::zeros(1, 1));
+        let d = DeviceModel::from_toml(&format!("{rigid}delay_samples = 3\n"), "r").unwrap();
+        assert_eq!(d.delay_samples, 3);
+        assert!(DeviceModel::excalibur().unwrap().force_sensor);
+        let e = DeviceModel::from_toml(&rigid.replace("[[1.0], [-1.0]]", "[[1.0]]"), "r")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("C_v must be 2 x 1 (n = 1 from M), but has 1 rows"),
+            "{e}"
+        );
     }
 }

@@ -28,6 +28,8 @@ pub struct PlantPoint {
     pub xaa_d: Complex64,
     /// ZOH-exact held actuator force to sampled `f_m`, `F_ma^d(z)` (N/N).
     pub fma_d: Complex64,
+    /// The device's measurement-to-actuation delay `z^-d` (1 without one).
+    pub delay: Complex64,
 }
 
 /// A single-input single-output discrete system `c (zI - H)^-1 b` with `H`
@@ -224,6 +226,7 @@ pub struct Plant {
     modal: Option<Modal>,
     modes: Vec<Mode>,
     discrete_angles: Vec<f64>,
+    delay_samples: u32,
 }
 
 fn row_major(a: &DMatrix<f64>) -> Vec<f64> {
@@ -329,6 +332,7 @@ impl Plant {
             modal,
             modes,
             discrete_angles,
+            delay_samples: model.delay_samples,
         };
         plant.keep_modal_if_exact();
         Ok(plant)
@@ -363,6 +367,11 @@ impl Plant {
     /// LU at each frequency (the fallback for nearly defective models).
     pub fn uses_modal_form(&self) -> bool {
         self.modal.is_some()
+    }
+
+    /// The device's measurement-to-actuation delay (ticks).
+    pub fn delay_samples(&self) -> u32 {
+        self.delay_samples
     }
 
     /// The sample period (s).
@@ -468,6 +477,7 @@ impl Plant {
             f,
             xaa_d: self.xaa.eval(z, work),
             fma_d: self.fma.eval(z, work),
+            delay: z.powi(-(self.delay_samples as i32)),
         }
     }
 
@@ -475,25 +485,33 @@ impl Plant {
     /// `K_p` (the admittance display with the VE port held): the loop is
     /// stable iff it is < 1. `K_p` is realised from its own z-domain form.
     pub fn regulated_pole_radius(&self, kp: &twoport_control::ZTransfer) -> f64 {
+        use crate::rational::{delayed, from_tf, realise};
         let n = self.xaa.n;
-        let (b0, b1, b2) = (kp.num[0], kp.num[1], kp.num[2]);
-        let (a1, a2) = (kp.den[1], kp.den[2]);
-        // K_p in transposed direct form II: states s1, s2.
-        let bk = [b1 - a1 * b0, b2 - a2 * b0];
+        // K_p z^-d in transposed direct form II.
+        let (num, den) = from_tf(kp);
+        let Ok(k) = realise(&delayed(&num, self.delay_samples as usize), &den) else {
+            return f64::INFINITY;
+        };
+        let nk = k.b.len();
         let h = &self.xaa;
-        let mut a = DMatrix::<f64>::zeros(n + 2, n + 2);
+        let mut a = DMatrix::<f64>::zeros(n + nk, n + nk);
         for r in 0..n {
             for c in 0..n {
                 // e = x_a - x_cmd = -(c x) with the VE port held.
-                a[(r, c)] = h.h[r * n + c] - b0 * h.b[r] * h.c[c];
+                a[(r, c)] = h.h[r * n + c] - k.d * h.b[r] * h.c[c];
             }
-            a[(r, n)] = h.b[r];
-            a[(n, r)] = -bk[0] * h.c[r];
-            a[(n + 1, r)] = -bk[1] * h.c[r];
+            for j in 0..nk {
+                a[(r, n + j)] = h.b[r] * k.c[j];
+            }
         }
-        a[(n, n)] = -a1;
-        a[(n, n + 1)] = 1.0;
-        a[(n + 1, n)] = -a2;
+        for i in 0..nk {
+            for c in 0..n {
+                a[(n + i, c)] = -k.b[i] * h.c[c];
+            }
+            for j in 0..nk {
+                a[(n + i, n + j)] = k.a[(i, j)];
+            }
+        }
         a.complex_eigenvalues()
             .iter()
             .map(|l| l.norm())

@@ -84,7 +84,8 @@ fn impedance_alias_terms(al: &[Alias], p: &PlantPoint, n: usize) -> f64 {
     let t = p.period_s;
     let th = p.omega * t;
     let s2 = 4.0 * (0.5 * th).sin().powi(2);
-    let rot = Complex64::from_polar(1.0, -th);
+    // e^{-jθ} from the hold and the first difference, times the delay.
+    let rot = Complex64::from_polar(1.0, -th) * p.delay;
     let mut sum = 0.0;
     let mut tail_ratio = 0.0f64;
     for a in al {
@@ -149,7 +150,7 @@ fn admittance_point(
     let t = p.period_s;
     let one = Complex64::new(1.0, 0.0);
     let diff = (one - p.z.inv()).norm();
-    let k = kp.eval(p.z);
+    let k = kp.eval(p.z) * p.delay;
     // Σ |α_k| |w_k| / |1 - z^-1| and Σ |φ_k| |w_k| / |1 - z^-1|, with
     // |w_k| <= 1/R_k: the aliased hand's reach into -x_a* and f_m* per unit
     // held force.

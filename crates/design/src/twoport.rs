@@ -6,7 +6,7 @@ use num_complex::Complex64;
 use twoport_control::ZTransfer;
 
 /// The human operator's bound `Z_max(s) = b + k/s` (N s/m), or none.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct HumanBound {
     /// Damping (N s/m).
     pub damping_nspm: f64,
@@ -36,13 +36,14 @@ fn y_hh(p: &PlantPoint, human: Option<HumanBound>) -> Complex64 {
 }
 
 /// The impedance display's hybrid form without the coupling (section 3):
-/// `[[Y_hh, Y_hc], [Y_ch*, Y_cc*]]`.
+/// `[[Y_hh, Y_hc], [Y_ch*, Y_cc*]]`. A measurement-to-actuation delay
+/// `z^-d` delays everything the coupling force drives (the second column).
 pub fn impedance_display(p: &PlantPoint, human: Option<HumanBound>) -> Matrix2 {
     [
-        [y_hh(p, human), p.y[0][1] * p.hold],
+        [y_hh(p, human), p.y[0][1] * p.hold * p.delay],
         [
             p.hold * p.y[1][0],
-            (Complex64::new(1.0, 0.0) - p.z.inv()) / p.period_s * p.xaa_d,
+            p.delay * (Complex64::new(1.0, 0.0) - p.z.inv()) / p.period_s * p.xaa_d,
         ],
     ]
 }
@@ -52,7 +53,8 @@ pub fn impedance_display(p: &PlantPoint, human: Option<HumanBound>) -> Matrix2 {
 /// `[[G_hh, G_hc], [G_ch*, G_cc*]]`.
 pub fn admittance_display(p: &PlantPoint, kp: &ZTransfer, human: Option<HumanBound>) -> Matrix2 {
     let one = Complex64::new(1.0, 0.0);
-    let k = kp.eval(p.z);
+    // A measurement-to-actuation delay acts as part of the regulator.
+    let k = kp.eval(p.z) * p.delay;
     let den = one + p.xaa_d * k;
     let x_ah = p.y[1][0] / p.s;
     let integ = p.period_s / (one - p.z.inv());
