@@ -341,13 +341,19 @@ fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
             v["b_c"] = json!(b);
         }
         None => {
-            v["message"] = json!(format!(
-                "no stiffness from {} to {} N/m meets the bound{}",
-                design::K_RANGE.0,
-                design::K_RANGE.1,
-                a.b.map(|b| format!(" at b_c = {b} N s/m"))
-                    .unwrap_or_default()
-            ))
+            v["message"] = json!(match design::low_frequency_obstacle(
+                &s.analysis,
+                &s.analysis.impedance_bound(s.human)
+            ) {
+                Some((f, b)) => low_frequency_text(f, b, "stiffness", "1/(N s/m)"),
+                None => format!(
+                    "no stiffness from {} to {} N/m meets the bound{}",
+                    design::K_RANGE.0,
+                    design::K_RANGE.1,
+                    a.b.map(|b| format!(" at b_c = {b} N s/m"))
+                        .unwrap_or_default()
+                ),
+            })
         }
     }
     s.emit(v.clone(), || {
@@ -362,6 +368,12 @@ fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
         println!("{}", binding_text(&v, "stiffness", "paper_k_c", "N/m"));
     });
     Ok(())
+}
+
+fn low_frequency_text(f_hz: f64, bound: f64, what: &str, unit: &str) -> String {
+    format!(
+        "no finite coupling {what} is absolutely stable: toward DC the bound stays positive ({bound:.4e} {unit} at {f_hz:.2e} Hz), while the coupling's real part goes to zero as the frequency does"
+    )
 }
 
 /// Why an admittance display cannot be built for `model`.
@@ -414,12 +426,19 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
             ))
         }
         None => {
-            v["message"] = json!(format!(
-                "no coupling mass from {} to {} kg meets the bound{}",
-                design::M_RANGE.0,
-                design::M_RANGE.1,
-                a.b.map(|b| format!(" at b_c = {b} N s/m")).unwrap_or_default()
-            ))
+            v["message"] = json!(match design::low_frequency_obstacle(
+                &s.analysis,
+                &s.analysis.admittance_bound(&k, s.human)
+            ) {
+                Some((f, b)) => low_frequency_text(f, b, "mass", "N s/m"),
+                None => format!(
+                    "no coupling mass from {} to {} kg meets the bound{}",
+                    design::M_RANGE.0,
+                    design::M_RANGE.1,
+                    a.b.map(|b| format!(" at b_c = {b} N s/m"))
+                        .unwrap_or_default()
+                ),
+            })
         }
     }
     s.emit(v.clone(), || {
