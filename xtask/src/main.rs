@@ -167,7 +167,7 @@ fn ci() -> Result<(), String> {
     // than the last crate's doc-test line. The long hard cases (24 h of
     // ticks, 2 x 10^4 random terminations) are ignored in debug builds and
     // run here in release.
-    let runs: [&[&str]; 3] = [
+    let runs: [&[&str]; 4] = [
         &[
             "test",
             "--release",
@@ -177,6 +177,15 @@ fn ci() -> Result<(), String> {
             "terminations",
             "--",
             "--ignored",
+        ],
+        // The designer's soundness: the verify searches run in release only.
+        &[
+            "test",
+            "--release",
+            "-p",
+            "twoport-design",
+            "--test",
+            "soundness",
         ],
         // The scope in a real window under Xvfb (screenshots) and an hour of
         // scope buffers.

@@ -345,7 +345,7 @@ fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
                 &s.analysis,
                 &s.analysis.impedance_bound(s.human)
             ) {
-                Some((f, b)) => low_frequency_text(f, b, "stiffness", "1/(N s/m)"),
+                Some(b) => low_frequency_text(b, "stiffness", "m/(N s)"),
                 None => format!(
                     "no stiffness from {} to {} N/m meets the bound{}",
                     design::K_RANGE.0,
@@ -370,9 +370,9 @@ fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
     Ok(())
 }
 
-fn low_frequency_text(f_hz: f64, bound: f64, what: &str, unit: &str) -> String {
+fn low_frequency_text(bound: f64, what: &str, unit: &str) -> String {
     format!(
-        "no finite coupling {what} is absolutely stable: toward DC the bound stays positive ({bound:.4e} {unit} at {f_hz:.2e} Hz), while the coupling's real part goes to zero as the frequency does"
+        "no finite coupling {what} is absolutely stable: toward DC the bound stays positive (its limit is {bound:.4e} {unit}), while the coupling's real part goes to zero as the frequency does"
     )
 }
 
@@ -430,7 +430,7 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
                 &s.analysis,
                 &s.analysis.admittance_bound(&k, s.human)
             ) {
-                Some((f, b)) => low_frequency_text(f, b, "mass", "N s/m"),
+                Some(b) => low_frequency_text(b, "mass", "N s/m"),
                 None => format!(
                     "no coupling mass from {} to {} kg meets the bound{}",
                     design::M_RANGE.0,

@@ -1,0 +1,193 @@
+//! The designer's proofs hold for the exact sampled-data loop: checked
+//! against closed forms (Colgate's passivity bound for a rigid device, with
+//! and without a delay), against the grid's ends, and against `verify`, a
+//! counterexample search on the exact discrete closed loop that shares
+//! nothing with the two-port analysis but the device model and the laws.
+//!
+//! The `verify` runs take about half a second each in release and much
+//! longer in a debug build, so they are ignored there; CI runs them in
+//! release.
+
+use twoport_design::design::*;
+use twoport_design::twoport::HumanBound;
+use twoport_design::verify::{verify, Gains};
+use twoport_design::{DeviceModel, Plant};
+
+const T: f64 = 1e-3;
+const HUMAN: Option<HumanBound> = Some(HumanBound::PAPER);
+
+/// A rigid 1-DOF device, handle and actuator at one point.
+fn rigid(mass_kg: f64, damping_nspm: f64, delay: u32) -> DeviceModel {
+    DeviceModel::from_toml(
+        &format!(
+            "period_s = 0.001\npeak_force_n = 50.0\ncontinuous_force_n = 20.0\n\
+             delay_samples = {delay}\nM = [[{mass_kg}]]\nD = [[{damping_nspm}]]\n\
+             K = [[0.0]]\nG = [[1.0, -1.0]]\nC_v = [[1.0], [-1.0]]\n"
+        ),
+        "rigid",
+    )
+    .unwrap()
+}
+
+fn analysis(m: &DeviceModel, spec: GridSpec) -> Analysis {
+    Analysis::new(&Plant::new(m, T).unwrap(), spec)
+}
+
+fn excalibur() -> DeviceModel {
+    DeviceModel::excalibur().unwrap()
+}
+
+/// Colgate & Schenkel: the rigid device with the virtual wall
+/// `K + B (1 - z^-1)/T` is passive iff `b > K T/2 + B`, whatever its mass.
+/// The designer's greatest stiffness is that bound at every coupling
+/// damping; the paper's approximation claims more as soon as `B > 0`.
+#[test]
+fn rigid_device_meets_colgates_closed_form() {
+    for (m, b) in [(1.0, 20.0), (0.05, 2.0)] {
+        let a = analysis(&rigid(m, b, 0), GridSpec::DEFAULT);
+        let bound = a.impedance_bound(None);
+        let paper = a.paper_impedance_bound(None);
+        for frac in [0.0, 0.1, 0.25, 0.5] {
+            let bc = frac * b;
+            let want = 2.0 * (b - bc) / T;
+            let k = max_stiffness(&a, &bound, bc).unwrap();
+            assert!(
+                k <= want * (1.0 + 1e-6) && k >= want * 0.995,
+                "m {m} b {b} b_c {bc}: {k} vs {want}"
+            );
+            let kp = max_stiffness(&a, &paper, bc).unwrap();
+            if frac > 0.0 {
+                assert!(kp > 1.1 * k, "the approximation: {kp} vs {k}");
+            }
+        }
+    }
+}
+
+/// With a delay of `d` ticks and every passive VE behind the coupling, the
+/// exact bound on the rigid device is `k_c T < 2 b/(d + 1)²` at `b_c = 0`
+/// (the all-VE form of Colgate's `K T (2d + 1)/2 < b`, which holds for the
+/// rigid VE alone).
+#[test]
+fn rigid_device_with_a_delay() {
+    for d in [1u32, 2, 3] {
+        let a = analysis(&rigid(1.0, 20.0, d), GridSpec::DEFAULT);
+        let k = max_stiffness(&a, &a.impedance_bound(None), 0.0).unwrap();
+        let want = 2.0 * 20.0 / ((d as f64 + 1.0).powi(2) * T);
+        assert!(
+            k <= want * (1.0 + 1e-6) && k >= 0.995 * want,
+            "d {d}: {k} vs {want}"
+        );
+    }
+}
+
+/// The issue's case: 40,000 N/m at 10 N s/m on the rigid device is refused
+/// (the paper's approximation called it proven), and the proven stiffness
+/// there is Colgate's 20,000 N/m.
+#[test]
+fn check_refuses_the_rigid_counterexample_gains() {
+    let a = analysis(&rigid(1.0, 20.0, 0), GridSpec::DEFAULT);
+    let c = check_impedance(&a, 40_000.0, 10.0, None).unwrap();
+    assert!(!c.absolutely_stable, "{c:?}");
+    assert!(c.paper.absolutely_stable, "{c:?}");
+    assert!((c.worst_frequency_hz - 500.0).abs() < 1.0, "{c:?}");
+    assert!(
+        check_impedance(&a, 19_900.0, 10.0, None)
+            .unwrap()
+            .absolutely_stable
+    );
+}
+
+/// No result is set by the grid's lowest frequency: starting it ten times
+/// lower moves nothing (both displays, with and without the human bound,
+/// the Excalibur and the rigid device), and the designs the low-frequency
+/// limit forbids stay infeasible.
+#[test]
+fn results_do_not_move_with_the_grids_start() {
+    let lower = GridSpec::DEFAULT.from_hz(GridSpec::DEFAULT.f_min_hz / 10.0);
+    let kp = regulator_tf(51_000.0, 90.0, T).unwrap();
+    for model in [excalibur(), rigid(1.0, 20.0, 0)] {
+        let (a, b) = (analysis(&model, GridSpec::DEFAULT), analysis(&model, lower));
+        for human in [HUMAN, None] {
+            for bc in [1.0, 10.0, 90.0] {
+                let k1 = max_stiffness(&a, &a.impedance_bound(human), bc);
+                let k2 = max_stiffness(&b, &b.impedance_bound(human), bc);
+                match (k1, k2) {
+                    (Some(x), Some(y)) => {
+                        assert!((x - y).abs() <= 1e-4 * x, "{}: {x} vs {y}", model.name)
+                    }
+                    (x, y) => assert_eq!(x, y),
+                }
+            }
+            if model.force_sensor {
+                for bc in [500.0, 1000.0] {
+                    let m1 = min_mass(&a, &a.admittance_bound(&kp, human), bc);
+                    let m2 = min_mass(&b, &b.admittance_bound(&kp, human), bc);
+                    match (m1, m2) {
+                        (Some(x), Some(y)) => assert!((x - y).abs() <= 1e-4 * x, "{x} vs {y}"),
+                        (x, y) => assert_eq!(x, y, "b_c {bc}, human {human:?}"),
+                    }
+                }
+            }
+        }
+    }
+    // The issue's case: no finite mass, for the low-frequency reason.
+    let a = analysis(&excalibur(), GridSpec::DEFAULT);
+    let bound = a.admittance_bound(&kp, None);
+    assert_eq!(min_mass(&a, &bound, 1000.0), None);
+    let b = low_frequency_obstacle(&a, &bound).expect("the DC limit forbids it");
+    assert!(b > 50.0, "{b}");
+    // With the human bound the limit is no obstacle.
+    assert!(low_frequency_obstacle(&a, &a.admittance_bound(&kp, HUMAN)).is_none());
+}
+
+/// A designed gain `verify` cannot break, and one 20% past it that it does.
+fn assert_tight(model: &DeviceModel, designed: Gains, past: Gains, human: Option<HumanBound>) {
+    let at = verify(model, T, &designed, human, model.delay_samples as usize).unwrap();
+    assert!(
+        !at.unstable,
+        "{}: {designed:?} broken by {at:?}",
+        model.name
+    );
+    let over = verify(model, T, &past, human, model.delay_samples as usize).unwrap();
+    assert!(
+        over.unstable,
+        "{}: nothing breaks {past:?}: {over:?}",
+        model.name
+    );
+}
+
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn verify_finds_nothing_at_the_excalibur_designs_and_breaks_them_past() {
+    let m = excalibur();
+    let a = analysis(&m, GridSpec::DEFAULT);
+    for human in [HUMAN, None] {
+        let k = max_stiffness(&a, &a.impedance_bound(human), 90.0).unwrap();
+        let g = |k_npm| Gains::Impedance {
+            k_npm,
+            b_nspm: 90.0,
+        };
+        assert_tight(&m, g(k), g(1.2 * k), human);
+    }
+    let kp = regulator_tf(51_000.0, 90.0, T).unwrap();
+    let mass = min_mass(&a, &a.admittance_bound(&kp, HUMAN), 500.0).unwrap();
+    let g = |m_kg| Gains::Admittance {
+        kp_npm: 51_000.0,
+        bp_nspm: 90.0,
+        m_kg,
+        b_nspm: 500.0,
+    };
+    assert_tight(&m, g(mass), g(mass / 1.2), HUMAN);
+}
+
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn verify_breaks_the_rigid_counterexample_and_not_the_design() {
+    let m = rigid(1.0, 20.0, 0);
+    let g = |k_npm, b_nspm| Gains::Impedance { k_npm, b_nspm };
+    let v = verify(&m, T, &g(40_000.0, 10.0), None, 0).unwrap();
+    assert!(v.unstable && (v.frequency_hz - 500.0).abs() < 5.0, "{v:?}");
+    let a = analysis(&m, GridSpec::DEFAULT);
+    let (k, b) = best_impedance(&a, &a.impedance_bound(None)).unwrap();
+    assert_tight(&m, g(k, b), g(1.2 * k, b), None);
+}
