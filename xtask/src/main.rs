@@ -175,6 +175,8 @@ fn ci() -> Result<(), String> {
             "hard_cases",
             "--test",
             "terminations",
+            "--test",
+            "verify_time_domain",
             "--",
             "--ignored",
         ],

@@ -1,0 +1,115 @@
+//! `twoport verify`'s counterexamples are real: the termination it names,
+//! simulated by host-sim with the board's own f32 servo (not the z-forms
+//! `verify` analyses), grows at the rate the spectral radius says, and the
+//! same termination at the designed gain does not.
+
+use host_sim::human::{Event, GraspKind};
+use host_sim::plant::Arm;
+use host_sim::scene::{Discretization, VeSpec};
+use host_sim::{Scene, Simulation};
+use std::path::Path;
+use twoport_design::design::*;
+use twoport_design::twoport::HumanBound;
+use twoport_design::verify::{radius, verify, Gains, Ve};
+use twoport_design::{DeviceModel, Plant};
+
+const T: f64 = 1e-3;
+
+fn scene(k: f64, b: f64, hand: &twoport_design::verify::Hand, ve: &Ve) -> Scene {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut s = Scene::load(
+        &root.join("scenes/table1/impedance_bilateral_hands_off.toml"),
+        &[],
+    )
+    .unwrap();
+    s.plant.model = root.join("models/excalibur.toml");
+    s.coupling.k = Some(k);
+    s.coupling.b = b;
+    s.duration_s = 6.0;
+    assert!(
+        hand.grasp.is_some(),
+        "the simulator's hand is the grasp plus an arm"
+    );
+    s.human.grasp = GraspKind::Maximum;
+    s.human.arm = Some(Arm {
+        mass_kg: hand.mass_kg,
+        damping_nspm: hand.damping_nspm,
+        stiffness_npm: hand.stiffness_npm,
+    });
+    s.ve = match *ve {
+        Ve::TrapezoidalSpring {
+            stiffness_npm,
+            damping_nspm,
+        } => VeSpec::Spring {
+            anchor_m: 0.0,
+            stiffness_npm,
+            damping_nspm,
+            discretization: Discretization::Trapezoidal,
+        },
+        Ve::Spring {
+            stiffness_npm,
+            damping_nspm,
+        } => VeSpec::Spring {
+            anchor_m: 0.0,
+            stiffness_npm,
+            damping_nspm,
+            discretization: Discretization::BackwardEuler,
+        },
+        Ve::Cursor { mass_kg } => VeSpec::Cursor { mass_kg },
+        Ve::Constraint => VeSpec::Bilateral,
+    };
+    s.human.script = vec![Event::Force {
+        at_s: 0.05,
+        force_n: 2.0,
+        for_s: 0.005,
+    }];
+    s
+}
+
+/// Peak |actuator force| in a window of the run (N).
+fn peaks(s: Scene, windows: &[(f64, f64)]) -> Vec<f64> {
+    let mut out = vec![0.0f64; windows.len()];
+    Simulation::new(s).unwrap().run(|x| {
+        for (o, (a, b)) in out.iter_mut().zip(windows) {
+            if x.t_s >= *a && x.t_s < *b {
+                *o = o.max(x.actuator_n.abs());
+            }
+        }
+    });
+    out
+}
+
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn verifys_counterexample_grows_in_the_simulator_at_its_rate() {
+    let model = DeviceModel::excalibur().unwrap();
+    let a = Analysis::new(&Plant::new(&model, T).unwrap(), GridSpec::DEFAULT);
+    let human = Some(HumanBound::PAPER);
+    let k_max = max_stiffness(&a, &a.impedance_bound(human), 90.0).unwrap();
+    let past = Gains::Impedance {
+        k_npm: 1.2 * k_max,
+        b_nspm: 90.0,
+    };
+    let v = verify(&model, T, &past, human, 0).unwrap();
+    assert!(v.unstable, "{v:?}");
+    let (hand, ve) = (v.termination.hand, v.termination.ve);
+    // Growth between two windows a second apart, against rho^(1 s / T).
+    let w = [(4.0, 4.5), (5.0, 5.5)];
+    let p = peaks(scene(1.2 * k_max, 90.0, &hand, &ve), &w);
+    let simulated = p[1] / p[0];
+    let predicted = v.spectral_radius.powf(1.0 / T);
+    eprintln!("growth per second: simulated x{simulated:.3}, verify x{predicted:.3}");
+    assert!(
+        simulated > 1.5 && (simulated.ln() / predicted.ln() - 1.0).abs() < 0.15,
+        "simulated x{simulated:.3}/s, verify says x{predicted:.3}/s ({v:?}, peaks {p:?})"
+    );
+    // The same termination at 90% of the designed stiffness decays.
+    let below = Gains::Impedance {
+        k_npm: 0.9 * k_max,
+        b_nspm: 90.0,
+    };
+    let r = radius(&model, T, &below, &v.termination, 0).unwrap();
+    assert!(r.spectral_radius < 1.0, "{r:?}");
+    let p = peaks(scene(0.9 * k_max, 90.0, &hand, &ve), &w);
+    assert!(p[1] < p[0], "decays at 0.9 k_max: {p:?}");
+}
