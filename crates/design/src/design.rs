@@ -126,6 +126,11 @@ impl Analysis {
         }
     }
 
+    /// The device this analysis is of.
+    pub fn plant(&self) -> &Plant {
+        &self.plant
+    }
+
     /// The impedance-display bound on `Re(1/Z_cI)` at each grid point,
     /// sound for the sampled-data loop (aliasing at the handle port
     /// included, see [`crate::sampled`]): what designs and checks use.
@@ -282,28 +287,54 @@ pub fn low_frequency_obstacle(a: &Analysis, bound: &[f64]) -> Option<f64> {
     })
 }
 
+/// One design inequality per pose of the device: its analysis and bound.
+/// A coupling is proven for a device with several poses when it meets
+/// every pose's bound, so each limit below is the worst over the poses,
+/// and a design over `n` poses costs `n` single-pose designs.
+pub type Poses<'a> = [(&'a Analysis, &'a [f64])];
+
 /// The greatest `k_cI` (N/m) that meets the impedance-display bound with
 /// damping `b` (N s/m); `None` if even `k = 1 N/m` does not.
 pub fn max_stiffness(a: &Analysis, bound: &[f64], b_nspm: f64) -> Option<f64> {
-    let t = a.period_s;
-    largest(K_RANGE.0, K_RANGE.1, |k| {
-        impedance_coupling_tf(k, b_nspm, t)
-            .map(|tf| slack(a, bound, |z| tf.eval(z).inv().re) >= 0.0)
-            .unwrap_or(false)
-    })
+    max_stiffness_poses(&[(a, bound)], b_nspm)
+}
+
+/// [`max_stiffness`] over every pose: the least of their limits.
+pub fn max_stiffness_poses(poses: &Poses, b_nspm: f64) -> Option<f64> {
+    poses
+        .iter()
+        .map(|(a, bound)| {
+            let t = a.period_s;
+            largest(K_RANGE.0, K_RANGE.1, |k| {
+                impedance_coupling_tf(k, b_nspm, t)
+                    .map(|tf| slack(a, bound, |z| tf.eval(z).inv().re) >= 0.0)
+                    .unwrap_or(false)
+            })
+        })
+        .try_fold(f64::INFINITY, |acc, k| k.map(|k| acc.min(k)))
 }
 
 /// The least `m_cA` (kg) that meets the admittance-display bound with
 /// damping `b` (N s/m); `None` if no mass up to 10^4 kg does.
 pub fn min_mass(a: &Analysis, bound: &[f64], b_nspm: f64) -> Option<f64> {
-    let t = a.period_s;
-    let ok = |m: f64| {
-        admittance_coupling_tf(m, b_nspm, t)
-            .map(|tf| slack(a, bound, |z| tf.eval(z).re) >= 0.0)
-            .unwrap_or(false)
-    };
-    // Heavier is more stable: search 1/m for the largest feasible.
-    largest(1.0 / M_RANGE.1, 1.0 / M_RANGE.0, |inv| ok(1.0 / inv)).map(|inv| 1.0 / inv)
+    min_mass_poses(&[(a, bound)], b_nspm)
+}
+
+/// [`min_mass`] over every pose: the greatest of their limits.
+pub fn min_mass_poses(poses: &Poses, b_nspm: f64) -> Option<f64> {
+    poses
+        .iter()
+        .map(|(a, bound)| {
+            let t = a.period_s;
+            let ok = |m: f64| {
+                admittance_coupling_tf(m, b_nspm, t)
+                    .map(|tf| slack(a, bound, |z| tf.eval(z).re) >= 0.0)
+                    .unwrap_or(false)
+            };
+            // Heavier is more stable: search 1/m for the largest feasible.
+            largest(1.0 / M_RANGE.1, 1.0 / M_RANGE.0, |inv| ok(1.0 / inv)).map(|inv| 1.0 / inv)
+        })
+        .try_fold(0.0f64, |acc, m| m.map(|m| acc.max(m)))
 }
 
 /// Maximise `score(b)` over `B_RANGE` on a log scan refined by golden
@@ -344,15 +375,32 @@ fn best_over_b(score: impl Fn(f64) -> Option<f64>) -> Option<(f64, f64)> {
 }
 
 /// The best impedance coupling: the `(k_cI, b_cI)` with the greatest
-/// stiffness that meets the bound.
+/// stiffness that meets the bound. No coupling damping at all is a
+/// candidate too: on a lightly damped device any `b_cI` costs stiffness
+/// (Colgate's `b > K T/2 + B`).
 pub fn best_impedance(a: &Analysis, bound: &[f64]) -> Option<(f64, f64)> {
-    best_over_b(|b| max_stiffness(a, bound, b)).map(|(b, k)| (k, b))
+    best_impedance_poses(&[(a, bound)])
+}
+
+/// [`best_impedance`] over every pose.
+pub fn best_impedance_poses(poses: &Poses) -> Option<(f64, f64)> {
+    let scanned = best_over_b(|b| max_stiffness_poses(poses, b)).map(|(b, k)| (k, b));
+    let undamped = max_stiffness_poses(poses, 0.0).map(|k| (k, 0.0));
+    match (scanned, undamped) {
+        (Some(s), Some(u)) if u.0 > s.0 => Some(u),
+        (s, u) => s.or(u),
+    }
 }
 
 /// The best admittance coupling: the `(m_cA, b_cA)` with the least mass
 /// that meets the bound.
 pub fn best_admittance(a: &Analysis, bound: &[f64]) -> Option<(f64, f64)> {
-    best_over_b(|b| min_mass(a, bound, b).map(|m| -m)).map(|(b, m)| (-m, b))
+    best_admittance_poses(&[(a, bound)])
+}
+
+/// [`best_admittance`] over every pose.
+pub fn best_admittance_poses(poses: &Poses) -> Option<(f64, f64)> {
+    best_over_b(|b| min_mass_poses(poses, b).map(|m| -m)).map(|(b, m)| (-m, b))
 }
 
 /// Result of an absolute-stability check.
@@ -560,7 +608,12 @@ pub fn region_impedance(
     range: (f64, f64),
     points: usize,
 ) -> Vec<(f64, f64)> {
-    region(range, points, |b| max_stiffness(a, bound, b))
+    region_impedance_poses(&[(a, bound)], range, points)
+}
+
+/// [`region_impedance`] over every pose.
+pub fn region_impedance_poses(poses: &Poses, range: (f64, f64), points: usize) -> Vec<(f64, f64)> {
+    region(range, points, |b| max_stiffness_poses(poses, b))
 }
 
 /// The proven region for a board's admittance display (one regulator):
@@ -571,7 +624,12 @@ pub fn region_admittance(
     range: (f64, f64),
     points: usize,
 ) -> Vec<(f64, f64)> {
-    region(range, points, |b| min_mass(a, bound, b))
+    region_admittance_poses(&[(a, bound)], range, points)
+}
+
+/// [`region_admittance`] over every pose.
+pub fn region_admittance_poses(poses: &Poses, range: (f64, f64), points: usize) -> Vec<(f64, f64)> {
+    region(range, points, |b| min_mass_poses(poses, b))
 }
 
 fn region(

@@ -5,6 +5,7 @@ use serde_json::{json, Value};
 use std::f64::consts::PI;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use twoport_control::ZTransfer;
 use twoport_design::design::{self, Analysis, GridSpec};
 use twoport_design::twoport::HumanBound;
 use twoport_design::{figures, plot, DeviceModel, Plant};
@@ -24,8 +25,10 @@ struct Cli {
 #[derive(Args, Clone)]
 struct Common {
     /// Device model file (TOML). The default is the paper's Excalibur.
-    #[arg(long, default_value = DEFAULT_MODEL)]
-    model: PathBuf,
+    /// Give it more than once for a device with several poses: a design
+    /// is then proven for all of them.
+    #[arg(long, default_value = DEFAULT_MODEL, action = clap::ArgAction::Append)]
+    model: Vec<PathBuf>,
     /// Sample period (s); the model's by default.
     #[arg(long, allow_negative_numbers = true)]
     period: Option<f64>,
@@ -205,38 +208,172 @@ struct PlotArgs {
     common: Common,
 }
 
-/// The model, the plant at the period, and the design grid.
-struct Session {
+/// One pose of the device: its model, the plant at the period, and the
+/// design grid.
+struct Pose {
     model: DeviceModel,
     plant: Plant,
     analysis: Analysis,
+}
+
+/// The poses a command works on.
+struct Session {
+    poses: Vec<Pose>,
     human: Option<HumanBound>,
     json: bool,
 }
 
 impl Session {
     fn open(c: &Common) -> Result<Self, String> {
-        let model = DeviceModel::load_or_excalibur(&c.model).map_err(|e| e.to_string())?;
-        let period = c.period.unwrap_or(model.period_s);
+        let mut models = Vec::with_capacity(c.model.len());
+        for path in &c.model {
+            let m = DeviceModel::load_or_excalibur(path).map_err(|e| e.to_string())?;
+            models.push((path, m));
+        }
+        let period = match c.period {
+            Some(p) => p,
+            None => {
+                let (p0, m0) = &models[0];
+                for (p, m) in &models[1..] {
+                    if m.period_s != m0.period_s {
+                        return Err(format!(
+                            "{} has period_s = {} but {} has {}: poses share one board, give --period",
+                            p.display(),
+                            m.period_s,
+                            p0.display(),
+                            m0.period_s
+                        ));
+                    }
+                }
+                m0.period_s
+            }
+        };
         if !(period.is_finite() && period > 0.0) {
             return Err(format!(
                 "--period {period}: must be a positive number of seconds"
             ));
         }
-        let plant =
-            Plant::new(&model, period).map_err(|e| format!("{}: {e}", c.model.display()))?;
-        let analysis = Analysis::new(&plant, GridSpec::DEFAULT);
+        let mut poses = Vec::with_capacity(models.len());
+        for (path, model) in models {
+            let plant =
+                Plant::new(&model, period).map_err(|e| format!("{}: {e}", path.display()))?;
+            let analysis = Analysis::new(&plant, GridSpec::DEFAULT);
+            poses.push(Pose {
+                model,
+                plant,
+                analysis,
+            });
+        }
         Ok(Session {
-            model,
-            plant,
-            analysis,
+            poses,
             human: (!c.no_human).then_some(HumanBound::PAPER),
             json: c.json,
         })
     }
 
+    /// The one pose of a command that takes one.
+    fn single(&self, command: &str) -> Result<&Pose, String> {
+        match self.poses.as_slice() {
+            [p] => Ok(p),
+            _ => Err(format!("{command} takes one --model")),
+        }
+    }
+
     fn period(&self) -> f64 {
-        self.plant.period_s()
+        self.poses[0].plant.period_s()
+    }
+
+    /// The device's name: its model's, or its poses'.
+    fn name(&self) -> String {
+        match self.poses.as_slice() {
+            [p] => p.model.name.clone(),
+            ps => format!(
+                "{} poses ({})",
+                ps.len(),
+                ps.iter()
+                    .map(|p| p.model.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ),
+        }
+    }
+
+    /// An admittance display needs a force sensor in every pose.
+    fn force_sensor(&self) -> Result<(), String> {
+        match self.poses.iter().find(|p| !p.model.force_sensor) {
+            Some(p) => Err(no_force_sensor(&p.model)),
+            None => Ok(()),
+        }
+    }
+
+    fn impedance_bounds(&self, paper: bool) -> Vec<Vec<f64>> {
+        self.poses
+            .iter()
+            .map(|p| {
+                if paper {
+                    p.analysis.paper_impedance_bound(self.human)
+                } else {
+                    p.analysis.impedance_bound(self.human)
+                }
+            })
+            .collect()
+    }
+
+    fn admittance_bounds(&self, kp: &ZTransfer, paper: bool) -> Vec<Vec<f64>> {
+        self.poses
+            .iter()
+            .map(|p| {
+                if paper {
+                    p.analysis.paper_admittance_bound(kp, self.human)
+                } else {
+                    p.analysis.admittance_bound(kp, self.human)
+                }
+            })
+            .collect()
+    }
+
+    /// Each pose's analysis beside its bound.
+    fn with<'a>(&'a self, bounds: &'a [Vec<f64>]) -> Vec<(&'a Analysis, &'a [f64])> {
+        self.poses
+            .iter()
+            .zip(bounds)
+            .map(|(p, b)| (&p.analysis, b.as_slice()))
+            .collect()
+    }
+
+    /// The regulated device's worst pole radius over the poses.
+    fn regulated_pole_radius(&self, kp: &ZTransfer) -> f64 {
+        self.poses
+            .iter()
+            .map(|p| p.plant.regulated_pole_radius(kp))
+            .fold(0.0, f64::max)
+    }
+
+    /// The check over every pose: stable where every pose is, with the
+    /// least margin and the pose that has it (the paper's figures likewise).
+    fn worst_check(
+        &self,
+        check: impl Fn(&Pose) -> Option<design::Check>,
+    ) -> Option<(design::Check, &str)> {
+        let mut all = Vec::with_capacity(self.poses.len());
+        for p in &self.poses {
+            all.push((check(p)?, p.model.name.as_str()));
+        }
+        let least = |key: fn(&design::Check) -> f64| {
+            all.iter()
+                .copied()
+                .min_by(|a, b| key(&a.0).total_cmp(&key(&b.0)))
+        };
+        let (mut c, name) = least(|c| c.min_margin)?;
+        let (paper, _) = least(|c| c.paper.min_margin)?;
+        c.absolutely_stable = all.iter().all(|x| x.0.absolutely_stable);
+        c.regulator_pole_radius = all
+            .iter()
+            .map(|x| x.0.regulator_pole_radius)
+            .fold(0.0, f64::max);
+        c.paper = paper.paper;
+        c.paper.absolutely_stable = all.iter().all(|x| x.0.paper.absolutely_stable);
+        Some((c, name))
     }
 
     fn human_text(&self) -> &'static str {
@@ -250,7 +387,7 @@ impl Session {
     fn header(&self, display: &str) {
         println!(
             "{display} display, {} at T = {} ms, {}",
-            self.model.name,
+            self.name(),
             self.period() * 1e3,
             self.human_text()
         );
@@ -276,17 +413,36 @@ fn gain(name: &str, v: f64) -> Result<f64, String> {
 
 fn impedance_design_on(
     s: &Session,
-    bound: &[f64],
+    bounds: &[Vec<f64>],
     b: Option<f64>,
 ) -> Result<Option<(f64, f64)>, String> {
+    let poses = s.with(bounds);
     Ok(match b {
-        Some(b) => design::max_stiffness(&s.analysis, bound, gain("b", b)?).map(|k| (k, b)),
-        None => design::best_impedance(&s.analysis, bound),
+        Some(b) => design::max_stiffness_poses(&poses, gain("b", b)?).map(|k| (k, b)),
+        None => design::best_impedance_poses(&poses),
     })
 }
 
 fn impedance_design(s: &Session, b: Option<f64>) -> Result<Option<(f64, f64)>, String> {
-    impedance_design_on(s, &s.analysis.impedance_bound(s.human), b)
+    impedance_design_on(s, &s.impedance_bounds(false), b)
+}
+
+/// Where a design binds: the pose (when there are several) and frequency.
+fn binding_pose(v: &mut Value, s: &Session, c: Option<(design::Check, &str)>) {
+    if let Some((c, name)) = c {
+        v["binding_frequency_hz"] = json!(c.worst_frequency_hz);
+        if s.poses.len() > 1 {
+            v["binding_pose"] = json!(name);
+        }
+    }
+}
+
+fn binding_pose_text(v: &Value) -> Option<String> {
+    let f = v["binding_frequency_hz"].as_f64()?;
+    Some(match v["binding_pose"].as_str() {
+        Some(p) => format!("  binds at {f:.2} Hz in pose {p}"),
+        None => format!("  binds at {f:.2} Hz"),
+    })
 }
 
 /// Which bound set a design, and by how much the paper's approximation
@@ -328,7 +484,7 @@ fn binding_text(v: &Value, what: &str, paper: &str, unit: &str) -> String {
 fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
     let s = Session::open(&a.common)?;
     let r = impedance_design(&s, a.b)?;
-    let paper = impedance_design_on(&s, &s.analysis.paper_impedance_bound(s.human), a.b)?;
+    let paper = impedance_design_on(&s, &s.impedance_bounds(true), a.b)?;
     let mut v = json!({"display": "impedance", "feasible": r.is_some(), "period_s": s.period(), "human_model": s.human.is_some()});
     if let Some((k, b)) = paper {
         v["paper_k_c"] = json!(k);
@@ -339,12 +495,16 @@ fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
         Some((k, b)) => {
             v["k_c"] = json!(k);
             v["b_c"] = json!(b);
+            let c = s.worst_check(|p| design::check_impedance(&p.analysis, k, b, s.human));
+            binding_pose(&mut v, &s, c);
         }
         None => {
-            v["message"] = json!(match design::low_frequency_obstacle(
-                &s.analysis,
-                &s.analysis.impedance_bound(s.human)
-            ) {
+            let bounds = s.impedance_bounds(false);
+            let obstacle = s
+                .with(&bounds)
+                .iter()
+                .find_map(|(a, b)| design::low_frequency_obstacle(a, b));
+            v["message"] = json!(match obstacle {
                 Some(b) => low_frequency_text(b, "stiffness", "m/(N s)"),
                 None => format!(
                     "no stiffness from {} to {} N/m meets the bound{}",
@@ -364,6 +524,9 @@ fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
             }
             Some((k, b)) => println!("  best coupling: k_c = {k:.0} N/m, b_c = {b:.1} N s/m"),
             None => println!("  infeasible: {}", v["message"].as_str().unwrap_or("")),
+        }
+        if let Some(t) = binding_pose_text(&v) {
+            println!("{t}");
         }
         println!("{}", binding_text(&v, "stiffness", "paper_k_c", "N/m"));
     });
@@ -386,28 +549,27 @@ fn no_force_sensor(model: &DeviceModel) -> String {
 
 fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
     let s = Session::open(&a.common)?;
-    if !s.model.force_sensor {
-        return Err(no_force_sensor(&s.model));
-    }
+    s.force_sensor()?;
     let (kp, bp) = match (a.kp, a.bp) {
         (Some(kp), Some(bp)) => (gain("kp", kp)?, gain("bp", bp)?),
         _ => impedance_design(&s, None)?
             .ok_or("no impedance design exists to take K_p from (eq 30); give --kp and --bp")?,
     };
     let k = design::regulator_tf(kp, bp, s.period()).map_err(|e| e.to_string())?;
-    let radius = s.plant.regulated_pole_radius(&k);
-    let design_on = |bound: &[f64]| -> Result<Option<(f64, f64)>, String> {
+    let radius = s.regulated_pole_radius(&k);
+    let design_on = |bounds: &[Vec<f64>]| -> Result<Option<(f64, f64)>, String> {
+        let poses = s.with(bounds);
         Ok(if radius >= 1.0 {
             None
         } else {
             match a.b {
-                Some(b) => design::min_mass(&s.analysis, bound, gain("b", b)?).map(|m| (m, b)),
-                None => design::best_admittance(&s.analysis, bound),
+                Some(b) => design::min_mass_poses(&poses, gain("b", b)?).map(|m| (m, b)),
+                None => design::best_admittance_poses(&poses),
             }
         })
     };
-    let r = design_on(&s.analysis.admittance_bound(&k, s.human))?;
-    let paper = design_on(&s.analysis.paper_admittance_bound(&k, s.human))?;
+    let r = design_on(&s.admittance_bounds(&k, false))?;
+    let paper = design_on(&s.admittance_bounds(&k, true))?;
     let mut v = json!({"display": "admittance", "feasible": r.is_some(), "kp": kp, "bp": bp,
         "period_s": s.period(), "human_model": s.human.is_some(), "regulator_pole_radius": radius});
     if let Some((m, b)) = paper {
@@ -419,6 +581,10 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
         Some((m, b)) => {
             v["m_c"] = json!(m);
             v["b_c"] = json!(b);
+            let c = s.worst_check(|p| {
+                design::check_admittance(&p.plant, &p.analysis, (kp, bp), (m, b), s.human)
+            });
+            binding_pose(&mut v, &s, c);
         }
         None if radius >= 1.0 => {
             v["message"] = json!(format!(
@@ -426,10 +592,12 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
             ))
         }
         None => {
-            v["message"] = json!(match design::low_frequency_obstacle(
-                &s.analysis,
-                &s.analysis.admittance_bound(&k, s.human)
-            ) {
+            let bounds = s.admittance_bounds(&k, false);
+            let obstacle = s
+                .with(&bounds)
+                .iter()
+                .find_map(|(a, b)| design::low_frequency_obstacle(a, b));
+            v["message"] = json!(match obstacle {
                 Some(b) => low_frequency_text(b, "mass", "N s/m"),
                 None => format!(
                     "no coupling mass from {} to {} kg meets the bound{}",
@@ -450,6 +618,9 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
             Some((m, b)) if a.b.is_some() => println!("  least m_c at b_c = {b} N s/m: {m:.3} kg"),
             Some((m, b)) => println!("  best coupling: m_c = {m:.3} kg, b_c = {b:.1} N s/m"),
             None => println!("  infeasible: {}", v["message"].as_str().unwrap_or("")),
+        }
+        if let Some(t) = binding_pose_text(&v) {
+            println!("{t}");
         }
         println!("{}", binding_text(&v, "mass", "paper_m_c", "kg"));
     });
@@ -500,11 +671,16 @@ fn check(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
         Display::Impedance(g) => {
             let s = Session::open(&g.common)?;
             let (k, b) = (gain("k", g.k)?, gain("b", g.b)?);
-            let c = design::check_impedance(&s.analysis, k, b, s.human).ok_or_else(|| {
-                format!("--k {k} --b {b}: not a valid coupling (k T + b must be > 0)")
-            })?;
+            let (c, pose) = s
+                .worst_check(|p| design::check_impedance(&p.analysis, k, b, s.human))
+                .ok_or_else(|| {
+                    format!("--k {k} --b {b}: not a valid coupling (k T + b must be > 0)")
+                })?;
             let mut v = check_json(&c);
             v["display"] = json!("impedance");
+            if s.poses.len() > 1 {
+                v["worst_pose"] = json!(pose);
+            }
             s.emit(v, || {
                 s.header("Impedance");
                 println!("  coupling k_c = {k} N/m, b_c = {b} N s/m");
@@ -513,18 +689,20 @@ fn check(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
         }
         Display::Admittance(g) => {
             let s = Session::open(&g.common)?;
-            if !s.model.force_sensor {
-                return Err(no_force_sensor(&s.model));
-            }
+            s.force_sensor()?;
             let kp = (gain("kp", g.kp)?, gain("bp", g.bp)?);
             let mb = (g.m, gain("b", g.b)?);
             if !(g.m.is_finite() && g.m > 0.0) {
                 return Err(format!("--m {}: must be a finite mass > 0 kg", g.m));
             }
-            let c = design::check_admittance(&s.plant, &s.analysis, kp, mb, s.human)
+            let (c, pose) = s
+                .worst_check(|p| design::check_admittance(&p.plant, &p.analysis, kp, mb, s.human))
                 .ok_or("--b must be > 0 for the admittance coupling")?;
             let mut v = check_json(&c);
             v["display"] = json!("admittance");
+            if s.poses.len() > 1 {
+                v["worst_pose"] = json!(pose);
+            }
             v["regulator_pole_radius"] = json!(c.regulator_pole_radius);
             s.emit(v, || {
                 s.header("Admittance");
@@ -546,10 +724,11 @@ fn zrange(d: &Display<ZrangeImpedance, ZrangeAdmittance>) -> Result<(), String> 
         return Err(format!("--points {points}: need at least 2"));
     }
     let s = Session::open(common)?;
-    let nyq = s.plant.nyquist();
+    let pose = s.single("zrange")?;
+    let nyq = pose.plant.nyquist();
     let lo = 2.0 * PI * 0.1;
     let omegas = design::log_grid(lo, nyq, points);
-    let a = Analysis::on(&s.plant, &omegas);
+    let a = Analysis::on(&pose.plant, &omegas);
     let range = match d {
         Display::Impedance(z) => {
             let (k, b) = (gain("k", z.gains.k)?, gain("b", z.gains.b)?);
@@ -586,19 +765,20 @@ fn zrange(d: &Display<ZrangeImpedance, ZrangeAdmittance>) -> Result<(), String> 
 
 fn plot_fig(p: &PlotArgs) -> Result<(), String> {
     let s = Session::open(&p.common)?;
+    let a = &s.single("plot")?.analysis;
     let t = s.period();
-    let bi = s.analysis.impedance_bound(Some(HumanBound::PAPER));
-    let (k, b) = design::max_stiffness(&s.analysis, &bi, gain("b-impedance", p.b_impedance)?)
+    let bi = a.impedance_bound(Some(HumanBound::PAPER));
+    let (k, b) = design::max_stiffness(a, &bi, gain("b-impedance", p.b_impedance)?)
         .map(|k| (k, p.b_impedance))
         .ok_or("no impedance coupling meets the bound at --b-impedance")?;
     let kp = design::regulator_tf(k, b, t).map_err(|e| e.to_string())?;
-    let ba = s.analysis.admittance_bound(&kp, Some(HumanBound::PAPER));
-    let m = design::min_mass(&s.analysis, &ba, gain("b-admittance", p.b_admittance)?)
+    let ba = a.admittance_bound(&kp, Some(HumanBound::PAPER));
+    let m = design::min_mass(a, &ba, gain("b-admittance", p.b_admittance)?)
         .ok_or("no admittance coupling meets the bound at --b-admittance")?;
     let fig = match p.figure {
-        Fig::Fig8 => figures::fig8(&s.analysis, k, b),
-        Fig::Fig9 => figures::fig9(&s.analysis, (k, b), (m, p.b_admittance)),
-        Fig::Fig10 => figures::fig10(&s.analysis, (k, b), (k, b), (m, p.b_admittance)),
+        Fig::Fig8 => figures::fig8(a, k, b),
+        Fig::Fig9 => figures::fig9(a, (k, b), (m, p.b_admittance)),
+        Fig::Fig10 => figures::fig10(a, (k, b), (k, b), (m, p.b_admittance)),
     }?;
     plot::render(&fig, &p.out)?;
     s.emit(
@@ -626,23 +806,21 @@ fn region(d: &Display<RegionImpedance, RegionAdmittance>) -> Result<(), String> 
     let s = Session::open(common)?;
     let (bound, rows, regulator) = match d {
         Display::Impedance(_) => {
-            let b = s.analysis.impedance_bound(s.human);
+            let b = s.impedance_bounds(false);
             (
                 "max_stiffness_npm",
-                design::region_impedance(&s.analysis, &b, (lo, hi), grid.points),
+                design::region_impedance_poses(&s.with(&b), (lo, hi), grid.points),
                 None,
             )
         }
         Display::Admittance(r) => {
-            if !s.model.force_sensor {
-                return Err(no_force_sensor(&s.model));
-            }
+            s.force_sensor()?;
             let (kp, bp) = (gain("kp", r.kp)?, gain("bp", r.bp)?);
             let k = design::regulator_tf(kp, bp, s.period()).map_err(|e| e.to_string())?;
-            let b = s.analysis.admittance_bound(&k, s.human);
+            let b = s.admittance_bounds(&k, false);
             (
                 "min_mass_kg",
-                design::region_admittance(&s.analysis, &b, (lo, hi), grid.points),
+                design::region_admittance_poses(&s.with(&b), (lo, hi), grid.points),
                 Some((kp, bp)),
             )
         }
@@ -697,20 +875,41 @@ fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
             )
         }
     };
-    let model = DeviceModel::load_or_excalibur(&common.model).map_err(|e| e.to_string())?;
-    let period = common.period.unwrap_or(model.period_s);
-    let human = (!common.no_human).then_some(HumanBound::PAPER);
-    if matches!(gains, Gains::Admittance { .. }) && !model.force_sensor {
-        return Err(no_force_sensor(&model));
+    let s = Session::open(common)?;
+    if matches!(gains, Gains::Admittance { .. }) {
+        s.force_sensor()?;
     }
-    let v = verify::verify(&model, period, &gains, human, model.delay_samples as usize)
-        .map_err(|e| format!("{}: {e}", common.model.display()))?;
+    let (period, human) = (s.period(), s.human);
+    let mut worst: Option<(verify::Verdict, &DeviceModel)> = None;
+    let mut evaluations = 0;
+    for p in &s.poses {
+        let v = verify::verify(
+            &p.model,
+            period,
+            &gains,
+            human,
+            p.model.delay_samples as usize,
+        )
+        .map_err(|e| format!("{}: {e}", p.model.name))?;
+        evaluations += v.evaluations;
+        if worst
+            .as_ref()
+            .is_none_or(|w| v.spectral_radius > w.0.spectral_radius)
+        {
+            worst = Some((v, &p.model));
+        }
+    }
+    let (mut v, model) = worst.ok_or("no pose to verify")?;
+    v.evaluations = evaluations;
     let display = match d {
         Display::Impedance(_) => "impedance",
         Display::Admittance(_) => "admittance",
     };
     let mut out = serde_json::to_value(v).map_err(|e| e.to_string())?;
     out["display"] = json!(display);
+    if s.poses.len() > 1 {
+        out["worst_pose"] = json!(model.name);
+    }
     out["human_model"] = json!(human.is_some());
     out["period_s"] = json!(period);
     if common.json {
@@ -718,7 +917,7 @@ fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
     } else {
         println!(
             "{display} display, {} at T = {} ms: {} closed loops searched",
-            model.name,
+            s.name(),
             period * 1e3,
             v.evaluations
         );

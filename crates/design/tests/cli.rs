@@ -270,3 +270,65 @@ fn region_tables_for_a_board() {
         .collect();
     assert!(m.iter().all(|x| (4.0..6.0).contains(x)), "{m:?}");
 }
+
+/// Several poses: the design is the worst pose's, names the pose that
+/// binds, and the commands that draw one device refuse several.
+#[test]
+fn several_poses_design_for_all() {
+    let k = |model: &[&str]| {
+        let mut args = vec!["design", "impedance", "--b", "90", "--json"];
+        for m in model {
+            args.extend(["--model", m]);
+        }
+        json(&args)
+    };
+    let (e, t) = (k(&["models/excalibur.toml"]), k(&["models/two_mass.toml"]));
+    let both = k(&["models/two_mass.toml", "models/excalibur.toml"]);
+    let (ke, kt, kb) = (
+        e["k_c"].as_f64().unwrap(),
+        t["k_c"].as_f64().unwrap(),
+        both["k_c"].as_f64().unwrap(),
+    );
+    assert_eq!(kb, ke.min(kt), "{both}");
+    let binding = if ke < kt { "Excalibur" } else { "Two-mass" };
+    assert!(
+        both["binding_pose"].as_str().unwrap().starts_with(binding),
+        "{both}"
+    );
+    assert!(both["binding_frequency_hz"].as_f64().unwrap() > 0.0);
+    let e = stderr_of_failure(&[
+        "zrange",
+        "impedance",
+        "--k",
+        "1000",
+        "--b",
+        "10",
+        "--model",
+        "models/excalibur.toml",
+        "--model",
+        "models/two_mass.toml",
+    ]);
+    assert!(e.contains("zrange takes one --model"), "{e}");
+}
+
+/// The rigid capstan has no force sensor: an admittance display is refused
+/// with the reason, and its impedance design is Colgate's 2b/T at b_c = 0,
+/// where the paper's approximation (aliasing neglected) proves more.
+#[test]
+fn a_device_without_a_force_sensor() {
+    let e = stderr_of_failure(&["design", "admittance", "--model", "models/capstan.toml"]);
+    assert!(e.contains("no force sensor"), "{e}");
+    let v = json(&[
+        "design",
+        "impedance",
+        "--no-human",
+        "--model",
+        "models/capstan.toml",
+        "--json",
+    ]);
+    let k = v["k_c"].as_f64().unwrap();
+    assert_eq!(v["b_c"], 0.0);
+    assert!((k - 2.0 * 2.0 / 1e-3).abs() < 0.002 * k, "{v}");
+    assert_eq!(v["binding_bound"], "sampled-data");
+    assert!(v["paper_k_c"].as_f64().unwrap() > 1.1 * k, "{v}");
+}
