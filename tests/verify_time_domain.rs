@@ -16,16 +16,7 @@ use twoport_design::{DeviceModel, Plant};
 const T: f64 = 1e-3;
 
 fn scene(k: f64, b: f64, hand: &twoport_design::verify::Hand, ve: &Ve) -> Scene {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut s = Scene::load(
-        &root.join("scenes/table1/impedance_bilateral_hands_off.toml"),
-        &[],
-    )
-    .unwrap();
-    s.plant.model = root.join("models/excalibur.toml");
-    s.coupling.k = Some(k);
-    s.coupling.b = b;
-    s.duration_s = 6.0;
+    let mut s = scene_on("models/excalibur.toml", k, b, ve);
     assert!(
         hand.grasp.is_some(),
         "the simulator's hand is the grasp plus an arm"
@@ -36,6 +27,22 @@ fn scene(k: f64, b: f64, hand: &twoport_design::verify::Hand, ve: &Ve) -> Scene 
         damping_nspm: hand.damping_nspm,
         stiffness_npm: hand.stiffness_npm,
     });
+    s
+}
+
+/// An impedance-display scene of the model file `model` (flexible, no
+/// other effect), hands off, with the VE `ve` and one small push.
+fn scene_on(model: &str, k: f64, b: f64, ve: &Ve) -> Scene {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut s = Scene::load(
+        &root.join("scenes/table1/impedance_bilateral_hands_off.toml"),
+        &[],
+    )
+    .unwrap();
+    s.plant.model = root.join(model);
+    s.coupling.k = Some(k);
+    s.coupling.b = b;
+    s.duration_s = 6.0;
     s.ve = match *ve {
         Ve::TrapezoidalSpring {
             stiffness_npm,
@@ -112,4 +119,45 @@ fn verifys_counterexample_grows_in_the_simulator_at_its_rate() {
     assert!(r.spectral_radius < 1.0, "{r:?}");
     let p = peaks(scene(0.9 * k_max, 90.0, &hand, &ve), &w);
     assert!(p[1] < p[0], "decays at 0.9 k_max: {p:?}");
+}
+
+/// A device that declares a measurement-to-actuation delay runs it in the
+/// simulator too: a rigid 1 kg, 20 N s/m handle with a one-tick delay is
+/// proven to 10,000 N/m (2b/((d+1)^2 T)); verify breaks 13,000 N/m with a
+/// cursor VE, and the simulator agrees for the delayed model and not for
+/// the same device without the delay.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn a_declared_delay_enters_the_simulator() {
+    let dir = std::env::temp_dir().join(format!("twoport-delay-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = |d: u32| {
+        format!(
+            "name = \"rigid, {d}-tick delay\"\nperiod_s = 0.001\npeak_force_n = 200.0\n\
+             continuous_force_n = 100.0\ndelay_samples = {d}\nM = [[1.0]]\nD = [[20.0]]\n\
+             K = [[0.0]]\nG = [[1.0, -1.0]]\nC_v = [[1.0], [-1.0]]\n"
+        )
+    };
+    let (delayed, prompt) = (dir.join("delayed.toml"), dir.join("prompt.toml"));
+    std::fs::write(&delayed, model(1)).unwrap();
+    std::fs::write(&prompt, model(0)).unwrap();
+    let m = DeviceModel::load(&delayed).unwrap();
+    let a = Analysis::new(&Plant::new(&m, T).unwrap(), GridSpec::DEFAULT);
+    let k_max = max_stiffness(&a, &a.impedance_bound(None), 0.0).unwrap();
+    assert!((k_max - 10_000.0).abs() < 50.0, "{k_max}");
+    let past = Gains::Impedance {
+        k_npm: 13_000.0,
+        b_nspm: 0.0,
+    };
+    let v = verify(&m, T, &past, None, 1).unwrap();
+    assert!(v.unstable, "{v:?}");
+    let run = |path: &Path| {
+        let mut s = scene_on(path.to_str().unwrap(), 13_000.0, 0.0, &v.termination.ve);
+        s.human.grasp = GraspKind::HandsOff;
+        Simulation::new(s).unwrap().run(|_| {})
+    };
+    let (d, p) = (run(&delayed), run(&prompt));
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(!d.stable, "the delayed device at 13,000 N/m: {d:?} ({v:?})");
+    assert!(p.stable, "the same device without the delay: {p:?}");
 }

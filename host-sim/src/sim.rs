@@ -448,10 +448,18 @@ pub fn integrator_warning(sys: &System, method: Method, h: f64) -> Option<String
 
 impl Simulation {
     /// Build a simulation for `scene`.
-    pub fn new(scene: Scene) -> Result<Self, String> {
-        let e = scene.effects.clone();
-        let device = if e.flexibility {
-            Device::flexible(&scene.device_model()?)?
+    pub fn new(mut scene: Scene) -> Result<Self, String> {
+        let device = if scene.effects.flexibility {
+            let model = scene.device_model()?;
+            // The model's own measurement-to-actuation delay is part of the
+            // device: it runs as the delay effect, after any the scene adds.
+            if model.delay_samples > 0 {
+                let extra = scene.effects.delay.map_or(0, |d| d.ticks);
+                scene.effects.delay = Some(crate::scene::DelayEffect {
+                    ticks: extra + model.delay_samples,
+                });
+            }
+            Device::flexible(&model)?
         } else {
             Device::rigid(
                 scene.plant.rigid_mass_kg,
@@ -459,6 +467,7 @@ impl Simulation {
                 235.0,
             )
         };
+        let e = scene.effects.clone();
         let period = scene.period();
         let human =
             Human::new(scene.human.grasp, scene.human.script.clone())?.with_arm(scene.human.arm)?;

@@ -177,6 +177,8 @@ fn ci() -> Result<(), String> {
             "terminations",
             "--test",
             "verify_time_domain",
+            "--test",
+            "shipped_devices",
             "--",
             "--ignored",
         ],

@@ -19,11 +19,12 @@
 //!   the perturbation of a ratio), infinite where the aliased hand could
 //!   destabilise the regulated device.
 //!
-//! Aliases are summed to `N` (the device's highest mode times 8, at least
-//! 16 either side); the rest is bounded by the last alias's ratio and the
-//! exact tail `Σ_{|k|>N} 1/(θ + 2πk)² <= 2/(4π² (N - 1/2))`, which assumes the
-//! ratios decay no slower beyond `N` (true above the device's modes, where
-//! the handle's inertia dominates).
+//! Aliases are summed outward pair by pair until, past the device's highest
+//! mode times 8, the rest is below 1e-4 of the sum: the rest is bounded by
+//! the last alias's ratio and the exact tail
+//! `Σ_{|k|>N} 1/(θ + 2πk)² <= 2/(4π² (N - 1/2))`, which assumes the ratios
+//! grow no further beyond `N` (true above the device's modes, where the
+//! handle's inertia dominates).
 
 use crate::twoport::{admittance_display, design_bound, impedance_display, HumanBound};
 use crate::{Plant, PlantPoint};
@@ -31,12 +32,20 @@ use num_complex::Complex64;
 use std::f64::consts::PI;
 use twoport_control::ZTransfer;
 
-/// How many aliases either side of the base band the sums take for `plant`.
+/// From how many aliases either side of the base band the sums may stop:
+/// past the device's highest mode times 8, where the tail bound's
+/// assumption holds (at least 16).
 pub fn alias_count(plant: &Plant) -> usize {
     let ws = 2.0 * PI / plant.period_s();
     let top = plant.modes().iter().map(|m| m.omega_n).fold(0.0, f64::max);
-    ((8.0 * top / ws).ceil() as usize).clamp(256, 4096)
+    ((8.0 * top / ws).ceil() as usize).clamp(16, MAX_ALIASES)
 }
+
+/// The most aliases either side a sum takes.
+pub const MAX_ALIASES: usize = 4096;
+
+/// A sum stops once its tail bound is below this share of what it bounds.
+const TAIL_SHARE: f64 = 1e-4;
 
 /// The device's hand-side terms at one alias frequency `ω_k` (rad/s, any
 /// sign): `Y_hh` with the human bound, `P = Y_ah Y_ha`, and `F_mh Y_ha`.
@@ -47,30 +56,50 @@ struct Alias {
     fy: Complex64,
 }
 
-fn aliases(plant: &Plant, p: &PlantPoint, human: Option<HumanBound>, n: usize) -> Vec<Alias> {
+/// What a sum does after a pair of aliases.
+enum Flow {
+    Go,
+    Stop,
+}
+
+/// Hand `f` the aliases `ω ± 2πn/T` pair by pair, `n = 1, 2, ...`, until it
+/// stops, at most [`MAX_ALIASES`] pairs; false where a term is unbounded
+/// (a lossless handle at an alias).
+fn each_alias_pair(
+    plant: &Plant,
+    p: &PlantPoint,
+    human: Option<HumanBound>,
+    mut f: impl FnMut(&[Alias; 2], usize) -> Flow,
+) -> bool {
     let mut work = plant.scratch();
     let ws = 2.0 * PI / p.period_s;
-    let n = n as i64;
-    (-n..=n)
-        .filter(|k| *k != 0)
-        .map(|k| {
-            let omega = p.omega + ws * k as f64;
-            let (mut y, mut f) = plant.continuous(omega.abs(), &mut work);
-            if omega < 0.0 {
-                y = y.map(|r| r.map(|v| v.conj()));
-                f = f.map(|v| v.conj());
-            }
-            let h = human.map_or(Complex64::new(0.0, 0.0), |h| {
-                h.admittance(Complex64::new(0.0, omega))
-            });
-            Alias {
-                omega,
-                re_yhh: (y[0][0] + h).re,
-                p: y[1][0] * y[0][1],
-                fy: f[0] * y[0][1],
-            }
-        })
-        .collect()
+    let mut at = |k: f64| {
+        let omega = p.omega + ws * k;
+        let (mut y, mut fm) = plant.continuous(omega.abs(), &mut work);
+        if omega < 0.0 {
+            y = y.map(|r| r.map(|v| v.conj()));
+            fm = fm.map(|v| v.conj());
+        }
+        let h = human.map_or(Complex64::new(0.0, 0.0), |h| {
+            h.admittance(Complex64::new(0.0, omega))
+        });
+        Alias {
+            omega,
+            re_yhh: (y[0][0] + h).re,
+            p: y[1][0] * y[0][1],
+            fy: fm[0] * y[0][1],
+        }
+    };
+    for n in 1..=MAX_ALIASES {
+        let pair = [at(n as f64), at(-(n as f64))];
+        if pair.iter().any(|a| a.re_yhh.is_nan() || a.re_yhh <= 0.0) {
+            return false;
+        }
+        if let Flow::Stop = f(&pair, n) {
+            return true;
+        }
+    }
+    true
 }
 
 /// `Σ_{|k|>N} 1/(θ + 2πk)²` is at most this (for `0 <= θ <= π`).
@@ -79,26 +108,39 @@ fn tail_sum(n: usize) -> f64 {
 }
 
 /// The alias terms of the impedance display at one point: what the
-/// aliased hand adds to the paper's bound on `Re(1/Z_cI)`.
-fn impedance_alias_terms(al: &[Alias], p: &PlantPoint, n: usize) -> f64 {
+/// aliased hand adds to the paper's bound `paper` on `Re(1/Z_cI)`.
+fn impedance_alias_terms(
+    plant: &Plant,
+    p: &PlantPoint,
+    human: Option<HumanBound>,
+    paper: f64,
+) -> f64 {
+    let n_min = alias_count(plant);
     let t = p.period_s;
     let th = p.omega * t;
     let s2 = 4.0 * (0.5 * th).sin().powi(2);
     // e^{-jθ} from the hold and the first difference, times the delay.
     let rot = Complex64::from_polar(1.0, -th) * p.delay;
-    let mut sum = 0.0;
-    let mut tail_ratio = 0.0f64;
-    for a in al {
-        if a.re_yhh.is_nan() || a.re_yhh <= 0.0 {
-            return f64::INFINITY;
+    let (mut sum, mut tail) = (0.0, 0.0);
+    let bounded = each_alias_pair(plant, p, human, |pair, n| {
+        let mut ratio = 0.0f64;
+        for a in pair {
+            let wt = a.omega * t;
+            sum += s2 / (wt * wt) * (a.p.norm() + (rot * a.p).re) / (2.0 * a.re_yhh);
+            ratio = ratio.max(a.p.norm() / a.re_yhh);
         }
-        let wt = a.omega * t;
-        sum += s2 / (wt * wt) * (a.p.norm() + (rot * a.p).re) / (2.0 * a.re_yhh);
-        if (a.omega.abs() * t / (2.0 * PI)).round() as usize >= n {
-            tail_ratio = tail_ratio.max(a.p.norm() / a.re_yhh);
+        tail = ratio * s2 * tail_sum(n);
+        if n >= n_min && tail <= TAIL_SHARE * (paper.abs() + sum) {
+            Flow::Stop
+        } else {
+            Flow::Go
         }
+    });
+    if bounded {
+        sum + tail
+    } else {
+        f64::INFINITY
     }
-    sum + tail_ratio * s2 * tail_sum(n)
 }
 
 /// The impedance-display bound on `Re(1/Z_cI)` at each point, exact for the
@@ -108,12 +150,11 @@ pub fn impedance_bound(
     points: &[PlantPoint],
     human: Option<HumanBound>,
 ) -> Vec<f64> {
-    let n = alias_count(plant);
     points
         .iter()
         .map(|p| {
             let paper = design_bound(&impedance_display(p, human));
-            paper + impedance_alias_terms(&aliases(plant, p, human, n), p, n)
+            paper + impedance_alias_terms(plant, p, human, paper)
         })
         .collect()
 }
@@ -127,19 +168,51 @@ pub fn admittance_bound(
     kp: &ZTransfer,
     human: Option<HumanBound>,
 ) -> Vec<f64> {
-    let n = alias_count(plant);
     points
         .iter()
-        .map(|p| admittance_point(p, &aliases(plant, p, human, n), kp, human, n))
+        .map(|p| match admittance_alias_reach(plant, p, human) {
+            Some(reach) => admittance_point(p, reach, kp, human),
+            None => f64::INFINITY,
+        })
         .collect()
+}
+
+/// `Σ |α_k| |w_k| / |1 - z^-1|` and `Σ |φ_k| |w_k| / |1 - z^-1|` over the
+/// aliases `k != 0`, with `|w_k| <= 1/R_k`: the aliased hand's reach into
+/// `-x_a*` and `f_m*` per unit held force. `None` where unbounded.
+fn admittance_alias_reach(
+    plant: &Plant,
+    p: &PlantPoint,
+    human: Option<HumanBound>,
+) -> Option<(f64, f64)> {
+    let n_min = alias_count(plant);
+    let t = p.period_s;
+    let (mut rx, mut rf, mut tx, mut tf) = (0.0, 0.0, 0.0, 0.0);
+    let bounded = each_alias_pair(plant, p, human, |pair, n| {
+        let (mut ratio_x, mut ratio_f) = (0.0f64, 0.0f64);
+        for a in pair {
+            let w = a.omega.abs();
+            rx += a.p.norm() / (t * w * w * a.re_yhh);
+            rf += a.fy.norm() / (t * w * a.re_yhh);
+            ratio_x = ratio_x.max(a.p.norm() / a.re_yhh);
+            ratio_f = ratio_f.max(a.fy.norm() * w / a.re_yhh);
+        }
+        // Σ_{|k|>N} 1/(T ω_k²) = T Σ 1/(θ + 2πk)².
+        (tx, tf) = (ratio_x * t * tail_sum(n), ratio_f * t * tail_sum(n));
+        if n >= n_min && tx <= TAIL_SHARE * rx && tf <= TAIL_SHARE * rf {
+            Flow::Stop
+        } else {
+            Flow::Go
+        }
+    });
+    bounded.then_some((rx + tx, rf + tf))
 }
 
 fn admittance_point(
     p: &PlantPoint,
-    al: &[Alias],
+    (rx, rf): (f64, f64),
     kp: &ZTransfer,
     human: Option<HumanBound>,
-    n: usize,
 ) -> f64 {
     let g = admittance_display(p, kp, human);
     let paper = design_bound(&g);
@@ -151,26 +224,6 @@ fn admittance_point(
     let one = Complex64::new(1.0, 0.0);
     let diff = (one - p.z.inv()).norm();
     let k = kp.eval(p.z) * p.delay;
-    // Σ |α_k| |w_k| / |1 - z^-1| and Σ |φ_k| |w_k| / |1 - z^-1|, with
-    // |w_k| <= 1/R_k: the aliased hand's reach into -x_a* and f_m* per unit
-    // held force.
-    let (mut rx, mut rf) = (0.0, 0.0);
-    let (mut tail_x, mut tail_f) = (0.0f64, 0.0f64);
-    for a in al {
-        if a.re_yhh.is_nan() || a.re_yhh <= 0.0 {
-            return f64::INFINITY;
-        }
-        let w2 = a.omega * a.omega;
-        rx += a.p.norm() / (t * w2 * a.re_yhh);
-        rf += a.fy.norm() / (t * a.omega.abs() * a.re_yhh);
-        if (a.omega.abs() * t / (2.0 * PI)).round() as usize >= n {
-            tail_x = tail_x.max(a.p.norm() / a.re_yhh);
-            tail_f = tail_f.max(a.fy.norm() * a.omega.abs() / a.re_yhh);
-        }
-    }
-    // Σ_{|k|>N} 1/(T ω_k²) = T Σ 1/(θ + 2πk)².
-    rx += tail_x * t * tail_sum(n);
-    rf += tail_f * t * tail_sum(n);
     let rho_d = k.norm() * diff * rx;
     // |c| ρ_F with c = K T/(1 - z^-1): the factors |1 - z^-1| cancel.
     let c_rho_f = k.norm() * t * rf;
@@ -257,10 +310,10 @@ mod tests {
         for p in &pts {
             let h = Some(HumanBound::PAPER);
             let paper = design_bound(&admittance_display(p, &kp, h));
-            let none = admittance_point(p, &[], &kp, h, 16);
+            let none = admittance_point(p, (0.0, 0.0), &kp, h);
             assert!((none - paper).abs() <= 1e-12 * paper.abs().max(1.0));
-            let with = admittance_point(p, &aliases(&plant, p, h, 16), &kp, h, 16);
-            assert!(with >= paper);
+            let reach = admittance_alias_reach(&plant, p, h).unwrap();
+            assert!(admittance_point(p, reach, &kp, h) >= paper);
         }
     }
 }

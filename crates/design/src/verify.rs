@@ -13,7 +13,7 @@
 //! nothing when it finds nothing; what it finds is a real instability.
 
 use crate::design::{admittance_coupling_tf, impedance_coupling_tf, regulator_tf};
-use crate::linalg::expm_balanced;
+use crate::linalg::{balance, expm_balanced};
 use crate::rational::{add, delayed, from_tf, mul, realise, reduced, scale, Rational};
 use crate::twoport::HumanBound;
 use crate::DeviceModel;
@@ -357,6 +357,11 @@ pub fn radius(
     if a.iter().any(|v| !v.is_finite()) {
         return Err("the closed loop is not finite".into());
     }
+    // Balanced first: a light hand's node and the load-cell filter make the
+    // entries span many orders of magnitude, which costs the eigenvalues
+    // near z = 1 (free motion) digits enough to push them past 1.
+    let d = balance(&a);
+    let a = DMatrix::from_fn(n, n, |i, j| a[(i, j)] * d[j] / d[i]);
     let (mut rho, mut arg, mut score) = (0.0, 0.0, 0.0f64);
     let slow = 2.0 * PI * 0.1 * period_s;
     for l in a.complex_eigenvalues().iter() {
