@@ -1,6 +1,7 @@
 //! Designer speed: the Excalibur 2x2 frequency response on 10,000 points
-//! (goal <= 2 ms), the discrete terms, and a full design of both displays
-//! (goal <= 20 ms).
+//! (goal <= 2 ms), the discrete terms, a full design of both displays
+//! (goal <= 20 ms), a design over 8 poses against one (goal: at most 8
+//! times), and `verify` on the Excalibur (goal <= 2 s).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::f64::consts::PI;
@@ -69,9 +70,61 @@ fn designs(c: &mut Criterion) {
     });
 }
 
+/// One pose against eight (the Excalibur's bound at slightly scaled
+/// masses, so no two poses are the same), measured in one run.
+fn poses(c: &mut Criterion) {
+    let human = Some(HumanBound::PAPER);
+    let base = excalibur_model();
+    let analyses: Vec<Analysis> = (0..8)
+        .map(|i| {
+            let mut m = base.clone();
+            m.m *= 1.0 + 0.02 * i as f64;
+            Analysis::new(&Plant::new(&m, 1e-3).unwrap(), GridSpec::DEFAULT)
+        })
+        .collect();
+    let design = |n: usize| {
+        let bounds: Vec<Vec<f64>> = analyses[..n]
+            .iter()
+            .map(|a| a.impedance_bound(human))
+            .collect();
+        let poses: Vec<(&Analysis, &[f64])> = analyses[..n]
+            .iter()
+            .zip(&bounds)
+            .map(|(a, b)| (a, b.as_slice()))
+            .collect();
+        max_stiffness_poses(&poses, 90.0)
+    };
+    c.bench_function("impedance design at b 90 (bound and search), 1 pose", |b| {
+        b.iter(|| black_box(design(1)))
+    });
+    c.bench_function(
+        "impedance design at b 90 (bound and search), 8 poses",
+        |b| b.iter(|| black_box(design(8))),
+    );
+}
+
+fn verify(c: &mut Criterion) {
+    use twoport_design::verify::{verify, Gains};
+    let m = excalibur_model();
+    let g = Gains::Impedance {
+        k_npm: 51_074.0,
+        b_nspm: 90.0,
+    };
+    let mut group = c.benchmark_group("verify");
+    group.sample_size(10);
+    group.bench_function("verify, Excalibur impedance display at the design", |b| {
+        b.iter(|| black_box(verify(&m, 1e-3, &g, Some(HumanBound::PAPER), 0).unwrap()))
+    });
+    group.finish();
+}
+
+fn excalibur_model() -> DeviceModel {
+    DeviceModel::from_toml(include_str!("../models/excalibur.toml"), "excalibur").unwrap()
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = responses, designs
+    targets = responses, designs, poses, verify
 }
 criterion_main!(benches);

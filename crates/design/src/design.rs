@@ -299,19 +299,20 @@ pub fn max_stiffness(a: &Analysis, bound: &[f64], b_nspm: f64) -> Option<f64> {
     max_stiffness_poses(&[(a, bound)], b_nspm)
 }
 
-/// [`max_stiffness`] over every pose: the least of their limits.
+/// [`max_stiffness`] over every pose: the least of their limits. Each pose
+/// searches below the least limit so far, so a pose that allows it costs
+/// one check.
 pub fn max_stiffness_poses(poses: &Poses, b_nspm: f64) -> Option<f64> {
-    poses
-        .iter()
-        .map(|(a, bound)| {
-            let t = a.period_s;
-            largest(K_RANGE.0, K_RANGE.1, |k| {
-                impedance_coupling_tf(k, b_nspm, t)
-                    .map(|tf| slack(a, bound, |z| tf.eval(z).inv().re) >= 0.0)
-                    .unwrap_or(false)
-            })
-        })
-        .try_fold(f64::INFINITY, |acc, k| k.map(|k| acc.min(k)))
+    let mut hi = K_RANGE.1;
+    for (a, bound) in poses {
+        let t = a.period_s;
+        hi = largest(K_RANGE.0, hi, |k| {
+            impedance_coupling_tf(k, b_nspm, t)
+                .map(|tf| slack(a, bound, |z| tf.eval(z).inv().re) >= 0.0)
+                .unwrap_or(false)
+        })?;
+    }
+    Some(hi)
 }
 
 /// The least `m_cA` (kg) that meets the admittance-display bound with
@@ -320,21 +321,21 @@ pub fn min_mass(a: &Analysis, bound: &[f64], b_nspm: f64) -> Option<f64> {
     min_mass_poses(&[(a, bound)], b_nspm)
 }
 
-/// [`min_mass`] over every pose: the greatest of their limits.
+/// [`min_mass`] over every pose: the greatest of their limits (each pose
+/// searches above the greatest so far).
 pub fn min_mass_poses(poses: &Poses, b_nspm: f64) -> Option<f64> {
-    poses
-        .iter()
-        .map(|(a, bound)| {
-            let t = a.period_s;
-            let ok = |m: f64| {
-                admittance_coupling_tf(m, b_nspm, t)
-                    .map(|tf| slack(a, bound, |z| tf.eval(z).re) >= 0.0)
-                    .unwrap_or(false)
-            };
-            // Heavier is more stable: search 1/m for the largest feasible.
-            largest(1.0 / M_RANGE.1, 1.0 / M_RANGE.0, |inv| ok(1.0 / inv)).map(|inv| 1.0 / inv)
-        })
-        .try_fold(0.0f64, |acc, m| m.map(|m| acc.max(m)))
+    // Heavier is more stable: search 1/m for the largest feasible.
+    let mut hi = 1.0 / M_RANGE.0;
+    for (a, bound) in poses {
+        let t = a.period_s;
+        let ok = |m: f64| {
+            admittance_coupling_tf(m, b_nspm, t)
+                .map(|tf| slack(a, bound, |z| tf.eval(z).re) >= 0.0)
+                .unwrap_or(false)
+        };
+        hi = largest(1.0 / M_RANGE.1, hi, |inv| ok(1.0 / inv))?;
+    }
+    Some(1.0 / hi)
 }
 
 /// Maximise `score(b)` over `B_RANGE` on a log scan refined by golden

@@ -289,7 +289,12 @@ fn several_poses_design_for_all() {
         t["k_c"].as_f64().unwrap(),
         both["k_c"].as_f64().unwrap(),
     );
-    assert_eq!(kb, ke.min(kt), "{both}");
+    // The worst pose's limit, to the search's 1e-6 and never above it.
+    let want = ke.min(kt);
+    assert!(
+        kb <= want && kb >= want * (1.0 - 2e-6),
+        "{kb} vs {want}: {both}"
+    );
     let binding = if ke < kt { "Excalibur" } else { "Two-mass" };
     assert!(
         both["binding_pose"].as_str().unwrap().starts_with(binding),
