@@ -439,11 +439,13 @@ impl ScopeState {
             let ring = self.ring(self.trigger.signal);
             let early = ring.iter().filter(|(t, _)| *t <= end - 0.8 * self.window_s);
             if let Some(t) = last_trigger(early, self.trigger.level, self.trigger.edge) {
-                let start = t - 0.2 * self.window_s;
+                let start = (t - 0.2 * self.window_s).max(0.0);
                 return (start, start + self.window_s);
             }
         }
-        (end - self.window_s, end)
+        // From the run's start until the window fills, then scrolling.
+        let start = (end - self.window_s).max(0.0);
+        (start, start + self.window_s)
     }
 
     /// Advance by one frame of `wall_s` wall time at the set speed.

@@ -242,35 +242,78 @@ fn light(ui: &mut Ui, s: &ScopeState) {
     });
 }
 
-/// The design bound and the coupling's response (Fig. 8 or 9), live.
+/// A curve of the design figure on log-log axes: `[log10 f, log10 v]`,
+/// leaving out the points where the value is not positive (where the bound
+/// turns negative any coupling meets it), as the paper's figures do.
+pub fn log_log(points: &[(f64, f64)]) -> Vec<[f64; 2]> {
+    points
+        .iter()
+        .filter(|(f, v)| *f > 0.0 && *v > 0.0 && v.is_finite())
+        .map(|(f, v)| [f.log10(), v.log10()])
+        .collect()
+}
+
+/// A grid line at every decade of an axis in decades (a linear spacer
+/// would step by ten decades over a range of seven, and label none).
+fn decades(input: egui_plot::GridInput) -> Vec<egui_plot::GridMark> {
+    let (lo, hi) = input.bounds;
+    let (lo, hi) = (lo.ceil() as i64, hi.floor() as i64);
+    (lo..=hi.max(lo))
+        .map(|d| egui_plot::GridMark {
+            value: d as f64,
+            step_size: 1.0,
+        })
+        .collect()
+}
+
+/// `10^x` for an axis in decades.
+fn decade_label(x: f64) -> String {
+    if (x - x.round()).abs() < 1e-6 {
+        format!("1e{:.0}", x.round())
+    } else {
+        String::new()
+    }
+}
+
+/// The design bound and the coupling's response (Fig. 8 or 9), live, on
+/// log-log axes as the paper's figures: the bound and the coupling span
+/// seven decades, and the margin is the gap between them.
 pub fn design_panel(ui: &mut Ui, s: &ScopeState) {
     let Some(fig) = s.light.as_ref().and_then(|l| l.figure.as_ref()) else {
         return;
     };
     ui.label(RichText::new(&fig.y_label).small());
-    // The bound dives at the resonances; frame the plot on the coupling's
-    // own scale, as the paper's figures do.
-    let scale = fig
-        .curves
+    let curves: Vec<Vec<[f64; 2]>> = fig.curves.iter().map(|c| log_log(&c.points)).collect();
+    // Framed on the coupling's decades (the last curve) and one below: the
+    // bound's dives at the resonances run off the bottom, as in the paper.
+    let (lo, hi) = curves
         .last()
-        .map(|c| c.points.iter().map(|p| p.1.abs()).fold(0.0, f64::max))
-        .filter(|m| *m > 0.0 && m.is_finite())
-        .unwrap_or(1.0);
+        .into_iter()
+        .flatten()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+            (l.min(p[1]), h.max(p[1]))
+        });
+    let (lo, hi) = if lo.is_finite() {
+        (lo, hi)
+    } else {
+        (-6.0, 0.0)
+    };
     Plot::new("design-bound")
-        .height(150.0)
-        .include_y(-1.5 * scale)
-        .include_y(1.5 * scale)
+        .height(210.0)
+        .include_y(lo.floor() - 1.0)
+        .include_y(hi.ceil() + 0.5)
         .auto_bounds([true, false])
-        .legend(Legend::default())
-        .x_axis_label("log10 frequency (Hz)")
+        // The curves rise to the right and dive at the resonances: the
+        // lower right is where they leave room for the names.
+        .legend(Legend::default().position(egui_plot::Corner::RightBottom))
+        .y_axis_min_width(40.0)
+        .x_axis_label("frequency (Hz)")
+        .x_axis_formatter(|m, _| decade_label(m.value))
+        .y_axis_formatter(|m, _| decade_label(m.value))
+        .x_grid_spacer(decades)
+        .y_grid_spacer(decades)
         .show(ui, |p| {
-            for (i, c) in fig.curves.iter().enumerate() {
-                let pts: Vec<[f64; 2]> = c
-                    .points
-                    .iter()
-                    .filter(|(f, v)| *f > 0.0 && v.is_finite())
-                    .map(|(f, v)| [f.log10(), *v])
-                    .collect();
+            for (i, (c, pts)) in fig.curves.iter().zip(curves).enumerate() {
                 let color = Color32::from_rgb(c.color.0, c.color.1, c.color.2);
                 p.line(
                     Line::new(c.label.clone(), PlotPoints::from(pts))

@@ -218,3 +218,69 @@ fn the_scene_picker_lists_the_scenes_and_the_table_i_folder() {
         18
     );
 }
+
+/// The time axes start at the run's start, not at minus the window.
+#[test]
+fn the_time_axes_start_at_the_runs_start() {
+    let mut h = harness();
+    let (t0, t1) = h.state().0.view();
+    assert_eq!(t0, 0.0);
+    assert_eq!(t1, h.state().0.window_s);
+    // Once the run is longer than the window, the window scrolls.
+    let ticks = (1.5 * h.state().0.window_s / 1e-3) as usize;
+    for _ in 0..ticks {
+        h.state_mut().0.tick();
+    }
+    let (t0, t1) = h.state().0.view();
+    assert!(
+        t0 > 0.0 && (t1 - h.state().0.time_s()).abs() < 1e-9,
+        "{t0} {t1}"
+    );
+}
+
+/// The live design plot is log-log like the paper's figures: its curves
+/// are drawn in decades, and at the worst frequency the gap between the
+/// coupling and the bound is the margin the light reports, in decades a
+/// person can see (the linear axis it replaced drew both flat on zero).
+#[test]
+fn the_design_plot_shows_the_margin_in_decades() {
+    let h = harness();
+    let light = h.state().0.light.as_ref().unwrap();
+    let fig = light.figure.as_ref().unwrap();
+    let drawn: Vec<Vec<[f64; 2]>> = fig
+        .curves
+        .iter()
+        .map(|c| host_sim::ui::log_log(&c.points))
+        .collect();
+    let decades = |c: &[[f64; 2]]| {
+        let (lo, hi) = c
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+                (l.min(p[1]), h.max(p[1]))
+            });
+        hi - lo
+    };
+    // The bound with the human model (drawn thin) and the coupling (bold).
+    let (bound, coupling) = (&drawn[drawn.len() - 2], &drawn[drawn.len() - 1]);
+    assert!(decades(bound) > 3.0 && decades(coupling) > 1.0);
+    // Every drawn value is a finite decade, and none was made up for a
+    // non-positive bound.
+    for c in &drawn {
+        assert!(c.iter().all(|p| p[0].is_finite() && p[1].is_finite()));
+    }
+    let at = |c: &[[f64; 2]], f: f64| {
+        c.iter()
+            .min_by(|a, b| {
+                (a[0] - f.log10())
+                    .abs()
+                    .total_cmp(&(b[0] - f.log10()).abs())
+            })
+            .unwrap()[1]
+    };
+    let gap = at(coupling, light.worst_hz) - at(bound, light.worst_hz);
+    assert!(
+        light.proven && gap >= -1e-6,
+        "gap {gap} decades at {} Hz",
+        light.worst_hz
+    );
+}
