@@ -1,5 +1,5 @@
-//! The published numbers of Adams & Hannaford (2002), section 7 of
-//! shared/design/two-port-equations.md, each within its stated tolerance.
+//! The published numbers of Adams & Hannaford (2002), the last table of
+//! docs/two-port.md, each within its stated tolerance.
 
 use std::f64::consts::PI;
 use std::sync::OnceLock;

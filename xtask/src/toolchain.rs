@@ -1,6 +1,6 @@
 //! How to build for thumbv7em-none-eabihf on this machine: the rustup target
 //! where it is installed, otherwise Debian's rustc with `build-std` and
-//! arm-none-eabi-ld (see shared/design/firmware-toolchain.md).
+//! arm-none-eabi-ld (see docs/firmware.md).
 
 use std::path::Path;
 use std::process::Command;

@@ -26,7 +26,7 @@
 //!
 //! Units are SI throughout (N, m, s, kg); positions are integer nanometres
 //! ([`Position`]) so that no position ever accumulates f32 rounding.
-//! Sign convention (the paper's, see `shared/design/two-port-equations.md`):
+//! Sign convention (the paper's, see `docs/two-port.md`):
 //! the actuator force is positive when it resists positive actuator motion;
 //! forces on the VE and all velocities are positive along +x.
 

@@ -1,6 +1,6 @@
 //! The device's frequency responses: the continuous `Y(s)`, `F(s)` by
 //! complex LU, and the ZOH-exact discrete `X_aa^d(z)`, `F_ma^d(z)` from the
-//! matrix exponential of the block matrix (note, section 2).
+//! matrix exponential of the block matrix (docs/two-port.md, sampled terms).
 
 use crate::linalg::{balance, expm_balanced, hessenberg_shift_solve, lu_solve};
 use crate::DeviceModel;

@@ -1,4 +1,4 @@
-//! The haptic-interface two-ports (note sections 3-6), their design bounds
+//! The haptic-interface two-ports (docs/two-port.md), their design bounds
 //! and Llewellyn's absolute-stability criteria.
 
 use crate::PlantPoint;
