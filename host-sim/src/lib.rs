@@ -1,10 +1,4 @@
-//! # host-sim
-//!
-//! The simulator: the device model from the designer's model files, the
-//! human operator and the VE around the board's own control code
-//! (`twoport-control`, f32), stepping at the control period behind a hold.
-//! Only the effects a scene names are simulated; a linear scene runs the
-//! exact discrete update with no sub-steps.
+#![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
 pub mod accuracy;

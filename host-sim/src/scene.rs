@@ -448,7 +448,7 @@ impl Scene {
         self.period_s.unwrap_or(1e-3)
     }
 
-    /// The scene's device model, [`DeviceModel::load_or_excalibur`]; the
+    /// The scene's device model, [`twoport_design::DeviceModel::load_or_excalibur`]; the
     /// error names `plant.model`.
     pub fn device_model(&self) -> Result<twoport_design::DeviceModel, String> {
         twoport_design::DeviceModel::load_or_excalibur(&self.plant.model)

@@ -150,6 +150,25 @@ fn ci() -> Result<(), String> {
             "warnings",
         ]),
     )?;
+    // The crates' docs (each README is its crate's page) build without a
+    // warning, and the design library builds without the CLI and plots.
+    run(
+        "cargo doc (warnings denied)",
+        cargo()
+            .args(["doc", "--workspace", "--no-deps"])
+            .env("RUSTDOCFLAGS", "-D warnings"),
+    )?;
+    run(
+        "twoport-design without its cli and plot features",
+        cargo().args([
+            "check",
+            "-p",
+            "twoport-design",
+            "--no-default-features",
+            "--lib",
+            "--examples",
+        ]),
+    )?;
     thumb()?;
     qemu()?;
     // Processor-in-the-loop: bit for bit against the in-process loop, with

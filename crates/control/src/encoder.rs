@@ -53,6 +53,18 @@ impl Encoder {
     /// A counter `bits` wide (2..=32) whose one count is `pm_per_count`
     /// picometres (1 ..= 2.097e9) of travel at the actuator. `first_raw` is
     /// the counter's value that maps to `origin`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_control::{Encoder, EncoderError, Position};
+    /// // A 16-bit timer counting 1 µm steps, read as 0 at the origin.
+    /// let mut enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    /// assert_eq!(enc.update(250).unwrap(), Position::from_nm(250_000));
+    /// // The counter wrapping past zero is unwrapped: -10 counts.
+    /// assert_eq!(enc.update(65_526).unwrap(), Position::from_nm(-10_000));
+    /// assert!(matches!(Encoder::new(40, 1_000_000, 0, Position::ZERO), Err(EncoderError::BadWidth(40))));
+    /// ```
     pub fn new(
         bits: u8,
         pm_per_count: i64,

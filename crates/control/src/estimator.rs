@@ -14,6 +14,17 @@ pub struct FirstDifference<R = f32> {
 
 impl FirstDifference {
     /// An estimator for sample period `period_s` (s), at rest at `x`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_control::{FirstDifference, Position};
+    /// let mut d = FirstDifference::new(1e-3, Position::ZERO)?;
+    /// // 1 µm in one 1 ms tick is 1 mm/s.
+    /// let v = d.step(Position::from_nm(1000));
+    /// assert!((v - 1e-3).abs() < 1e-9);
+    /// # Ok::<(), twoport_control::ParamError>(())
+    /// ```
     pub fn new(period_s: f32, x: Position) -> Result<Self, ParamError> {
         Self::new_in(period_s, x)
     }

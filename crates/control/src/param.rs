@@ -20,6 +20,8 @@ impl fmt::Display for ParamError {
     }
 }
 
+impl core::error::Error for ParamError {}
+
 /// `value` if finite and > 0.
 pub(crate) fn positive(name: &'static str, value: f32) -> Result<f32, ParamError> {
     if value.is_finite() && value > 0.0 {

@@ -30,6 +30,18 @@ pub struct PositionRegulator<R = f32> {
 impl PositionRegulator {
     /// A regulator of stiffness `kp_npm` (N/m) and damping `bp_nspm`
     /// (N s/m), with zero error history.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_control::PositionRegulator;
+    /// let k = PositionRegulator::new(51_000.0, 90.0, 1e-3)?;
+    /// // K_p(z) = k_p + b_p (1 - z^-1)/T: at DC it is the stiffness.
+    /// let dc = k.tf().eval(twoport_control::Complex64::new(1.0, 0.0));
+    /// assert!((dc.re - 51_000.0).abs() < 1e-6);
+    /// assert!(PositionRegulator::new(-1.0, 90.0, 1e-3).is_err());
+    /// # Ok::<(), twoport_control::ParamError>(())
+    /// ```
     pub fn new(kp_npm: f32, bp_nspm: f32, period_s: f32) -> Result<Self, ParamError> {
         Self::new_in(kp_npm, bp_nspm, period_s)
     }

@@ -110,6 +110,36 @@ pub struct SafetyConfig {
 }
 
 impl SafetyConfig {
+    /// A cautious configuration for any actuator: `peak_force_n` (N) for
+    /// at most 2 s from cold, `continuous_force_n` (N) indefinitely, at
+    /// period `period_s` (s); 1 m/s at most, a load-cell range of 1.25 times
+    /// the peak, a 100 ms ramp-in, the dead-man switch required and no link
+    /// heartbeat. Adjust the fields for the device; [`validate`](Self::validate)
+    /// names a bad one.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_control::SafetyConfig;
+    /// let cfg = SafetyConfig::new(1e-3, 10.0, 4.0);
+    /// assert!(cfg.validate().is_ok());
+    /// assert!(cfg.require_dead_man);
+    /// assert!(SafetyConfig::new(1e-3, 4.0, 10.0).validate().is_err());
+    /// ```
+    pub fn new(period_s: f32, peak_force_n: f32, continuous_force_n: f32) -> Self {
+        SafetyConfig {
+            period_s,
+            peak_force_n,
+            continuous_force_n,
+            peak_duration_s: 2.0,
+            max_velocity_mps: 1.0,
+            max_sensor_force_n: 1.25 * peak_force_n,
+            heartbeat_timeout_ticks: 0,
+            ramp_ticks: ((0.1 / period_s) as u32).max(1),
+            require_dead_man: true,
+        }
+    }
+
     /// Excalibur's axis: 200 N peak, 100 N continuous (paper section III),
     /// 2 s at peak, 1 m/s, a 250 N load cell, 100 ms ramp, 1 kHz.
     pub const fn excalibur() -> Self {

@@ -172,6 +172,22 @@ pub struct ImpedanceServo<V, R = f32> {
 
 impl<V: VirtualEnvironment> ImpedanceServo<V> {
     /// A disabled servo with coupling gains `k_npm` (N/m), `b_nspm` (N s/m).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_control::ve::BilateralConstraint;
+    /// use twoport_control::{Encoder, ImpedanceServo, Position, SafetyConfig, SensorFrame};
+    /// let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap(); // 1 µm counts
+    /// let ve = BilateralConstraint::new(Position::ZERO);
+    /// let mut servo = ImpedanceServo::new(51_000.0, 90.0, enc, SafetyConfig::new(1e-3, 200.0, 100.0), ve)?;
+    /// let frame = |tick| SensorFrame { tick, encoder_raw: 0, load_cell_n: 0.0, dead_man_closed: true };
+    /// // Disabled: zero force. Enabled, it ramps in.
+    /// assert_eq!(servo.tick(&frame(0)).actuator_force_n, 0.0);
+    /// servo.enable().unwrap();
+    /// assert!(servo.tick(&frame(1)).actuator_force_n.is_finite());
+    /// # Ok::<(), twoport_control::ParamError>(())
+    /// ```
     pub fn new(
         k_npm: f32,
         b_nspm: f32,

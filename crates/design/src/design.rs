@@ -109,6 +109,19 @@ pub struct Analysis {
 
 impl Analysis {
     /// Evaluate `plant` on the grid `spec`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_design::design::{max_stiffness, Analysis, GridSpec};
+    /// use twoport_design::twoport::HumanBound;
+    /// use twoport_design::{DeviceModel, Plant};
+    /// let m = DeviceModel::excalibur()?;
+    /// let a = Analysis::new(&Plant::new(&m, 1e-3)?, GridSpec::DEFAULT);
+    /// let k = max_stiffness(&a, &a.impedance_bound(Some(HumanBound::PAPER)), 90.0).unwrap();
+    /// assert!((k - 51_000.0).abs() < 0.03 * 51_000.0); // the paper's design
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn new(plant: &Plant, spec: GridSpec) -> Self {
         Analysis {
             points: plant.response(&grid(plant, spec)),

@@ -1,15 +1,13 @@
-//! # twoport-design
-//!
-//! Two-port analysis and virtual-coupling synthesis for haptic displays
-//! (Adams & Hannaford 2002), in f64. The couplings and regulator analysed
-//! here are the control crate's own laws, through their z-domain forms.
+#![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
 pub mod design;
+#[cfg(feature = "plot")]
 pub mod figures;
 pub mod linalg;
 pub mod model;
 pub mod plant;
+#[cfg(feature = "plot")]
 pub mod plot;
 pub mod rational;
 pub mod sampled;

@@ -124,6 +124,19 @@ impl DeviceModel {
     }
 
     /// Parse and check model text; `source` names it in errors.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_design::DeviceModel;
+    /// let rigid = "period_s = 0.001\npeak_force_n = 10.0\ncontinuous_force_n = 4.0\n\
+    ///              M = [[0.25]]\nD = [[2.0]]\nK = [[0.0]]\nG = [[1.0, -1.0]]\nC_v = [[1.0], [-1.0]]\n";
+    /// let m = DeviceModel::from_toml(rigid, "capstan.toml")?;
+    /// assert!(!m.force_sensor); // no C_f: no load cell
+    /// let bad = DeviceModel::from_toml(&rigid.replace("0.25", "-0.25"), "capstan.toml");
+    /// assert!(bad.unwrap_err().to_string().contains("M is not positive definite"));
+    /// # Ok::<(), twoport_design::ModelError>(())
+    /// ```
     pub fn from_toml(text: &str, source: &str) -> Result<Self, ModelError> {
         let err = |message: String| ModelError {
             source: source.to_string(),

@@ -241,6 +241,17 @@ fn row_major(a: &DMatrix<f64>) -> Vec<f64> {
 
 impl Plant {
     /// Prepare `model` for analysis at sample period `period_s` (s).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_design::{DeviceModel, Plant};
+    /// let p = Plant::new(&DeviceModel::excalibur()?, 1e-3)?;
+    /// // The Excalibur's lightly damped modes: about 45, 79, 277 Hz and 3.5 kHz.
+    /// assert_eq!(p.modes().len(), 4);
+    /// assert!(Plant::new(&DeviceModel::excalibur()?, 0.0).is_err());
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn new(model: &DeviceModel, period_s: f64) -> Result<Self, String> {
         if !(period_s.is_finite() && period_s > 0.0) {
             return Err(format!("period {period_s} s must be finite and > 0"));

@@ -1,14 +1,4 @@
-//! # twoport-link
-//!
-//! The board-host protocol, `no_std` and allocation-free: serde messages
-//! encoded with postcard, a sequence number and a CRC-16 on every frame, COBS
-//! framing with a zero delimiter, and a protocol-version handshake. A
-//! corrupted, truncated or garbage frame is dropped and counted; the decoder
-//! resynchronises at the next delimiter and never panics.
-//!
-//! ```text
-//! frame = COBS( postcard(Envelope { seq: u16, msg: Message }) ++ crc16_le ) 0x00
-//! ```
+#![doc = include_str!("../README.md")]
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]

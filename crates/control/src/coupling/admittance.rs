@@ -36,6 +36,17 @@ pub struct AdmittanceStep<R = f32> {
 
 impl AdmittanceCoupling {
     /// A coupling of mass `m_kg` (kg) and damping `b_nspm` (N s/m), at rest.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_control::AdmittanceCoupling;
+    /// // The paper's admittance-display coupling: 5 kg and 500 N s/m at 1 kHz.
+    /// let c = AdmittanceCoupling::new(5.0, 500.0, 1e-3)?;
+    /// assert_eq!(c.gains(), (5.0, 500.0));
+    /// assert!(AdmittanceCoupling::new(0.0, 500.0, 1e-3).is_err()); // a mass > 0
+    /// # Ok::<(), twoport_control::ParamError>(())
+    /// ```
     pub fn new(m_kg: f32, b_nspm: f32, period_s: f32) -> Result<Self, ParamError> {
         Self::new_in(m_kg, b_nspm, period_s)
     }

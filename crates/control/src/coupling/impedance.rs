@@ -37,6 +37,20 @@ pub struct ImpedanceStep<R = f32> {
 impl ImpedanceCoupling {
     /// A coupling of stiffness `k_npm` (N/m) and damping `b_nspm` (N s/m) at
     /// period `period_s` (s). `kT + b` must be > 0.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_control::ImpedanceCoupling;
+    /// // The paper's impedance-display coupling at 1 kHz.
+    /// let c = ImpedanceCoupling::new(51_000.0, 90.0, 1e-3)?;
+    /// assert_eq!(c.gains(), (51_000.0, 90.0));
+    /// // Z_cI(z) = b + kTz/(z - 1): at Nyquist (z = -1) it is b + kT/2.
+    /// let nyq = c.tf().eval(twoport_control::Complex64::new(-1.0, 0.0));
+    /// assert!((nyq.re - (90.0 + 25.5)).abs() < 1e-3);
+    /// assert!(ImpedanceCoupling::new(-1.0, 90.0, 1e-3).is_err());
+    /// # Ok::<(), twoport_control::ParamError>(())
+    /// ```
     pub fn new(k_npm: f32, b_nspm: f32, period_s: f32) -> Result<Self, ParamError> {
         Self::new_in(k_npm, b_nspm, period_s)
     }
