@@ -2,8 +2,8 @@
 //! tick of the 5-DOF Excalibur (10 states, maximum grasp) with held inputs.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use host_sim::human::GraspKind;
-use host_sim::plant::{Device, Method, Stepper};
+use host_sim::engine::human::GraspKind;
+use host_sim::engine::plant::{Device, Method, Stepper};
 use std::hint::black_box;
 use twoport_design::DeviceModel;
 

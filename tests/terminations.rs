@@ -6,8 +6,8 @@
 //! may be unstable. The theory covers linear passive terminations; a wall
 //! that makes and breaks contact is a nonlinear VE and is not drawn here.
 
-use host_sim::plant::Arm;
-use host_sim::scene::{Display, VeSpec};
+use host_sim::engine::plant::Arm;
+use host_sim::engine::scene::{Display, VeSpec};
 use host_sim::{Scene, Simulation};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
@@ -127,13 +127,13 @@ fn stable(display: Display, c: &Case, set: &[(&str, f64)]) -> Result<(), String>
     s.duration_s = 2.5;
     s.ve = c.ve.clone();
     s.human.grasp = if c.grasp_max {
-        host_sim::human::GraspKind::Maximum
+        host_sim::engine::human::GraspKind::Maximum
     } else {
-        host_sim::human::GraspKind::Relaxed
+        host_sim::engine::human::GraspKind::Relaxed
     };
     s.human.arm = c.arm;
     // A short push on the handle, then the termination alone.
-    s.human.script = vec![host_sim::human::Event::Force {
+    s.human.script = vec![host_sim::engine::human::Event::Force {
         at_s: 0.1,
         force_n: c.push_n,
         for_s: 0.02,
@@ -309,15 +309,15 @@ fn impedance_gains_past_the_bound_meet_the_termination_the_two_port_names() {
             damping_nspm: 0.5 * b_e,
             discretization,
         };
-        s.human.grasp = host_sim::human::GraspKind::HandsOff;
-        s.human.script = vec![host_sim::human::Event::Force {
+        s.human.grasp = host_sim::engine::human::GraspKind::HandsOff;
+        s.human.script = vec![host_sim::engine::human::Event::Force {
             at_s: 0.1,
             force_n: 30.0,
             for_s: 0.005,
         }];
         Simulation::new(s).unwrap().run(|_| {})
     };
-    use host_sim::scene::Discretization::{BackwardEuler, Trapezoidal};
+    use host_sim::engine::scene::Discretization::{BackwardEuler, Trapezoidal};
     let past = run(k, Trapezoidal);
     assert!(
         !past.stable,

@@ -3,9 +3,9 @@
 //! `verify` analyses), grows at the rate the spectral radius says, and the
 //! same termination at the designed gain does not.
 
-use host_sim::human::{Event, GraspKind};
-use host_sim::plant::Arm;
-use host_sim::scene::{Discretization, VeSpec};
+use host_sim::engine::human::{Event, GraspKind};
+use host_sim::engine::plant::Arm;
+use host_sim::engine::scene::{Discretization, VeSpec};
 use host_sim::{Scene, Simulation};
 use std::path::Path;
 use twoport_design::design::*;

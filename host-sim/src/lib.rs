@@ -1,22 +1,10 @@
 #![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
 
-pub mod accuracy;
-pub mod app;
-pub mod blocks;
-pub mod human;
+pub mod engine;
 pub mod pil;
-pub mod plant;
-pub mod plot;
-pub mod scene;
 pub mod scope;
-pub mod sim;
-pub mod stability;
-#[cfg(feature = "gui")]
-pub mod ui;
-pub mod ve;
-#[cfg(feature = "gui")]
-pub mod window;
+pub mod study;
 
-pub use scene::Scene;
-pub use sim::{Report, Sample, Simulation};
+pub use engine::scene::Scene;
+pub use engine::sim::{Report, Sample, Simulation};

@@ -2,7 +2,8 @@
 //! stability boundary, the paper's Table I, and processor-in-the-loop.
 
 use clap::{Args, Parser, Subcommand};
-use host_sim::scene::{Display, Scene};
+use host_sim::engine::scene::Scene;
+use host_sim::study::{sweep, table1};
 use host_sim::{Report, Sample, Simulation};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
@@ -203,7 +204,7 @@ fn run(a: &RunArgs) -> Result<(), String> {
         w.flush().map_err(|e| format!("writing the CSV: {e}"))?;
     }
     if let Some(p) = &a.png {
-        host_sim::plot::png(&kept, &name, p)?;
+        host_sim::study::plot::png(&kept, &name, p)?;
     }
     if a.scene.json {
         println!(
@@ -235,52 +236,6 @@ fn print_report(r: &Report) {
     }
 }
 
-/// Stability of `scene` with `param = value`.
-fn stable_at(path: &Path, sets: &[String], param: &str, value: f64) -> Result<bool, String> {
-    let mut s = sets.to_vec();
-    s.push(format!("{param}={value}"));
-    Ok(run_scene(load(path, &s)?, |_| {})?.stable)
-}
-
-/// Bisect between `from` and `to` (geometric when both are positive) for the
-/// value where stability changes; returns the last stable value.
-fn marginal(
-    path: &Path,
-    sets: &[String],
-    param: &str,
-    from: f64,
-    to: f64,
-    tol: f64,
-    bar: &ProgressBar,
-) -> Result<f64, String> {
-    let (s_from, s_to) = (
-        stable_at(path, sets, param, from)?,
-        stable_at(path, sets, param, to)?,
-    );
-    if s_from == s_to {
-        return Err(format!(
-            "{param}: {} at both {from} and {to}; widen the range",
-            if s_from { "stable" } else { "unstable" }
-        ));
-    }
-    let (mut good, mut bad) = if s_from { (from, to) } else { (to, from) };
-    let geometric = good > 0.0 && bad > 0.0;
-    while (good - bad).abs() > tol * good.abs().max(bad.abs()) {
-        let mid = if geometric {
-            (good * bad).sqrt()
-        } else {
-            0.5 * (good + bad)
-        };
-        if stable_at(path, sets, param, mid)? {
-            good = mid;
-        } else {
-            bad = mid;
-        }
-        bar.inc(1);
-    }
-    Ok(good)
-}
-
 fn bar(len: u64, msg: String) -> ProgressBar {
     let b = ProgressBar::new(len);
     b.set_style(
@@ -291,28 +246,21 @@ fn bar(len: u64, msg: String) -> ProgressBar {
     b
 }
 
-fn steps(from: f64, to: f64, tol: f64) -> u64 {
-    let span = if from > 0.0 && to > 0.0 {
-        (to / from).ln().abs()
-    } else {
-        1.0 / tol
-    };
-    (span / tol).log2().ceil().max(1.0) as u64
-}
-
 fn sweep(a: &SweepArgs) -> Result<(), String> {
     if !(a.tol > 0.0 && a.tol < 1.0) {
         return Err(format!("--tol {}: must be between 0 and 1", a.tol));
     }
-    let b = bar(steps(a.from, a.to, a.tol), format!("sweeping {}", a.param));
-    let m = marginal(
+    let b = bar(
+        sweep::steps(a.from, a.to, a.tol),
+        format!("sweeping {}", a.param),
+    );
+    let m = sweep::marginal(
         &a.scene.scene,
         &a.scene.sets,
         &a.param,
-        a.from,
-        a.to,
+        (a.from, a.to),
         a.tol,
-        &b,
+        &mut || b.inc(1),
     )?;
     b.finish_and_clear();
     if a.scene.json {
@@ -330,54 +278,29 @@ fn sweep(a: &SweepArgs) -> Result<(), String> {
 /// Table I: every VE state x grasp at the theoretical gains, then the
 /// boundaries swept as the paper did.
 fn table1(a: &Table1Args) -> Result<(), String> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&a.scenes)
-        .map_err(|e| format!("{}: {e}", a.scenes.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    files.sort();
-    if files.is_empty() {
-        return Err(format!("{}: no scenes", a.scenes.display()));
-    }
-    let b = bar(files.len() as u64, "Table I".into());
-    let mut rows = Vec::new();
-    let (mut k_bound, mut m_bound) = (f64::INFINITY, 0.0f64);
-    for f in &files {
-        let scene = load(f, &[])?;
-        let display = scene.display;
-        let report = run_scene(scene, |_| {})?;
-        let quiet = ProgressBar::hidden();
-        let m = match display {
-            Display::Impedance => {
-                marginal(f, &[], "coupling.k", 51_000.0, 2.0e6, 0.005, &quiet).ok()
-            }
-            Display::Admittance => marginal(f, &[], "coupling.m", 5.0, 0.01, 0.005, &quiet).ok(),
-        };
-        match (display, m) {
-            (Display::Impedance, Some(k)) => k_bound = k_bound.min(k),
-            (Display::Admittance, Some(mm)) => m_bound = m_bound.max(mm),
-            _ => {}
-        }
-        let case = f
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        rows.push(
-            json!({"case": case, "display": format!("{display:?}").to_lowercase(),
-            "stable_at_theoretical_gains": report.stable, "marginal": m}),
-        );
-        b.inc(1);
-    }
+    let n = table1::case_files(&a.scenes)?.len();
+    let b = bar(n as u64, "Table I".into());
+    let t = table1::table1(&a.scenes, &mut || b.inc(1))?;
     b.finish_and_clear();
-    let all_stable = rows
+    let rows: Vec<serde_json::Value> = t
+        .cases
         .iter()
-        .all(|r| r["stable_at_theoretical_gains"] == true);
+        .map(|c| {
+            json!({"case": c.case, "display": format!("{:?}", c.display).to_lowercase(),
+                "stable_at_theoretical_gains": c.stable_at_theoretical_gains, "marginal": c.marginal})
+        })
+        .collect();
+    let (all_stable, k_bound, m_bound) = (
+        t.all_stable(),
+        t.impedance_boundary_k,
+        t.admittance_boundary_m,
+    );
     if a.json {
         println!(
             "{}",
             json!({"cases": rows, "all_stable_at_theoretical_gains": all_stable,
-            "impedance_boundary_k": k_bound.is_finite().then_some(k_bound),
-            "admittance_boundary_m": (m_bound > 0.0).then_some(m_bound)})
+            "impedance_boundary_k": k_bound,
+            "admittance_boundary_m": m_bound})
         );
         return Ok(());
     }
@@ -394,16 +317,8 @@ fn table1(a: &Table1Args) -> Result<(), String> {
         "{:<26} {:>10} {:>6}   {:>8} {:>6}",
         "experimental (paper)", "75,000", "90", "4.3", "500"
     );
-    let fmt_k = if k_bound.is_finite() {
-        format!("{k_bound:.0}")
-    } else {
-        "> 2e6".into()
-    };
-    let fmt_m = if m_bound > 0.0 {
-        format!("{m_bound:.2}")
-    } else {
-        "< 0.01".into()
-    };
+    let fmt_k = k_bound.map_or("> 2e6".into(), |k| format!("{k:.0}"));
+    let fmt_m = m_bound.map_or("< 0.01".into(), |m| format!("{m:.2}"));
     println!(
         "{:<26} {:>10} {:>6}   {:>8} {:>6}",
         "simulated (this model)", fmt_k, "90", fmt_m, "500"
@@ -429,11 +344,15 @@ fn table1(a: &Table1Args) -> Result<(), String> {
 
 fn accuracy(a: &AccuracyArgs) -> Result<(), String> {
     std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
-    let scenes = host_sim::accuracy::scenes(Path::new("."))?;
+    let scenes = host_sim::study::accuracy::scenes(Path::new("."))?;
     let b = bar(scenes.len() as u64, "accuracy study".into());
     let mut cells = Vec::new();
     for s in &scenes {
-        cells.extend(host_sim::accuracy::study(&s.label, &s.scene, s.reference)?);
+        cells.extend(host_sim::study::accuracy::study(
+            &s.label,
+            &s.scene,
+            s.reference,
+        )?);
         b.inc(1);
     }
     b.finish_and_clear();
@@ -444,7 +363,7 @@ fn accuracy(a: &AccuracyArgs) -> Result<(), String> {
          ZOH for the linear scene (exact there), RK4 at 1,000 sub-steps (1 us) for the nonlinear one, both with the \
          f64 controller. Controller: the board's f32 laws, or the same laws computing in f64 (`integrator.controller`); \
          the f32 rows' error cannot fall below what the board's rounding does to the trajectory.\n\n![accuracy](accuracy.png)\n\n{}",
-        host_sim::accuracy::markdown(&cells)
+        host_sim::study::accuracy::markdown(&cells)
     );
     let write = |name: &str, text: String| {
         std::fs::write(a.out.join(name), text).map_err(|e| format!("{name}: {e}"))
@@ -454,7 +373,7 @@ fn accuracy(a: &AccuracyArgs) -> Result<(), String> {
         "accuracy.json",
         serde_json::to_string_pretty(&cells).map_err(|e| e.to_string())?,
     )?;
-    host_sim::plot::accuracy_png(&cells, &a.out.join("accuracy.png"))?;
+    host_sim::study::plot::accuracy_png(&cells, &a.out.join("accuracy.png"))?;
     println!(
         "wrote {}/accuracy.md, accuracy.json, accuracy.png ({} runs)",
         a.out.display(),
@@ -533,39 +452,8 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         }
     }
     if a.check {
-        let mut bad = Vec::new();
-        if c.duty_mismatches > 0 || c.max_position_error_m > 0.0 || c.max_force_error_n > 0.0 {
-            bad.push(format!(
-                "the board differs from the in-process loop ({} duties, {:.3e} m, {:.3e} N)",
-                c.duty_mismatches, c.max_position_error_m, c.max_force_error_n
-            ));
-        }
-        if c.ticks != ticks {
-            bad.push(format!("{} of {ticks} ticks ran", c.ticks));
-        }
-        if u64::from(run.board_stats.rx.dropped()) < run.corrupted_sent {
-            bad.push(format!(
-                "{} corrupted frames sent, the board dropped {}",
-                run.corrupted_sent,
-                run.board_stats.rx.dropped()
-            ));
-        }
         let deadline = u64::from(twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS);
-        if let (Some(t0), Some(z)) = (link_loss_at, run.zero_after_loss_ticks) {
-            let pushing = run.duties[..t0 as usize]
-                .iter()
-                .rev()
-                .take(10)
-                .any(|d| *d != 0);
-            if !pushing {
-                bad.push("no force before the link loss: the check would prove nothing".into());
-            }
-            if z > deadline {
-                bad.push(format!(
-                    "zero force {z} ticks after the link loss (deadline {deadline})"
-                ));
-            }
-        }
+        let bad = pil::failures(&run, &c, ticks, faults, deadline);
         if !bad.is_empty() {
             return Err(format!("PIL check failed: {}", bad.join("; ")));
         }
@@ -628,16 +516,16 @@ fn scope(a: &ScopeArgs) -> Result<(), String> {
 /// The scope window; `Ok(Some(why))` where none can open.
 #[cfg(feature = "gui")]
 fn open_window(a: &ScopeArgs) -> Result<Option<String>, String> {
-    if !host_sim::window::display_available() {
+    if !host_sim::scope::window::display_available() {
         return Ok(Some(
             "no display (DISPLAY and WAYLAND_DISPLAY are unset)".to_string(),
         ));
     }
-    let script = host_sim::window::Script {
+    let script = host_sim::scope::window::Script {
         screenshot: a.screenshot.clone(),
         exit_after_s: a.exit_after,
     };
-    match host_sim::window::run(&a.scene, script) {
+    match host_sim::scope::window::run(&a.scene, script) {
         Ok(shots) => {
             for p in shots {
                 eprintln!("host-sim: saved {}", p.display());

@@ -386,3 +386,48 @@ pub fn compare(a: &Run, b: &Run) -> Comparison {
         .count() as u64;
     c
 }
+/// Why a PIL run fails its check, or nothing where it passes. `run` is the
+/// board's, compared with the in-process loop as `c`; it was to take
+/// `ticks` ticks with the host's heartbeats stopping at `faults.link_loss_at`,
+/// after which the board must have zeroed the force within
+/// `deadline_ticks`. A run fails where the board differs from the loop at
+/// all (bit for bit), where ticks are missing, where it dropped fewer frames
+/// than were corrupted on purpose, or where it was late to zero the force
+/// (or was not pushing before the loss, so the check would prove nothing).
+pub fn failures(
+    run: &Run,
+    c: &Comparison,
+    ticks: u64,
+    faults: Faults,
+    deadline_ticks: u64,
+) -> Vec<String> {
+    let mut bad = Vec::new();
+    if c.duty_mismatches > 0 || c.max_position_error_m > 0.0 || c.max_force_error_n > 0.0 {
+        bad.push(format!(
+            "the board differs from the in-process loop ({} duties, {:.3e} m, {:.3e} N)",
+            c.duty_mismatches, c.max_position_error_m, c.max_force_error_n
+        ));
+    }
+    if c.ticks != ticks {
+        bad.push(format!("{} of {ticks} ticks ran", c.ticks));
+    }
+    if u64::from(run.board_stats.rx.dropped()) < run.corrupted_sent {
+        bad.push(format!(
+            "{} corrupted frames sent, the board dropped {}",
+            run.corrupted_sent,
+            run.board_stats.rx.dropped()
+        ));
+    }
+    if let (Some(t0), Some(z)) = (faults.link_loss_at, run.zero_after_loss_ticks) {
+        let before = &run.duties[..(t0 as usize).min(run.duties.len())];
+        if !before.iter().rev().take(10).any(|d| *d != 0) {
+            bad.push("no force before the link loss: the check would prove nothing".into());
+        }
+        if z > deadline_ticks {
+            bad.push(format!(
+                "zero force {z} ticks after the link loss (deadline {deadline_ticks})"
+            ));
+        }
+    }
+    bad
+}

@@ -3,7 +3,7 @@
 //! bound is detected; RK4 converges to the exact-ZOH trajectory; the exact
 //! ZOH plant conserves energy without damping; effects run only when named.
 
-use host_sim::plant::{Device, Grasp, Method, Stepper};
+use host_sim::engine::plant::{Device, Grasp, Method, Stepper};
 use host_sim::{Scene, Simulation};
 use std::path::{Path, PathBuf};
 
@@ -58,7 +58,7 @@ fn gains_far_past_the_bound_are_detected_unstable() {
         "scenes/table1/impedance_bilateral_maximum.toml",
         &["coupling.k=400000"],
     );
-    s.effects.saturation = Some(host_sim::scene::SaturationEffect { limit_n: 20.0 });
+    s.effects.saturation = Some(host_sim::engine::scene::SaturationEffect { limit_n: 20.0 });
     let r = Simulation::new(s).unwrap().run(|_| {});
     assert!(!r.stable, "{r:?}");
 }

@@ -5,9 +5,9 @@
 use eframe::egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
-use host_sim::app::Signal;
-use host_sim::app::{ScopeState, SliderGains, Speed, RING_SAMPLES};
-use host_sim::ui::BoardChoice;
+use host_sim::scope::app::Signal;
+use host_sim::scope::app::{ScopeState, SliderGains, Speed, RING_SAMPLES};
+use host_sim::scope::ui::BoardChoice;
 use std::path::Path;
 
 fn harness() -> Harness<'static, (ScopeState, BoardChoice)> {
@@ -15,7 +15,7 @@ fn harness() -> Harness<'static, (ScopeState, BoardChoice)> {
     let mut h = Harness::new_ui_state(
         |ui, s: &mut (ScopeState, BoardChoice)| {
             let (state, link) = s;
-            host_sim::ui::scope(ui, state, link)
+            host_sim::scope::ui::scope(ui, state, link)
         },
         (state, BoardChoice::default()),
     );
@@ -78,7 +78,7 @@ fn the_grasp_buttons_and_the_wall_act_on_the_simulation() {
     h.run();
     assert_eq!(
         h.state().0.grasp,
-        Some(host_sim::human::GraspKind::HandsOff)
+        Some(host_sim::engine::human::GraspKind::HandsOff)
     );
     h.get_by_role_and_label(Role::Slider, "surface (m)")
         .set_value_accesskit(0.02);
@@ -146,7 +146,11 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
     let b = s.board.as_ref().unwrap();
     let t = b.telemetry.expect("telemetry from the board");
     assert!(t.tick >= 1900, "tick {}", t.tick);
-    assert!(s.board_ring(host_sim::app::BoardSignal::Actuator).len() >= 150);
+    assert!(
+        s.board_ring(host_sim::scope::app::BoardSignal::Actuator)
+            .len()
+            >= 150
+    );
     // The board's position agrees with the simulated handle's encoder.
     let x_board = t.position_pm as f64 * 1e-12;
     assert!(
@@ -250,7 +254,7 @@ fn the_design_plot_shows_the_margin_in_decades() {
     let drawn: Vec<Vec<[f64; 2]>> = fig
         .curves
         .iter()
-        .map(|c| host_sim::ui::log_log(&c.points))
+        .map(|c| host_sim::scope::ui::log_log(&c.points))
         .collect();
     let decades = |c: &[[f64; 2]]| {
         let (lo, hi) = c

@@ -44,7 +44,7 @@ fn the_scope_draws_and_its_plots_move() {
         .expect("xvfb-run runs (install xvfb)");
     assert!(status.success(), "host-sim under Xvfb: {status}");
     let last = load(&out);
-    let first = load(&host_sim::window::first_shot_path(&out));
+    let first = load(&host_sim::scope::window::first_shot_path(&out));
     assert_eq!(first.dimensions(), last.dimensions());
     let (w, h) = last.dimensions();
     assert!(w >= 800 && h >= 600, "{w} x {h}");

@@ -221,6 +221,8 @@ fn ci() -> Result<(), String> {
             "screenshot",
             "--test",
             "scope",
+            "--test",
+            "study",
             "--",
             "--ignored",
             "--skip",

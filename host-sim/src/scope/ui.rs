@@ -1,9 +1,9 @@
 //! The scope's drawing: small functions, one per panel, over `ScopeState`.
 //! Nothing here owns simulation state.
 
-use crate::app::{list_ports, BoardSignal, ScopeState, Signal, SliderGains, Speed};
-use crate::human::GraspKind;
-use crate::scope::{minmax, Edge, Ring};
+use crate::engine::human::GraspKind;
+use crate::scope::app::{list_ports, BoardSignal, ScopeState, Signal, SliderGains, Speed};
+use crate::scope::rings::{minmax, Edge, Ring};
 use eframe::egui::{self, Color32, RichText, Ui};
 use egui_plot::{Legend, Line, Plot, PlotPoints};
 

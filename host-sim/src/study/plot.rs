@@ -95,7 +95,7 @@ pub fn png(samples: &[Sample], title: &str, out: &Path) -> Result<(), String> {
 
 /// The accuracy study as a PNG: error against cost, one line per method,
 /// a panel per scene.
-pub fn accuracy_png(cells: &[crate::accuracy::Cell], out: &Path) -> Result<(), String> {
+pub fn accuracy_png(cells: &[crate::study::accuracy::Cell], out: &Path) -> Result<(), String> {
     let _ =
         plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
     let root = BitMapBackend::new(out, (1200, 560)).into_drawing_area();

@@ -1,7 +1,7 @@
 //! The human operator: a grasp impedance `b + k/s` between the handle and
 //! a hand whose motion (and grip) follows a script.
 
-use crate::plant::{Arm, Grasp};
+use crate::engine::plant::{Arm, Grasp};
 use serde::Deserialize;
 
 /// Grasp presets. The paper bounds the human by `Z_max = 300 + 1000/s`

@@ -1,12 +1,12 @@
 //! One simulation: the plant between the hand and the board's own control
 //! code, ticking at the control period, with only the named effects.
 
-use crate::blocks::{Block, Blocks};
-use crate::human::{GraspKind, Human};
-use crate::plant::{Device, Method, Stepper, System};
-use crate::scene::{Discretization, Display, Precision, Scene, SolidSide, VeSpec};
-use crate::stability::{Detector, Verdict};
-use crate::ve::SceneVe;
+use crate::engine::blocks::{Block, Blocks};
+use crate::engine::human::{GraspKind, Human};
+use crate::engine::plant::{Device, Method, Stepper, System};
+use crate::engine::scene::{Discretization, Display, Precision, Scene, SolidSide, VeSpec};
+use crate::engine::stability::{Detector, Verdict};
+use crate::engine::ve::SceneVe;
 use std::collections::VecDeque;
 use std::time::Instant;
 use twoport_control::servo::{SensorFrame, ServoOutput};
@@ -455,7 +455,7 @@ impl Simulation {
             // device: it runs as the delay effect, after any the scene adds.
             if model.delay_samples > 0 {
                 let extra = scene.effects.delay.map_or(0, |d| d.ticks);
-                scene.effects.delay = Some(crate::scene::DelayEffect {
+                scene.effects.delay = Some(crate::engine::scene::DelayEffect {
                     ticks: extra + model.delay_samples,
                 });
             }

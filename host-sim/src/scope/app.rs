@@ -3,10 +3,10 @@
 //! trigger and freeze, the gains with the designer's live verdict, the hand
 //! and wall controls, and the link to a board. `ui.rs` draws it.
 
-use crate::human::GraspKind;
+use crate::engine::human::GraspKind;
+use crate::engine::scene::{Display, Scene, VeSpec};
 use crate::pil::{SerialBoard, Session};
-use crate::scene::{Display, Scene, VeSpec};
-use crate::scope::{last_trigger, Edge, Ring};
+use crate::scope::rings::{last_trigger, Edge, Ring};
 use crate::{Sample, Simulation};
 use std::path::{Path, PathBuf};
 use std::time::Duration;

@@ -2,7 +2,7 @@
 //! time since the last one, then draws. With `--screenshot` it saves the
 //! window twice (half-way and at `--exit-after`) and closes.
 
-use crate::app::ScopeState;
+use crate::scope::app::ScopeState;
 use eframe::egui;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -31,7 +31,7 @@ pub fn first_shot_path(p: &Path) -> PathBuf {
 
 struct ScopeApp {
     state: ScopeState,
-    link: crate::ui::BoardChoice,
+    link: crate::scope::ui::BoardChoice,
     script: Script,
     started: Instant,
     last_frame: Instant,
@@ -87,7 +87,7 @@ impl eframe::App for ScopeApp {
         let dt = (now - self.last_frame).as_secs_f64();
         self.last_frame = now;
         self.state.advance(dt);
-        crate::ui::scope(ui, &mut self.state, &mut self.link);
+        crate::scope::ui::scope(ui, &mut self.state, &mut self.link);
         self.scripted(&ctx);
         ctx.request_repaint();
     }
@@ -106,7 +106,7 @@ pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, String> {
     let saved = Arc::new(Mutex::new(Vec::new()));
     let app = ScopeApp {
         state,
-        link: crate::ui::BoardChoice::default(),
+        link: crate::scope::ui::BoardChoice::default(),
         script,
         started: Instant::now(),
         last_frame: Instant::now(),

@@ -5,8 +5,8 @@
 //! references run the f64 controller, so the f32 rows show the board's
 //! rounding as an error floor.
 
-use crate::plant::Method;
-use crate::scene::Precision;
+use crate::engine::plant::Method;
+use crate::engine::scene::Precision;
 use crate::{Scene, Simulation};
 use std::path::Path;
 use std::time::Instant;

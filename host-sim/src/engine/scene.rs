@@ -1,7 +1,7 @@
 //! Scene files: what to simulate, and only the effects named.
 
-use crate::human::{Event, GraspKind};
-use crate::plant::Method;
+use crate::engine::human::{Event, GraspKind};
+use crate::engine::plant::Method;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -269,7 +269,7 @@ pub struct HumanSpec {
     #[serde(default)]
     pub script: Vec<Event>,
     /// A passive arm behind the grasp (paper Fig. 3's `Z_p`).
-    pub arm: Option<crate::plant::Arm>,
+    pub arm: Option<crate::engine::plant::Arm>,
 }
 
 fn default_grasp() -> GraspKind {

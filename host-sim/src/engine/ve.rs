@@ -1,6 +1,6 @@
 //! The scene's VE: the control crate's VEs, or the building-block world.
 
-use crate::blocks::Blocks;
+use crate::engine::blocks::Blocks;
 use twoport_control::ve::{
     BilateralConstraint, Causality, CursorMass, Port, Spring, TrapezoidalSpring, UnilateralWall,
     VeOutput, VeTransfer, VirtualEnvironment,

@@ -1,0 +1,12 @@
+//! The simulation engine: the scene, the device's dynamics, the hand, the
+//! VEs and the building blocks, the effects, the stability judgement and
+//! the loop that runs them around the board's servo. Nothing here draws
+//! or studies; `scope` and `study` build on it.
+
+pub mod blocks;
+pub mod human;
+pub mod plant;
+pub mod scene;
+pub mod sim;
+pub mod stability;
+pub mod ve;

@@ -1,0 +1,111 @@
+//! The studies as a library: the bisection of a stability boundary, the
+//! paper's Table I, and the rules a processor-in-the-loop run is judged by.
+
+use host_sim::pil::{failures, Comparison, Faults, Run};
+use host_sim::study::{sweep, table1};
+use host_sim::{Scene, Simulation};
+use std::path::Path;
+
+const SCENE: &str = "../scenes/table1/impedance_bilateral_hands_off.toml";
+
+fn stable_with(k: f64) -> bool {
+    let s = Scene::load(Path::new(SCENE), &[format!("coupling.k={k}")]).unwrap();
+    Simulation::new(s).unwrap().run(|_| {}).stable
+}
+
+#[test]
+fn the_bisection_brackets_the_boundary() {
+    let mut steps = 0;
+    let k = sweep::marginal(
+        Path::new(SCENE),
+        &[],
+        "coupling.k",
+        (51_000.0, 1.0e6),
+        0.02,
+        &mut || steps += 1,
+    )
+    .unwrap();
+    assert!(k > 51_000.0 && k < 1.0e6, "{k}");
+    assert!(stable_with(k) && !stable_with(1.05 * k), "{k}");
+    assert_eq!(steps as u64, sweep::steps(51_000.0, 1.0e6, 0.02));
+    // Both ends stable: the error says to widen the range.
+    let e = sweep::marginal(
+        Path::new(SCENE),
+        &[],
+        "coupling.k",
+        (1e4, 2e4),
+        0.02,
+        &mut || {},
+    );
+    assert!(e.unwrap_err().contains("widen the range"));
+    assert!(sweep::marginal(
+        Path::new(SCENE),
+        &[],
+        "coupling.k",
+        (1e4, 2e4),
+        2.0,
+        &mut || {}
+    )
+    .unwrap_err()
+    .contains("between 0 and 1"));
+}
+
+#[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "18 cases and their sweeps: release only (CI runs it)"
+)]
+fn table1_every_case_is_stable_at_the_theoretical_gains() {
+    let mut n = 0;
+    let t = table1::table1(Path::new("../scenes/table1"), &mut || n += 1).unwrap();
+    assert_eq!((t.cases.len(), n), (18, 18));
+    assert!(t.all_stable(), "{t:?}");
+    // The simulated boundaries lie beyond the theoretical gains, as
+    // absolute stability must.
+    assert!(t.impedance_boundary_k.unwrap() > 51_000.0);
+    let m = t.admittance_boundary_m.unwrap();
+    assert!(m > 0.0 && m < 5.0, "{m}");
+}
+
+fn clean(ticks: u64) -> (Run, Comparison) {
+    let run = Run {
+        duties: vec![100; ticks as usize],
+        ..Run::default()
+    };
+    let c = Comparison {
+        ticks,
+        ..Comparison::default()
+    };
+    (run, c)
+}
+
+#[test]
+fn pil_runs_fail_for_any_difference_and_a_late_zero() {
+    let (run, c) = clean(100);
+    assert!(failures(&run, &c, 100, Faults::default(), 50).is_empty());
+    // Bit for bit or nothing: one duty, a femtometre, a missing tick.
+    let mut d = c;
+    d.duty_mismatches = 1;
+    assert!(failures(&run, &d, 100, Faults::default(), 50)[0].contains("differs"));
+    let mut d = c;
+    d.max_position_error_m = 1e-15;
+    assert!(!failures(&run, &d, 100, Faults::default(), 50).is_empty());
+    assert!(failures(&run, &c, 101, Faults::default(), 50)[0].contains("100 of 101 ticks"));
+    // Corrupted frames must all be dropped.
+    let mut r = run.clone();
+    r.corrupted_sent = 3;
+    assert!(failures(&r, &c, 100, Faults::default(), 50)[0].contains("corrupted"));
+    // The link lost at tick 60: zero force within the deadline, after force.
+    let loss = Faults {
+        corrupt_every: 0,
+        link_loss_at: Some(60),
+    };
+    let mut r = run.clone();
+    r.zero_after_loss_ticks = Some(40);
+    assert!(failures(&r, &c, 100, loss, 50).is_empty());
+    r.zero_after_loss_ticks = Some(51);
+    assert!(failures(&r, &c, 100, loss, 50)[0].contains("51 ticks after the link loss"));
+    r.duties = vec![0; 100];
+    r.zero_after_loss_ticks = Some(1);
+    assert!(failures(&r, &c, 100, loss, 50)[0].contains("would prove nothing"));
+}
