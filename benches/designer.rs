@@ -4,41 +4,45 @@
 //! times), and `verify` on the Excalibur (goal <= 2 s).
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use num_complex::Complex64;
 use std::f64::consts::PI;
 use std::hint::black_box;
 use twoport_design::design::*;
+use twoport_design::plant::Scratch;
 use twoport_design::twoport::HumanBound;
 use twoport_design::{DeviceModel, Plant};
 
 fn excalibur() -> Plant {
-    let m = DeviceModel::from_toml(include_str!("../models/excalibur.toml"), "excalibur").unwrap();
-    Plant::new(&m, 1e-3).unwrap()
+    Analysis::excalibur().plant().clone()
 }
 
 fn responses(c: &mut Criterion) {
     let plant = excalibur();
     let w = log_grid(2.0 * PI * 0.1, plant.nyquist(), 10_000);
     let mut scratch = plant.scratch();
-    c.bench_function("Y(s) and F(s), modal form, 10,000 points", |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for &omega in &w {
-                let (y, f) = plant.continuous(omega, &mut scratch);
-                acc += y[0][0].re + f[1].re;
-            }
-            black_box(acc)
-        })
-    });
-    c.bench_function("Y(s) and F(s), complex LU per point, 10,000 points", |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for &omega in &w {
-                let (y, f) = plant.continuous_lu(omega, &mut scratch);
-                acc += y[0][0].re + f[1].re;
-            }
-            black_box(acc)
-        })
-    });
+    type Method = fn(&Plant, f64, &mut Scratch) -> ([[Complex64; 2]; 2], [Complex64; 2]);
+    let methods: [(&str, Method); 2] = [
+        (
+            "Y(s) and F(s), modal form, 10,000 points",
+            Plant::continuous,
+        ),
+        (
+            "Y(s) and F(s), complex LU per point, 10,000 points",
+            Plant::continuous_lu,
+        ),
+    ];
+    for (name, method) in methods {
+        c.bench_function(name, |b| {
+            b.iter(|| {
+                let mut acc = 0.0;
+                for &omega in &w {
+                    let (y, f) = method(&plant, omega, &mut scratch);
+                    acc += y[0][0].re + f[1].re;
+                }
+                black_box(acc)
+            })
+        });
+    }
     c.bench_function(
         "all plant terms incl. ZOH-exact X_aa^d, F_ma^d, 10,000 points",
         |b| b.iter(|| black_box(plant.response(&w))),
@@ -62,8 +66,7 @@ fn designs(c: &mut Criterion) {
             })
         },
     );
-    let plant = excalibur();
-    let a = Analysis::new(&plant, GridSpec::DEFAULT);
+    let a = Analysis::excalibur();
     let bi = a.impedance_bound(human);
     c.bench_function("best (k, b) pair, impedance display", |b| {
         b.iter(|| black_box(best_impedance(&a, &bi)))

@@ -64,10 +64,8 @@ fn admittance_display_does_not_creep_in_24_hours() {
 }
 
 fn excalibur() -> (Plant, Analysis) {
-    let m = DeviceModel::from_toml(EXCALIBUR, "excalibur").unwrap();
-    let p = Plant::new(&m, 1e-3).unwrap();
-    let a = Analysis::new(&p, GridSpec::DEFAULT);
-    (p, a)
+    let a = Analysis::excalibur();
+    (a.plant().clone(), a)
 }
 
 /// Gains far outside any sensible range are reported not stable, with

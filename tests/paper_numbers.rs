@@ -5,7 +5,7 @@ use std::f64::consts::PI;
 use std::sync::OnceLock;
 use twoport_design::design::*;
 use twoport_design::twoport::HumanBound;
-use twoport_design::{DeviceModel, Plant};
+use twoport_design::Plant;
 
 const HUMAN: Option<HumanBound> = Some(HumanBound::PAPER);
 const PAPER_K: f64 = 51_000.0;
@@ -21,11 +21,11 @@ struct Excalibur {
 fn excalibur() -> &'static Excalibur {
     static E: OnceLock<Excalibur> = OnceLock::new();
     E.get_or_init(|| {
-        let m =
-            DeviceModel::from_toml(include_str!("../models/excalibur.toml"), "excalibur").unwrap();
-        let plant = Plant::new(&m, 1e-3).unwrap();
-        let a = Analysis::new(&plant, GridSpec::DEFAULT);
-        Excalibur { plant, a }
+        let a = Analysis::excalibur();
+        Excalibur {
+            plant: a.plant().clone(),
+            a,
+        }
     })
 }
 

@@ -7,17 +7,17 @@ use twoport_control::ve::BilateralConstraint;
 use twoport_control::{Encoder, ImpedanceServo, Position, SafetyConfig};
 use twoport_design::design::*;
 use twoport_design::twoport::HumanBound;
-use twoport_design::{DeviceModel, Plant};
+
 use twoport_link::{encode, Decoder, Gains, GainsReply, Message, MAX_FRAME};
 
 const N: usize = 16;
 
 #[test]
 fn the_board_accepts_only_what_the_designer_proves() {
-    let m = DeviceModel::from_toml(include_str!("../models/excalibur.toml"), "excalibur").unwrap();
-    let a = Analysis::new(&Plant::new(&m, 1e-3).unwrap(), GridSpec::DEFAULT);
+    let a = Analysis::excalibur();
     let h = Some(HumanBound::PAPER);
-    let rows = region_impedance(&a, &a.impedance_bound(h), (10.0, 150.0), N);
+    let bound = a.impedance_bound(h);
+    let rows = region_impedance(&[(&a, &bound)], (10.0, 150.0), N);
     assert_eq!(
         rows.len(),
         N,

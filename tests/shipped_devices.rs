@@ -7,7 +7,7 @@ use std::path::Path;
 use twoport_design::design::*;
 use twoport_design::twoport::HumanBound;
 use twoport_design::verify::{verify, Gains};
-use twoport_design::{DeviceModel, Plant};
+use twoport_design::DeviceModel;
 
 const T: f64 = 1e-3;
 
@@ -42,7 +42,7 @@ fn every_model_has_a_scene_here() {
 fn every_device_design_survives_verify_and_breaks_past_it() {
     for (model, _) in DEVICES {
         let m = DeviceModel::load(&root().join(model)).unwrap();
-        let a = Analysis::new(&Plant::new(&m, T).unwrap(), GridSpec::DEFAULT);
+        let a = Analysis::of(&m).unwrap();
         for human in [Some(HumanBound::PAPER), None] {
             let (k, b) = best_impedance(&a, &a.impedance_bound(human)).unwrap();
             let g = |k_npm| Gains::Impedance { k_npm, b_nspm: b };
@@ -70,7 +70,7 @@ fn every_device_scene_is_proven_and_stable() {
             Path::new(model).file_name(),
             "{scene} runs {model}"
         );
-        let a = Analysis::new(&Plant::new(&m, T).unwrap(), GridSpec::DEFAULT);
+        let a = Analysis::of(&m).unwrap();
         let k = s.coupling.k.unwrap();
         let c = check_impedance(&a, k, s.coupling.b, Some(HumanBound::PAPER)).unwrap();
         assert!(c.absolutely_stable, "{scene}: {c:?}");

@@ -6,7 +6,6 @@
 use twoport_board::excalibur;
 use twoport_design::design::*;
 use twoport_design::twoport::HumanBound;
-use twoport_design::{DeviceModel, Plant};
 
 #[test]
 fn the_shipped_region_is_the_designers() {
@@ -20,14 +19,9 @@ fn the_shipped_region_is_the_designers() {
         how,
         "twoport region impedance --b-from 10 --b-to 810 --points 17 --rust"
     );
-    let m = DeviceModel::from_toml(include_str!("../models/excalibur.toml"), "excalibur").unwrap();
-    let a = Analysis::new(&Plant::new(&m, 1e-3).unwrap(), GridSpec::DEFAULT);
-    let rows = region_impedance(
-        &a,
-        &a.impedance_bound(Some(HumanBound::PAPER)),
-        (10.0, 810.0),
-        17,
-    );
+    let a = Analysis::excalibur();
+    let bound = a.impedance_bound(Some(HumanBound::PAPER));
+    let rows = region_impedance(&[(&a, &bound)], (10.0, 810.0), 17);
     assert_eq!(region_rust_source(&rows, true, None, how), shipped);
     // Rounded toward safety: no f32 limit exceeds the f64 proof.
     for (i, (_, k)) in rows.iter().enumerate() {

@@ -224,9 +224,9 @@ fn admittance_gains_past_the_bound_meet_an_unstable_termination() {
 
 /// The designer's Excalibur at T = 1 ms.
 fn excalibur_plant() -> twoport_design::Plant {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let model = twoport_design::DeviceModel::load(&root.join("models/excalibur.toml")).unwrap();
-    twoport_design::Plant::new(&model, 1e-3).unwrap()
+    twoport_design::design::Analysis::excalibur()
+        .plant()
+        .clone()
 }
 
 /// The designer's view of the impedance display at the VE port, hand off:

@@ -11,7 +11,7 @@ use std::path::Path;
 use twoport_design::design::*;
 use twoport_design::twoport::HumanBound;
 use twoport_design::verify::{radius, verify, Gains, Ve};
-use twoport_design::{DeviceModel, Plant};
+use twoport_design::DeviceModel;
 
 const T: f64 = 1e-3;
 
@@ -43,25 +43,21 @@ fn scene_on(model: &str, k: f64, b: f64, ve: &Ve) -> Scene {
     s.coupling.k = Some(k);
     s.coupling.b = b;
     s.duration_s = 6.0;
+    let spring = |stiffness_npm, damping_nspm, discretization| VeSpec::Spring {
+        anchor_m: 0.0,
+        stiffness_npm,
+        damping_nspm,
+        discretization,
+    };
     s.ve = match *ve {
         Ve::TrapezoidalSpring {
-            stiffness_npm,
-            damping_nspm,
-        } => VeSpec::Spring {
-            anchor_m: 0.0,
-            stiffness_npm,
-            damping_nspm,
-            discretization: Discretization::Trapezoidal,
-        },
+            stiffness_npm: k,
+            damping_nspm: b,
+        } => spring(k, b, Discretization::Trapezoidal),
         Ve::Spring {
-            stiffness_npm,
-            damping_nspm,
-        } => VeSpec::Spring {
-            anchor_m: 0.0,
-            stiffness_npm,
-            damping_nspm,
-            discretization: Discretization::BackwardEuler,
-        },
+            stiffness_npm: k,
+            damping_nspm: b,
+        } => spring(k, b, Discretization::BackwardEuler),
         Ve::Cursor { mass_kg } => VeSpec::Cursor { mass_kg },
         Ve::Constraint => VeSpec::Bilateral,
     };
@@ -90,7 +86,7 @@ fn peaks(s: Scene, windows: &[(f64, f64)]) -> Vec<f64> {
 #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
 fn verifys_counterexample_grows_in_the_simulator_at_its_rate() {
     let model = DeviceModel::excalibur().unwrap();
-    let a = Analysis::new(&Plant::new(&model, T).unwrap(), GridSpec::DEFAULT);
+    let a = Analysis::of(&model).unwrap();
     let human = Some(HumanBound::PAPER);
     let k_max = max_stiffness(&a, &a.impedance_bound(human), 90.0).unwrap();
     let past = Gains::Impedance {
@@ -142,7 +138,7 @@ fn a_declared_delay_enters_the_simulator() {
     std::fs::write(&delayed, model(1)).unwrap();
     std::fs::write(&prompt, model(0)).unwrap();
     let m = DeviceModel::load(&delayed).unwrap();
-    let a = Analysis::new(&Plant::new(&m, T).unwrap(), GridSpec::DEFAULT);
+    let a = Analysis::of(&m).unwrap();
     let k_max = max_stiffness(&a, &a.impedance_bound(None), 0.0).unwrap();
     assert!((k_max - 10_000.0).abs() < 50.0, "{k_max}");
     let past = Gains::Impedance {

@@ -1,33 +1,21 @@
 //! `host-sim` as a user runs it: JSON on stdout, CSV columns, sweeps, the
 //! Table I command, and errors with exit code 2.
 
-use serde_json::Value;
+#[path = "../../tests/support/cli.rs"]
+mod support;
+
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn host_sim(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_host-sim"))
-        .args(args)
-        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
-        .output()
-        .expect("run host-sim")
-}
-
-fn json(args: &[&str]) -> Value {
-    let out = host_sim(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).unwrap();
-    assert_eq!(text.trim().lines().count(), 1, "one JSON object: {text}");
-    serde_json::from_str(&text).unwrap()
-}
+/// `host-sim`, run from the repository root.
+const HOST_SIM: support::Tool = support::Tool {
+    bin: env!("CARGO_BIN_EXE_host-sim"),
+    root: concat!(env!("CARGO_MANIFEST_DIR"), "/.."),
+};
 
 #[test]
 fn run_json_has_the_documented_fields() {
-    let v = json(&["run", "scenes/stiff_wall.toml", "--duration", "3", "--json"]);
+    let v = HOST_SIM.json(&["run", "scenes/stiff_wall.toml", "--duration", "3", "--json"]);
     for key in [
         "stable",
         "peak_force_n",
@@ -54,7 +42,7 @@ fn run_json_has_the_documented_fields() {
 
 #[test]
 fn set_overrides_any_value_and_a_big_gain_is_unstable() {
-    let v = json(&[
+    let v = HOST_SIM.json(&[
         "run",
         "scenes/table1/impedance_bilateral_hands_off.toml",
         "--set",
@@ -69,7 +57,7 @@ fn set_overrides_any_value_and_a_big_gain_is_unstable() {
 fn csv_has_one_row_per_tick_and_the_documented_columns() {
     let path = std::env::temp_dir().join(format!("host-sim-{}.csv", std::process::id()));
     let png = path.with_extension("png");
-    json(&[
+    HOST_SIM.json(&[
         "run",
         "scenes/vbb_blocks.toml",
         "--duration",
@@ -104,7 +92,7 @@ fn csv_has_one_row_per_tick_and_the_documented_columns() {
 
 #[test]
 fn sweep_finds_a_marginal_gain_between_stable_and_unstable() {
-    let v = json(&[
+    let v = HOST_SIM.json(&[
         "sweep",
         "scenes/table1/impedance_bilateral_hands_off.toml",
         "--param",
@@ -120,7 +108,7 @@ fn sweep_finds_a_marginal_gain_between_stable_and_unstable() {
     assert_eq!(v["param"], "coupling.k");
     let k = v["marginal"].as_f64().unwrap();
     assert!(k > 51_000.0 && k < 1_000_000.0, "{k}");
-    let stable = json(&[
+    let stable = HOST_SIM.json(&[
         "run",
         "scenes/table1/impedance_bilateral_hands_off.toml",
         "--set",
@@ -128,7 +116,7 @@ fn sweep_finds_a_marginal_gain_between_stable_and_unstable() {
         "--json",
     ]);
     assert_eq!(stable["stable"], true);
-    let past = json(&[
+    let past = HOST_SIM.json(&[
         "run",
         "scenes/table1/impedance_bilateral_hands_off.toml",
         "--set",
@@ -147,7 +135,7 @@ fn table1_json_has_the_documented_fields() {
     let scene = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../scenes/table1/impedance_bilateral_hands_off.toml");
     std::fs::copy(&scene, dir.join("impedance_bilateral_hands_off.toml")).unwrap();
-    let v = json(&["table1", "--scenes", dir.to_str().unwrap(), "--json"]);
+    let v = HOST_SIM.json(&["table1", "--scenes", dir.to_str().unwrap(), "--json"]);
     std::fs::remove_dir_all(&dir).ok();
     let cases = v["cases"].as_array().unwrap();
     assert_eq!(cases.len(), 1);
@@ -189,7 +177,7 @@ fn errors_name_the_problem_and_exit_2() {
             "stable at both",
         ),
     ] {
-        let out = host_sim(&args);
+        let out = HOST_SIM.run(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         let e = String::from_utf8_lossy(&out.stderr);
         assert!(e.contains(want), "{args:?}: {e}");

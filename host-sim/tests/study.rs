@@ -16,38 +16,22 @@ fn stable_with(k: f64) -> bool {
 #[test]
 fn the_bisection_brackets_the_boundary() {
     let mut steps = 0;
-    let k = sweep::marginal(
-        Path::new(SCENE),
-        &[],
-        "coupling.k",
-        (51_000.0, 1.0e6),
-        0.02,
-        &mut || steps += 1,
-    )
-    .unwrap();
+    let mut k_between = |range, tol| {
+        sweep::marginal(Path::new(SCENE), &[], "coupling.k", range, tol, &mut || {
+            steps += 1
+        })
+    };
+    let k = k_between((51_000.0, 1.0e6), 0.02).unwrap();
     assert!(k > 51_000.0 && k < 1.0e6, "{k}");
-    assert!(stable_with(k) && !stable_with(1.05 * k), "{k}");
-    assert_eq!(steps as u64, sweep::steps(51_000.0, 1.0e6, 0.02));
     // Both ends stable: the error says to widen the range.
-    let e = sweep::marginal(
-        Path::new(SCENE),
-        &[],
-        "coupling.k",
-        (1e4, 2e4),
-        0.02,
-        &mut || {},
-    );
-    assert!(e.unwrap_err().contains("widen the range"));
-    assert!(sweep::marginal(
-        Path::new(SCENE),
-        &[],
-        "coupling.k",
-        (1e4, 2e4),
-        2.0,
-        &mut || {}
-    )
-    .unwrap_err()
-    .contains("between 0 and 1"));
+    assert!(k_between((1e4, 2e4), 0.02)
+        .unwrap_err()
+        .contains("widen the range"));
+    assert!(k_between((1e4, 2e4), 2.0)
+        .unwrap_err()
+        .contains("between 0 and 1"));
+    assert_eq!(steps as u64, sweep::steps(51_000.0, 1.0e6, 0.02));
+    assert!(stable_with(k) && !stable_with(1.05 * k), "{k}");
 }
 
 #[test]

@@ -130,6 +130,19 @@ impl Analysis {
         }
     }
 
+    /// `model` at its own period on the default grid: where most designs
+    /// start. The error names what the model's dynamics refused.
+    pub fn of(model: &crate::DeviceModel) -> Result<Self, String> {
+        Plant::new(model, model.period_s).map(|p| Analysis::new(&p, GridSpec::DEFAULT))
+    }
+
+    /// The paper's Excalibur (the built-in model) at 1 ms on the default
+    /// grid.
+    pub fn excalibur() -> Self {
+        let m = crate::DeviceModel::excalibur().expect("the built-in Excalibur model is valid");
+        Analysis::of(&m).expect("the built-in Excalibur model discretises")
+    }
+
     /// Evaluate `plant` on the given angular frequencies (rad/s).
     pub fn on(plant: &Plant, omegas: &[f64]) -> Self {
         Analysis {
@@ -177,27 +190,22 @@ impl Analysis {
     }
 }
 
-/// The z-domain form of the impedance coupling the board would run.
-pub fn impedance_coupling_tf(
-    k_npm: f64,
-    b_nspm: f64,
-    period_s: f64,
-) -> Result<ZTransfer, ParamError> {
-    ImpedanceCoupling::new(k_npm as f32, b_nspm as f32, period_s as f32).map(|c| c.tf())
+/// The z-domain form of the impedance coupling the board would run:
+/// stiffness `k` (N/m), damping `b` (N s/m), period `t` (s).
+pub fn impedance_coupling_tf(k: f64, b: f64, t: f64) -> Result<ZTransfer, ParamError> {
+    ImpedanceCoupling::new(k as f32, b as f32, t as f32).map(|c| c.tf())
 }
 
-/// The z-domain form of the admittance coupling the board would run.
-pub fn admittance_coupling_tf(
-    m_kg: f64,
-    b_nspm: f64,
-    period_s: f64,
-) -> Result<ZTransfer, ParamError> {
-    AdmittanceCoupling::new(m_kg as f32, b_nspm as f32, period_s as f32).map(|c| c.tf())
+/// The z-domain form of the admittance coupling the board would run:
+/// mass `m` (kg), damping `b` (N s/m), period `t` (s).
+pub fn admittance_coupling_tf(m: f64, b: f64, t: f64) -> Result<ZTransfer, ParamError> {
+    AdmittanceCoupling::new(m as f32, b as f32, t as f32).map(|c| c.tf())
 }
 
-/// The z-domain form of the position regulator the board would run.
-pub fn regulator_tf(kp_npm: f64, bp_nspm: f64, period_s: f64) -> Result<ZTransfer, ParamError> {
-    PositionRegulator::new(kp_npm as f32, bp_nspm as f32, period_s as f32).map(|r| r.tf())
+/// The z-domain form of the position regulator the board would run:
+/// stiffness `kp` (N/m), damping `bp` (N s/m), period `t` (s).
+pub fn regulator_tf(kp: f64, bp: f64, t: f64) -> Result<ZTransfer, ParamError> {
+    PositionRegulator::new(kp as f32, bp as f32, t as f32).map(|r| r.tf())
 }
 
 /// Smallest `lhs(ω) - bound(ω)` over the grid, or the negative
@@ -507,8 +515,7 @@ pub fn check_admittance(
     (m, b): (f64, f64),
     human: Option<HumanBound>,
 ) -> Option<Check> {
-    let k = regulator_tf(kp, bp, a.period_s).ok()?;
-    let zc = admittance_coupling_tf(m, b, a.period_s).ok()?;
+    let (k, zc) = admittance_laws(a, (kp, bp), (m, b))?;
     let radius = plant.regulated_pole_radius(&k);
     let lhs = |z: Complex64| zc.eval(z).re;
     let (mg, f) = worst(a, &a.admittance_bound(&k, human), lhs);
@@ -546,6 +553,19 @@ pub fn llewellyn_impedance(
     )
 }
 
+/// The admittance display's regulator and coupling z-forms, as the board
+/// would run them.
+fn admittance_laws(
+    a: &Analysis,
+    (kp, bp): (f64, f64),
+    (m, b): (f64, f64),
+) -> Option<(ZTransfer, ZTransfer)> {
+    Some((
+        regulator_tf(kp, bp, a.period_s).ok()?,
+        admittance_coupling_tf(m, b, a.period_s).ok()?,
+    ))
+}
+
 /// Llewellyn's `η - 1` of the full interface at every grid point,
 /// admittance display.
 pub fn llewellyn_admittance(
@@ -554,8 +574,7 @@ pub fn llewellyn_admittance(
     (m, b): (f64, f64),
     human: Option<HumanBound>,
 ) -> Option<Vec<f64>> {
-    let k = regulator_tf(kp, bp, a.period_s).ok()?;
-    let zc = admittance_coupling_tf(m, b, a.period_s).ok()?;
+    let (k, zc) = admittance_laws(a, (kp, bp), (m, b))?;
     Some(
         a.points
             .iter()
@@ -597,8 +616,7 @@ pub fn impedance_range_admittance(
     (kp, bp): (f64, f64),
     (m, b): (f64, f64),
 ) -> Option<Vec<(Complex64, Complex64)>> {
-    let k = regulator_tf(kp, bp, a.period_s).ok()?;
-    let zc = admittance_coupling_tf(m, b, a.period_s).ok()?;
+    let (k, zc) = admittance_laws(a, (kp, bp), (m, b))?;
     Some(
         a.points
             .iter()
@@ -614,35 +632,15 @@ pub fn impedance_range_admittance(
 
 /// The proven region for a board: for each damping on a log grid from
 /// `b_lo` to `b_hi` (N s/m, `points` of them), the greatest coupling
-/// stiffness (impedance display). Dampings where nothing is stable are left
-/// out.
-pub fn region_impedance(
-    a: &Analysis,
-    bound: &[f64],
-    range: (f64, f64),
-    points: usize,
-) -> Vec<(f64, f64)> {
-    region_impedance_poses(&[(a, bound)], range, points)
-}
-
-/// [`region_impedance`] over every pose.
-pub fn region_impedance_poses(poses: &Poses, range: (f64, f64), points: usize) -> Vec<(f64, f64)> {
+/// stiffness (impedance display) over every pose. Dampings where nothing is
+/// stable are left out. (One pose: `&[(&analysis, &bound)]`.)
+pub fn region_impedance(poses: &Poses, range: (f64, f64), points: usize) -> Vec<(f64, f64)> {
     region(range, points, |b| max_stiffness_poses(poses, b))
 }
 
 /// The proven region for a board's admittance display (one regulator):
-/// the least coupling mass for each damping on a log grid.
-pub fn region_admittance(
-    a: &Analysis,
-    bound: &[f64],
-    range: (f64, f64),
-    points: usize,
-) -> Vec<(f64, f64)> {
-    region_admittance_poses(&[(a, bound)], range, points)
-}
-
-/// [`region_admittance`] over every pose.
-pub fn region_admittance_poses(poses: &Poses, range: (f64, f64), points: usize) -> Vec<(f64, f64)> {
+/// the least coupling mass for each damping on a log grid, over every pose.
+pub fn region_admittance(poses: &Poses, range: (f64, f64), points: usize) -> Vec<(f64, f64)> {
     region(range, points, |b| min_mass_poses(poses, b))
 }
 

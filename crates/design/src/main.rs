@@ -445,6 +445,26 @@ fn binding_pose_text(v: &Value) -> Option<String> {
     })
 }
 
+/// The sound design `r` and the paper's `paper` as `(limit, b_c)` into `v`
+/// (`key` and `paper_key`, with `b_c`), and which of the two binds.
+fn designs(
+    v: &mut Value,
+    key: &str,
+    r: Option<(f64, f64)>,
+    paper: Option<(f64, f64)>,
+    more_is_bolder: bool,
+) {
+    if let Some((l, b)) = paper {
+        v[format!("paper_{key}")] = json!(l);
+        v["paper_b_c"] = json!(b);
+    }
+    if let Some((l, b)) = r {
+        v[key] = json!(l);
+        v["b_c"] = json!(b);
+    }
+    binding(v, r.map(|r| r.0), paper.map(|p| p.0), more_is_bolder);
+}
+
 /// Which bound set a design, and by how much the paper's approximation
 /// (aliasing at the handle port neglected) would have claimed more. `sound`
 /// and `paper` are the designed limits; `more_is_bolder` says whether a
@@ -486,34 +506,15 @@ fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
     let r = impedance_design(&s, a.b)?;
     let paper = impedance_design_on(&s, &s.impedance_bounds(true), a.b)?;
     let mut v = json!({"display": "impedance", "feasible": r.is_some(), "period_s": s.period(), "human_model": s.human.is_some()});
-    if let Some((k, b)) = paper {
-        v["paper_k_c"] = json!(k);
-        v["paper_b_c"] = json!(b);
-    }
-    binding(&mut v, r.map(|r| r.0), paper.map(|p| p.0), true);
+    designs(&mut v, "k_c", r, paper, true);
     match r {
         Some((k, b)) => {
-            v["k_c"] = json!(k);
-            v["b_c"] = json!(b);
             let c = s.worst_check(|p| design::check_impedance(&p.analysis, k, b, s.human));
             binding_pose(&mut v, &s, c);
         }
         None => {
-            let bounds = s.impedance_bounds(false);
-            let obstacle = s
-                .with(&bounds)
-                .iter()
-                .find_map(|(a, b)| design::low_frequency_obstacle(a, b));
-            v["message"] = json!(match obstacle {
-                Some(b) => low_frequency_text(b, "stiffness", "m/(N s)"),
-                None => format!(
-                    "no stiffness from {} to {} N/m meets the bound{}",
-                    design::K_RANGE.0,
-                    design::K_RANGE.1,
-                    a.b.map(|b| format!(" at b_c = {b} N s/m"))
-                        .unwrap_or_default()
-                ),
-            })
+            let what = ("stiffness", "m/(N s)", design::K_RANGE, "N/m");
+            v["message"] = json!(infeasible(&s, &s.impedance_bounds(false), what, a.b));
         }
     }
     s.emit(v.clone(), || {
@@ -533,10 +534,27 @@ fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
     Ok(())
 }
 
-fn low_frequency_text(bound: f64, what: &str, unit: &str) -> String {
-    format!(
-        "no finite coupling {what} is absolutely stable: toward DC the bound stays positive (its limit is {bound:.4e} {unit}), while the coupling's real part goes to zero as the frequency does"
-    )
+/// Why no coupling `what` (its bound's unit, its search range and unit)
+/// meets `bounds`: the limit toward DC, or the range searched.
+fn infeasible(
+    s: &Session,
+    bounds: &[Vec<f64>],
+    (what, bound_unit, (lo, hi), unit): (&str, &str, (f64, f64), &str),
+    b: Option<f64>,
+) -> String {
+    let at = b
+        .map(|b| format!(" at b_c = {b} N s/m"))
+        .unwrap_or_default();
+    match s
+        .with(bounds)
+        .iter()
+        .find_map(|(a, b)| design::low_frequency_obstacle(a, b))
+    {
+        Some(limit) => format!(
+            "no finite coupling {what} is absolutely stable: toward DC the bound stays positive (its limit is {limit:.4e} {bound_unit}), while the coupling's real part goes to zero as the frequency does"
+        ),
+        None => format!("no coupling {what} from {lo} to {hi} {unit} meets the bound{at}"),
+    }
 }
 
 /// Why an admittance display cannot be built for `model`.
@@ -572,15 +590,9 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
     let paper = design_on(&s.admittance_bounds(&k, true))?;
     let mut v = json!({"display": "admittance", "feasible": r.is_some(), "kp": kp, "bp": bp,
         "period_s": s.period(), "human_model": s.human.is_some(), "regulator_pole_radius": radius});
-    if let Some((m, b)) = paper {
-        v["paper_m_c"] = json!(m);
-        v["paper_b_c"] = json!(b);
-    }
-    binding(&mut v, r.map(|r| r.0), paper.map(|p| p.0), false);
+    designs(&mut v, "m_c", r, paper, false);
     match r {
         Some((m, b)) => {
-            v["m_c"] = json!(m);
-            v["b_c"] = json!(b);
             let c = s.worst_check(|p| {
                 design::check_admittance(&p.plant, &p.analysis, (kp, bp), (m, b), s.human)
             });
@@ -592,21 +604,8 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
             ))
         }
         None => {
-            let bounds = s.admittance_bounds(&k, false);
-            let obstacle = s
-                .with(&bounds)
-                .iter()
-                .find_map(|(a, b)| design::low_frequency_obstacle(a, b));
-            v["message"] = json!(match obstacle {
-                Some(b) => low_frequency_text(b, "mass", "N s/m"),
-                None => format!(
-                    "no coupling mass from {} to {} kg meets the bound{}",
-                    design::M_RANGE.0,
-                    design::M_RANGE.1,
-                    a.b.map(|b| format!(" at b_c = {b} N s/m"))
-                        .unwrap_or_default()
-                ),
-            })
+            let what = ("mass", "N s/m", design::M_RANGE, "kg");
+            v["message"] = json!(infeasible(&s, &s.admittance_bounds(&k, false), what, a.b));
         }
     }
     s.emit(v.clone(), || {
@@ -809,7 +808,7 @@ fn region(d: &Display<RegionImpedance, RegionAdmittance>) -> Result<(), String> 
             let b = s.impedance_bounds(false);
             (
                 "max_stiffness_npm",
-                design::region_impedance_poses(&s.with(&b), (lo, hi), grid.points),
+                design::region_impedance(&s.with(&b), (lo, hi), grid.points),
                 None,
             )
         }
@@ -820,7 +819,7 @@ fn region(d: &Display<RegionImpedance, RegionAdmittance>) -> Result<(), String> 
             let b = s.admittance_bounds(&k, false);
             (
                 "min_mass_kg",
-                design::region_admittance_poses(&s.with(&b), (lo, hi), grid.points),
+                design::region_admittance(&s.with(&b), (lo, hi), grid.points),
                 Some((kp, bp)),
             )
         }

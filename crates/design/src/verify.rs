@@ -147,30 +147,17 @@ impl Ve {
                 &twoport_control::ve::CursorMass::new(mass_kg as f32, t32, p).map_err(e)?,
             ),
             Ve::Spring {
-                stiffness_npm,
-                damping_nspm,
+                stiffness_npm: k,
+                damping_nspm: b,
             } => VirtualEnvironment::<f32>::tf(
-                &twoport_control::ve::Spring::new(
-                    stiffness_npm as f32,
-                    damping_nspm as f32,
-                    p,
-                    t32,
-                    p,
-                )
-                .map_err(e)?,
+                &twoport_control::ve::Spring::new(k as f32, b as f32, p, t32, p).map_err(e)?,
             ),
             Ve::TrapezoidalSpring {
-                stiffness_npm,
-                damping_nspm,
+                stiffness_npm: k,
+                damping_nspm: b,
             } => VirtualEnvironment::<f32>::tf(
-                &twoport_control::ve::TrapezoidalSpring::new(
-                    stiffness_npm as f32,
-                    damping_nspm as f32,
-                    p,
-                    t32,
-                    p,
-                )
-                .map_err(e)?,
+                &twoport_control::ve::TrapezoidalSpring::new(k as f32, b as f32, p, t32, p)
+                    .map_err(e)?,
             ),
         };
         Ok(match tf {

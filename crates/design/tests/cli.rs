@@ -1,41 +1,32 @@
 //! The `twoport` command line as a user runs it: one JSON object per
 //! command, clear errors with exit code 2, figures written to disk.
 
-use serde_json::Value;
+#[path = "../../../tests/support/cli.rs"]
+mod support;
+
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
-fn twoport(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_twoport"))
-        .args(args)
-        // The default model path is relative to the repository root.
-        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
-        .output()
-        .expect("run twoport")
-}
+/// `twoport`, run from the repository root (the default model path is
+/// relative to it).
+const TWOPORT: support::Tool = support::Tool {
+    bin: env!("CARGO_BIN_EXE_twoport"),
+    root: concat!(env!("CARGO_MANIFEST_DIR"), "/../.."),
+};
 
-fn json(args: &[&str]) -> Value {
-    let out = twoport(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).unwrap();
-    assert_eq!(text.trim().lines().count(), 1, "one JSON object: {text}");
-    serde_json::from_str(&text).unwrap()
-}
+/// The paper's admittance-display gains: `K_p` and a 5 kg, 500 N s/m coupling.
+const PAPER_ADMITTANCE: [&str; 8] = ["--kp", "51000", "--bp", "90", "--m", "5", "--b", "500"];
 
-fn stderr_of_failure(args: &[&str]) -> String {
-    let out = twoport(args);
-    assert_eq!(out.status.code(), Some(2), "{args:?} should fail with 2");
-    assert!(out.stdout.is_empty());
-    String::from_utf8(out.stderr).unwrap()
+/// `command admittance` at the paper's gains, with `extra` arguments.
+fn paper_admittance(command: &'static str, extra: &[&'static str]) -> Vec<&'static str> {
+    let mut a = vec![command, "admittance"];
+    a.extend(PAPER_ADMITTANCE);
+    a.extend(extra);
+    a
 }
 
 #[test]
 fn design_impedance_json() {
-    let v = json(&["design", "impedance", "--b", "90", "--json"]);
+    let v = TWOPORT.json(&["design", "impedance", "--b", "90", "--json"]);
     assert_eq!(v["display"], "impedance");
     assert_eq!(v["feasible"], true);
     assert_eq!(v["human_model"], true);
@@ -47,35 +38,29 @@ fn design_impedance_json() {
 
 #[test]
 fn design_admittance_json_and_infeasible_without_human() {
-    let v = json(&[
-        "design",
-        "admittance",
-        "--kp",
-        "51000",
-        "--bp",
-        "90",
-        "--b",
-        "500",
-        "--json",
-    ]);
+    let paper = |human: &[&str]| {
+        let mut args = vec![
+            "design",
+            "admittance",
+            "--kp",
+            "51000",
+            "--bp",
+            "90",
+            "--b",
+            "500",
+            "--json",
+        ];
+        args.extend(human);
+        TWOPORT.json(&args)
+    };
+    let v = paper(&[]);
     assert_eq!(v["display"], "admittance");
     assert_eq!(v["feasible"], true);
     assert_eq!(v["kp"], 51_000.0);
     assert_eq!(v["bp"], 90.0);
     let m = v["m_c"].as_f64().unwrap();
     assert!((m - 5.0).abs() < 0.15, "{m}");
-    let v = json(&[
-        "design",
-        "admittance",
-        "--kp",
-        "51000",
-        "--bp",
-        "90",
-        "--b",
-        "500",
-        "--no-human",
-        "--json",
-    ]);
+    let v = paper(&["--no-human"]);
     assert_eq!(v["feasible"], false);
     assert!(v.get("m_c").is_none(), "no made-up number: {v}");
     // The reason is the low-frequency limit, not the search range.
@@ -88,46 +73,22 @@ fn design_admittance_json_and_infeasible_without_human() {
 
 #[test]
 fn check_json_both_displays() {
-    let v = json(&["check", "impedance", "--k", "51000", "--b", "90", "--json"]);
+    let v = TWOPORT.json(&["check", "impedance", "--k", "51000", "--b", "90", "--json"]);
     assert_eq!(v["absolutely_stable"], true);
     assert!(v["min_margin"].as_f64().unwrap() >= 0.0);
-    let v = json(&["check", "impedance", "--k", "60000", "--b", "90", "--json"]);
+    let v = TWOPORT.json(&["check", "impedance", "--k", "60000", "--b", "90", "--json"]);
     assert_eq!(v["absolutely_stable"], false);
     let f = v["worst_frequency_hz"].as_f64().unwrap();
     assert!(f > 1.0 && f < 500.0, "{f}");
-    let v = json(&[
-        "check",
-        "admittance",
-        "--kp",
-        "51000",
-        "--bp",
-        "90",
-        "--m",
-        "5.1",
-        "--b",
-        "500",
-        "--json",
-    ]);
+    let mut args = paper_admittance("check", &["--json"]);
+    args[7] = "5.1";
+    let v = TWOPORT.json(&args);
     assert_eq!(v["absolutely_stable"], true);
 }
 
 #[test]
 fn zrange_json_runs_from_a_tenth_of_a_hertz_to_nyquist() {
-    let v = json(&[
-        "zrange",
-        "admittance",
-        "--kp",
-        "51000",
-        "--bp",
-        "90",
-        "--m",
-        "5",
-        "--b",
-        "500",
-        "--points",
-        "50",
-        "--json",
-    ]);
+    let v = TWOPORT.json(&paper_admittance("zrange", &["--points", "50", "--json"]));
     let f = v["freq_hz"].as_array().unwrap();
     assert_eq!(f.len(), 50);
     assert!((f[0].as_f64().unwrap() - 0.1).abs() < 1e-12);
@@ -141,9 +102,9 @@ fn zrange_json_runs_from_a_tenth_of_a_hertz_to_nyquist() {
 
 #[test]
 fn bad_inputs_are_named() {
-    let e = stderr_of_failure(&["check", "impedance", "--k", "-3", "--b", "90"]);
+    let e = TWOPORT.failure(&["check", "impedance", "--k", "-3", "--b", "90"]);
     assert!(e.contains("--k -3"), "{e}");
-    let e = stderr_of_failure(&[
+    let e = TWOPORT.failure(&[
         "check",
         "impedance",
         "--k",
@@ -167,12 +128,12 @@ fn bad_inputs_are_named() {
     .unwrap()
     .replacen("0.2799, 0.3343", "0.28, 0.3343", 1);
     std::fs::write(&bad, text).unwrap();
-    let e = stderr_of_failure(&["design", "impedance", "--model", bad.to_str().unwrap()]);
+    let e = TWOPORT.failure(&["design", "impedance", "--model", bad.to_str().unwrap()]);
     assert!(
         e.contains("M is not symmetric: M[2][3] = 0.2799 but M[3][2] = 0.28"),
         "{e}"
     );
-    let e = stderr_of_failure(&[
+    let e = TWOPORT.failure(&[
         "check",
         "impedance",
         "--k",
@@ -183,7 +144,7 @@ fn bad_inputs_are_named() {
         "0",
     ]);
     assert!(e.contains("--period 0"), "{e}");
-    let e = stderr_of_failure(&["plot", "fig8", "--out", dir.join("x.jpg").to_str().unwrap()]);
+    let e = TWOPORT.failure(&["plot", "fig8", "--out", dir.join("x.jpg").to_str().unwrap()]);
     assert!(e.contains(".png or .svg"), "{e}");
 }
 
@@ -193,7 +154,7 @@ fn plots_are_written_as_png_and_svg() {
     std::fs::create_dir_all(&dir).unwrap();
     for (fig, ext) in [("fig8", "png"), ("fig9", "svg"), ("fig10", "png")] {
         let out = dir.join(format!("{fig}.{ext}"));
-        json(&["plot", fig, "--out", out.to_str().unwrap(), "--json"]);
+        TWOPORT.json(&["plot", fig, "--out", out.to_str().unwrap(), "--json"]);
         let bytes = std::fs::read(&out).unwrap();
         match ext {
             "png" => assert_eq!(&bytes[1..4], b"PNG"),
@@ -216,7 +177,7 @@ fn every_subcommand_has_help() {
         vec!["zrange", "admittance", "--help"],
         vec!["plot", "--help"],
     ] {
-        let out = twoport(&args);
+        let out = TWOPORT.run(&args);
         assert!(out.status.success(), "{args:?}");
         assert!(
             String::from_utf8_lossy(&out.stdout).contains("Usage"),
@@ -227,7 +188,7 @@ fn every_subcommand_has_help() {
 
 #[test]
 fn region_tables_for_a_board() {
-    let v = json(&[
+    let v = TWOPORT.json(&[
         "region",
         "impedance",
         "--b-from",
@@ -245,7 +206,7 @@ fn region_tables_for_a_board() {
     );
     assert_eq!((b.len(), k.len()), (6, 6));
     assert!(k.iter().all(|x| x.as_f64().unwrap() > 1e4));
-    let v = json(&[
+    let v = TWOPORT.json(&[
         "region",
         "admittance",
         "--kp",
@@ -280,7 +241,7 @@ fn several_poses_design_for_all() {
         for m in model {
             args.extend(["--model", m]);
         }
-        json(&args)
+        TWOPORT.json(&args)
     };
     let (e, t) = (k(&["models/excalibur.toml"]), k(&["models/two_mass.toml"]));
     let both = k(&["models/two_mass.toml", "models/excalibur.toml"]);
@@ -301,7 +262,7 @@ fn several_poses_design_for_all() {
         "{both}"
     );
     assert!(both["binding_frequency_hz"].as_f64().unwrap() > 0.0);
-    let e = stderr_of_failure(&[
+    let e = TWOPORT.failure(&[
         "zrange",
         "impedance",
         "--k",
@@ -321,9 +282,9 @@ fn several_poses_design_for_all() {
 /// where the paper's approximation (aliasing neglected) proves more.
 #[test]
 fn a_device_without_a_force_sensor() {
-    let e = stderr_of_failure(&["design", "admittance", "--model", "models/capstan.toml"]);
+    let e = TWOPORT.failure(&["design", "admittance", "--model", "models/capstan.toml"]);
     assert!(e.contains("no force sensor"), "{e}");
-    let v = json(&[
+    let v = TWOPORT.json(&[
         "design",
         "impedance",
         "--no-human",
