@@ -3,8 +3,8 @@
 //! million ticks (1000 s at 1 kHz) with no error growth; the textbook spring
 //! built by summing velocities in f32 is shown to drift on the same path.
 
-use twoport::control::ve::BilateralConstraint;
-use twoport::control::{FirstDifference, ImpedanceCoupling, Position};
+use twoport_control::ve::BilateralConstraint;
+use twoport_control::{FirstDifference, ImpedanceCoupling, Position};
 
 const K: f32 = 51_000.0;
 const B: f32 = 90.0;

@@ -2,9 +2,9 @@
 //! display's sensor-to-actuator response equals the composition of its laws'
 //! z-domain forms, and every sensor fault gives zero force in the same tick.
 
-use twoport::control::servo::SensorFrame;
-use twoport::control::ve::{CursorMass, Solid, UnilateralWall, VeTransfer, VirtualEnvironment};
-use twoport::control::{
+use twoport_control::servo::SensorFrame;
+use twoport_control::ve::{CursorMass, Solid, UnilateralWall, VeTransfer, VirtualEnvironment};
+use twoport_control::{
     AdmittanceServo, Complex64, Encoder, Faults, ImpedanceServo, Position, SafetyConfig, SineProbe,
 };
 
