@@ -105,6 +105,9 @@ pub struct Analysis {
     pub period_s: f64,
     /// The device, for the alias sums of the sampled-data bounds.
     plant: Plant,
+    /// The index of twice the lowest frequency, where the grid has it: with
+    /// the lowest, the pair the limit toward DC is taken from.
+    dc_pair: Option<usize>,
 }
 
 impl Analysis {
@@ -123,11 +126,7 @@ impl Analysis {
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn new(plant: &Plant, spec: GridSpec) -> Self {
-        Analysis {
-            points: plant.response(&grid(plant, spec)),
-            period_s: plant.period_s(),
-            plant: plant.clone(),
-        }
+        Analysis::from_points(plant, plant.response(&grid(plant, spec)))
     }
 
     /// `model` at its own period on the default grid: where most designs
@@ -145,10 +144,20 @@ impl Analysis {
 
     /// Evaluate `plant` on the given angular frequencies (rad/s).
     pub fn on(plant: &Plant, omegas: &[f64]) -> Self {
+        Analysis::from_points(plant, plant.response(omegas))
+    }
+
+    fn from_points(plant: &Plant, points: Vec<PlantPoint>) -> Self {
+        let dc_pair = points.first().and_then(|p1| {
+            points
+                .iter()
+                .position(|p| (p.omega - 2.0 * p1.omega).abs() <= 1e-12 * p.omega)
+        });
         Analysis {
-            points: plant.response(omegas),
+            points,
             period_s: plant.period_s(),
             plant: plant.clone(),
+            dc_pair,
         }
     }
 
@@ -233,34 +242,35 @@ fn slack(a: &Analysis, bound: &[f64], lhs: impl Fn(Complex64) -> f64) -> f64 {
 /// terms near their rigid-body pole lose more digits than the result can
 /// spare.
 pub fn dc_margin(a: &Analysis, bound: &[f64], lhs: &dyn Fn(Complex64) -> f64) -> f64 {
-    let Some(p1) = a.points.first() else {
-        return f64::INFINITY;
-    };
-    let Some(i2) = a
-        .points
-        .iter()
-        .position(|p| (p.omega - 2.0 * p1.omega).abs() <= 1e-12 * p.omega)
-    else {
+    let Some((beta0, beta2)) = dc_series(a, bound) else {
         // A grid without its DC pair (Analysis::on): no limit to take.
         return f64::INFINITY;
     };
-    let (c1, c2) = (lhs(p1.z), lhs(a.points[i2].z));
-    let (b1, b2) = (bound[0], bound[i2]);
-    if !(b1.is_finite() && b2.is_finite()) {
+    if !(beta0.is_finite() && beta2.is_finite()) {
         return -1.0;
     }
-    // q(ω1) = q0 + q2 ω1², q(2ω1) = q0 + 4 q2 ω1².
-    let w2 = p1.omega * p1.omega;
-    let beta0 = (4.0 * b1 - b2) / 3.0;
-    let beta2 = (b2 - b1) / (3.0 * w2);
-    let c2q = (c2 - c1) / (3.0 * w2);
+    let i2 = a.dc_pair.unwrap_or(0);
+    let (_, c2q) = even_series(a, lhs(a.points[0].z), lhs(a.points[i2].z));
     // A bound whose limit is clearly non-zero decides alone: met strictly
     // (β_0 < 0 = lhs_0) or never (β_0 > 0). Otherwise β_0 is the O(ω_1⁴)
     // residue of a bound that vanishes as ω², and the ω² terms decide.
+    let (b1, b2) = (bound[0], bound[i2]);
     if beta0.abs() > 0.01 * b1.abs().max(b2.abs()) {
         return relative_margin(0.0, beta0);
     }
     relative_margin(c2q, beta2)
+}
+
+/// `(q_0, q_2)` of `q(ω) = q_0 + q_2 ω² + O(ω⁴)` from `q(ω_1) = q1` and
+/// `q(2 ω_1) = q2` at the grid's lowest frequency `ω_1`.
+fn even_series(a: &Analysis, q1: f64, q2: f64) -> (f64, f64) {
+    let w2 = a.points[0].omega * a.points[0].omega;
+    ((4.0 * q1 - q2) / 3.0, (q2 - q1) / (3.0 * w2))
+}
+
+/// The bound's [`even_series`] toward DC, where the grid has its DC pair.
+fn dc_series(a: &Analysis, bound: &[f64]) -> Option<(f64, f64)> {
+    a.dc_pair.map(|i2| even_series(a, bound[0], bound[i2]))
 }
 
 /// Largest `x` in `[lo, hi]` with `ok(x)`, assuming `ok` holds below a
@@ -298,14 +308,9 @@ pub const B_RANGE: (f64, f64) = (1.0, 1.0e4);
 /// finite stiffness or mass. Returns the bound's DC limit (the bound's
 /// unit), or `None`.
 pub fn low_frequency_obstacle(a: &Analysis, bound: &[f64]) -> Option<f64> {
-    (dc_margin(a, bound, &|_| 0.0) <= -1.0).then(|| {
-        let i2 = a
-            .points
-            .iter()
-            .position(|p| (p.omega - 2.0 * a.points[0].omega).abs() <= 1e-12 * p.omega)
-            .unwrap_or(0);
-        (4.0 * bound[0] - bound[i2]) / 3.0
-    })
+    (dc_margin(a, bound, &|_| 0.0) <= -1.0)
+        .then(|| dc_series(a, bound).map(|(beta0, _)| beta0))
+        .flatten()
 }
 
 /// One design inequality per pose of the device: its analysis and bound.
@@ -443,6 +448,16 @@ pub struct Check {
     /// The same check on the paper's approximation (aliasing at the handle
     /// port neglected), for comparison.
     pub paper: PaperCheck,
+}
+
+impl Check {
+    /// Whether the sampled-data analysis decides differently from the
+    /// paper's approximation: another verdict, or a margin smaller by more
+    /// than 1e-6.
+    pub fn sampled_binds(&self) -> bool {
+        self.absolutely_stable != self.paper.absolutely_stable
+            || self.paper.min_margin - self.min_margin > 1e-6
+    }
 }
 
 /// The paper's approximate check beside the sound one.

@@ -628,12 +628,11 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
 
 fn check_json(c: &design::Check) -> Value {
     let p = &c.paper;
-    let binding =
-        if c.absolutely_stable != p.absolutely_stable || (p.min_margin - c.min_margin) > 1e-6 {
-            "sampled-data"
-        } else {
-            "both"
-        };
+    let binding = if c.sampled_binds() {
+        "sampled-data"
+    } else {
+        "both"
+    };
     json!({"absolutely_stable": c.absolutely_stable, "min_margin": c.min_margin,
         "worst_frequency_hz": c.worst_frequency_hz, "binding_bound": binding,
         "paper_absolutely_stable": p.absolutely_stable, "paper_min_margin": p.min_margin,
@@ -655,7 +654,7 @@ fn print_check(c: &design::Check) {
         c.worst_frequency_hz
     );
     let p = &c.paper;
-    if p.absolutely_stable != c.absolutely_stable || (p.min_margin - c.min_margin) > 1e-6 {
+    if c.sampled_binds() {
         println!(
             "  the paper's approximation (aliasing at the handle neglected) would say {}: margin {:.4} at {:.2} Hz",
             verdict(p.absolutely_stable),

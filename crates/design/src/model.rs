@@ -293,6 +293,21 @@ fn semidefinite(name: &str, a: &DMatrix<f64>, unit: &str) -> Result<(), String> 
     Ok(())
 }
 
+/// A rigid one-coordinate device of mass `m` (kg) and damping `b` (N s/m),
+/// handle at the actuator, no force sensor, at 1 kHz: the device the
+/// design crate's unit tests check closed forms on.
+#[cfg(test)]
+pub(crate) fn rigid_for_tests(m: f64, b: f64) -> DeviceModel {
+    DeviceModel::from_toml(
+        &format!(
+            "period_s = 0.001\npeak_force_n = 50.0\ncontinuous_force_n = 20.0\n\
+             M = [[{m}]]\nD = [[{b}]]\nK = [[0.0]]\nG = [[1.0, -1.0]]\nC_v = [[1.0], [-1.0]]\n"
+        ),
+        "rigid",
+    )
+    .expect("a valid rigid model")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

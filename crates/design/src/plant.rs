@@ -229,6 +229,54 @@ pub struct Plant {
     delay_samples: u32,
 }
 
+/// The device's state space on `x = [q, q', w]`, `w` the load cell's
+/// filter state (`w' = -p w + p C_f q`): `(A, B)` with one column of `B`
+/// per input, from `M^-1 K`, `M^-1 D` and `M^-1 G` (the caller solves with
+/// `M`), the strain-gauge row `c_f` (1 x n) and the pole `p` (rad/s).
+pub(crate) fn augmented(
+    minv_k: &DMatrix<f64>,
+    minv_d: &DMatrix<f64>,
+    minv_g: &DMatrix<f64>,
+    c_f: &DMatrix<f64>,
+    p: f64,
+) -> (DMatrix<f64>, DMatrix<f64>) {
+    let n = minv_k.nrows();
+    let na = 2 * n + 1;
+    let mut a = DMatrix::<f64>::zeros(na, na);
+    let mut b = DMatrix::<f64>::zeros(na, minv_g.ncols());
+    for i in 0..n {
+        a[(i, n + i)] = 1.0;
+        for j in 0..n {
+            a[(n + i, j)] = -minv_k[(i, j)];
+            a[(n + i, n + j)] = -minv_d[(i, j)];
+        }
+        for j in 0..minv_g.ncols() {
+            b[(n + i, j)] = minv_g[(i, j)];
+        }
+        a[(2 * n, i)] = p * c_f[(0, i)];
+    }
+    a[(2 * n, 2 * n)] = -p;
+    (a, b)
+}
+
+/// The zero-order-hold equivalent `(A_d, B_d)` of `(A, B)` at period `t`
+/// (s): `exp([[A, B], [0, 0]] t) = [[A_d, B_d], [0, I]]`.
+pub(crate) fn zoh(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    t: f64,
+) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
+    let (na, m) = (a.nrows(), b.ncols());
+    let mut blk = DMatrix::<f64>::zeros(na + m, na + m);
+    blk.view_mut((0, 0), (na, na)).copy_from(&(a * t));
+    blk.view_mut((0, na), (na, m)).copy_from(&(b * t));
+    let e = expm_balanced(&blk)?;
+    Ok((
+        e.view((0, 0), (na, na)).into_owned(),
+        e.view((0, na), (na, m)).into_owned(),
+    ))
+}
+
 fn row_major(a: &DMatrix<f64>) -> Vec<f64> {
     let mut v = Vec::with_capacity(a.len());
     for r in 0..a.nrows() {
@@ -262,29 +310,10 @@ impl Plant {
         let minv_d = chol.solve(&model.d);
         let minv_g = chol.solve(&model.g);
         let p = model.load_cell_pole_rad_s;
-        // Augmented state [q, q', w] with the load-cell filter w.
         let na = 2 * n + 1;
-        let mut a = DMatrix::<f64>::zeros(na, na);
-        let mut b = DMatrix::<f64>::zeros(na, 2);
-        for i in 0..n {
-            a[(i, n + i)] = 1.0;
-            for j in 0..n {
-                a[(n + i, j)] = -minv_k[(i, j)];
-                a[(n + i, n + j)] = -minv_d[(i, j)];
-            }
-            for j in 0..2 {
-                b[(n + i, j)] = minv_g[(i, j)];
-            }
-            a[(2 * n, i)] = p * model.c_f[(0, i)];
-        }
-        a[(2 * n, 2 * n)] = -p;
-        // ZOH: exp([[A, B], [0, 0]] T) = [[A_d, B_d], [0, I]].
-        let mut blk = DMatrix::<f64>::zeros(na + 2, na + 2);
-        blk.view_mut((0, 0), (na, na)).copy_from(&(&a * period_s));
-        blk.view_mut((0, na), (na, 2)).copy_from(&(&b * period_s));
-        let e = expm_balanced(&blk)?;
-        let ad = e.view((0, 0), (na, na)).into_owned();
-        let bd_act: Vec<f64> = (0..na).map(|i| e[(i, na + 1)]).collect();
+        let (a, b) = augmented(&minv_k, &minv_d, &minv_g, &model.c_f, p);
+        let (ad, bd) = zoh(&a, &b, period_s)?;
+        let bd_act: Vec<f64> = bd.column(1).iter().copied().collect();
         // -x_a is C_v's second row applied to positions.
         let mut c_xa = vec![0.0; na];
         for (j, c) in c_xa.iter_mut().take(n).enumerate() {

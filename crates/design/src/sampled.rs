@@ -253,12 +253,7 @@ mod tests {
     use crate::DeviceModel;
 
     fn rigid(m: f64, b: f64) -> Plant {
-        let text = format!(
-            "name = \"rigid\"\nperiod_s = 0.001\nload_cell_pole_rad_s = 235.0\npeak_force_n = 50.0\ncontinuous_force_n = 20.0\nM = [[{m}]]\nD = [[{b}]]\nK = [[0.0]]\n\
-             G = [[1.0, -1.0]]\nC_v = [[1.0], [-1.0]]\nC_f = [[0.0]]\n"
-        );
-        let model = DeviceModel::from_toml(&text, "rigid").unwrap();
-        Plant::new(&model, 1e-3).unwrap()
+        Plant::new(&crate::model::rigid_for_tests(m, b), 1e-3).unwrap()
     }
 
     /// On a rigid device the exact bound is Colgate & Schenkel's passivity

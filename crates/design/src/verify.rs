@@ -13,7 +13,8 @@
 //! nothing when it finds nothing; what it finds is a real instability.
 
 use crate::design::{admittance_coupling_tf, impedance_coupling_tf, regulator_tf};
-use crate::linalg::{balance, expm_balanced};
+use crate::linalg::balance;
+use crate::plant::{augmented, zoh};
 use crate::rational::{add, delayed, from_tf, mul, realise, reduced, scale, Rational};
 use crate::twoport::HumanBound;
 use crate::DeviceModel;
@@ -227,31 +228,22 @@ fn sampled(model: &DeviceModel, hand: &Hand, t: f64) -> Result<Sampled, String> 
         .clone()
         .try_inverse()
         .ok_or("the device with the hand has a singular mass matrix")?;
-    let mk = &minv * &k;
-    let md = &minv * &d;
     let mut ga = DMatrix::<f64>::zeros(nq, 1);
+    let mut c_f = DMatrix::<f64>::zeros(1, nq);
     for i in 0..n {
         ga[(i, 0)] = model.g[(i, 1)];
+        c_f[(0, i)] = model.c_f[(0, i)];
     }
-    let mg = &minv * &ga;
-    let p = model.load_cell_pole_rad_s;
-    let na = 2 * nq + 1;
-    let mut blk = DMatrix::<f64>::zeros(na + 1, na + 1);
-    for i in 0..nq {
-        blk[(i, nq + i)] = t;
-        for j in 0..nq {
-            blk[(nq + i, j)] = -mk[(i, j)] * t;
-            blk[(nq + i, nq + j)] = -md[(i, j)] * t;
-        }
-        blk[(nq + i, na)] = mg[(i, 0)] * t;
-    }
-    for j in 0..n {
-        blk[(2 * nq, j)] = p * model.c_f[(0, j)] * t;
-    }
-    blk[(2 * nq, 2 * nq)] = -p * t;
-    let e = expm_balanced(&blk)?;
-    let ad = e.view((0, 0), (na, na)).into_owned();
-    let bd = (0..na).map(|i| e[(i, na)]).collect();
+    let (a, b) = augmented(
+        &(&minv * &k),
+        &(&minv * &d),
+        &(&minv * &ga),
+        &c_f,
+        model.load_cell_pole_rad_s,
+    );
+    let (ad, bd) = zoh(&a, &b, t)?;
+    let na = ad.nrows();
+    let bd = bd.column(0).iter().copied().collect();
     let mut c_xa = vec![0.0; na];
     for (j, c) in c_xa.iter_mut().take(n).enumerate() {
         // C_v's second row gives -v_a.
@@ -637,13 +629,7 @@ mod tests {
     use super::*;
 
     fn rigid() -> DeviceModel {
-        DeviceModel::from_toml(
-            "period_s = 0.001\nload_cell_pole_rad_s = 235.0\npeak_force_n = 50.0\n\
-             continuous_force_n = 20.0\nM = [[1.0]]\nD = [[20.0]]\nK = [[0.0]]\n\
-             G = [[1.0, -1.0]]\nC_v = [[1.0], [-1.0]]\nC_f = [[0.0]]\n",
-            "rigid",
-        )
-        .unwrap()
+        crate::model::rigid_for_tests(1.0, 20.0)
     }
 
     fn hands_off(ve: Ve) -> Termination {
