@@ -14,8 +14,8 @@ use twoport_control::ve::{
     BilateralConstraint, CursorMass, Port, Solid, UnilateralWall, VirtualEnvironment,
 };
 use twoport_control::{
-    AdmittanceCoupling, AdmittanceServo, Encoder, FirstDifference, ImpedanceCoupling,
-    ImpedanceServo, Integrator, Position, PositionRegulator, SafetyConfig,
+    AdmittanceCoupling, AdmittanceGains, Encoder, FirstDifference, ImpedanceCoupling,
+    ImpedanceGains, Integrator, Position, PositionRegulator, SafetyConfig, Servo,
 };
 
 const T: f32 = 1e-3;
@@ -96,8 +96,17 @@ fn encoder() -> Encoder {
 
 /// The impedance display's whole tick with the VE `ve`.
 fn impedance_tick<V: VirtualEnvironment>(c: &mut Criterion, ve_name: &str, ve: V) {
-    let mut s =
-        ImpedanceServo::new(51_000.0, 90.0, encoder(), SafetyConfig::excalibur(), ve).unwrap();
+    let mut s = Servo::new(
+        ImpedanceGains {
+            k_npm: 51_000.0,
+            b_nspm: 90.0,
+        }
+        .into(),
+        encoder(),
+        SafetyConfig::excalibur(),
+        ve,
+    )
+    .unwrap();
     s.enable().unwrap();
     let mut k = 0u32;
     c.bench_function(
@@ -127,9 +136,14 @@ fn servos(c: &mut Criterion) {
     // and its own integrator add to the tick.
     impedance_tick(c, "bilateral VE", BilateralConstraint::new(Position::ZERO));
     let cursor = CursorMass::new(0.25, T, Position::ZERO).unwrap();
-    let mut a = AdmittanceServo::new(
-        (51_000.0, 90.0),
-        (5.0, 500.0),
+    let mut a = Servo::new(
+        AdmittanceGains {
+            kp_npm: 51_000.0,
+            bp_nspm: 90.0,
+            m_kg: 5.0,
+            b_nspm: 500.0,
+        }
+        .into(),
         encoder(),
         SafetyConfig::excalibur(),
         cursor,

@@ -5,7 +5,7 @@
 use std::f64::consts::PI;
 use twoport::control::servo::SensorFrame;
 use twoport::control::ve::{Solid, UnilateralWall};
-use twoport::control::{AdmittanceServo, Encoder, Position, SafetyConfig};
+use twoport::control::{AdmittanceGains, Encoder, Position, SafetyConfig, Servo};
 use twoport_design::design::*;
 use twoport_design::twoport::HumanBound;
 use twoport_design::{DeviceModel, Plant};
@@ -25,9 +25,14 @@ fn admittance_display_does_not_creep_in_24_hours() {
     let enc = Encoder::new(16, count_nm as i64 * 1000, 0, Position::ZERO).unwrap();
     let wall =
         UnilateralWall::new(2e4, 50.0, Position::ZERO, Solid::Above, T, Position::ZERO).unwrap();
-    let mut s = AdmittanceServo::new(
-        (51_000.0, 90.0),
-        (5.0, 500.0),
+    let mut s = Servo::new(
+        AdmittanceGains {
+            kp_npm: 51_000.0,
+            bp_nspm: 90.0,
+            m_kg: 5.0,
+            b_nspm: 500.0,
+        }
+        .into(),
         enc,
         SafetyConfig::excalibur(),
         wall,

@@ -2,9 +2,9 @@
 //! designer, loaded into the portable firmware loop, accepts only gains the
 //! designer's own check calls absolutely stable, off the grid included.
 
-use twoport_board::{Board, Bound, Law, Region};
+use twoport_board::{Board, Bound, Region};
 use twoport_control::ve::BilateralConstraint;
-use twoport_control::{Encoder, ImpedanceServo, Position, SafetyConfig};
+use twoport_control::{Encoder, ImpedanceGains, Position, SafetyConfig, Servo};
 use twoport_design::design::*;
 use twoport_design::twoport::HumanBound;
 
@@ -27,15 +27,18 @@ fn the_board_accepts_only_what_the_designer_proves() {
     let k: [f32; N] = std::array::from_fn(|i| rows[i].1 as f32);
     let region = Region::new(Bound::MaxStiffness, b, k, None).unwrap();
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
-    let servo = ImpedanceServo::new(
-        10_000.0,
-        50.0,
+    let servo = Servo::new(
+        ImpedanceGains {
+            k_npm: 10_000.0,
+            b_nspm: 50.0,
+        }
+        .into(),
         enc,
         SafetyConfig::excalibur(),
         BilateralConstraint::new(Position::ZERO),
     )
     .unwrap();
-    let mut board = Board::new(Law::Impedance(servo), region, 0);
+    let mut board = Board::new(servo, region, 0);
     let mut accepted = 0;
     for i in 0..60 {
         let damping = 10.0 * 15f32.powf(i as f32 / 59.0); // 10..150, mostly off the grid

@@ -32,7 +32,7 @@ fn the_shipped_region_is_the_designers() {
 #[test]
 fn the_images_gains_are_proven() {
     let r = excalibur::proven_region().unwrap();
-    let (k, b) = excalibur::COUPLING;
+    let (k, b) = (excalibur::COUPLING.k_npm, excalibur::COUPLING.b_nspm);
     let limit = r.limit_at(b).expect("b = 90 N s/m is on the grid");
     assert!(k <= limit, "{k} N/m > proven {limit} N/m at {b} N s/m");
 }

@@ -46,7 +46,7 @@ fn ve() -> impl Strategy<Value = VeSpec> {
             anchor_m: -0.001,
             stiffness_npm: k,
             damping_nspm: b,
-            discretization: Default::default(),
+            discretization: Default::default()
         }),
         Just(VeSpec::Bilateral),
     ]
@@ -73,7 +73,7 @@ fn tuned_case(f_hz: f64) -> impl Strategy<Value = Case> {
             anchor_m: -0.001,
             stiffness_npm: k,
             damping_nspm: b,
-            discretization: Default::default(),
+            discretization: Default::default()
         }),
         Just(VeSpec::Bilateral),
     ];
@@ -341,7 +341,7 @@ fn impedance_gains_past_the_bound_meet_the_termination_the_two_port_names() {
 fn the_simulated_ve_port_impedance_is_the_designers() {
     use twoport_control::ve::{Causality, Port, VeOutput, VeTransfer, VirtualEnvironment};
     use twoport_control::{
-        Encoder, ImpedanceServo, Integrator, Position, SafetyConfig, SineProbe, ZTransfer,
+        Encoder, ImpedanceGains, Integrator, Position, SafetyConfig, Servo, SineProbe, ZTransfer,
     };
     /// A VE that is a velocity source, moves as it says, and records the
     /// force it meets.
@@ -392,7 +392,17 @@ fn the_simulated_ve_port_impedance_is_the_designers() {
                 f: 0.0,
                 x: Integrator::new(1e-3, Position::ZERO),
             };
-            let mut servo = ImpedanceServo::new(k as f32, 90.0, enc, safety, ve).unwrap();
+            let mut servo = Servo::new(
+                ImpedanceGains {
+                    k_npm: k as f32,
+                    b_nspm: 90.0,
+                }
+                .into(),
+                enc,
+                safety,
+                ve,
+            )
+            .unwrap();
             servo.enable().unwrap();
             let th = 2.0 * std::f64::consts::PI * bin as f64 / 4000.0;
             let z_net = SineProbe::measure(th.cos(), th.sin(), 6000, 4000, |u| {

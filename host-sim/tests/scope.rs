@@ -6,9 +6,10 @@ use eframe::egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use host_sim::scope::app::Signal;
-use host_sim::scope::app::{ScopeState, SliderGains, Speed, RING_SAMPLES};
+use host_sim::scope::app::{ScopeState, Speed, RING_SAMPLES};
 use host_sim::scope::ui::BoardChoice;
 use std::path::Path;
+use twoport_control::servo::{Gains, ImpedanceGains};
 
 fn harness() -> Harness<'static, (ScopeState, BoardChoice)> {
     let state = ScopeState::open(Path::new("../scenes/stiff_wall.toml")).unwrap();
@@ -24,22 +25,19 @@ fn harness() -> Harness<'static, (ScopeState, BoardChoice)> {
     h
 }
 
+fn imp(k_npm: f32, b_nspm: f32) -> Gains {
+    ImpedanceGains { k_npm, b_nspm }.into()
+}
+
 #[test]
 fn the_stiffness_slider_changes_the_running_simulations_gain() {
     let mut h = harness();
-    assert_eq!(h.state().0.running_coupling(), (51_000.0, 90.0));
+    assert_eq!(h.state().0.running_gains(), imp(51_000.0, 90.0));
     h.get_by_role_and_label(Role::Slider, "k_c (N/m)")
         .set_value_accesskit(30_000.0);
     h.run();
-    let (k, b) = h.state().0.running_coupling();
-    assert_eq!((k, b), (30_000.0, 90.0));
-    assert_eq!(
-        h.state().0.gains,
-        SliderGains::Impedance {
-            k: 30_000.0,
-            b: 90.0
-        }
-    );
+    assert_eq!(h.state().0.running_gains(), imp(30_000.0, 90.0));
+    assert_eq!(h.state().0.gains, imp(30_000.0, 90.0));
 }
 
 #[test]
@@ -158,18 +156,12 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
         "the hand has pushed into the wall: {x_board} m"
     );
     // Inside the proven region: accepted; outside: refused with the reason.
-    s.set_gains(SliderGains::Impedance {
-        k: 40_000.0,
-        b: 90.0,
-    });
+    s.set_gains(imp(40_000.0, 90.0));
     for _ in 0..5 {
         s.tick();
     }
     assert_eq!(s.board.as_ref().unwrap().reply.as_deref(), Some("accepted"));
-    s.set_gains(SliderGains::Impedance {
-        k: 60_000.0,
-        b: 90.0,
-    });
+    s.set_gains(imp(60_000.0, 90.0));
     for _ in 0..5 {
         s.tick();
     }
@@ -184,10 +176,7 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
         "{:?}",
         s.message
     );
-    s.set_gains(SliderGains::Impedance {
-        k: 45_000.0,
-        b: 90.0,
-    });
+    s.set_gains(imp(45_000.0, 90.0));
     // The answer comes when QEMU gets to it: wait in wall time (10 s at
     // most), not in a count of frames, which a loaded machine outruns.
     let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);

@@ -3,12 +3,12 @@
 use crate::io::IoScale;
 use crate::region::{Bound, Region};
 use heapless::{Deque, Vec};
-use twoport_control::servo::{SensorFrame, ServoOutput};
+use twoport_control::servo::{Gains, SensorFrame, Servo, ServoOutput};
 use twoport_control::ve::VirtualEnvironment;
-use twoport_control::{AdmittanceServo, Faults, ImpedanceServo};
+use twoport_control::Faults;
 use twoport_link::{
-    encode, ActuatorFrame, Decoder, Gains, GainsReply, LinkStats, Message, Refusal, Stats,
-    Telemetry, MAX_FRAME,
+    encode, ActuatorFrame, Decoder, GainsReply, LinkStats, Message, Refusal, Stats, Telemetry,
+    MAX_FRAME,
 };
 
 /// One encoded frame, delimiter included.
@@ -17,61 +17,10 @@ pub type Frame = Vec<u8, MAX_FRAME>;
 /// telemetry in the other, so a telemetry flood never crowds out an answer.
 pub const TX_FRAMES: usize = 8;
 
-/// The display's law, with the board's VE.
-#[derive(Clone, Debug)]
-pub enum Law<V> {
-    /// Impedance display.
-    Impedance(ImpedanceServo<V>),
-    /// Admittance display.
-    Admittance(AdmittanceServo<V>),
-}
-
-macro_rules! both {
-    ($self:expr, $s:ident => $e:expr) => {
-        match $self {
-            Law::Impedance($s) => $e,
-            Law::Admittance($s) => $e,
-        }
-    };
-}
-
-impl<V: VirtualEnvironment> Law<V> {
-    fn tick(&mut self, f: &SensorFrame) -> ServoOutput {
-        both!(self, s => s.tick(f))
-    }
-
-    fn gains(&self) -> Gains {
-        match self {
-            Law::Impedance(s) => {
-                let (k, b) = s.coupling().gains();
-                Gains::Impedance {
-                    k_npm: k,
-                    b_nspm: b,
-                }
-            }
-            Law::Admittance(s) => {
-                let (kp, bp) = s.regulator().gains();
-                let (m, b) = s.coupling().gains();
-                Gains::Admittance {
-                    kp_npm: kp,
-                    bp_nspm: bp,
-                    m_kg: m,
-                    b_nspm: b,
-                }
-            }
-        }
-    }
-
-    /// The VE position (pm).
-    fn ve_position_pm(&self) -> i64 {
-        both!(self, s => s.ve().position().nm() as i64 * 1000)
-    }
-}
-
 /// The portable firmware loop.
 #[derive(Clone, Debug)]
 pub struct Board<V, const R: usize> {
-    law: Law<V>,
+    servo: Servo<V>,
     region: Region<R>,
     decoder: Decoder,
     /// Replies and fault reports, sent first.
@@ -92,24 +41,12 @@ pub struct Board<V, const R: usize> {
     pil_refused: u32,
 }
 
-fn all_finite(g: &Gains) -> bool {
-    match *g {
-        Gains::Impedance { k_npm, b_nspm } => k_npm.is_finite() && b_nspm.is_finite(),
-        Gains::Admittance {
-            kp_npm,
-            bp_nspm,
-            m_kg,
-            b_nspm,
-        } => kp_npm.is_finite() && bp_nspm.is_finite() && m_kg.is_finite() && b_nspm.is_finite(),
-    }
-}
-
 impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
-    /// A board running `law`, accepting gain changes inside `region`, and
+    /// A board running `servo`, accepting gain changes inside `region`, and
     /// sending telemetry every `telemetry_every` ticks (0: never).
-    pub fn new(law: Law<V>, region: Region<R>, telemetry_every: u32) -> Self {
+    pub fn new(servo: Servo<V>, region: Region<R>, telemetry_every: u32) -> Self {
         Board {
-            law,
+            servo,
             region,
             decoder: Decoder::new(),
             control: Deque::new(),
@@ -162,9 +99,9 @@ impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
         self.io.duty(self.last.actuator_force_n)
     }
 
-    /// The law (gains, safety state).
-    pub fn law(&self) -> &Law<V> {
-        &self.law
+    /// The servo (gains, safety state).
+    pub fn servo(&self) -> &Servo<V> {
+        &self.servo
     }
 
     /// The link decoder's counters.
@@ -226,9 +163,10 @@ impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
             return;
         }
         match msg {
-            Message::Heartbeat => both!(&mut self.law, s => s.heartbeat()),
-            Message::GetGains => self.queue(Message::Gains(self.law.gains())),
+            Message::Heartbeat => self.servo.heartbeat(),
+            Message::GetGains => self.queue(Message::Gains(self.servo.gains().into())),
             Message::SetGains(g) => {
+                let g = Gains::from(g);
                 let reply = match self.check(&g) {
                     Ok(()) => self.apply(g),
                     Err(why) => GainsReply::Refused(why),
@@ -236,18 +174,18 @@ impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
                 self.queue(Message::GainsReply(reply));
             }
             Message::ClearFaults => {
-                both!(&mut self.law, s => s.clear());
+                self.servo.clear();
                 self.reported = Faults::NONE;
             }
             Message::Enable => {
-                if let Err(f) = both!(&mut self.law, s => s.enable()) {
+                if let Err(f) = self.servo.enable() {
                     self.queue(Message::FaultReport {
                         faults: f.0,
                         first: f.lowest().0,
                     });
                 }
             }
-            Message::Disable => both!(&mut self.law, s => s.disable()),
+            Message::Disable => self.servo.disable(),
             Message::GetStats => self.queue(Message::Stats(LinkStats {
                 rx: self.decoder.stats(),
                 tx_dropped: self.tx_dropped,
@@ -274,69 +212,47 @@ impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
 
     /// Whether `g` is inside the proven region for this board's display.
     fn check(&self, g: &Gains) -> Result<(), Refusal> {
-        if !all_finite(g) {
+        if !g.all_finite() {
             return Err(Refusal::NotFinite);
         }
         let r = &self.region;
-        match (&self.law, *g) {
-            (Law::Impedance(_), Gains::Impedance { k_npm, b_nspm })
-                if r.bound() == Bound::MaxStiffness =>
-            {
-                if k_npm < 0.0 || b_nspm < 0.0 {
+        if g.display() != self.servo.display() {
+            return Err(Refusal::WrongDisplay);
+        }
+        let (limit, within) = match *g {
+            Gains::Impedance(g) if r.bound() == Bound::MaxStiffness => {
+                if g.k_npm < 0.0 || g.b_nspm < 0.0 {
                     return Err(Refusal::OutOfRange);
                 }
-                match r.limit_at(b_nspm) {
-                    Some(kmax) if k_npm <= kmax => Ok(()),
-                    Some(kmax) => Err(Refusal::NotProvenStable { limit: kmax }),
-                    None => Err(Refusal::NotProvenStable { limit: 0.0 }),
-                }
+                let limit = r.limit_at(g.b_nspm);
+                (limit, limit.is_some_and(|kmax| g.k_npm <= kmax))
             }
-            (
-                Law::Admittance(_),
-                Gains::Admittance {
-                    kp_npm,
-                    bp_nspm,
-                    m_kg,
-                    b_nspm,
-                },
-            ) if r.bound() == Bound::MinMass => {
-                if m_kg <= 0.0 || b_nspm <= 0.0 || kp_npm < 0.0 || bp_nspm < 0.0 {
+            Gains::Admittance(g) if r.bound() == Bound::MinMass => {
+                if g.m_kg <= 0.0 || g.b_nspm <= 0.0 || g.kp_npm < 0.0 || g.bp_nspm < 0.0 {
                     return Err(Refusal::OutOfRange);
                 }
                 // The region holds for the regulator it was proven with.
                 match r.regulator() {
-                    Some((kp, bp)) if kp == kp_npm && bp == bp_nspm => {}
+                    Some((kp, bp)) if kp == g.kp_npm && bp == g.bp_nspm => {}
                     Some((kp, _)) => return Err(Refusal::NotProvenStable { limit: kp }),
                     None => return Err(Refusal::NotProvenStable { limit: 0.0 }),
                 }
-                match r.limit_at(b_nspm) {
-                    Some(mmin) if m_kg >= mmin => Ok(()),
-                    Some(mmin) => Err(Refusal::NotProvenStable { limit: mmin }),
-                    None => Err(Refusal::NotProvenStable { limit: 0.0 }),
-                }
+                let limit = r.limit_at(g.b_nspm);
+                (limit, limit.is_some_and(|mmin| g.m_kg >= mmin))
             }
-            _ => Err(Refusal::WrongDisplay),
+            _ => return Err(Refusal::WrongDisplay),
+        };
+        match (within, limit) {
+            (true, _) => Ok(()),
+            (false, limit) => Err(Refusal::NotProvenStable {
+                limit: limit.unwrap_or(0.0),
+            }),
         }
     }
 
     fn apply(&mut self, g: Gains) -> GainsReply {
-        let r = match (&mut self.law, g) {
-            (Law::Impedance(s), Gains::Impedance { k_npm, b_nspm }) => s.set_gains(k_npm, b_nspm),
-            (
-                Law::Admittance(s),
-                Gains::Admittance {
-                    kp_npm,
-                    bp_nspm,
-                    m_kg,
-                    b_nspm,
-                },
-            ) => s
-                .set_regulator_gains(kp_npm, bp_nspm)
-                .and_then(|_| s.set_coupling_gains(m_kg, b_nspm)),
-            _ => return GainsReply::Refused(Refusal::WrongDisplay),
-        };
-        match r {
-            Ok(()) => GainsReply::Accepted(self.law.gains()),
+        match self.servo.set_gains(g) {
+            Ok(()) => GainsReply::Accepted(self.servo.gains().into()),
             Err(_) => GainsReply::Refused(Refusal::OutOfRange),
         }
     }
@@ -344,7 +260,7 @@ impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
     /// One control tick: the law, a fault report when new faults latch,
     /// telemetry on schedule. Returns the held actuator command.
     pub fn tick(&mut self, frame: &SensorFrame) -> ServoOutput {
-        let out = self.law.tick(frame);
+        let out = self.servo.tick(frame);
         self.last = out;
         if !out.faults.is_empty() && out.faults != self.reported {
             self.reported = out.faults;
@@ -364,7 +280,7 @@ impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
                     load_cell_n: frame.load_cell_n,
                     commanded_n: out.commanded_force_n,
                     actuator_n: out.actuator_force_n,
-                    ve_position_pm: self.law.ve_position_pm(),
+                    ve_position_pm: self.servo.ve().position().nm() as i64 * 1000,
                     faults: out.faults.0,
                     loop_cycles: self.loop_cycles,
                 }));

@@ -6,9 +6,11 @@
 
 use crate::io::IoScale;
 use crate::region::{Bound, Region, RegionError};
-use crate::{Board, Law};
+use crate::Board;
 use twoport_control::ve::{Solid, UnilateralWall};
-use twoport_control::{Encoder, EncoderError, ImpedanceServo, ParamError, Position, SafetyConfig};
+use twoport_control::{
+    Encoder, EncoderError, ImpedanceGains, ParamError, Position, SafetyConfig, Servo,
+};
 
 /// Why the board image could not be built (a constant here is wrong).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -47,8 +49,11 @@ pub mod region {
 pub const PERIOD_S: f32 = 1.0e-3;
 /// Encoder counter width (bits) and resolution (pm per count): 1 um.
 pub const ENCODER: (u8, i64) = (16, 1_000_000);
-/// Coupling stiffness (N/m) and damping (N s/m): the paper's design.
-pub const COUPLING: (f32, f32) = (51_000.0, 90.0);
+/// The coupling: the paper's design.
+pub const COUPLING: ImpedanceGains = ImpedanceGains {
+    k_npm: 51_000.0,
+    b_nspm: 90.0,
+};
 /// The wall: surface (nm, 1 cm), stiffness (N/m), damping (N s/m); solid
 /// above.
 pub const WALL: (i32, f32, f32) = (10_000_000, 5.0e6, 200.0);
@@ -81,9 +86,9 @@ pub fn proven_region() -> Result<Region<REGION_POINTS>, RegionError> {
     )
 }
 
-/// The board's law: the impedance display on the wall, disabled until the
+/// The board's servo: the impedance display on the wall, disabled until the
 /// host enables it.
-pub fn stiff_wall_law() -> Result<Law<UnilateralWall>, BuildError> {
+pub fn stiff_wall_servo() -> Result<Servo<UnilateralWall>, BuildError> {
     let (bits, pm) = ENCODER;
     let enc = Encoder::new(bits, pm, 0, Position::ZERO)?;
     let (x, k, b) = WALL;
@@ -95,21 +100,14 @@ pub fn stiff_wall_law() -> Result<Law<UnilateralWall>, BuildError> {
         PERIOD_S,
         Position::ZERO,
     )?;
-    let (kc, bc) = COUPLING;
-    Ok(Law::Impedance(ImpedanceServo::new(
-        kc,
-        bc,
-        enc,
-        safety(),
-        ve,
-    )?))
+    Ok(Servo::new(COUPLING.into(), enc, safety(), ve)?)
 }
 
-/// The whole board: law, region, telemetry rate, I/O scaling. It reads its
+/// The whole board: servo, region, telemetry rate, I/O scaling. It reads its
 /// own sensors; the processor-in-the-loop images add `.with_pil(true)`.
 pub fn stiff_wall_board() -> Result<Board<UnilateralWall, REGION_POINTS>, BuildError> {
     Ok(
-        Board::new(stiff_wall_law()?, proven_region()?, TELEMETRY_EVERY)
+        Board::new(stiff_wall_servo()?, proven_region()?, TELEMETRY_EVERY)
             .with_io(IoScale::EXCALIBUR),
     )
 }

@@ -8,6 +8,6 @@ pub mod excalibur;
 mod io;
 mod region;
 
-pub use board::{Board, Frame, Law, TX_FRAMES};
+pub use board::{Board, Frame, TX_FRAMES};
 pub use io::{IoScale, DUTY_FULL_SCALE};
 pub use region::{Bound, Region, RegionError};

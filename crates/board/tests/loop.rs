@@ -1,9 +1,11 @@
 //! The portable firmware loop driven over the wire, as a host drives it.
 
-use twoport_board::{Board, Bound, Law, Region};
+use twoport_board::{Board, Bound, Region};
 use twoport_control::servo::SensorFrame;
 use twoport_control::ve::BilateralConstraint;
-use twoport_control::{AdmittanceServo, Encoder, Faults, ImpedanceServo, Position, SafetyConfig};
+use twoport_control::{
+    AdmittanceGains, Encoder, Faults, ImpedanceGains, Position, SafetyConfig, Servo,
+};
 use twoport_link::{
     encode, Decoder, Gains, GainsReply, Message, Refusal, Role, MAX_FRAME, PROTOCOL_VERSION,
 };
@@ -27,15 +29,18 @@ fn safety() -> SafetyConfig {
 
 fn board() -> Board<BilateralConstraint, 3> {
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
-    let s = ImpedanceServo::new(
-        51_000.0,
-        90.0,
+    let s = Servo::new(
+        ImpedanceGains {
+            k_npm: 51_000.0,
+            b_nspm: 90.0,
+        }
+        .into(),
         enc,
         safety(),
         BilateralConstraint::new(Position::ZERO),
     )
     .unwrap();
-    Board::new(Law::Impedance(s), region(), 10)
+    Board::new(s, region(), 10)
 }
 
 fn send(b: &mut Board<BilateralConstraint, 3>, seq: u16, m: Message) {
@@ -277,15 +282,20 @@ fn admittance_gains_need_the_proven_regulator() {
     )
     .unwrap();
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
-    let s = AdmittanceServo::new(
-        (51_000.0, 90.0),
-        (5.0, 500.0),
+    let s = Servo::new(
+        AdmittanceGains {
+            kp_npm: 51_000.0,
+            bp_nspm: 90.0,
+            m_kg: 5.0,
+            b_nspm: 500.0,
+        }
+        .into(),
         enc,
         safety(),
         BilateralConstraint::new(Position::ZERO),
     )
     .unwrap();
-    let mut b = Board::new(Law::Admittance(s), region, 0);
+    let mut b = Board::new(s, region, 0);
     let ok = Gains::Admittance {
         kp_npm: 51_000.0,
         bp_nspm: 90.0,

@@ -5,7 +5,7 @@
 //! the timers and the force goes to the PWM.
 
 use twoport_control::ve::{Solid, UnilateralWall};
-use twoport_control::{Encoder, ImpedanceServo, Position, SafetyConfig, SensorFrame};
+use twoport_control::{Encoder, ImpedanceGains, Position, SafetyConfig, SensorFrame, Servo};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let t = 1e-3;
@@ -15,7 +15,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let wall_at = Position::from_m(1e-3).ok_or("wall position")?;
     let wall = UnilateralWall::new(2.0e6, 50.0, wall_at, Solid::Above, t, Position::ZERO)?;
     // twoport design impedance --model models/capstan.toml: 27,886 N/m at 147.9 N s/m.
-    let mut servo = ImpedanceServo::new(27_800.0, 148.0, encoder, safety, wall)?;
+    let mut servo = Servo::new(
+        ImpedanceGains {
+            k_npm: 27_800.0,
+            b_nspm: 148.0,
+        }
+        .into(),
+        encoder,
+        safety,
+        wall,
+    )?;
     servo
         .enable()
         .map_err(|f| format!("refused to enable: {f:?}"))?;

@@ -32,5 +32,7 @@ pub use probe::SineProbe;
 pub use real::Real;
 pub use regulator::PositionRegulator;
 pub use safety::{Faults, SafetyConfig, SafetyLayer};
-pub use servo::{AdmittanceServo, ImpedanceServo, SensorFrame, ServoOutput};
+pub use servo::{
+    AdmittanceGains, Display, Gains, GainsError, ImpedanceGains, SensorFrame, Servo, ServoOutput,
+};
 pub use tf::ZTransfer;

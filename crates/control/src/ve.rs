@@ -453,7 +453,9 @@ impl<R: Real> VirtualEnvironment<R> for TrapezoidalSpring<R> {
 #[derive(Clone, Copy, Debug)]
 pub struct UnilateralWall<R = f32> {
     spring: Spring<R>,
-    solid: Solid,
+    /// +1 when solid above, -1 when below: kept as a number, not read from
+    /// a `Solid` each tick (a load, compare and select on the board).
+    sign: R,
 }
 
 impl UnilateralWall {
@@ -484,7 +486,10 @@ impl<R: Real> UnilateralWall<R> {
     ) -> Result<Self, ParamError> {
         Ok(UnilateralWall {
             spring: Spring::new_in(k_npm, b_nspm, surface, period_s, probe)?,
-            solid,
+            sign: match solid {
+                Solid::Above => R::ONE,
+                Solid::Below => -R::ONE,
+            },
         })
     }
 
@@ -503,12 +508,9 @@ impl<R: Real> UnilateralWall<R> {
         self.spring.gains()
     }
 
-    /// +1 when solid above, -1 when below.
+    #[inline]
     fn sign(&self) -> R {
-        match self.solid {
-            Solid::Above => R::ONE,
-            Solid::Below => -R::ONE,
-        }
+        self.sign
     }
 
     /// Penetration (> 0 inside) and inward push (before clamping) of the

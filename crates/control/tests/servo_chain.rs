@@ -2,10 +2,11 @@
 //! display's sensor-to-actuator response equals the composition of its laws'
 //! z-domain forms, and every sensor fault gives zero force in the same tick.
 
-use twoport_control::servo::SensorFrame;
+use twoport_control::servo::{LawsRef, SensorFrame};
 use twoport_control::ve::{CursorMass, Solid, UnilateralWall, VeTransfer, VirtualEnvironment};
 use twoport_control::{
-    AdmittanceServo, Complex64, Encoder, Faults, ImpedanceServo, Position, SafetyConfig, SineProbe,
+    AdmittanceGains, Complex64, Encoder, Faults, ImpedanceGains, Position, SafetyConfig, Servo,
+    SineProbe,
 };
 
 const T: f32 = 1.0e-3;
@@ -41,9 +42,14 @@ fn wall() -> UnilateralWall {
 #[test]
 fn admittance_display_tick_matches_its_composed_z_domain_form() {
     for p in [1usize, 10, 100, 400, 1000, 1999] {
-        let mut s = AdmittanceServo::new(
-            (51_000.0, 90.0),
-            (5.0, 500.0),
+        let mut s = Servo::new(
+            AdmittanceGains {
+                kp_npm: 51_000.0,
+                bp_nspm: 90.0,
+                m_kg: 5.0,
+                b_nspm: 500.0,
+            }
+            .into(),
             encoder(),
             SafetyConfig::excalibur(),
             wall(),
@@ -63,13 +69,20 @@ fn admittance_display_tick_matches_its_composed_z_domain_form() {
             }
         }
         let z = Complex64::new(th.cos(), th.sin());
-        let kp = s.regulator().tf().eval(z);
+        let LawsRef::Admittance {
+            coupling,
+            regulator,
+        } = s.laws()
+        else {
+            panic!("an admittance servo");
+        };
+        let kp = regulator.tf().eval(z);
         let integ = T as f64 / (1.0 - z.inv());
         let zw = match s.ve().tf() {
             VeTransfer::Impedance(t) => t.eval(z),
             VeTransfer::Admittance(_) => unreachable!(),
         };
-        let want = -kp * integ / (s.coupling().tf().eval(z) + zw);
+        let want = -kp * integ / (coupling.tf().eval(z) + zw);
         let got = probe.response();
         assert!(
             (got - want).norm() <= 1e-4 * want.norm(),
@@ -105,9 +118,14 @@ fn bad_sensor_readings_give_zero_force_in_the_same_tick() {
         ),
     ];
     for (what, mut bad_frame, fault) in bad {
-        let mut s = AdmittanceServo::new(
-            (51_000.0, 90.0),
-            (5.0, 500.0),
+        let mut s = Servo::new(
+            AdmittanceGains {
+                kp_npm: 51_000.0,
+                bp_nspm: 90.0,
+                m_kg: 5.0,
+                b_nspm: 500.0,
+            }
+            .into(),
             encoder(),
             SafetyConfig::excalibur(),
             CursorMass::new(0.25, T, Position::ZERO).unwrap(),
@@ -146,8 +164,17 @@ fn bad_sensor_readings_give_zero_force_in_the_same_tick() {
 /// stiffness of coupling and wall in the steady state.
 #[test]
 fn impedance_display_renders_the_series_of_coupling_and_wall() {
-    let mut s =
-        ImpedanceServo::new(51_000.0, 90.0, encoder(), SafetyConfig::excalibur(), wall()).unwrap();
+    let mut s = Servo::new(
+        ImpedanceGains {
+            k_npm: 51_000.0,
+            b_nspm: 90.0,
+        }
+        .into(),
+        encoder(),
+        SafetyConfig::excalibur(),
+        wall(),
+    )
+    .unwrap();
     s.enable().unwrap();
     let mut out = Default::default();
     for k in 0..3000u32 {

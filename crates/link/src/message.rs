@@ -192,3 +192,42 @@ impl Message {
         }
     }
 }
+
+/// The one conversion between the servo's gains and the wire's.
+impl From<twoport_control::Gains> for Gains {
+    fn from(g: twoport_control::Gains) -> Self {
+        match g {
+            twoport_control::Gains::Impedance(g) => Gains::Impedance {
+                k_npm: g.k_npm,
+                b_nspm: g.b_nspm,
+            },
+            twoport_control::Gains::Admittance(g) => Gains::Admittance {
+                kp_npm: g.kp_npm,
+                bp_nspm: g.bp_nspm,
+                m_kg: g.m_kg,
+                b_nspm: g.b_nspm,
+            },
+        }
+    }
+}
+
+impl From<Gains> for twoport_control::Gains {
+    fn from(g: Gains) -> Self {
+        use twoport_control::{AdmittanceGains, ImpedanceGains};
+        match g {
+            Gains::Impedance { k_npm, b_nspm } => ImpedanceGains { k_npm, b_nspm }.into(),
+            Gains::Admittance {
+                kp_npm,
+                bp_nspm,
+                m_kg,
+                b_nspm,
+            } => AdmittanceGains {
+                kp_npm,
+                bp_nspm,
+                m_kg,
+                b_nspm,
+            }
+            .into(),
+        }
+    }
+}

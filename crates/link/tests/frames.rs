@@ -227,3 +227,31 @@ proptest! {
         prop_assert_eq!(got, vec![Envelope { seq: tick as u16, msg: m }]);
     }
 }
+
+#[test]
+fn wire_gains_convert_to_the_servos_and_back() {
+    let wire = [
+        Gains::Impedance {
+            k_npm: 51_000.0,
+            b_nspm: 90.0,
+        },
+        Gains::Admittance {
+            kp_npm: 1.0,
+            bp_nspm: 2.0,
+            m_kg: 3.0,
+            b_nspm: 4.0,
+        },
+    ];
+    for g in wire {
+        let servo: twoport_control::Gains = g.into();
+        assert_eq!(Gains::from(servo), g);
+    }
+    let a: twoport_control::Gains = wire[1].into();
+    let twoport_control::Gains::Admittance(a) = a else {
+        panic!("admittance gains stay admittance gains");
+    };
+    assert_eq!(
+        (a.kp_npm, a.bp_nspm, a.m_kg, a.b_nspm),
+        (1.0, 2.0, 3.0, 4.0)
+    );
+}

@@ -14,7 +14,7 @@ use twoport_control::ve::{
 };
 use twoport_control::{
     AdmittanceCoupling, Complex64, Encoder, Faults, FirstDifference, ImpedanceCoupling,
-    ImpedanceServo, Position, SafetyConfig, SafetyLayer, SineProbe, ZTransfer,
+    ImpedanceGains, Position, SafetyConfig, SafetyLayer, Servo, SineProbe, ZTransfer,
 };
 use twoport_qemu_exit::exit;
 
@@ -120,7 +120,17 @@ fn servo_wall_and_fault(t: &mut Tally) {
         Position::ZERO,
     )
     .unwrap();
-    let mut s = ImpedanceServo::new(51_000.0, 90.0, enc, SafetyConfig::excalibur(), wall).unwrap();
+    let mut s = Servo::new(
+        ImpedanceGains {
+            k_npm: 51_000.0,
+            b_nspm: 90.0,
+        }
+        .into(),
+        enc,
+        SafetyConfig::excalibur(),
+        wall,
+    )
+    .unwrap();
     let _ = s.enable();
     let mut f = 0.0;
     let mut k = 0u32;
@@ -161,7 +171,17 @@ fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
     use cortex_m::peripheral::syst::SystClkSource;
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let wall = timing_wall();
-    let mut s = ImpedanceServo::new(51_000.0, 90.0, enc, SafetyConfig::excalibur(), wall).unwrap();
+    let mut s = Servo::new(
+        ImpedanceGains {
+            k_npm: 51_000.0,
+            b_nspm: 90.0,
+        }
+        .into(),
+        enc,
+        SafetyConfig::excalibur(),
+        wall,
+    )
+    .unwrap();
     let _ = s.enable();
     syst.set_clock_source(SystClkSource::Core);
     syst.set_reload(0x00FF_FFFF);

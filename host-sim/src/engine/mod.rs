@@ -7,6 +7,7 @@ pub mod blocks;
 pub mod human;
 pub mod plant;
 pub mod scene;
+pub mod servo;
 pub mod sim;
 pub mod stability;
 pub mod ve;

@@ -4,6 +4,7 @@ use crate::engine::human::{Event, GraspKind};
 use crate::engine::plant::Method;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
+use twoport_control::servo::{AdmittanceGains, Gains, ImpedanceGains};
 
 /// A scene, as read from TOML. Every section but `display`, `coupling` and
 /// `ve` has defaults; unknown keys are errors.
@@ -159,6 +160,30 @@ pub struct Coupling {
     pub kp: Option<f64>,
     /// Position regulator damping (N s/m).
     pub bp: Option<f64>,
+}
+
+impl Scene {
+    /// The servo's gains: the one reading of `[coupling]` (checked by
+    /// validation, so a missing gain cannot reach here from a loaded scene;
+    /// it reads as zero, which the laws refuse where zero is invalid).
+    pub fn gains(&self) -> Gains {
+        let c = &self.coupling;
+        let g = |v: Option<f64>| v.unwrap_or(0.0) as f32;
+        match self.display {
+            Display::Impedance => ImpedanceGains {
+                k_npm: g(c.k),
+                b_nspm: c.b as f32,
+            }
+            .into(),
+            Display::Admittance => AdmittanceGains {
+                kp_npm: g(c.kp),
+                bp_nspm: g(c.bp),
+                m_kg: g(c.m),
+                b_nspm: c.b as f32,
+            }
+            .into(),
+        }
+    }
 }
 
 /// Which side of a wall is solid.

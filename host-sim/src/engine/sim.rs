@@ -1,286 +1,18 @@
 //! One simulation: the plant between the hand and the board's own control
 //! code, ticking at the control period, with only the named effects.
 
-use crate::engine::blocks::{Block, Blocks};
 use crate::engine::human::{GraspKind, Human};
 use crate::engine::plant::{Device, Method, Stepper, System};
-use crate::engine::scene::{Discretization, Display, Precision, Scene, SolidSide, VeSpec};
+use crate::engine::scene::Scene;
+use crate::engine::servo::{frame_f32, output_f64, SceneServo};
 use crate::engine::stability::{Detector, Verdict};
-use crate::engine::ve::SceneVe;
 use std::collections::VecDeque;
 use std::time::Instant;
 use twoport_control::servo::{SensorFrame, ServoOutput};
-use twoport_control::ve::{
-    BilateralConstraint, CursorMass, Solid, Spring, TrapezoidalSpring, UnilateralWall,
-    VirtualEnvironment,
-};
-use twoport_control::{AdmittanceServo, Encoder, ImpedanceServo, Position, Real, SafetyConfig};
+use twoport_control::{Encoder, Position, SafetyConfig};
 
 /// One tick in this many is timed for the effects' cost.
 const TIMING_STRIDE: u64 = 64;
-
-/// One display's laws and VE, computing in `R`.
-#[derive(Clone, Debug)]
-pub enum Law<R: Real> {
-    /// Impedance display.
-    Impedance(Box<ImpedanceServo<SceneVe<R>, R>>),
-    /// Admittance display.
-    Admittance(Box<AdmittanceServo<SceneVe<R>, R>>),
-}
-
-/// `$e` on the servo of either display.
-macro_rules! each_display {
-    ($self:expr, $s:ident => $e:expr) => {
-        match $self {
-            Law::Impedance($s) => $e,
-            Law::Admittance($s) => $e,
-        }
-    };
-}
-
-impl<R: Real> Law<R> {
-    /// The scene's display with its coupling, regulator and VE, enabled.
-    fn new(scene: &Scene, encoder: Encoder, safety: SafetyConfig) -> Result<Self, String> {
-        let c = scene.coupling;
-        let ve = scene_ve(scene, safety.period_s)?;
-        let err = |e: twoport_control::ParamError| e.to_string();
-        let mut law = match scene.display {
-            Display::Impedance => Law::Impedance(Box::new(
-                ImpedanceServo::new_in(c.k.unwrap_or(0.0) as f32, c.b as f32, encoder, safety, ve)
-                    .map_err(err)?,
-            )),
-            Display::Admittance => Law::Admittance(Box::new(
-                AdmittanceServo::new_in(
-                    (c.kp.unwrap_or(0.0) as f32, c.bp.unwrap_or(0.0) as f32),
-                    (c.m.unwrap_or(1.0) as f32, c.b as f32),
-                    encoder,
-                    safety,
-                    ve,
-                )
-                .map_err(err)?,
-            )),
-        };
-        each_display!(&mut law, s => s.enable())
-            .map_err(|f| format!("the servo would not enable: {f}"))?;
-        Ok(law)
-    }
-
-    fn tick(&mut self, f: &SensorFrame<R>) -> ServoOutput<R> {
-        each_display!(self, s => s.tick(f))
-    }
-
-    fn set_regulator(&mut self, kp: f32, bp: f32) -> Result<(), String> {
-        match self {
-            Law::Impedance(_) => Err("an impedance display has no regulator".into()),
-            Law::Admittance(s) => s.set_regulator_gains(kp, bp).map_err(|e| e.to_string()),
-        }
-    }
-
-    fn set_wall(&mut self, surface: Position, k_npm: f32) -> Result<(), String> {
-        let SceneVe::Wall(w) = each_display!(self, s => s.ve_mut()) else {
-            return Err("the scene's VE is not a wall".into());
-        };
-        let (_, b) = w.gains();
-        w.set_gains(k_npm, b).map_err(|e| e.to_string())?;
-        w.set_surface(surface);
-        Ok(())
-    }
-
-    fn set_coupling(&mut self, a: f32, b: f32) -> Result<(), String> {
-        match self {
-            Law::Impedance(s) => s.set_gains(a, b),
-            Law::Admittance(s) => s.set_coupling_gains(a, b),
-        }
-        .map_err(|e| e.to_string())
-    }
-}
-
-/// The board's code for the scene's display: the board's f32 laws, or the
-/// same laws computing in f64 (`integrator.controller = "f64"`).
-#[derive(Clone, Debug)]
-pub enum Servo {
-    /// The board's f32 laws.
-    F32(Law<f32>),
-    /// The same laws computing in f64.
-    F64(Law<f64>),
-}
-
-/// `$e` on the laws of the servo of either float type and display.
-macro_rules! each_servo {
-    ($self:expr, $s:ident => $e:expr) => {
-        match $self {
-            Servo::F32(l) => each_display!(l, $s => $e),
-            Servo::F64(l) => each_display!(l, $s => $e),
-        }
-    };
-}
-
-/// `$e` on the [`Law`] of either float type.
-macro_rules! each_law {
-    ($self:expr, $l:ident => $e:expr) => {
-        match $self {
-            Servo::F32($l) => $e,
-            Servo::F64($l) => $e,
-        }
-    };
-}
-
-/// The sensors as the f32 board reads them.
-fn frame_f32(f: &SensorFrame<f64>) -> SensorFrame {
-    SensorFrame {
-        tick: f.tick,
-        encoder_raw: f.encoder_raw,
-        load_cell_n: f.load_cell_n as f32,
-        dead_man_closed: f.dead_man_closed,
-    }
-}
-
-/// An f32 servo's output, widened.
-fn output_f64(o: ServoOutput) -> ServoOutput<f64> {
-    ServoOutput {
-        actuator_force_n: o.actuator_force_n as f64,
-        commanded_force_n: o.commanded_force_n as f64,
-        position: o.position,
-        velocity_mps: o.velocity_mps as f64,
-        ve_velocity_mps: o.ve_velocity_mps as f64,
-        ve_force_n: o.ve_force_n as f64,
-        coupling_force_n: o.coupling_force_n as f64,
-        reference: o.reference,
-        faults: o.faults,
-        limited: o.limited,
-    }
-}
-
-impl Servo {
-    fn new(scene: &Scene, encoder: Encoder, safety: SafetyConfig) -> Result<Self, String> {
-        Ok(match scene.integrator.controller {
-            Precision::F32 => Servo::F32(Law::new(scene, encoder, safety)?),
-            Precision::F64 => Servo::F64(Law::new(scene, encoder, safety)?),
-        })
-    }
-
-    fn tick(&mut self, f: &SensorFrame<f64>) -> ServoOutput<f64> {
-        match self {
-            Servo::F32(l) => output_f64(l.tick(&frame_f32(f))),
-            Servo::F64(l) => l.tick(f),
-        }
-    }
-
-    /// The VE's position.
-    pub fn ve_position(&self) -> Position {
-        each_servo!(self, s => s.ve().position())
-    }
-
-    /// The coupling gains: `(k, b)` on an impedance display, `(m, b)` on an
-    /// admittance display.
-    pub fn coupling_gains(&self) -> (f32, f32) {
-        each_servo!(self, s => s.coupling().gains())
-    }
-
-    /// Change the admittance display's regulator `K_p` (N/m, N s/m); an
-    /// error on an impedance display.
-    pub fn set_regulator(&mut self, kp: f64, bp: f64) -> Result<(), String> {
-        each_law!(self, l => l.set_regulator(kp as f32, bp as f32))
-    }
-
-    /// Move the wall and change its stiffness while running (the scope's
-    /// controls); an error if the scene's VE is not a wall.
-    pub fn set_wall(&mut self, surface_m: f64, stiffness_npm: f64) -> Result<(), String> {
-        let x = Position::from_m_f64(surface_m).ok_or(format!(
-            "wall position {surface_m} m is out of range (±2.147 m)"
-        ))?;
-        each_law!(self, l => l.set_wall(x, stiffness_npm as f32))
-    }
-
-    /// Change the coupling gains while running (the scope's sliders).
-    /// Impedance: `(k, b)`; admittance: `(m, b)`.
-    pub fn set_coupling(&mut self, a: f64, b: f64) -> Result<(), String> {
-        each_law!(self, l => l.set_coupling(a as f32, b as f32))
-    }
-}
-
-/// The scene's VE, computing in `R`.
-fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, String> {
-    let pos = |m: f64| {
-        Position::from_m_f64(m).ok_or(format!("position {m} m is out of range (±2.147 m)"))
-    };
-    Ok(match &scene.ve {
-        VeSpec::Cursor { mass_kg } => SceneVe::Cursor(
-            CursorMass::new_in(*mass_kg as f32, t32, Position::ZERO).map_err(|e| e.to_string())?,
-        ),
-        VeSpec::Wall {
-            position_m,
-            stiffness_npm,
-            damping_nspm,
-            solid,
-        } => {
-            let side = match solid {
-                SolidSide::Above => Solid::Above,
-                SolidSide::Below => Solid::Below,
-            };
-            SceneVe::Wall(
-                UnilateralWall::new_in(
-                    *stiffness_npm as f32,
-                    *damping_nspm as f32,
-                    pos(*position_m)?,
-                    side,
-                    t32,
-                    Position::ZERO,
-                )
-                .map_err(|e| e.to_string())?,
-            )
-        }
-        VeSpec::Bilateral => SceneVe::Bilateral(BilateralConstraint::new(Position::ZERO)),
-        VeSpec::Spring {
-            anchor_m,
-            stiffness_npm,
-            damping_nspm,
-            discretization,
-        } => {
-            let (k, b, a) = (*stiffness_npm as f32, *damping_nspm as f32, pos(*anchor_m)?);
-            match discretization {
-                Discretization::BackwardEuler => SceneVe::Spring(
-                    Spring::new_in(k, b, a, t32, Position::ZERO).map_err(|e| e.to_string())?,
-                ),
-                Discretization::Trapezoidal => SceneVe::TrapezoidalSpring(
-                    TrapezoidalSpring::new_in(k, b, a, t32, Position::ZERO)
-                        .map_err(|e| e.to_string())?,
-                ),
-            }
-        }
-        VeSpec::Blocks {
-            cursor_mass_kg,
-            blocks,
-            limits_m,
-            stick_force_n,
-            floor_damping_nspm,
-            grab_at_s,
-            release_at_s,
-        } => {
-            let bs = blocks
-                .iter()
-                .map(|b| {
-                    Ok(Block {
-                        left: pos(b.at_m)?,
-                        width_nm: pos(b.width_m)?.nm(),
-                        mass_kg: b.mass_kg as f32,
-                        velocity_mps: 0.0,
-                    })
-                })
-                .collect::<Result<Vec<_>, String>>()?;
-            SceneVe::Blocks(Box::new(Blocks::new(
-                t32,
-                *cursor_mass_kg as f32,
-                bs,
-                [pos(limits_m[0])?, pos(limits_m[1])?],
-                *stick_force_n as f32,
-                *floor_damping_nspm as f32,
-                *grab_at_s,
-                *release_at_s,
-            )?))
-        }
-    })
-}
 
 /// One tick's record.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -378,7 +110,7 @@ pub struct Simulation {
     substeps: u32,
     /// Plant state `[q, q', w]`.
     x: Vec<f64>,
-    servo: Servo,
+    servo: SceneServo,
     human: Human,
     tick: u64,
     total_ticks: u64,
@@ -502,7 +234,7 @@ impl Simulation {
             period_s: t32,
             ..SafetyConfig::excalibur()
         };
-        let servo = Servo::new(&scene, encoder, safety)?;
+        let servo = SceneServo::new(&scene, encoder, safety)?;
         let total_ticks = (scene.duration_s / period).round() as u64;
         let quiet_tick = ((human.last_event_end() / period).ceil() as u64).min(total_ticks);
         let ns = 2 * device.n + usize::from(e.load_cell) + if human.has_arm() { 2 } else { 0 };
@@ -621,12 +353,12 @@ impl Simulation {
     }
 
     /// The running servo (gains, VE).
-    pub fn servo(&self) -> &Servo {
+    pub fn servo(&self) -> &SceneServo {
         &self.servo
     }
 
     /// The running servo, to change gains between ticks.
-    pub fn servo_mut(&mut self) -> &mut Servo {
+    pub fn servo_mut(&mut self) -> &mut SceneServo {
         &mut self.servo
     }
 

@@ -4,17 +4,18 @@
 //! and wall controls, and the link to a board. `ui.rs` draws it.
 
 use crate::engine::human::GraspKind;
-use crate::engine::scene::{Display, Scene, VeSpec};
+use crate::engine::scene::{Scene, VeSpec};
 use crate::pil::{SerialBoard, Session};
 use crate::scope::rings::{last_trigger, Edge, Ring};
 use crate::{Sample, Simulation};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
+use twoport_control::servo::Gains;
 use twoport_design::design::{self, Analysis, Check, GridSpec};
 use twoport_design::plot::Figure;
 use twoport_design::twoport::HumanBound;
 use twoport_design::Plant;
-use twoport_link::{Gains, GainsReply, Message, Telemetry};
+use twoport_link::{GainsReply, Message, Telemetry};
 
 /// Samples each signal's ring holds: 20 s at 1 kHz.
 pub const RING_SAMPLES: usize = 20_000;
@@ -164,29 +165,6 @@ pub struct Trigger {
     pub edge: Edge,
 }
 
-/// The coupling (and regulator) gains as the sliders hold them.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum SliderGains {
-    /// Impedance display: `k_c` (N/m), `b_c` (N s/m).
-    Impedance {
-        /// Stiffness (N/m).
-        k: f64,
-        /// Damping (N s/m).
-        b: f64,
-    },
-    /// Admittance display: `K_p` (N/m, N s/m), `m_c` (kg), `b_c` (N s/m).
-    Admittance {
-        /// Regulator stiffness (N/m).
-        kp: f64,
-        /// Regulator damping (N s/m).
-        bp: f64,
-        /// Coupling mass (kg).
-        m: f64,
-        /// Coupling damping (N s/m).
-        b: f64,
-    },
-}
-
 /// The designer's verdict on the gains in force.
 pub struct Light {
     /// Proven absolutely stable.
@@ -241,7 +219,7 @@ pub struct ScopeState {
     /// A frozen copy of the rings, drawn instead of the live ones.
     frozen: Option<(Vec<Ring>, Vec<Ring>, f64)>,
     /// The gains in force.
-    pub gains: SliderGains,
+    pub gains: Gains,
     /// The designer's verdict on them.
     pub light: Option<Light>,
     /// The grasp override (None: the scene's script).
@@ -257,22 +235,6 @@ pub struct ScopeState {
     /// Simulated seconds owed to real time (real-time speeds).
     debt_s: f64,
     last: Option<Sample>,
-}
-
-fn gains_of(scene: &Scene) -> SliderGains {
-    let c = scene.coupling;
-    match scene.display {
-        Display::Impedance => SliderGains::Impedance {
-            k: c.k.unwrap_or(0.0),
-            b: c.b,
-        },
-        Display::Admittance => SliderGains::Admittance {
-            kp: c.kp.unwrap_or(0.0),
-            bp: c.bp.unwrap_or(0.0),
-            m: c.m.unwrap_or(1.0),
-            b: c.b,
-        },
-    }
 }
 
 /// The scene files in `dir` and its sub-folders one level down (the
@@ -310,7 +272,7 @@ impl ScopeState {
                 let a = Analysis::new(&p, GridSpec::DEFAULT);
                 (p, a)
             }),
-            gains: gains_of(&scene),
+            gains: scene.gains(),
             wall: wall_of(&scene),
             scene,
             sim,
@@ -374,11 +336,9 @@ impl ScopeState {
         }
     }
 
-    /// The coupling gains the running simulation uses: `(k, b)` on an
-    /// impedance display, `(m, b)` on an admittance display.
-    pub fn running_coupling(&self) -> (f64, f64) {
-        let (a, b) = self.sim.servo().coupling_gains();
-        (a as f64, b as f64)
+    /// The gains the running simulation uses.
+    pub fn running_gains(&self) -> Gains {
+        self.sim.servo().gains()
     }
 
     /// The scene in force.
@@ -548,34 +508,14 @@ impl ScopeState {
 
     /// New gains for the running simulation (and the board, which may
     /// refuse them); the light follows.
-    pub fn set_gains(&mut self, g: SliderGains) {
-        let r = match g {
-            SliderGains::Impedance { k, b } => self.sim.servo_mut().set_coupling(k, b),
-            SliderGains::Admittance { kp, bp, m, b } => self
-                .sim
-                .servo_mut()
-                .set_regulator(kp, bp)
-                .and_then(|_| self.sim.servo_mut().set_coupling(m, b)),
-        };
-        if let Err(e) = r {
+    pub fn set_gains(&mut self, g: Gains) {
+        if let Err(e) = self.sim.servo_mut().set_gains(g) {
             self.message = Some(format!("gains not applied: {e}"));
             return;
         }
         self.gains = g;
         if let Some(b) = self.board.as_mut() {
-            let msg = Message::SetGains(match g {
-                SliderGains::Impedance { k, b } => Gains::Impedance {
-                    k_npm: k as f32,
-                    b_nspm: b as f32,
-                },
-                SliderGains::Admittance { kp, bp, m, b } => Gains::Admittance {
-                    kp_npm: kp as f32,
-                    bp_nspm: bp as f32,
-                    m_kg: m as f32,
-                    b_nspm: b as f32,
-                },
-            });
-            if let Err(e) = b.session.send(&msg) {
+            if let Err(e) = b.session.send(&Message::SetGains(g.into())) {
                 self.message = Some(format!("board: {e}"));
             }
         }
@@ -589,14 +529,21 @@ impl ScopeState {
         };
         let h = Some(HumanBound::PAPER);
         let (check, figure): (Option<Check>, _) = match self.gains {
-            SliderGains::Impedance { k, b } => (
-                design::check_impedance(a, k, b, h),
-                twoport_design::figures::fig8(a, k, b).ok(),
-            ),
-            SliderGains::Admittance { kp, bp, m, b } => (
-                design::check_admittance(plant, a, (kp, bp), (m, b), h),
-                twoport_design::figures::fig9(a, (kp, bp), (m, b)).ok(),
-            ),
+            Gains::Impedance(g) => {
+                let (k, b) = (g.k_npm as f64, g.b_nspm as f64);
+                (
+                    design::check_impedance(a, k, b, h),
+                    twoport_design::figures::fig8(a, k, b).ok(),
+                )
+            }
+            Gains::Admittance(g) => {
+                let kp = (g.kp_npm as f64, g.bp_nspm as f64);
+                let c = (g.m_kg as f64, g.b_nspm as f64);
+                (
+                    design::check_admittance(plant, a, kp, c, h),
+                    twoport_design::figures::fig9(a, kp, c).ok(),
+                )
+            }
         };
         self.light = Some(match check {
             Some(c) => Light {

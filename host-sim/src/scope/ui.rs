@@ -2,10 +2,11 @@
 //! Nothing here owns simulation state.
 
 use crate::engine::human::GraspKind;
-use crate::scope::app::{list_ports, BoardSignal, ScopeState, Signal, SliderGains, Speed};
+use crate::scope::app::{list_ports, BoardSignal, ScopeState, Signal, Speed};
 use crate::scope::rings::{minmax, Edge, Ring};
 use eframe::egui::{self, Color32, RichText, Ui};
 use egui_plot::{Legend, Line, Plot, PlotPoints};
+use twoport_control::servo::Gains;
 
 /// Per-pixel min/max columns of `ring` over `[t0, t1)`, as a polyline that
 /// runs down each column: every peak drawn, none aliased away.
@@ -181,7 +182,8 @@ pub fn gains(ui: &mut Ui, s: &mut ScopeState) {
     ui.heading("Coupling");
     let mut g = s.gains;
     let changed = match &mut g {
-        SliderGains::Impedance { k, b } => {
+        Gains::Impedance(g) => {
+            let (k, b) = (&mut g.k_npm, &mut g.b_nspm);
             let a = ui
                 .add(egui::Slider::new(k, 0.0..=150_000.0).text("k_c (N/m)"))
                 .changed();
@@ -190,7 +192,8 @@ pub fn gains(ui: &mut Ui, s: &mut ScopeState) {
                 .changed();
             a || c
         }
-        SliderGains::Admittance { kp, bp, m, b } => {
+        Gains::Admittance(g) => {
+            let (kp, bp, m, b) = (&mut g.kp_npm, &mut g.bp_nspm, &mut g.m_kg, &mut g.b_nspm);
             let a = ui
                 .add(egui::Slider::new(kp, 0.0..=150_000.0).text("K_p stiffness (N/m)"))
                 .changed();

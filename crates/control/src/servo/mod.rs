@@ -1,0 +1,407 @@
+//! One control tick of either display, as the board runs it and the
+//! simulator runs it: sensors in, law, VE, safety layer, held actuator force
+//! out.
+
+mod gains;
+
+pub use gains::{AdmittanceGains, Display, Gains, GainsError, ImpedanceGains};
+
+use crate::coupling::{AdmittanceCoupling, AdmittanceStep, ImpedanceCoupling, ImpedanceStep};
+use crate::estimator::FirstDifference;
+use crate::regulator::PositionRegulator;
+use crate::safety::{Faults, SafeForce, SafetyConfig, SafetyInputs, SafetyLayer};
+use crate::ve::VirtualEnvironment;
+use crate::{Encoder, Integrator, ParamError, Position, Real};
+
+/// The sensors of one tick.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SensorFrame<R = f32> {
+    /// Timer tick number (must increase by one every tick).
+    pub tick: u32,
+    /// Raw hardware encoder counter.
+    pub encoder_raw: u32,
+    /// Load-cell force on the handle along +x (N); only the admittance
+    /// display reads it.
+    pub load_cell_n: R,
+    /// Dead-man switch closed (operator present).
+    pub dead_man_closed: bool,
+}
+
+/// The result of one tick.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ServoOutput<R = f32> {
+    /// Force to hold on the actuator (N), after the safety layer; positive
+    /// resists positive actuator motion (the paper's `f_a`).
+    pub actuator_force_n: R,
+    /// What the law asked for before the safety layer (N).
+    pub commanded_force_n: R,
+    /// Actuator position from the encoder.
+    pub position: Position,
+    /// First-difference actuator velocity (m/s).
+    pub velocity_mps: R,
+    /// VE velocity `v_e` (m/s).
+    pub ve_velocity_mps: R,
+    /// Force on the VE `f_e` (N).
+    pub ve_force_n: R,
+    /// Force in the virtual coupling (N).
+    pub coupling_force_n: R,
+    /// Impedance display: the VE point the coupling holds; admittance
+    /// display: the position command `x_cmd`.
+    pub reference: Position,
+    /// Latched faults.
+    pub faults: Faults,
+    /// Whether the safety layer clipped the force.
+    pub limited: bool,
+}
+
+/// Encoder, velocity estimate and safety layer: the part both displays share.
+#[derive(Clone, Copy, Debug)]
+struct Frontend<R> {
+    encoder: Encoder,
+    estimator: FirstDifference<R>,
+    safety: SafetyLayer<R>,
+    position: Position,
+}
+
+impl<R: Real> Frontend<R> {
+    fn new(encoder: Encoder, safety: SafetyConfig) -> Result<Self, ParamError> {
+        let position = encoder.position();
+        Ok(Frontend {
+            estimator: FirstDifference::new_in(safety.period_s, position)?,
+            safety: SafetyLayer::new_in(safety)?,
+            encoder,
+            position,
+        })
+    }
+
+    /// Read the encoder; returns the velocity and the sensor faults.
+    fn sense(&mut self, frame: &SensorFrame<R>) -> (R, Faults) {
+        let mut faults = Faults::NONE;
+        match self.encoder.update(frame.encoder_raw) {
+            Ok(p) => self.position = p,
+            Err(_) => faults = Faults::ENCODER_INVALID,
+        }
+        (self.estimator.step(self.position), faults)
+    }
+
+    /// Whether the laws may run this tick.
+    fn runnable(&self, sensor_faults: Faults) -> bool {
+        sensor_faults.is_empty() && self.safety.faults().is_empty()
+    }
+
+    /// The safety layer's answer to the law's `command_n` (N).
+    fn limit(
+        &mut self,
+        frame: &SensorFrame<R>,
+        v: R,
+        faults: Faults,
+        command_n: R,
+    ) -> SafeForce<R> {
+        self.safety.step(
+            &SafetyInputs {
+                tick: frame.tick,
+                dead_man_closed: frame.dead_man_closed,
+                velocity_mps: v,
+                sensor_faults: faults,
+            },
+            command_n,
+        )
+    }
+}
+
+/// The admittance display's laws: coupling, velocity-to-position command
+/// and position regulator.
+#[derive(Clone, Copy, Debug)]
+struct AdmittanceLaws<R> {
+    coupling: AdmittanceCoupling<R>,
+    command: Integrator<R>,
+    regulator: PositionRegulator<R>,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Laws<R> {
+    Impedance(ImpedanceCoupling<R>),
+    Admittance(AdmittanceLaws<R>),
+}
+
+/// The laws a servo runs, to read their gains and z-domain forms.
+#[derive(Clone, Copy, Debug)]
+pub enum LawsRef<'a, R> {
+    /// The impedance display's coupling `Z_cI`.
+    Impedance(&'a ImpedanceCoupling<R>),
+    /// The admittance display's coupling `Z_cA` and regulator `K_p`.
+    Admittance {
+        /// `Z_cA`.
+        coupling: &'a AdmittanceCoupling<R>,
+        /// `K_p`.
+        regulator: &'a PositionRegulator<R>,
+    },
+}
+
+/// A haptic display's servo, either display (impedance, paper Fig. 5:
+/// measure motion, command force through `Z_cI`; admittance, Fig. 6:
+/// measure force, command motion through `Z_cA`, the velocity integrated to
+/// a position command and the regulator `K_p`), computing in `R` (`f32` on
+/// the board, `f64` in the simulator on request).
+///
+/// A servo starts disabled: it outputs zero force until [`Servo::enable`],
+/// then ramps in. Any fault latches zero force until [`Servo::clear`].
+#[derive(Clone, Copy, Debug)]
+pub struct Servo<V, R = f32> {
+    front: Frontend<R>,
+    laws: Laws<R>,
+    ve: V,
+}
+
+impl<V: VirtualEnvironment> Servo<V> {
+    /// A disabled f32 servo running `gains`' display.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_control::servo::{ImpedanceGains, SensorFrame, Servo};
+    /// use twoport_control::ve::BilateralConstraint;
+    /// use twoport_control::{Encoder, Position, SafetyConfig};
+    /// let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap(); // 1 µm counts
+    /// let ve = BilateralConstraint::new(Position::ZERO);
+    /// let gains = ImpedanceGains { k_npm: 51_000.0, b_nspm: 90.0 };
+    /// let mut servo = Servo::new(gains.into(), enc, SafetyConfig::new(1e-3, 200.0, 100.0), ve)?;
+    /// let frame = |tick| SensorFrame { tick, encoder_raw: 0, load_cell_n: 0.0, dead_man_closed: true };
+    /// // Disabled: zero force. Enabled, it ramps in.
+    /// assert_eq!(servo.tick(&frame(0)).actuator_force_n, 0.0);
+    /// servo.enable().unwrap();
+    /// assert!(servo.tick(&frame(1)).actuator_force_n.is_finite());
+    /// # Ok::<(), twoport_control::ParamError>(())
+    /// ```
+    pub fn new(
+        gains: Gains,
+        encoder: Encoder,
+        safety: SafetyConfig,
+        ve: V,
+    ) -> Result<Self, ParamError> {
+        Self::new_in(gains, encoder, safety, ve)
+    }
+}
+
+impl<V: VirtualEnvironment<R>, R: Real> Servo<V, R> {
+    /// [`Servo::new`] computing in `R`.
+    pub fn new_in(
+        gains: Gains,
+        encoder: Encoder,
+        safety: SafetyConfig,
+        ve: V,
+    ) -> Result<Self, ParamError> {
+        let t = safety.period_s;
+        let front = Frontend::new(encoder, safety)?;
+        let laws = match gains {
+            Gains::Impedance(g) => {
+                Laws::Impedance(ImpedanceCoupling::new_in(g.k_npm, g.b_nspm, t)?)
+            }
+            Gains::Admittance(g) => Laws::Admittance(AdmittanceLaws {
+                coupling: AdmittanceCoupling::new_in(g.m_kg, g.b_nspm, t)?,
+                command: Integrator::new_in(t, front.position),
+                regulator: PositionRegulator::new_in(g.kp_npm, g.bp_nspm, t)?,
+            }),
+        };
+        let mut s = Servo { front, laws, ve };
+        s.realign();
+        Ok(s)
+    }
+
+    /// Enable force output (ramping in), re-aligning the laws to the device
+    /// if it was disabled. Refused while a fault is latched.
+    pub fn enable(&mut self) -> Result<(), Faults> {
+        if !self.front.safety.faults().is_empty() {
+            return Err(self.front.safety.faults());
+        }
+        if !self.front.safety.is_enabled() {
+            self.realign();
+        }
+        self.front.safety.enable()
+    }
+
+    /// Disable force output.
+    pub fn disable(&mut self) {
+        self.front.safety.disable();
+    }
+
+    /// Clear latched faults and re-align the laws to the device.
+    pub fn clear(&mut self) {
+        self.front.safety.clear();
+        self.realign();
+    }
+
+    /// A link heartbeat arrived.
+    pub fn heartbeat(&mut self) {
+        self.front.safety.heartbeat();
+    }
+
+    /// Latch a fault found outside the tick (e.g. by the link).
+    pub fn trip(&mut self, f: Faults) {
+        self.front.safety.trip(f);
+    }
+
+    /// The safety layer (limits, latched faults, thermal state).
+    pub fn safety(&self) -> &SafetyLayer<R> {
+        &self.front.safety
+    }
+
+    /// The virtual environment.
+    pub fn ve(&self) -> &V {
+        &self.ve
+    }
+
+    /// The virtual environment, to change it between ticks.
+    pub fn ve_mut(&mut self) -> &mut V {
+        &mut self.ve
+    }
+
+    /// The current actuator position.
+    pub fn position(&self) -> Position {
+        self.front.position
+    }
+
+    /// The display this servo runs.
+    pub fn display(&self) -> Display {
+        match self.laws {
+            Laws::Impedance(_) => Display::Impedance,
+            Laws::Admittance(_) => Display::Admittance,
+        }
+    }
+
+    /// The laws, for their gains and z-domain forms.
+    pub fn laws(&self) -> LawsRef<'_, R> {
+        match &self.laws {
+            Laws::Impedance(c) => LawsRef::Impedance(c),
+            Laws::Admittance(a) => LawsRef::Admittance {
+                coupling: &a.coupling,
+                regulator: &a.regulator,
+            },
+        }
+    }
+
+    /// The gains in force.
+    pub fn gains(&self) -> Gains {
+        match &self.laws {
+            Laws::Impedance(c) => {
+                let (k_npm, b_nspm) = c.gains();
+                Gains::Impedance(ImpedanceGains { k_npm, b_nspm })
+            }
+            Laws::Admittance(a) => {
+                let (kp_npm, bp_nspm) = a.regulator.gains();
+                let (m_kg, b_nspm) = a.coupling.gains();
+                Gains::Admittance(AdmittanceGains {
+                    kp_npm,
+                    bp_nspm,
+                    m_kg,
+                    b_nspm,
+                })
+            }
+        }
+    }
+
+    /// Change the gains between ticks. All of them change or, on an error,
+    /// none do.
+    pub fn set_gains(&mut self, gains: Gains) -> Result<(), GainsError> {
+        match (&mut self.laws, gains) {
+            (Laws::Impedance(c), Gains::Impedance(g)) => Ok(c.set_gains(g.k_npm, g.b_nspm)?),
+            (Laws::Admittance(a), Gains::Admittance(g)) => {
+                let (mut coupling, mut regulator) = (a.coupling, a.regulator);
+                coupling.set_gains(g.m_kg, g.b_nspm)?;
+                regulator.set_gains(g.kp_npm, g.bp_nspm)?;
+                (a.coupling, a.regulator) = (coupling, regulator);
+                Ok(())
+            }
+            _ => Err(GainsError::WrongDisplay {
+                servo: self.display(),
+                gains: gains.display(),
+            }),
+        }
+    }
+
+    fn realign(&mut self) {
+        let x = self.front.position;
+        self.front.estimator.reset(x);
+        if let Laws::Admittance(a) = &mut self.laws {
+            a.coupling.reset();
+            a.command.reset(x);
+            a.regulator.reset();
+        }
+        self.ve.reset(x);
+    }
+
+    /// One control tick.
+    pub fn tick(&mut self, frame: &SensorFrame<R>) -> ServoOutput<R> {
+        match &mut self.laws {
+            Laws::Impedance(c) => impedance_tick(&mut self.front, c, &mut self.ve, frame),
+            Laws::Admittance(a) => admittance_tick(&mut self.front, a, &mut self.ve, frame),
+        }
+    }
+}
+
+// The impedance display's tick is the board's hot path: inlined into
+// `tick`, with the admittance display's kept out of line so that its
+// registers do not crowd the impedance tick (the M4F tick count).
+#[inline(always)]
+fn impedance_tick<R: Real, V: VirtualEnvironment<R>>(
+    front: &mut Frontend<R>,
+    coupling: &mut ImpedanceCoupling<R>,
+    ve: &mut V,
+    frame: &SensorFrame<R>,
+) -> ServoOutput<R> {
+    let (v, faults) = front.sense(frame);
+    let s = if front.runnable(faults) {
+        coupling.step(front.position, v, ve)
+    } else {
+        ImpedanceStep::default()
+    };
+    let safe = front.limit(frame, v, faults, s.force_n);
+    ServoOutput {
+        actuator_force_n: safe.force_n,
+        commanded_force_n: s.force_n,
+        position: front.position,
+        velocity_mps: v,
+        ve_velocity_mps: s.ve_velocity_mps,
+        ve_force_n: s.force_n,
+        coupling_force_n: s.force_n,
+        reference: ve.position(),
+        faults: safe.faults,
+        limited: safe.limited,
+    }
+}
+
+#[inline(never)]
+fn admittance_tick<R: Real, V: VirtualEnvironment<R>>(
+    front: &mut Frontend<R>,
+    laws: &mut AdmittanceLaws<R>,
+    ve: &mut V,
+    frame: &SensorFrame<R>,
+) -> ServoOutput<R> {
+    let (v, mut faults) = front.sense(frame);
+    let f_c = frame.load_cell_n;
+    if !f_c.is_finite() {
+        faults = faults.with(Faults::SENSOR_NOT_FINITE);
+    } else if f_c.abs() > R::of(front.safety.config().max_sensor_force_n) {
+        faults = faults.with(Faults::SENSOR_OUT_OF_RANGE);
+    }
+    let (s, command_n) = if front.runnable(faults) {
+        let s = laws.coupling.step(f_c, ve);
+        let x_cmd = laws.command.step_unsplit(s.velocity_mps);
+        (s, laws.regulator.step(front.position, x_cmd))
+    } else {
+        (AdmittanceStep::default(), R::ZERO)
+    };
+    let safe = front.limit(frame, v, faults, command_n);
+    ServoOutput {
+        actuator_force_n: safe.force_n,
+        commanded_force_n: command_n,
+        position: front.position,
+        velocity_mps: v,
+        ve_velocity_mps: s.velocity_mps,
+        ve_force_n: s.ve_force_n,
+        coupling_force_n: s.coupling_force_n,
+        reference: laws.command.position(),
+        faults: safe.faults,
+        limited: safe.limited,
+    }
+}

@@ -1,0 +1,211 @@
+//! The scene's servo: the control crate's [`Servo`] on the scene's VE, in
+//! the float type the scene names (the board's f32, or f64 to take the
+//! laws' rounding out of a study).
+
+use crate::engine::blocks::{Block, Blocks};
+use crate::engine::scene::{Discretization, Precision, Scene, SolidSide, VeSpec};
+use crate::engine::ve::SceneVe;
+use twoport_control::servo::{Gains, SensorFrame, Servo, ServoOutput};
+use twoport_control::ve::{
+    BilateralConstraint, CursorMass, Solid, Spring, TrapezoidalSpring, UnilateralWall,
+    VirtualEnvironment,
+};
+use twoport_control::{Encoder, Position, Real, SafetyConfig};
+
+/// The board's code for the scene's display, enabled.
+#[derive(Clone, Debug)]
+pub enum SceneServo {
+    /// The board's f32 laws.
+    F32(Box<Servo<SceneVe<f32>, f32>>),
+    /// The same laws computing in f64.
+    F64(Box<Servo<SceneVe<f64>, f64>>),
+}
+
+fn build<R: Real>(
+    scene: &Scene,
+    encoder: Encoder,
+    safety: SafetyConfig,
+) -> Result<Box<Servo<SceneVe<R>, R>>, String> {
+    let ve = scene_ve(scene, safety.period_s)?;
+    let mut s = Servo::new_in(scene.gains(), encoder, safety, ve).map_err(|e| e.to_string())?;
+    s.enable()
+        .map_err(|f| format!("the servo would not enable: {f}"))?;
+    Ok(Box::new(s))
+}
+
+fn set_wall<R: Real>(ve: &mut SceneVe<R>, surface: Position, k_npm: f32) -> Result<(), String> {
+    let SceneVe::Wall(w) = ve else {
+        return Err("the scene's VE is not a wall".into());
+    };
+    let (_, b) = w.gains();
+    w.set_gains(k_npm, b).map_err(|e| e.to_string())?;
+    w.set_surface(surface);
+    Ok(())
+}
+
+/// The sensors as the f32 board reads them.
+pub(crate) fn frame_f32(f: &SensorFrame<f64>) -> SensorFrame {
+    SensorFrame {
+        tick: f.tick,
+        encoder_raw: f.encoder_raw,
+        load_cell_n: f.load_cell_n as f32,
+        dead_man_closed: f.dead_man_closed,
+    }
+}
+
+/// An f32 servo's output, widened.
+pub(crate) fn output_f64(o: ServoOutput) -> ServoOutput<f64> {
+    ServoOutput {
+        actuator_force_n: o.actuator_force_n as f64,
+        commanded_force_n: o.commanded_force_n as f64,
+        position: o.position,
+        velocity_mps: o.velocity_mps as f64,
+        ve_velocity_mps: o.ve_velocity_mps as f64,
+        ve_force_n: o.ve_force_n as f64,
+        coupling_force_n: o.coupling_force_n as f64,
+        reference: o.reference,
+        faults: o.faults,
+        limited: o.limited,
+    }
+}
+
+impl SceneServo {
+    /// The scene's display, gains and VE, in the scene's float type.
+    pub fn new(scene: &Scene, encoder: Encoder, safety: SafetyConfig) -> Result<Self, String> {
+        Ok(match scene.integrator.controller {
+            Precision::F32 => SceneServo::F32(build(scene, encoder, safety)?),
+            Precision::F64 => SceneServo::F64(build(scene, encoder, safety)?),
+        })
+    }
+
+    /// One tick on sensors given in f64 (rounded to f32 for the board's
+    /// laws).
+    pub fn tick(&mut self, f: &SensorFrame<f64>) -> ServoOutput<f64> {
+        match self {
+            SceneServo::F32(s) => output_f64(s.tick(&frame_f32(f))),
+            SceneServo::F64(s) => s.tick(f),
+        }
+    }
+
+    /// The VE's position.
+    pub fn ve_position(&self) -> Position {
+        match self {
+            SceneServo::F32(s) => s.ve().position(),
+            SceneServo::F64(s) => s.ve().position(),
+        }
+    }
+
+    /// The gains in force.
+    pub fn gains(&self) -> Gains {
+        match self {
+            SceneServo::F32(s) => s.gains(),
+            SceneServo::F64(s) => s.gains(),
+        }
+    }
+
+    /// Change the gains while running (the scope's sliders); they must be
+    /// for the scene's display.
+    pub fn set_gains(&mut self, g: Gains) -> Result<(), String> {
+        match self {
+            SceneServo::F32(s) => s.set_gains(g),
+            SceneServo::F64(s) => s.set_gains(g),
+        }
+        .map_err(|e| e.to_string())
+    }
+
+    /// Move the wall and change its stiffness while running (the scope's
+    /// controls); an error if the scene's VE is not a wall.
+    pub fn set_wall(&mut self, surface_m: f64, stiffness_npm: f64) -> Result<(), String> {
+        let x = Position::from_m_f64(surface_m).ok_or(format!(
+            "wall position {surface_m} m is out of range (±2.147 m)"
+        ))?;
+        let k = stiffness_npm as f32;
+        match self {
+            SceneServo::F32(s) => set_wall(s.ve_mut(), x, k),
+            SceneServo::F64(s) => set_wall(s.ve_mut(), x, k),
+        }
+    }
+}
+
+/// The scene's VE, computing in `R`.
+fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, String> {
+    let pos = |m: f64| {
+        Position::from_m_f64(m).ok_or(format!("position {m} m is out of range (±2.147 m)"))
+    };
+    Ok(match &scene.ve {
+        VeSpec::Cursor { mass_kg } => SceneVe::Cursor(
+            CursorMass::new_in(*mass_kg as f32, t32, Position::ZERO).map_err(|e| e.to_string())?,
+        ),
+        VeSpec::Wall {
+            position_m,
+            stiffness_npm,
+            damping_nspm,
+            solid,
+        } => {
+            let side = match solid {
+                SolidSide::Above => Solid::Above,
+                SolidSide::Below => Solid::Below,
+            };
+            SceneVe::Wall(
+                UnilateralWall::new_in(
+                    *stiffness_npm as f32,
+                    *damping_nspm as f32,
+                    pos(*position_m)?,
+                    side,
+                    t32,
+                    Position::ZERO,
+                )
+                .map_err(|e| e.to_string())?,
+            )
+        }
+        VeSpec::Bilateral => SceneVe::Bilateral(BilateralConstraint::new(Position::ZERO)),
+        VeSpec::Spring {
+            anchor_m,
+            stiffness_npm,
+            damping_nspm,
+            discretization,
+        } => {
+            let (k, b, a) = (*stiffness_npm as f32, *damping_nspm as f32, pos(*anchor_m)?);
+            match discretization {
+                Discretization::BackwardEuler => SceneVe::Spring(
+                    Spring::new_in(k, b, a, t32, Position::ZERO).map_err(|e| e.to_string())?,
+                ),
+                Discretization::Trapezoidal => SceneVe::TrapezoidalSpring(
+                    TrapezoidalSpring::new_in(k, b, a, t32, Position::ZERO)
+                        .map_err(|e| e.to_string())?,
+                ),
+            }
+        }
+        VeSpec::Blocks {
+            cursor_mass_kg,
+            blocks,
+            limits_m,
+            stick_force_n,
+            floor_damping_nspm,
+            grab_at_s,
+            release_at_s,
+        } => {
+            let bs = blocks
+                .iter()
+                .map(|b| {
+                    Ok(Block {
+                        left: pos(b.at_m)?,
+                        width_nm: pos(b.width_m)?.nm(),
+                        mass_kg: b.mass_kg as f32,
+                        velocity_mps: 0.0,
+                    })
+                })
+                .collect::<Result<Vec<_>, String>>()?;
+            SceneVe::Blocks(Box::new(Blocks::new(
+                t32,
+                *cursor_mass_kg as f32,
+                bs,
+                [pos(limits_m[0])?, pos(limits_m[1])?],
+                *stick_force_n as f32,
+                *floor_damping_nspm as f32,
+                *grab_at_s,
+                *release_at_s,
+            )?))
+        }
+    })
+}
