@@ -1,12 +1,20 @@
 //! Simulator speed: one simulated second (1,000 ticks) of the linear 5-DOF
 //! Excalibur scene with exact ZOH (goal: 20,000x real time, i.e. 50 us per
-//! simulated second), and the added cost of each effect, all measured in
-//! one run so they compare as ratios.
+//! simulated second), the added cost of each effect, and the tick's parts
+//! alone (the plant's step, the servo's tick), all measured in one run so
+//! they compare as ratios: what the whole tick costs beyond its parts is
+//! the hand, the bookkeeping and the recording.
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use host_sim::engine::human::GraspKind;
+use host_sim::engine::plant::{Device, Method, Stepper};
+use host_sim::engine::servo::SceneServo;
 use host_sim::{Scene, Simulation};
 use std::hint::black_box;
 use std::path::Path;
+use twoport_control::servo::SensorFrame;
+use twoport_control::{Encoder, Position, SafetyConfig};
+use twoport_design::DeviceModel;
 
 const SCENE: &str = "scenes/table1/impedance_bilateral_maximum.toml";
 
@@ -34,6 +42,42 @@ fn one_second(c: &mut Criterion, name: &str, sets: &[&str]) {
             },
             BatchSize::LargeInput,
         )
+    });
+}
+
+/// 1,000 of the tick's parts alone, as the linear scene runs them.
+fn parts(c: &mut Criterion) {
+    let s = scene(&[]);
+    let model = DeviceModel::from_toml(include_str!("../models/excalibur.toml"), "excalibur")
+        .expect("the shipped model");
+    let dev = Device::flexible(&model).expect("a device");
+    let sys = dev.system(GraspKind::Maximum.grasp(), false);
+    let mut st = Stepper::new(&sys, Method::ExactZoh, 1e-3).expect("a stepper");
+    let mut x = vec![0.0; sys.states()];
+    c.bench_function("part: 1,000 plant steps (10 states, exact ZOH)", |b| {
+        b.iter(|| {
+            for _ in 0..1000 {
+                st.step(&mut x, black_box([1.0, 0.5]), None);
+            }
+            black_box(&x);
+        })
+    });
+    let enc = Encoder::new(32, 1000, 0, Position::ZERO).expect("an encoder");
+    let mut servo = SceneServo::new(&s, enc, SafetyConfig::excalibur()).expect("the scene's servo");
+    let mut tick = 0u32;
+    c.bench_function("part: 1,000 servo ticks (board f32 laws)", |b| {
+        b.iter(|| {
+            for _ in 0..1000 {
+                tick = tick.wrapping_add(1);
+                let f = SensorFrame {
+                    tick,
+                    encoder_raw: black_box(tick % 64),
+                    load_cell_n: 0.0,
+                    dead_man_closed: true,
+                };
+                black_box(servo.tick(&f));
+            }
+        })
     });
 }
 
@@ -79,6 +123,6 @@ fn effects(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = effects
+    targets = effects, parts
 }
 criterion_main!(benches);

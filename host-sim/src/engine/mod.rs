@@ -4,6 +4,7 @@
 //! or studies; `scope` and `study` build on it.
 
 pub mod blocks;
+pub mod effects;
 pub mod human;
 pub mod plant;
 pub mod scene;

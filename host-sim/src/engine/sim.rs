@@ -1,18 +1,15 @@
 //! One simulation: the plant between the hand and the board's own control
 //! code, ticking at the control period, with only the named effects.
 
+use crate::engine::effects::{Effect, Pipeline, TIMING_STRIDE};
 use crate::engine::human::{GraspKind, Human};
 use crate::engine::plant::{Device, Method, Stepper, System};
 use crate::engine::scene::Scene;
 use crate::engine::servo::{frame_f32, output_f64, SceneServo};
 use crate::engine::stability::{Detector, Verdict};
-use std::collections::VecDeque;
 use std::time::Instant;
 use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::{Encoder, Position, SafetyConfig};
-
-/// One tick in this many is timed for the effects' cost.
-const TIMING_STRIDE: u64 = 64;
 
 /// One tick's record.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -82,23 +79,6 @@ pub struct Report {
     pub late_rms_n: [f64; 2],
 }
 
-#[derive(Clone, Debug)]
-struct Rng(u64);
-
-impl Rng {
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn gaussian(&mut self) -> f64 {
-        let u = self.uniform().max(1e-300);
-        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * self.uniform()).cos()
-    }
-}
-
 /// A simulation in progress.
 pub struct Simulation {
     scene: Scene,
@@ -117,20 +97,18 @@ pub struct Simulation {
     held_force: f64,
     encoder_mask: u32,
     counts_per_m: f64,
-    rng: Rng,
-    delay: VecDeque<SensorFrame<f64>>,
+    /// The scene's effects, compiled.
+    effects: Pipeline,
+    /// Which stepper runs: the hand's grasp and its index in `steppers`.
+    current: Option<(GraspKind, usize)>,
     peak_force: f64,
     energy_in: f64,
     last_power: f64,
     detector: Detector,
     failure: Option<String>,
-    costs: Vec<(String, f64)>,
     warning: Option<String>,
     actuator_dir: Vec<f64>,
-    cable_k: f64,
     track_energy: bool,
-    /// What reading the clock twice costs (ns), subtracted from timings.
-    clock_ns: f64,
     /// The scope's grasp, instead of the script's.
     grasp_override: Option<GraspKind>,
     /// The scope's mouse push, added to the script's (N).
@@ -246,7 +224,7 @@ impl Simulation {
         } else {
             0.0
         };
-        let mut sim = Simulation {
+        let sim = Simulation {
             period,
             load_cell: e.load_cell,
             steppers,
@@ -264,67 +242,37 @@ impl Simulation {
                 (1u32 << bits) - 1
             },
             counts_per_m: 1e12 / pm_per_count,
-            rng: Rng(e.adc.map_or(1, |a| a.seed.max(1))),
-            delay: VecDeque::new(),
+            effects: Pipeline::new(&e, cable_k),
+            current: None,
             peak_force: 0.0,
             energy_in: 0.0,
             last_power: 0.0,
             detector: Detector::new(total_ticks, quiet_tick, (1.0 / period).round() as u64),
             failure: None,
-            costs: Vec::new(),
             warning,
             actuator_dir,
-            cable_k,
             track_energy: false,
-            clock_ns: (0..32)
-                .map(|_| {
-                    let t = Instant::now();
-                    t.elapsed().as_nanos() as f64
-                })
-                .fold(f64::INFINITY, f64::min),
             device,
             scene,
             grasp_override: None,
             extra_push_n: 0.0,
         };
-        sim.costs = sim.effect_names().into_iter().map(|n| (n, 0.0)).collect();
         Ok(sim)
     }
 
     /// Names of the effects this scene simulates.
     pub fn effect_names(&self) -> Vec<String> {
-        let e = &self.scene.effects;
-        let mut v = Vec::new();
-        let mut add = |on: bool, n: &str| {
-            if on {
-                v.push(n.to_string());
-            }
-        };
-        add(e.flexibility, "flexibility");
-        add(e.load_cell, "load_cell");
-        add(e.encoder.is_some(), "encoder");
-        add(e.adc.is_some(), "adc");
-        add(e.saturation.is_some(), "saturation");
-        add(e.coulomb.is_some(), "coulomb");
-        add(e.cogging.is_some(), "cogging");
-        add(e.cable_slack.is_some(), "cable_slack");
-        add(e.delay.is_some(), "delay");
-        v
+        self.effects
+            .costs
+            .per_tick(1.0)
+            .map(|(e, _)| e.name().to_string())
+            .collect()
     }
 
     /// Effects are timed on one tick in [`TIMING_STRIDE`] and the time is
     /// scaled up: a clock read costs more than most effects do.
     fn timing(&self) -> bool {
         self.tick.is_multiple_of(TIMING_STRIDE)
-    }
-
-    fn cost(&mut self, name: &str, since: Option<Instant>) {
-        let Some(since) = since else { return };
-        let raw = since.elapsed().as_nanos() as f64 - self.clock_ns;
-        let ns = raw.max(0.0) * TIMING_STRIDE as f64;
-        if let Some(c) = self.costs.iter_mut().find(|c| c.0 == name) {
-            c.1 += ns;
-        }
     }
 
     /// Compute the device's stored energy every tick (for a passivity view;
@@ -391,29 +339,22 @@ impl Simulation {
         a.iter().zip(b).map(|(x, y)| x * y).sum()
     }
 
-    fn sense(&mut self) -> SensorFrame<f64> {
+    fn sense(&mut self, timing: bool) -> SensorFrame<f64> {
         let n = self.device.n;
         let x_a = Self::dot(&self.actuator_dir, &self.x[..n]);
-        let timing = self.timing();
-        let t0 = self.scene.effects.encoder.and(timing.then(Instant::now));
+        let t0 = (timing && self.effects.encoder_timed()).then(Instant::now);
         // Round half away from zero without a libm call.
         let c = x_a * self.counts_per_m;
         let counts = (c + 0.5f64.copysign(c)) as i64;
         // The counter keeps the low `bits` of the count: for a power-of-two
         // modulus that is a mask of the two's-complement value.
         let raw = (counts as u32) & self.encoder_mask;
-        self.cost("encoder", t0);
-        let mut f_m = if self.load_cell { self.x[2 * n] } else { 0.0 };
-        if let Some(adc) = self.scene.effects.adc {
-            let t0 = timing.then(Instant::now);
-            f_m += adc.noise_rms_n * self.rng.gaussian();
-            f_m = (f_m / adc.lsb_n).round() * adc.lsb_n;
-            self.cost("adc", t0);
-        }
+        self.effects.costs.charge(&[Effect::Encoder], t0);
+        let f_m = if self.load_cell { self.x[2 * n] } else { 0.0 };
         SensorFrame {
             tick: self.tick as u32,
             encoder_raw: raw,
-            load_cell_n: f_m,
+            load_cell_n: self.effects.adc(f_m, timing),
             dead_man_closed: true,
         }
     }
@@ -446,30 +387,15 @@ impl Simulation {
             hand.grasp = g;
         }
         hand.push_n += self.extra_push_n;
-        let mut frame = self.sense();
         let timing = self.timing();
-        if let Some(d) = self.scene.effects.delay {
-            let t0 = timing.then(Instant::now);
-            self.delay.push_back(frame);
-            frame = if self.delay.len() > d.ticks as usize {
-                self.delay.pop_front().unwrap_or(frame)
-            } else {
-                *self.delay.front().unwrap_or(&frame)
-            };
-            frame.tick = self.tick as u32;
-            self.cost("delay", t0);
-        }
+        let frame = self.sense(timing);
+        let frame = self.effects.delay(frame, timing);
         let is_external = external.is_some();
         let out = match external {
             Some(c) => output_f64(c(&frame_f32(&frame))),
             None => self.servo.tick(&frame),
         };
-        let mut f_a = out.actuator_force_n;
-        if let Some(s) = self.scene.effects.saturation {
-            let t0 = timing.then(Instant::now);
-            f_a = f_a.clamp(-s.limit_n, s.limit_n);
-            self.cost("saturation", t0);
-        }
+        let f_a = self.effects.saturate(out.actuator_force_n, timing);
         self.held_force = f_a;
         if !out.faults.is_empty() && self.failure.is_none() {
             self.failure = Some(format!("the safety layer tripped: {}", out.faults));
@@ -483,58 +409,37 @@ impl Simulation {
             },
             f_a,
         ];
-        let stepper = &mut self
-            .steppers
-            .iter_mut()
-            .find(|(g, _)| *g == hand.grasp)
-            .expect("a stepper for every grasp in the script")
-            .1;
-        let e = &self.scene.effects;
-        if self.scene.nonlinear() {
-            let t0 = timing.then(Instant::now);
-            let dir = &self.actuator_dir;
-            let (coulomb, cogging, slack, kc) = (e.coulomb, e.cogging, e.cable_slack, self.cable_k);
-            let mut nl = |x: &[f64], f: &mut [f64]| {
-                let xa = Self::dot(dir, &x[..n]);
-                let va = Self::dot(dir, &x[n..2 * n]);
-                let mut fa = 0.0;
-                if let Some(c) = coulomb {
-                    fa -= c.force_n * (va / c.smoothing_mps).tanh();
-                }
-                if let Some(c) = cogging {
-                    fa += c.amplitude_n * (2.0 * std::f64::consts::PI * xa / c.period_m).sin();
-                }
-                for (fi, di) in f.iter_mut().zip(dir) {
-                    *fi += di * fa;
-                }
-                if let Some(s) = slack {
-                    // The linear K has the cable as k_c (q1 - q2); with free
-                    // play the cable only pulls past half the play.
-                    let d = x[0] - x[1];
-                    let h = 0.5 * s.width_m;
-                    let dz = d.signum() * (d.abs() - h).max(0.0);
-                    let corr = kc * (d - dz);
-                    f[0] += corr;
-                    f[1] -= corr;
-                }
-            };
-            for _ in 0..self.substeps {
-                stepper.step(&mut self.x, u, Some(&mut nl));
+        let at = match self.current {
+            Some((g, at)) if g == hand.grasp => at,
+            _ => {
+                let at = self
+                    .steppers
+                    .iter()
+                    .position(|(g, _)| *g == hand.grasp)
+                    .expect("a stepper for every grasp in the script");
+                self.current = Some((hand.grasp, at));
+                at
             }
-            // On a timed tick, the sub-stepping's cost is shared among the
-            // nonlinear effects that ran (they are evaluated together).
-            if let Some(t) = t0 {
-                let ns =
-                    (t.elapsed().as_nanos() as f64 - self.clock_ns).max(0.0) * TIMING_STRIDE as f64;
-                let is_nl = |n: &str| matches!(n, "coulomb" | "cogging" | "cable_slack");
-                let count = self.costs.iter().filter(|c| is_nl(&c.0)).count().max(1);
-                for c in self.costs.iter_mut().filter(|c| is_nl(&c.0)) {
-                    c.1 += ns / count as f64;
+        };
+        let stepper = &mut self.steppers[at].1;
+        match self.effects.forces() {
+            Some(forces) => {
+                let t0 = timing.then(Instant::now);
+                let dir = &self.actuator_dir;
+                let mut nl = |x: &[f64], f: &mut [f64]| forces.add(n, dir, x, f);
+                for _ in 0..self.substeps {
+                    stepper.step(&mut self.x, u, Some(&mut nl));
                 }
+                // On a timed tick, the sub-stepping's cost is shared among
+                // the nonlinear effects that ran (they are evaluated
+                // together).
+                let names: Vec<Effect> = forces.effects().to_vec();
+                self.effects.costs.charge(&names, t0);
             }
-        } else {
-            for _ in 0..self.substeps {
-                stepper.step(&mut self.x, u, None);
+            None => {
+                for _ in 0..self.substeps {
+                    stepper.step(&mut self.x, u, None);
+                }
             }
         }
         self.tick += 1;
@@ -623,11 +528,12 @@ impl Simulation {
                 f64::INFINITY
             },
             effects: self
+                .effects
                 .costs
-                .iter()
-                .map(|(n, ns)| EffectCost {
-                    name: n.clone(),
-                    ns_per_tick: ns / ticks,
+                .per_tick(ticks)
+                .map(|(e, ns)| EffectCost {
+                    name: e.name().to_string(),
+                    ns_per_tick: ns,
                 })
                 .collect(),
             integrator: self.method.name().to_string(),

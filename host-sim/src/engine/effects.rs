@@ -1,0 +1,296 @@
+//! A scene's effects compiled into the per-tick pipeline when the
+//! simulation is built: each stage holds its own parameters, the tick asks
+//! nothing of the scene, and each effect's measured cost has a slot of its
+//! own instead of a name to look up.
+
+use crate::engine::scene::{Effects, SlackEffect};
+use std::collections::VecDeque;
+use std::time::Instant;
+use twoport_control::servo::SensorFrame;
+
+/// The effects a scene can name, in the order reports list them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Effect {
+    /// The device's structure (the 5-DOF model instead of a rigid mass).
+    Flexibility,
+    /// The flexure and filter of a load cell.
+    LoadCell,
+    /// Encoder quantisation and counter wrap.
+    Encoder,
+    /// The load cell's ADC: noise and quantisation.
+    Adc,
+    /// The amplifier's force limit.
+    Saturation,
+    /// Coulomb friction at the actuator.
+    Coulomb,
+    /// Motor cogging.
+    Cogging,
+    /// Free play in the cable.
+    CableSlack,
+    /// Measurement-to-actuation delay.
+    Delay,
+}
+
+impl Effect {
+    /// Every effect.
+    pub const ALL: [Effect; 9] = [
+        Effect::Flexibility,
+        Effect::LoadCell,
+        Effect::Encoder,
+        Effect::Adc,
+        Effect::Saturation,
+        Effect::Coulomb,
+        Effect::Cogging,
+        Effect::CableSlack,
+        Effect::Delay,
+    ];
+
+    /// The name scene files and reports use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Effect::Flexibility => "flexibility",
+            Effect::LoadCell => "load_cell",
+            Effect::Encoder => "encoder",
+            Effect::Adc => "adc",
+            Effect::Saturation => "saturation",
+            Effect::Coulomb => "coulomb",
+            Effect::Cogging => "cogging",
+            Effect::CableSlack => "cable_slack",
+            Effect::Delay => "delay",
+        }
+    }
+
+    fn on(self, e: &Effects) -> bool {
+        match self {
+            Effect::Flexibility => e.flexibility,
+            Effect::LoadCell => e.load_cell,
+            Effect::Encoder => e.encoder.is_some(),
+            Effect::Adc => e.adc.is_some(),
+            Effect::Saturation => e.saturation.is_some(),
+            Effect::Coulomb => e.coulomb.is_some(),
+            Effect::Cogging => e.cogging.is_some(),
+            Effect::CableSlack => e.cable_slack.is_some(),
+            Effect::Delay => e.delay.is_some(),
+        }
+    }
+}
+
+/// One tick in this many is timed for the effects' cost: a clock read costs
+/// more than most effects do.
+pub const TIMING_STRIDE: u64 = 64;
+
+/// Wall time each effect added (ns, summed over the timed ticks and scaled
+/// by [`TIMING_STRIDE`]).
+#[derive(Clone, Debug)]
+pub struct Costs {
+    on: [bool; Effect::ALL.len()],
+    ns: [f64; Effect::ALL.len()],
+    /// What reading the clock twice costs (ns), subtracted from timings.
+    clock_ns: f64,
+}
+
+impl Costs {
+    fn new(e: &Effects) -> Self {
+        Costs {
+            on: Effect::ALL.map(|x| x.on(e)),
+            ns: [0.0; Effect::ALL.len()],
+            clock_ns: (0..32)
+                .map(|_| {
+                    let t = Instant::now();
+                    t.elapsed().as_nanos() as f64
+                })
+                .fold(f64::INFINITY, f64::min),
+        }
+    }
+
+    /// Charge the time since `since` to the effects in `to`, shared evenly.
+    pub fn charge(&mut self, to: &[Effect], since: Option<Instant>) {
+        let Some(since) = since else { return };
+        let raw = since.elapsed().as_nanos() as f64 - self.clock_ns;
+        let ns = raw.max(0.0) * TIMING_STRIDE as f64 / to.len().max(1) as f64;
+        for e in to {
+            self.ns[*e as usize] += ns;
+        }
+    }
+
+    /// The effects the scene names, with their cost per tick over `ticks`.
+    pub fn per_tick(&self, ticks: f64) -> impl Iterator<Item = (Effect, f64)> + '_ {
+        Effect::ALL
+            .into_iter()
+            .filter(|e| self.on[*e as usize])
+            .map(move |e| (e, self.ns[e as usize] / ticks))
+    }
+}
+
+#[derive(Clone, Debug)]
+struct Rng(u64);
+
+impl Rng {
+    fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn gaussian(&mut self) -> f64 {
+        let u = self.uniform().max(1e-300);
+        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * self.uniform()).cos()
+    }
+}
+
+/// The load cell's ADC: Gaussian noise, then quantisation.
+#[derive(Clone, Debug)]
+struct Adc {
+    noise_rms_n: f64,
+    lsb_n: f64,
+    rng: Rng,
+}
+
+/// A delay line of sensor frames.
+#[derive(Clone, Debug)]
+struct Delay {
+    ticks: usize,
+    frames: VecDeque<SensorFrame<f64>>,
+}
+
+/// The nonlinear forces, evaluated inside the integrator's sub-steps.
+#[derive(Clone, Debug)]
+pub struct Forces {
+    /// Coulomb friction `(force N, smoothing m/s)`.
+    coulomb: Option<(f64, f64)>,
+    /// Cogging `(amplitude N, period m)`.
+    cogging: Option<(f64, f64)>,
+    /// Cable slack: half the play (m) and the cable's stiffness (N/m).
+    slack: Option<(f64, f64)>,
+    /// Which of them run (their cost is shared).
+    names: Vec<Effect>,
+}
+
+impl Forces {
+    /// The forces on the coordinates (N) at state `x` (`n` coordinates),
+    /// added into `f`; the actuator acts along `dir`.
+    pub fn add(&self, n: usize, dir: &[f64], x: &[f64], f: &mut [f64]) {
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
+        let xa = dot(dir, &x[..n]);
+        let va = dot(dir, &x[n..2 * n]);
+        let mut fa = 0.0;
+        if let Some((force_n, smoothing_mps)) = self.coulomb {
+            fa -= force_n * (va / smoothing_mps).tanh();
+        }
+        if let Some((amplitude_n, period_m)) = self.cogging {
+            fa += amplitude_n * (2.0 * std::f64::consts::PI * xa / period_m).sin();
+        }
+        for (fi, di) in f.iter_mut().zip(dir) {
+            *fi += di * fa;
+        }
+        if let Some((half_play_m, cable_k)) = self.slack {
+            // The linear K has the cable as k_c (q1 - q2); with free play the
+            // cable only pulls past half the play.
+            let d = x[0] - x[1];
+            let dz = d.signum() * (d.abs() - half_play_m).max(0.0);
+            let corr = cable_k * (d - dz);
+            f[0] += corr;
+            f[1] -= corr;
+        }
+    }
+
+    /// The effects these forces are.
+    pub fn effects(&self) -> &[Effect] {
+        &self.names
+    }
+}
+
+/// The per-tick pipeline: sensing (ADC), the delay line, the amplifier's
+/// limit, and the nonlinear forces.
+#[derive(Clone, Debug)]
+pub struct Pipeline {
+    encoder_timed: bool,
+    adc: Option<Adc>,
+    delay: Option<Delay>,
+    saturation_n: Option<f64>,
+    forces: Option<Forces>,
+    /// What each effect cost.
+    pub costs: Costs,
+}
+
+impl Pipeline {
+    /// Compile `e`; `cable_k` is the device's cable stiffness (N/m).
+    pub fn new(e: &Effects, cable_k: f64) -> Self {
+        let forces = Forces {
+            coulomb: e.coulomb.map(|c| (c.force_n, c.smoothing_mps)),
+            cogging: e.cogging.map(|c| (c.amplitude_n, c.period_m)),
+            slack: e
+                .cable_slack
+                .map(|s: SlackEffect| (0.5 * s.width_m, cable_k)),
+            names: [Effect::Coulomb, Effect::Cogging, Effect::CableSlack]
+                .into_iter()
+                .filter(|x| x.on(e))
+                .collect(),
+        };
+        Pipeline {
+            encoder_timed: e.encoder.is_some(),
+            adc: e.adc.map(|a| Adc {
+                noise_rms_n: a.noise_rms_n,
+                lsb_n: a.lsb_n,
+                rng: Rng(a.seed.max(1)),
+            }),
+            delay: e.delay.map(|d| Delay {
+                ticks: d.ticks as usize,
+                frames: VecDeque::with_capacity(d.ticks as usize + 1),
+            }),
+            saturation_n: e.saturation.map(|s| s.limit_n),
+            forces: (!forces.names.is_empty()).then_some(forces),
+            costs: Costs::new(e),
+        }
+    }
+
+    /// Whether the encoder's quantisation is timed (it always runs; ideal
+    /// sensing is 1 nm counts).
+    pub fn encoder_timed(&self) -> bool {
+        self.encoder_timed
+    }
+
+    /// The load cell's reading of the force `f_n` (N).
+    pub fn adc(&mut self, f_n: f64, timing: bool) -> f64 {
+        let Some(adc) = &mut self.adc else { return f_n };
+        let t0 = timing.then(Instant::now);
+        let f = f_n + adc.noise_rms_n * adc.rng.gaussian();
+        let f = (f / adc.lsb_n).round() * adc.lsb_n;
+        self.costs.charge(&[Effect::Adc], t0);
+        f
+    }
+
+    /// The frame the controller sees this tick.
+    pub fn delay(&mut self, frame: SensorFrame<f64>, timing: bool) -> SensorFrame<f64> {
+        let Some(d) = &mut self.delay else {
+            return frame;
+        };
+        let t0 = timing.then(Instant::now);
+        d.frames.push_back(frame);
+        let mut out = if d.frames.len() > d.ticks {
+            d.frames.pop_front().unwrap_or(frame)
+        } else {
+            *d.frames.front().unwrap_or(&frame)
+        };
+        out.tick = frame.tick;
+        self.costs.charge(&[Effect::Delay], t0);
+        out
+    }
+
+    /// The force the amplifier delivers for `f_n` (N).
+    pub fn saturate(&mut self, f_n: f64, timing: bool) -> f64 {
+        let Some(limit) = self.saturation_n else {
+            return f_n;
+        };
+        let t0 = timing.then(Instant::now);
+        let f = f_n.clamp(-limit, limit);
+        self.costs.charge(&[Effect::Saturation], t0);
+        f
+    }
+
+    /// The nonlinear forces, if the scene has any.
+    pub fn forces(&self) -> Option<&Forces> {
+        self.forces.as_ref()
+    }
+}
