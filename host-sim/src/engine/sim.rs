@@ -79,6 +79,32 @@ pub struct Report {
     pub late_rms_n: [f64; 2],
 }
 
+/// A coordinate read off the plant's positions or velocities, compiled
+/// once: one entry when its direction is a unit vector (a handle or an
+/// actuator on one coordinate, the usual case), a dot product otherwise.
+#[derive(Clone, Debug)]
+enum Pick {
+    At(usize),
+    Dot(Vec<f64>),
+}
+
+impl Pick {
+    fn new(dir: &[f64]) -> Self {
+        let ones: Vec<usize> = (0..dir.len()).filter(|&i| dir[i] != 0.0).collect();
+        match ones[..] {
+            [i] if dir[i] == 1.0 => Pick::At(i),
+            _ => Pick::Dot(dir.to_vec()),
+        }
+    }
+
+    fn of(&self, q: &[f64]) -> f64 {
+        match self {
+            Pick::At(i) => q[*i],
+            Pick::Dot(d) => d.iter().zip(q).map(|(a, b)| a * b).sum(),
+        }
+    }
+}
+
 /// A simulation in progress.
 pub struct Simulation {
     scene: Scene,
@@ -108,6 +134,9 @@ pub struct Simulation {
     failure: Option<String>,
     warning: Option<String>,
     actuator_dir: Vec<f64>,
+    /// The actuator's and the handle's coordinate.
+    actuator: Pick,
+    handle: Pick,
     track_energy: bool,
     /// The scope's grasp, instead of the script's.
     grasp_override: Option<GraspKind>,
@@ -250,6 +279,8 @@ impl Simulation {
             detector: Detector::new(total_ticks, quiet_tick, (1.0 / period).round() as u64),
             failure: None,
             warning,
+            actuator: Pick::new(&actuator_dir),
+            handle: Pick::new(&device.handle),
             actuator_dir,
             track_energy: false,
             device,
@@ -335,13 +366,10 @@ impl Simulation {
         self.x.copy_from_slice(x);
     }
 
-    fn dot(a: &[f64], b: &[f64]) -> f64 {
-        a.iter().zip(b).map(|(x, y)| x * y).sum()
-    }
 
     fn sense(&mut self, timing: bool) -> SensorFrame<f64> {
         let n = self.device.n;
-        let x_a = Self::dot(&self.actuator_dir, &self.x[..n]);
+        let x_a = self.actuator.of(&self.x[..n]);
         let t0 = (timing && self.effects.encoder_timed()).then(Instant::now);
         // Round half away from zero without a libm call.
         let c = x_a * self.counts_per_m;
@@ -443,8 +471,8 @@ impl Simulation {
             }
         }
         self.tick += 1;
-        let x_h = Self::dot(&self.device.handle, &self.x[..n]);
-        let v_h = Self::dot(&self.device.handle, &self.x[n..2 * n]);
+        let x_h = self.handle.of(&self.x[..n]);
+        let v_h = self.handle.of(&self.x[n..2 * n]);
         let f_h = match self.human.grasp_of(hand.grasp).arm {
             Some(_) => {
                 let g = hand.grasp.grasp();
