@@ -366,7 +366,6 @@ impl Simulation {
         self.x.copy_from_slice(x);
     }
 
-
     fn sense(&mut self, timing: bool) -> SensorFrame<f64> {
         let n = self.device.n;
         let x_a = self.actuator.of(&self.x[..n]);

@@ -340,8 +340,9 @@ impl<V: VirtualEnvironment<R>, R: Real> Servo<V, R> {
 }
 
 // The impedance display's tick is the board's hot path: inlined into
-// `tick`, with the admittance display's kept out of line so that its
-// registers do not crowd the impedance tick (the M4F tick count).
+// `tick`, with the admittance display's kept out of line on the board so
+// that its registers do not crowd the impedance tick (the M4F tick count).
+// On the host, with registers to spare, both inline.
 #[inline(always)]
 fn impedance_tick<R: Real, V: VirtualEnvironment<R>>(
     front: &mut Frontend<R>,
@@ -370,7 +371,7 @@ fn impedance_tick<R: Real, V: VirtualEnvironment<R>>(
     }
 }
 
-#[inline(never)]
+#[cfg_attr(target_arch = "arm", inline(never))]
 fn admittance_tick<R: Real, V: VirtualEnvironment<R>>(
     front: &mut Frontend<R>,
     laws: &mut AdmittanceLaws<R>,
