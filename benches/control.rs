@@ -97,11 +97,7 @@ fn encoder() -> Encoder {
 /// The impedance display's whole tick with the VE `ve`.
 fn impedance_tick<V: VirtualEnvironment>(c: &mut Criterion, ve_name: &str, ve: V) {
     let mut s = Servo::new(
-        ImpedanceGains {
-            k_npm: 51_000.0,
-            b_nspm: 90.0,
-        }
-        .into(),
+        ImpedanceGains::new(51_000.0, 90.0).into(),
         encoder(),
         SafetyConfig::excalibur(),
         ve,
@@ -137,13 +133,7 @@ fn servos(c: &mut Criterion) {
     impedance_tick(c, "bilateral VE", BilateralConstraint::new(Position::ZERO));
     let cursor = CursorMass::new(0.25, T, Position::ZERO).unwrap();
     let mut a = Servo::new(
-        AdmittanceGains {
-            kp_npm: 51_000.0,
-            bp_nspm: 90.0,
-            m_kg: 5.0,
-            b_nspm: 500.0,
-        }
-        .into(),
+        AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into(),
         encoder(),
         SafetyConfig::excalibur(),
         cursor,

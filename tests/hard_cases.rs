@@ -26,13 +26,7 @@ fn admittance_display_does_not_creep_in_24_hours() {
     let wall =
         UnilateralWall::new(2e4, 50.0, Position::ZERO, Solid::Above, T, Position::ZERO).unwrap();
     let mut s = Servo::new(
-        AdmittanceGains {
-            kp_npm: 51_000.0,
-            bp_nspm: 90.0,
-            m_kg: 5.0,
-            b_nspm: 500.0,
-        }
-        .into(),
+        AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into(),
         enc,
         SafetyConfig::excalibur(),
         wall,

@@ -392,17 +392,8 @@ fn the_simulated_ve_port_impedance_is_the_designers() {
                 f: 0.0,
                 x: Integrator::new(1e-3, Position::ZERO),
             };
-            let mut servo = Servo::new(
-                ImpedanceGains {
-                    k_npm: k as f32,
-                    b_nspm: 90.0,
-                }
-                .into(),
-                enc,
-                safety,
-                ve,
-            )
-            .unwrap();
+            let mut servo =
+                Servo::new(ImpedanceGains::new(k as f32, 90.0).into(), enc, safety, ve).unwrap();
             servo.enable().unwrap();
             let th = 2.0 * std::f64::consts::PI * bin as f64 / 4000.0;
             let z_net = SineProbe::measure(th.cos(), th.sin(), 6000, 4000, |u| {

@@ -50,10 +50,7 @@ pub const PERIOD_S: f32 = 1.0e-3;
 /// Encoder counter width (bits) and resolution (pm per count): 1 um.
 pub const ENCODER: (u8, i64) = (16, 1_000_000);
 /// The coupling: the paper's design.
-pub const COUPLING: ImpedanceGains = ImpedanceGains {
-    k_npm: 51_000.0,
-    b_nspm: 90.0,
-};
+pub const COUPLING: ImpedanceGains = ImpedanceGains::new(51_000.0, 90.0);
 /// The wall: surface (nm, 1 cm), stiffness (N/m), damping (N s/m); solid
 /// above.
 pub const WALL: (i32, f32, f32) = (10_000_000, 5.0e6, 200.0);

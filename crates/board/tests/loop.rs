@@ -30,11 +30,7 @@ fn safety() -> SafetyConfig {
 fn board() -> Board<BilateralConstraint, 3> {
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let s = Servo::new(
-        ImpedanceGains {
-            k_npm: 51_000.0,
-            b_nspm: 90.0,
-        }
-        .into(),
+        ImpedanceGains::new(51_000.0, 90.0).into(),
         enc,
         safety(),
         BilateralConstraint::new(Position::ZERO),
@@ -283,13 +279,7 @@ fn admittance_gains_need_the_proven_regulator() {
     .unwrap();
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let s = Servo::new(
-        AdmittanceGains {
-            kp_npm: 51_000.0,
-            bp_nspm: 90.0,
-            m_kg: 5.0,
-            b_nspm: 500.0,
-        }
-        .into(),
+        AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into(),
         enc,
         safety(),
         BilateralConstraint::new(Position::ZERO),

@@ -16,11 +16,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let wall = UnilateralWall::new(2.0e6, 50.0, wall_at, Solid::Above, t, Position::ZERO)?;
     // twoport design impedance --model models/capstan.toml: 27,886 N/m at 147.9 N s/m.
     let mut servo = Servo::new(
-        ImpedanceGains {
-            k_npm: 27_800.0,
-            b_nspm: 148.0,
-        }
-        .into(),
+        ImpedanceGains::new(27_800.0, 148.0).into(),
         encoder,
         safety,
         wall,

@@ -43,13 +43,7 @@ fn wall() -> UnilateralWall {
 fn admittance_display_tick_matches_its_composed_z_domain_form() {
     for p in [1usize, 10, 100, 400, 1000, 1999] {
         let mut s = Servo::new(
-            AdmittanceGains {
-                kp_npm: 51_000.0,
-                bp_nspm: 90.0,
-                m_kg: 5.0,
-                b_nspm: 500.0,
-            }
-            .into(),
+            AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into(),
             encoder(),
             SafetyConfig::excalibur(),
             wall(),
@@ -119,13 +113,7 @@ fn bad_sensor_readings_give_zero_force_in_the_same_tick() {
     ];
     for (what, mut bad_frame, fault) in bad {
         let mut s = Servo::new(
-            AdmittanceGains {
-                kp_npm: 51_000.0,
-                bp_nspm: 90.0,
-                m_kg: 5.0,
-                b_nspm: 500.0,
-            }
-            .into(),
+            AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into(),
             encoder(),
             SafetyConfig::excalibur(),
             CursorMass::new(0.25, T, Position::ZERO).unwrap(),
@@ -165,11 +153,7 @@ fn bad_sensor_readings_give_zero_force_in_the_same_tick() {
 #[test]
 fn impedance_display_renders_the_series_of_coupling_and_wall() {
     let mut s = Servo::new(
-        ImpedanceGains {
-            k_npm: 51_000.0,
-            b_nspm: 90.0,
-        }
-        .into(),
+        ImpedanceGains::new(51_000.0, 90.0).into(),
         encoder(),
         SafetyConfig::excalibur(),
         wall(),

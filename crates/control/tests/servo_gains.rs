@@ -12,16 +12,8 @@ fn servo(g: Gains) -> Servo<BilateralConstraint> {
     Servo::new(g, enc, SafetyConfig::excalibur(), ve).unwrap()
 }
 
-const IMP: ImpedanceGains = ImpedanceGains {
-    k_npm: 51_000.0,
-    b_nspm: 90.0,
-};
-const ADM: AdmittanceGains = AdmittanceGains {
-    kp_npm: 51_000.0,
-    bp_nspm: 90.0,
-    m_kg: 5.0,
-    b_nspm: 500.0,
-};
+const IMP: ImpedanceGains = ImpedanceGains::new(51_000.0, 90.0);
+const ADM: AdmittanceGains = AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0);
 
 #[test]
 fn gains_round_trip_through_the_servo() {
@@ -68,9 +60,6 @@ fn a_refused_admittance_change_changes_nothing() {
 fn invalid_gains_are_refused_at_construction() {
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let ve = BilateralConstraint::new(Position::ZERO);
-    let bad = ImpedanceGains {
-        k_npm: -1.0,
-        b_nspm: -1.0,
-    };
+    let bad = ImpedanceGains::new(-1.0, -1.0);
     assert!(Servo::new(bad.into(), enc, SafetyConfig::excalibur(), ve).is_err());
 }

@@ -120,17 +120,7 @@ fn servo_wall_and_fault(t: &mut Tally) {
         Position::ZERO,
     )
     .unwrap();
-    let mut s = Servo::new(
-        ImpedanceGains {
-            k_npm: 51_000.0,
-            b_nspm: 90.0,
-        }
-        .into(),
-        enc,
-        SafetyConfig::excalibur(),
-        wall,
-    )
-    .unwrap();
+    let mut s = paper_servo(enc, wall);
     let _ = s.enable();
     let mut f = 0.0;
     let mut k = 0u32;
@@ -164,6 +154,12 @@ fn timing_wall() -> UnilateralWall {
     .unwrap()
 }
 
+/// The impedance display at the paper's coupling on `wall`.
+fn paper_servo(enc: Encoder, wall: UnilateralWall) -> Servo<UnilateralWall> {
+    let gains = ImpedanceGains::new(51_000.0, 90.0);
+    Servo::new(gains.into(), enc, SafetyConfig::excalibur(), wall).unwrap()
+}
+
 /// The servo tick's cost in QEMU: SysTick counts the 25 MHz system clock, and
 /// with `-icount shift=6` each instruction takes 64 ns of virtual time, so
 /// one instruction is 1.6 counts (deterministic, unlike wall time).
@@ -171,17 +167,7 @@ fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
     use cortex_m::peripheral::syst::SystClkSource;
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let wall = timing_wall();
-    let mut s = Servo::new(
-        ImpedanceGains {
-            k_npm: 51_000.0,
-            b_nspm: 90.0,
-        }
-        .into(),
-        enc,
-        SafetyConfig::excalibur(),
-        wall,
-    )
-    .unwrap();
+    let mut s = paper_servo(enc, wall);
     let _ = s.enable();
     syst.set_clock_source(SystClkSource::Core);
     syst.set_reload(0x00FF_FFFF);

@@ -170,18 +170,10 @@ impl Scene {
         let c = &self.coupling;
         let g = |v: Option<f64>| v.unwrap_or(0.0) as f32;
         match self.display {
-            Display::Impedance => ImpedanceGains {
-                k_npm: g(c.k),
-                b_nspm: c.b as f32,
+            Display::Impedance => ImpedanceGains::new(g(c.k), c.b as f32).into(),
+            Display::Admittance => {
+                AdmittanceGains::new(g(c.kp), g(c.bp), g(c.m), c.b as f32).into()
             }
-            .into(),
-            Display::Admittance => AdmittanceGains {
-                kp_npm: g(c.kp),
-                bp_nspm: g(c.bp),
-                m_kg: g(c.m),
-                b_nspm: c.b as f32,
-            }
-            .into(),
         }
     }
 }

@@ -31,6 +31,13 @@ pub struct ImpedanceGains {
     pub b_nspm: f32,
 }
 
+impl ImpedanceGains {
+    /// Stiffness `k_npm` (N/m) and damping `b_nspm` (N s/m).
+    pub const fn new(k_npm: f32, b_nspm: f32) -> Self {
+        ImpedanceGains { k_npm, b_nspm }
+    }
+}
+
 /// The admittance display's regulator `K_p` (eq 30) and coupling `Z_cA`
 /// (eq 21).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -43,6 +50,19 @@ pub struct AdmittanceGains {
     pub m_kg: f32,
     /// Coupling damping `b_c` (N s/m).
     pub b_nspm: f32,
+}
+
+impl AdmittanceGains {
+    /// Regulator `kp_npm` (N/m), `bp_nspm` (N s/m); coupling `m_kg` (kg),
+    /// `b_nspm` (N s/m).
+    pub const fn new(kp_npm: f32, bp_nspm: f32, m_kg: f32, b_nspm: f32) -> Self {
+        AdmittanceGains {
+            kp_npm,
+            bp_nspm,
+            m_kg,
+            b_nspm,
+        }
+    }
 }
 
 /// The gains of either display.
