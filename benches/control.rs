@@ -14,7 +14,7 @@ use twoport_control::ve::{
     BilateralConstraint, CursorMass, Port, Solid, UnilateralWall, VirtualEnvironment,
 };
 use twoport_control::{
-    AdmittanceCoupling, AdmittanceGains, Encoder, FirstDifference, ImpedanceCoupling,
+    AdmittanceCoupling, AdmittanceGains, Encoder, FirstDifference, Gains, ImpedanceCoupling,
     ImpedanceGains, Integrator, Position, PositionRegulator, SafetyConfig, Servo,
 };
 
@@ -94,16 +94,16 @@ fn encoder() -> Encoder {
     Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap()
 }
 
+/// An enabled servo on Excalibur's limits.
+fn enabled<V: VirtualEnvironment>(gains: Gains, ve: V) -> Servo<V> {
+    let mut s = Servo::new(gains, encoder(), SafetyConfig::excalibur(), ve).unwrap();
+    s.enable().unwrap();
+    s
+}
+
 /// The impedance display's whole tick with the VE `ve`.
 fn impedance_tick<V: VirtualEnvironment>(c: &mut Criterion, ve_name: &str, ve: V) {
-    let mut s = Servo::new(
-        ImpedanceGains::new(51_000.0, 90.0).into(),
-        encoder(),
-        SafetyConfig::excalibur(),
-        ve,
-    )
-    .unwrap();
-    s.enable().unwrap();
+    let mut s = enabled(ImpedanceGains::new(51_000.0, 90.0).into(), ve);
     let mut k = 0u32;
     c.bench_function(
         &format!("impedance servo tick: encoder, estimator, Z_cI, {ve_name}, safety"),
@@ -132,14 +132,10 @@ fn servos(c: &mut Criterion) {
     // and its own integrator add to the tick.
     impedance_tick(c, "bilateral VE", BilateralConstraint::new(Position::ZERO));
     let cursor = CursorMass::new(0.25, T, Position::ZERO).unwrap();
-    let mut a = Servo::new(
+    let mut a = enabled(
         AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into(),
-        encoder(),
-        SafetyConfig::excalibur(),
         cursor,
-    )
-    .unwrap();
-    a.enable().unwrap();
+    );
     let mut k = 0u32;
     c.bench_function(
         "admittance servo tick: load cell, Z_cA, cursor, T/(1-1/z), K_p, safety",
