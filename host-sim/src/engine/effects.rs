@@ -163,8 +163,10 @@ pub struct Forces {
     cogging: Option<(f64, f64)>,
     /// Cable slack: half the play (m) and the cable's stiffness (N/m).
     slack: Option<(f64, f64)>,
-    /// Which of them run (their cost is shared).
-    names: Vec<Effect>,
+    /// Which of them run (their cost is shared): the first `count` of
+    /// `names`, kept inline so that charging them allocates nothing.
+    names: [Effect; 3],
+    count: usize,
 }
 
 impl Forces {
@@ -197,7 +199,7 @@ impl Forces {
 
     /// The effects these forces are.
     pub fn effects(&self) -> &[Effect] {
-        &self.names
+        &self.names[..self.count]
     }
 }
 
@@ -217,16 +219,22 @@ pub struct Pipeline {
 impl Pipeline {
     /// Compile `e`; `cable_k` is the device's cable stiffness (N/m).
     pub fn new(e: &Effects, cable_k: f64) -> Self {
+        let mut names = [Effect::Coulomb; 3];
+        let mut count = 0;
+        for x in [Effect::Coulomb, Effect::Cogging, Effect::CableSlack] {
+            if x.on(e) {
+                names[count] = x;
+                count += 1;
+            }
+        }
         let forces = Forces {
             coulomb: e.coulomb.map(|c| (c.force_n, c.smoothing_mps)),
             cogging: e.cogging.map(|c| (c.amplitude_n, c.period_m)),
             slack: e
                 .cable_slack
                 .map(|s: SlackEffect| (0.5 * s.width_m, cable_k)),
-            names: [Effect::Coulomb, Effect::Cogging, Effect::CableSlack]
-                .into_iter()
-                .filter(|x| x.on(e))
-                .collect(),
+            names,
+            count,
         };
         Pipeline {
             encoder_timed: e.encoder.is_some(),
@@ -240,7 +248,7 @@ impl Pipeline {
                 frames: VecDeque::with_capacity(d.ticks as usize + 1),
             }),
             saturation_n: e.saturation.map(|s| s.limit_n),
-            forces: (!forces.names.is_empty()).then_some(forces),
+            forces: (count > 0).then_some(forces),
             costs: Costs::new(e),
         }
     }
@@ -289,8 +297,9 @@ impl Pipeline {
         f
     }
 
-    /// The nonlinear forces, if the scene has any.
-    pub fn forces(&self) -> Option<&Forces> {
-        self.forces.as_ref()
+    /// The nonlinear forces, if the scene has any, and the costs to charge
+    /// their time to.
+    pub fn forces(&mut self) -> Option<(&Forces, &mut Costs)> {
+        self.forces.as_ref().map(|f| (f, &mut self.costs))
     }
 }

@@ -450,7 +450,7 @@ impl Simulation {
         };
         let stepper = &mut self.steppers[at].1;
         match self.effects.forces() {
-            Some(forces) => {
+            Some((forces, costs)) => {
                 let t0 = timing.then(Instant::now);
                 let dir = &self.actuator_dir;
                 let mut nl = |x: &[f64], f: &mut [f64]| forces.add(n, dir, x, f);
@@ -460,8 +460,7 @@ impl Simulation {
                 // On a timed tick, the sub-stepping's cost is shared among
                 // the nonlinear effects that ran (they are evaluated
                 // together).
-                let names: Vec<Effect> = forces.effects().to_vec();
-                self.effects.costs.charge(&names, t0);
+                costs.charge(forces.effects(), t0);
             }
             None => {
                 for _ in 0..self.substeps {
