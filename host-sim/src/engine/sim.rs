@@ -291,6 +291,14 @@ impl Simulation {
         Ok(sim)
     }
 
+    /// The time (s) at the start of `tick`. Through `i64`, whose
+    /// conversion is one instruction where `u64`'s is a branchy sequence:
+    /// a run never reaches 2^63 ticks, so the value is the same.
+    #[inline]
+    fn time_of(&self, tick: u64) -> f64 {
+        tick as i64 as f64 * self.period
+    }
+
     /// Names of the effects this scene simulates.
     pub fn effect_names(&self) -> Vec<String> {
         self.effects
@@ -407,7 +415,7 @@ impl Simulation {
         &mut self,
         external: Option<&mut dyn FnMut(&SensorFrame) -> ServoOutput>,
     ) -> Sample {
-        let t = self.tick as f64 * self.period;
+        let t = self.time_of(self.tick);
         let n = self.device.n;
         let mut hand = self.human.at(t);
         if let Some(g) = self.grasp_override {
@@ -498,7 +506,7 @@ impl Simulation {
             });
         }
         Sample {
-            t_s: self.tick as f64 * self.period,
+            t_s: self.time_of(self.tick),
             handle_m: x_h,
             handle_mps: v_h,
             human_n: f_h,
