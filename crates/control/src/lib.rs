@@ -10,6 +10,7 @@ pub mod coupling;
 mod encoder;
 mod estimator;
 mod param;
+pub mod passivity;
 mod position;
 mod probe;
 mod real;
