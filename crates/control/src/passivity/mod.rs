@@ -35,7 +35,9 @@
 //! hardware, where an `f64` sum would call the soft-float library.
 
 mod observer;
+mod series;
 mod sum;
 
 pub use observer::EnergyObserver;
+pub use series::{PassivityLimits, SeriesDamper};
 pub use sum::CompensatedSum;

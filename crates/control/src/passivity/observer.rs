@@ -76,10 +76,11 @@ impl<R: Real> EnergyObserver<R> {
         self.taken_in_nj.value() * R::M_PER_NM
     }
 
-    /// Forget the energy booked so far; the tick being held is still
-    /// booked when it ends.
-    pub fn reset_energy(&mut self) {
+    /// Set the energy booked so far to `energy_j` (J): a reserve cap or a
+    /// reset. The tick being held is still booked when it ends.
+    pub fn set_energy_j(&mut self, energy_j: R) {
         self.taken_in_nj = CompensatedSum::new();
+        self.taken_in_nj.add(energy_j * R::NM_PER_M);
     }
 }
 
