@@ -349,10 +349,7 @@ fn affine_fixed_in_place<const N: usize>(a: &[f64], b: &[f64], x: &mut [f64], u:
 }
 
 /// `x <- A x + B u` in place for the common state counts (rigid 2-3, the
-/// 5-DOF Excalibur 10-13); `false` for any other size. Compiled for AVX2
-/// as well as the baseline and chosen once at run time: the lanes do the
-/// same operations in the same order, so both give the same bits.
-#[multiversion::multiversion(targets("x86_64+avx2"))]
+/// 5-DOF Excalibur 10-13); `false` for any other size.
 fn zoh_in_place(a: &[f64], b: &[f64], x: &mut [f64], u: [f64; 2]) -> bool {
     match x.len() {
         2 => affine_fixed_in_place::<2>(a, b, x, u),
@@ -569,9 +566,10 @@ impl Stepper {
 mod tests {
     use super::*;
 
-    /// The dispatched kernel (AVX2 where the machine has it) gives the bits
-    /// of a plain scalar loop in the same order, for every size it takes,
-    /// and refuses the others.
+    /// The unrolled, vectorised kernel gives the bits of a plain scalar
+    /// loop in the same order, for every size it takes, and refuses the
+    /// others: vector lanes do the same IEEE operations, and nothing is
+    /// fused or reordered.
     #[test]
     fn zoh_kernel_matches_the_scalar_loop_bit_for_bit() {
         let mut seed = 0x2545_f491_4f6c_dd1du64;
