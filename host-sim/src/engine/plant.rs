@@ -350,7 +350,7 @@ fn affine_fixed_in_place<const N: usize>(a: &[f64], b: &[f64], x: &mut [f64], u:
 
 /// `x <- A x + B u` in place for the common state counts (rigid 2-3, the
 /// 5-DOF Excalibur 10-13); `false` for any other size.
-fn zoh_in_place(a: &[f64], b: &[f64], x: &mut [f64], u: [f64; 2]) -> bool {
+fn affine_in_place(a: &[f64], b: &[f64], x: &mut [f64], u: [f64; 2]) -> bool {
     match x.len() {
         2 => affine_fixed_in_place::<2>(a, b, x, u),
         3 => affine_fixed_in_place::<3>(a, b, x, u),
@@ -358,24 +358,6 @@ fn zoh_in_place(a: &[f64], b: &[f64], x: &mut [f64], u: [f64; 2]) -> bool {
         11 => affine_fixed_in_place::<11>(a, b, x, u),
         12 => affine_fixed_in_place::<12>(a, b, x, u),
         13 => affine_fixed_in_place::<13>(a, b, x, u),
-        _ => false,
-    }
-}
-
-/// `out <- A x + B u` for `N` states; `false` when the sizes differ.
-#[inline(always)]
-fn affine_fixed_into<const N: usize>(
-    a: &[f64],
-    b: &[f64],
-    x: &[f64],
-    u: [f64; 2],
-    out: &mut [f64],
-) -> bool {
-    match (affine_fixed::<N>(a, b, x, u), out.get_mut(..N)) {
-        (Some(y), Some(out)) => {
-            out.copy_from_slice(&y);
-            true
-        }
         _ => false,
     }
 }
@@ -435,18 +417,11 @@ impl Stepper {
         // The common sizes (rigid 2-3 states, the 5-DOF Excalibur 10-11)
         // get fixed-size loops the compiler unrolls and vectorises.
         if f.is_none() {
-            let (a, b) = (&self.a[..], &self.b[..]);
-            let done = match self.ns {
-                2 => affine_fixed_into::<2>(a, b, x, u, out),
-                3 => affine_fixed_into::<3>(a, b, x, u, out),
-                10 => affine_fixed_into::<10>(a, b, x, u, out),
-                11 => affine_fixed_into::<11>(a, b, x, u, out),
-                12 => affine_fixed_into::<12>(a, b, x, u, out),
-                13 => affine_fixed_into::<13>(a, b, x, u, out),
-                _ => false,
-            };
-            if done {
-                return;
+            if let (Some(o), Some(x)) = (out.get_mut(..self.ns), x.get(..self.ns)) {
+                o.copy_from_slice(x);
+                if affine_in_place(&self.a, &self.b, o, u) {
+                    return;
+                }
             }
         }
         let ns = self.ns;
@@ -499,7 +474,7 @@ impl Stepper {
         // the common sizes; it stays small enough to inline at the caller.
         if self.method == Method::ExactZoh && nl.is_none() {
             if let Some(x) = x.get_mut(..self.ns) {
-                if zoh_in_place(&self.a, &self.b, x, u) {
+                if affine_in_place(&self.a, &self.b, x, u) {
                     return;
                 }
             }
@@ -571,7 +546,7 @@ mod tests {
     /// others: vector lanes do the same IEEE operations, and nothing is
     /// fused or reordered.
     #[test]
-    fn zoh_kernel_matches_the_scalar_loop_bit_for_bit() {
+    fn affine_kernel_matches_the_scalar_loop_bit_for_bit() {
         // Arbitrary values of mixed sign and size (a Weyl sequence).
         let mut i = 0u32;
         let mut next = move || {
@@ -593,11 +568,11 @@ mod tests {
                 }
             }
             let mut x = x0.clone();
-            assert!(zoh_in_place(&a, &b, &mut x, u), "{ns} states");
+            assert!(affine_in_place(&a, &b, &mut x, u), "{ns} states");
             let same = x.iter().zip(&want).all(|(p, q)| p.to_bits() == q.to_bits());
             assert!(same, "{ns} states: {x:?} != {want:?}");
         }
         let mut x = vec![0.0; 4];
-        assert!(!zoh_in_place(&[0.0; 16], &[0.0; 8], &mut x, [0.0; 2]));
+        assert!(!affine_in_place(&[0.0; 16], &[0.0; 8], &mut x, [0.0; 2]));
     }
 }
