@@ -35,9 +35,11 @@
 //! hardware, where an `f64` sum would call the soft-float library.
 
 mod observer;
+mod parallel;
 mod series;
 mod sum;
 
 pub use observer::EnergyObserver;
+pub use parallel::{ParallelDamper, ParallelLimits};
 pub use series::{PassivityLimits, SeriesDamper};
 pub use sum::CompensatedSum;

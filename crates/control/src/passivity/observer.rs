@@ -35,6 +35,9 @@ pub struct EnergyObserver<R = f32> {
     start: Option<Position>,
     /// The force held over that tick (N).
     held_n: R,
+    /// The device's own damping `b` over `T`, in N per nm (see
+    /// [`with_device_damping`](Self::with_device_damping)).
+    credit_n_per_nm: R,
 }
 
 impl<R: Real> EnergyObserver<R> {
@@ -44,7 +47,22 @@ impl<R: Real> EnergyObserver<R> {
             taken_in_nj: CompensatedSum::new(),
             start: None,
             held_n: R::ZERO,
+            credit_n_per_nm: R::ZERO,
         }
+    }
+
+    /// An observer whose port lies outside the device's own viscous
+    /// damping `b_nspm` (N s/m) at period `period_s` (s): the element it
+    /// watches is the sampled law with that damper beside it, which is
+    /// passive when Colgate's `b > KT/2 + |B|` holds for a wall of
+    /// stiffness `K` and damping `B`. The damper's dissipation over a tick
+    /// is credited as `b Δx² / T`, a lower bound on `∫ b v² dt` over the
+    /// tick (Cauchy-Schwarz), so the credit never exceeds what the damper
+    /// took.
+    pub fn with_device_damping(b_nspm: f32, period_s: f32) -> Self {
+        let mut o = Self::new();
+        o.credit_n_per_nm = R::of(b_nspm / period_s) * R::M_PER_NM;
+        o
     }
 
     /// Book the tick that ends now and start the next one: `x` is the
@@ -55,7 +73,8 @@ impl<R: Real> EnergyObserver<R> {
     pub fn update(&mut self, x: Position, force_n: R) -> R {
         if let Some(start) = self.start {
             let moved_nm: R = x.nm_from(start);
-            self.taken_in_nj.add(-(self.held_n * moved_nm));
+            self.taken_in_nj
+                .add(moved_nm * (self.credit_n_per_nm * moved_nm - self.held_n));
         }
         self.start = Some(x);
         self.held_n = force_n;
@@ -74,6 +93,14 @@ impl<R: Real> EnergyObserver<R> {
     #[inline]
     pub fn energy_in_j(&self) -> R {
         self.taken_in_nj.value() * R::M_PER_NM
+    }
+
+    /// Forget everything booked (the damping credit stays): the element
+    /// starts again at rest.
+    pub fn reset(&mut self) {
+        self.taken_in_nj = CompensatedSum::new();
+        self.start = None;
+        self.held_n = R::ZERO;
     }
 
     /// Set the energy booked so far to `energy_j` (J): a reserve cap or a

@@ -8,10 +8,13 @@ pub struct PassivityLimits {
     /// Control period `T` (s).
     pub period_s: f32,
     /// The most damping the controller may add (N s/m). The controller is
-    /// itself a sampled damper on a backward-difference velocity: on a free
-    /// mass `m` that loop is unstable from `2m/T` on, so a damper meant to
-    /// calm the loop can start it ringing. [`for_device`](Self::for_device)
-    /// takes half of that bound.
+    /// itself a sampled damper on a backward-difference velocity. On a free
+    /// mass `m` that loop is unstable from `2m/T` on, and it rings (complex
+    /// poles) from `(3 - 2√2) 2m/T ≈ 0.34 m/T` on. A ringing damper
+    /// reverses the motion within a few ticks, so the velocity it was
+    /// sized by no longer predicts the displacement, and it gives energy
+    /// out where it meant to take it back. [`for_device`](Self::for_device)
+    /// takes the ringing bound.
     pub max_damping_nspm: f32,
     /// Below this speed (m/s) the controller adds nothing: the damping it
     /// would need grows as `1/v²`, and at a few encoder counts per tick the
@@ -22,15 +25,34 @@ pub struct PassivityLimits {
     /// The most energy (J) the observer keeps in reserve. Dissipation
     /// banked beyond it is forgotten, so that a long passive stretch (a
     /// hand damping the handle for minutes) does not let a later burst of
-    /// active behaviour run unchecked until the bank is spent.
+    /// active behaviour run unchecked until the bank is spent. It must
+    /// hold what the element may store and rightly give back (a VE body's
+    /// kinetic energy, the coupling spring's stretch), or the controller
+    /// would brake a VE that returns its own energy.
     pub max_reserve_j: f32,
+    /// The device's own viscous damping at the port (N s/m), credited to
+    /// the element ([`EnergyObserver::with_device_damping`]). A sampled
+    /// coupling on a device without it is never passive at the tick's
+    /// half-frequency (Colgate's `b > KT/2 + |B|` with `b = 0`), so with 0
+    /// here the controller acts on any loop that rings there. Give a lower
+    /// bound of the device's damping: more than it has would credit
+    /// dissipation that does not happen.
+    pub device_damping_nspm: f32,
 }
+
+/// The damping, as a fraction of `2m/T`, from which a sampled damper on a
+/// free mass rings: the poles of `z² + (c - 1) z + c` (with `c = αT/2m`)
+/// turn complex at `c = 3 - 2√2`.
+const NON_RINGING: f32 = 0.171_572_88;
 
 impl PassivityLimits {
     /// Limits for a device whose moving mass at the port is `mass_kg`
     /// (kg), run at `period_s` (s) with an actuator limit `force_limit_n`
-    /// (N): the damping cap at `m/T`, half the sampled damper's bound; a
-    /// velocity floor of 1 mm/s; a reserve of 10 mJ.
+    /// (N): the damping cap at `0.34 m/T`, where the sampled damper alone
+    /// starts to ring; a
+    /// velocity floor of 1 mm/s; a reserve of 0.5 J, what a 1 kg VE body
+    /// holds at 1 m/s (the safety layer's default speed limit); no device
+    /// damping credited.
     ///
     /// # Examples
     ///
@@ -39,18 +61,19 @@ impl PassivityLimits {
     ///
     /// // Excalibur's x axis: about 0.7 kg at the handle, 1 kHz, 200 N.
     /// let l = PassivityLimits::for_device(0.7, 1e-3, 200.0).unwrap();
-    /// assert!((l.max_damping_nspm - 700.0).abs() < 1e-3);
+    /// assert!((l.max_damping_nspm - 240.2).abs() < 0.1);
     /// assert!(PassivityLimits::for_device(0.0, 1e-3, 200.0).is_err());
     /// ```
     pub fn for_device(mass_kg: f32, period_s: f32, force_limit_n: f32) -> Result<Self, ParamError> {
         let m = positive("mass (kg)", mass_kg)?;
-        let t = positive("period (s)", period_s)?;
+        // `checked` names a bad period before the cap it spoils.
         Self {
-            period_s: t,
-            max_damping_nspm: m / t,
+            period_s,
+            max_damping_nspm: NON_RINGING * 2.0 * m / period_s,
             min_velocity_mps: 1e-3,
             force_limit_n,
-            max_reserve_j: 1e-2,
+            max_reserve_j: 0.5,
+            device_damping_nspm: 0.0,
         }
         .checked()
     }
@@ -63,6 +86,7 @@ impl PassivityLimits {
         positive("passivity.min_velocity (m/s)", self.min_velocity_mps)?;
         positive("passivity.force_limit (N)", self.force_limit_n)?;
         non_negative("passivity.max_reserve (J)", self.max_reserve_j)?;
+        non_negative("passivity.device_damping (N s/m)", self.device_damping_nspm)?;
         Ok(self)
     }
 }
@@ -111,7 +135,7 @@ impl<R: Real> SeriesDamper<R> {
     pub fn new(limits: PassivityLimits) -> Result<Self, ParamError> {
         let l = limits.checked()?;
         Ok(SeriesDamper {
-            observer: EnergyObserver::new(),
+            observer: EnergyObserver::with_device_damping(l.device_damping_nspm, l.period_s),
             period_s: R::of(l.period_s),
             max_damping_nspm: R::of(l.max_damping_nspm),
             min_velocity_mps: R::of(l.min_velocity_mps),
@@ -157,6 +181,20 @@ impl<R: Real> SeriesDamper<R> {
         f
     }
 
+    /// Book `force_n` (N, on the port along `+x`) as the force held over
+    /// the tick that [`step`](Self::step) started, in place of what it
+    /// returned: what a safety layer downstream finally let through.
+    #[inline]
+    pub fn hold(&mut self, force_n: R) {
+        self.observer.hold(force_n);
+    }
+
+    /// Forget everything booked: the element starts again at rest.
+    pub fn reset(&mut self) {
+        self.observer.reset();
+        self.damping_nspm = R::ZERO;
+    }
+
     /// The damping added in the last tick (N s/m); 0 while passive.
     pub fn damping_nspm(&self) -> R {
         self.damping_nspm
@@ -173,31 +211,42 @@ impl<R: Real> SeriesDamper<R> {
 mod tests {
     use super::*;
 
-    /// The cap `m/T` is inside the sampled damper's stability bound: alone
-    /// on a free mass, a damper at the cap brings the mass to rest, and one
-    /// at 2.1 m/T (past the 2m/T bound) makes it run away.
+    /// The cap is where the sampled damper alone on a free mass stops
+    /// settling monotonically: at the cap the mass comes to rest without
+    /// a tick's displacement changing sign; a little above, it rings
+    /// through zero; past `2m/T` the mass runs away.
     #[test]
-    fn the_damping_cap_is_inside_the_sampled_dampers_bound() {
+    fn the_damping_cap_is_where_the_sampled_damper_starts_to_ring() {
         let (m, t) = (0.7f64, 1e-3f64);
         let cap = PassivityLimits::for_device(m as f32, t as f32, 200.0)
             .unwrap()
             .max_damping_nspm as f64;
+        // Returns the final speed and whether the velocity changed sign.
         let run = |b: f64| {
             let (mut x, mut v, mut last) = (0.0f64, 0.01f64, -0.01 * t);
+            let mut reversed = false;
             for _ in 0..5000 {
                 let f = -b * (x - last) / t;
                 last = x;
                 x += v * t + 0.5 * f / m * t * t;
                 v += f / m * t;
+                // What the controller sees: the tick's displacement.
+                reversed |= x < last;
             }
-            v.abs()
+            (v.abs(), reversed)
         };
-        assert!(run(cap) < 1e-12, "at the cap: {}", run(cap));
+        let (rest, reversed) = run(cap);
         assert!(
-            run(2.1 * m / t) > 1.0,
-            "past the bound: {}",
-            run(2.1 * m / t)
+            rest < 1e-12 && !reversed,
+            "at the cap: {rest} m/s, {reversed}"
         );
+        let (rest, reversed) = run(1.1 * cap);
+        assert!(
+            rest < 1e-12 && reversed,
+            "above the cap: {rest}, {reversed}"
+        );
+        let (away, _) = run(2.1 * m / t);
+        assert!(away > 1.0, "past the bound: {away}");
     }
 
     /// Steps a mass `m` under a sampled spring `K` (which alone pumps
