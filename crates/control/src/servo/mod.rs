@@ -3,8 +3,10 @@
 //! out.
 
 mod gains;
+mod layer;
 
 pub use gains::{AdmittanceGains, Display, Gains, GainsError, ImpedanceGains};
+pub use layer::{Direct, PortLayer};
 
 use crate::coupling::{AdmittanceCoupling, AdmittanceStep, ImpedanceCoupling, ImpedanceStep};
 use crate::estimator::FirstDifference;
@@ -146,11 +148,16 @@ pub enum LawsRef<'a, R> {
 ///
 /// A servo starts disabled: it outputs zero force until [`Servo::enable`],
 /// then ramps in. Any fault latches zero force until [`Servo::clear`].
+///
+/// Between the device's port and the laws sits a [`PortLayer`] `L`:
+/// [`Direct`] (nothing) unless [`Servo::with_layer`] puts a passivity
+/// controller there.
 #[derive(Clone, Copy, Debug)]
-pub struct Servo<V, R = f32> {
+pub struct Servo<V, R = f32, L = Direct> {
     front: Frontend<R>,
     laws: Laws<R>,
     ve: V,
+    layer: L,
 }
 
 impl<V: VirtualEnvironment> Servo<V> {
@@ -203,9 +210,64 @@ impl<V: VirtualEnvironment<R>, R: Real> Servo<V, R> {
                 regulator: PositionRegulator::new_in(g.kp_npm, g.bp_nspm, t)?,
             }),
         };
-        let mut s = Servo { front, laws, ve };
+        let mut s = Servo {
+            front,
+            laws,
+            ve,
+            layer: Direct,
+        };
         s.realign();
         Ok(s)
+    }
+}
+
+impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
+    /// This servo with `layer` between the device's port and its laws;
+    /// refused when the layer serves the other display.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_control::passivity::{PassivityLimits, SeriesDamper};
+    /// use twoport_control::servo::{ImpedanceGains, Servo};
+    /// use twoport_control::ve::BilateralConstraint;
+    /// use twoport_control::{Encoder, Position, SafetyConfig};
+    /// let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    /// let ve = BilateralConstraint::new(Position::ZERO);
+    /// let gains = ImpedanceGains { k_npm: 51_000.0, b_nspm: 90.0 };
+    /// let servo = Servo::new(gains.into(), enc, SafetyConfig::new(1e-3, 200.0, 100.0), ve)?;
+    /// let pc = SeriesDamper::new(PassivityLimits::for_device(0.7, 1e-3, 200.0)?)?;
+    /// let servo = servo.with_layer(pc).unwrap();
+    /// assert_eq!(servo.layer().damping_nspm(), 0.0);
+    /// # Ok::<(), twoport_control::ParamError>(())
+    /// ```
+    pub fn with_layer<M: PortLayer<R>>(self, layer: M) -> Result<Servo<V, R, M>, GainsError> {
+        if let Some(d) = layer.display() {
+            if d != self.display() {
+                return Err(GainsError::WrongDisplay {
+                    servo: self.display(),
+                    gains: d,
+                });
+            }
+        }
+        let mut s = Servo {
+            front: self.front,
+            laws: self.laws,
+            ve: self.ve,
+            layer,
+        };
+        s.layer.reset();
+        Ok(s)
+    }
+
+    /// The layer between the device's port and the laws.
+    pub fn layer(&self) -> &L {
+        &self.layer
+    }
+
+    /// The layer, to change it between ticks.
+    pub fn layer_mut(&mut self) -> &mut L {
+        &mut self.layer
     }
 
     /// Enable force output (ramping in), re-aligning the laws to the device
@@ -328,13 +390,15 @@ impl<V: VirtualEnvironment<R>, R: Real> Servo<V, R> {
             a.regulator.reset();
         }
         self.ve.reset(x);
+        self.layer.reset();
     }
 
     /// One control tick.
     pub fn tick(&mut self, frame: &SensorFrame<R>) -> ServoOutput<R> {
+        let (front, ve, layer) = (&mut self.front, &mut self.ve, &mut self.layer);
         match &mut self.laws {
-            Laws::Impedance(c) => impedance_tick(&mut self.front, c, &mut self.ve, frame),
-            Laws::Admittance(a) => admittance_tick(&mut self.front, a, &mut self.ve, frame),
+            Laws::Impedance(c) => impedance_tick(front, c, ve, layer, frame),
+            Laws::Admittance(a) => admittance_tick(front, a, ve, layer, frame),
         }
     }
 }
@@ -344,22 +408,29 @@ impl<V: VirtualEnvironment<R>, R: Real> Servo<V, R> {
 // that its registers do not crowd the impedance tick (the M4F tick count).
 // On the host, with registers to spare, both inline.
 #[inline(always)]
-fn impedance_tick<R: Real, V: VirtualEnvironment<R>>(
+fn impedance_tick<R: Real, V: VirtualEnvironment<R>, L: PortLayer<R>>(
     front: &mut Frontend<R>,
     coupling: &mut ImpedanceCoupling<R>,
     ve: &mut V,
+    layer: &mut L,
     frame: &SensorFrame<R>,
 ) -> ServoOutput<R> {
     let (v, faults) = front.sense(frame);
-    let s = if front.runnable(faults) {
-        coupling.step(front.position, v, ve)
+    let runnable = front.runnable(faults);
+    let (s, command_n) = if runnable {
+        let (x_e, v_e) = layer.element_motion(front.position, v);
+        let s = coupling.step(x_e, v_e, ve);
+        (s, layer.impedance_force(front.position, v, s.force_n))
     } else {
-        ImpedanceStep::default()
+        (ImpedanceStep::default(), R::ZERO)
     };
-    let safe = front.limit(frame, v, faults, s.force_n);
+    let safe = front.limit(frame, v, faults, command_n);
+    if runnable {
+        layer.held(safe.force_n);
+    }
     ServoOutput {
         actuator_force_n: safe.force_n,
-        commanded_force_n: s.force_n,
+        commanded_force_n: command_n,
         position: front.position,
         velocity_mps: v,
         ve_velocity_mps: s.ve_velocity_mps,
@@ -372,10 +443,11 @@ fn impedance_tick<R: Real, V: VirtualEnvironment<R>>(
 }
 
 #[cfg_attr(target_arch = "arm", inline(never))]
-fn admittance_tick<R: Real, V: VirtualEnvironment<R>>(
+fn admittance_tick<R: Real, V: VirtualEnvironment<R>, L: PortLayer<R>>(
     front: &mut Frontend<R>,
     laws: &mut AdmittanceLaws<R>,
     ve: &mut V,
+    layer: &mut L,
     frame: &SensorFrame<R>,
 ) -> ServoOutput<R> {
     let (v, mut faults) = front.sense(frame);
@@ -387,7 +459,8 @@ fn admittance_tick<R: Real, V: VirtualEnvironment<R>>(
     }
     let (s, command_n) = if front.runnable(faults) {
         let s = laws.coupling.step(f_c, ve);
-        let x_cmd = laws.command.step_unsplit(s.velocity_mps);
+        let v_cmd = layer.admittance_velocity(f_c, s.velocity_mps);
+        let x_cmd = laws.command.step_unsplit(v_cmd);
         (s, laws.regulator.step(front.position, x_cmd))
     } else {
         (AdmittanceStep::default(), R::ZERO)

@@ -1,0 +1,105 @@
+//! What runs between the device's port and the display's element (the
+//! coupling with its VE): nothing by default, a passivity controller on
+//! request.
+
+use super::Display;
+use crate::passivity::{ParallelDamper, SeriesDamper};
+use crate::{Position, Real};
+
+/// A stage between the device's port and the display's element. The servo
+/// calls it each tick its laws run; every method defaults to passing its
+/// input through, so a layer implements the display it serves and
+/// [`Direct`], the default, costs nothing.
+///
+/// Forces are in the servo's sign: positive resists positive actuator
+/// motion (the paper's `f_a`), except the admittance display's measured
+/// force, which is the load cell's (on the handle along `+x`).
+pub trait PortLayer<R: Real = f32> {
+    /// The display this layer serves; `None` for either.
+    fn display(&self) -> Option<Display> {
+        None
+    }
+
+    /// Impedance display: the position and velocity (m/s) the element is
+    /// given for the device's `x` and `v_mps` (a study of latency gives it
+    /// an older sample).
+    #[inline(always)]
+    fn element_motion(&mut self, x: Position, v_mps: R) -> (Position, R) {
+        (x, v_mps)
+    }
+
+    /// Impedance display: the force (N) to command for the element's
+    /// `force_n`, the device being at `x` moving at `v_mps` (m/s).
+    #[inline(always)]
+    fn impedance_force(&mut self, x: Position, v_mps: R, force_n: R) -> R {
+        let _ = (x, v_mps);
+        force_n
+    }
+
+    /// Admittance display: the velocity (m/s) to command for the element's
+    /// `velocity_mps` answering the measured force `force_n` (N).
+    #[inline(always)]
+    fn admittance_velocity(&mut self, force_n: R, velocity_mps: R) -> R {
+        let _ = force_n;
+        velocity_mps
+    }
+
+    /// The force (N) the safety layer let through this tick, held until the
+    /// next.
+    #[inline(always)]
+    fn held(&mut self, force_n: R) {
+        let _ = force_n;
+    }
+
+    /// Forget the past: the servo re-aligns to the device.
+    #[inline(always)]
+    fn reset(&mut self) {}
+}
+
+/// No layer: the element's output is the servo's command.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Direct;
+
+impl<R: Real> PortLayer<R> for Direct {}
+
+/// The impedance display's passivity controller at the device's port: it
+/// watches the element (coupling and VE) take the device's motion and put
+/// out a force.
+impl<R: Real> PortLayer<R> for SeriesDamper<R> {
+    fn display(&self) -> Option<Display> {
+        Some(Display::Impedance)
+    }
+
+    #[inline(always)]
+    fn impedance_force(&mut self, x: Position, v_mps: R, force_n: R) -> R {
+        // The controller books the force on the port, along +x.
+        -self.step(x, v_mps, -force_n)
+    }
+
+    #[inline(always)]
+    fn held(&mut self, force_n: R) {
+        self.hold(-force_n);
+    }
+
+    fn reset(&mut self) {
+        SeriesDamper::reset(self);
+    }
+}
+
+/// The admittance display's passivity controller at the load cell: it
+/// watches the element (coupling and VE) take the measured force and put
+/// out the velocity the device is commanded to.
+impl<R: Real> PortLayer<R> for ParallelDamper<R> {
+    fn display(&self) -> Option<Display> {
+        Some(Display::Admittance)
+    }
+
+    #[inline(always)]
+    fn admittance_velocity(&mut self, force_n: R, velocity_mps: R) -> R {
+        self.step(force_n, velocity_mps)
+    }
+
+    fn reset(&mut self) {
+        ParallelDamper::reset(self);
+    }
+}
