@@ -8,8 +8,8 @@
 extern crate std;
 
 use crate::ve::{
-    BilateralConstraint, Causality, CursorMass, Port, Solid, Spring, TrapezoidalSpring,
-    UnilateralWall, VeOutput, VeTransfer, VirtualEnvironment,
+    BilateralConstraint, Causality, CursorMass, ExplicitCursor, Port, Solid, Spring,
+    TrapezoidalSpring, UnilateralWall, VeOutput, VeTransfer, VirtualEnvironment,
 };
 use crate::*;
 use std::f64::consts::PI;
@@ -172,6 +172,22 @@ fn cursor_mass_ve() {
         let mut ve = CursorMass::new(0.25, T, Position::ZERO).unwrap();
         let got = ve_response(p, &mut ve, 0.0, 10.0);
         assert_close("cursor (T/m)/(1 - z^-1)", p, got, ve_tf(&ve).eval(z_of(p)));
+    }
+}
+
+#[test]
+fn explicit_cursor_ve() {
+    // The mean velocity has a zero at Nyquist: skip that bin.
+    for p in BINS.into_iter().filter(|&p| 2 * p < WINDOW) {
+        let mut ve = ExplicitCursor::new_in(0.25, T, Position::ZERO).unwrap();
+        let got = ve_response(p, &mut ve, 0.0, 10.0);
+        let want = ve_tf(&ve).eval(z_of(p));
+        assert_close(
+            "explicit cursor (T/2m)(z^-1 + z^-2)/(1 - z^-1)",
+            p,
+            got,
+            want,
+        );
     }
 }
 

@@ -90,6 +90,10 @@ impl<R: Real> ImpedanceCoupling<R> {
 
     /// One tick: device position `x_c` and its velocity estimate `v_c`
     /// (m/s) in, the VE solved exactly against the coupling, force out.
+    // Always inlined: it runs once per tick, and an image with two servo
+    // types (with and without a passivity layer) would otherwise share one
+    // out-of-line copy and pay a call on the board's hot path.
+    #[inline(always)]
     pub fn step<V: VirtualEnvironment<R> + ?Sized>(
         &mut self,
         x_c: Position,

@@ -4,12 +4,13 @@ use crate::{Position, Real};
 /// The energy (J) an element has taken in at one port, booked with the
 /// force it held over each tick and the displacement during that tick.
 ///
-/// The element exerts `f(j)` on the port from tick `j` to tick `j + 1`
-/// (positive along `+x`), and the port moves by `x(j+1) - x(j)` meanwhile.
-/// The energy the element has taken in by tick `k` is
-/// `E(k) = -Σ_{j<k} f(j) (x(j+1) - x(j))`. An element that starts at rest
-/// is passive when `E(k) >= 0` at every `k`: it has never given out more
-/// than it took in.
+/// The element holds the force `f(j)` on the port from tick `j` to tick
+/// `j + 1`, in the servo's sign (the paper's `f_a`): positive resists
+/// positive motion, that is pushes along `-x`. The port moves by
+/// `x(j+1) - x(j)` meanwhile. The energy the element has taken in by tick
+/// `k` is `E(k) = Σ_{j<k} f(j) (x(j+1) - x(j))`. An element that starts
+/// at rest is passive when `E(k) >= 0` at every `k`: it has never given
+/// out more than it took in.
 ///
 /// # Examples
 ///
@@ -17,12 +18,12 @@ use crate::{Position, Real};
 /// use twoport_control::passivity::EnergyObserver;
 /// use twoport_control::Position;
 ///
-/// // A damper of 10 N s/m pushing back on a port moving at 1 mm/s (1 µm
-/// // per 1 ms tick) takes in energy.
+/// // A damper of 10 N s/m resisting a port moving at 1 mm/s (1 µm per
+/// // 1 ms tick) takes in energy.
 /// let mut obs = EnergyObserver::<f32>::new();
 /// for k in 0..1000 {
 ///     let x = Position::from_nm(1000 * k);
-///     obs.update(x, -10.0 * 1e-3);
+///     obs.update(x, 10.0 * 1e-3);
 /// }
 /// // 999 ticks of 0.01 N over 1 µm.
 /// assert!((obs.energy_in_j() - 999.0 * 1e-8).abs() < 1e-11);
@@ -31,8 +32,10 @@ use crate::{Position, Real};
 pub struct EnergyObserver<R = f32> {
     /// Energy taken in (nJ: newtons times nanometres).
     taken_in_nj: CompensatedSum<R>,
-    /// The port's position at the start of the tick now being held.
-    start: Option<Position>,
+    /// The port's position at the start of the tick now being held (the
+    /// origin, or where [`restart`](Self::restart) put it, before the
+    /// first: nothing is held then, so nothing is booked).
+    start: Position,
     /// The force held over that tick (N).
     held_n: R,
     /// The device's own damping `b` over `T`, in N per nm (see
@@ -45,7 +48,7 @@ impl<R: Real> EnergyObserver<R> {
     pub const fn new() -> Self {
         EnergyObserver {
             taken_in_nj: CompensatedSum::new(),
-            start: None,
+            start: Position::ZERO,
             held_n: R::ZERO,
             credit_n_per_nm: R::ZERO,
         }
@@ -71,14 +74,24 @@ impl<R: Real> EnergyObserver<R> {
     /// [`energy_in_j`](Self::energy_in_j).
     #[inline]
     pub fn update(&mut self, x: Position, force_n: R) -> R {
-        if let Some(start) = self.start {
-            let moved_nm: R = x.nm_from(start);
-            self.taken_in_nj
-                .add(moved_nm * (self.credit_n_per_nm * moved_nm - self.held_n));
-        }
-        self.start = Some(x);
-        self.held_n = force_n;
+        self.book(x, force_n);
         self.energy_in_j()
+    }
+
+    /// [`update`](Self::update) without the conversion to joules.
+    #[inline(always)]
+    pub(crate) fn book(&mut self, x: Position, force_n: R) {
+        let moved_nm: R = x.nm_from(self.start);
+        self.taken_in_nj
+            .add(moved_nm * (self.credit_n_per_nm * moved_nm + self.held_n));
+        self.start = x;
+        self.held_n = force_n;
+    }
+
+    /// The energy taken in so far, in nJ (N nm).
+    #[inline(always)]
+    pub(crate) fn energy_in_nj(&self) -> R {
+        self.taken_in_nj.value()
     }
 
     /// Change the force held over the tick that starts now (N), after an
@@ -96,18 +109,23 @@ impl<R: Real> EnergyObserver<R> {
     }
 
     /// Forget everything booked (the damping credit stays): the element
-    /// starts again at rest.
-    pub fn reset(&mut self) {
+    /// starts again at rest, the port at `x`.
+    pub fn restart(&mut self, x: Position) {
         self.taken_in_nj = CompensatedSum::new();
-        self.start = None;
+        self.start = x;
         self.held_n = R::ZERO;
     }
 
     /// Set the energy booked so far to `energy_j` (J): a reserve cap or a
     /// reset. The tick being held is still booked when it ends.
     pub fn set_energy_j(&mut self, energy_j: R) {
+        self.set_energy_nj(energy_j * R::NM_PER_M);
+    }
+
+    /// [`set_energy_j`](Self::set_energy_j) in nJ.
+    pub(crate) fn set_energy_nj(&mut self, energy_nj: R) {
         self.taken_in_nj = CompensatedSum::new();
-        self.taken_in_nj.add(energy_j * R::NM_PER_M);
+        self.taken_in_nj.add(energy_nj);
     }
 }
 
@@ -116,7 +134,7 @@ mod tests {
     use super::*;
     use std::vec::Vec;
 
-    /// A unit mass on a sampled spring `f = -K x` held over each 1 ms tick,
+    /// A unit mass on a sampled spring `f = K x` (resisting) held over each 1 ms tick,
     /// integrated exactly between ticks. The ZOH spring pumps energy in:
     /// the oscillation grows. The observer sees the spring give out energy
     /// (its taken-in energy falls below minus its initial store), and what
@@ -143,7 +161,7 @@ mod tests {
             let p = Position::from_m_f64(x).expect("in range");
             let xq = p.nm() as f64 * 1e-9;
             let f = -k * xq;
-            let e = obs.update(p, f);
+            let e = obs.update(p, -f);
             if let Some(l) = last_nm {
                 naive -= f * (p.nm() - l) as f64 * 1e-9;
             }
@@ -188,7 +206,7 @@ mod tests {
             let p = Position::from_m_f64(2e-3 * ph.sin()).unwrap();
             let v = (p.nm() - last.nm()) as f64 * 1e-9 / 1e-3;
             last = p;
-            let f = -50.0 * v;
+            let f = 50.0 * v;
             let e32 = o32.update(p, f as f32);
             let e64 = o64.update(p, f);
             assert!(e64 >= -1e-12, "tick {i}: {e64}");

@@ -101,8 +101,8 @@ impl PassivityLimits {
 /// While the element is passive the controller does no arithmetic on its
 /// force: the output is the input, bit for bit.
 ///
-/// Forces here are those the element exerts on the port, positive along
-/// `+x`.
+/// Forces are in the servo's sign (the paper's `f_a`): positive resists
+/// positive motion.
 ///
 /// # Examples
 ///
@@ -115,17 +115,19 @@ impl PassivityLimits {
 /// // A damper-like element is passive: nothing is added.
 /// let f = pc.step(Position::from_nm(0), 0.0, 0.0);
 /// assert_eq!(f, 0.0);
-/// let f = pc.step(Position::from_nm(10_000), 0.01, -0.5);
-/// assert_eq!((f, pc.damping_nspm()), (-0.5, 0.0));
+/// let f = pc.step(Position::from_nm(10_000), 0.01, 0.5);
+/// assert_eq!((f, pc.damping_nspm()), (0.5, 0.0));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SeriesDamper<R = f32> {
     observer: EnergyObserver<R>,
-    period_s: R,
+    /// `-1e-9 / T` (J per nJ per s): the observer books in nJ.
+    neg_j_per_nj_per_s: R,
     max_damping_nspm: R,
-    min_velocity_mps: R,
+    /// The velocity floor, squared (m²/s²).
+    min_velocity_sq: R,
     force_limit_n: R,
-    max_reserve_j: R,
+    max_reserve_nj: R,
     damping_nspm: R,
 }
 
@@ -136,52 +138,72 @@ impl<R: Real> SeriesDamper<R> {
         let l = limits.checked()?;
         Ok(SeriesDamper {
             observer: EnergyObserver::with_device_damping(l.device_damping_nspm, l.period_s),
-            period_s: R::of(l.period_s),
+            neg_j_per_nj_per_s: -R::M_PER_NM / R::of(l.period_s),
             max_damping_nspm: R::of(l.max_damping_nspm),
-            min_velocity_mps: R::of(l.min_velocity_mps),
+            min_velocity_sq: R::of(l.min_velocity_mps) * R::of(l.min_velocity_mps),
             force_limit_n: R::of(l.force_limit_n),
-            max_reserve_j: R::of(l.max_reserve_j),
+            max_reserve_nj: R::of(l.max_reserve_j) * R::NM_PER_M,
             damping_nspm: R::ZERO,
         })
     }
 
     /// One tick: `x` the port's position now, `v` its velocity estimate
     /// (m/s), `force_n` the element's force for the coming tick (N).
-    /// Returns the force to hold.
+    /// Returns the force to hold, within the force limit.
     #[inline]
     pub fn step(&mut self, x: Position, v: R, force_n: R) -> R {
-        let e = self.observer.update(x, force_n);
-        if e > self.max_reserve_j {
-            self.observer.set_energy_j(self.max_reserve_j);
+        let f = self.correct(x, v, force_n);
+        if f == force_n {
+            return f;
         }
-        let speed = v.abs();
-        // A NaN energy or speed leaves the force alone: the safety layer
-        // downstream refuses a non-finite force on its own.
-        let active = e < R::ZERO && speed >= self.min_velocity_mps;
-        if !active {
+        // (On the servo's path the safety layer limits the force and
+        // books what it let through.)
+        let lim = self.force_limit_n;
+        let f = if f > lim {
+            lim
+        } else if f < -lim {
+            -lim
+        } else {
+            f
+        };
+        self.observer.hold(f);
+        f
+    }
+
+    /// [`step`](Self::step) without the force limit, for a caller whose
+    /// safety layer clips the force and books what it let through with
+    /// [`hold`](Self::hold) (the servo's tick).
+    #[inline(always)]
+    pub(crate) fn correct(&mut self, x: Position, v: R, force_n: R) -> R {
+        self.observer.book(x, force_n);
+        let e = self.observer.energy_in_nj();
+        if e > self.max_reserve_nj {
+            self.observer.set_energy_nj(self.max_reserve_nj);
+        }
+        // Passive (or a NaN energy, which leaves the force alone: the
+        // safety layer downstream refuses a non-finite force on its own).
+        let in_deficit = e < R::ZERO;
+        if !in_deficit {
             self.damping_nspm = R::ZERO;
             return force_n;
         }
-        let wanted = -e / (self.period_s * speed * speed);
+        let v2 = v * v;
+        let fast_enough = v2 >= self.min_velocity_sq;
+        if !fast_enough {
+            self.damping_nspm = R::ZERO;
+            return force_n;
+        }
+        let wanted = e * self.neg_j_per_nj_per_s / v2;
         let alpha = if wanted < self.max_damping_nspm {
             wanted
         } else {
             self.max_damping_nspm
         };
-        let f = force_n - alpha * v;
-        let f = if f > self.force_limit_n {
-            self.force_limit_n
-        } else if f < -self.force_limit_n {
-            -self.force_limit_n
-        } else {
-            f
-        };
-        self.observer.hold(f);
         self.damping_nspm = alpha;
-        f
+        force_n + alpha * v
     }
 
-    /// Book `force_n` (N, on the port along `+x`) as the force held over
+    /// Book `force_n` (N, the servo's sign) as the force held over
     /// the tick that [`step`](Self::step) started, in place of what it
     /// returned: what a safety layer downstream finally let through.
     #[inline]
@@ -189,9 +211,10 @@ impl<R: Real> SeriesDamper<R> {
         self.observer.hold(force_n);
     }
 
-    /// Forget everything booked: the element starts again at rest.
-    pub fn reset(&mut self) {
-        self.observer.reset();
+    /// Forget everything booked: the element starts again at rest, the
+    /// port at `x`.
+    pub fn reset(&mut self, x: Position) {
+        self.observer.restart(x);
         self.damping_nspm = R::ZERO;
     }
 
@@ -272,10 +295,12 @@ mod tests {
             let v_est = (p.nm() - last.nm()) as f64 * 1e-9 / t;
             largest = largest.max((held * (p.nm() - last.nm()) as f64 * 1e-9).abs());
             last = p;
-            let f_ve = -k * p.nm() as f64 * 1e-9;
+            // The spring resists its stretch; the mass feels minus that.
+            let f_ve = k * p.nm() as f64 * 1e-9;
             let f = if on { pc.step(p, v_est, f_ve) } else { f_ve };
             lowest = lowest.min(obs.update(p, f));
             held = f;
+            let f = -f;
             if i < ticks / 10 {
                 early = early.max(x.abs());
             } else if i >= ticks - ticks / 10 {
@@ -342,7 +367,7 @@ mod tests {
             nm += (seed % 2001) as i32 - 1000;
             let v = (nm - last) as f32 * 1e-9 / 1e-3;
             last = nm;
-            let f = -30.0 * v;
+            let f = 30.0 * v;
             let out = pc.step(Position::from_nm(nm), v, f);
             assert_eq!(out.to_bits(), f.to_bits());
             assert_eq!(pc.damping_nspm(), 0.0);

@@ -51,9 +51,11 @@ pub trait PortLayer<R: Real = f32> {
         let _ = force_n;
     }
 
-    /// Forget the past: the servo re-aligns to the device.
+    /// Forget the past: the servo re-aligns to the device, at `x`.
     #[inline(always)]
-    fn reset(&mut self) {}
+    fn reset(&mut self, x: Position) {
+        let _ = x;
+    }
 }
 
 /// No layer: the element's output is the servo's command.
@@ -72,17 +74,18 @@ impl<R: Real> PortLayer<R> for SeriesDamper<R> {
 
     #[inline(always)]
     fn impedance_force(&mut self, x: Position, v_mps: R, force_n: R) -> R {
-        // The controller books the force on the port, along +x.
-        -self.step(x, v_mps, -force_n)
+        // The safety layer limits the force, and `held` books what it let
+        // through.
+        self.correct(x, v_mps, force_n)
     }
 
     #[inline(always)]
     fn held(&mut self, force_n: R) {
-        self.hold(-force_n);
+        self.hold(force_n);
     }
 
-    fn reset(&mut self) {
-        SeriesDamper::reset(self);
+    fn reset(&mut self, x: Position) {
+        SeriesDamper::reset(self, x);
     }
 }
 
@@ -99,7 +102,7 @@ impl<R: Real> PortLayer<R> for ParallelDamper<R> {
         self.step(force_n, velocity_mps)
     }
 
-    fn reset(&mut self) {
+    fn reset(&mut self, _: Position) {
         ParallelDamper::reset(self);
     }
 }

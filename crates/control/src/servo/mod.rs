@@ -256,7 +256,8 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
             ve: self.ve,
             layer,
         };
-        s.layer.reset();
+        let x = s.front.position;
+        s.layer.reset(x);
         Ok(s)
     }
 
@@ -390,7 +391,7 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
             a.regulator.reset();
         }
         self.ve.reset(x);
-        self.layer.reset();
+        self.layer.reset(x);
     }
 
     /// One control tick.
