@@ -186,6 +186,56 @@ fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
     t.check("servo tick measured", per_tick > 0.0);
 }
 
+/// The same tick with the passivity layer (the series damper) between the
+/// device and the coupling, in two sweeps: pressing into the wall (the
+/// element takes energy in, the layer only books it) and withdrawing from
+/// it (the wall gives its energy back plus what the hold adds, and the
+/// layer damps from the second tick on).
+fn tick_cost_layered(t: &mut Tally) {
+    use twoport_control::passivity::{PassivityLimits, SeriesDamper};
+    let limits = PassivityLimits::for_device(0.7, T, 200.0).unwrap();
+    let layered = |first_raw: u32| {
+        let origin = Position::from_nm(first_raw as i32 * 1000);
+        let enc = Encoder::new(16, 1_000_000, first_raw, origin).unwrap();
+        let pc = SeriesDamper::new(limits).unwrap();
+        let mut s = paper_servo(enc, timing_wall()).with_layer(pc).unwrap();
+        let _ = s.enable();
+        s
+    };
+    let mut s = layered(0);
+    let (pressing, _) = counts_per_call(1000, |k| {
+        let f = frame(k, core::hint::black_box(k * 2), 0.0);
+        s.tick(&f).actuator_force_n
+    });
+    let passive = s.layer().damping_nspm() == 0.0 && s.safety().faults().is_empty();
+    let mut s = layered(2000);
+    let (withdrawing, _) = counts_per_call(1000, |k| {
+        let f = frame(k, core::hint::black_box(2000 - k * 2), 0.0);
+        s.tick(&f).actuator_force_n
+    });
+    // The same sweep again, untimed, to count the ticks the layer damped.
+    let mut s = layered(2000);
+    let mut damped = 0u32;
+    for k in 0..1000 {
+        s.tick(&frame(k, 2000 - k * 2, 0.0));
+        damped += (s.layer().damping_nspm() > 0.0) as u32;
+    }
+    hprintln!(
+        "  impedance servo tick with the passivity layer, pressing (passive): {} instructions",
+        pressing / 1.6
+    );
+    hprintln!(
+        "  impedance servo tick with the passivity layer, withdrawing (damping on {} of 1000 ticks): {} instructions",
+        damped,
+        withdrawing / 1.6
+    );
+    t.check("passivity layer idle while pressing", passive);
+    t.check(
+        "passivity layer damping while withdrawing",
+        damped > 900 && s.safety().faults().is_empty(),
+    );
+}
+
 /// SysTick counts per call of `f` over `n` calls, less the loop's own
 /// cost; and that cost, per iteration of an empty loop.
 fn counts_per_call(n: u32, mut f: impl FnMut(u32) -> f32) -> (f32, f32) {
@@ -255,6 +305,7 @@ fn main() -> ! {
     servo_wall_and_fault(&mut t);
     if let Some(mut p) = cortex_m::Peripherals::take() {
         tick_cost(&mut t, &mut p.SYST);
+        tick_cost_layered(&mut t);
         cost_breakdown();
     }
     hprintln!("{} passed, {} failed", t.passed, t.failed);
