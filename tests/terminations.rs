@@ -7,7 +7,7 @@
 //! that makes and breaks contact is a nonlinear VE and is not drawn here.
 
 use host_sim::engine::plant::Arm;
-use host_sim::engine::scene::{Display, VeSpec};
+use host_sim::engine::scene::{Display, Integration, VeSpec};
 use host_sim::{Scene, Simulation};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
@@ -41,7 +41,10 @@ fn arm() -> impl Strategy<Value = Arm> {
 
 fn ve() -> impl Strategy<Value = VeSpec> {
     prop_oneof![
-        log_uniform(0.25, 20.0).prop_map(|mass_kg| VeSpec::Cursor { mass_kg }),
+        log_uniform(0.25, 20.0).prop_map(|mass_kg| VeSpec::Cursor {
+            mass_kg,
+            integration: Integration::Implicit
+        }),
         (log_uniform(1e2, 1e7), log_uniform(0.1, 1e4)).prop_map(|(k, b)| VeSpec::Spring {
             anchor_m: -0.001,
             stiffness_npm: k,
@@ -68,7 +71,10 @@ fn tuned_case(f_hz: f64) -> impl Strategy<Value = Case> {
             stiffness_npm: m * (r * w) * (r * w),
         });
     let ve = prop_oneof![
-        log_uniform(0.25, 50.0).prop_map(|mass_kg| VeSpec::Cursor { mass_kg }),
+        log_uniform(0.25, 50.0).prop_map(|mass_kg| VeSpec::Cursor {
+            mass_kg,
+            integration: Integration::Implicit
+        }),
         (log_uniform(1e2, 1e7), log_uniform(0.001, 10.0)).prop_map(|(k, b)| VeSpec::Spring {
             anchor_m: -0.001,
             stiffness_npm: k,

@@ -58,7 +58,10 @@ fn scene_on(model: &str, k: f64, b: f64, ve: &Ve) -> Scene {
             stiffness_npm: k,
             damping_nspm: b,
         } => spring(k, b, Discretization::BackwardEuler),
-        Ve::Cursor { mass_kg } => VeSpec::Cursor { mass_kg },
+        Ve::Cursor { mass_kg } => VeSpec::Cursor {
+            mass_kg,
+            integration: host_sim::engine::scene::Integration::Implicit,
+        },
         Ve::Constraint => VeSpec::Bilateral,
     };
     s.human.script = vec![Event::Force {

@@ -37,6 +37,36 @@ pub struct Scene {
     /// Effects to simulate; none by default.
     #[serde(default)]
     pub effects: Effects,
+    /// The time-domain passivity layer; absent means none.
+    pub passivity: Option<PassivitySpec>,
+}
+
+/// The passivity layer between the device's port and the display's
+/// element: the series damper on an impedance display, the parallel damper
+/// on an admittance display (see `docs/passivity.md`).
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PassivitySpec {
+    /// Whether the layer runs (`--set passivity.enabled=false` turns a
+    /// scene's layer off, everything else equal).
+    #[serde(default = "default_true")]
+    pub enabled: bool,
+    /// Moving mass at the port (kg), which sets the damping cap; the
+    /// plant's `rigid_mass_kg` by default.
+    pub mass_kg: Option<f64>,
+    /// The device's own viscous damping credited to the element (N s/m):
+    /// a lower bound of it. 0 by default.
+    #[serde(default)]
+    pub device_damping_nspm: f64,
+    /// Velocity floor (m/s); a few encoder counts per tick. 1 mm/s by
+    /// default.
+    pub min_velocity_mps: Option<f64>,
+    /// Energy reserve (J); 0.5 J by default.
+    pub max_reserve_j: Option<f64>,
+}
+
+fn default_true() -> bool {
+    true
 }
 
 fn default_duration() -> f64 {
@@ -211,6 +241,18 @@ pub enum Discretization {
     Trapezoidal,
 }
 
+/// How a VE body is integrated on the board.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Integration {
+    /// Backward Euler on this tick's force: passive for every mass.
+    #[default]
+    Implicit,
+    /// The paper's building blocks: the velocity from last tick's force
+    /// (forward Euler), the position by the trapezoidal rule. Not passive.
+    Explicit,
+}
+
 /// The virtual environment.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
@@ -219,6 +261,11 @@ pub enum VeSpec {
     Cursor {
         /// Mass (kg); the paper's minimum is 0.25.
         mass_kg: f64,
+        /// How the board integrates it: `implicit` (backward Euler,
+        /// passive, the default) or `explicit` (the paper's: Euler
+        /// velocity, trapezoidal position).
+        #[serde(default)]
+        integration: Integration,
     },
     /// A unilateral spring-damper wall.
     Wall {
@@ -327,6 +374,10 @@ pub struct Effects {
     pub cable_slack: Option<SlackEffect>,
     /// Sensor delay.
     pub delay: Option<DelayEffect>,
+    /// The coupling and VE see the device's position this many ticks late
+    /// (a VE on a host behind a link), while the board's passivity layer
+    /// reads it fresh.
+    pub element_delay: Option<DelayEffect>,
 }
 
 /// Encoder quantisation.
@@ -621,7 +672,7 @@ impl Scene {
             }
         }
         match &self.ve {
-            VeSpec::Cursor { mass_kg } => pos("ve.mass_kg", *mass_kg)?,
+            VeSpec::Cursor { mass_kg, .. } => pos("ve.mass_kg", *mass_kg)?,
             VeSpec::Wall {
                 position_m,
                 stiffness_npm,
@@ -711,6 +762,29 @@ impl Scene {
         if let Some(x) = e.delay {
             if x.ticks > 1000 {
                 return Err(format!("effects.delay.ticks = {} must be <= 1000", x.ticks));
+            }
+        }
+        if let Some(x) = e.element_delay {
+            if x.ticks > 1000 {
+                return Err(format!(
+                    "effects.element_delay.ticks = {} must be <= 1000",
+                    x.ticks
+                ));
+            }
+            if self.display != Display::Impedance {
+                return Err("effects.element_delay delays the impedance display's element; an admittance display has none to delay".into());
+            }
+        }
+        if let Some(p) = &self.passivity {
+            if let Some(m) = p.mass_kg {
+                pos("passivity.mass_kg", m)?;
+            }
+            nonneg("passivity.device_damping_nspm", p.device_damping_nspm)?;
+            if let Some(v) = p.min_velocity_mps {
+                pos("passivity.min_velocity_mps", v)?;
+            }
+            if let Some(e) = p.max_reserve_j {
+                nonneg("passivity.max_reserve_j", e)?;
             }
         }
         Ok(())

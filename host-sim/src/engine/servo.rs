@@ -3,12 +3,13 @@
 //! laws' rounding out of a study).
 
 use crate::engine::blocks::{Block, Blocks};
-use crate::engine::scene::{Discretization, Precision, Scene, SolidSide, VeSpec};
+use crate::engine::layer::SceneLayer;
+use crate::engine::scene::{Discretization, Integration, Precision, Scene, SolidSide, VeSpec};
 use crate::engine::ve::SceneVe;
-use twoport_control::servo::{Gains, SensorFrame, Servo, ServoOutput};
+use twoport_control::servo::{Gains, PortLayer, SensorFrame, Servo, ServoOutput};
 use twoport_control::ve::{
-    BilateralConstraint, CursorMass, Solid, Spring, TrapezoidalSpring, UnilateralWall,
-    VirtualEnvironment,
+    BilateralConstraint, CursorMass, ExplicitCursor, Solid, Spring, TrapezoidalSpring,
+    UnilateralWall, VirtualEnvironment,
 };
 use twoport_control::{Encoder, Position, Real, SafetyConfig};
 
@@ -19,18 +20,49 @@ pub enum SceneServo {
     F32(Box<Servo<SceneVe<f32>, f32>>),
     /// The same laws computing in f64.
     F64(Box<Servo<SceneVe<f64>, f64>>),
+    /// The f32 laws with the scene's port layer (passivity, element delay).
+    F32Layered(Box<LayeredServo<f32>>),
+    /// The f64 laws with the scene's port layer.
+    F64Layered(Box<LayeredServo<f64>>),
+}
+
+/// The board's servo with the scene's port layer, computing in `R`.
+pub type LayeredServo<R> = Servo<SceneVe<R>, R, SceneLayer<R>>;
+
+/// `$e` on the servo whatever its variant.
+macro_rules! each_servo {
+    ($self:expr, $s:ident => $e:expr) => {
+        match $self {
+            SceneServo::F32($s) => $e,
+            SceneServo::F64($s) => $e,
+            SceneServo::F32Layered($s) => $e,
+            SceneServo::F64Layered($s) => $e,
+        }
+    };
 }
 
 fn build<R: Real>(
     scene: &Scene,
     encoder: Encoder,
     safety: SafetyConfig,
-) -> Result<Box<Servo<SceneVe<R>, R>>, String> {
+) -> Result<Servo<SceneVe<R>, R>, String> {
     let ve = scene_ve(scene, safety.period_s)?;
-    let mut s = Servo::new_in(scene.gains(), encoder, safety, ve).map_err(|e| e.to_string())?;
+    Servo::new_in(scene.gains(), encoder, safety, ve).map_err(|e| e.to_string())
+}
+
+fn enabled<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>>(
+    mut s: Servo<V, R, L>,
+) -> Result<Box<Servo<V, R, L>>, String> {
     s.enable()
         .map_err(|f| format!("the servo would not enable: {f}"))?;
     Ok(Box::new(s))
+}
+
+fn layered<R: Real>(
+    s: Servo<SceneVe<R>, R>,
+    layer: SceneLayer<R>,
+) -> Result<Box<LayeredServo<R>>, String> {
+    enabled(s.with_layer(layer).map_err(|e| e.to_string())?)
 }
 
 fn set_wall<R: Real>(ve: &mut SceneVe<R>, surface: Position, k_npm: f32) -> Result<(), String> {
@@ -70,11 +102,18 @@ pub(crate) fn output_f64(o: ServoOutput) -> ServoOutput<f64> {
 }
 
 impl SceneServo {
-    /// The scene's display, gains and VE, in the scene's float type.
+    /// The scene's display, gains, VE and port layer, in the scene's float
+    /// type.
     pub fn new(scene: &Scene, encoder: Encoder, safety: SafetyConfig) -> Result<Self, String> {
         Ok(match scene.integrator.controller {
-            Precision::F32 => SceneServo::F32(build(scene, encoder, safety)?),
-            Precision::F64 => SceneServo::F64(build(scene, encoder, safety)?),
+            Precision::F32 => match SceneLayer::for_scene(scene, &safety)? {
+                None => SceneServo::F32(enabled(build(scene, encoder, safety)?)?),
+                Some(l) => SceneServo::F32Layered(layered(build(scene, encoder, safety)?, l)?),
+            },
+            Precision::F64 => match SceneLayer::for_scene(scene, &safety)? {
+                None => SceneServo::F64(enabled(build(scene, encoder, safety)?)?),
+                Some(l) => SceneServo::F64Layered(layered(build(scene, encoder, safety)?, l)?),
+            },
         })
     }
 
@@ -84,33 +123,34 @@ impl SceneServo {
         match self {
             SceneServo::F32(s) => output_f64(s.tick(&frame_f32(f))),
             SceneServo::F64(s) => s.tick(f),
+            SceneServo::F32Layered(s) => output_f64(s.tick(&frame_f32(f))),
+            SceneServo::F64Layered(s) => s.tick(f),
         }
     }
 
     /// The VE's position.
     pub fn ve_position(&self) -> Position {
-        match self {
-            SceneServo::F32(s) => s.ve().position(),
-            SceneServo::F64(s) => s.ve().position(),
-        }
+        each_servo!(self, s => s.ve().position())
     }
 
     /// The gains in force.
     pub fn gains(&self) -> Gains {
+        each_servo!(self, s => s.gains())
+    }
+
+    /// The port layer, if the scene has one.
+    pub fn layer(&self) -> Option<LayerView<'_>> {
         match self {
-            SceneServo::F32(s) => s.gains(),
-            SceneServo::F64(s) => s.gains(),
+            SceneServo::F32Layered(s) => Some(LayerView::F32(s.layer())),
+            SceneServo::F64Layered(s) => Some(LayerView::F64(s.layer())),
+            _ => None,
         }
     }
 
     /// Change the gains while running (the scope's sliders); they must be
     /// for the scene's display.
     pub fn set_gains(&mut self, g: Gains) -> Result<(), String> {
-        match self {
-            SceneServo::F32(s) => s.set_gains(g),
-            SceneServo::F64(s) => s.set_gains(g),
-        }
-        .map_err(|e| e.to_string())
+        each_servo!(self, s => s.set_gains(g)).map_err(|e| e.to_string())
     }
 
     /// Move the wall and change its stiffness while running (the scope's
@@ -120,9 +160,41 @@ impl SceneServo {
             "wall position {surface_m} m is out of range (±2.147 m)"
         ))?;
         let k = stiffness_npm as f32;
+        each_servo!(self, s => set_wall(s.ve_mut(), x, k))
+    }
+}
+
+/// A scene servo's port layer, in its float type.
+#[derive(Clone, Copy, Debug)]
+pub enum LayerView<'a> {
+    /// The f32 laws' layer.
+    F32(&'a SceneLayer<f32>),
+    /// The f64 laws' layer.
+    F64(&'a SceneLayer<f64>),
+}
+
+impl LayerView<'_> {
+    /// See [`SceneLayer::energy_in_j`].
+    pub fn energy_in_j(&self) -> f64 {
         match self {
-            SceneServo::F32(s) => set_wall(s.ve_mut(), x, k),
-            SceneServo::F64(s) => set_wall(s.ve_mut(), x, k),
+            LayerView::F32(l) => l.energy_in_j(),
+            LayerView::F64(l) => l.energy_in_j(),
+        }
+    }
+
+    /// See [`SceneLayer::added`].
+    pub fn added(&self) -> f64 {
+        match self {
+            LayerView::F32(l) => l.added(),
+            LayerView::F64(l) => l.added(),
+        }
+    }
+
+    /// See [`SceneLayer::dissipated_j`].
+    pub fn dissipated_j(&self) -> f64 {
+        match self {
+            LayerView::F32(l) => l.dissipated_j(),
+            LayerView::F64(l) => l.dissipated_j(),
         }
     }
 }
@@ -133,8 +205,18 @@ fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, String> {
         Position::from_m_f64(m).ok_or(format!("position {m} m is out of range (±2.147 m)"))
     };
     Ok(match &scene.ve {
-        VeSpec::Cursor { mass_kg } => SceneVe::Cursor(
+        VeSpec::Cursor {
+            mass_kg,
+            integration: Integration::Implicit,
+        } => SceneVe::Cursor(
             CursorMass::new_in(*mass_kg as f32, t32, Position::ZERO).map_err(|e| e.to_string())?,
+        ),
+        VeSpec::Cursor {
+            mass_kg,
+            integration: Integration::Explicit,
+        } => SceneVe::ExplicitCursor(
+            ExplicitCursor::new_in(*mass_kg as f32, t32, Position::ZERO)
+                .map_err(|e| e.to_string())?,
         ),
         VeSpec::Wall {
             position_m,

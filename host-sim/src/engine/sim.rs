@@ -37,6 +37,23 @@ pub struct Sample {
     /// Energy stored in the device (J); NaN unless energy tracking is on
     /// (see [`Simulation::track_energy`]).
     pub energy_stored_j: f64,
+    /// The energy the passivity layer's observer has seen the element take
+    /// in (J); NaN without the layer.
+    pub layer_energy_j: f64,
+    /// What the layer added this tick: damping (N s/m, impedance display)
+    /// or conductance (m/(N s), admittance display); NaN without it.
+    pub layer_added: f64,
+}
+
+/// What the passivity layer did over a run.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct PassivityReport {
+    /// Energy the layer dissipated (J): its transparency cost in energy.
+    pub dissipated_j: f64,
+    /// Ticks on which it added damping.
+    pub active_ticks: u64,
+    /// The lowest energy its observer saw the element hold (J).
+    pub lowest_energy_j: f64,
 }
 
 /// An effect's measured cost.
@@ -77,6 +94,8 @@ pub struct Report {
     pub integrator_warning: Option<String>,
     /// RMS oscillatory force over the final quiet second (N).
     pub late_rms_n: [f64; 2],
+    /// The passivity layer's work, when the scene runs one.
+    pub passivity: Option<PassivityReport>,
 }
 
 /// A coordinate read off the plant's positions or velocities, compiled
@@ -142,6 +161,9 @@ pub struct Simulation {
     grasp_override: Option<GraspKind>,
     /// The scope's mouse push, added to the script's (N).
     extra_push_n: f64,
+    /// Ticks the passivity layer acted, and the lowest energy it saw.
+    layer_active: u64,
+    layer_lowest: f64,
 }
 
 /// Largest stable sub-step for `method` over `poles` (s), by bisection.
@@ -287,6 +309,8 @@ impl Simulation {
             scene,
             grasp_override: None,
             extra_push_n: 0.0,
+            layer_active: 0,
+            layer_lowest: 0.0,
         };
         Ok(sim)
     }
@@ -505,6 +529,15 @@ impl Simulation {
                 None => "diverged: the device ran 10 m away".to_string(),
             });
         }
+        let (layer_energy_j, layer_added) = match self.servo.layer() {
+            Some(l) if !is_external => {
+                let (e, a) = (l.energy_in_j(), l.added());
+                self.layer_active += u64::from(a > 0.0);
+                self.layer_lowest = self.layer_lowest.min(e);
+                (e, a)
+            }
+            _ => (f64::NAN, f64::NAN),
+        };
         Sample {
             t_s: self.time_of(self.tick),
             handle_m: x_h,
@@ -521,6 +554,8 @@ impl Simulation {
             coupling_n: out.coupling_force_n,
             energy_in_j: self.energy_in,
             energy_stored_j: stored,
+            layer_energy_j,
+            layer_added,
         }
     }
 
@@ -574,6 +609,15 @@ impl Simulation {
             substeps: self.substeps,
             integrator_warning: self.warning.clone(),
             late_rms_n,
+            passivity: self
+                .servo
+                .layer()
+                .filter(|l| !l.energy_in_j().is_nan())
+                .map(|l| PassivityReport {
+                    dissipated_j: l.dissipated_j(),
+                    active_ticks: self.layer_active,
+                    lowest_energy_j: self.layer_lowest.min(0.0),
+                }),
         }
     }
 }

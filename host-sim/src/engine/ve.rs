@@ -2,8 +2,8 @@
 
 use crate::engine::blocks::Blocks;
 use twoport_control::ve::{
-    BilateralConstraint, Causality, CursorMass, Port, Spring, TrapezoidalSpring, UnilateralWall,
-    VeOutput, VeTransfer, VirtualEnvironment,
+    BilateralConstraint, Causality, CursorMass, ExplicitCursor, Port, Spring, TrapezoidalSpring,
+    UnilateralWall, VeOutput, VeTransfer, VirtualEnvironment,
 };
 use twoport_control::{Position, Real};
 
@@ -13,6 +13,8 @@ use twoport_control::{Position, Real};
 pub enum SceneVe<R: Real = f32> {
     /// A free cursor mass.
     Cursor(CursorMass<R>),
+    /// A free cursor mass integrated explicitly (the paper's).
+    ExplicitCursor(ExplicitCursor<R>),
     /// A unilateral wall.
     Wall(UnilateralWall<R>),
     /// A fixed point.
@@ -31,6 +33,7 @@ macro_rules! each {
     ($self:expr, $v:ident => $e:expr, $b:ident => $blocks:expr) => {
         match $self {
             SceneVe::Cursor($v) => $e,
+            SceneVe::ExplicitCursor($v) => $e,
             SceneVe::Wall($v) => $e,
             SceneVe::Bilateral($v) => $e,
             SceneVe::Spring($v) => $e,
