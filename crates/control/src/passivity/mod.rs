@@ -38,8 +38,10 @@ mod observer;
 mod parallel;
 mod series;
 mod sum;
+mod ve_port;
 
 pub use observer::EnergyObserver;
 pub use parallel::{ParallelDamper, ParallelLimits};
 pub use series::{PassivityLimits, SeriesDamper};
 pub use sum::CompensatedSum;
+pub use ve_port::PassiveVe;
