@@ -3,7 +3,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use host_sim::engine::scene::Scene;
-use host_sim::study::{sweep, table1};
+use host_sim::study::{passivity, sweep, table1};
 use host_sim::{Report, Sample, Simulation};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
@@ -51,6 +51,8 @@ enum Cmd {
     Table1(Table1Args),
     /// Measure what accuracy costs: every integrator x sub-step count.
     Accuracy(AccuracyArgs),
+    /// The passivity layer's scenes: off, on, and at passive settings.
+    Passivity(PassivityArgs),
     /// Processor-in-the-loop: this plant against a board over a serial port
     /// (the firmware in QEMU, or a real board), compared with the same
     /// board loop run in-process.
@@ -84,6 +86,16 @@ struct PilArgs {
     /// within its watchdog deadline.
     #[arg(long)]
     check: bool,
+}
+
+#[derive(Args)]
+struct PassivityArgs {
+    /// The folder of the passivity scenes.
+    #[arg(long, default_value = "scenes/passivity")]
+    scenes: PathBuf,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(Args)]
@@ -271,6 +283,21 @@ fn sweep(a: &SweepArgs) -> Result<(), String> {
             a.param,
             a.tol * 100.0
         );
+    }
+    Ok(())
+}
+
+/// The passivity layer's table: each scene off, on, and at its passive
+/// reference.
+fn passivity(a: &PassivityArgs) -> Result<(), String> {
+    let n = table1::case_files(&a.scenes)?.len();
+    let b = bar(n as u64, "passivity scenes".into());
+    let rows = passivity::table(&a.scenes, &mut || b.inc(1))?;
+    b.finish_and_clear();
+    if a.json {
+        println!("{}", json!({ "rows": rows }));
+    } else {
+        print!("{}", passivity::markdown(&rows));
     }
     Ok(())
 }
@@ -548,6 +575,7 @@ fn subcommand(c: &Cmd) -> Result<(), String> {
         Cmd::Scope(a) => scope(a),
         Cmd::Run(a) => run(a),
         Cmd::Sweep(a) => sweep(a),
+        Cmd::Passivity(a) => passivity(a),
         Cmd::Table1(a) => table1(a),
         Cmd::Accuracy(a) => accuracy(a),
         Cmd::Pil(a) => pil(a),

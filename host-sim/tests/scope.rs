@@ -97,14 +97,24 @@ fn pause_and_step_advance_one_tick() {
 
 #[test]
 fn the_scope_memory_is_bounded() {
-    let mut s = ScopeState::open(Path::new("../scenes/stiff_wall.toml")).unwrap();
-    s.speed = Speed::Fastest;
-    for _ in 0..3 * RING_SAMPLES {
-        assert!(s.tick());
-    }
-    for sig in Signal::ALL {
-        assert_eq!(s.ring(sig).len(), RING_SAMPLES);
-        assert_eq!(s.ring(sig).capacity(), RING_SAMPLES);
+    // Without a passivity layer its two signals stay empty; with one,
+    // every ring fills to its bound and no further.
+    for (scene, layer) in [
+        ("../scenes/stiff_wall.toml", false),
+        ("../scenes/passivity/stiff_wall_4x.toml", true),
+    ] {
+        let mut s = ScopeState::open(Path::new(scene)).unwrap();
+        assert_eq!(s.has_layer(), layer);
+        s.speed = Speed::Fastest;
+        for _ in 0..3 * RING_SAMPLES {
+            assert!(s.tick());
+        }
+        for sig in Signal::ALL {
+            let of_layer = matches!(sig, Signal::LayerEnergy | Signal::LayerAdded);
+            let want = if of_layer && !layer { 0 } else { RING_SAMPLES };
+            assert_eq!(s.ring(sig).len(), want, "{scene}: {sig:?}");
+            assert_eq!(s.ring(sig).capacity(), RING_SAMPLES);
+        }
     }
 }
 

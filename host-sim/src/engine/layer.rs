@@ -2,7 +2,7 @@
 //! what the display's element sees, and the books the scope and the report
 //! read (observed energy, added damping, energy dissipated).
 
-use crate::engine::scene::{Display, Scene};
+use crate::engine::scene::{Display, LayerPort, Scene};
 use std::collections::VecDeque;
 use twoport_control::passivity::{
     EnergyObserver, ParallelDamper, ParallelLimits, PassivityLimits, SeriesDamper,
@@ -31,7 +31,10 @@ impl<R: Real> SceneLayer<R> {
     /// nor an element delay (the servo then runs with no layer at all).
     pub fn for_scene(scene: &Scene, safety: &SafetyConfig) -> Result<Option<Self>, String> {
         let delay_ticks = scene.effects.element_delay.map_or(0, |d| d.ticks as usize);
-        let spec = scene.passivity.filter(|p| p.enabled);
+        let spec = scene
+            .passivity
+            .as_ref()
+            .filter(|p| p.enabled && p.port == LayerPort::Device);
         if spec.is_none() && delay_ticks == 0 {
             return Ok(None);
         }

@@ -44,13 +44,18 @@ pub struct Scene {
 /// The passivity layer between the device's port and the display's
 /// element: the series damper on an impedance display, the parallel damper
 /// on an admittance display (see `docs/passivity.md`).
-#[derive(Clone, Copy, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PassivitySpec {
     /// Whether the layer runs (`--set passivity.enabled=false` turns a
     /// scene's layer off, everything else equal).
     #[serde(default = "default_true")]
     pub enabled: bool,
+    /// Which port it watches: `device` (the default: the series damper at
+    /// the encoder) or `ve` (a parallel damper between the coupling and an
+    /// admittance VE, for a VE that is unstable on its own).
+    #[serde(default)]
+    pub port: LayerPort,
     /// Moving mass at the port (kg), which sets the damping cap; the
     /// plant's `rigid_mass_kg` by default.
     pub mass_kg: Option<f64>,
@@ -63,6 +68,22 @@ pub struct PassivitySpec {
     pub min_velocity_mps: Option<f64>,
     /// Energy reserve (J); 0.5 J by default.
     pub max_reserve_j: Option<f64>,
+    /// The `--set` assignments that make this scene passive without the
+    /// layer (an implicit VE, the proven gains, no delay): the reference
+    /// the layer's transparency cost is measured against.
+    #[serde(default)]
+    pub reference: Vec<String>,
+}
+
+/// Where the passivity layer sits.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LayerPort {
+    /// At the device's port (the encoder).
+    #[default]
+    Device,
+    /// Between the coupling and the VE.
+    Ve,
 }
 
 fn default_true() -> bool {
@@ -776,6 +797,14 @@ impl Scene {
             }
         }
         if let Some(p) = &self.passivity {
+            if p.port == LayerPort::Ve {
+                if self.display != Display::Impedance {
+                    return Err("passivity.port = \"ve\" is for an impedance display (an admittance display's layer already sits at the load cell)".into());
+                }
+                if !matches!(self.ve, VeSpec::Cursor { .. }) {
+                    return Err("passivity.port = \"ve\" needs a cursor VE (one that takes a force and answers with a velocity)".into());
+                }
+            }
             if let Some(m) = p.mass_kg {
                 pos("passivity.mass_kg", m)?;
             }

@@ -4,8 +4,11 @@
 
 use crate::engine::blocks::{Block, Blocks};
 use crate::engine::layer::SceneLayer;
-use crate::engine::scene::{Discretization, Integration, Precision, Scene, SolidSide, VeSpec};
+use crate::engine::scene::{
+    Discretization, Integration, LayerPort, Precision, Scene, SolidSide, VeSpec,
+};
 use crate::engine::ve::SceneVe;
+use twoport_control::passivity::{ParallelLimits, PassiveVe};
 use twoport_control::servo::{Gains, PortLayer, SensorFrame, Servo, ServoOutput};
 use twoport_control::ve::{
     BilateralConstraint, CursorMass, ExplicitCursor, Solid, Spring, TrapezoidalSpring,
@@ -47,6 +50,20 @@ fn build<R: Real>(
     safety: SafetyConfig,
 ) -> Result<Servo<SceneVe<R>, R>, String> {
     let ve = scene_ve(scene, safety.period_s)?;
+    let ve = match (&scene.passivity, &scene.ve) {
+        (Some(p), VeSpec::Cursor { mass_kg, .. }) if p.enabled && p.port == LayerPort::Ve => {
+            let limits = ParallelLimits::for_display(
+                *mass_kg as f32,
+                safety.period_s,
+                safety.max_velocity_mps,
+            )
+            .map_err(|e| e.to_string())?;
+            SceneVe::Passive(Box::new(
+                PassiveVe::new(ve, limits).map_err(|e| e.to_string())?,
+            ))
+        }
+        _ => ve,
+    };
     Servo::new_in(scene.gains(), encoder, safety, ve).map_err(|e| e.to_string())
 }
 
@@ -138,12 +155,20 @@ impl SceneServo {
         each_servo!(self, s => s.gains())
     }
 
-    /// The port layer, if the scene has one.
+    /// The passivity layer, if the scene runs one (at the device's port,
+    /// or at the VE's), or its element delay.
     pub fn layer(&self) -> Option<LayerView<'_>> {
         match self {
-            SceneServo::F32Layered(s) => Some(LayerView::F32(s.layer())),
-            SceneServo::F64Layered(s) => Some(LayerView::F64(s.layer())),
-            _ => None,
+            SceneServo::F32Layered(s) => Some(LayerView::Device32(s.layer())),
+            SceneServo::F64Layered(s) => Some(LayerView::Device64(s.layer())),
+            SceneServo::F32(s) => match s.ve() {
+                SceneVe::Passive(p) => Some(LayerView::Ve32(p)),
+                _ => None,
+            },
+            SceneServo::F64(s) => match s.ve() {
+                SceneVe::Passive(p) => Some(LayerView::Ve64(p)),
+                _ => None,
+            },
         }
     }
 
@@ -164,37 +189,49 @@ impl SceneServo {
     }
 }
 
-/// A scene servo's port layer, in its float type.
+/// A scene servo's passivity layer, where it sits and in its float type.
 #[derive(Clone, Copy, Debug)]
 pub enum LayerView<'a> {
-    /// The f32 laws' layer.
-    F32(&'a SceneLayer<f32>),
-    /// The f64 laws' layer.
-    F64(&'a SceneLayer<f64>),
+    /// At the device's port, the f32 laws'.
+    Device32(&'a SceneLayer<f32>),
+    /// At the device's port, the f64 laws'.
+    Device64(&'a SceneLayer<f64>),
+    /// At the VE's port, the f32 laws'.
+    Ve32(&'a PassiveVe<SceneVe<f32>, f32>),
+    /// At the VE's port, the f64 laws'.
+    Ve64(&'a PassiveVe<SceneVe<f64>, f64>),
 }
 
 impl LayerView<'_> {
-    /// See [`SceneLayer::energy_in_j`].
+    /// The energy (J) its observer has seen the element take in; NaN for
+    /// an element delay without a controller.
     pub fn energy_in_j(&self) -> f64 {
         match self {
-            LayerView::F32(l) => l.energy_in_j(),
-            LayerView::F64(l) => l.energy_in_j(),
+            LayerView::Device32(l) => l.energy_in_j(),
+            LayerView::Device64(l) => l.energy_in_j(),
+            LayerView::Ve32(p) => p.energy_in_j() as f64,
+            LayerView::Ve64(p) => p.energy_in_j(),
         }
     }
 
-    /// See [`SceneLayer::added`].
+    /// What it added this tick: damping (N s/m) at the device's port,
+    /// conductance (m/(N s)) at a load cell or the VE's port.
     pub fn added(&self) -> f64 {
         match self {
-            LayerView::F32(l) => l.added(),
-            LayerView::F64(l) => l.added(),
+            LayerView::Device32(l) => l.added(),
+            LayerView::Device64(l) => l.added(),
+            LayerView::Ve32(p) => p.conductance_mpns() as f64,
+            LayerView::Ve64(p) => p.conductance_mpns(),
         }
     }
 
-    /// See [`SceneLayer::dissipated_j`].
+    /// The energy (J) it has dissipated so far.
     pub fn dissipated_j(&self) -> f64 {
         match self {
-            LayerView::F32(l) => l.dissipated_j(),
-            LayerView::F64(l) => l.dissipated_j(),
+            LayerView::Device32(l) => l.dissipated_j(),
+            LayerView::Device64(l) => l.dissipated_j(),
+            LayerView::Ve32(p) => p.dissipated_j() as f64,
+            LayerView::Ve64(p) => p.dissipated_j(),
         }
     }
 }

@@ -1,6 +1,7 @@
 //! The scene's VE: the control crate's VEs, or the building-block world.
 
 use crate::engine::blocks::Blocks;
+use twoport_control::passivity::PassiveVe;
 use twoport_control::ve::{
     BilateralConstraint, Causality, CursorMass, ExplicitCursor, Port, Spring, TrapezoidalSpring,
     UnilateralWall, VeOutput, VeTransfer, VirtualEnvironment,
@@ -26,6 +27,8 @@ pub enum SceneVe<R: Real = f32> {
     /// The building-block world (host-only, computing in f32 whatever the
     /// controller's type: an f64 controller's port is rounded to it).
     Blocks(Box<Blocks>),
+    /// A VE behind the passivity controller at its port.
+    Passive(Box<PassiveVe<SceneVe<R>, R>>),
 }
 
 /// `$e` on the VE in any variant but the blocks, `$blocks` on those.
@@ -38,9 +41,34 @@ macro_rules! each {
             SceneVe::Bilateral($v) => $e,
             SceneVe::Spring($v) => $e,
             SceneVe::TrapezoidalSpring($v) => $e,
+            SceneVe::Passive(p) => {
+                let $v = p.unbox();
+                $e
+            }
             SceneVe::Blocks($b) => $blocks,
         }
     };
+}
+
+/// A boxed VE as a reference to it, shared or not, so that `each!` calls
+/// the same code on it as on the others.
+trait Unbox {
+    type Out;
+    fn unbox(self) -> Self::Out;
+}
+
+impl<'a, T> Unbox for &'a Box<T> {
+    type Out = &'a T;
+    fn unbox(self) -> &'a T {
+        self
+    }
+}
+
+impl<'a, T> Unbox for &'a mut Box<T> {
+    type Out = &'a mut T;
+    fn unbox(self) -> &'a mut T {
+        self
+    }
 }
 
 impl<R: Real> VirtualEnvironment<R> for SceneVe<R> {

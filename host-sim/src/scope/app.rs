@@ -48,11 +48,16 @@ pub enum Signal {
     EnergyIn,
     /// Energy stored in the device (J).
     EnergyStored,
+    /// Energy the passivity layer saw its element take in (J).
+    LayerEnergy,
+    /// What the passivity layer added: damping (N s/m) or conductance
+    /// (m/(N s)).
+    LayerAdded,
 }
 
 impl Signal {
     /// Every signal, in ring order.
-    pub const ALL: [Signal; 10] = [
+    pub const ALL: [Signal; 12] = [
         Signal::HandlePosition,
         Signal::HandleVelocity,
         Signal::HumanForce,
@@ -63,6 +68,8 @@ impl Signal {
         Signal::CouplingForce,
         Signal::EnergyIn,
         Signal::EnergyStored,
+        Signal::LayerEnergy,
+        Signal::LayerAdded,
     ];
 
     /// Legend text with unit.
@@ -78,6 +85,8 @@ impl Signal {
             Signal::CouplingForce => "coupling force (N)",
             Signal::EnergyIn => "energy in from the human (J)",
             Signal::EnergyStored => "energy stored in the device (J)",
+            Signal::LayerEnergy => "energy the passivity layer saw taken in (J)",
+            Signal::LayerAdded => "damping the passivity layer added (N s/m, or m/(N s) at a VE)",
         }
     }
 
@@ -93,6 +102,8 @@ impl Signal {
             Signal::CouplingForce => s.coupling_n,
             Signal::EnergyIn => s.energy_in_j,
             Signal::EnergyStored => s.energy_stored_j,
+            Signal::LayerEnergy => s.layer_energy_j,
+            Signal::LayerAdded => s.layer_added,
         }
     }
 
@@ -346,6 +357,11 @@ impl ScopeState {
         &self.scene
     }
 
+    /// Whether the scene runs a passivity layer (its plot is shown).
+    pub fn has_layer(&self) -> bool {
+        self.sim.servo().layer().is_some()
+    }
+
     /// Simulated time (s).
     pub fn time_s(&self) -> f64 {
         self.last.map_or(0.0, |s| s.t_s)
@@ -450,7 +466,11 @@ impl ScopeState {
         };
         self.debt_s -= self.sim.period();
         for (sig, ring) in Signal::ALL.iter().zip(&mut self.rings) {
-            ring.push(s.t_s, sig.of(&s));
+            // A scene without a passivity layer has no layer signals.
+            let v = sig.of(&s);
+            if !v.is_nan() {
+                ring.push(s.t_s, v);
+            }
         }
         self.last = Some(s);
         self.board_messages();

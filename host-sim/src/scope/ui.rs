@@ -71,10 +71,13 @@ fn signal_plot(
         });
 }
 
-/// The four plots on one time axis. The span is found once a frame (a
-/// triggered one scans the trigger signal's ring).
+/// The plots on one time axis: positions, velocity, forces, energy, and
+/// the passivity layer's damping when the scene runs one. The span is
+/// found once a frame (a triggered one scans the trigger signal's ring).
 pub fn plots(ui: &mut Ui, s: &ScopeState) {
-    let h = ((ui.available_height() - 24.0) / 4.0).max(80.0);
+    let layer = s.has_layer();
+    let n = if layer { 5.0 } else { 4.0 };
+    let h = ((ui.available_height() - 24.0) / n).max(80.0);
     let span = s.view();
     signal_plot(
         ui,
@@ -107,9 +110,20 @@ pub fn plots(ui: &mut Ui, s: &ScopeState) {
         span,
         "energy",
         h,
-        &[Signal::EnergyIn, Signal::EnergyStored],
+        &[Signal::EnergyIn, Signal::EnergyStored, Signal::LayerEnergy],
         &[],
     );
+    if layer {
+        signal_plot(
+            ui,
+            s,
+            span,
+            "passivity layer",
+            h,
+            &[Signal::LayerAdded],
+            &[],
+        );
+    }
 }
 
 /// Scene picker, play/pause/step/reset, speed, time and status.
