@@ -78,6 +78,10 @@ struct PilArgs {
     /// zero force within its watchdog deadline.
     #[arg(long)]
     link_loss_at_s: Option<f64>,
+    /// The board runs the passivity image (the series damper at the
+    /// actuator's port): compare it with that image's in-process loop.
+    #[arg(long)]
+    passivity: bool,
     /// Print one JSON object on stdout.
     #[arg(long)]
     json: bool,
@@ -427,7 +431,16 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         link_loss_at,
     };
     let start = std::time::Instant::now();
-    let reference = pil::run(scene.clone(), ticks, pil::LocalBoard::excalibur()?, faults)?;
+    let reference = if a.passivity {
+        pil::run(
+            scene.clone(),
+            ticks,
+            pil::LocalBoard::excalibur_with_passivity()?,
+            faults,
+        )?
+    } else {
+        pil::run(scene.clone(), ticks, pil::LocalBoard::excalibur()?, faults)?
+    };
     let local_s = start.elapsed().as_secs_f64();
     let (run, remote_s) = match &a.port {
         Some(p) => {

@@ -12,6 +12,8 @@ use crate::{Sample, Scene, Simulation};
 use std::time::{Duration, Instant};
 use twoport_board::excalibur::{self, REGION_POINTS};
 use twoport_board::Board;
+use twoport_control::passivity::SeriesDamper;
+use twoport_control::servo::{Direct, PortLayer};
 use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::ve::UnilateralWall;
 use twoport_link::{
@@ -60,9 +62,10 @@ impl BoardPort for SerialBoard {
     }
 }
 
-/// The Excalibur board image's loop, in this process.
-pub struct LocalBoard {
-    board: Board<UnilateralWall, REGION_POINTS>,
+/// The Excalibur board image's loop, in this process: the plain image's,
+/// or the passivity image's (`L` the series damper).
+pub struct LocalBoard<L = Direct> {
+    board: Board<UnilateralWall, REGION_POINTS, L>,
     out: Vec<u8>,
 }
 
@@ -78,7 +81,19 @@ impl LocalBoard {
     }
 }
 
-impl BoardPort for LocalBoard {
+impl LocalBoard<SeriesDamper> {
+    /// The passivity image ([`excalibur::stiff_wall_board_with_passivity`]).
+    pub fn excalibur_with_passivity() -> Result<Self, String> {
+        Ok(LocalBoard {
+            board: excalibur::stiff_wall_board_with_passivity()
+                .map_err(|e| format!("the Excalibur passivity image: {e:?}"))?
+                .with_pil(true),
+            out: Vec::new(),
+        })
+    }
+}
+
+impl<L: PortLayer> BoardPort for LocalBoard<L> {
     fn send(&mut self, bytes: &[u8]) -> Result<(), String> {
         // Byte by byte, as a UART delivers them.
         for &b in bytes {

@@ -180,6 +180,14 @@ fn ci() -> Result<(), String> {
         "3".into(),
         "--check".into(),
     ])?;
+    // The passivity image too: the layered tick on the M4F against the
+    // same code on the host.
+    pil(&[
+        "--passivity".into(),
+        "--seconds".into(),
+        "3".into(),
+        "--check".into(),
+    ])?;
     scope_board()?;
     fuzz(60)?;
     // Last, closing on the total so that CI reads the whole count rather
@@ -325,14 +333,36 @@ fn firmware() -> Result<PathBuf, String> {
     Ok(out)
 }
 
+/// The an386 image built with the passivity layer (its own target folder,
+/// so that the plain image is not rebuilt over); returns its ELF.
+fn passivity_image() -> Result<PathBuf, String> {
+    let tc = Toolchain::detect()?;
+    let dir = cross_target_dir("firmware-passivity");
+    run(
+        &format!("build firmware: the passivity image ({})", tc.describe()),
+        &mut tc.build(
+            &root().join("firmware"),
+            &dir,
+            &["-p", "twoport-an386", "--features", "passivity"],
+        ),
+    )?;
+    Ok(dir.join(TARGET).join("release").join("twoport-an386"))
+}
+
 /// Processor-in-the-loop: start the an386 image in QEMU with its UART on a
-/// pty, point `host-sim pil` at it, and fail if either side fails.
+/// pty, point `host-sim pil` at it, and fail if either side fails. With
+/// `--passivity` among the options, the passivity image.
 fn pil(extra: &[String]) -> Result<(), String> {
     run(
         "build host-sim",
         cargo().args(["build", "--release", "-q", "-p", "host-sim"]),
     )?;
-    with_board_in_qemu(|pty| {
+    let elf = if extra.iter().any(|a| a == "--passivity") {
+        passivity_image()?
+    } else {
+        firmware()?.join("twoport-an386")
+    };
+    with_board_in_qemu(&elf, |pty| {
         run(
             "host-sim pil",
             cargo()
@@ -345,7 +375,8 @@ fn pil(extra: &[String]) -> Result<(), String> {
 
 /// The scope's board mode against the firmware in QEMU.
 fn scope_board() -> Result<(), String> {
-    with_board_in_qemu(|pty| {
+    let elf = firmware()?.join("twoport-an386");
+    with_board_in_qemu(&elf, |pty| {
         run(
             "scope board mode against QEMU",
             cargo()
@@ -360,10 +391,12 @@ fn scope_board() -> Result<(), String> {
 /// Run `f` with the an386 image in QEMU, its UART on the pty `f` gets;
 /// fails if the firmware stops (a panic or HardFault exits QEMU) or `f`
 /// fails.
-fn with_board_in_qemu(f: impl FnOnce(&str) -> Result<(), String>) -> Result<(), String> {
+fn with_board_in_qemu(
+    elf: &Path,
+    f: impl FnOnce(&str) -> Result<(), String>,
+) -> Result<(), String> {
     use std::io::{BufRead, BufReader, Read};
-    let elf = firmware()?.join("twoport-an386");
-    let mut qemu = qemu_an386(&elf)
+    let mut qemu = qemu_an386(elf)
         .args(["-display", "none", "-monitor", "none", "-serial", "pty"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())

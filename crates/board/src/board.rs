@@ -3,7 +3,7 @@
 use crate::io::IoScale;
 use crate::region::{Bound, Region};
 use heapless::{Deque, Vec};
-use twoport_control::servo::{Gains, SensorFrame, Servo, ServoOutput};
+use twoport_control::servo::{Direct, Gains, PortLayer, SensorFrame, Servo, ServoOutput};
 use twoport_control::ve::VirtualEnvironment;
 use twoport_control::Faults;
 use twoport_link::{
@@ -17,10 +17,11 @@ pub type Frame = Vec<u8, MAX_FRAME>;
 /// telemetry in the other, so a telemetry flood never crowds out an answer.
 pub const TX_FRAMES: usize = 8;
 
-/// The portable firmware loop.
+/// The portable firmware loop, around a servo with port layer `L` (none by
+/// default; the passivity image runs the series damper).
 #[derive(Clone, Debug)]
-pub struct Board<V, const R: usize> {
-    servo: Servo<V>,
+pub struct Board<V, const R: usize, L = Direct> {
+    servo: Servo<V, f32, L>,
     region: Region<R>,
     decoder: Decoder,
     /// Replies and fault reports, sent first.
@@ -41,10 +42,10 @@ pub struct Board<V, const R: usize> {
     pil_refused: u32,
 }
 
-impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
+impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     /// A board running `servo`, accepting gain changes inside `region`, and
     /// sending telemetry every `telemetry_every` ticks (0: never).
-    pub fn new(servo: Servo<V>, region: Region<R>, telemetry_every: u32) -> Self {
+    pub fn new(servo: Servo<V, f32, L>, region: Region<R>, telemetry_every: u32) -> Self {
         Board {
             servo,
             region,
@@ -100,7 +101,7 @@ impl<V: VirtualEnvironment, const R: usize> Board<V, R> {
     }
 
     /// The servo (gains, safety state).
-    pub fn servo(&self) -> &Servo<V> {
+    pub fn servo(&self) -> &Servo<V, f32, L> {
         &self.servo
     }
 

@@ -7,6 +7,8 @@
 use crate::io::IoScale;
 use crate::region::{Bound, Region, RegionError};
 use crate::Board;
+use twoport_control::passivity::{PassivityLimits, SeriesDamper};
+use twoport_control::servo::GainsError;
 use twoport_control::ve::{Solid, UnilateralWall};
 use twoport_control::{
     Encoder, EncoderError, ImpedanceGains, ParamError, Position, SafetyConfig, Servo,
@@ -21,6 +23,8 @@ pub enum BuildError {
     Encoder(EncoderError),
     /// The shipped region table.
     Region(RegionError),
+    /// A port layer for the other display.
+    Layer(GainsError),
 }
 
 impl From<ParamError> for BuildError {
@@ -98,6 +102,36 @@ pub fn stiff_wall_servo() -> Result<Servo<UnilateralWall>, BuildError> {
         Position::ZERO,
     )?;
     Ok(Servo::new(COUPLING.into(), enc, safety(), ve)?)
+}
+
+/// The actuator's port as the passivity layer sees it: the moving mass at
+/// the encoder (kg, the model's actuator inertia) and a lower bound of its
+/// own viscous damping (N s/m).
+pub const ACTUATOR_PORT: (f32, f32) = (0.93, 4.0);
+
+/// The stiff wall's servo with the passivity layer (the series damper) at
+/// the actuator's port: the passivity image's.
+pub fn stiff_wall_servo_with_passivity(
+) -> Result<Servo<UnilateralWall, f32, SeriesDamper>, BuildError> {
+    let (mass_kg, damping_nspm) = ACTUATOR_PORT;
+    let mut limits = PassivityLimits::for_device(mass_kg, PERIOD_S, safety().peak_force_n)?;
+    limits.device_damping_nspm = damping_nspm;
+    let layer = SeriesDamper::new(limits)?;
+    stiff_wall_servo()?
+        .with_layer(layer)
+        .map_err(BuildError::Layer)
+}
+
+/// The passivity image's board: [`stiff_wall_board`] with the series
+/// damper between the actuator's port and the coupling.
+pub fn stiff_wall_board_with_passivity(
+) -> Result<Board<UnilateralWall, REGION_POINTS, SeriesDamper>, BuildError> {
+    Ok(Board::new(
+        stiff_wall_servo_with_passivity()?,
+        proven_region()?,
+        TELEMETRY_EVERY,
+    )
+    .with_io(IoScale::EXCALIBUR))
 }
 
 /// The whole board: servo, region, telemetry rate, I/O scaling. It reads its

@@ -3,6 +3,8 @@
 //! sensors arriving and its PWM duty leaving as link frames on UART0, one
 //! tick per sensor frame (lockstep with host-sim). Started by
 //! `cargo xtask pil`; a panic or HardFault ends QEMU with a failure code.
+//! With the `passivity` feature the image runs the series damper at the
+//! actuator's port (`cargo xtask pil --passivity`).
 
 #![no_std]
 #![no_main]
@@ -17,7 +19,11 @@ use twoport_qemu_exit::exit;
 
 #[entry]
 fn main() -> ! {
-    let Ok(mut board) = excalibur::stiff_wall_board().map(|b| b.with_pil(true)) else {
+    #[cfg(not(feature = "passivity"))]
+    let board = excalibur::stiff_wall_board();
+    #[cfg(feature = "passivity")]
+    let board = excalibur::stiff_wall_board_with_passivity();
+    let Ok(mut board) = board.map(|b| b.with_pil(true)) else {
         hprintln!("the Excalibur board image would not build");
         exit(false)
     };
