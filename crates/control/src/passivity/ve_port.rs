@@ -101,7 +101,7 @@ impl<V: VirtualEnvironment<R>, R: Real> PassiveVe<V, R> {
     }
 
     /// The conductance for this tick, from what was booked up to the last.
-    #[inline]
+    #[inline(always)]
     fn conductance(&self) -> R {
         let e = self.taken_in_j.value();
         let f = self.last_force_n;
@@ -125,6 +125,9 @@ impl<V: VirtualEnvironment<R>, R: Real> VirtualEnvironment<R> for PassiveVe<V, R
         self.ve.causality()
     }
 
+    // Always inlined: once per tick, inside the coupling's step, where a
+    // call would spill the tick's registers (the M4F count).
+    #[inline(always)]
     fn step(&mut self, port: Port<R>) -> VeOutput<R> {
         let beta = self.conductance();
         self.conductance_mpns = beta;
