@@ -59,7 +59,7 @@ impl PassivityLimits {
     /// ```
     /// use twoport_control::passivity::PassivityLimits;
     ///
-    /// // Excalibur's x axis: about 0.7 kg at the handle, 1 kHz, 200 N.
+    /// // A 0.7 kg port at 1 kHz with a 200 N actuator.
     /// let l = PassivityLimits::for_device(0.7, 1e-3, 200.0).unwrap();
     /// assert!((l.max_damping_nspm - 240.2).abs() < 0.1);
     /// assert!(PassivityLimits::for_device(0.0, 1e-3, 200.0).is_err());
