@@ -333,11 +333,13 @@ fn firmware() -> Result<PathBuf, String> {
     Ok(out)
 }
 
-/// The an386 image built with the passivity layer (its own target folder,
-/// so that the plain image is not rebuilt over); returns its ELF.
+/// The an386 image built with the passivity layer; returns its ELF. It
+/// shares the firmware's target folder, so only the image's own crate is
+/// rebuilt (the feature is its alone), and is copied aside, because the
+/// next plain build writes the same file.
 fn passivity_image() -> Result<PathBuf, String> {
     let tc = Toolchain::detect()?;
-    let dir = cross_target_dir("firmware-passivity");
+    let dir = cross_target_dir("firmware");
     run(
         &format!("build firmware: the passivity image ({})", tc.describe()),
         &mut tc.build(
@@ -346,7 +348,11 @@ fn passivity_image() -> Result<PathBuf, String> {
             &["-p", "twoport-an386", "--features", "passivity"],
         ),
     )?;
-    Ok(dir.join(TARGET).join("release").join("twoport-an386"))
+    let out = dir.join(TARGET).join("release");
+    let elf = out.join("twoport-an386-passivity");
+    std::fs::copy(out.join("twoport-an386"), &elf)
+        .map_err(|e| format!("copy the passivity image: {e}"))?;
+    Ok(elf)
 }
 
 /// Processor-in-the-loop: start the an386 image in QEMU with its UART on a
