@@ -19,7 +19,8 @@ pub struct SceneLayer<R: Real> {
     delay: VecDeque<(Position, R)>,
     delay_ticks: usize,
     /// The series damper's correction, booked like the element's force:
-    /// the energy it took in is what the layer dissipated.
+    /// the energy it took in is what the layer dissipated (as commanded,
+    /// before the safety layer's limit, which rarely binds here).
     correction: EnergyObserver<R>,
     /// The parallel damper's dissipation (J).
     parallel_dissipated_j: f64,
