@@ -69,27 +69,31 @@ pub struct LocalBoard<L = Direct> {
     out: Vec<u8>,
 }
 
+impl<L: PortLayer> LocalBoard<L> {
+    /// `board`, driven by the link's sensor frames.
+    fn driven(board: Board<UnilateralWall, REGION_POINTS, L>) -> Self {
+        LocalBoard {
+            board: board.with_pil(true),
+            out: Vec::new(),
+        }
+    }
+}
+
 impl LocalBoard {
     /// The image the firmware ships ([`excalibur::stiff_wall_board`]).
     pub fn excalibur() -> Result<Self, String> {
-        Ok(LocalBoard {
-            board: excalibur::stiff_wall_board()
-                .map_err(|e| format!("the Excalibur board image: {e:?}"))?
-                .with_pil(true),
-            out: Vec::new(),
-        })
+        excalibur::stiff_wall_board()
+            .map(Self::driven)
+            .map_err(|e| format!("the Excalibur board image: {e:?}"))
     }
 }
 
 impl LocalBoard<SeriesDamper> {
     /// The passivity image ([`excalibur::stiff_wall_board_with_passivity`]).
     pub fn excalibur_with_passivity() -> Result<Self, String> {
-        Ok(LocalBoard {
-            board: excalibur::stiff_wall_board_with_passivity()
-                .map_err(|e| format!("the Excalibur passivity image: {e:?}"))?
-                .with_pil(true),
-            out: Vec::new(),
-        })
+        excalibur::stiff_wall_board_with_passivity()
+            .map(Self::driven)
+            .map_err(|e| format!("the Excalibur passivity image: {e:?}"))
     }
 }
 
