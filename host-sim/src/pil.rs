@@ -9,9 +9,10 @@
 //! run is the reference the firmware must match.
 
 use crate::{Sample, Scene, Simulation};
+use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 use twoport_board::excalibur::{self, REGION_POINTS};
-use twoport_board::Board;
+use twoport_board::{Board, BoardSupport, RawSensors};
 use twoport_control::passivity::SeriesDamper;
 use twoport_control::servo::{Direct, PortLayer};
 use twoport_control::servo::{SensorFrame, ServoOutput};
@@ -66,7 +67,32 @@ impl BoardPort for SerialBoard {
 /// or the passivity image's (`L` the series damper).
 pub struct LocalBoard<L = Direct> {
     board: Board<UnilateralWall, REGION_POINTS, L>,
+    link: HostLink,
+}
+
+/// The in-process board's only peripheral: its link, as two byte queues.
+#[derive(Default)]
+struct HostLink {
+    rx: VecDeque<u8>,
     out: Vec<u8>,
+}
+
+impl BoardSupport for HostLink {
+    // A processor-in-the-loop board reads no sensors of its own.
+    fn sample(&mut self) -> RawSensors {
+        RawSensors::default()
+    }
+    // The duty goes back in the board's actuator frame.
+    fn set_duty(&mut self, _: i16) {}
+    fn read_byte(&mut self) -> Option<u8> {
+        self.rx.pop_front()
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        self.out.extend_from_slice(bytes);
+    }
+    fn cycles(&mut self) -> u32 {
+        0
+    }
 }
 
 impl<L: PortLayer> LocalBoard<L> {
@@ -74,7 +100,7 @@ impl<L: PortLayer> LocalBoard<L> {
     fn driven(board: Board<UnilateralWall, REGION_POINTS, L>) -> Self {
         LocalBoard {
             board: board.with_pil(true),
-            out: Vec::new(),
+            link: HostLink::default(),
         }
     }
 }
@@ -99,19 +125,25 @@ impl LocalBoard<SeriesDamper> {
 
 impl<L: PortLayer> BoardPort for LocalBoard<L> {
     fn send(&mut self, bytes: &[u8]) -> Result<(), String> {
-        // Byte by byte, as a UART delivers them.
-        for &b in bytes {
-            self.board.on_bytes(&[b]);
-            while let Some(f) = self.board.pop_tx() {
-                self.out.extend_from_slice(&f);
+        // What the images do: the control tick runs each sensor frame as
+        // it completes, and the main loop sends what was queued.
+        self.link.rx.extend(bytes);
+        loop {
+            let ready = self.board.poll_link(&mut self.link);
+            if ready {
+                self.board.control_tick(&mut self.link);
+            }
+            self.board.flush(&mut self.link);
+            if !ready && self.link.rx.is_empty() {
+                return Ok(());
             }
         }
-        Ok(())
     }
     fn recv(&mut self, buf: &mut [u8], _: Duration) -> Result<usize, String> {
-        let n = buf.len().min(self.out.len());
-        buf[..n].copy_from_slice(&self.out[..n]);
-        self.out.drain(..n);
+        let out = &mut self.link.out;
+        let n = buf.len().min(out.len());
+        buf[..n].copy_from_slice(&out[..n]);
+        out.drain(..n);
         Ok(n)
     }
 }

@@ -5,9 +5,10 @@
 //! - `thumb`: build `twoport-control` for thumbv7em-none-eabihf.
 //! - `firmware`: build the firmware workspace.
 //! - `qemu`: build and run the on-target tests in QEMU mps2-an386.
-//! - `pil [host-sim pil options]`: processor-in-the-loop, the firmware in
-//!   QEMU against host-sim's plant over `-serial pty` (e.g. `--json`,
-//!   `--seconds 4`, `--link-loss-at-s 3`, `--check`).
+//! - `pil [--board an386|stm32f405] [host-sim pil options]`:
+//!   processor-in-the-loop, a board image in QEMU against host-sim's plant
+//!   over `-serial pty` (e.g. `--json`, `--seconds 4`, `--link-loss-at-s 3`,
+//!   `--check`, `--passivity`).
 //! - `scope-board`: the scope's board mode against the firmware in QEMU.
 //! - `fuzz [seconds]`: run each cargo-fuzz target (default 60 s each).
 //! - `accuracy`: regenerate docs/accuracy.md and docs/accuracy.png.
@@ -48,7 +49,7 @@ fn main() -> ExitCode {
             ]),
         ),
         _ => Err(format!(
-            "usage: cargo xtask <ci|thumb|firmware|qemu|pil [options]|scope-board|fuzz [seconds]|accuracy>\n  got: {}",
+            "usage: cargo xtask <ci|thumb|firmware|qemu|pil [--board an386|stm32f405] [options]|scope-board|fuzz [seconds]|accuracy>\n  got: {}",
             args.join(" ")
         )),
     };
@@ -185,6 +186,17 @@ fn ci() -> Result<(), String> {
     pil(&[
         "--passivity".into(),
         "--seconds".into(),
+        "3".into(),
+        "--check".into(),
+    ])?;
+    // The STM32F405 image's own loop on QEMU's netduinoplus2, the same
+    // checks; the log of what it touches that QEMU does not model is shown.
+    pil(&[
+        "--board".into(),
+        "stm32f405".into(),
+        "--seconds".into(),
+        "4".into(),
+        "--link-loss-at-s".into(),
         "3".into(),
         "--check".into(),
     ])?;
@@ -355,34 +367,136 @@ fn passivity_image() -> Result<PathBuf, String> {
     Ok(elf)
 }
 
-/// Processor-in-the-loop: start the an386 image in QEMU with its UART on a
-/// pty, point `host-sim pil` at it, and fail if either side fails. With
-/// `--passivity` among the options, the passivity image.
+/// The STM32F405 image's `qemu` build, for QEMU's netduinoplus2; returns
+/// its ELF, copied aside as the passivity image is.
+fn stm32f405_qemu_image() -> Result<PathBuf, String> {
+    let tc = Toolchain::detect()?;
+    let dir = cross_target_dir("firmware");
+    run(
+        &format!(
+            "build firmware: the STM32F405 image for QEMU ({})",
+            tc.describe()
+        ),
+        &mut tc.build(
+            &root().join("firmware/stm32f405"),
+            &dir,
+            &["--features", "qemu"],
+        ),
+    )?;
+    let out = dir.join(TARGET).join("release");
+    let elf = out.join("twoport-stm32f405-qemu");
+    std::fs::copy(out.join("twoport-stm32f405"), &elf)
+        .map_err(|e| format!("copy the STM32F405 QEMU image: {e}"))?;
+    Ok(elf)
+}
+
+/// Processor-in-the-loop: start a board image in QEMU with its link on a
+/// pty, point `host-sim pil` at it, and fail if either side fails. The
+/// an386 image by default (`--passivity`: its passivity build); with
+/// `--board stm32f405`, the STM32F405 image's own loop on netduinoplus2,
+/// whose accesses to devices QEMU does not model are logged and summed up.
 fn pil(extra: &[String]) -> Result<(), String> {
+    let mut args = extra.to_vec();
+    let board = match args.iter().position(|a| a == "--board") {
+        Some(i) if i + 1 < args.len() => {
+            let b = args.remove(i + 1);
+            args.remove(i);
+            b
+        }
+        Some(_) => return Err("pil: --board needs a name (an386 or stm32f405)".into()),
+        None => "an386".into(),
+    };
     run(
         "build host-sim",
         cargo().args(["build", "--release", "-q", "-p", "host-sim"]),
     )?;
-    let elf = if extra.iter().any(|a| a == "--passivity") {
-        passivity_image()?
-    } else {
-        firmware()?.join("twoport-an386")
-    };
-    with_board_in_qemu(&elf, |pty| {
+    let host = |pty: &str| {
         run(
             "host-sim pil",
             cargo()
                 .args(["run", "--release", "-q", "-p", "host-sim", "--"])
                 .args(["pil", "--port", pty])
-                .args(extra),
+                .args(&args),
         )
-    })
+    };
+    match board.as_str() {
+        "an386" => {
+            let elf = if args.iter().any(|a| a == "--passivity") {
+                passivity_image()?
+            } else {
+                firmware()?.join("twoport-an386")
+            };
+            let mut qemu = qemu_an386(&elf);
+            qemu.args(["-serial", "pty"]);
+            with_board_in_qemu(qemu, host)
+        }
+        "stm32f405" => {
+            if args.iter().any(|a| a == "--passivity") {
+                return Err("pil: the STM32F405 image has no passivity build".into());
+            }
+            let elf = stm32f405_qemu_image()?;
+            let log = cross_target_dir("firmware").join("qemu-unmodelled-stm32f405.log");
+            let _ = std::fs::remove_file(&log);
+            let mut qemu = qemu_netduino(&elf);
+            // USART2 is the second serial port.
+            qemu.args(["-serial", "null", "-serial", "pty"])
+                .args(["-d", "unimp,guest_errors", "-D"])
+                .arg(&log);
+            let result = with_board_in_qemu(qemu, host);
+            eprint!("{}", unmodelled_summary(&log));
+            result
+        }
+        other => Err(format!(
+            "pil: no board image called {other:?} (an386 or stm32f405)"
+        )),
+    }
+}
+
+/// What QEMU logged of the image's accesses to devices it does not model:
+/// a line per device, with its read and write counts.
+fn unmodelled_summary(log: &Path) -> String {
+    let Ok(text) = std::fs::read_to_string(log) else {
+        return format!("xtask: no QEMU log at {}\n", log.display());
+    };
+    let mut seen: Vec<(String, u64, u64)> = Vec::new();
+    let mut other = 0u64;
+    for line in text.lines() {
+        let Some((device, rest)) = line.split_once(": unimplemented device ") else {
+            other += u64::from(!line.trim().is_empty());
+            continue;
+        };
+        let i = match seen.iter().position(|(d, _, _)| d == device) {
+            Some(i) => i,
+            None => {
+                seen.push((device.to_string(), 0, 0));
+                seen.len() - 1
+            }
+        };
+        if rest.starts_with("read") {
+            seen[i].1 += 1;
+        } else {
+            seen[i].2 += 1;
+        }
+    }
+    let mut s = format!(
+        "xtask: devices the image touches that QEMU does not model (log: {}):\n",
+        log.display()
+    );
+    for (d, r, w) in &seen {
+        s += &format!("  {d:<10} {r:>6} reads {w:>6} writes\n");
+    }
+    if other > 0 {
+        s += &format!("  and {other} other lines (guest errors)\n");
+    }
+    s
 }
 
 /// The scope's board mode against the firmware in QEMU.
 fn scope_board() -> Result<(), String> {
     let elf = firmware()?.join("twoport-an386");
-    with_board_in_qemu(&elf, |pty| {
+    let mut qemu = qemu_an386(&elf);
+    qemu.args(["-serial", "pty"]);
+    with_board_in_qemu(qemu, |pty| {
         run(
             "scope board mode against QEMU",
             cargo()
@@ -394,16 +508,17 @@ fn scope_board() -> Result<(), String> {
     })
 }
 
-/// Run `f` with the an386 image in QEMU, its UART on the pty `f` gets;
-/// fails if the firmware stops (a panic or HardFault exits QEMU) or `f`
-/// fails.
+/// Run `f` with a board image in QEMU (`qemu`, its link on a `-serial
+/// pty`), passing it the pty; fails if the firmware stops (a panic or
+/// HardFault exits QEMU) or `f` fails. QEMU is killed, not asked, to stop:
+/// under `-icount sleep=off` it may not answer a SIGTERM.
 fn with_board_in_qemu(
-    elf: &Path,
+    mut qemu: Command,
     f: impl FnOnce(&str) -> Result<(), String>,
 ) -> Result<(), String> {
     use std::io::{BufRead, BufReader, Read};
-    let mut qemu = qemu_an386(elf)
-        .args(["-display", "none", "-monitor", "none", "-serial", "pty"])
+    let mut qemu = qemu
+        .args(["-display", "none", "-monitor", "none"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -496,6 +611,20 @@ fn qemu_an386(elf: &Path) -> Command {
     let mut c = Command::new("qemu-system-arm");
     c.args(["-machine", "mps2-an386", "-cpu", "cortex-m4"])
         .args(["-icount", "shift=6"])
+        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
+        .arg(elf)
+        .stdin(Stdio::null());
+    c
+}
+
+/// QEMU's netduinoplus2 (an STM32F405 SoC) running `elf`, with
+/// semihosting, and virtual time from the instruction count, 16 ns each
+/// (the image's `ICOUNT_SHIFT`), so that its TIM5 counts instructions and
+/// its TIM2 control interrupt is periodic in them.
+fn qemu_netduino(elf: &Path) -> Command {
+    let mut c = Command::new("qemu-system-arm");
+    c.args(["-machine", "netduinoplus2"])
+        .args(["-icount", "shift=4"])
         .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
         .arg(elf)
         .stdin(Stdio::null());

@@ -2,6 +2,7 @@
 
 use crate::io::IoScale;
 use crate::region::{Bound, Region};
+use crate::support::BoardSupport;
 use heapless::{Deque, Vec};
 use twoport_control::servo::{Direct, Gains, PortLayer, SensorFrame, Servo, ServoOutput};
 use twoport_control::ve::VirtualEnvironment;
@@ -40,6 +41,10 @@ pub struct Board<V, const R: usize, L = Direct> {
     /// loop). A board with real sensors must never let the host move it.
     pil: bool,
     pil_refused: u32,
+    /// The host's sensor frame waiting for the next control tick (PIL).
+    pending: Option<SensorFrame>,
+    /// Ticks run from the board's own sensors (their frame's `tick`).
+    ticks: u32,
 }
 
 impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
@@ -62,6 +67,8 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             last: ServoOutput::default(),
             pil: false,
             pil_refused: 0,
+            pending: None,
+            ticks: 0,
         }
     }
 
@@ -114,11 +121,6 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     /// oldest of their queue).
     pub fn tx_dropped(&self) -> u32 {
         self.tx_dropped
-    }
-
-    /// What the board support measured the last tick to cost.
-    pub fn set_loop_cycles(&mut self, cycles: u32) {
-        self.loop_cycles = cycles;
     }
 
     /// Bytes from the link.
@@ -191,21 +193,18 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
                 rx: self.decoder.stats(),
                 tx_dropped: self.tx_dropped,
             })),
-            // Processor-in-the-loop: the host's sensors drive one tick, the
-            // duty goes straight back.
+            // Processor-in-the-loop: the host's sensors wait for the next
+            // control tick, which answers with the duty.
             Message::Sensors(_) if !self.pil => {
                 self.pil_refused = self.pil_refused.saturating_add(1);
             }
             Message::Sensors(s) => {
-                let frame = SensorFrame {
+                self.pending = Some(SensorFrame {
                     tick: s.tick,
                     encoder_raw: s.encoder_raw,
                     load_cell_n: self.io.load_cell_n(s.load_cell_raw),
                     dead_man_closed: s.dead_man_closed,
-                };
-                self.tick(&frame);
-                let duty = self.duty();
-                self.queue(Message::Actuator(ActuatorFrame { tick: s.tick, duty }));
+                });
             }
             _ => {}
         }
@@ -256,6 +255,74 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             Ok(()) => GainsReply::Accepted(self.servo.gains().into()),
             Err(_) => GainsReply::Refused(Refusal::OutOfRange),
         }
+    }
+
+    /// Whether a host's sensor frame waits for a control tick (PIL only).
+    pub fn sensors_pending(&self) -> bool {
+        self.pending.is_some()
+    }
+
+    /// Take the bytes the link has received, stopping early where one
+    /// completes a sensor frame (PIL), so that each frame gets its own
+    /// tick. Returns whether a sensor frame waits.
+    pub fn poll_link(&mut self, io: &mut impl BoardSupport) -> bool {
+        while self.pending.is_none() {
+            let Some(b) = io.read_byte() else { break };
+            self.on_bytes(&[b]);
+        }
+        self.pending.is_some()
+    }
+
+    /// Send every queued frame (replies first, then telemetry).
+    pub fn flush(&mut self, io: &mut impl BoardSupport) {
+        while let Some(f) = self.pop_tx() {
+            io.write(&f);
+        }
+    }
+
+    /// The control interrupt's body, the same in every image: sample the
+    /// sensors, run one [`tick`](Self::tick), command the amplifier.
+    ///
+    /// A processor-in-the-loop board takes its sensors from the host
+    /// instead: it serves the link (answering as it goes) until the host's
+    /// sensor frame for this tick has come, which is what an emulated
+    /// board's ADC conversion amounts to, and answers with the duty. The
+    /// time from the sensors to the command, in the support's
+    /// [`cycles`](BoardSupport::cycles), goes out in the next telemetry.
+    pub fn control_tick(&mut self, io: &mut impl BoardSupport) -> ServoOutput {
+        let (frame, start) = if self.pil {
+            let frame = loop {
+                if self.poll_link(io) {
+                    if let Some(f) = self.pending.take() {
+                        break f;
+                    }
+                }
+                self.flush(io);
+            };
+            (frame, io.cycles())
+        } else {
+            let start = io.cycles();
+            let raw = io.sample();
+            let frame = SensorFrame {
+                tick: self.ticks,
+                encoder_raw: raw.encoder_raw,
+                load_cell_n: self.io.load_cell_n(raw.load_cell_counts),
+                dead_man_closed: raw.dead_man_closed,
+            };
+            self.ticks = self.ticks.wrapping_add(1);
+            (frame, start)
+        };
+        let out = self.tick(&frame);
+        let duty = self.duty();
+        io.set_duty(duty);
+        if self.pil {
+            self.queue(Message::Actuator(ActuatorFrame {
+                tick: frame.tick,
+                duty,
+            }));
+        }
+        self.loop_cycles = io.cycles().wrapping_sub(start);
+        out
     }
 
     /// One control tick: the law, a fault report when new faults latch,

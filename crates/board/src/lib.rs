@@ -7,7 +7,9 @@ mod board;
 pub mod excalibur;
 mod io;
 mod region;
+mod support;
 
 pub use board::{Board, Frame, TX_FRAMES};
 pub use io::{IoScale, DUTY_FULL_SCALE};
 pub use region::{Bound, Region, RegionError};
+pub use support::{BoardSupport, RawSensors};

@@ -1,6 +1,6 @@
 //! The portable firmware loop driven over the wire, as a host drives it.
 
-use twoport_board::{Board, Bound, Region};
+use twoport_board::{Board, BoardSupport, Bound, RawSensors, Region};
 use twoport_control::servo::SensorFrame;
 use twoport_control::ve::BilateralConstraint;
 use twoport_control::{
@@ -23,6 +23,7 @@ fn region() -> Region<3> {
 fn safety() -> SafetyConfig {
     SafetyConfig {
         heartbeat_timeout_ticks: 50,
+        require_dead_man: true,
         ..SafetyConfig::excalibur()
     }
 }
@@ -353,24 +354,142 @@ fn a_board_with_real_sensors_ignores_sensor_frames_from_the_link() {
         .all(|m| !matches!(m, Message::Actuator(_))));
 }
 
+/// A board's peripherals in a test: link bytes in and out, the duties
+/// commanded, sensors that never change.
+#[derive(Default)]
+struct Io {
+    rx: std::collections::VecDeque<u8>,
+    tx: Vec<u8>,
+    duties: Vec<i16>,
+    sensors: RawSensors,
+    samples: u32,
+    clock: u32,
+}
+
+impl BoardSupport for Io {
+    fn sample(&mut self) -> RawSensors {
+        self.samples += 1;
+        self.sensors
+    }
+    fn set_duty(&mut self, duty: i16) {
+        self.duties.push(duty);
+    }
+    fn read_byte(&mut self) -> Option<u8> {
+        self.rx.pop_front()
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        self.tx.extend_from_slice(bytes);
+    }
+    fn cycles(&mut self) -> u32 {
+        // A clock that advances 7 per look, so that a tick measures 7.
+        self.clock = self.clock.wrapping_add(7);
+        self.clock
+    }
+}
+
+impl Io {
+    fn queue(&mut self, seq: u16, m: Message) {
+        let mut buf = [0u8; MAX_FRAME];
+        let n = encode(seq, &m, &mut buf).unwrap();
+        self.rx.extend(&buf[..n]);
+    }
+    fn messages(&mut self) -> Vec<Message> {
+        let mut out = Vec::new();
+        Decoder::new().feed(&std::mem::take(&mut self.tx), |e| out.push(e.msg));
+        out
+    }
+}
+
 #[test]
 fn a_pil_board_ticks_once_per_sensor_frame_and_answers_with_the_duty() {
     let mut b = board().with_pil(true);
-    send(&mut b, 0, Message::Enable);
+    let mut io = Io::default();
+    io.queue(0, Message::hello(Role::Host));
+    io.queue(1, Message::Enable);
     for k in 0..30u16 {
-        send(&mut b, 1 + k, sensors(u32::from(k), u32::from(k) * 10));
+        io.queue(2 + k, sensors(u32::from(k), u32::from(k) * 10));
     }
-    let acts: Vec<_> = replies(&mut b)
-        .into_iter()
+    // Sensor frames from the link only wait; the control tick runs them.
+    b.on_bytes(&[]);
+    assert!(!b.sensors_pending());
+    // As an image's main loop does, send what each tick queued.
+    for _ in 0..30 {
+        b.control_tick(&mut io);
+        b.flush(&mut io);
+    }
+    assert!(io.rx.is_empty());
+    let msgs = io.messages();
+    assert!(matches!(msgs[0], Message::HelloAck { accepted: true, .. }));
+    let acts: Vec<_> = msgs
+        .iter()
         .filter_map(|m| match m {
-            Message::Actuator(a) => Some(a),
+            Message::Actuator(a) => Some(*a),
             _ => None,
         })
         .collect();
-    // The queue holds the newest replies; each answers its own tick with
-    // the duty of the force that tick held.
-    assert!(!acts.is_empty());
-    assert_eq!(acts.last().unwrap().tick, 29);
-    assert_eq!(acts.last().unwrap().duty, b.duty());
+    // Each tick answers its own frame with the duty it commanded, and the
+    // board never read its own sensors.
+    assert_eq!(acts.len(), 30);
+    for (k, a) in acts.iter().enumerate() {
+        assert_eq!(a.tick, k as u32);
+        assert_eq!(a.duty, io.duties[k]);
+    }
+    assert!(io.duties.iter().any(|d| *d != 0));
+    assert_eq!(io.samples, 0);
     assert_eq!(b.pil_refused(), 0);
+}
+
+#[test]
+fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
+    let mut b = board();
+    let mut io = Io {
+        sensors: RawSensors {
+            encoder_raw: 30,
+            load_cell_counts: 1_500,
+            dead_man_closed: true,
+        },
+        ..Io::default()
+    };
+    io.queue(0, Message::Enable);
+    // Not a PIL board: nothing the link says makes a tick wait.
+    assert!(!b.poll_link(&mut io));
+    let mut outs = Vec::new();
+    // Past the enable's force ramp.
+    let mut tx = Vec::new();
+    for k in 0..120 {
+        // The host's heartbeats, which the main loop takes off the link.
+        io.queue(1 + k, Message::Heartbeat);
+        b.poll_link(&mut io);
+        outs.push(b.control_tick(&mut io));
+        b.flush(&mut io);
+        tx.extend(io.messages());
+    }
+    assert_eq!(io.samples, 120);
+    // 30 um off the constraint at 51 kN/m is about 1.5 N of pull back;
+    // the load cell reads 1.5 N through the scale.
+    assert!(
+        outs.last().unwrap().actuator_force_n.abs() > 1.0,
+        "{:?}",
+        outs.last()
+    );
+    assert_eq!(*io.duties.last().unwrap(), b.duty());
+    let telemetry: Vec<_> = tx
+        .into_iter()
+        .filter_map(|m| match m {
+            Message::Telemetry(t) => Some(t),
+            _ => None,
+        })
+        .collect();
+    // Telemetry every 10 ticks, numbered by the board's own count, with
+    // the time one tick took in the support's cycles.
+    assert_eq!(
+        telemetry.iter().map(|t| t.tick).collect::<Vec<_>>(),
+        (9..120).step_by(10).collect::<Vec<u32>>()
+    );
+    assert!(telemetry.iter().all(|t| (t.load_cell_n - 1.5).abs() < 1e-6));
+    assert!(telemetry.iter().all(|t| t.loop_cycles == 7));
+    // The dead-man opens: zero force in that very tick.
+    io.sensors.dead_man_closed = false;
+    let out = b.control_tick(&mut io);
+    assert_eq!(*io.duties.last().unwrap(), 0, "{out:?}");
 }

@@ -11,7 +11,7 @@
 
 mod uart;
 
-use cortex_m::peripheral::{syst::SystClkSource, SYST};
+use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
 use twoport_board::excalibur;
@@ -27,9 +27,9 @@ fn main() -> ! {
         hprintln!("the Excalibur board image would not build");
         exit(false)
     };
-    let mut uart = uart::Uart::take();
-    // SysTick measures each frame's handling; with `-icount shift=N` it is
-    // a deterministic function of the instructions executed.
+    let mut io = uart::Uart::take();
+    // SysTick times each tick; with `-icount shift=N` it is a
+    // deterministic function of the instructions executed.
     if let Some(mut p) = cortex_m::Peripherals::take() {
         p.SYST.set_clock_source(SystClkSource::Core);
         p.SYST.set_reload(0x00FF_FFFF);
@@ -37,19 +37,9 @@ fn main() -> ! {
         p.SYST.enable_counter();
     }
     hprintln!("twoport-an386: board loop up, waiting on UART0");
+    // Lockstep: each control tick waits for the host's sensor frame.
     loop {
-        if let Some(b) = uart.read() {
-            let start = SYST::get_current();
-            board.on_bytes(&[b]);
-            if b == 0 {
-                // A frame ended here: what handling it (and any tick it
-                // drove) cost.
-                let used = start.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF;
-                board.set_loop_cycles(used);
-            }
-        }
-        while let Some(frame) = board.pop_tx() {
-            uart.write(&frame);
-        }
+        board.control_tick(&mut io);
+        board.flush(&mut io);
     }
 }

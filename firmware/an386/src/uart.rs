@@ -1,8 +1,11 @@
-//! The CMSDK APB UART of the ARM MPS2 boards (QEMU `mps2-an386`, UART0 is
-//! the first `-serial`). Polled: the loop is driven by the bytes that
-//! arrive, so nothing here needs an interrupt.
+//! The image's board support: the CMSDK APB UART of the ARM MPS2 boards
+//! (QEMU `mps2-an386`, UART0 is the first `-serial`) and SysTick. Polled:
+//! the loop is driven by the bytes that arrive, so nothing here needs an
+//! interrupt. The sensors and the amplifier are the host's, over the link.
 
 use core::ptr::{read_volatile, write_volatile};
+use cortex_m::peripheral::SYST;
+use twoport_board::{BoardSupport, RawSensors};
 
 /// UART0's registers.
 const BASE: usize = 0x4000_4000;
@@ -15,8 +18,12 @@ const STATE_RX_FULL: u32 = 1 << 1;
 const CTRL_TX_EN: u32 = 1 << 0;
 const CTRL_RX_EN: u32 = 1 << 1;
 
-/// UART0, owned by the loop.
-pub struct Uart(());
+/// UART0 and SysTick, owned by the loop.
+pub struct Uart {
+    /// SysTick's last reading, and the 32-bit count it extends to.
+    last: u32,
+    cycles: u32,
+}
 
 impl Uart {
     /// Enable transmit and receive. The divider only matters to real
@@ -28,7 +35,7 @@ impl Uart {
             write_volatile(BAUDDIV as *mut u32, 16);
             write_volatile(CTRL as *mut u32, CTRL_TX_EN | CTRL_RX_EN);
         }
-        Uart(())
+        Uart { last: 0, cycles: 0 }
     }
 
     fn state(&self) -> u32 {
@@ -36,8 +43,7 @@ impl Uart {
         unsafe { read_volatile(STATE as *const u32) }
     }
 
-    /// A received byte, if one is waiting.
-    pub fn read(&mut self) -> Option<u8> {
+    fn read(&mut self) -> Option<u8> {
         if self.state() & STATE_RX_FULL == 0 {
             return None;
         }
@@ -45,12 +51,37 @@ impl Uart {
         Some(unsafe { read_volatile(DATA as *const u32) } as u8)
     }
 
-    /// Send `bytes`, waiting while the transmit buffer is full.
-    pub fn write(&mut self, bytes: &[u8]) {
+    fn send(&mut self, bytes: &[u8]) {
         for &b in bytes {
             while self.state() & STATE_TX_FULL != 0 {}
             // SAFETY: UART0's DATA register; writing it sends the byte.
             unsafe { write_volatile(DATA as *mut u32, b as u32) };
         }
+    }
+}
+
+impl BoardSupport for Uart {
+    // Never called: this image is processor-in-the-loop only.
+    fn sample(&mut self) -> RawSensors {
+        RawSensors::default()
+    }
+    // The duty goes back to the host in the board's actuator frame.
+    fn set_duty(&mut self, _: i16) {}
+    fn read_byte(&mut self) -> Option<u8> {
+        self.read()
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        self.send(bytes)
+    }
+    fn cycles(&mut self) -> u32 {
+        // SysTick counts down over 24 bits; the elapsed counts since the
+        // last look extend it to 32, which is right while looks come less
+        // than 2^24 cycles apart (both looks of a tick do).
+        let now = SYST::get_current();
+        self.cycles = self
+            .cycles
+            .wrapping_add(self.last.wrapping_sub(now) & 0x00FF_FFFF);
+        self.last = now;
+        self.cycles
     }
 }

@@ -1,0 +1,40 @@
+//! What a board image provides to the portable loop: its peripherals,
+//! behind one trait, so that the control interrupt's body
+//! ([`Board::control_tick`](crate::Board::control_tick)) is written once
+//! for every image, and a host test can stand in for the hardware.
+
+/// One tick's sensors as the peripherals give them, before any scaling.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RawSensors {
+    /// The encoder timer's count (its low `bits` are meaningful).
+    pub encoder_raw: u32,
+    /// The load-cell ADC reading, offset removed (counts; signed).
+    pub load_cell_counts: i32,
+    /// Whether the dead-man switch is closed (the hand is on the handle).
+    pub dead_man_closed: bool,
+}
+
+/// A board's peripherals, as the loop uses them.
+///
+/// The image owns the timer that calls the control interrupt; the loop
+/// needs only what is below. Every method is called with the board's lock
+/// held, so none of them may wait long: `write` only ever sends a queued
+/// frame, and `sample` waits only for the conversion it started.
+pub trait BoardSupport {
+    /// Latch every sensor at one instant and return the readings: the
+    /// encoder count, the load cell (starting its conversion and waiting
+    /// for it) and the dead-man input.
+    fn sample(&mut self) -> RawSensors;
+    /// Command the amplifier: a signed duty, ±[`DUTY_FULL_SCALE`] at
+    /// full-scale force, 0 for none.
+    ///
+    /// [`DUTY_FULL_SCALE`]: crate::DUTY_FULL_SCALE
+    fn set_duty(&mut self, duty: i16);
+    /// A byte the link received, if one is waiting.
+    fn read_byte(&mut self) -> Option<u8>;
+    /// Send bytes on the link.
+    fn write(&mut self, bytes: &[u8]);
+    /// A free-running count for timing the loop: core cycles on hardware,
+    /// instructions in an emulator with `-icount`, 0 where there is none.
+    fn cycles(&mut self) -> u32;
+}

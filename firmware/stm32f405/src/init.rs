@@ -1,0 +1,195 @@
+//! Bringing the chip up: clocks, pins and peripheral modes. The emulated
+//! build (`qemu` feature) differs only where QEMU's `netduinoplus2` does:
+//! no RCC ready bits to wait on, and timers with a fixed 1 GHz clock.
+
+use stm32f4::stm32f405 as pac;
+use twoport_board::excalibur;
+
+/// TIM1 auto-reload: 168 MHz / (2 x 4200) = 20 kHz centre-aligned PWM.
+pub const PWM_ARR: u32 = 4200;
+
+/// HSE and PLL to 168 MHz, flash wait states, peripheral clocks on.
+pub fn clocks(rcc: &pac::RCC, flash: &pac::FLASH) {
+    rcc.cr().modify(|_, w| w.hseon().set_bit());
+    wait_for(|| rcc.cr().read().hserdy().bit_is_set());
+    // SAFETY: PLLM = 8, PLLN = 336, PLLQ = 7 are inside the reference
+    // manual's ranges (8 MHz / 8 x 336 / 2 = 168 MHz, / 7 = 48 MHz).
+    rcc.pllcfgr().write(|w| unsafe {
+        w.pllsrc()
+            .hse()
+            .pllm()
+            .bits(8)
+            .plln()
+            .bits(336)
+            .pllp()
+            .div2()
+            .pllq()
+            .bits(7)
+    });
+    rcc.cr().modify(|_, w| w.pllon().set_bit());
+    wait_for(|| rcc.cr().read().pllrdy().bit_is_set());
+    flash.acr().modify(|_, w| {
+        w.latency()
+            .ws5()
+            .prften()
+            .set_bit()
+            .icen()
+            .set_bit()
+            .dcen()
+            .set_bit()
+    });
+    rcc.cfgr()
+        .modify(|_, w| w.hpre().div1().ppre1().div4().ppre2().div2().sw().pll());
+    wait_for(|| rcc.cfgr().read().sws().is_pll());
+    rcc.ahb1enr().modify(|_, w| {
+        w.gpioaen()
+            .set_bit()
+            .gpioben()
+            .set_bit()
+            .gpiocen()
+            .set_bit()
+    });
+    rcc.apb1enr().modify(|_, w| {
+        w.tim2en()
+            .set_bit()
+            .tim3en()
+            .set_bit()
+            .tim5en()
+            .set_bit()
+            .usart2en()
+            .set_bit()
+    });
+    rcc.apb2enr()
+        .modify(|_, w| w.tim1en().set_bit().adc1en().set_bit());
+}
+
+/// The pins of the table in the crate docs.
+pub fn pins(a: &pac::GPIOA, b: &pac::GPIOB, c: &pac::GPIOC) {
+    a.afrl().modify(|_, w| w.afrl2().af7().afrl3().af7());
+    a.afrh().modify(|_, w| w.afrh8().af1());
+    a.moder().modify(|_, w| {
+        w.moder0()
+            .analog()
+            .moder2()
+            .alternate()
+            .moder3()
+            .alternate()
+            .moder8()
+            .alternate()
+    });
+    b.afrl().modify(|_, w| w.afrl4().af2().afrl5().af2());
+    b.afrh().modify(|_, w| w.afrh13().af1());
+    b.moder().modify(|_, w| {
+        w.moder4()
+            .alternate()
+            .moder5()
+            .alternate()
+            .moder13()
+            .alternate()
+    });
+    b.pupdr()
+        .modify(|_, w| w.pupdr4().pull_up().pupdr5().pull_up());
+    c.moder().modify(|_, w| w.moder0().input());
+    c.pupdr().modify(|_, w| w.pupdr0().pull_up());
+}
+
+/// TIM3 counts the encoder's quadrature edges.
+pub fn encoder(t: &pac::TIM3) {
+    // Encoder mode 3: count on both edges of both channels.
+    t.ccmr1_input().write(|w| w.cc1s().ti1().cc2s().ti2());
+    t.smcr().write(|w| w.sms().encoder_mode_3());
+    t.arr().write(|w| w.arr().set(0xFFFF));
+    t.cr1().modify(|_, w| w.cen().set_bit());
+}
+
+/// TIM1 channel 1 drives the amplifier in locked antiphase.
+pub fn pwm(t: &pac::TIM1) {
+    t.arr().write(|w| w.arr().set(PWM_ARR as u16));
+    t.ccr1().write(|w| w.ccr().set((PWM_ARR / 2) as u16));
+    t.ccmr1_output()
+        .write(|w| w.oc1m().pwm_mode1().oc1pe().set_bit());
+    t.ccer().write(|w| w.cc1e().set_bit().cc1ne().set_bit());
+    // SAFETY: DTG = 84 is 500 ns of dead time at 168 MHz, inside the
+    // field's 8 bits.
+    t.bdtr().write(|w| unsafe { w.dtg().bits(84) });
+    t.cr1()
+        .write(|w| w.cms().center_aligned1().arpe().set_bit().cen().set_bit());
+}
+
+/// ADC1 converts the load cell on request.
+pub fn adc(a: &pac::ADC1) {
+    a.smpr2().write(|w| w.smp0().cycles84());
+    // SAFETY: channel 0 is a valid first conversion of the sequence.
+    a.sqr3().write(|w| unsafe { w.sq1().bits(0) });
+    a.cr2().write(|w| w.adon().set_bit());
+}
+
+/// USART2 carries the link.
+pub fn usart(u: &pac::USART2) {
+    // 42 MHz / 115200 = 22.79: mantissa 22, fraction 13/16.
+    u.brr()
+        .write(|w| w.div_mantissa().set(22).div_fraction().set(13));
+    u.cr1()
+        .write(|w| w.ue().set_bit().te().set_bit().re().set_bit());
+}
+
+/// Control-loop timer counts (1 us each) per tick: the image's period, so
+/// the interrupt rate and the laws' `T` cannot disagree. 1 kHz as shipped;
+/// 100 to 1000 counts give the 1-10 kHz range (a new `T` needs its own
+/// proven region: `twoport region impedance --period T --rust`).
+const LOOP_COUNTS: u32 = (excalibur::PERIOD_S * 1.0e6 + 0.5) as u32;
+const _: () = assert!(LOOP_COUNTS >= 100 && LOOP_COUNTS <= 1000);
+
+/// TIM2's update interrupt calls the control tick every `PERIOD_S`.
+#[cfg(not(feature = "qemu"))]
+pub fn control_timer(t: &pac::TIM2) {
+    // 84 MHz timer clock / 84 = 1 MHz; the chip counts ARR + 1 per period.
+    t.psc().write(|w| w.psc().set(83));
+    t.arr().write(|w| w.set(LOOP_COUNTS - 1));
+    // Load the prescaler now, not at the first update (which would come
+    // 84 times early), and drop the flag that load raises.
+    t.egr().write(|w| w.ug().set_bit());
+    t.sr().modify(|_, w| w.uif().clear_bit());
+    t.dier().write(|w| w.uie().set_bit());
+    t.cr1().write(|w| w.cen().set_bit());
+}
+
+/// TIM2's update interrupt calls the control tick every `PERIOD_S`.
+///
+/// QEMU's timers count a fixed 1 GHz over PSC + 1, whatever RCC says, a
+/// period is ARR counts (not ARR + 1), and the alarm is armed by the
+/// DIER and CR1 writes, so those come first. The count runs from reset
+/// and never wraps at ARR, so it is zeroed before ARR is set: an ARR below
+/// the count arms no alarm at all.
+#[cfg(feature = "qemu")]
+pub fn control_timer(t: &pac::TIM2) {
+    t.dier().write(|w| w.uie().set_bit());
+    t.cr1().write(|w| w.cen().set_bit());
+    t.psc().write(|w| w.psc().set(999));
+    t.cnt().write(|w| w.set(0));
+    t.arr().write(|w| w.set(LOOP_COUNTS));
+}
+
+/// The `-icount shift` QEMU runs this image with: each instruction is
+/// 2^shift ns of virtual time (a 62.5 MHz core at 4).
+#[cfg(feature = "qemu")]
+pub const ICOUNT_SHIFT: u32 = 4;
+
+/// TIM5 free-running at QEMU's 1 GHz over 2^ICOUNT_SHIFT: one count per
+/// instruction, which times the loop there.
+#[cfg(feature = "qemu")]
+pub fn instruction_counter(t: &pac::TIM5) {
+    t.cr1().write(|w| w.cen().set_bit());
+    t.psc().write(|w| w.psc().set((1 << ICOUNT_SHIFT) - 1));
+    t.cnt().write(|w| w.set(0));
+    t.arr().write(|w| w.set(u32::MAX));
+}
+
+/// Wait for a clock to come up. QEMU models no RCC ready bit, so the
+/// emulated build goes on at once: its clocks are fixed.
+fn wait_for(ready: impl Fn() -> bool) {
+    if cfg!(feature = "qemu") {
+        return;
+    }
+    while !ready() {}
+}
