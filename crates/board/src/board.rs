@@ -292,10 +292,9 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     pub fn control_tick(&mut self, io: &mut impl BoardSupport) -> ServoOutput {
         let (frame, start) = if self.pil {
             let frame = loop {
-                if self.poll_link(io) {
-                    if let Some(f) = self.pending.take() {
-                        break f;
-                    }
+                self.poll_link(io);
+                if let Some(f) = self.pending.take() {
+                    break f;
                 }
                 self.flush(io);
             };
