@@ -472,6 +472,10 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         "telemetry_frames": run.telemetry.len(),
         "peak_force_n": run.samples.iter().map(|s| s.actuator_n.abs()).fold(0.0, f64::max),
         "last_loop_cycles": loop_cycles,
+        "start": run.start,
+        "armed_at_tick": run.armed_at_tick,
+        "homing_ticks": run.homing.map(|h| h.0),
+        "homing_error_m": run.homing.map(|h| h.1),
         "board": board,
         "wall_s": remote_s,
     });
@@ -484,6 +488,14 @@ fn pil(a: &PilArgs) -> Result<(), String> {
             c.ticks, c.max_position_error_m, c.max_force_error_n, c.duty_mismatches,
             run.corrupted_sent
         );
+        match run.homing {
+            Some((n, err)) => println!(
+                "  homed onto the hard stop in {n} ticks (calibration {:+.1} um off the plant), armed at tick {}",
+                err * 1e6,
+                run.armed_at_tick
+            ),
+            None => println!("  calibrated at rest, armed at tick {}", run.armed_at_tick),
+        }
         if let Some(z) = run.zero_after_loss_ticks {
             println!(
                 "  link loss: zero force after {z} ticks (watchdog deadline {})",

@@ -17,9 +17,16 @@ use twoport_control::passivity::SeriesDamper;
 use twoport_control::servo::{Direct, PortLayer};
 use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::ve::UnilateralWall;
+use twoport_control::Faults as BoardFaults;
 use twoport_link::{
-    encode, Decoder, LinkStats, Message, Role, SensorFrame as LinkSensors, Telemetry, MAX_FRAME,
+    encode, Decoder, LinkStats, Message, Mode, Role, SensorFrame as LinkSensors, Status, Telemetry,
+    MAX_FRAME,
 };
+
+/// How far a homed board's position may be from the plant's: the stop's
+/// give under the homing force (25 µm on the scenes' 2e5 N/m stop) and a
+/// count or two.
+pub const HOMING_TOLERANCE_M: f64 = 50e-6;
 
 /// How long the host waits for the board's answer to one frame.
 pub const ANSWER_TIMEOUT: Duration = Duration::from_secs(5);
@@ -84,6 +91,8 @@ impl BoardSupport for HostLink {
     }
     // The duty goes back in the board's actuator frame.
     fn set_duty(&mut self, _: i16) {}
+    // So do the outputs: a disarmed board answers zero duty.
+    fn set_outputs(&mut self, _: bool) {}
     fn read_byte(&mut self) -> Option<u8> {
         self.rx.pop_front()
     }
@@ -175,6 +184,33 @@ pub struct Run {
     pub host_dropped: u32,
     /// Ticks from the link loss to the first zero duty that stayed zero.
     pub zero_after_loss_ticks: Option<u64>,
+    /// How the board was armed.
+    pub start: Option<Start>,
+    /// The tick the board armed at.
+    pub armed_at_tick: u64,
+    /// Homing: the ticks it took, and how far the board's calibrated
+    /// position was from the plant's then (m).
+    pub homing: Option<(u64, f64)>,
+}
+
+/// How a run gets its board from disarmed to armed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum Start {
+    /// Tell the board where it stands: every scene starts at rest at 0.
+    Calibrate,
+    /// Home it onto the scene's hard stop (`effects.hard_stop`).
+    Home,
+}
+
+impl Start {
+    /// Home where the scene has a hard stop, else calibrate.
+    pub fn for_scene(scene: &Scene) -> Start {
+        if scene.effects.hard_stop.is_some() {
+            Start::Home
+        } else {
+            Start::Calibrate
+        }
+    }
 }
 
 /// The host side of a lockstep link to a board: handshake, heartbeats,
@@ -193,7 +229,8 @@ pub struct Session<P: BoardPort> {
 }
 
 impl<P: BoardPort> Session<P> {
-    /// Shake hands with the board at `port` and enable it.
+    /// Shake hands with the board at `port`. It is disarmed until
+    /// [`arm`](Self::arm).
     pub fn open(port: P, faults: Faults) -> Result<Self, String> {
         let mut s = Session {
             port,
@@ -206,8 +243,38 @@ impl<P: BoardPort> Session<P> {
             corrupted_sent: 0,
         };
         s.handshake()?;
-        s.send(&Message::Enable)?;
         Ok(s)
+    }
+
+    /// Ask for a mode change and wait for the board's status or refusal.
+    fn ask(&mut self, msg: Message, what: &str) -> Result<Status, String> {
+        self.send(&msg)?;
+        let r = self.wait(what, |m| match m {
+            Message::Status(s) => Some(Ok(*s)),
+            Message::ModeRefused { why, .. } => Some(Err(*why)),
+            _ => None,
+        })?;
+        r.map_err(|why| format!("the board refused {what}: {why:?}"))
+    }
+
+    /// Calibrate a disarmed board: it stands at `position_m` (m).
+    pub fn calibrate(&mut self, position_m: f64) -> Result<Status, String> {
+        let position_pm = (position_m * 1e12).round() as i64;
+        self.ask(Message::Calibrate { position_pm }, "Calibrate")
+    }
+
+    /// Arm the board (it must have had a tick, to see its dead-man).
+    pub fn arm(&mut self) -> Result<Status, String> {
+        let s = self.ask(Message::Arm, "Arm")?;
+        match s.mode {
+            Mode::Armed => Ok(s),
+            m => Err(format!("the board answered Arm in mode {m:?}")),
+        }
+    }
+
+    /// Start homing; the caller runs ticks until [`homed`].
+    pub fn home(&mut self) -> Result<Status, String> {
+        self.ask(Message::Home, "Home")
     }
 
     fn frame(&mut self, msg: &Message) -> Result<Vec<u8>, String> {
@@ -379,19 +446,86 @@ pub fn check_scene(scene: &Scene) -> Result<(), String> {
     }
 }
 
-/// Run `scene` for `ticks` against the board at `port`.
+/// How homing has ended, from the statuses a board sent: `None` while it
+/// goes on, the error where it failed.
+pub fn homed(statuses: &[Status]) -> Option<Result<(), String>> {
+    statuses.iter().find_map(|s| match s.mode {
+        Mode::Homing => None,
+        _ if s.faults != 0 => Some(Err(format!(
+            "homing ended with faults: {}",
+            BoardFaults(s.faults)
+        ))),
+        _ if s.calibrated => Some(Ok(())),
+        m => Some(Err(format!("homing ended uncalibrated, in mode {m:?}"))),
+    })
+}
+
+/// One tick of a run, recorded; returns the statuses the board sent.
+fn record<P: BoardPort>(
+    session: &mut Session<P>,
+    sim: &mut Simulation,
+    r: &mut Run,
+) -> Result<Vec<Status>, String> {
+    let (s, duty) = session.step(sim)?;
+    r.samples.push(s);
+    r.duties.push(duty);
+    let mut statuses = Vec::new();
+    for m in session.take_messages() {
+        match m {
+            Message::Telemetry(t) => r.telemetry.push(t),
+            Message::Status(s) => statuses.push(s),
+            _ => {}
+        }
+    }
+    Ok(statuses)
+}
+
+/// Run `scene` for `ticks` against the board at `port`: the first tick
+/// disarmed, then the board calibrated (or homed, for a scene with a hard
+/// stop) and armed, then the rest.
 pub fn run<P: BoardPort>(scene: Scene, ticks: u64, port: P, faults: Faults) -> Result<Run, String> {
     check_scene(&scene)?;
+    let start = Start::for_scene(&scene);
     let mut sim = Simulation::new(scene)?;
     let mut session = Session::open(port, faults)?;
-    let mut r = Run::default();
-    for _ in 0..ticks {
-        let (s, duty) = session.step(&mut sim)?;
-        r.samples.push(s);
-        r.duties.push(duty);
-        for m in session.take_messages() {
-            if let Message::Telemetry(t) = m {
-                r.telemetry.push(t);
+    let mut r = Run {
+        start: Some(start),
+        ..Run::default()
+    };
+    record(&mut session, &mut sim, &mut r)?;
+    match start {
+        Start::Calibrate => {
+            session.calibrate(0.0)?;
+        }
+        Start::Home => {
+            session.home()?;
+            loop {
+                let statuses = record(&mut session, &mut sim, &mut r)?;
+                if let Some(done) = homed(&statuses) {
+                    done?;
+                    break;
+                }
+                if r.samples.len() as u64 >= ticks {
+                    return Err(format!("the board had not homed after {ticks} ticks"));
+                }
+            }
+            r.homing = Some((r.samples.len() as u64 - 1, f64::NAN));
+        }
+    }
+    // Armed straight after the status that allowed it, which the board
+    // sends before that tick's actuator frame: the same tick on every
+    // transport.
+    session.arm()?;
+    r.armed_at_tick = r.samples.len() as u64;
+    while (r.samples.len() as u64) < ticks {
+        record(&mut session, &mut sim, &mut r)?;
+    }
+    if let Some((n, err)) = &mut r.homing {
+        // The board's position in its first telemetry after homing, at
+        // rest on the stop, against the plant's at that tick.
+        if let Some(t) = r.telemetry.iter().find(|t| u64::from(t.tick) > *n) {
+            if let Some(s) = r.samples.get(t.tick as usize) {
+                *err = t.position_pm as f64 * 1e-12 - s.handle_m;
             }
         }
     }
@@ -417,6 +551,8 @@ pub struct Comparison {
     pub max_force_error_n: f64,
     /// Ticks whose duty differs.
     pub duty_mismatches: u64,
+    /// Whether the two boards armed (or homed) at different ticks.
+    pub start_differs: bool,
 }
 
 /// Compare a run with its reference, tick by tick.
@@ -429,6 +565,8 @@ pub fn compare(a: &Run, b: &Run) -> Comparison {
         c.max_position_error_m = c.max_position_error_m.max((x.handle_m - y.handle_m).abs());
         c.max_force_error_n = c.max_force_error_n.max((x.actuator_n - y.actuator_n).abs());
     }
+    c.start_differs =
+        (a.armed_at_tick, a.homing.map(|h| h.0)) != (b.armed_at_tick, b.homing.map(|h| h.0));
     c.duty_mismatches = a
         .duties
         .iter()
@@ -459,6 +597,12 @@ pub fn failures(
             c.duty_mismatches, c.max_position_error_m, c.max_force_error_n
         ));
     }
+    if c.start_differs {
+        bad.push(format!(
+            "the board armed at tick {}, the in-process loop at another",
+            run.armed_at_tick
+        ));
+    }
     if c.ticks != ticks {
         bad.push(format!("{} of {ticks} ticks ran", c.ticks));
     }
@@ -468,6 +612,24 @@ pub fn failures(
             run.corrupted_sent,
             run.board_stats.rx.dropped()
         ));
+    }
+    if let Some((n, err_m)) = run.homing {
+        if err_m.is_nan() || err_m.abs() > HOMING_TOLERANCE_M {
+            bad.push(format!(
+                "homing calibrated {:.1} um off the plant (tolerance {:.0} um)",
+                err_m * 1e6,
+                HOMING_TOLERANCE_M * 1e6
+            ));
+        }
+        let limit = excalibur::HOMING.force_limit_n as f64;
+        let io = twoport_board::IoScale::EXCALIBUR;
+        let peak = run.duties[..(n as usize + 1).min(run.duties.len())]
+            .iter()
+            .map(|d| io.force_n(*d).abs() as f64)
+            .fold(0.0, f64::max);
+        if peak > limit + 0.01 {
+            bad.push(format!("homing pushed {peak:.2} N (limit {limit} N)"));
+        }
     }
     if let (Some(t0), Some(z)) = (faults.link_loss_at, run.zero_after_loss_ticks) {
         let before = &run.duties[..(t0 as usize).min(run.duties.len())];

@@ -245,4 +245,23 @@ fn bad_scene_files_name_the_line_and_field() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("cable_slack needs the flexible model"), "{e}");
+    for (set, want) in [
+        (
+            "effects.hard_stop={position_m=-5.0}",
+            "effects.hard_stop.position_m = -5 must be within ±1 m",
+        ),
+        (
+            "effects.hard_stop={position_m=-0.02,stiffness_npm=0.0}",
+            "effects.hard_stop.stiffness_npm",
+        ),
+        (
+            "effects.hard_stop={position_m=-0.02,solid=\"left\"}",
+            "unknown variant `left`",
+        ),
+    ] {
+        let e = Scene::parse(&text, "w", &[set.into()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(want), "{set}: {e}");
+    }
 }

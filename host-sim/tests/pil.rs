@@ -92,3 +92,51 @@ fn a_scene_with_another_encoder_is_refused_by_name() {
         .unwrap();
     assert!(e.contains("effects.encoder"), "{e}");
 }
+
+/// The homing scene: the board refuses nothing, homes onto the hard stop
+/// with at most 5 N, lands within the stop's give of the plant's position,
+/// arms, and then holds the wall at its surface against the hand.
+#[test]
+fn a_board_homes_onto_the_hard_stop_then_arms_and_holds_the_wall() {
+    let s = Scene::load(Path::new("../scenes/homing.toml"), &[]).unwrap();
+    let r = pil::run(s, 4500, LocalBoard::excalibur().unwrap(), Faults::default()).unwrap();
+    assert_eq!(r.start, Some(pil::Start::Home));
+    let (n, err_m) = r.homing.expect("homed");
+    // 20 mm at 20 mm/s, the stall and the ramp-in.
+    assert!((1000..2000).contains(&n), "{n} ticks");
+    assert!(err_m.abs() < pil::HOMING_TOLERANCE_M, "{err_m} m");
+    assert!(r.armed_at_tick > n);
+    let c = pil::compare(&r, &r);
+    assert!(pil::failures(&r, &c, 4500, Faults::default(), 50).is_empty());
+    // Before arming nothing pushes harder than the homing limit; after the
+    // hand has pushed the handle into the wall, the wall pushes back hard.
+    let io = twoport_board::IoScale::EXCALIBUR;
+    let peak_before = r.duties[..r.armed_at_tick as usize]
+        .iter()
+        .map(|d| io.force_n(*d).abs())
+        .fold(0.0, f32::max);
+    assert!(peak_before <= 5.01, "{peak_before} N");
+    let peak_after = r.duties[r.armed_at_tick as usize..]
+        .iter()
+        .map(|d| io.force_n(*d).abs())
+        .fold(0.0, f32::max);
+    assert!(peak_after > 10.0, "{peak_after} N");
+    // The hand, led 10 mm past the wall, is held at its surface (the
+    // board's frame is the plant's to within the homing tolerance).
+    let x = r.samples.last().unwrap().handle_m;
+    assert!((0.0095..0.0106).contains(&x), "handle at {x} m");
+}
+
+/// Without homing or a calibration, a board refuses to arm; the run says
+/// so by name instead of running a board that does nothing.
+#[test]
+fn an_uncalibrated_board_refuses_to_arm_by_name() {
+    let mut session =
+        pil::Session::open(LocalBoard::excalibur().unwrap(), Faults::default()).unwrap();
+    let mut sim = Simulation::new(scene()).unwrap();
+    session.step(&mut sim).unwrap();
+    let e = session.arm().unwrap_err();
+    assert!(e.contains("NotCalibrated"), "{e}");
+    session.calibrate(0.0).unwrap();
+    assert_eq!(session.arm().unwrap().mode, twoport_link::Mode::Armed);
+}

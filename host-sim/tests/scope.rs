@@ -10,6 +10,7 @@ use host_sim::scope::app::{ScopeState, Speed, RING_SAMPLES};
 use host_sim::scope::ui::BoardChoice;
 use std::path::Path;
 use twoport_control::servo::{Gains, ImpedanceGains};
+use twoport_link::{Message, Mode};
 
 fn harness() -> Harness<'static, (ScopeState, BoardChoice)> {
     let state = ScopeState::open(Path::new("../scenes/stiff_wall.toml")).unwrap();
@@ -148,10 +149,23 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
     let mut s = ScopeState::open(Path::new("../scenes/stiff_wall.toml")).unwrap();
     s.connect(&pty, true);
     assert!(s.board.is_some(), "{:?}", s.message);
-    for _ in 0..2000 {
+    // It boots disarmed and uncalibrated, and says why it will not arm.
+    s.tell_board(Message::Arm);
+    for _ in 0..5 {
         assert!(s.tick(), "{:?}", s.message);
     }
     let b = s.board.as_ref().unwrap();
+    assert_eq!(b.status.map(|st| st.mode), Some(Mode::Disarmed));
+    assert_eq!(b.refusal.as_deref(), Some("Arm refused: NotCalibrated"));
+    // Calibrated where it stands (at rest at 0), it arms.
+    s.tell_board(Message::Calibrate { position_pm: 0 });
+    s.tell_board(Message::Arm);
+    for _ in 5..2000 {
+        assert!(s.tick(), "{:?}", s.message);
+    }
+    let b = s.board.as_ref().unwrap();
+    let st = b.status.expect("the board's status");
+    assert_eq!((st.mode, st.calibrated, st.faults), (Mode::Armed, true, 0));
     let t = b.telemetry.expect("telemetry from the board");
     assert!(t.tick >= 1900, "tick {}", t.tick);
     assert!(
@@ -159,10 +173,10 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
             .len()
             >= 150
     );
-    // The board's position agrees with the simulated handle's encoder.
+    // The hand, led to 30 mm, is held at the board's wall at 10 mm.
     let x_board = t.position_pm as f64 * 1e-12;
     assert!(
-        x_board > 0.005,
+        (0.0095..0.0106).contains(&x_board),
         "the hand has pushed into the wall: {x_board} m"
     );
     // Inside the proven region: accepted; outside: refused with the reason.

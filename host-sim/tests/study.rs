@@ -92,4 +92,19 @@ fn pil_runs_fail_for_any_difference_and_a_late_zero() {
     r.duties = vec![0; 100];
     r.zero_after_loss_ticks = Some(1);
     assert!(failures(&r, &c, 100, loss, 50)[0].contains("would prove nothing"));
+    // Armed at another tick than the in-process loop.
+    let mut d = c;
+    d.start_differs = true;
+    assert!(failures(&run, &d, 100, Faults::default(), 50)[0].contains("armed at tick"));
+    // Homing: within the stop's give of the plant, and never above 5 N.
+    let mut r = run.clone();
+    r.homing = Some((50, 20e-6));
+    assert!(failures(&r, &c, 100, Faults::default(), 50).is_empty());
+    r.homing = Some((50, 80e-6));
+    assert!(failures(&r, &c, 100, Faults::default(), 50)[0].contains("80.0 um off"));
+    r.homing = Some((50, f64::NAN));
+    assert!(!failures(&r, &c, 100, Faults::default(), 50).is_empty());
+    r.homing = Some((50, 0.0));
+    r.duties[10] = 1000; // 6.1 N
+    assert!(failures(&r, &c, 100, Faults::default(), 50)[0].contains("homing pushed 6.10 N"));
 }

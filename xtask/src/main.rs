@@ -187,6 +187,17 @@ fn ci() -> Result<(), String> {
             "--check",
         ];
         pil(&args.map(String::from))?;
+        // Homing onto the scene's hard stop, then armed: the state machine
+        // bit for bit too.
+        let homing = [
+            "--board",
+            board,
+            "scenes/homing.toml",
+            "--seconds",
+            "3",
+            "--check",
+        ];
+        pil(&homing.map(String::from))?;
     }
     // The passivity image too: the layered tick on the M4F against the
     // same code on the host.

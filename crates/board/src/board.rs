@@ -1,15 +1,18 @@
 //! The loop: servo tick, link in, frames out.
 
+mod arming;
+
 use crate::io::IoScale;
 use crate::region::{Bound, Region};
 use crate::support::BoardSupport;
 use heapless::{Deque, Vec};
+use twoport_control::homing::{Homing, HomingConfig};
 use twoport_control::servo::{Direct, Gains, PortLayer, SensorFrame, Servo, ServoOutput};
 use twoport_control::ve::VirtualEnvironment;
-use twoport_control::Faults;
+use twoport_control::{Faults, Position};
 use twoport_link::{
-    encode, ActuatorFrame, Decoder, GainsReply, LinkStats, Message, Refusal, Stats, Telemetry,
-    MAX_FRAME,
+    encode, ActuatorFrame, Decoder, GainsReply, LinkStats, Message, Mode, Refusal, Stats,
+    Telemetry, MAX_FRAME,
 };
 
 /// One encoded frame, delimiter included.
@@ -45,12 +48,27 @@ pub struct Board<V, const R: usize, L = Direct> {
     pending: Option<SensorFrame>,
     /// Ticks run from the board's own sensors (their frame's `tick`).
     ticks: u32,
+    /// The state machine: disarmed at boot.
+    mode: Mode,
+    /// Whether the encoder's offset is known.
+    calibrated: bool,
+    /// How to home, and the run in progress (in [`Mode::Homing`]).
+    homing_cfg: HomingConfig,
+    homing: Option<Homing>,
+    /// The dead-man switch at the last tick (open before the first).
+    dead_man_closed: bool,
+    /// Whether the amplifier's outputs are on (as last commanded).
+    outputs_on: bool,
 }
 
 impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     /// A board running `servo`, accepting gain changes inside `region`, and
-    /// sending telemetry every `telemetry_every` ticks (0: never).
+    /// sending telemetry every `telemetry_every` ticks (0: never). It
+    /// boots disarmed and uncalibrated, homing toward the negative end
+    /// with [`HomingConfig::gentle`] onto a stop at the origin unless
+    /// [`with_homing`](Self::with_homing) says otherwise.
     pub fn new(servo: Servo<V, f32, L>, region: Region<R>, telemetry_every: u32) -> Self {
+        let period_s = servo.safety().config().period_s;
         Board {
             servo,
             region,
@@ -69,7 +87,21 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             pil_refused: 0,
             pending: None,
             ticks: 0,
+            mode: Mode::Disarmed,
+            calibrated: false,
+            homing_cfg: HomingConfig::gentle(Position::ZERO, period_s),
+            homing: None,
+            dead_man_closed: false,
+            outputs_on: false,
         }
+    }
+
+    /// The same board homing with `cfg` (its `period_s` must be the
+    /// servo's; [`Message::Home`] refuses a configuration that does not
+    /// validate).
+    pub fn with_homing(mut self, cfg: HomingConfig) -> Self {
+        self.homing_cfg = cfg;
+        self
     }
 
     /// The same board driven by sensor frames from the link (processor in
@@ -179,16 +211,13 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             Message::ClearFaults => {
                 self.servo.clear();
                 self.reported = Faults::NONE;
+                self.queue_status();
             }
-            Message::Enable => {
-                if let Err(f) = self.servo.enable() {
-                    self.queue(Message::FaultReport {
-                        faults: f.0,
-                        first: f.lowest().0,
-                    });
-                }
-            }
-            Message::Disable => self.servo.disable(),
+            Message::Arm => self.arm(),
+            Message::Disarm => self.disarm(),
+            Message::Home => self.home(),
+            Message::Calibrate { position_pm } => self.calibrate(position_pm),
+            Message::GetStatus => self.queue_status(),
             Message::GetStats => self.queue(Message::Stats(LinkStats {
                 rx: self.decoder.stats(),
                 tx_dropped: self.tx_dropped,
@@ -290,6 +319,13 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     /// time from the sensors to the command, in the support's
     /// [`cycles`](BoardSupport::cycles), goes out in the next telemetry.
     pub fn control_tick(&mut self, io: &mut impl BoardSupport) -> ServoOutput {
+        let out = self.control_tick_inner(io);
+        // Outputs follow the mode, within the tick that changed it.
+        self.drive_outputs(io);
+        out
+    }
+
+    fn control_tick_inner(&mut self, io: &mut impl BoardSupport) -> ServoOutput {
         let (frame, start) = if self.pil {
             let frame = loop {
                 self.poll_link(io);
@@ -327,8 +363,13 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     /// One control tick: the law, a fault report when new faults latch,
     /// telemetry on schedule. Returns the held actuator command.
     pub fn tick(&mut self, frame: &SensorFrame) -> ServoOutput {
-        let out = self.servo.tick(frame);
+        self.dead_man_closed = frame.dead_man_closed;
+        let out = match &mut self.homing {
+            Some(h) => self.servo.tick_with(frame, |x, v| h.step(x, v)),
+            None => self.servo.tick(frame),
+        };
         self.last = out;
+        self.after_tick(&out);
         if !out.faults.is_empty() && out.faults != self.reported {
             self.reported = out.faults;
             self.queue(Message::FaultReport {
@@ -350,6 +391,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
                     ve_position_pm: self.servo.ve().position().nm() as i64 * 1000,
                     faults: out.faults.0,
                     loop_cycles: self.loop_cycles,
+                    mode: self.mode,
                 }));
             }
         }

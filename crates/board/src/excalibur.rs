@@ -7,6 +7,7 @@
 use crate::io::IoScale;
 use crate::region::{Bound, Region, RegionError};
 use crate::Board;
+use twoport_control::homing::HomingConfig;
 use twoport_control::passivity::{PassivityLimits, SeriesDamper};
 use twoport_control::servo::GainsError;
 use twoport_control::ve::{Solid, UnilateralWall};
@@ -60,6 +61,10 @@ pub const COUPLING: ImpedanceGains = ImpedanceGains::new(51_000.0, 90.0);
 pub const WALL: (i32, f32, f32) = (10_000_000, 5.0e6, 200.0);
 /// Ticks without a host heartbeat before the board forces zero (50 ms).
 pub const HEARTBEAT_TIMEOUT_TICKS: u32 = 50;
+/// Homing: the hard stop is 20 mm below the origin (the wall's surface is
+/// at +10 mm), and the axis homes onto it gently
+/// ([`HomingConfig::gentle`]: 20 mm/s, at most 5 N).
+pub const HOMING: HomingConfig = HomingConfig::gentle(Position::from_nm(-20_000_000), PERIOD_S);
 /// Telemetry every this many ticks (100 Hz).
 pub const TELEMETRY_EVERY: u32 = 10;
 
@@ -131,7 +136,8 @@ pub fn stiff_wall_board_with_passivity(
         proven_region()?,
         TELEMETRY_EVERY,
     )
-    .with_io(IoScale::EXCALIBUR))
+    .with_io(IoScale::EXCALIBUR)
+    .with_homing(HOMING))
 }
 
 /// The whole board: servo, region, telemetry rate, I/O scaling. It reads its
@@ -139,6 +145,7 @@ pub fn stiff_wall_board_with_passivity(
 pub fn stiff_wall_board() -> Result<Board<UnilateralWall, REGION_POINTS>, BuildError> {
     Ok(
         Board::new(stiff_wall_servo()?, proven_region()?, TELEMETRY_EVERY)
-            .with_io(IoScale::EXCALIBUR),
+            .with_io(IoScale::EXCALIBUR)
+            .with_homing(HOMING),
     )
 }

@@ -30,6 +30,10 @@ pub trait BoardSupport {
     ///
     /// [`DUTY_FULL_SCALE`]: crate::DUTY_FULL_SCALE
     fn set_duty(&mut self, duty: i16);
+    /// Switch the amplifier's outputs on or off (a gate-driver enable, a
+    /// timer's main output enable). Off at boot, before the first call;
+    /// the loop turns them on only while homing or armed.
+    fn set_outputs(&mut self, on: bool);
     /// A byte the link received, if one is waiting.
     fn read_byte(&mut self) -> Option<u8>;
     /// Send bytes on the link.

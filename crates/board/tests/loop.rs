@@ -7,7 +7,7 @@ use twoport_control::{
     AdmittanceGains, Encoder, Faults, ImpedanceGains, Position, SafetyConfig, Servo,
 };
 use twoport_link::{
-    encode, Decoder, Gains, GainsReply, Message, Refusal, Role, MAX_FRAME, PROTOCOL_VERSION,
+    encode, Decoder, Gains, GainsReply, Message, Mode, Refusal, Role, MAX_FRAME, PROTOCOL_VERSION,
 };
 
 fn region() -> Region<3> {
@@ -53,6 +53,16 @@ fn replies(b: &mut Board<BilateralConstraint, 3>) -> Vec<Message> {
         d.feed(&f, |e| out.push(e.msg));
     }
     out
+}
+
+/// Tick 0 (the board then knows the dead-man is closed), calibrate where
+/// it stands and arm; the next tick is 1.
+fn arm(b: &mut Board<BilateralConstraint, 3>, raw: u32) {
+    b.tick(&frame(0, raw));
+    send(b, 100, Message::Calibrate { position_pm: 0 });
+    send(b, 101, Message::Arm);
+    assert_eq!(b.mode(), Mode::Armed, "{:?}", replies(b));
+    replies(b);
 }
 
 fn frame(tick: u32, raw: u32) -> SensorFrame {
@@ -173,9 +183,9 @@ fn gains_outside_the_proven_region_are_refused() {
 #[test]
 fn link_loss_gives_zero_force_within_the_watchdog_deadline() {
     let mut b = board();
-    send(&mut b, 0, Message::Enable);
+    arm(&mut b, 0);
     let mut seq = 1;
-    for k in 0..500u32 {
+    for k in 1..500u32 {
         if k % 10 == 0 {
             send(&mut b, seq, Message::Heartbeat);
             seq += 1;
@@ -338,8 +348,8 @@ fn sensors(tick: u32, raw: u32) -> Message {
 #[test]
 fn a_board_with_real_sensors_ignores_sensor_frames_from_the_link() {
     let mut b = board();
-    send(&mut b, 0, Message::Enable);
-    for k in 0..20u32 {
+    arm(&mut b, 0);
+    for k in 1..20u32 {
         b.tick(&frame(k, k));
     }
     let before = b.last_output().position;
@@ -374,6 +384,7 @@ impl BoardSupport for Io {
     fn set_duty(&mut self, duty: i16) {
         self.duties.push(duty);
     }
+    fn set_outputs(&mut self, _: bool) {}
     fn read_byte(&mut self) -> Option<u8> {
         self.rx.pop_front()
     }
@@ -405,9 +416,13 @@ fn a_pil_board_ticks_once_per_sensor_frame_and_answers_with_the_duty() {
     let mut b = board().with_pil(true);
     let mut io = Io::default();
     io.queue(0, Message::hello(Role::Host));
-    io.queue(1, Message::Enable);
+    io.queue(1, Message::Calibrate { position_pm: 0 });
+    // Armed once the first tick has seen the dead-man closed.
     for k in 0..30u16 {
-        io.queue(2 + k, sensors(u32::from(k), u32::from(k) * 10));
+        io.queue(2 + 2 * k, sensors(u32::from(k), u32::from(k) * 10));
+        if k == 0 {
+            io.queue(3, Message::Arm);
+        }
     }
     // Sensor frames from the link only wait; the control tick runs them.
     b.on_bytes(&[]);
@@ -444,13 +459,13 @@ fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
     let mut b = board();
     let mut io = Io {
         sensors: RawSensors {
-            encoder_raw: 30,
+            encoder_raw: 0,
             load_cell_counts: 1_500,
             dead_man_closed: true,
         },
         ..Io::default()
     };
-    io.queue(0, Message::Enable);
+    io.queue(0, Message::Calibrate { position_pm: 0 });
     // Not a PIL board: nothing the link says makes a tick wait.
     assert!(!b.poll_link(&mut io));
     let mut outs = Vec::new();
@@ -459,6 +474,13 @@ fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
     for k in 0..120 {
         // The host's heartbeats, which the main loop takes off the link.
         io.queue(1 + k, Message::Heartbeat);
+        // Armed at rest, then the handle moves 30 um.
+        if k == 1 {
+            io.queue(500, Message::Arm);
+        }
+        if k == 2 {
+            io.sensors.encoder_raw = 30;
+        }
         b.poll_link(&mut io);
         outs.push(b.control_tick(&mut io));
         b.flush(&mut io);

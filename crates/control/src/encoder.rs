@@ -135,6 +135,27 @@ impl Encoder {
         Ok(self.position())
     }
 
+    /// Calibrate: from now on the counter's present value reads as
+    /// `position` (what homing does once it has found the hard stop).
+    /// Resolution and width are kept; the unwrapped count restarts at 0.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_control::{Encoder, Position};
+    /// let mut enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    /// enc.update(500).unwrap(); // 0.5 mm from where it powered on
+    /// enc.rezero(Position::from_nm(-20_000_000)); // this is the stop, -20 mm
+    /// assert_eq!(enc.update(510).unwrap(), Position::from_nm(-19_990_000));
+    /// ```
+    pub fn rezero(&mut self, position: Position) {
+        let bits = (32 - self.shift) as u8;
+        // The width, resolution and last reading were all accepted once.
+        if let Ok(e) = Encoder::new(bits, self.pm_per_count, self.last_raw, position) {
+            *self = e;
+        }
+    }
+
     /// Unwrapped counts since construction.
     pub fn count(&self) -> i32 {
         self.count
@@ -255,6 +276,18 @@ mod tests {
                 assert!(lo == i32::MIN as i64 || exact(&e, lo - 1) < i32::MIN as i64);
             }
         }
+    }
+
+    #[test]
+    fn rezero_keeps_unwrapping_across_the_counter_wrap() {
+        let mut e = Encoder::new(16, 1_000_000, 65_000, Position::ZERO).unwrap();
+        e.update(65_500).unwrap();
+        e.rezero(Position::from_nm(-30_000_000));
+        assert_eq!(e.position().nm(), -30_000_000);
+        // 100 counts on, across the 16-bit wrap.
+        assert_eq!(e.update(64).unwrap().nm(), -30_000_000 + 100_000);
+        assert_eq!(e.pm_per_count(), 1_000_000);
+        assert_eq!(e.max_counts_per_read(), 32_767);
     }
 
     #[test]

@@ -9,6 +9,7 @@ extern crate std;
 pub mod coupling;
 mod encoder;
 mod estimator;
+pub mod homing;
 mod param;
 pub mod passivity;
 mod position;

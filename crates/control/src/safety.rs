@@ -28,8 +28,12 @@ impl Faults {
     pub const HEARTBEAT_LOST: Faults = Faults(1 << 6);
     /// A law produced a non-finite force.
     pub const COMMAND_NOT_FINITE: Faults = Faults(1 << 7);
+    /// Homing found no hard stop: it timed out, or its own checks failed.
+    pub const HOMING_FAILED: Faults = Faults(1 << 8);
+    /// The board restarted from its watchdog: the loop had hung.
+    pub const WATCHDOG_RESET: Faults = Faults(1 << 9);
 
-    const NAMES: [(Faults, &'static str); 8] = [
+    const NAMES: [(Faults, &'static str); 10] = [
         (Faults::SENSOR_NOT_FINITE, "sensor reading not finite"),
         (Faults::SENSOR_OUT_OF_RANGE, "sensor reading out of range"),
         (Faults::ENCODER_INVALID, "encoder value invalid"),
@@ -38,6 +42,8 @@ impl Faults {
         (Faults::MISSED_TICK, "control tick missed"),
         (Faults::HEARTBEAT_LOST, "link heartbeat lost"),
         (Faults::COMMAND_NOT_FINITE, "force command not finite"),
+        (Faults::HOMING_FAILED, "homing found no hard stop"),
+        (Faults::WATCHDOG_RESET, "watchdog reset: the loop hung"),
     ];
 
     /// Whether no fault is set.

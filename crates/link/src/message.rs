@@ -6,7 +6,7 @@ use crate::frame::Stats;
 use serde::{Deserialize, Serialize};
 
 /// The protocol version both ends must share (checked by the handshake).
-pub const PROTOCOL_VERSION: u16 = 2;
+pub const PROTOCOL_VERSION: u16 = 3;
 
 /// Which end is speaking in a handshake.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -38,6 +38,68 @@ pub struct Telemetry {
     pub faults: u16,
     /// Cycles (or instructions, in QEMU) the last tick took.
     pub loop_cycles: u32,
+    /// What the board is doing (protocol 3).
+    pub mode: Mode,
+}
+
+/// The board's state machine (protocol 3). A board boots disarmed with its
+/// outputs off; any fault returns it here.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Mode {
+    /// Outputs off, zero force.
+    #[default]
+    Disarmed,
+    /// Moving slowly to the hard stop to find the encoder offset.
+    Homing,
+    /// Running the law: force output on.
+    Armed,
+}
+
+/// What the host asked the state machine for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ModeRequest {
+    /// [`Message::Arm`].
+    Arm,
+    /// [`Message::Home`].
+    Home,
+    /// [`Message::Calibrate`].
+    Calibrate,
+}
+
+/// Why the board would not change mode.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ModeRefusal {
+    /// The encoder offset is unknown: home or calibrate first.
+    NotCalibrated,
+    /// The gains in force are outside the proven region.
+    GainsNotProven,
+    /// The dead-man switch is open (or no sensor reading has come yet).
+    DeadManOpen,
+    /// Faults are latched (their bits): clear them first.
+    Faulted {
+        /// The latched fault bits.
+        faults: u16,
+    },
+    /// Only a disarmed board may do this.
+    NotDisarmed {
+        /// The mode it is in.
+        mode: Mode,
+    },
+    /// The position is beyond the board's range (±2.147 m).
+    OutOfRange,
+}
+
+/// The board's state, sent on request and whenever it changes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Status {
+    /// Where the state machine is.
+    pub mode: Mode,
+    /// Whether the encoder offset is known (homed or calibrated).
+    pub calibrated: bool,
+    /// Latched fault bits (`twoport_control::Faults`).
+    pub faults: u16,
+    /// The first fault to latch, alone (0: none).
+    pub first_fault: u16,
 }
 
 /// Coupling (and regulator) gains.
@@ -149,10 +211,30 @@ pub enum Message {
     },
     /// Clear latched faults.
     ClearFaults,
-    /// Enable force output.
-    Enable,
-    /// Disable force output.
-    Disable,
+    /// Arm: outputs on and the law running. Needs the dead-man closed,
+    /// proven gains, a calibrated encoder and no fault (protocol 3).
+    Arm,
+    /// Disarm: outputs off (protocol 3).
+    Disarm,
+    /// Home: find the encoder offset on the hard stop (protocol 3).
+    Home,
+    /// Calibrate where the device stands now: it is at `position_pm`
+    /// (a jig, or a simulator that knows). Disarmed only (protocol 3).
+    Calibrate {
+        /// The device's position now (pm).
+        position_pm: i64,
+    },
+    /// Ask for the state machine's [`Status`] (protocol 3).
+    GetStatus,
+    /// The board's state (protocol 3).
+    Status(Status),
+    /// A mode change the board refused (protocol 3).
+    ModeRefused {
+        /// What was asked.
+        asked: ModeRequest,
+        /// Why not.
+        why: ModeRefusal,
+    },
     /// PIL sensors in.
     Sensors(SensorFrame),
     /// PIL actuator out.

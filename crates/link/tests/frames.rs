@@ -32,6 +32,7 @@ fn all_messages() -> Vec<Message> {
             ve_position_pm: i64::MAX,
             faults: 0xFFFF,
             loop_cycles: 1234,
+            mode: Mode::Homing,
         }),
         Message::GetGains,
         Message::Gains(gi),
@@ -45,8 +46,27 @@ fn all_messages() -> Vec<Message> {
             first: 1,
         },
         Message::ClearFaults,
-        Message::Enable,
-        Message::Disable,
+        Message::Arm,
+        Message::Disarm,
+        Message::Home,
+        Message::Calibrate {
+            position_pm: i64::MIN,
+        },
+        Message::GetStatus,
+        Message::Status(Status {
+            mode: Mode::Armed,
+            calibrated: true,
+            faults: 0xFFFF,
+            first_fault: 0x8000,
+        }),
+        Message::ModeRefused {
+            asked: ModeRequest::Arm,
+            why: ModeRefusal::Faulted { faults: 0xFFFF },
+        },
+        Message::ModeRefused {
+            asked: ModeRequest::Calibrate,
+            why: ModeRefusal::NotDisarmed { mode: Mode::Homing },
+        },
         Message::Sensors(SensorFrame {
             tick: 7,
             encoder_raw: 65_535,

@@ -67,6 +67,9 @@ impl BoardSupport for Uart {
     }
     // The duty goes back to the host in the board's actuator frame.
     fn set_duty(&mut self, _: i16) {}
+    // No amplifier: the host sees the outputs as the duty it is sent,
+    // which is zero whenever the board is disarmed.
+    fn set_outputs(&mut self, _: bool) {}
     fn read_byte(&mut self) -> Option<u8> {
         self.read()
     }

@@ -11,8 +11,9 @@
 //! | control loop      | TIM2 update interrupt, 1/T (1 kHz shipped) |      |
 //!
 //! Clocks: 8 MHz crystal, PLL to 168 MHz (APB1 42 MHz, APB2 84 MHz).
-//! Zero duty is 50 % in locked antiphase, i.e. zero average voltage; the
-//! outputs are off (MOE clear) until the loop runs, and any panic or
+//! Zero duty is 50 % in locked antiphase, i.e. zero average voltage. The
+//! board boots disarmed with the outputs off (MOE clear); the loop turns
+//! them on only while it homes or is armed, and any fault, panic or
 //! HardFault turns them off again. Loop timing comes from the DWT cycle
 //! counter.
 //!
@@ -95,7 +96,6 @@ fn main() -> ! {
     };
     let board = board.with_pil(cfg!(feature = "qemu"));
     cortex_m::interrupt::free(|cs| BOARD.borrow(cs).replace(Some(board)));
-    dp.TIM1.bdtr().modify(|_, w| w.moe().set_bit());
     // Said before the first tick, which in QEMU waits for the host.
     #[cfg(feature = "qemu")]
     cortex_m_semihosting::hprintln!("twoport-stm32f405 (qemu): board loop up, waiting on USART2");

@@ -80,6 +80,12 @@ impl BoardSupport for Stm32 {
         self.tim1.ccr1().write(|w| w.ccr().set(ccr as u16));
     }
 
+    fn set_outputs(&mut self, on: bool) {
+        // TIM1's main output enable gates both bridge legs: off, the
+        // amplifier sees no drive whatever the compare register holds.
+        self.tim1.bdtr().modify(|_, w| w.moe().bit(on));
+    }
+
     fn read_byte(&mut self) -> Option<u8> {
         let sr = self.usart.sr().read();
         if sr.rxne().bit_is_set() || sr.ore().bit_is_set() {

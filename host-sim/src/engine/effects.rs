@@ -3,7 +3,7 @@
 //! nothing of the scene, and each effect's measured cost has a slot of its
 //! own instead of a name to look up.
 
-use crate::engine::scene::{Effects, SlackEffect};
+use crate::engine::scene::{Effects, SlackEffect, StopSide};
 use std::collections::VecDeque;
 use std::time::Instant;
 use twoport_control::servo::SensorFrame;
@@ -29,11 +29,13 @@ pub enum Effect {
     CableSlack,
     /// Measurement-to-actuation delay.
     Delay,
+    /// A hard stop at the end of travel.
+    HardStop,
 }
 
 impl Effect {
     /// Every effect.
-    pub const ALL: [Effect; 9] = [
+    pub const ALL: [Effect; 10] = [
         Effect::Flexibility,
         Effect::LoadCell,
         Effect::Encoder,
@@ -43,6 +45,7 @@ impl Effect {
         Effect::Cogging,
         Effect::CableSlack,
         Effect::Delay,
+        Effect::HardStop,
     ];
 
     /// The name scene files and reports use.
@@ -57,6 +60,7 @@ impl Effect {
             Effect::Cogging => "cogging",
             Effect::CableSlack => "cable_slack",
             Effect::Delay => "delay",
+            Effect::HardStop => "hard_stop",
         }
     }
 
@@ -71,6 +75,7 @@ impl Effect {
             Effect::Cogging => e.cogging.is_some(),
             Effect::CableSlack => e.cable_slack.is_some(),
             Effect::Delay => e.delay.is_some(),
+            Effect::HardStop => e.hard_stop.is_some(),
         }
     }
 }
@@ -163,9 +168,12 @@ pub struct Forces {
     cogging: Option<(f64, f64)>,
     /// Cable slack: half the play (m) and the cable's stiffness (N/m).
     slack: Option<(f64, f64)>,
+    /// Hard stop: face (m), +1 solid above or -1 below, stiffness (N/m),
+    /// damping (N s/m).
+    stop: Option<(f64, f64, f64, f64)>,
     /// Which of them run (their cost is shared): the first `count` of
     /// `names`, kept inline so that charging them allocates nothing.
-    names: [Effect; 3],
+    names: [Effect; 4],
     count: usize,
 }
 
@@ -182,6 +190,13 @@ impl Forces {
         }
         if let Some((amplitude_n, period_m)) = self.cogging {
             fa += amplitude_n * (2.0 * std::f64::consts::PI * xa / period_m).sin();
+        }
+        if let Some((face_m, side, k, b)) = self.stop {
+            // Penetration into the solid side, and a push that never pulls.
+            let depth = side * (xa - face_m);
+            if depth > 0.0 {
+                fa -= side * (k * depth + b * side * va).max(0.0);
+            }
         }
         for (fi, di) in f.iter_mut().zip(dir) {
             *fi += di * fa;
@@ -219,9 +234,14 @@ pub struct Pipeline {
 impl Pipeline {
     /// Compile `e`; `cable_k` is the device's cable stiffness (N/m).
     pub fn new(e: &Effects, cable_k: f64) -> Self {
-        let mut names = [Effect::Coulomb; 3];
+        let mut names = [Effect::Coulomb; 4];
         let mut count = 0;
-        for x in [Effect::Coulomb, Effect::Cogging, Effect::CableSlack] {
+        for x in [
+            Effect::Coulomb,
+            Effect::Cogging,
+            Effect::CableSlack,
+            Effect::HardStop,
+        ] {
             if x.on(e) {
                 names[count] = x;
                 count += 1;
@@ -233,6 +253,13 @@ impl Pipeline {
             slack: e
                 .cable_slack
                 .map(|s: SlackEffect| (0.5 * s.width_m, cable_k)),
+            stop: e.hard_stop.map(|s| {
+                let side = match s.solid {
+                    StopSide::Above => 1.0,
+                    StopSide::Below => -1.0,
+                };
+                (s.position_m, side, s.stiffness_npm, s.damping_nspm)
+            }),
             names,
             count,
         };
@@ -301,5 +328,42 @@ impl Pipeline {
     /// their time to.
     pub fn forces(&mut self) -> Option<(&Forces, &mut Costs)> {
         self.forces.as_ref().map(|f| (f, &mut self.costs))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::scene::HardStopEffect;
+
+    /// The stop pushes back only from inside its solid side, with its
+    /// stiffness and damping, and never pulls the actuator in.
+    #[test]
+    fn a_hard_stop_only_pushes_out_of_its_solid_side() {
+        let stop = |solid| Effects {
+            hard_stop: Some(HardStopEffect {
+                position_m: -0.02,
+                solid,
+                stiffness_npm: 2.0e5,
+                damping_nspm: 50.0,
+            }),
+            ..Effects::default()
+        };
+        let force = |e: &Effects, x: f64, v: f64| {
+            let mut p = Pipeline::new(e, 0.0);
+            let (forces, _) = p.forces().expect("a hard stop is a nonlinear force");
+            let mut f = [0.0];
+            forces.add(1, &[1.0], &[x, v], &mut f);
+            f[0]
+        };
+        let below = stop(StopSide::Below);
+        assert_eq!(force(&below, -0.019, -0.1), 0.0);
+        // 1 mm in, still moving in at 0.1 m/s: 200 N + 5 N, outward (+x).
+        assert!((force(&below, -0.021, -0.1) - 205.0).abs() < 1e-9);
+        // Leaving fast: the damping would pull; the stop does not.
+        assert_eq!(force(&below, -0.020_01, 10.0), 0.0);
+        let above = stop(StopSide::Above);
+        assert!((force(&above, -0.019, 0.0) + 200.0).abs() < 1e-9);
+        assert_eq!(force(&above, -0.021, 0.0), 0.0);
     }
 }

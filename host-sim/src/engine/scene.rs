@@ -395,6 +395,8 @@ pub struct Effects {
     pub cable_slack: Option<SlackEffect>,
     /// Sensor delay.
     pub delay: Option<DelayEffect>,
+    /// A hard stop at the end of the actuator's travel (what homing finds).
+    pub hard_stop: Option<HardStopEffect>,
     /// The coupling and VE see the device's position this many ticks late
     /// (a VE on a host behind a link), while the board's passivity layer
     /// reads it fresh.
@@ -467,6 +469,43 @@ pub struct CoggingEffect {
 pub struct SlackEffect {
     /// Total free play (m).
     pub width_m: f64,
+}
+
+/// A hard stop on the actuator: a stiff, damped spring that only pushes,
+/// where the actuator passes `position_m`.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HardStopEffect {
+    /// Where the stop's face is (m).
+    pub position_m: f64,
+    /// Which side of the face is solid.
+    #[serde(default = "default_stop_side")]
+    pub solid: StopSide,
+    /// Its stiffness (N/m).
+    #[serde(default = "default_stop_stiffness")]
+    pub stiffness_npm: f64,
+    /// Its damping while pressed (N s/m).
+    #[serde(default = "default_stop_damping")]
+    pub damping_nspm: f64,
+}
+fn default_stop_side() -> StopSide {
+    StopSide::Below
+}
+fn default_stop_stiffness() -> f64 {
+    2.0e5
+}
+fn default_stop_damping() -> f64 {
+    50.0
+}
+
+/// The solid side of a hard stop.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StopSide {
+    /// It stops travel toward negative positions.
+    Below,
+    /// It stops travel toward positive positions.
+    Above,
 }
 
 /// Sensor delay.
@@ -759,6 +798,16 @@ impl Scene {
                 return Err(format!("effects.encoder.bits = {} must be 2..=32", x.bits));
             }
         }
+        if let Some(x) = e.hard_stop {
+            if !(x.position_m.is_finite() && x.position_m.abs() <= 1.0) {
+                return Err(format!(
+                    "effects.hard_stop.position_m = {} must be within ±1 m",
+                    x.position_m
+                ));
+            }
+            pos("effects.hard_stop.stiffness_npm", x.stiffness_npm)?;
+            nonneg("effects.hard_stop.damping_nspm", x.damping_nspm)?;
+        }
         if let Some(x) = e.adc {
             pos("effects.adc.lsb_n", x.lsb_n)?;
             nonneg("effects.adc.noise_rms_n", x.noise_rms_n)?;
@@ -822,6 +871,9 @@ impl Scene {
     /// Whether any effect makes the plant nonlinear (and so sub-stepped).
     pub fn nonlinear(&self) -> bool {
         let e = &self.effects;
-        e.coulomb.is_some() || e.cogging.is_some() || e.cable_slack.is_some()
+        e.coulomb.is_some()
+            || e.cogging.is_some()
+            || e.cable_slack.is_some()
+            || e.hard_stop.is_some()
     }
 }

@@ -167,6 +167,11 @@ pub struct Simulation {
 }
 
 /// Largest stable sub-step for `method` over `poles` (s), by bisection.
+/// Round half away from zero without a libm call.
+fn round_counts(c: f64) -> i64 {
+    (c + 0.5f64.copysign(c)) as i64
+}
+
 fn max_stable_step(method: Method, poles: &[nalgebra::Complex<f64>]) -> f64 {
     poles
         .iter()
@@ -256,6 +261,11 @@ impl Simulation {
             // Ideal sensing: 1 nm counts, the resolution of a Position.
             None => (32, 1000.0),
         };
+        let mask = if bits >= 32 {
+            u32::MAX
+        } else {
+            (1u32 << bits) - 1
+        };
         let encoder = Encoder::new(bits, pm_per_count as i64, 0, Position::ZERO)
             .map_err(|e| format!("effects.encoder: {e:?}"))?;
         let t32 = period as f32;
@@ -287,11 +297,7 @@ impl Simulation {
             tick: 0,
             total_ticks,
             held_force: 0.0,
-            encoder_mask: if bits >= 32 {
-                u32::MAX
-            } else {
-                (1u32 << bits) - 1
-            },
+            encoder_mask: mask,
             counts_per_m: 1e12 / pm_per_count,
             effects: Pipeline::new(&e, cable_k),
             current: None,
@@ -402,9 +408,7 @@ impl Simulation {
         let n = self.device.n;
         let x_a = self.actuator.of(&self.x[..n]);
         let t0 = (timing && self.effects.encoder_timed()).then(Instant::now);
-        // Round half away from zero without a libm call.
-        let c = x_a * self.counts_per_m;
-        let counts = (c + 0.5f64.copysign(c)) as i64;
+        let counts = round_counts(x_a * self.counts_per_m);
         // The counter keeps the low `bits` of the count: for a power-of-two
         // modulus that is a mask of the two's-complement value.
         let raw = (counts as u32) & self.encoder_mask;

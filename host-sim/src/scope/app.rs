@@ -15,7 +15,7 @@ use twoport_design::design::{self, Analysis, Check, GridSpec};
 use twoport_design::plot::Figure;
 use twoport_design::twoport::HumanBound;
 use twoport_design::Plant;
-use twoport_link::{GainsReply, Message, Telemetry};
+use twoport_link::{GainsReply, Message, Status, Telemetry};
 
 /// Samples each signal's ring holds: 20 s at 1 kHz.
 pub const RING_SAMPLES: usize = 20_000;
@@ -203,6 +203,10 @@ pub struct BoardLink {
     pub reply: Option<String>,
     /// Latched faults the board reported.
     pub faults: Option<u16>,
+    /// The board's state machine, as it last said.
+    pub status: Option<Status>,
+    /// Its last refusal of a mode change.
+    pub refusal: Option<String>,
 }
 
 /// Everything the scope shows and controls.
@@ -521,6 +525,14 @@ impl ScopeState {
                     b.reply = Some(format!("refused: {why:?}"));
                 }
                 Message::FaultReport { faults, .. } => b.faults = Some(faults),
+                Message::Status(st) => {
+                    b.faults = (st.faults != 0).then_some(st.faults);
+                    b.status = Some(st);
+                    b.refusal = None;
+                }
+                Message::ModeRefused { asked, why } => {
+                    b.refusal = Some(format!("{asked:?} refused: {why:?}"));
+                }
                 _ => {}
             }
         }
@@ -614,7 +626,8 @@ impl ScopeState {
         };
         let r = scene_ok
             .and_then(|_| SerialBoard::open(port))
-            .and_then(|p| Session::open(p, crate::pil::Faults::default()));
+            .and_then(|p| Session::open(p, crate::pil::Faults::default()))
+            .and_then(|mut s| s.send(&Message::GetStatus).map(|_| s));
         match r {
             Ok(session) => {
                 self.board = Some(BoardLink {
@@ -624,6 +637,8 @@ impl ScopeState {
                     telemetry: None,
                     reply: None,
                     faults: None,
+                    status: None,
+                    refusal: None,
                 });
                 self.message = None;
             }
@@ -631,20 +646,27 @@ impl ScopeState {
         }
     }
 
-    /// Leave board mode.
+    /// Leave board mode, disarming the board.
     pub fn disconnect(&mut self) {
         if let Some(mut b) = self.board.take() {
-            let _ = b.session.send(&Message::Disable);
+            let _ = b.session.send(&Message::Disarm);
         }
     }
 
-    /// Clear the board's latched faults.
-    pub fn clear_board_faults(&mut self) {
+    /// Say `msg` to the board (a mode change or a fault clear); its answer
+    /// comes back as a status or a refusal.
+    pub fn tell_board(&mut self, msg: Message) {
         if let Some(b) = self.board.as_mut() {
-            let _ = b.session.send(&Message::ClearFaults);
-            let _ = b.session.send(&Message::Enable);
-            b.faults = None;
+            if let Err(e) = b.session.send(&msg) {
+                self.message = Some(format!("board: {e}"));
+            }
         }
+    }
+
+    /// Clear the board's latched faults. It stays disarmed: arming is a
+    /// separate, deliberate step.
+    pub fn clear_board_faults(&mut self) {
+        self.tell_board(Message::ClearFaults);
     }
 }
 

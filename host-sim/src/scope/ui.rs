@@ -443,21 +443,13 @@ pub fn board(ui: &mut Ui, s: &mut ScopeState, link: &mut BoardChoice) {
             "free running on its own sensors"
         };
         ui.label(format!("connected: {} ({how})", b.port));
+        board_state(ui, s);
+        let Some(b) = &s.board else { return };
         if let Some(t) = &b.telemetry {
-            ui.label(format!(
-                "tick {}  loop {} cycles  faults {:#06x}",
-                t.tick, t.loop_cycles, t.faults
-            ));
+            ui.label(format!("tick {}  loop {} cycles", t.tick, t.loop_cycles));
         }
         if let Some(r) = &b.reply {
             ui.label(format!("last gain request: {r}"));
-        }
-        let faults = b.faults;
-        if let Some(f) = faults {
-            ui.colored_label(Color32::RED, format!("fault latched: {f:#06x}"));
-            if ui.button("clear faults").clicked() {
-                s.clear_board_faults();
-            }
         }
         if ui.button("disconnect").clicked() {
             s.disconnect();
@@ -487,6 +479,64 @@ pub fn board(ui: &mut Ui, s: &mut ScopeState, link: &mut BoardChoice) {
     if ui.button("connect").clicked() && !link.port.is_empty() {
         let p = link.port.clone();
         s.connect(&p, link.lockstep);
+    }
+}
+
+/// The board's state machine: its mode, calibration and latched faults by
+/// name, and the buttons that move it.
+fn board_state(ui: &mut Ui, s: &mut ScopeState) {
+    use twoport_control::Faults;
+    use twoport_link::{Message, Mode};
+    let Some(b) = &s.board else { return };
+    let st = b.status.unwrap_or_default();
+    let mode = b.telemetry.map_or(st.mode, |t| t.mode);
+    let colour = match mode {
+        Mode::Armed => Color32::GREEN,
+        Mode::Homing => Color32::YELLOW,
+        Mode::Disarmed => Color32::GRAY,
+    };
+    ui.colored_label(
+        colour,
+        format!(
+            "{mode:?}, {}",
+            if st.calibrated {
+                "calibrated"
+            } else {
+                "not calibrated: home first"
+            }
+        ),
+    );
+    let faults = b.faults.unwrap_or(st.faults);
+    if faults != 0 {
+        ui.colored_label(Color32::RED, format!("faults: {}", Faults(faults)));
+        if st.first_fault != 0 {
+            ui.label(format!("first: {}", Faults(st.first_fault)));
+        }
+    }
+    if let Some(r) = &b.refusal {
+        ui.colored_label(Color32::RED, r);
+    }
+    let mut say = None;
+    ui.horizontal(|ui| {
+        if ui.button("home").clicked() {
+            say = Some(Message::Home);
+        }
+        if ui
+            .button("arm")
+            .on_hover_text("needs calibration, proven gains, the dead-man closed and no fault")
+            .clicked()
+        {
+            say = Some(Message::Arm);
+        }
+        if ui.button("disarm").clicked() {
+            say = Some(Message::Disarm);
+        }
+        if faults != 0 && ui.button("clear faults").clicked() {
+            say = Some(Message::ClearFaults);
+        }
+    });
+    if let Some(m) = say {
+        s.tell_board(m);
     }
 }
 

@@ -299,6 +299,16 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
         self.front.safety.heartbeat();
     }
 
+    /// Calibrate the encoder: where the device is now reads as `position`
+    /// from this tick on (homing's result), and the laws re-align to it.
+    /// Meant for a disabled servo; an enabled one would see its position
+    /// jump.
+    pub fn calibrate(&mut self, position: Position) {
+        self.front.encoder.rezero(position);
+        self.front.position = position;
+        self.realign();
+    }
+
     /// Latch a fault found outside the tick (e.g. by the link).
     pub fn trip(&mut self, f: Faults) {
         self.front.safety.trip(f);
@@ -392,6 +402,38 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
         }
         self.ve.reset(x);
         self.layer.reset(x);
+    }
+
+    /// One control tick with `law` in place of the display's laws and the
+    /// VE: the same encoder, velocity estimate and safety layer, so every
+    /// limit and fault check holds for it too. `law` gets the position and
+    /// the velocity (m/s) and answers with the actuator force (N, the
+    /// paper's `f_a`: positive resists positive motion); it is not called
+    /// on a faulted tick. Homing runs through this.
+    pub fn tick_with(
+        &mut self,
+        frame: &SensorFrame<R>,
+        law: impl FnOnce(Position, R) -> R,
+    ) -> ServoOutput<R> {
+        let (v, faults) = self.front.sense(frame);
+        let command_n = if self.front.runnable(faults) {
+            law(self.front.position, v)
+        } else {
+            R::ZERO
+        };
+        let safe = self.front.limit(frame, v, faults, command_n);
+        ServoOutput {
+            actuator_force_n: safe.force_n,
+            commanded_force_n: command_n,
+            position: self.front.position,
+            velocity_mps: v,
+            ve_velocity_mps: R::ZERO,
+            ve_force_n: R::ZERO,
+            coupling_force_n: R::ZERO,
+            reference: self.front.position,
+            faults: safe.faults,
+            limited: safe.limited,
+        }
     }
 
     /// One control tick.

@@ -1,0 +1,397 @@
+//! The board's state machine over the wire: it boots disarmed with its
+//! outputs off, arms only when it is safe to, disarms on any fault, and
+//! homes onto a hard stop with a small force to find the encoder offset.
+
+use twoport_board::{Board, BoardSupport, Bound, IoScale, RawSensors, Region};
+use twoport_control::homing::HomingConfig;
+use twoport_control::ve::BilateralConstraint;
+use twoport_control::{Encoder, Faults, ImpedanceGains, Position, SafetyConfig, Servo};
+use twoport_link::{encode, Decoder, Message, Mode, ModeRefusal, ModeRequest, Status, MAX_FRAME};
+
+const T: f32 = 1e-3;
+
+fn region() -> Region<3> {
+    Region::new(
+        Bound::MaxStiffness,
+        [30.0, 60.0, 90.0],
+        [46_000.0, 51_400.0, 51_000.0],
+        None,
+    )
+    .unwrap()
+}
+
+type TestBoard = Board<BilateralConstraint, 3>;
+
+fn board_with(k_npm: f32) -> TestBoard {
+    let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    let safety = SafetyConfig {
+        require_dead_man: true,
+        ..SafetyConfig::excalibur()
+    };
+    let s = Servo::new(
+        ImpedanceGains::new(k_npm, 90.0).into(),
+        enc,
+        safety,
+        BilateralConstraint::new(Position::ZERO),
+    )
+    .unwrap();
+    Board::new(s, region(), 0).with_homing(HomingConfig::gentle(Position::from_nm(-20_000_000), T))
+}
+
+fn board() -> TestBoard {
+    board_with(51_000.0)
+}
+
+/// One axis on a bench: a 0.93 kg actuator with 4 N s/m of damping, a hard
+/// stop (2e5 N/m) `stop_m` metres from where it powered on, a 16-bit
+/// 1 µm encoder that read 0 at power-on, an amplifier whose outputs the
+/// board switches, and the link.
+struct Bench {
+    x_m: f64,
+    v_mps: f64,
+    stop_m: Option<f64>,
+    duty: i16,
+    outputs: bool,
+    outputs_calls: Vec<bool>,
+    dead_man_closed: bool,
+    peak_force_n: f64,
+    rx: std::collections::VecDeque<u8>,
+    tx: Vec<u8>,
+    seq: u16,
+}
+
+impl Bench {
+    fn new(stop_m: Option<f64>) -> Self {
+        Bench {
+            x_m: 0.0,
+            v_mps: 0.0,
+            stop_m,
+            duty: 0,
+            outputs: false,
+            outputs_calls: Vec::new(),
+            dead_man_closed: true,
+            peak_force_n: 0.0,
+            rx: Default::default(),
+            tx: Vec::new(),
+            seq: 0,
+        }
+    }
+
+    fn say(&mut self, m: Message) {
+        let mut buf = [0u8; MAX_FRAME];
+        let n = encode(self.seq, &m, &mut buf).unwrap();
+        self.seq += 1;
+        self.rx.extend(&buf[..n]);
+    }
+
+    fn heard(&mut self) -> Vec<Message> {
+        let mut out = Vec::new();
+        Decoder::new().feed(&std::mem::take(&mut self.tx), |e| out.push(e.msg));
+        out
+    }
+
+    /// The force the amplifier applies (N, resisting positive motion).
+    fn force_n(&self) -> f64 {
+        if self.outputs {
+            IoScale::EXCALIBUR.force_n(self.duty) as f64
+        } else {
+            0.0
+        }
+    }
+}
+
+impl BoardSupport for Bench {
+    fn sample(&mut self) -> RawSensors {
+        // The plant moves for one period under the force held last tick.
+        let f_a = self.force_n();
+        self.peak_force_n = self.peak_force_n.max(f_a.abs());
+        let h = T as f64 / 50.0;
+        for _ in 0..50 {
+            let mut f = -f_a - 4.0 * self.v_mps;
+            if let Some(s) = self.stop_m {
+                if self.x_m < s {
+                    f += 2.0e5 * (s - self.x_m) - 50.0 * self.v_mps;
+                }
+            }
+            self.v_mps += f / 0.93 * h;
+            self.x_m += self.v_mps * h;
+        }
+        let counts = (self.x_m * 1e6).round() as i64;
+        RawSensors {
+            encoder_raw: (counts as u32) & 0xFFFF,
+            load_cell_counts: 0,
+            dead_man_closed: self.dead_man_closed,
+        }
+    }
+    fn set_duty(&mut self, duty: i16) {
+        self.duty = duty;
+    }
+    fn set_outputs(&mut self, on: bool) {
+        self.outputs = on;
+        self.outputs_calls.push(on);
+    }
+    fn read_byte(&mut self) -> Option<u8> {
+        self.rx.pop_front()
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        self.tx.extend_from_slice(bytes);
+    }
+    fn cycles(&mut self) -> u32 {
+        0
+    }
+}
+
+/// What an image's interrupt and main loop do for one tick.
+fn tick(b: &mut TestBoard, io: &mut Bench) {
+    b.poll_link(io);
+    b.control_tick(io);
+    b.flush(io);
+}
+
+fn refused(msgs: &[Message]) -> Vec<(ModeRequest, ModeRefusal)> {
+    msgs.iter()
+        .filter_map(|m| match m {
+            Message::ModeRefused { asked, why } => Some((*asked, *why)),
+            _ => None,
+        })
+        .collect()
+}
+
+fn statuses(msgs: &[Message]) -> Vec<Status> {
+    msgs.iter()
+        .filter_map(|m| match m {
+            Message::Status(s) => Some(*s),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn boots_disarmed_with_outputs_off_and_names_why_it_will_not_arm() {
+    let mut b = board();
+    let mut io = Bench::new(None);
+    assert_eq!(b.mode(), Mode::Disarmed);
+    assert!(!b.outputs_on() && !b.calibrated());
+    // Before any tick the dead-man is unknown; before calibration it may
+    // not arm at all. The first reason that holds is the one named.
+    io.say(Message::Arm);
+    tick(&mut b, &mut io);
+    assert_eq!(
+        refused(&io.heard()),
+        [(ModeRequest::Arm, ModeRefusal::NotCalibrated)]
+    );
+    io.say(Message::Calibrate { position_pm: 0 });
+    io.dead_man_closed = false;
+    tick(&mut b, &mut io);
+    io.say(Message::Arm);
+    tick(&mut b, &mut io);
+    assert_eq!(
+        refused(&io.heard()),
+        [(ModeRequest::Arm, ModeRefusal::DeadManOpen)]
+    );
+    // Displaced 1 mm from the constraint it was calibrated at, the
+    // disarmed board still commands nothing and its outputs stay off.
+    io.x_m = 0.001;
+    for _ in 0..20 {
+        tick(&mut b, &mut io);
+    }
+    assert_eq!(io.duty, 0);
+    assert!(io.outputs_calls.is_empty());
+    io.dead_man_closed = true;
+    tick(&mut b, &mut io);
+    io.say(Message::Arm);
+    tick(&mut b, &mut io);
+    let msgs = io.heard();
+    assert_eq!(refused(&msgs), []);
+    assert_eq!(
+        statuses(&msgs),
+        [Status {
+            mode: Mode::Armed,
+            calibrated: true,
+            faults: 0,
+            first_fault: 0,
+        }]
+    );
+    assert_eq!(io.outputs_calls, [true]);
+}
+
+#[test]
+fn gains_outside_the_proven_region_never_arm() {
+    // An image built with gains its region does not hold.
+    let mut b = board_with(60_000.0);
+    let mut io = Bench::new(None);
+    io.say(Message::Calibrate { position_pm: 0 });
+    tick(&mut b, &mut io);
+    io.say(Message::Arm);
+    tick(&mut b, &mut io);
+    assert_eq!(
+        refused(&io.heard()),
+        [(ModeRequest::Arm, ModeRefusal::GainsNotProven)]
+    );
+    assert_eq!(b.mode(), Mode::Disarmed);
+}
+
+/// Armed and pushing, the dead-man opens: the fault latches, the board
+/// disarms and its outputs go off in that same tick, the status names the
+/// fault, and neither arming nor clearing brings the force back alone.
+#[test]
+fn any_fault_disarms_and_latches_until_cleared_and_re_armed() {
+    let mut b = board();
+    let mut io = Bench::new(None);
+    io.say(Message::Calibrate { position_pm: 0 });
+    tick(&mut b, &mut io);
+    io.say(Message::Arm);
+    for k in 0..400 {
+        tick(&mut b, &mut io);
+        // Pull the handle 2 mm out at 10 mm/s and hold it there, against
+        // the coupling.
+        io.x_m = (k as f64 * 1e-5).min(0.002);
+        io.v_mps = 0.0;
+    }
+    assert_eq!(b.mode(), Mode::Armed);
+    assert!(io.force_n().abs() > 50.0, "{} N", io.force_n());
+    io.heard();
+    io.dead_man_closed = false;
+    tick(&mut b, &mut io);
+    assert_eq!(b.mode(), Mode::Disarmed);
+    assert_eq!(io.force_n(), 0.0);
+    assert_eq!(
+        (io.duty, io.outputs_calls.as_slice()),
+        (0, &[true, false][..])
+    );
+    let msgs = io.heard();
+    let s = statuses(&msgs);
+    assert_eq!(s.len(), 1);
+    assert_eq!(s[0].mode, Mode::Disarmed);
+    assert_eq!(Faults(s[0].faults), Faults::DEAD_MAN);
+    assert_eq!(Faults(s[0].faults).to_string(), "dead-man switch released");
+    io.dead_man_closed = true;
+    io.say(Message::Arm);
+    tick(&mut b, &mut io);
+    assert_eq!(
+        refused(&io.heard()),
+        [(
+            ModeRequest::Arm,
+            ModeRefusal::Faulted {
+                faults: Faults::DEAD_MAN.0
+            }
+        )]
+    );
+    io.say(Message::ClearFaults);
+    tick(&mut b, &mut io);
+    assert_eq!(b.mode(), Mode::Disarmed);
+    io.say(Message::Arm);
+    tick(&mut b, &mut io);
+    assert_eq!(b.mode(), Mode::Armed, "{:?}", io.heard());
+}
+
+/// The stop is 15 mm below where the axis powered on, and the board's
+/// frame puts it at -20 mm. Homing finds it without ever pushing harder
+/// than its 5 N, calibrates the encoder and leaves the board disarmed;
+/// from then on the board's positions are the truth less 5 mm, to within
+/// the stop's give under 5 N and a count.
+#[test]
+fn homing_finds_the_stop_gently_and_calibrates_the_encoder() {
+    let mut b = board();
+    let mut io = Bench::new(Some(-0.015));
+    tick(&mut b, &mut io);
+    io.say(Message::Home);
+    let mut ticks = 0;
+    loop {
+        tick(&mut b, &mut io);
+        ticks += 1;
+        if b.mode() != Mode::Homing || ticks > 5000 {
+            break;
+        }
+    }
+    assert!(b.calibrated(), "after {ticks} ticks: {:?}", io.heard());
+    assert_eq!(b.mode(), Mode::Disarmed);
+    assert!(b.servo().safety().faults().is_empty());
+    // 15 mm at 20 mm/s, the stall time and the ramp-in.
+    assert!((800..1100).contains(&ticks), "{ticks} ticks");
+    assert!(io.peak_force_n <= 5.0 + 0.01, "{} N", io.peak_force_n);
+    assert_eq!(io.outputs_calls, [true, false]);
+    let s = statuses(&io.heard());
+    assert_eq!(
+        s.iter().map(|s| (s.mode, s.calibrated)).collect::<Vec<_>>(),
+        [(Mode::Homing, false), (Mode::Disarmed, true)]
+    );
+    // Walk the axis back to where it powered on, at 15 mm/s: the board
+    // reads -5 mm.
+    let from = io.x_m;
+    for k in 1..=1000 {
+        io.x_m = from * (1.0 - k as f64 / 1000.0);
+        io.v_mps = 0.0;
+        tick(&mut b, &mut io);
+    }
+    let err_nm = b.last_output().position.nm() - -5_000_000;
+    assert!(err_nm.abs() <= 30_000, "{err_nm} nm");
+    // Homed, it arms.
+    io.say(Message::Arm);
+    tick(&mut b, &mut io);
+    assert_eq!(b.mode(), Mode::Armed);
+}
+
+#[test]
+fn homing_without_a_stop_times_out_as_a_named_fault() {
+    let mut cfg = HomingConfig::gentle(Position::ZERO, T);
+    cfg.timeout_s = 0.5;
+    let mut b = board().with_homing(cfg);
+    let mut io = Bench::new(None);
+    tick(&mut b, &mut io);
+    io.say(Message::Home);
+    for _ in 0..600 {
+        tick(&mut b, &mut io);
+    }
+    assert_eq!(b.mode(), Mode::Disarmed);
+    assert!(!b.calibrated());
+    assert_eq!(b.servo().safety().faults(), Faults::HOMING_FAILED);
+    assert_eq!(io.force_n(), 0.0);
+    let msgs = io.heard();
+    assert!(msgs.iter().any(|m| matches!(m, Message::FaultReport { faults, .. } if Faults(*faults) == Faults::HOMING_FAILED)));
+    assert_eq!(
+        Faults::HOMING_FAILED.to_string(),
+        "homing found no hard stop"
+    );
+}
+
+/// Requests that would move an armed or homing board are refused, and a
+/// `Disarm` ends a homing run where it is.
+#[test]
+fn calibrate_and_home_need_a_disarmed_board_and_disarm_stops_homing() {
+    let mut b = board();
+    let mut io = Bench::new(Some(-0.015));
+    tick(&mut b, &mut io);
+    io.say(Message::Home);
+    tick(&mut b, &mut io);
+    assert_eq!(b.mode(), Mode::Homing);
+    io.say(Message::Calibrate { position_pm: 0 });
+    io.say(Message::Home);
+    io.say(Message::Arm);
+    tick(&mut b, &mut io);
+    let busy = ModeRefusal::NotDisarmed { mode: Mode::Homing };
+    assert_eq!(
+        refused(&io.heard()),
+        [
+            (ModeRequest::Calibrate, busy),
+            (ModeRequest::Home, busy),
+            (ModeRequest::Arm, busy),
+        ]
+    );
+    for _ in 0..100 {
+        tick(&mut b, &mut io);
+    }
+    io.say(Message::Disarm);
+    tick(&mut b, &mut io);
+    assert_eq!((b.mode(), b.calibrated()), (Mode::Disarmed, false));
+    assert_eq!(io.force_n(), 0.0);
+    // A position beyond the board's range is refused by name.
+    io.say(Message::Calibrate {
+        position_pm: 3_000_000_000_000_000,
+    });
+    tick(&mut b, &mut io);
+    assert_eq!(
+        refused(&io.heard()),
+        [(ModeRequest::Calibrate, ModeRefusal::OutOfRange)]
+    );
+}
