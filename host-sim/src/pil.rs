@@ -13,6 +13,7 @@ use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 use twoport_board::excalibur::{self, REGION_POINTS};
 use twoport_board::{Board, BoardSupport, RawSensors};
+use twoport_config::{RamFlash, Store};
 use twoport_control::passivity::SeriesDamper;
 use twoport_control::servo::{Direct, PortLayer};
 use twoport_control::servo::{SensorFrame, ServoOutput};
@@ -107,8 +108,12 @@ impl BoardSupport for HostLink {
 impl<L: PortLayer> LocalBoard<L> {
     /// `board`, driven by the link's sensor frames.
     fn driven(board: Board<UnilateralWall, REGION_POINTS, L>) -> Self {
+        let mut board = board.with_pil(true);
+        // As the QEMU images boot: the configuration from a RAM flash.
+        let mut store = Store::new(RamFlash::<512, 256>::new(), 0, 256);
+        board.boot_config(&mut store);
         LocalBoard {
-            board: board.with_pil(true),
+            board,
             link: HostLink::default(),
         }
     }

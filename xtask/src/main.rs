@@ -568,7 +568,12 @@ fn with_board_in_qemu(
 }
 
 /// The cargo-fuzz targets in fuzz/.
-const FUZZ_TARGETS: [&str; 3] = ["link_decoder", "model_parser", "scene_parser"];
+const FUZZ_TARGETS: [&str; 4] = [
+    "link_decoder",
+    "config_record",
+    "model_parser",
+    "scene_parser",
+];
 
 /// Run each fuzz target for `secs` seconds on a scratch copy of its seed
 /// corpus. On a stable toolchain cargo-fuzz needs RUSTC_BOOTSTRAP=1 for its

@@ -1,6 +1,7 @@
 //! The loop: servo tick, link in, frames out.
 
 mod arming;
+mod persist;
 
 use crate::io::IoScale;
 use crate::region::{Bound, Region};
@@ -59,6 +60,10 @@ pub struct Board<V, const R: usize, L = Direct> {
     dead_man_closed: bool,
     /// Whether the amplifier's outputs are on (as last commanded).
     outputs_on: bool,
+    /// Where the configuration in force came from.
+    config_source: Option<twoport_link::ConfigSource>,
+    /// A `SaveConfig` waiting for the main loop.
+    save_pending: bool,
 }
 
 impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
@@ -93,6 +98,8 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             homing: None,
             dead_man_closed: false,
             outputs_on: false,
+            config_source: None,
+            save_pending: false,
         }
     }
 
@@ -218,6 +225,8 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             Message::Home => self.home(),
             Message::Calibrate { position_pm } => self.calibrate(position_pm),
             Message::GetStatus => self.queue_status(),
+            Message::SaveConfig => self.request_save(),
+            Message::GetConfig => self.report_config(),
             Message::GetStats => self.queue(Message::Stats(LinkStats {
                 rx: self.decoder.stats(),
                 tx_dropped: self.tx_dropped,

@@ -14,6 +14,8 @@ pub struct IoScale {
     pub force_full_scale_n: f32,
     /// Load-cell force per ADC count (N).
     pub load_cell_n_per_count: f32,
+    /// The load cell's ADC reading at zero force (counts).
+    pub load_cell_offset_counts: i32,
 }
 
 impl IoScale {
@@ -22,6 +24,7 @@ impl IoScale {
     pub const EXCALIBUR: IoScale = IoScale {
         force_full_scale_n: 200.0,
         load_cell_n_per_count: 1.0e-3,
+        load_cell_offset_counts: 0,
     };
 
     /// The signed duty for `force_n`, rounded to the nearest step and
@@ -44,7 +47,7 @@ impl IoScale {
 
     /// The load-cell force for an ADC reading (N).
     pub fn load_cell_n(&self, counts: i32) -> f32 {
-        counts as f32 * self.load_cell_n_per_count
+        counts.saturating_sub(self.load_cell_offset_counts) as f32 * self.load_cell_n_per_count
     }
 
     /// The ADC reading (counts, nearest, half away from zero; saturating,
@@ -52,7 +55,7 @@ impl IoScale {
     /// host sends for a simulated force.
     pub fn load_cell_counts(&self, force_n: f32) -> i32 {
         let c = force_n / self.load_cell_n_per_count;
-        (c + 0.5f32.copysign(c)) as i32
+        ((c + 0.5f32.copysign(c)) as i32).saturating_add(self.load_cell_offset_counts)
     }
 }
 
@@ -88,5 +91,13 @@ mod tests {
         assert_eq!(s.load_cell_counts(0.0014), 1);
         assert_eq!(s.load_cell_counts(-0.0016), -2);
         assert_eq!(s.load_cell_counts(f32::NAN), 0);
+        // A calibrated zero offset shifts the counts, not the forces.
+        let o = IoScale {
+            load_cell_offset_counts: 2048,
+            ..s
+        };
+        assert_eq!(o.load_cell_counts(0.0), 2048);
+        assert_eq!(o.load_cell_n(2048 + 1500), s.load_cell_n(1500));
+        assert_eq!(o.load_cell_n(i32::MIN), i32::MIN as f32 * 1e-3);
     }
 }

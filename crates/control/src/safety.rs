@@ -277,6 +277,37 @@ impl<R: Real> SafetyLayer<R> {
         &self.cfg
     }
 
+    /// New limits (a stored configuration, at boot): only while disabled,
+    /// and only limits that validate; the thermal state and the latch are
+    /// kept. The period must stay the laws'.
+    pub fn reconfigure(&mut self, cfg: SafetyConfig) -> Result<(), ParamError> {
+        cfg.validate()?;
+        if self.enabled {
+            return Err(ParamError {
+                name: "safety",
+                value: 0.0,
+                problem: "can change only while disabled",
+            });
+        }
+        if cfg.period_s != self.cfg.period_s {
+            return Err(ParamError {
+                name: "safety.period_s (s)",
+                value: cfg.period_s,
+                problem: "must stay the laws' period",
+            });
+        }
+        let fresh = Self::new_in(cfg)?;
+        *self = SafetyLayer {
+            heat: self.heat,
+            latched: self.latched,
+            first: self.first,
+            next_tick: self.next_tick,
+            ticking: self.ticking,
+            ..fresh
+        };
+        Ok(())
+    }
+
     /// Enable force output, ramping in. Refused while a fault is latched.
     pub fn enable(&mut self) -> Result<(), Faults> {
         if !self.latched.is_empty() {

@@ -10,6 +10,6 @@ mod message;
 pub use crc::crc16;
 pub use frame::{encode, Decoder, Envelope, FrameError, Stats, MAX_FRAME, MAX_PAYLOAD};
 pub use message::{
-    ActuatorFrame, Gains, GainsReply, LinkStats, Message, Mode, ModeRefusal, ModeRequest, Refusal,
-    Role, SensorFrame, Status, Telemetry, PROTOCOL_VERSION,
+    ActuatorFrame, ConfigFallback, ConfigSource, Gains, GainsReply, LinkStats, Message, Mode,
+    ModeRefusal, ModeRequest, Refusal, Role, SensorFrame, Status, Telemetry, PROTOCOL_VERSION,
 };

@@ -64,6 +64,8 @@ pub enum ModeRequest {
     Home,
     /// [`Message::Calibrate`].
     Calibrate,
+    /// [`Message::SaveConfig`].
+    SaveConfig,
 }
 
 /// Why the board would not change mode.
@@ -87,6 +89,48 @@ pub enum ModeRefusal {
     },
     /// The position is beyond the board's range (±2.147 m).
     OutOfRange,
+    /// The configuration could not be written to flash.
+    FlashFailed,
+}
+
+/// Where the configuration in force came from (protocol 3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ConfigSource {
+    /// A valid record read from flash (or just written there).
+    Stored {
+        /// The record's sequence number (each save adds one).
+        seq: u32,
+    },
+    /// The image's safe defaults, because of `why`.
+    Defaults {
+        /// Why no stored record is in force.
+        why: ConfigFallback,
+    },
+}
+
+/// Why a board runs its built-in defaults instead of a stored record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ConfigFallback {
+    /// No record was ever written (the flash is erased).
+    Missing,
+    /// Both copies fail their check (CRC, length or encoding).
+    Corrupt,
+    /// The newest record is of an older format than this image reads.
+    OlderVersion {
+        /// The record's format version.
+        found: u16,
+    },
+    /// The newest record is of a newer format than this image reads.
+    NewerVersion {
+        /// The record's format version.
+        found: u16,
+    },
+    /// The record decodes but a value is out of its range.
+    Invalid,
+    /// The stored gains are outside the region this image proves stable.
+    NotProven,
+    /// The flash could not be read.
+    Unreadable,
 }
 
 /// The board's state, sent on request and whenever it changes.
@@ -228,6 +272,14 @@ pub enum Message {
     GetStatus,
     /// The board's state (protocol 3).
     Status(Status),
+    /// Store the configuration in force (gains, calibration, limits) in
+    /// flash. Disarmed only: writing flash stalls the processor (protocol 3).
+    SaveConfig,
+    /// Ask where the configuration in force came from (protocol 3).
+    GetConfig,
+    /// Where the configuration in force came from: sent at boot, on
+    /// request and after a save (protocol 3).
+    Config(ConfigSource),
     /// A mode change the board refused (protocol 3).
     ModeRefused {
         /// What was asked.

@@ -53,6 +53,12 @@ fn all_messages() -> Vec<Message> {
             position_pm: i64::MIN,
         },
         Message::GetStatus,
+        Message::SaveConfig,
+        Message::GetConfig,
+        Message::Config(ConfigSource::Stored { seq: u32::MAX }),
+        Message::Config(ConfigSource::Defaults {
+            why: ConfigFallback::OlderVersion { found: 0 },
+        }),
         Message::Status(Status {
             mode: Mode::Armed,
             calibrated: true,

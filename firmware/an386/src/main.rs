@@ -15,6 +15,7 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
 use twoport_board::excalibur;
+use twoport_config::{RamFlash, Store};
 use twoport_qemu_exit::exit;
 
 #[entry]
@@ -27,6 +28,10 @@ fn main() -> ! {
         hprintln!("the Excalibur board image would not build");
         exit(false)
     };
+    // QEMU's board has no flash for it: the configuration lives in RAM,
+    // so every boot reports the defaults, and why (nothing stored).
+    let mut store = Store::new(RamFlash::<512, 256>::new(), 0, 256);
+    board.boot_config(&mut store);
     let mut io = uart::Uart::take();
     // SysTick times each tick; with `-icount shift=N` it is a
     // deterministic function of the instructions executed.
@@ -40,6 +45,7 @@ fn main() -> ! {
     // Lockstep: each control tick waits for the host's sensor frame.
     loop {
         board.control_tick(&mut io);
+        board.service_config(&mut store);
         board.flush(&mut io);
     }
 }

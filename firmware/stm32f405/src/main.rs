@@ -32,6 +32,8 @@
 #![no_std]
 #![no_main]
 
+#[cfg(not(feature = "qemu"))]
+mod flash;
 mod init;
 mod support;
 
@@ -94,7 +96,9 @@ fn main() -> ! {
     let Ok(board) = excalibur::stiff_wall_board() else {
         halt()
     };
-    let board = board.with_pil(cfg!(feature = "qemu"));
+    let mut board = board.with_pil(cfg!(feature = "qemu"));
+    let mut store = config_store(dp.FLASH);
+    board.boot_config(&mut store);
     cortex_m::interrupt::free(|cs| BOARD.borrow(cs).replace(Some(board)));
     // Said before the first tick, which in QEMU waits for the host.
     #[cfg(feature = "qemu")]
@@ -109,7 +113,26 @@ fn main() -> ! {
     let mut io = unsafe { Stm32::steal() };
     loop {
         service_link(&mut io);
+        // A save the host asked for (disarmed only): under the lock, so
+        // the tick waits out an erase, which it may, with the outputs off.
+        cortex_m::interrupt::free(|cs| {
+            if let Some(b) = BOARD.borrow(cs).borrow_mut().as_mut() {
+                b.service_config(&mut store);
+            }
+        });
     }
+}
+
+/// The stored configuration: sectors 10 and 11 on the chip.
+#[cfg(not(feature = "qemu"))]
+fn config_store(flash: pac::FLASH) -> twoport_config::Store<flash::ConfigFlash> {
+    twoport_config::Store::new(flash::ConfigFlash::new(flash), 0, 128 * 1024)
+}
+
+/// QEMU models no flash interface: the configuration lives in RAM there.
+#[cfg(feature = "qemu")]
+fn config_store(_: pac::FLASH) -> twoport_config::Store<twoport_config::RamFlash<512, 256>> {
+    twoport_config::Store::new(twoport_config::RamFlash::new(), 0, 256)
 }
 
 /// The main loop's work on real hardware: take the bytes received and the

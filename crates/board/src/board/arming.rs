@@ -61,7 +61,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
         self.queue(Message::Status(self.status()));
     }
 
-    fn refuse(&mut self, asked: ModeRequest, why: ModeRefusal) {
+    pub(super) fn refuse(&mut self, asked: ModeRequest, why: ModeRefusal) {
         self.queue(Message::ModeRefused { asked, why });
     }
 

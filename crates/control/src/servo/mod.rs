@@ -314,6 +314,11 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
         self.front.safety.trip(f);
     }
 
+    /// New safety limits, while disabled (see [`SafetyLayer::reconfigure`]).
+    pub fn set_limits(&mut self, cfg: SafetyConfig) -> Result<(), ParamError> {
+        self.front.safety.reconfigure(cfg)
+    }
+
     /// The safety layer (limits, latched faults, thermal state).
     pub fn safety(&self) -> &SafetyLayer<R> {
         &self.front.safety

@@ -1,0 +1,146 @@
+//! The board's stored configuration: read at boot (falling back to the
+//! image's defaults, with the reason, over the link), saved on the host's
+//! request while disarmed.
+
+use super::Board;
+use crate::io::IoScale;
+use embedded_storage::nor_flash::NorFlash;
+use twoport_config::{Config, HomingSetup, Limits, LoadCell, Store};
+use twoport_control::homing::HomingConfig;
+use twoport_control::servo::{Gains, PortLayer};
+use twoport_control::ve::VirtualEnvironment;
+use twoport_control::{Position, SafetyConfig};
+use twoport_link::{ConfigFallback, ConfigSource, Message, Mode, ModeRefusal, ModeRequest};
+
+impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
+    /// The configuration in force, as a record would store it.
+    pub fn config(&self) -> Config {
+        let s = self.servo.safety().config();
+        let h = &self.homing_cfg;
+        Config {
+            gains: self.servo.gains().into(),
+            load_cell: LoadCell {
+                offset_counts: self.io.load_cell_offset_counts,
+                n_per_count: self.io.load_cell_n_per_count,
+            },
+            homing: HomingSetup {
+                stop_nm: h.stop_position.nm(),
+                toward_positive: h.toward_positive,
+                force_limit_n: h.force_limit_n,
+            },
+            limits: Limits {
+                peak_force_n: s.peak_force_n,
+                continuous_force_n: s.continuous_force_n,
+                max_velocity_mps: s.max_velocity_mps,
+                heartbeat_timeout_ticks: s.heartbeat_timeout_ticks,
+            },
+        }
+    }
+
+    /// Where the configuration in force came from (`None` before
+    /// [`boot_config`](Self::boot_config)).
+    pub fn config_source(&self) -> Option<ConfigSource> {
+        self.config_source
+    }
+
+    /// Put `cfg` in force, all of it or, with the reason, none: its gains
+    /// must lie in this image's proven region and every value must hold.
+    /// Disarmed only.
+    pub fn apply_config(&mut self, cfg: &Config) -> Result<(), ConfigFallback> {
+        if self.mode != Mode::Disarmed || cfg.validate().is_err() {
+            return Err(ConfigFallback::Invalid);
+        }
+        let gains = Gains::from(cfg.gains);
+        if self.check(&gains).is_err() {
+            return Err(ConfigFallback::NotProven);
+        }
+        let now = *self.servo.safety().config();
+        let limits = SafetyConfig {
+            peak_force_n: cfg.limits.peak_force_n,
+            continuous_force_n: cfg.limits.continuous_force_n,
+            max_velocity_mps: cfg.limits.max_velocity_mps,
+            heartbeat_timeout_ticks: cfg.limits.heartbeat_timeout_ticks,
+            ..now
+        };
+        let homing = HomingConfig {
+            stop_position: Position::from_nm(cfg.homing.stop_nm),
+            toward_positive: cfg.homing.toward_positive,
+            force_limit_n: cfg.homing.force_limit_n,
+            ..self.homing_cfg
+        };
+        if limits.validate().is_err() || homing.validate().is_err() {
+            return Err(ConfigFallback::Invalid);
+        }
+        // Gains first: the only step that can still refuse, and it
+        // changes nothing when it does.
+        let old = self.servo.gains();
+        self.servo
+            .set_gains(gains)
+            .map_err(|_| ConfigFallback::Invalid)?;
+        if self.servo.set_limits(limits).is_err() {
+            // Validated above and disarmed: unreachable, but never half
+            // applied.
+            let _ = self.servo.set_gains(old);
+            return Err(ConfigFallback::Invalid);
+        }
+        self.homing_cfg = homing;
+        self.io = IoScale {
+            load_cell_offset_counts: cfg.load_cell.offset_counts,
+            load_cell_n_per_count: cfg.load_cell.n_per_count,
+            ..self.io
+        };
+        Ok(())
+    }
+
+    /// At boot: the stored configuration if there is a valid one that this
+    /// image can run, else the image's own, and a [`Message::Config`]
+    /// saying which and why.
+    pub fn boot_config<F: NorFlash>(&mut self, store: &mut Store<F>) -> ConfigSource {
+        let defaults = self.config();
+        let (cfg, mut source) = store.load(&defaults);
+        if let ConfigSource::Stored { .. } = source {
+            if let Err(why) = self.apply_config(&cfg) {
+                let _ = self.apply_config(&defaults);
+                source = ConfigSource::Defaults { why };
+            }
+        }
+        self.config_source = Some(source);
+        self.queue(Message::Config(source));
+        source
+    }
+
+    /// `SaveConfig`: remembered for the main loop, which owns the flash.
+    pub(super) fn request_save(&mut self) {
+        match self.mode {
+            Mode::Disarmed => self.save_pending = true,
+            mode => self.refuse(ModeRequest::SaveConfig, ModeRefusal::NotDisarmed { mode }),
+        }
+    }
+
+    /// The main loop's part: write a requested save to `store` and report
+    /// the outcome. Writing flash may stall the processor for the erase,
+    /// so it runs only while disarmed (checked again here).
+    pub fn service_config<F: NorFlash>(&mut self, store: &mut Store<F>) {
+        if !core::mem::take(&mut self.save_pending) {
+            return;
+        }
+        if self.mode != Mode::Disarmed {
+            let mode = self.mode;
+            return self.refuse(ModeRequest::SaveConfig, ModeRefusal::NotDisarmed { mode });
+        }
+        match store.save(&self.config()) {
+            Ok(seq) => {
+                let source = ConfigSource::Stored { seq };
+                self.config_source = Some(source);
+                self.queue(Message::Config(source));
+            }
+            Err(_) => self.refuse(ModeRequest::SaveConfig, ModeRefusal::FlashFailed),
+        }
+    }
+
+    pub(super) fn report_config(&mut self) {
+        if let Some(s) = self.config_source {
+            self.queue(Message::Config(s));
+        }
+    }
+}

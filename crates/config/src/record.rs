@@ -1,0 +1,194 @@
+//! The configuration record: what a board keeps across power cycles, and
+//! its byte layout in flash.
+//!
+//! ```text
+//! offset  size  field
+//!      0     4  magic "TPCF" (written last: a record without it is absent)
+//!      4     2  format version, little-endian
+//!      6     2  payload length n, little-endian (<= MAX_PAYLOAD)
+//!      8     4  sequence number, little-endian (each save adds one)
+//!     12     n  payload: the Config, postcard-encoded
+//!   12+n     4  CRC-32 of bytes 4 .. 12+n, little-endian
+//! ```
+
+use crate::crc32::crc32;
+use serde::{Deserialize, Serialize};
+use twoport_link::Gains;
+
+/// The record's first word, "TPCF" in ASCII.
+pub const MAGIC: [u8; 4] = *b"TPCF";
+/// The record format this crate writes and reads.
+pub const FORMAT_VERSION: u16 = 1;
+/// The largest payload (bytes).
+pub const MAX_PAYLOAD: usize = 96;
+/// Header bytes before the payload.
+pub const HEADER: usize = 12;
+/// The largest record (bytes).
+pub const MAX_RECORD: usize = HEADER + MAX_PAYLOAD + 4;
+
+/// What a board keeps across power cycles. Units are SI.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Config {
+    /// The gains in force.
+    pub gains: Gains,
+    /// The load cell's calibration.
+    pub load_cell: LoadCell,
+    /// How the axis homes.
+    pub homing: HomingSetup,
+    /// The safety limits.
+    pub limits: Limits,
+}
+
+/// A load cell's calibration: force = (counts - offset) x scale.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LoadCell {
+    /// ADC counts at zero force.
+    pub offset_counts: i32,
+    /// Force per count (N).
+    pub n_per_count: f32,
+}
+
+/// Where the hard stop is and how hard homing may push.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HomingSetup {
+    /// The stop's position, as the encoder reads it once homed (nm).
+    pub stop_nm: i32,
+    /// Whether the stop lies toward positive positions.
+    pub toward_positive: bool,
+    /// The largest force homing pushes with (N).
+    pub force_limit_n: f32,
+}
+
+/// The safety layer's limits that a lab sets for its device.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Limits {
+    /// Largest force at any instant (N).
+    pub peak_force_n: f32,
+    /// Largest force held indefinitely (N).
+    pub continuous_force_n: f32,
+    /// Largest handle speed (m/s).
+    pub max_velocity_mps: f32,
+    /// Ticks without a link heartbeat before a fault (0: unchecked).
+    pub heartbeat_timeout_ticks: u32,
+}
+
+/// Why bytes are not a record this crate can use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RecordError {
+    /// No record: the magic word is absent (erased, or a write that never
+    /// finished).
+    Absent,
+    /// The length field exceeds [`MAX_PAYLOAD`] or the bytes available.
+    BadLength(u16),
+    /// The CRC does not match: the record is corrupt.
+    BadCrc,
+    /// A format this crate does not read.
+    Version(u16),
+    /// The CRC matches but the payload does not decode.
+    Payload,
+    /// A value is out of range; the field is named.
+    Invalid(&'static str),
+}
+
+/// Encode `config` as a record numbered `seq` into `buf`, returning its
+/// length. `None` if `buf` is shorter than [`MAX_RECORD`] or the config
+/// does not validate.
+pub fn encode(config: &Config, seq: u32, buf: &mut [u8]) -> Option<usize> {
+    encode_as(FORMAT_VERSION, config, seq, buf)
+}
+
+/// [`encode`] stamped with another format `version`: for migration tools
+/// and for testing how a reader treats records it does not know.
+pub fn encode_as(version: u16, config: &Config, seq: u32, buf: &mut [u8]) -> Option<usize> {
+    config.validate().ok()?;
+    if buf.len() < MAX_RECORD {
+        return None;
+    }
+    let n = postcard::to_slice(config, &mut buf[HEADER..HEADER + MAX_PAYLOAD])
+        .ok()?
+        .len();
+    buf[..4].copy_from_slice(&MAGIC);
+    buf[4..6].copy_from_slice(&version.to_le_bytes());
+    buf[6..8].copy_from_slice(&(n as u16).to_le_bytes());
+    buf[8..12].copy_from_slice(&seq.to_le_bytes());
+    let end = HEADER + n;
+    let crc = crc32(&buf[4..end]);
+    buf[end..end + 4].copy_from_slice(&crc.to_le_bytes());
+    Some(end + 4)
+}
+
+/// Decode a record from the start of `bytes` (which may run on past it):
+/// its sequence number and config, or why not. Never panics.
+pub fn decode(bytes: &[u8]) -> Result<(u32, Config), RecordError> {
+    if bytes.len() < HEADER + 4 || bytes[..4] != MAGIC {
+        return Err(RecordError::Absent);
+    }
+    let word = |i: usize| u16::from_le_bytes([bytes[i], bytes[i + 1]]);
+    let (version, len) = (word(4), word(6));
+    let n = len as usize;
+    if n > MAX_PAYLOAD || bytes.len() < HEADER + n + 4 {
+        return Err(RecordError::BadLength(len));
+    }
+    let end = HEADER + n;
+    let stored = u32::from_le_bytes([bytes[end], bytes[end + 1], bytes[end + 2], bytes[end + 3]]);
+    if crc32(&bytes[4..end]) != stored {
+        return Err(RecordError::BadCrc);
+    }
+    if version != FORMAT_VERSION {
+        return Err(RecordError::Version(version));
+    }
+    let seq = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]);
+    let (config, rest) = postcard::take_from_bytes::<Config>(&bytes[HEADER..end])
+        .map_err(|_| RecordError::Payload)?;
+    if !rest.is_empty() {
+        return Err(RecordError::Payload);
+    }
+    config.validate().map_err(RecordError::Invalid)?;
+    Ok((seq, config))
+}
+
+fn positive(name: &'static str, v: f32) -> Result<(), &'static str> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(name)
+    }
+}
+
+impl Config {
+    /// Every value finite and in its range; the error names the field.
+    /// (Whether the gains are proven stable is the board's to check: the
+    /// region belongs to its image.)
+    pub fn validate(&self) -> Result<(), &'static str> {
+        let gains_finite = match self.gains {
+            Gains::Impedance { k_npm, b_nspm } => [k_npm, b_nspm, 0.0, 0.0],
+            Gains::Admittance {
+                kp_npm,
+                bp_nspm,
+                m_kg,
+                b_nspm,
+            } => [kp_npm, bp_nspm, m_kg, b_nspm],
+        };
+        if gains_finite.iter().any(|g| !(g.is_finite() && *g >= 0.0)) {
+            return Err("gains");
+        }
+        positive("load_cell.n_per_count (N)", self.load_cell.n_per_count)?;
+        positive("limits.peak_force_n (N)", self.limits.peak_force_n)?;
+        positive(
+            "limits.continuous_force_n (N)",
+            self.limits.continuous_force_n,
+        )?;
+        if self.limits.continuous_force_n > self.limits.peak_force_n {
+            return Err("limits.continuous_force_n (N)");
+        }
+        positive(
+            "limits.max_velocity_mps (m/s)",
+            self.limits.max_velocity_mps,
+        )?;
+        positive("homing.force_limit_n (N)", self.homing.force_limit_n)?;
+        if self.homing.force_limit_n > self.limits.peak_force_n {
+            return Err("homing.force_limit_n (N)");
+        }
+        Ok(())
+    }
+}
