@@ -20,8 +20,8 @@ use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::ve::UnilateralWall;
 use twoport_control::Faults as BoardFaults;
 use twoport_link::{
-    encode, Decoder, LinkStats, Message, Mode, Role, SensorFrame as LinkSensors, Status, Telemetry,
-    MAX_FRAME,
+    encode, Decoder, LinkStats, Message, Mode, ModeRequest, Role, SensorFrame as LinkSensors,
+    Status, Telemetry, MAX_FRAME,
 };
 
 /// How far a homed board's position may be from the plant's: the stop's
@@ -94,6 +94,8 @@ impl BoardSupport for HostLink {
     fn set_duty(&mut self, _: i16) {}
     // So do the outputs: a disarmed board answers zero duty.
     fn set_outputs(&mut self, _: bool) {}
+    // The host's loop cannot hang unseen: no watchdog.
+    fn feed_watchdog(&mut self) {}
     fn read_byte(&mut self) -> Option<u8> {
         self.rx.pop_front()
     }
@@ -251,35 +253,61 @@ impl<P: BoardPort> Session<P> {
         Ok(s)
     }
 
-    /// Ask for a mode change and wait for the board's status or refusal.
-    fn ask(&mut self, msg: Message, what: &str) -> Result<Status, String> {
+    /// Ask for a mode change and wait for the board's status that shows it
+    /// done, or its refusal of it: over a real link, other statuses may
+    /// still be on their way.
+    fn ask(
+        &mut self,
+        msg: Message,
+        asked: ModeRequest,
+        done: fn(&Status) -> bool,
+    ) -> Result<Status, String> {
+        self.drop_stale_statuses();
         self.send(&msg)?;
-        let r = self.wait(what, |m| match m {
-            Message::Status(s) => Some(Ok(*s)),
-            Message::ModeRefused { why, .. } => Some(Err(*why)),
+        let what = format!("{asked:?}");
+        let r = self.wait(&what, |m| match m {
+            Message::Status(s) if done(s) => Some(Ok(*s)),
+            Message::ModeRefused { asked: a, why } if *a == asked => Some(Err(*why)),
             _ => None,
         })?;
         r.map_err(|why| format!("the board refused {what}: {why:?}"))
     }
 
+    /// Statuses and refusals already received answer earlier questions,
+    /// not the next one.
+    fn drop_stale_statuses(&mut self) {
+        self.inbox
+            .retain(|m| !matches!(m, Message::Status(_) | Message::ModeRefused { .. }));
+    }
+
     /// Calibrate a disarmed board: it stands at `position_m` (m).
     pub fn calibrate(&mut self, position_m: f64) -> Result<Status, String> {
         let position_pm = (position_m * 1e12).round() as i64;
-        self.ask(Message::Calibrate { position_pm }, "Calibrate")
+        self.ask(
+            Message::Calibrate { position_pm },
+            ModeRequest::Calibrate,
+            |s| s.calibrated,
+        )
     }
 
     /// Arm the board (it must have had a tick, to see its dead-man).
     pub fn arm(&mut self) -> Result<Status, String> {
-        let s = self.ask(Message::Arm, "Arm")?;
-        match s.mode {
-            Mode::Armed => Ok(s),
-            m => Err(format!("the board answered Arm in mode {m:?}")),
-        }
+        self.ask(Message::Arm, ModeRequest::Arm, |s| s.mode == Mode::Armed)
     }
 
     /// Start homing; the caller runs ticks until [`homed`].
     pub fn home(&mut self) -> Result<Status, String> {
-        self.ask(Message::Home, "Home")
+        self.ask(Message::Home, ModeRequest::Home, |s| s.mode == Mode::Homing)
+    }
+
+    /// The board's state machine, asked for.
+    pub fn status(&mut self) -> Result<Status, String> {
+        self.drop_stale_statuses();
+        self.send(&Message::GetStatus)?;
+        self.wait("GetStatus", |m| match m {
+            Message::Status(s) => Some(*s),
+            _ => None,
+        })
     }
 
     fn frame(&mut self, msg: &Message) -> Result<Vec<u8>, String> {

@@ -140,3 +140,64 @@ fn an_uncalibrated_board_refuses_to_arm_by_name() {
     session.calibrate(0.0).unwrap();
     assert_eq!(session.arm().unwrap().mode, twoport_link::Mode::Armed);
 }
+
+/// The watchdog in QEMU: `cargo xtask watchdog` runs the an386 image that
+/// hangs its loop on purpose after 1,500 armed ticks (the hand pushing
+/// into the wall) and passes its pty in `TWOPORT_PTY`. The board stops
+/// answering; the CMSDK watchdog resets it; it comes back disarmed,
+/// uncalibrated, with zero force, and the reset latched as a named fault
+/// that refuses arming until it is cleared.
+#[test]
+#[ignore = "needs the watchdog-test image in QEMU; run by `cargo xtask watchdog`"]
+fn a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed() {
+    use twoport_control::Faults as F;
+    use twoport_link::Mode;
+    let pty = std::env::var("TWOPORT_PTY").expect("TWOPORT_PTY names the board's pty");
+    let open = || pil::Session::open(pil::SerialBoard::open(&pty).unwrap(), Faults::default());
+    let mut s = open().unwrap();
+    let mut sim = Simulation::new(scene()).unwrap();
+    s.step(&mut sim).unwrap();
+    s.calibrate(0.0).unwrap();
+    s.arm().unwrap();
+    let io = twoport_board::IoScale::EXCALIBUR;
+    let (mut last_force, mut hung_at) = (0.0f32, None);
+    for k in 1..3000u32 {
+        match s.step(&mut sim) {
+            Ok((_, duty)) => last_force = io.force_n(duty),
+            Err(e) => {
+                assert!(e.contains("did not answer"), "{e}");
+                hung_at = Some(k);
+                break;
+            }
+        }
+    }
+    assert_eq!(
+        hung_at,
+        Some(1501),
+        "the image hangs after 1,500 armed ticks"
+    );
+    assert!(
+        last_force.abs() > 10.0,
+        "pushing when it hung: {last_force} N"
+    );
+    drop(s);
+    let mut s = open().expect("the board answers again after the reset");
+    let st = s.status().unwrap();
+    assert_eq!((st.mode, st.calibrated), (Mode::Disarmed, false));
+    assert_eq!(F(st.faults), F::WATCHDOG_RESET, "{}", F(st.faults));
+    assert_eq!(
+        F(st.first_fault).to_string(),
+        "watchdog reset: the loop hung"
+    );
+    let mut sim = Simulation::new(scene()).unwrap();
+    for _ in 0..20 {
+        assert_eq!(s.step(&mut sim).unwrap().1, 0, "zero force after the reset");
+    }
+    s.calibrate(0.0).unwrap();
+    let e = s.arm().unwrap_err();
+    assert!(e.contains("Faulted"), "{e}");
+    // Seen and cleared, it arms again.
+    s.send(&twoport_link::Message::ClearFaults).unwrap();
+    assert_eq!(s.status().unwrap().faults, 0);
+    assert_eq!(s.arm().unwrap().mode, Mode::Armed);
+}

@@ -10,6 +10,8 @@
 //!   over `-serial pty` (e.g. `--json`, `--seconds 4`, `--link-loss-at-s 3`,
 //!   `--check`, `--passivity`).
 //! - `scope-board`: the scope's board mode against the firmware in QEMU.
+//! - `watchdog`: hang the an386 image's loop on purpose; the watchdog
+//!   resets it and it comes back disarmed with the reset as a fault.
 //! - `fuzz [seconds]`: run each cargo-fuzz target (default 60 s each).
 //! - `accuracy`: regenerate docs/accuracy.md and docs/accuracy.png.
 
@@ -28,6 +30,7 @@ fn main() -> ExitCode {
         Some("firmware") => firmware().map(|_| ()),
         Some("qemu") => qemu(),
         Some("pil") => pil(&args[1..]),
+        Some("watchdog") => watchdog(),
         Some("scope-board") => scope_board(),
         Some("fuzz") => {
             let secs = args.get(1).map_or(Ok(60), |s| {
@@ -49,7 +52,7 @@ fn main() -> ExitCode {
             ]),
         ),
         _ => Err(format!(
-            "usage: cargo xtask <ci|thumb|firmware|qemu|pil [--board an386|stm32f405] [options]|scope-board|fuzz [seconds]|accuracy>\n  got: {}",
+            "usage: cargo xtask <ci|thumb|firmware|qemu|pil [--board an386|stm32f405] [options]|scope-board|watchdog|fuzz [seconds]|accuracy>\n  got: {}",
             args.join(" ")
         )),
     };
@@ -208,6 +211,7 @@ fn ci() -> Result<(), String> {
         "--check".into(),
     ])?;
     scope_board()?;
+    watchdog()?;
     fuzz(60)?;
     // Last, closing on the total so that CI reads the whole count rather
     // than the last crate's doc-test line. The long hard cases (24 h of
@@ -357,21 +361,47 @@ fn firmware() -> Result<PathBuf, String> {
 /// rebuilt (the feature is its alone), and is copied aside, because the
 /// next plain build writes the same file.
 fn passivity_image() -> Result<PathBuf, String> {
+    an386_image_with("passivity")
+}
+
+/// The an386 image built with `feature`; returns its ELF, copied aside as
+/// `twoport-an386-<feature>`.
+fn an386_image_with(feature: &str) -> Result<PathBuf, String> {
     let tc = Toolchain::detect()?;
     let dir = cross_target_dir("firmware");
     run(
-        &format!("build firmware: the passivity image ({})", tc.describe()),
+        &format!("build firmware: the {feature} image ({})", tc.describe()),
         &mut tc.build(
             &root().join("firmware"),
             &dir,
-            &["-p", "twoport-an386", "--features", "passivity"],
+            &["-p", "twoport-an386", "--features", feature],
         ),
     )?;
     let out = dir.join(TARGET).join("release");
-    let elf = out.join("twoport-an386-passivity");
+    let elf = out.join(format!("twoport-an386-{feature}"));
     std::fs::copy(out.join("twoport-an386"), &elf)
-        .map_err(|e| format!("copy the passivity image: {e}"))?;
+        .map_err(|e| format!("copy the {feature} image: {e}"))?;
     Ok(elf)
+}
+
+/// The watchdog test: the an386 image that hangs its loop on purpose
+/// after 500 armed ticks, against host-sim's check that the CMSDK
+/// watchdog resets it and that it comes back disarmed, outputs off, with
+/// the reset latched as a fault.
+fn watchdog() -> Result<(), String> {
+    let elf = an386_image_with("watchdog-test")?;
+    let mut qemu = qemu_an386(&elf);
+    qemu.args(["-serial", "pty"]);
+    with_board_in_qemu(qemu, |pty| {
+        run(
+            "watchdog reset in QEMU",
+            cargo()
+                .env("TWOPORT_PTY", pty)
+                .args(["test", "--release", "-p", "host-sim", "--test", "pil"])
+                .args(["--", "--ignored", "--exact"])
+                .arg("a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed"),
+        )
+    })
 }
 
 /// The STM32F405 image's `qemu` build, for QEMU's netduinoplus2; returns

@@ -337,6 +337,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     fn control_tick_inner(&mut self, io: &mut impl BoardSupport) -> ServoOutput {
         let (frame, start) = if self.pil {
             let frame = loop {
+                io.feed_watchdog();
                 self.poll_link(io);
                 if let Some(f) = self.pending.take() {
                     break f;
@@ -359,6 +360,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
         let out = self.tick(&frame);
         let duty = self.duty();
         io.set_duty(duty);
+        io.feed_watchdog();
         if self.pil {
             self.queue(Message::Actuator(ActuatorFrame {
                 tick: frame.tick,

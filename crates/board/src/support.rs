@@ -34,6 +34,10 @@ pub trait BoardSupport {
     /// timer's main output enable). Off at boot, before the first call;
     /// the loop turns them on only while homing or armed.
     fn set_outputs(&mut self, on: bool);
+    /// Feed the watchdog: the loop does once a tick, and a processor-in-the-
+    /// loop board as it waits for its host, so that only a loop that has
+    /// stopped lets it bite. Boards without one do nothing.
+    fn feed_watchdog(&mut self);
     /// A byte the link received, if one is waiting.
     fn read_byte(&mut self) -> Option<u8>;
     /// Send bytes on the link.

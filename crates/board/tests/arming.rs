@@ -130,6 +130,7 @@ impl BoardSupport for Bench {
         self.outputs = on;
         self.outputs_calls.push(on);
     }
+    fn feed_watchdog(&mut self) {}
     fn read_byte(&mut self) -> Option<u8> {
         self.rx.pop_front()
     }

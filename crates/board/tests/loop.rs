@@ -374,6 +374,7 @@ struct Io {
     sensors: RawSensors,
     samples: u32,
     clock: u32,
+    feeds: u32,
 }
 
 impl BoardSupport for Io {
@@ -385,6 +386,9 @@ impl BoardSupport for Io {
         self.duties.push(duty);
     }
     fn set_outputs(&mut self, _: bool) {}
+    fn feed_watchdog(&mut self) {
+        self.feeds += 1;
+    }
     fn read_byte(&mut self) -> Option<u8> {
         self.rx.pop_front()
     }
@@ -487,6 +491,8 @@ fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
         tx.extend(io.messages());
     }
     assert_eq!(io.samples, 120);
+    // The watchdog is fed once a tick.
+    assert_eq!(io.feeds, 120);
     // 30 um off the constraint at 51 kN/m is about 1.5 N of pull back;
     // the load cell reads 1.5 N through the scale.
     assert!(

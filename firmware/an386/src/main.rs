@@ -10,6 +10,7 @@
 #![no_main]
 
 mod uart;
+mod watchdog;
 
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::entry;
@@ -17,6 +18,10 @@ use cortex_m_semihosting::hprintln;
 use twoport_board::excalibur;
 use twoport_config::{RamFlash, Store};
 use twoport_qemu_exit::exit;
+
+/// The watchdog's time-out (ms): the reset follows a second one, so a
+/// hung loop is reset within 100 ms.
+const WATCHDOG_MS: u32 = 50;
 
 #[entry]
 fn main() -> ! {
@@ -32,7 +37,14 @@ fn main() -> ! {
     // so every boot reports the defaults, and why (nothing stored).
     let mut store = Store::new(RamFlash::<512, 256>::new(), 0, 256);
     board.boot_config(&mut store);
+    // A hung loop was reset by the watchdog: say so, latched, so that the
+    // board stays disarmed until the host has seen it and cleared it.
+    if watchdog::reset_by_watchdog() {
+        board.trip(twoport_control::Faults::WATCHDOG_RESET);
+        hprintln!("twoport-an386: restarted by the watchdog");
+    }
     let mut io = uart::Uart::take();
+    io.watchdog = Some(watchdog::Watchdog::start(WATCHDOG_MS));
     // SysTick times each tick; with `-icount shift=N` it is a
     // deterministic function of the instructions executed.
     if let Some(mut p) = cortex_m::Peripherals::take() {
@@ -43,9 +55,24 @@ fn main() -> ! {
     }
     hprintln!("twoport-an386: board loop up, waiting on UART0");
     // Lockstep: each control tick waits for the host's sensor frame.
+    #[cfg(feature = "watchdog-test")]
+    let mut armed_ticks = 0u32;
     loop {
         board.control_tick(&mut io);
         board.service_config(&mut store);
         board.flush(&mut io);
+        // The watchdog test's image hangs on purpose after 1,500 armed
+        // ticks, as a loop stuck in a bug would.
+        #[cfg(feature = "watchdog-test")]
+        {
+            if board.mode() == twoport_link::Mode::Armed {
+                armed_ticks += 1;
+            }
+            if armed_ticks == 1500 {
+                hprintln!("twoport-an386: hanging on purpose (watchdog test)");
+                #[allow(clippy::empty_loop)]
+                loop {}
+            }
+        }
     }
 }

@@ -23,6 +23,8 @@ pub struct Uart {
     /// SysTick's last reading, and the 32-bit count it extends to.
     last: u32,
     cycles: u32,
+    /// The watchdog the loop feeds.
+    pub watchdog: Option<crate::watchdog::Watchdog>,
 }
 
 impl Uart {
@@ -35,7 +37,11 @@ impl Uart {
             write_volatile(BAUDDIV as *mut u32, 16);
             write_volatile(CTRL as *mut u32, CTRL_TX_EN | CTRL_RX_EN);
         }
-        Uart { last: 0, cycles: 0 }
+        Uart {
+            last: 0,
+            cycles: 0,
+            watchdog: None,
+        }
     }
 
     fn state(&self) -> u32 {
@@ -70,6 +76,11 @@ impl BoardSupport for Uart {
     // No amplifier: the host sees the outputs as the duty it is sent,
     // which is zero whenever the board is disarmed.
     fn set_outputs(&mut self, _: bool) {}
+    fn feed_watchdog(&mut self) {
+        if let Some(w) = &mut self.watchdog {
+            w.feed();
+        }
+    }
     fn read_byte(&mut self) -> Option<u8> {
         self.read()
     }

@@ -5,7 +5,8 @@
 //!
 //! Programming is by 32-bit words (x32 parallelism, which needs 2.7-3.6 V).
 //! An erase stalls instruction fetch from flash for up to 2 s, so the
-//! board saves only while disarmed with its outputs off.
+//! board saves only while disarmed with its outputs off, and the watchdog's
+//! time-out is stretched to 32 s for the erase and set back after it.
 
 use embedded_storage::nor_flash::{
     check_erase, check_read, check_write, ErrorType, NorFlash, NorFlashError, NorFlashErrorKind,
@@ -120,7 +121,8 @@ impl NorFlash for ConfigFlash {
     fn erase(&mut self, from: u32, to: u32) -> Result<(), Self::Error> {
         check_erase(self, from, to).map_err(FlashError::Kind)?;
         for s in (from as usize / SECTOR)..(to as usize / SECTOR) {
-            self.unlocked(|f| {
+            stretch_watchdog(true);
+            let r = self.unlocked(|f| {
                 f.flash.cr().modify(|_, w| {
                     w.psize().psize32();
                     w.ser().set_bit();
@@ -130,7 +132,9 @@ impl NorFlash for ConfigFlash {
                 });
                 f.flash.cr().modify(|_, w| w.strt().set_bit());
                 f.wait()
-            })?;
+            });
+            stretch_watchdog(false);
+            r?;
         }
         Ok(())
     }
@@ -154,4 +158,26 @@ impl NorFlash for ConfigFlash {
             Ok(())
         })
     }
+}
+
+/// The watchdog's time-out: 32 s for a sector erase, which stalls the
+/// processor, or the loop's 50 ms (as `init::watchdog` sets it).
+fn stretch_watchdog(long: bool) {
+    // SAFETY: called from the main loop under the board's lock, where
+    // nothing else uses the watchdog; these are its documented key,
+    // prescaler and reload writes.
+    let iwdg = unsafe { pac::IWDG::steal() };
+    // A new prescaler or reload takes effect once the last has.
+    while iwdg.sr().read().bits() != 0 {}
+    iwdg.kr().write(|w| w.key().feed());
+    iwdg.kr().write(|w| w.key().unlock());
+    if long {
+        iwdg.pr().write(|w| w.pr().divide_by256());
+        iwdg.rlr().write(|w| w.rl().set(4095));
+    } else {
+        iwdg.pr().write(|w| w.pr().divide_by4());
+        iwdg.rlr().write(|w| w.rl().set(400));
+    }
+    while iwdg.sr().read().bits() != 0 {}
+    iwdg.kr().write(|w| w.key().feed());
 }

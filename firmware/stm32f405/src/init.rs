@@ -193,3 +193,23 @@ fn wait_for(ready: impl Fn() -> bool) {
     }
     while !ready() {}
 }
+
+/// The independent watchdog, from the ~32 kHz LSI divided by 4 (8 kHz):
+/// 400 counts, 50 ms without a feed, resets the chip (the reset turns the
+/// outputs off, and the next boot reports it). Once started it cannot be
+/// stopped. QEMU models no IWDG: there these writes go nowhere.
+pub fn watchdog(iwdg: &pac::IWDG) {
+    iwdg.kr().write(|w| w.key().unlock());
+    iwdg.pr().write(|w| w.pr().divide_by4());
+    iwdg.rlr().write(|w| w.rl().set(400));
+    iwdg.kr().write(|w| w.key().feed());
+    iwdg.kr().write(|w| w.key().start());
+}
+
+/// Whether the last reset was the independent watchdog's; clears the
+/// reset flags for the next boot.
+pub fn reset_by_watchdog(rcc: &pac::RCC) -> bool {
+    let was = rcc.csr().read().wdgrstf().bit_is_set();
+    rcc.csr().modify(|_, w| w.rmvf().set_bit());
+    was
+}

@@ -97,12 +97,16 @@ fn main() -> ! {
         halt()
     };
     let mut board = board.with_pil(cfg!(feature = "qemu"));
+    if init::reset_by_watchdog(&dp.RCC) {
+        board.trip(twoport_control::Faults::WATCHDOG_RESET);
+    }
     let mut store = config_store(dp.FLASH);
     board.boot_config(&mut store);
     cortex_m::interrupt::free(|cs| BOARD.borrow(cs).replace(Some(board)));
     // Said before the first tick, which in QEMU waits for the host.
     #[cfg(feature = "qemu")]
     cortex_m_semihosting::hprintln!("twoport-stm32f405 (qemu): board loop up, waiting on USART2");
+    init::watchdog(&dp.IWDG);
     init::control_timer(&dp.TIM2);
     // SAFETY: the handler only shares state through the critical-section
     // mutex above.

@@ -18,6 +18,7 @@ pub struct Stm32 {
     adc: pac::ADC1,
     gpioc: pac::GPIOC,
     usart: pac::USART2,
+    iwdg: pac::IWDG,
     #[cfg(feature = "qemu")]
     tim5: pac::TIM5,
 }
@@ -41,6 +42,7 @@ impl Stm32 {
                 adc: pac::ADC1::steal(),
                 gpioc: pac::GPIOC::steal(),
                 usart: pac::USART2::steal(),
+                iwdg: pac::IWDG::steal(),
                 #[cfg(feature = "qemu")]
                 tim5: pac::TIM5::steal(),
             }
@@ -84,6 +86,10 @@ impl BoardSupport for Stm32 {
         // TIM1's main output enable gates both bridge legs: off, the
         // amplifier sees no drive whatever the compare register holds.
         self.tim1.bdtr().modify(|_, w| w.moe().bit(on));
+    }
+
+    fn feed_watchdog(&mut self) {
+        self.iwdg.kr().write(|w| w.key().feed());
     }
 
     fn read_byte(&mut self) -> Option<u8> {
