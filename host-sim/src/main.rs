@@ -472,6 +472,7 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         "telemetry_frames": run.telemetry.len(),
         "peak_force_n": run.samples.iter().map(|s| s.actuator_n.abs()).fold(0.0, f64::max),
         "last_loop_cycles": loop_cycles,
+        "last_stage_cycles": run.telemetry.last().map(|t| t.stage_cycles),
         "start": run.start,
         "armed_at_tick": run.armed_at_tick,
         "homing_ticks": run.homing.map(|h| h.0),

@@ -96,6 +96,10 @@ impl BoardSupport for HostLink {
     fn set_outputs(&mut self, _: bool) {}
     // The host's loop cannot hang unseen: no watchdog.
     fn feed_watchdog(&mut self) {}
+    // The host paces the ticks.
+    fn cycles_per_tick(&self) -> u32 {
+        0
+    }
     fn read_byte(&mut self) -> Option<u8> {
         self.rx.pop_front()
     }

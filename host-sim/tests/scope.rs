@@ -173,6 +173,18 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
             .len()
             >= 150
     );
+    // The loop's timing is plotted: the law and safety layer take a few
+    // hundred of the emulated Cortex-M4F's instructions.
+    assert!(
+        s.board_ring(host_sim::scope::app::BoardSignal::LawCycles)
+            .len()
+            >= 150
+    );
+    assert!(
+        (100..5000).contains(&t.stage_cycles[1]),
+        "{:?}",
+        t.stage_cycles
+    );
     // The hand, led to 30 mm, is held at the board's wall at 10 mm.
     let x_board = t.position_pm as f64 * 1e-12;
     assert!(

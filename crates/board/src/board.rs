@@ -64,6 +64,42 @@ pub struct Board<V, const R: usize, L = Direct> {
     config_source: Option<twoport_link::ConfigSource>,
     /// A `SaveConfig` waiting for the main loop.
     save_pending: bool,
+    /// Loop timing: the last tick's stages, its start, the overruns and
+    /// the worst jitter since boot.
+    timing: Timing,
+}
+
+/// The loop's timing, in the support's count.
+#[derive(Clone, Copy, Debug, Default)]
+struct Timing {
+    stages: [u32; 3],
+    last_start: Option<u32>,
+    deadline_misses: u32,
+    worst_jitter: u32,
+}
+
+impl Timing {
+    /// A tick that started at `start` and ran its stages through the
+    /// instants `t`, against a period of `period` (0: unchecked).
+    fn record(&mut self, start: u32, t: [u32; 3], period: u32) {
+        self.stages = [
+            t[0].wrapping_sub(start),
+            t[1].wrapping_sub(t[0]),
+            t[2].wrapping_sub(t[1]),
+        ];
+        if period > 0 {
+            let took = t[2].wrapping_sub(start);
+            let late = self.last_start.is_some_and(|s0| {
+                let dt = start.wrapping_sub(s0);
+                self.worst_jitter = self.worst_jitter.max(dt.abs_diff(period));
+                dt > period + period / 2
+            });
+            if took > period || late {
+                self.deadline_misses = self.deadline_misses.saturating_add(1);
+            }
+        }
+        self.last_start = Some(start);
+    }
 }
 
 impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
@@ -100,6 +136,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             outputs_on: false,
             config_source: None,
             save_pending: false,
+            timing: Timing::default(),
         }
     }
 
@@ -357,7 +394,9 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             self.ticks = self.ticks.wrapping_add(1);
             (frame, start)
         };
+        let sensed = io.cycles();
         let out = self.tick(&frame);
+        let ruled = io.cycles();
         let duty = self.duty();
         io.set_duty(duty);
         io.feed_watchdog();
@@ -367,7 +406,10 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
                 duty,
             }));
         }
-        self.loop_cycles = io.cycles().wrapping_sub(start);
+        let end = io.cycles();
+        self.loop_cycles = end.wrapping_sub(start);
+        let period = io.cycles_per_tick();
+        self.timing.record(start, [sensed, ruled, end], period);
         out
     }
 
@@ -403,6 +445,9 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
                     faults: out.faults.0,
                     loop_cycles: self.loop_cycles,
                     mode: self.mode,
+                    stage_cycles: self.timing.stages,
+                    deadline_misses: self.timing.deadline_misses,
+                    worst_jitter_cycles: self.timing.worst_jitter,
                 }));
             }
         }

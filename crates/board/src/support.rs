@@ -45,4 +45,8 @@ pub trait BoardSupport {
     /// A free-running count for timing the loop: core cycles on hardware,
     /// instructions in an emulator with `-icount`, 0 where there is none.
     fn cycles(&mut self) -> u32;
+    /// The control period in [`cycles`](Self::cycles)' count, for the
+    /// deadline and jitter checks; 0 where the host paces the ticks
+    /// (processor in the loop) or there is no count.
+    fn cycles_per_tick(&self) -> u32;
 }

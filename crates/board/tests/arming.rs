@@ -131,6 +131,9 @@ impl BoardSupport for Bench {
         self.outputs_calls.push(on);
     }
     fn feed_watchdog(&mut self) {}
+    fn cycles_per_tick(&self) -> u32 {
+        0
+    }
     fn read_byte(&mut self) -> Option<u8> {
         self.rx.pop_front()
     }

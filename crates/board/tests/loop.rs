@@ -375,6 +375,10 @@ struct Io {
     samples: u32,
     clock: u32,
     feeds: u32,
+    /// The control period in the clock's count (0: unchecked).
+    period: u32,
+    /// How far the clock moves per look (7 by default).
+    step: u32,
 }
 
 impl BoardSupport for Io {
@@ -389,6 +393,9 @@ impl BoardSupport for Io {
     fn feed_watchdog(&mut self) {
         self.feeds += 1;
     }
+    fn cycles_per_tick(&self) -> u32 {
+        self.period
+    }
     fn read_byte(&mut self) -> Option<u8> {
         self.rx.pop_front()
     }
@@ -396,8 +403,11 @@ impl BoardSupport for Io {
         self.tx.extend_from_slice(bytes);
     }
     fn cycles(&mut self) -> u32 {
-        // A clock that advances 7 per look, so that a tick measures 7.
-        self.clock = self.clock.wrapping_add(7);
+        // A clock that advances a fixed step per look (7 unless set), so
+        // that each stage of a tick measures one step.
+        self.clock = self
+            .clock
+            .wrapping_add(if self.step == 0 { 7 } else { self.step });
         self.clock
     }
 }
@@ -515,9 +525,70 @@ fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
         (9..120).step_by(10).collect::<Vec<u32>>()
     );
     assert!(telemetry.iter().all(|t| (t.load_cell_n - 1.5).abs() < 1e-6));
-    assert!(telemetry.iter().all(|t| t.loop_cycles == 7));
+    // Three stages (sensors, law, drive), one step of the clock each.
+    assert!(telemetry
+        .iter()
+        .all(|t| t.loop_cycles == 21 && t.stage_cycles == [7, 7, 7]));
+    // Without a period, nothing is checked.
+    assert!(telemetry
+        .iter()
+        .all(|t| t.deadline_misses == 0 && t.worst_jitter_cycles == 0));
     // The dead-man opens: zero force in that very tick.
     io.sensors.dead_man_closed = false;
     let out = b.control_tick(&mut io);
     assert_eq!(*io.duties.last().unwrap(), 0, "{out:?}");
+}
+
+/// Loop timing against a period of 30 counts: ticks of 21 that start 28
+/// apart are on time with 2 of jitter; a tick of 33 overruns its period,
+/// and a tick that starts 78 after the last (a late interrupt) is a miss
+/// too. Each telemetry frame, sent from inside a tick, carries the timing
+/// of the ticks before it.
+#[test]
+fn deadline_misses_and_the_worst_jitter_are_counted_and_reported() {
+    let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    let s = Servo::new(
+        ImpedanceGains::new(51_000.0, 90.0).into(),
+        enc,
+        safety(),
+        BilateralConstraint::new(Position::ZERO),
+    )
+    .unwrap();
+    let mut b = Board::new(s, region(), 1);
+    let mut io = Io {
+        period: 30,
+        ..Io::default()
+    };
+    // One tick, and the telemetry it sent.
+    let tick = |b: &mut Board<BilateralConstraint, 3>, io: &mut Io| {
+        b.control_tick(io);
+        b.flush(io);
+        io.messages()
+            .into_iter()
+            .find_map(|m| match m {
+                Message::Telemetry(t) => Some(t),
+                _ => None,
+            })
+            .unwrap()
+    };
+    let mut t = tick(&mut b, &mut io);
+    for _ in 0..10 {
+        t = tick(&mut b, &mut io);
+    }
+    assert_eq!((t.deadline_misses, t.worst_jitter_cycles), (0, 2));
+    // One slow tick: 11 a look, 33 in all.
+    io.step = 11;
+    tick(&mut b, &mut io);
+    io.step = 7;
+    let t = tick(&mut b, &mut io);
+    assert_eq!((t.deadline_misses, t.stage_cycles), (1, [11, 11, 11]));
+    // The tick after it started 33 + 7 = 40 after it: 10 of jitter, but
+    // less than half a period late.
+    let t = tick(&mut b, &mut io);
+    assert_eq!((t.deadline_misses, t.worst_jitter_cycles), (1, 10));
+    // An interrupt 50 counts late: 78 from start to start.
+    io.clock = io.clock.wrapping_add(50);
+    tick(&mut b, &mut io);
+    let t = tick(&mut b, &mut io);
+    assert_eq!((t.deadline_misses, t.worst_jitter_cycles), (2, 48));
 }

@@ -40,6 +40,17 @@ pub struct Telemetry {
     pub loop_cycles: u32,
     /// What the board is doing (protocol 3).
     pub mode: Mode,
+    /// The last tick's stages, in the same count: reading the sensors,
+    /// the law and the safety layer, driving the amplifier and queueing
+    /// the answer (protocol 3).
+    pub stage_cycles: [u32; 3],
+    /// Ticks since boot that overran their period, or came more than half
+    /// a period late (protocol 3; 0 where the host paces the ticks).
+    pub deadline_misses: u32,
+    /// The largest difference since boot between a tick's start-to-start
+    /// time and the period, in the same count (protocol 3; 0 where the
+    /// host paces the ticks).
+    pub worst_jitter_cycles: u32,
 }
 
 /// The board's state machine (protocol 3). A board boots disarmed with its

@@ -81,6 +81,10 @@ impl BoardSupport for Uart {
             w.feed();
         }
     }
+    // Processor in the loop: the host paces the ticks.
+    fn cycles_per_tick(&self) -> u32 {
+        0
+    }
     fn read_byte(&mut self) -> Option<u8> {
         self.read()
     }

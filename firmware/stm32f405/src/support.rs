@@ -119,4 +119,16 @@ impl BoardSupport for Stm32 {
     fn cycles(&mut self) -> u32 {
         self.tim5.cnt().read().bits()
     }
+
+    /// 168 MHz at 1 kHz.
+    #[cfg(not(feature = "qemu"))]
+    fn cycles_per_tick(&self) -> u32 {
+        168_000
+    }
+
+    /// In QEMU the host paces the ticks (processor in the loop).
+    #[cfg(feature = "qemu")]
+    fn cycles_per_tick(&self) -> u32 {
+        0
+    }
 }

@@ -123,15 +123,35 @@ pub enum BoardSignal {
     Actuator,
     /// The board's VE position (m).
     VePosition,
+    /// The whole tick (cycles, or instructions in QEMU).
+    LoopCycles,
+    /// Reading the sensors (cycles).
+    SenseCycles,
+    /// The law and the safety layer (cycles).
+    LawCycles,
+    /// Driving the amplifier and queueing the answer (cycles).
+    DriveCycles,
 }
 
 impl BoardSignal {
     /// Every board signal, in ring order.
-    pub const ALL: [BoardSignal; 4] = [
+    pub const ALL: [BoardSignal; 8] = [
         BoardSignal::Position,
         BoardSignal::Commanded,
         BoardSignal::Actuator,
         BoardSignal::VePosition,
+        BoardSignal::LoopCycles,
+        BoardSignal::SenseCycles,
+        BoardSignal::LawCycles,
+        BoardSignal::DriveCycles,
+    ];
+
+    /// The loop-timing signals, plotted together.
+    pub const TIMING: [BoardSignal; 4] = [
+        BoardSignal::LoopCycles,
+        BoardSignal::SenseCycles,
+        BoardSignal::LawCycles,
+        BoardSignal::DriveCycles,
     ];
 
     /// Legend text with unit.
@@ -141,6 +161,10 @@ impl BoardSignal {
             BoardSignal::Commanded => "board: commanded force (N)",
             BoardSignal::Actuator => "board: actuator force (N)",
             BoardSignal::VePosition => "board: VE position (m)",
+            BoardSignal::LoopCycles => "board: tick (cycles)",
+            BoardSignal::SenseCycles => "board: sensors (cycles)",
+            BoardSignal::LawCycles => "board: law + safety (cycles)",
+            BoardSignal::DriveCycles => "board: drive + answer (cycles)",
         }
     }
 
@@ -150,6 +174,10 @@ impl BoardSignal {
             BoardSignal::Commanded => t.commanded_n as f64,
             BoardSignal::Actuator => t.actuator_n as f64,
             BoardSignal::VePosition => t.ve_position_pm as f64 * 1e-12,
+            BoardSignal::LoopCycles => t.loop_cycles as f64,
+            BoardSignal::SenseCycles => t.stage_cycles[0] as f64,
+            BoardSignal::LawCycles => t.stage_cycles[1] as f64,
+            BoardSignal::DriveCycles => t.stage_cycles[2] as f64,
         }
     }
 }

@@ -76,7 +76,8 @@ fn signal_plot(
 /// found once a frame (a triggered one scans the trigger signal's ring).
 pub fn plots(ui: &mut Ui, s: &ScopeState) {
     let layer = s.has_layer();
-    let n = if layer { 5.0 } else { 4.0 };
+    let board = s.board.is_some();
+    let n = 4.0 + f32::from(u8::from(layer)) + f32::from(u8::from(board));
     let h = ((ui.available_height() - 24.0) / n).max(80.0);
     let span = s.view();
     signal_plot(
@@ -123,6 +124,9 @@ pub fn plots(ui: &mut Ui, s: &ScopeState) {
             &[Signal::LayerAdded],
             &[],
         );
+    }
+    if board {
+        signal_plot(ui, s, span, "board loop", h, &[], &BoardSignal::TIMING);
     }
 }
 
@@ -446,7 +450,19 @@ pub fn board(ui: &mut Ui, s: &mut ScopeState, link: &mut BoardChoice) {
         board_state(ui, s);
         let Some(b) = &s.board else { return };
         if let Some(t) = &b.telemetry {
-            ui.label(format!("tick {}  loop {} cycles", t.tick, t.loop_cycles));
+            ui.label(format!(
+                "tick {}  loop {} cycles ({} / {} / {})",
+                t.tick, t.loop_cycles, t.stage_cycles[0], t.stage_cycles[1], t.stage_cycles[2]
+            ));
+            let misses = format!(
+                "deadline misses {}  worst jitter {} cycles",
+                t.deadline_misses, t.worst_jitter_cycles
+            );
+            if t.deadline_misses > 0 {
+                ui.colored_label(Color32::RED, misses);
+            } else {
+                ui.label(misses);
+            }
         }
         if let Some(r) = &b.reply {
             ui.label(format!("last gain request: {r}"));
