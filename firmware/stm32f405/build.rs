@@ -6,4 +6,11 @@ fn main() {
     fs::copy("memory.x", out.join("memory.x")).expect("copy memory.x to OUT_DIR");
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed=memory.x");
+    // defmt's linker script, only where its feature is on.
+    if env::var_os("CARGO_FEATURE_DEFMT").is_some() {
+        if env::var_os("CARGO_FEATURE_QEMU").is_some() {
+            panic!("the defmt feature is for the hardware image: QEMU builds log by semihosting");
+        }
+        println!("cargo:rustc-link-arg=-Tdefmt.x");
+    }
 }

@@ -340,14 +340,37 @@ fn firmware() -> Result<PathBuf, String> {
         &format!("build firmware: QEMU images ({})", tc.describe()),
         &mut tc.build(&root().join("firmware"), &dir, &[]),
     )?;
+    let out = dir.join(TARGET).join("release");
+    // With RTT logging first, copied aside, then the plain image last, so
+    // that `twoport-stm32f405` is the plain one.
+    run(
+        &format!(
+            "build firmware: STM32F405 image with defmt ({})",
+            tc.describe()
+        ),
+        &mut tc.build(
+            &root().join("firmware/stm32f405"),
+            &dir,
+            &["--features", "defmt"],
+        ),
+    )?;
+    std::fs::copy(
+        out.join("twoport-stm32f405"),
+        out.join("twoport-stm32f405-defmt"),
+    )
+    .map_err(|e| format!("copy the defmt image: {e}"))?;
     run(
         &format!("build firmware: STM32F405 image ({})", tc.describe()),
         &mut tc.build(&root().join("firmware/stm32f405"), &dir, &[]),
     )?;
-    let out = dir.join(TARGET).join("release");
     // Flash and RAM of each image (text + data in flash; data + bss in RAM).
     let size = Command::new("arm-none-eabi-size")
-        .args(["twoport-stm32f405", "twoport-an386", "twoport-probe"])
+        .args([
+            "twoport-stm32f405",
+            "twoport-stm32f405-defmt",
+            "twoport-an386",
+            "twoport-probe",
+        ])
         .current_dir(&out)
         .output();
     if let Ok(o) = size {

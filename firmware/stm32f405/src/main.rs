@@ -35,6 +35,7 @@
 #[cfg(not(feature = "qemu"))]
 mod flash;
 mod init;
+mod log;
 mod support;
 
 use core::cell::RefCell;
@@ -99,9 +100,10 @@ fn main() -> ! {
     let mut board = board.with_pil(cfg!(feature = "qemu"));
     if init::reset_by_watchdog(&dp.RCC) {
         board.trip(twoport_control::Faults::WATCHDOG_RESET);
+        log::watchdog_reset();
     }
     let mut store = config_store(dp.FLASH);
-    board.boot_config(&mut store);
+    log::config(board.boot_config(&mut store));
     cortex_m::interrupt::free(|cs| BOARD.borrow(cs).replace(Some(board)));
     // Said before the first tick, which in QEMU waits for the host.
     #[cfg(feature = "qemu")]
@@ -115,8 +117,14 @@ fn main() -> ! {
     // critical section, or to transmit, which the interrupt does only in
     // the emulated build, where this loop transmits inside it too.
     let mut io = unsafe { Stm32::steal() };
+    let mut seen = log::Seen::default();
     loop {
         service_link(&mut io);
+        cortex_m::interrupt::free(|cs| {
+            if let Some(b) = BOARD.borrow(cs).borrow().as_ref() {
+                seen.changes(b.status());
+            }
+        });
         // A save the host asked for (disarmed only): under the lock, so
         // the tick waits out an erase, which it may, with the outputs off.
         cortex_m::interrupt::free(|cs| {
@@ -186,7 +194,10 @@ fn TIM2() {
 
 #[cfg(not(feature = "qemu"))]
 #[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
+fn panic(_info: &core::panic::PanicInfo) -> ! {
+    force_off();
+    #[cfg(feature = "defmt")]
+    defmt::error!("panic: outputs off");
     halt()
 }
 
