@@ -474,6 +474,8 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         "last_loop_cycles": loop_cycles,
         "last_stage_cycles": run.telemetry.last().map(|t| t.stage_cycles),
         "start": run.start,
+        "config_booted": run.config.map(|c| format!("{:?}", c.0)),
+        "config_saved": run.config.map(|c| format!("{:?}", c.1)),
         "armed_at_tick": run.armed_at_tick,
         "homing_ticks": run.homing.map(|h| h.0),
         "homing_error_m": run.homing.map(|h| h.1),

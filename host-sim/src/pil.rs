@@ -20,8 +20,8 @@ use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::ve::UnilateralWall;
 use twoport_control::Faults as BoardFaults;
 use twoport_link::{
-    encode, Decoder, LinkStats, Message, Mode, ModeRequest, Role, SensorFrame as LinkSensors,
-    Status, Telemetry, MAX_FRAME,
+    encode, ConfigSource, Decoder, LinkStats, Message, Mode, ModeRequest, Role,
+    SensorFrame as LinkSensors, Status, Telemetry, MAX_FRAME,
 };
 
 /// How far a homed board's position may be from the plant's: the stop's
@@ -76,6 +76,8 @@ impl BoardPort for SerialBoard {
 pub struct LocalBoard<L = Direct> {
     board: Board<UnilateralWall, REGION_POINTS, L>,
     link: HostLink,
+    /// Its stored configuration, in RAM as on the QEMU images.
+    store: Store<RamFlash<512, 256>>,
 }
 
 /// The in-process board's only peripheral: its link, as two byte queues.
@@ -121,6 +123,7 @@ impl<L: PortLayer> LocalBoard<L> {
         LocalBoard {
             board,
             link: HostLink::default(),
+            store,
         }
     }
 }
@@ -151,8 +154,11 @@ impl<L: PortLayer> BoardPort for LocalBoard<L> {
         loop {
             let ready = self.board.poll_link(&mut self.link);
             if ready {
-                self.board.control_tick(&mut self.link);
+                let store = &mut self.store;
+                self.board
+                    .control_tick_serving(&mut self.link, |b| b.service_config(store));
             }
+            self.board.service_config(&mut self.store);
             self.board.flush(&mut self.link);
             if !ready && self.link.rx.is_empty() {
                 return Ok(());
@@ -197,6 +203,9 @@ pub struct Run {
     pub zero_after_loss_ticks: Option<u64>,
     /// How the board was armed.
     pub start: Option<Start>,
+    /// Where its configuration came from at boot, and after the run saved
+    /// it (disarmed, before arming).
+    pub config: Option<(ConfigSource, ConfigSource)>,
     /// The tick the board armed at.
     pub armed_at_tick: u64,
     /// Homing: the ticks it took, and how far the board's calibrated
@@ -302,6 +311,16 @@ impl<P: BoardPort> Session<P> {
     /// Start homing; the caller runs ticks until [`homed`].
     pub fn home(&mut self) -> Result<Status, String> {
         self.ask(Message::Home, ModeRequest::Home, |s| s.mode == Mode::Homing)
+    }
+
+    /// Where the board's configuration came from.
+    pub fn config(&mut self) -> Result<ConfigSource, String> {
+        self.inbox.retain(|m| !matches!(m, Message::Config(_)));
+        self.send(&Message::GetConfig)?;
+        self.wait("GetConfig", |m| match m {
+            Message::Config(c) => Some(*c),
+            _ => None,
+        })
     }
 
     /// The board's state machine, asked for.
@@ -529,6 +548,19 @@ pub fn run<P: BoardPort>(scene: Scene, ticks: u64, port: P, faults: Faults) -> R
         start: Some(start),
         ..Run::default()
     };
+    // The configuration: what it booted with, then saved, which a PIL
+    // board does while it waits for its first tick.
+    let booted = session.config()?;
+    session.send(&Message::SaveConfig)?;
+    let saved = session.wait("SaveConfig", |m| match m {
+        Message::Config(c @ ConfigSource::Stored { .. }) => Some(Ok(*c)),
+        Message::ModeRefused {
+            asked: ModeRequest::SaveConfig,
+            why,
+        } => Some(Err(format!("the board refused SaveConfig: {why:?}"))),
+        _ => None,
+    })??;
+    r.config = Some((booted, saved));
     record(&mut session, &mut sim, &mut r)?;
     match start {
         Start::Calibrate => {
@@ -633,6 +665,13 @@ pub fn failures(
             "the board differs from the in-process loop ({} duties, {:.3e} m, {:.3e} N)",
             c.duty_mismatches, c.max_position_error_m, c.max_force_error_n
         ));
+    }
+    match run.config {
+        Some((ConfigSource::Defaults { .. }, ConfigSource::Stored { .. })) => {}
+        Some((booted, saved)) => bad.push(format!(
+            "a fresh board should boot on its defaults and save: {booted:?}, then {saved:?}"
+        )),
+        None => bad.push("the board never said where its configuration came from".into()),
     }
     if c.start_differs {
         bad.push(format!(

@@ -5,6 +5,7 @@ use host_sim::pil::{failures, Comparison, Faults, Run};
 use host_sim::study::{sweep, table1};
 use host_sim::{Scene, Simulation};
 use std::path::Path;
+use twoport_link::{ConfigFallback, ConfigSource};
 
 const SCENE: &str = "../scenes/table1/impedance_bilateral_hands_off.toml";
 
@@ -54,6 +55,12 @@ fn table1_every_case_is_stable_at_the_theoretical_gains() {
 fn clean(ticks: u64) -> (Run, Comparison) {
     let run = Run {
         duties: vec![100; ticks as usize],
+        config: Some((
+            ConfigSource::Defaults {
+                why: ConfigFallback::Missing,
+            },
+            ConfigSource::Stored { seq: 1 },
+        )),
         ..Run::default()
     };
     let c = Comparison {
@@ -104,6 +111,16 @@ fn pil_runs_fail_for_any_difference_and_a_late_zero() {
     assert!(failures(&r, &c, 100, Faults::default(), 50)[0].contains("80.0 um off"));
     r.homing = Some((50, f64::NAN));
     assert!(!failures(&r, &c, 100, Faults::default(), 50).is_empty());
+    // A board that booted on a stored record, or never said.
+    let mut r = run.clone();
+    r.config = Some((
+        ConfigSource::Stored { seq: 3 },
+        ConfigSource::Stored { seq: 4 },
+    ));
+    assert!(failures(&r, &c, 100, Faults::default(), 50)[0].contains("boot on its defaults"));
+    r.config = None;
+    assert!(failures(&r, &c, 100, Faults::default(), 50)[0].contains("never said"));
+    let mut r = run.clone();
     r.homing = Some((50, 0.0));
     r.duties[10] = 1000; // 6.1 N
     assert!(failures(&r, &c, 100, Faults::default(), 50)[0].contains("homing pushed 6.10 N"));

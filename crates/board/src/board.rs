@@ -365,13 +365,29 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     /// time from the sensors to the command, in the support's
     /// [`cycles`](BoardSupport::cycles), goes out in the next telemetry.
     pub fn control_tick(&mut self, io: &mut impl BoardSupport) -> ServoOutput {
-        let out = self.control_tick_inner(io);
+        self.control_tick_serving(io, |_| {})
+    }
+
+    /// [`control_tick`](Self::control_tick) that, while a processor-in-
+    /// the-loop board waits for its host, also runs `serve` on it: the
+    /// main loop's other work, such as [`service_config`](Self::service_config),
+    /// which would otherwise wait for the tick the host is waiting on.
+    pub fn control_tick_serving(
+        &mut self,
+        io: &mut impl BoardSupport,
+        serve: impl FnMut(&mut Self),
+    ) -> ServoOutput {
+        let out = self.control_tick_inner(io, serve);
         // Outputs follow the mode, within the tick that changed it.
         self.drive_outputs(io);
         out
     }
 
-    fn control_tick_inner(&mut self, io: &mut impl BoardSupport) -> ServoOutput {
+    fn control_tick_inner(
+        &mut self,
+        io: &mut impl BoardSupport,
+        mut serve: impl FnMut(&mut Self),
+    ) -> ServoOutput {
         let (frame, start) = if self.pil {
             let frame = loop {
                 io.feed_watchdog();
@@ -379,6 +395,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
                 if let Some(f) = self.pending.take() {
                     break f;
                 }
+                serve(self);
                 self.flush(io);
             };
             (frame, io.cycles())

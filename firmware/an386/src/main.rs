@@ -58,7 +58,7 @@ fn main() -> ! {
     #[cfg(feature = "watchdog-test")]
     let mut armed_ticks = 0u32;
     loop {
-        board.control_tick(&mut io);
+        board.control_tick_serving(&mut io, |b| b.service_config(&mut store));
         board.service_config(&mut store);
         board.flush(&mut io);
         // The watchdog test's image hangs on purpose after 1,500 armed

@@ -55,6 +55,23 @@ type TheBoard = Board<UnilateralWall, REGION_POINTS>;
 /// (link bytes).
 static BOARD: Mutex<RefCell<Option<TheBoard>>> = Mutex::new(RefCell::new(None));
 
+/// The stored configuration, shared the same way: the main loop saves,
+/// and so does a processor-in-the-loop tick waiting on its host.
+static STORE: Mutex<RefCell<Option<ConfigStore>>> = Mutex::new(RefCell::new(None));
+
+#[cfg(not(feature = "qemu"))]
+type ConfigStore = twoport_config::Store<flash::ConfigFlash>;
+#[cfg(feature = "qemu")]
+type ConfigStore = twoport_config::Store<twoport_config::RamFlash<512, 256>>;
+
+/// Write a save the host asked for (disarmed only), under the lock, so
+/// that the tick waits out an erase, which it may, with the outputs off.
+fn service_config(b: &mut TheBoard, cs: &cortex_m::interrupt::CriticalSection) {
+    if let Some(st) = STORE.borrow(cs).borrow_mut().as_mut() {
+        b.service_config(st);
+    }
+}
+
 /// Outputs off: the amplifier sees no drive, the actuator no force.
 fn force_off() {
     // SAFETY: only clears TIM1's main output enable, which is safe to do
@@ -104,7 +121,10 @@ fn main() -> ! {
     }
     let mut store = config_store(dp.FLASH);
     log::config(board.boot_config(&mut store));
-    cortex_m::interrupt::free(|cs| BOARD.borrow(cs).replace(Some(board)));
+    cortex_m::interrupt::free(|cs| {
+        BOARD.borrow(cs).replace(Some(board));
+        STORE.borrow(cs).replace(Some(store));
+    });
     // Said before the first tick, which in QEMU waits for the host.
     #[cfg(feature = "qemu")]
     cortex_m_semihosting::hprintln!("twoport-stm32f405 (qemu): board loop up, waiting on USART2");
@@ -125,11 +145,9 @@ fn main() -> ! {
                 seen.changes(b.status());
             }
         });
-        // A save the host asked for (disarmed only): under the lock, so
-        // the tick waits out an erase, which it may, with the outputs off.
         cortex_m::interrupt::free(|cs| {
             if let Some(b) = BOARD.borrow(cs).borrow_mut().as_mut() {
-                b.service_config(&mut store);
+                service_config(b, cs);
             }
         });
     }
@@ -137,13 +155,13 @@ fn main() -> ! {
 
 /// The stored configuration: sectors 10 and 11 on the chip.
 #[cfg(not(feature = "qemu"))]
-fn config_store(flash: pac::FLASH) -> twoport_config::Store<flash::ConfigFlash> {
+fn config_store(flash: pac::FLASH) -> ConfigStore {
     twoport_config::Store::new(flash::ConfigFlash::new(flash), 0, 128 * 1024)
 }
 
 /// QEMU models no flash interface: the configuration lives in RAM there.
 #[cfg(feature = "qemu")]
-fn config_store(_: pac::FLASH) -> twoport_config::Store<twoport_config::RamFlash<512, 256>> {
+fn config_store(_: pac::FLASH) -> ConfigStore {
     twoport_config::Store::new(twoport_config::RamFlash::new(), 0, 256)
 }
 
@@ -187,7 +205,7 @@ fn TIM2() {
     let mut io = unsafe { Stm32::steal() };
     cortex_m::interrupt::free(|cs| {
         if let Some(b) = BOARD.borrow(cs).borrow_mut().as_mut() {
-            b.control_tick(&mut io);
+            b.control_tick_serving(&mut io, |b| service_config(b, cs));
         }
     });
 }
