@@ -212,7 +212,7 @@ fn ci() -> Result<(), String> {
     ])?;
     scope_board()?;
     watchdog()?;
-    fuzz(60)?;
+    fuzz(45)?;
     // Last, closing on the total so that CI reads the whole count rather
     // than the last crate's doc-test line. The long hard cases (24 h of
     // ticks, 2 x 10^4 random terminations) are ignored in debug builds and
