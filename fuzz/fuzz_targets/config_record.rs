@@ -47,6 +47,7 @@ fuzz_target!(|data: &[u8]| {
                 stop_nm: 0,
                 toward_positive: false,
                 force_limit_n: 1.0,
+                index_nm: None,
             },
             limits: twoport_config::Limits {
                 peak_force_n: 2.0,

@@ -128,6 +128,14 @@ impl<L: PortLayer> LocalBoard<L> {
     }
 }
 
+impl<L: PortLayer> LocalBoard<L> {
+    /// The same board homing with `cfg` (e.g. on an encoder's index).
+    pub fn with_homing(mut self, cfg: twoport_control::homing::HomingConfig) -> Self {
+        self.board = self.board.with_homing(cfg);
+        self
+    }
+}
+
 impl LocalBoard {
     /// The image the firmware ships ([`excalibur::stiff_wall_board`]).
     pub fn excalibur() -> Result<Self, String> {
@@ -244,6 +252,9 @@ pub struct Session<P: BoardPort> {
     io: twoport_board::IoScale,
     faults: Faults,
     tick: u64,
+    /// The encoder's index mark as a count, and the unwrapped count of
+    /// the last frame: the host plays the encoder's index hardware.
+    index: Option<(i64, Option<i64>)>,
     /// Frames the host injected corrupted.
     pub corrupted_sent: u64,
 }
@@ -260,6 +271,7 @@ impl<P: BoardPort> Session<P> {
             io: twoport_board::IoScale::EXCALIBUR,
             faults,
             tick: 0,
+            index: None,
             corrupted_sent: 0,
         };
         s.handshake()?;
@@ -321,6 +333,30 @@ impl<P: BoardPort> Session<P> {
             Message::Config(c) => Some(*c),
             _ => None,
         })
+    }
+
+    /// The scene's encoder has an index mark at `index_m` (m): send the
+    /// count it latches in the sensor frame of each tick that passes it.
+    pub fn set_index(&mut self, index_m: Option<f64>) {
+        let (_, pm) = excalibur::ENCODER;
+        self.index = index_m.map(|m| ((m * 1e12 / pm as f64).round() as i64, None));
+    }
+
+    /// The count the index latched this tick, if the axis passed it
+    /// between the last frame's `raw` and this one.
+    fn index_crossing(&mut self, raw: u32) -> Option<u32> {
+        let (bits, _) = excalibur::ENCODER;
+        let (mark, last) = self.index.as_mut()?;
+        let shift = 32 - u32::from(bits);
+        let now = match *last {
+            // The counter's difference, sign-extended (it wraps).
+            Some(l) => l + (((raw.wrapping_sub(l as u32) << shift) as i32) >> shift) as i64,
+            None => ((raw << shift) as i32 >> shift) as i64,
+        };
+        let crossed = last.is_some_and(|l| (l.min(now) < *mark) && (*mark <= l.max(now)));
+        *last = Some(now);
+        let mask = (1u64 << bits) - 1;
+        crossed.then_some((*mark as u64 & mask) as u32)
     }
 
     /// The board's state machine, asked for.
@@ -465,6 +501,7 @@ impl<P: BoardPort> Session<P> {
             encoder_raw: f.encoder_raw,
             load_cell_raw: self.io.load_cell_counts(f.load_cell_n),
             dead_man_closed: f.dead_man_closed,
+            index_raw: self.index_crossing(f.encoder_raw),
         });
         let good = self.frame(&sensors)?;
         let every = self.faults.corrupt_every;
@@ -486,6 +523,11 @@ impl<P: BoardPort> Session<P> {
             _ => None,
         })
     }
+}
+
+/// The scene's encoder index mark (m), if any.
+fn sim_index(sim: &Simulation) -> Option<f64> {
+    sim.scene().effects.encoder.and_then(|e| e.index_m)
 }
 
 /// The scene's sensors must be the board's: the same encoder.
@@ -544,6 +586,7 @@ pub fn run<P: BoardPort>(scene: Scene, ticks: u64, port: P, faults: Faults) -> R
     let start = Start::for_scene(&scene);
     let mut sim = Simulation::new(scene)?;
     let mut session = Session::open(port, faults)?;
+    session.set_index(sim_index(&sim));
     let mut r = Run {
         start: Some(start),
         ..Run::default()
@@ -590,10 +633,11 @@ pub fn run<P: BoardPort>(scene: Scene, ticks: u64, port: P, faults: Faults) -> R
         record(&mut session, &mut sim, &mut r)?;
     }
     if let Some((n, err)) = &mut r.homing {
-        // The board's position in its first telemetry after homing, at
-        // rest on the stop, against the plant's at that tick.
+        // The board's position in its first telemetry after homing
+        // against the plant's where that tick read its sensors: the end of
+        // the tick before.
         if let Some(t) = r.telemetry.iter().find(|t| u64::from(t.tick) > *n) {
-            if let Some(s) = r.samples.get(t.tick as usize) {
+            if let Some(s) = r.samples.get(t.tick as usize - 1) {
                 *err = t.position_pm as f64 * 1e-12 - s.handle_m;
             }
         }

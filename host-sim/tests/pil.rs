@@ -201,3 +201,25 @@ fn a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed() {
     assert_eq!(s.status().unwrap().faults, 0);
     assert_eq!(s.arm().unwrap().mode, Mode::Armed);
 }
+
+/// A board homing on its encoder's index: it stops at the first pulse,
+/// 6 mm down, long before the stop, calibrated to the count, and arms.
+#[test]
+fn a_board_homes_on_the_index_pulse_before_the_stop() {
+    let s = Scene::load(Path::new("../scenes/homing_index.toml"), &[]).unwrap();
+    let mut cfg = twoport_board::excalibur::HOMING;
+    cfg.index_position = Some(twoport_control::Position::from_nm(-6_000_000));
+    let board = LocalBoard::excalibur().unwrap().with_homing(cfg);
+    let r = pil::run(s, 3000, board, Faults::default()).unwrap();
+    let (n, err_m) = r.homing.expect("homed");
+    // 6 mm at 20 mm/s and the ramp-in.
+    assert!((250..600).contains(&n), "{n} ticks");
+    // To the count, and the stop never reached.
+    assert!(err_m.abs() < 2e-6, "{err_m} m");
+    let lowest = r.samples[..n as usize]
+        .iter()
+        .map(|s| s.handle_m)
+        .fold(0.0, f64::min);
+    assert!(lowest > -0.008, "went down to {lowest} m");
+    assert!(r.armed_at_tick > n);
+}

@@ -64,6 +64,10 @@ pub struct Board<V, const R: usize, L = Direct> {
     config_source: Option<twoport_link::ConfigSource>,
     /// A `SaveConfig` waiting for the main loop.
     save_pending: bool,
+    /// The encoder count an index pulse latched, for this tick.
+    index: Option<u32>,
+    /// The host's index count waiting with its sensor frame (PIL).
+    pending_index: Option<u32>,
     /// Loop timing: the last tick's stages, its start, the overruns and
     /// the worst jitter since boot.
     timing: Timing,
@@ -136,6 +140,8 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             outputs_on: false,
             config_source: None,
             save_pending: false,
+            index: None,
+            pending_index: None,
             timing: Timing::default(),
         }
     }
@@ -274,6 +280,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
                 self.pil_refused = self.pil_refused.saturating_add(1);
             }
             Message::Sensors(s) => {
+                self.pending_index = s.index_raw;
                 self.pending = Some(SensorFrame {
                     tick: s.tick,
                     encoder_raw: s.encoder_raw,
@@ -398,6 +405,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
                 serve(self);
                 self.flush(io);
             };
+            self.index = self.pending_index.take();
             (frame, io.cycles())
         } else {
             let start = io.cycles();
@@ -408,11 +416,13 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
                 load_cell_n: self.io.load_cell_n(raw.load_cell_counts),
                 dead_man_closed: raw.dead_man_closed,
             };
+            self.index = raw.index_raw;
             self.ticks = self.ticks.wrapping_add(1);
             (frame, start)
         };
         let sensed = io.cycles();
         let out = self.tick(&frame);
+        self.index = None;
         let ruled = io.cycles();
         let duty = self.duty();
         io.set_duty(duty);

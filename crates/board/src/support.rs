@@ -12,6 +12,9 @@ pub struct RawSensors {
     pub load_cell_counts: i32,
     /// Whether the dead-man switch is closed (the hand is on the handle).
     pub dead_man_closed: bool,
+    /// The encoder count latched by its index pulse since the last
+    /// sample, where the encoder has an index and it passed.
+    pub index_raw: Option<u32>,
 }
 
 /// A board's peripherals, as the loop uses them.

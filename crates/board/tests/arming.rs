@@ -58,6 +58,9 @@ struct Bench {
     rx: std::collections::VecDeque<u8>,
     tx: Vec<u8>,
     seq: u16,
+    /// The encoder's index mark (m from power-on), if it has one.
+    index_m: Option<f64>,
+    last_x_m: f64,
 }
 
 impl Bench {
@@ -74,6 +77,8 @@ impl Bench {
             rx: Default::default(),
             tx: Vec::new(),
             seq: 0,
+            index_m: None,
+            last_x_m: 0.0,
         }
     }
 
@@ -117,10 +122,18 @@ impl BoardSupport for Bench {
             self.x_m += self.v_mps * h;
         }
         let counts = (self.x_m * 1e6).round() as i64;
+        // The index pulse latches the count at its mark when the axis
+        // passes it.
+        let index_raw = self.index_m.and_then(|m| {
+            let crossed = (self.last_x_m - m) * (self.x_m - m) <= 0.0 && self.last_x_m != self.x_m;
+            crossed.then(|| ((m * 1e6).round() as i64 as u32) & 0xFFFF)
+        });
+        self.last_x_m = self.x_m;
         RawSensors {
             encoder_raw: (counts as u32) & 0xFFFF,
             load_cell_counts: 0,
             dead_man_closed: self.dead_man_closed,
+            index_raw,
         }
     }
     fn set_duty(&mut self, duty: i16) {
@@ -398,4 +411,55 @@ fn calibrate_and_home_need_a_disarmed_board_and_disarm_stops_homing() {
         refused(&io.heard()),
         [(ModeRequest::Calibrate, ModeRefusal::OutOfRange)]
     );
+}
+
+/// An encoder with an index mark 6 mm below where the axis powered on,
+/// and the board's frame putting the mark at -12 mm: homing creeps toward
+/// the stop, stops at the first index pulse and calibrates from the count
+/// the pulse latched, to the count, long before the stop (15 mm down).
+#[test]
+fn homing_on_an_index_pulse_calibrates_to_the_count_before_the_stop() {
+    let mut cfg = HomingConfig::gentle(Position::from_nm(-20_000_000), T);
+    cfg.index_position = Some(Position::from_nm(-12_000_000));
+    let mut b = board().with_homing(cfg);
+    let mut io = Bench::new(Some(-0.015));
+    io.index_m = Some(-0.006);
+    tick(&mut b, &mut io);
+    io.say(Message::Home);
+    let mut ticks = 0;
+    while ticks < 5000 {
+        tick(&mut b, &mut io);
+        ticks += 1;
+        if b.mode() != Mode::Homing {
+            break;
+        }
+    }
+    assert!(b.calibrated(), "{:?}", io.heard());
+    assert!(b.servo().safety().faults().is_empty());
+    // 6 mm at 20 mm/s and the ramp-in: well before the stop.
+    assert!((250..600).contains(&ticks), "{ticks} ticks");
+    assert!(io.x_m > -0.0075, "stopped at {} m", io.x_m);
+    // The board's frame is the truth less 6 mm, to the count, from the
+    // next tick on.
+    tick(&mut b, &mut io);
+    let err_nm = b.last_output().position.nm() - ((io.x_m * 1e9).round() as i32 - 6_000_000);
+    assert!(err_nm.abs() <= 1_000, "{err_nm} nm");
+}
+
+/// Homing on an index that never comes: the stall on the stop is a
+/// failure, not a calibration.
+#[test]
+fn homing_on_an_index_that_never_pulses_fails_at_the_stop() {
+    let mut cfg = HomingConfig::gentle(Position::from_nm(-20_000_000), T);
+    cfg.index_position = Some(Position::from_nm(-12_000_000));
+    let mut b = board().with_homing(cfg);
+    let mut io = Bench::new(Some(-0.015));
+    tick(&mut b, &mut io);
+    io.say(Message::Home);
+    for _ in 0..3000 {
+        tick(&mut b, &mut io);
+    }
+    assert!(!b.calibrated());
+    assert_eq!(b.servo().safety().faults(), Faults::HOMING_FAILED);
+    assert_eq!(b.mode(), Mode::Disarmed);
 }

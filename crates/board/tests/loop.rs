@@ -342,6 +342,7 @@ fn sensors(tick: u32, raw: u32) -> Message {
         encoder_raw: raw,
         load_cell_raw: 0,
         dead_man_closed: true,
+        index_raw: None,
     })
 }
 
@@ -476,6 +477,7 @@ fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
             encoder_raw: 0,
             load_cell_counts: 1_500,
             dead_man_closed: true,
+            index_raw: None,
         },
         ..Io::default()
     };

@@ -57,6 +57,8 @@ pub struct HomingSetup {
     pub toward_positive: bool,
     /// The largest force homing pushes with (N).
     pub force_limit_n: f32,
+    /// The encoder's index mark (nm), where homing uses the index pulse.
+    pub index_nm: Option<i32>,
 }
 
 /// The safety layer's limits that a lab sets for its device.

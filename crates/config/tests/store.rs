@@ -22,6 +22,7 @@ fn defaults() -> Config {
             stop_nm: -20_000_000,
             toward_positive: false,
             force_limit_n: 5.0,
+            index_nm: None,
         },
         limits: Limits {
             peak_force_n: 200.0,

@@ -156,6 +156,30 @@ impl Encoder {
         }
     }
 
+    /// Calibrate from a reading in the past: the counter read `raw` at
+    /// `position` (an index pulse latched it), and it has moved on to its
+    /// last reading since. Returns the position now; a `raw` wider than the
+    /// counter is refused and nothing changes.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_control::{Encoder, Position};
+    /// let mut enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    /// enc.update(1_200).unwrap();
+    /// // The index mark, at +5 mm, latched the counter at 1,180.
+    /// let now = enc.rezero_at(1_180, Position::from_nm(5_000_000)).unwrap();
+    /// assert_eq!(now, Position::from_nm(5_020_000));
+    /// ```
+    pub fn rezero_at(&mut self, raw: u32, position: Position) -> Result<Position, EncoderError> {
+        let bits = (32 - self.shift) as u8;
+        let now = self.last_raw;
+        let mut e = Encoder::new(bits, self.pm_per_count, raw, position)?;
+        let p = e.update(now)?;
+        *self = e;
+        Ok(p)
+    }
+
     /// Unwrapped counts since construction.
     pub fn count(&self) -> i32 {
         self.count

@@ -41,6 +41,11 @@ pub struct HomingConfig {
     /// Where the handle is when it rests on the stop under the homing
     /// force: the position the encoder reads from then on.
     pub stop_position: Position,
+    /// The encoder's index mark, where it has one: the position its
+    /// pulse marks. Homing then ends at the first index pulse (the board
+    /// calibrates from the count it latched) and a stall before it is a
+    /// failure; without one, the stall on the stop ends it.
+    pub index_position: Option<Position>,
     /// Control period `T` (s).
     pub period_s: f32,
 }
@@ -70,6 +75,7 @@ impl HomingConfig {
             stall_s: 0.1,
             timeout_s: 10.0,
             stop_position,
+            index_position: None,
             period_s,
         }
     }
@@ -110,7 +116,8 @@ pub enum HomingState {
     /// Stalled on the stop: the encoder should now read
     /// [`HomingConfig::stop_position`].
     Found,
-    /// No stall within the timeout.
+    /// No stall within the timeout (or, homing on an index, a stall
+    /// before the pulse).
     TimedOut,
 }
 
@@ -202,7 +209,11 @@ impl Homing {
         }
         self.ticks += 1;
         if self.still_ticks >= self.stall_ticks {
-            self.state = HomingState::Found;
+            // Stalled: the stop, unless an index pulse was to come first.
+            self.state = match c.index_position {
+                None => HomingState::Found,
+                Some(_) => HomingState::TimedOut,
+            };
         } else if self.ticks >= self.timeout_ticks {
             self.state = HomingState::TimedOut;
         }

@@ -217,6 +217,9 @@ pub struct SensorFrame {
     pub load_cell_raw: i32,
     /// Dead-man switch closed.
     pub dead_man_closed: bool,
+    /// The encoder count its index pulse latched this tick, if it passed
+    /// (protocol 3).
+    pub index_raw: Option<u32>,
 }
 
 /// Processor-in-the-loop: the actuator command for one tick (board to host).

@@ -81,6 +81,7 @@ fn all_messages() -> Vec<Message> {
             encoder_raw: 65_535,
             load_cell_raw: -2048,
             dead_man_closed: true,
+            index_raw: Some(u32::MAX),
         }),
         Message::Actuator(ActuatorFrame {
             tick: 7,

@@ -65,6 +65,7 @@ impl BoardSupport for Stm32 {
                     encoder_raw,
                     load_cell_counts: i32::MAX,
                     dead_man_closed,
+                    index_raw: None,
                 };
             }
         }
@@ -72,6 +73,8 @@ impl BoardSupport for Stm32 {
             encoder_raw,
             load_cell_counts: self.adc.dr().read().data().bits() as i32 - ADC_ZERO,
             dead_man_closed,
+            // The shipped wiring has no index input.
+            index_raw: None,
         }
     }
 

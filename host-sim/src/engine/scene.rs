@@ -412,6 +412,10 @@ pub struct EncoderEffect {
     /// Counter width (bits).
     #[serde(default = "default_bits")]
     pub bits: u8,
+    /// Where the encoder's index mark is (m), if it has one: passing it
+    /// latches the count for a board that homes on the index.
+    #[serde(default)]
+    pub index_m: Option<f64>,
 }
 fn default_bits() -> u8 {
     16
@@ -796,6 +800,11 @@ impl Scene {
             pos("effects.encoder.resolution_m", x.resolution_m)?;
             if !(2..=32).contains(&x.bits) {
                 return Err(format!("effects.encoder.bits = {} must be 2..=32", x.bits));
+            }
+            if let Some(m) = x.index_m {
+                if !(m.is_finite() && m.abs() <= 1.0) {
+                    return Err(format!("effects.encoder.index_m = {m} must be within ±1 m"));
+                }
             }
         }
         if let Some(x) = e.hard_stop {

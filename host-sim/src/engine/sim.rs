@@ -399,6 +399,11 @@ impl Simulation {
         &self.x
     }
 
+    /// The scene this simulation runs.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
     /// Set the plant state (tests).
     pub fn set_state(&mut self, x: &[f64]) {
         self.x.copy_from_slice(x);

@@ -161,6 +161,15 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     /// run that has ended calibrates the encoder or latches its failure.
     pub(super) fn after_tick(&mut self, out: &ServoOutput) {
         if let Some(h) = self.homing {
+            // Homing on an index: its first pulse calibrates the encoder
+            // from the count it latched.
+            if let (Some(at), Some(raw)) = (h.config().index_position, self.index) {
+                match self.servo.calibrate_at(raw, at) {
+                    Ok(()) => self.calibrated = true,
+                    Err(_) => self.servo.trip(Faults::HOMING_FAILED),
+                }
+                return self.disarm();
+            }
             match h.state() {
                 HomingState::Seeking => {}
                 HomingState::Found => {

@@ -27,6 +27,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
                 stop_nm: h.stop_position.nm(),
                 toward_positive: h.toward_positive,
                 force_limit_n: h.force_limit_n,
+                index_nm: h.index_position.map(Position::nm),
             },
             limits: Limits {
                 peak_force_n: s.peak_force_n,
@@ -66,6 +67,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             stop_position: Position::from_nm(cfg.homing.stop_nm),
             toward_positive: cfg.homing.toward_positive,
             force_limit_n: cfg.homing.force_limit_n,
+            index_position: cfg.homing.index_nm.map(Position::from_nm),
             ..self.homing_cfg
         };
         if limits.validate().is_err() || homing.validate().is_err() {

@@ -13,7 +13,7 @@ use crate::estimator::FirstDifference;
 use crate::regulator::PositionRegulator;
 use crate::safety::{Faults, SafeForce, SafetyConfig, SafetyInputs, SafetyLayer};
 use crate::ve::VirtualEnvironment;
-use crate::{Encoder, Integrator, ParamError, Position, Real};
+use crate::{Encoder, EncoderError, Integrator, ParamError, Position, Real};
 
 /// The sensors of one tick.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -407,6 +407,17 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
         }
         self.ve.reset(x);
         self.layer.reset(x);
+    }
+
+    /// Calibrate from an index pulse: the counter read `raw` at `position`
+    /// (see [`Encoder::rezero_at`]); the laws re-align to where the device
+    /// is now. Refused, changing nothing, for a raw value the counter
+    /// cannot hold.
+    pub fn calibrate_at(&mut self, raw: u32, position: Position) -> Result<(), EncoderError> {
+        let now = self.front.encoder.rezero_at(raw, position)?;
+        self.front.position = now;
+        self.realign();
+        Ok(())
     }
 
     /// One control tick with `law` in place of the display's laws and the
