@@ -197,7 +197,7 @@ fn ci() -> Result<(), String> {
             board,
             "scenes/homing.toml",
             "--seconds",
-            "3",
+            "2",
             "--check",
         ];
         pil(&homing.map(String::from))?;
@@ -212,7 +212,7 @@ fn ci() -> Result<(), String> {
     ])?;
     scope_board()?;
     watchdog()?;
-    fuzz(45)?;
+    fuzz(40)?;
     // Last, closing on the total so that CI reads the whole count rather
     // than the last crate's doc-test line. The long hard cases (24 h of
     // ticks, 2 x 10^4 random terminations) are ignored in debug builds and
