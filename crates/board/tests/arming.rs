@@ -2,40 +2,23 @@
 //! outputs off, arms only when it is safe to, disarms on any fault, and
 //! homes onto a hard stop with a small force to find the encoder offset.
 
-use twoport_board::{Board, BoardSupport, Bound, IoScale, RawSensors, Region};
+use twoport_board::{BoardSupport, IoScale, RawSensors};
 use twoport_control::homing::HomingConfig;
-use twoport_control::ve::BilateralConstraint;
-use twoport_control::{Encoder, Faults, ImpedanceGains, Position, SafetyConfig, Servo};
+use twoport_control::{Faults, Position, SafetyConfig};
 use twoport_link::{encode, Decoder, Message, Mode, ModeRefusal, ModeRequest, Status, MAX_FRAME};
 
 const T: f32 = 1e-3;
 
-fn region() -> Region<3> {
-    Region::new(
-        Bound::MaxStiffness,
-        [30.0, 60.0, 90.0],
-        [46_000.0, 51_400.0, 51_000.0],
-        None,
-    )
-    .unwrap()
-}
-
-type TestBoard = Board<BilateralConstraint, 3>;
+mod common;
+use common::TestBoard;
 
 fn board_with(k_npm: f32) -> TestBoard {
-    let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let safety = SafetyConfig {
         require_dead_man: true,
         ..SafetyConfig::excalibur()
     };
-    let s = Servo::new(
-        ImpedanceGains::new(k_npm, 90.0).into(),
-        enc,
-        safety,
-        BilateralConstraint::new(Position::ZERO),
-    )
-    .unwrap();
-    Board::new(s, region(), 0).with_homing(HomingConfig::gentle(Position::from_nm(-20_000_000), T))
+    common::board(k_npm, safety, 0)
+        .with_homing(HomingConfig::gentle(Position::from_nm(-20_000_000), T))
 }
 
 fn board() -> TestBoard {

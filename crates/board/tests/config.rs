@@ -2,36 +2,20 @@
 //! defaults and the reason when there is none it can run, what a save
 //! keeps, and a save cut by a power loss.
 
-use twoport_board::{Board, Bound, Region};
 use twoport_config::record::{encode, MAX_RECORD};
 use twoport_config::{Config, RamFlash, Store};
-use twoport_control::ve::BilateralConstraint;
-use twoport_control::{Encoder, ImpedanceGains, Position, SafetyConfig, Servo};
+use twoport_control::SafetyConfig;
 use twoport_link::{
     encode as frame, ConfigFallback, ConfigSource, Decoder, Gains, GainsReply, Message, Mode,
     ModeRefusal, ModeRequest, MAX_FRAME,
 };
 
 type Flash = RamFlash<512, 256>;
-type TestBoard = Board<BilateralConstraint, 3>;
+mod common;
+use common::TestBoard;
 
 fn board() -> TestBoard {
-    let region = Region::new(
-        Bound::MaxStiffness,
-        [30.0, 60.0, 90.0],
-        [46_000.0, 51_400.0, 51_000.0],
-        None,
-    )
-    .unwrap();
-    let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
-    let s = Servo::new(
-        ImpedanceGains::new(51_000.0, 90.0).into(),
-        enc,
-        SafetyConfig::excalibur(),
-        BilateralConstraint::new(Position::ZERO),
-    )
-    .unwrap();
-    Board::new(s, region, 0)
+    common::board(51_000.0, SafetyConfig::excalibur(), 0)
 }
 
 fn say(b: &mut TestBoard, m: Message) {

@@ -3,22 +3,12 @@
 use twoport_board::{Board, BoardSupport, Bound, RawSensors, Region};
 use twoport_control::servo::SensorFrame;
 use twoport_control::ve::BilateralConstraint;
-use twoport_control::{
-    AdmittanceGains, Encoder, Faults, ImpedanceGains, Position, SafetyConfig, Servo,
-};
+use twoport_control::{AdmittanceGains, Encoder, Faults, Position, SafetyConfig, Servo};
 use twoport_link::{
     encode, Decoder, Gains, GainsReply, Message, Mode, Refusal, Role, MAX_FRAME, PROTOCOL_VERSION,
 };
 
-fn region() -> Region<3> {
-    Region::new(
-        Bound::MaxStiffness,
-        [30.0, 60.0, 90.0],
-        [46_000.0, 51_400.0, 51_000.0],
-        None,
-    )
-    .unwrap()
-}
+mod common;
 
 fn safety() -> SafetyConfig {
     SafetyConfig {
@@ -29,15 +19,7 @@ fn safety() -> SafetyConfig {
 }
 
 fn board() -> Board<BilateralConstraint, 3> {
-    let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
-    let s = Servo::new(
-        ImpedanceGains::new(51_000.0, 90.0).into(),
-        enc,
-        safety(),
-        BilateralConstraint::new(Position::ZERO),
-    )
-    .unwrap();
-    Board::new(s, region(), 10)
+    common::board(51_000.0, safety(), 10)
 }
 
 fn send(b: &mut Board<BilateralConstraint, 3>, seq: u16, m: Message) {
@@ -548,15 +530,7 @@ fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
 /// of the ticks before it.
 #[test]
 fn deadline_misses_and_the_worst_jitter_are_counted_and_reported() {
-    let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
-    let s = Servo::new(
-        ImpedanceGains::new(51_000.0, 90.0).into(),
-        enc,
-        safety(),
-        BilateralConstraint::new(Position::ZERO),
-    )
-    .unwrap();
-    let mut b = Board::new(s, region(), 1);
+    let mut b = common::board(51_000.0, safety(), 1);
     let mut io = Io {
         period: 30,
         ..Io::default()

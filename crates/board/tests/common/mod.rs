@@ -1,0 +1,36 @@
+//! What the board's test files share: a three-point proven region and a
+//! board on a bilateral constraint at the origin.
+
+use twoport_board::{Board, Bound, Region};
+use twoport_control::ve::BilateralConstraint;
+use twoport_control::{Encoder, ImpedanceGains, Position, SafetyConfig, Servo};
+
+/// The board every test drives.
+pub type TestBoard = Board<BilateralConstraint, 3>;
+
+/// A proven region of three damping points (N s/m) and their largest
+/// stiffness (N/m).
+pub fn region() -> Region<3> {
+    Region::new(
+        Bound::MaxStiffness,
+        [30.0, 60.0, 90.0],
+        [46_000.0, 51_400.0, 51_000.0],
+        None,
+    )
+    .unwrap()
+}
+
+/// An impedance display at `k_npm` (N/m) and 90 N s/m on a 16-bit, 1 µm
+/// encoder, with `safety`'s limits and telemetry every `telemetry_every`
+/// ticks (0: none).
+pub fn board(k_npm: f32, safety: SafetyConfig, telemetry_every: u32) -> TestBoard {
+    let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    let s = Servo::new(
+        ImpedanceGains::new(k_npm, 90.0).into(),
+        enc,
+        safety,
+        BilateralConstraint::new(Position::ZERO),
+    )
+    .unwrap();
+    Board::new(s, region(), telemetry_every)
+}
