@@ -408,21 +408,31 @@ fn an386_image_with(feature: &str) -> Result<PathBuf, String> {
 }
 
 /// The watchdog test: the an386 image that hangs its loop on purpose
-/// after 500 armed ticks, against host-sim's check that the CMSDK
+/// after 1,500 armed ticks, against host-sim's check that the CMSDK
 /// watchdog resets it and that it comes back disarmed, outputs off, with
 /// the reset latched as a fault.
 fn watchdog() -> Result<(), String> {
     let elf = an386_image_with("watchdog-test")?;
-    let mut qemu = qemu_an386(&elf);
+    host_test_against_an386(
+        "watchdog reset in QEMU",
+        &elf,
+        "pil",
+        "a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed",
+    )
+}
+
+/// Run the ignored host-sim test `name` (in test file `file`) against
+/// the an386 image `elf` in QEMU, its link's pty in `TWOPORT_PTY`.
+fn host_test_against_an386(what: &str, elf: &Path, file: &str, name: &str) -> Result<(), String> {
+    let mut qemu = qemu_an386(elf);
     qemu.args(["-serial", "pty"]);
     with_board_in_qemu(qemu, |pty| {
         run(
-            "watchdog reset in QEMU",
+            what,
             cargo()
                 .env("TWOPORT_PTY", pty)
-                .args(["test", "--release", "-p", "host-sim", "--test", "pil"])
-                .args(["--", "--ignored", "--exact"])
-                .arg("a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed"),
+                .args(["test", "--release", "-p", "host-sim", "--test", file])
+                .args(["--", "--ignored", "--exact", name]),
         )
     })
 }
@@ -554,18 +564,12 @@ fn unmodelled_summary(log: &Path) -> String {
 /// The scope's board mode against the firmware in QEMU.
 fn scope_board() -> Result<(), String> {
     let elf = firmware()?.join("twoport-an386");
-    let mut qemu = qemu_an386(&elf);
-    qemu.args(["-serial", "pty"]);
-    with_board_in_qemu(qemu, |pty| {
-        run(
-            "scope board mode against QEMU",
-            cargo()
-                .env("TWOPORT_PTY", pty)
-                .args(["test", "--release", "-p", "host-sim", "--test", "scope"])
-                .args(["--", "--ignored", "--exact"])
-                .arg("board_mode_shows_telemetry_and_the_boards_gain_answers"),
-        )
-    })
+    host_test_against_an386(
+        "scope board mode against QEMU",
+        &elf,
+        "scope",
+        "board_mode_shows_telemetry_and_the_boards_gain_answers",
+    )
 }
 
 /// Run `f` with a board image in QEMU (`qemu`, its link on a `-serial
