@@ -690,12 +690,6 @@ impl ScopeState {
             }
         }
     }
-
-    /// Clear the board's latched faults. It stays disarmed: arming is a
-    /// separate, deliberate step.
-    pub fn clear_board_faults(&mut self) {
-        self.tell_board(Message::ClearFaults);
-    }
 }
 
 fn wall_of(scene: &Scene) -> Option<(f64, f64)> {
