@@ -20,6 +20,7 @@ pub mod safety;
 pub mod servo;
 mod tf;
 pub mod ve;
+pub mod world;
 
 #[cfg(test)]
 mod response_tests;
@@ -33,7 +34,7 @@ pub use position::{Integrator, Position, NM_PER_M};
 pub use probe::SineProbe;
 pub use real::Real;
 pub use regulator::PositionRegulator;
-pub use safety::{Faults, SafetyConfig, SafetyLayer};
+pub use safety::{AxisError, Faults, SafetyConfig, SafetyLayer};
 pub use servo::{
     AdmittanceGains, Display, Gains, GainsError, ImpedanceGains, SensorFrame, Servo, ServoOutput,
 };

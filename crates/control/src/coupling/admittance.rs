@@ -1,7 +1,7 @@
 //! The admittance-display virtual coupling, a mass and a damper whose
 //! admittances add (eq 21).
 
-use crate::ve::{Port, VirtualEnvironment};
+use crate::ve::{Port, VeOutput, VirtualEnvironment};
 use crate::{param, ParamError, Real, ZTransfer};
 
 /// `Z_cA(z) = m b (z - 1) / ((m + bT) z - m)` (paper eq 21), i.e.
@@ -99,12 +99,27 @@ impl<R: Real> AdmittanceCoupling<R> {
         f_c_n: R,
         ve: &mut V,
     ) -> AdmittanceStep<R> {
+        let out = ve.step(self.port(f_c_n));
+        self.finish(f_c_n, out)
+    }
+
+    /// This tick's law as the VE sees it, for the measured handle force
+    /// `f_c` (N): what [`step`](Self::step) hands its VE, for a VE that
+    /// several couplings share (one per axis). Give the VE's answer to
+    /// [`finish`](Self::finish).
+    #[inline(always)]
+    pub fn port(&self, f_c_n: R) -> Port<R> {
         // Coupling force Z_cA v = z (v - v_mass[k-1]); the VE gets the rest.
-        let port = Port {
+        Port {
             f0_n: f_c_n + self.z_direct * self.mass_velocity_mps,
             z_nspm: self.z_direct,
-        };
-        let out = ve.step(port);
+        }
+    }
+
+    /// Complete the tick [`port`](Self::port) began with the VE's answer
+    /// `out` on that port.
+    #[inline(always)]
+    pub fn finish(&mut self, f_c_n: R, out: VeOutput<R>) -> AdmittanceStep<R> {
         let coupling = self.z_direct * (out.velocity_mps - self.mass_velocity_mps);
         let vm = self.mass_velocity_mps + self.t_over_m * coupling;
         if vm.is_finite() {

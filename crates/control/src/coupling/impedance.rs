@@ -1,6 +1,6 @@
 //! The impedance-display virtual coupling, a shunt spring-damper (eq 20).
 
-use crate::ve::{Port, VirtualEnvironment};
+use crate::ve::{Port, VeOutput, VirtualEnvironment};
 use crate::{param, ParamError, Position, Real, ZTransfer};
 
 /// `Z_cI(z) = b + kTz/(z - 1)` between the device and the VE (paper eq 20).
@@ -32,6 +32,18 @@ pub struct ImpedanceStep<R = f32> {
     pub force_n: R,
     /// VE velocity `v_e` (m/s).
     pub ve_velocity_mps: R,
+}
+
+// The VE's answer is on the port's line, so its force is this tick's
+// coupling force: f_c and f_e are one number.
+impl<R> From<VeOutput<R>> for ImpedanceStep<R> {
+    #[inline(always)]
+    fn from(out: VeOutput<R>) -> Self {
+        ImpedanceStep {
+            force_n: out.force_n,
+            ve_velocity_mps: out.velocity_mps,
+        }
+    }
 }
 
 impl ImpedanceCoupling {
@@ -100,18 +112,20 @@ impl<R: Real> ImpedanceCoupling<R> {
         v_c_mps: R,
         ve: &mut V,
     ) -> ImpedanceStep<R> {
-        let stretch_prev = -ve.offset_m(x_c);
+        let port = self.port(-ve.offset_m(x_c), v_c_mps);
+        ImpedanceStep::from(ve.step(port))
+    }
+
+    /// This tick's law as the VE sees it, for the spring's stretch
+    /// `x_c - x_e[k-1]` (m) and the device velocity `v_c` (m/s): what
+    /// [`step`](Self::step) hands its VE, for a VE that several couplings
+    /// share (one per axis) and that answers them all at once.
+    #[inline(always)]
+    pub fn port(&self, stretch_m: R, v_c_mps: R) -> Port<R> {
         // f = k (x_c - x_e[k-1] - T v_e) + b (v_c - v_e) = f0 - (kT + b) v_e
-        let port = Port {
-            f0_n: self.k * stretch_prev + self.b * v_c_mps,
+        Port {
+            f0_n: self.k * stretch_m + self.b * v_c_mps,
             z_nspm: self.z_direct,
-        };
-        // The VE's answer is on the port's line, so its force is this
-        // tick's coupling force: f_c and f_e are one number.
-        let out = ve.step(port);
-        ImpedanceStep {
-            force_n: out.force_n,
-            ve_velocity_mps: out.velocity_mps,
         }
     }
 

@@ -2,9 +2,11 @@
 //! simulator runs it: sensors in, law, VE, safety layer, held actuator force
 //! out.
 
+mod axes;
 mod gains;
 mod layer;
 
+pub use axes::{AxesFrame, AxesOutput, AxesServo};
 pub use gains::{AdmittanceGains, Display, Gains, GainsError, ImpedanceGains};
 pub use layer::{Direct, PortLayer};
 
@@ -56,34 +58,69 @@ pub struct ServoOutput<R = f32> {
     pub limited: bool,
 }
 
-/// Encoder, velocity estimate and safety layer: the part both displays share.
+/// One axis's sensing: its encoder and velocity estimate.
 #[derive(Clone, Copy, Debug)]
-struct Frontend<R> {
+struct Axis<R> {
     encoder: Encoder,
     estimator: FirstDifference<R>,
-    safety: SafetyLayer<R>,
     position: Position,
 }
 
-impl<R: Real> Frontend<R> {
-    fn new(encoder: Encoder, safety: SafetyConfig) -> Result<Self, ParamError> {
+impl<R: Real> Axis<R> {
+    fn new(encoder: Encoder, period_s: f32) -> Result<Self, ParamError> {
         let position = encoder.position();
-        Ok(Frontend {
-            estimator: FirstDifference::new_in(safety.period_s, position)?,
-            safety: SafetyLayer::new_in(safety)?,
+        Ok(Axis {
+            estimator: FirstDifference::new_in(period_s, position)?,
             encoder,
             position,
         })
     }
 
-    /// Read the encoder; returns the velocity and the sensor faults.
-    fn sense(&mut self, frame: &SensorFrame<R>) -> (R, Faults) {
+    /// Read the encoder's `raw` count; returns the velocity and the sensor
+    /// faults.
+    #[inline(always)]
+    fn sense(&mut self, raw: u32) -> (R, Faults) {
         let mut faults = Faults::NONE;
-        match self.encoder.update(frame.encoder_raw) {
+        match self.encoder.update(raw) {
             Ok(p) => self.position = p,
             Err(_) => faults = Faults::ENCODER_INVALID,
         }
         (self.estimator.step(self.position), faults)
+    }
+}
+
+/// The faults of a load-cell reading `f_c` (N) on a cell of range
+/// `max_n` (N).
+#[inline(always)]
+fn load_cell_faults<R: Real>(f_c: R, max_n: f32) -> Faults {
+    if !f_c.is_finite() {
+        Faults::SENSOR_NOT_FINITE
+    } else if f_c.abs() > R::of(max_n) {
+        Faults::SENSOR_OUT_OF_RANGE
+    } else {
+        Faults::NONE
+    }
+}
+
+/// Encoder, velocity estimate and safety layer: the part both displays share.
+#[derive(Clone, Copy, Debug)]
+struct Frontend<R> {
+    axis: Axis<R>,
+    safety: SafetyLayer<R>,
+}
+
+impl<R: Real> Frontend<R> {
+    fn new(encoder: Encoder, safety: SafetyConfig) -> Result<Self, ParamError> {
+        Ok(Frontend {
+            axis: Axis::new(encoder, safety.period_s)?,
+            safety: SafetyLayer::new_in(safety)?,
+        })
+    }
+
+    /// Read the encoder; returns the velocity and the sensor faults.
+    #[inline(always)]
+    fn sense(&mut self, frame: &SensorFrame<R>) -> (R, Faults) {
+        self.axis.sense(frame.encoder_raw)
     }
 
     /// Whether the laws may run this tick.
@@ -92,6 +129,9 @@ impl<R: Real> Frontend<R> {
     }
 
     /// The safety layer's answer to the law's `command_n` (N).
+    // (Always inlined, as the layer's step is: out of line, the answer
+    // passes through memory, 15 of the board tick's instructions.)
+    #[inline(always)]
     fn limit(
         &mut self,
         frame: &SensorFrame<R>,
@@ -118,6 +158,48 @@ struct AdmittanceLaws<R> {
     coupling: AdmittanceCoupling<R>,
     command: Integrator<R>,
     regulator: PositionRegulator<R>,
+}
+
+impl<R: Real> AdmittanceLaws<R> {
+    fn new(g: AdmittanceGains, period_s: f32, x: Position) -> Result<Self, ParamError> {
+        Ok(AdmittanceLaws {
+            coupling: AdmittanceCoupling::new_in(g.m_kg, g.b_nspm, period_s)?,
+            command: Integrator::new_in(period_s, x),
+            regulator: PositionRegulator::new_in(g.kp_npm, g.bp_nspm, period_s)?,
+        })
+    }
+
+    fn gains(&self) -> AdmittanceGains {
+        let (kp_npm, bp_nspm) = self.regulator.gains();
+        let (m_kg, b_nspm) = self.coupling.gains();
+        AdmittanceGains {
+            kp_npm,
+            bp_nspm,
+            m_kg,
+            b_nspm,
+        }
+    }
+
+    /// All the gains change or, on an error, none do.
+    fn set_gains(&mut self, g: AdmittanceGains) -> Result<(), ParamError> {
+        let (mut coupling, mut regulator) = (self.coupling, self.regulator);
+        coupling.set_gains(g.m_kg, g.b_nspm)?;
+        regulator.set_gains(g.kp_npm, g.bp_nspm)?;
+        (self.coupling, self.regulator) = (coupling, regulator);
+        Ok(())
+    }
+
+    /// Re-align to the device at `x`.
+    fn reset(&mut self, x: Position) {
+        self.coupling.reset();
+        self.command.reset(x);
+        self.regulator.reset();
+    }
+}
+
+fn impedance_gains<R: Real>(c: &ImpedanceCoupling<R>) -> ImpedanceGains {
+    let (k_npm, b_nspm) = c.gains();
+    ImpedanceGains { k_npm, b_nspm }
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -204,11 +286,9 @@ impl<V: VirtualEnvironment<R>, R: Real> Servo<V, R> {
             Gains::Impedance(g) => {
                 Laws::Impedance(ImpedanceCoupling::new_in(g.k_npm, g.b_nspm, t)?)
             }
-            Gains::Admittance(g) => Laws::Admittance(AdmittanceLaws {
-                coupling: AdmittanceCoupling::new_in(g.m_kg, g.b_nspm, t)?,
-                command: Integrator::new_in(t, front.position),
-                regulator: PositionRegulator::new_in(g.kp_npm, g.bp_nspm, t)?,
-            }),
+            Gains::Admittance(g) => {
+                Laws::Admittance(AdmittanceLaws::new(g, t, front.axis.position)?)
+            }
         };
         let mut s = Servo {
             front,
@@ -256,7 +336,7 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
             ve: self.ve,
             layer,
         };
-        let x = s.front.position;
+        let x = s.front.axis.position;
         s.layer.reset(x);
         Ok(s)
     }
@@ -304,8 +384,8 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
     /// Meant for a disabled servo; an enabled one would see its position
     /// jump.
     pub fn calibrate(&mut self, position: Position) {
-        self.front.encoder.rezero(position);
-        self.front.position = position;
+        self.front.axis.encoder.rezero(position);
+        self.front.axis.position = position;
         self.realign();
     }
 
@@ -336,7 +416,7 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
 
     /// The current actuator position.
     pub fn position(&self) -> Position {
-        self.front.position
+        self.front.axis.position
     }
 
     /// The display this servo runs.
@@ -361,20 +441,8 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
     /// The gains in force.
     pub fn gains(&self) -> Gains {
         match &self.laws {
-            Laws::Impedance(c) => {
-                let (k_npm, b_nspm) = c.gains();
-                Gains::Impedance(ImpedanceGains { k_npm, b_nspm })
-            }
-            Laws::Admittance(a) => {
-                let (kp_npm, bp_nspm) = a.regulator.gains();
-                let (m_kg, b_nspm) = a.coupling.gains();
-                Gains::Admittance(AdmittanceGains {
-                    kp_npm,
-                    bp_nspm,
-                    m_kg,
-                    b_nspm,
-                })
-            }
+            Laws::Impedance(c) => Gains::Impedance(impedance_gains(c)),
+            Laws::Admittance(a) => Gains::Admittance(a.gains()),
         }
     }
 
@@ -383,13 +451,7 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
     pub fn set_gains(&mut self, gains: Gains) -> Result<(), GainsError> {
         match (&mut self.laws, gains) {
             (Laws::Impedance(c), Gains::Impedance(g)) => Ok(c.set_gains(g.k_npm, g.b_nspm)?),
-            (Laws::Admittance(a), Gains::Admittance(g)) => {
-                let (mut coupling, mut regulator) = (a.coupling, a.regulator);
-                coupling.set_gains(g.m_kg, g.b_nspm)?;
-                regulator.set_gains(g.kp_npm, g.bp_nspm)?;
-                (a.coupling, a.regulator) = (coupling, regulator);
-                Ok(())
-            }
+            (Laws::Admittance(a), Gains::Admittance(g)) => Ok(a.set_gains(g)?),
             _ => Err(GainsError::WrongDisplay {
                 servo: self.display(),
                 gains: gains.display(),
@@ -398,12 +460,10 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
     }
 
     fn realign(&mut self) {
-        let x = self.front.position;
-        self.front.estimator.reset(x);
+        let x = self.front.axis.position;
+        self.front.axis.estimator.reset(x);
         if let Laws::Admittance(a) = &mut self.laws {
-            a.coupling.reset();
-            a.command.reset(x);
-            a.regulator.reset();
+            a.reset(x);
         }
         self.ve.reset(x);
         self.layer.reset(x);
@@ -414,8 +474,8 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
     /// is now. Refused, changing nothing, for a raw value the counter
     /// cannot hold.
     pub fn calibrate_at(&mut self, raw: u32, position: Position) -> Result<(), EncoderError> {
-        let now = self.front.encoder.rezero_at(raw, position)?;
-        self.front.position = now;
+        let now = self.front.axis.encoder.rezero_at(raw, position)?;
+        self.front.axis.position = now;
         self.realign();
         Ok(())
     }
@@ -433,7 +493,7 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
     ) -> ServoOutput<R> {
         let (v, faults) = self.front.sense(frame);
         let command_n = if self.front.runnable(faults) {
-            law(self.front.position, v)
+            law(self.front.axis.position, v)
         } else {
             R::ZERO
         };
@@ -441,12 +501,12 @@ impl<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>> Servo<V, R, L> {
         ServoOutput {
             actuator_force_n: safe.force_n,
             commanded_force_n: command_n,
-            position: self.front.position,
+            position: self.front.axis.position,
             velocity_mps: v,
             ve_velocity_mps: R::ZERO,
             ve_force_n: R::ZERO,
             coupling_force_n: R::ZERO,
-            reference: self.front.position,
+            reference: self.front.axis.position,
             faults: safe.faults,
             limited: safe.limited,
         }
@@ -477,9 +537,10 @@ fn impedance_tick<R: Real, V: VirtualEnvironment<R>, L: PortLayer<R>>(
     let (v, faults) = front.sense(frame);
     let runnable = front.runnable(faults);
     let (s, command_n) = if runnable {
-        let (x_e, v_e) = layer.element_motion(front.position, v);
+        let x = front.axis.position;
+        let (x_e, v_e) = layer.element_motion(x, v);
         let s = coupling.step(x_e, v_e, ve);
-        (s, layer.impedance_force(front.position, v, s.force_n))
+        (s, layer.impedance_force(x, v, s.force_n))
     } else {
         (ImpedanceStep::default(), R::ZERO)
     };
@@ -490,7 +551,7 @@ fn impedance_tick<R: Real, V: VirtualEnvironment<R>, L: PortLayer<R>>(
     ServoOutput {
         actuator_force_n: safe.force_n,
         commanded_force_n: command_n,
-        position: front.position,
+        position: front.axis.position,
         velocity_mps: v,
         ve_velocity_mps: s.ve_velocity_mps,
         ve_force_n: s.force_n,
@@ -509,18 +570,17 @@ fn admittance_tick<R: Real, V: VirtualEnvironment<R>, L: PortLayer<R>>(
     layer: &mut L,
     frame: &SensorFrame<R>,
 ) -> ServoOutput<R> {
-    let (v, mut faults) = front.sense(frame);
+    let (v, faults) = front.sense(frame);
     let f_c = frame.load_cell_n;
-    if !f_c.is_finite() {
-        faults = faults.with(Faults::SENSOR_NOT_FINITE);
-    } else if f_c.abs() > R::of(front.safety.config().max_sensor_force_n) {
-        faults = faults.with(Faults::SENSOR_OUT_OF_RANGE);
-    }
+    let faults = faults.with(load_cell_faults(
+        f_c,
+        front.safety.config().max_sensor_force_n,
+    ));
     let (s, command_n) = if front.runnable(faults) {
         let s = laws.coupling.step(f_c, ve);
         let v_cmd = layer.admittance_velocity(f_c, s.velocity_mps);
         let x_cmd = laws.command.step_unsplit(v_cmd);
-        (s, laws.regulator.step(front.position, x_cmd))
+        (s, laws.regulator.step(front.axis.position, x_cmd))
     } else {
         (AdmittanceStep::default(), R::ZERO)
     };
@@ -528,7 +588,7 @@ fn admittance_tick<R: Real, V: VirtualEnvironment<R>, L: PortLayer<R>>(
     ServoOutput {
         actuator_force_n: safe.force_n,
         commanded_force_n: command_n,
-        position: front.position,
+        position: front.axis.position,
         velocity_mps: v,
         ve_velocity_mps: s.velocity_mps,
         ve_force_n: s.ve_force_n,
