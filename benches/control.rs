@@ -81,15 +81,6 @@ fn laws(c: &mut Criterion) {
     });
 }
 
-fn frame(k: u32, raw: u32, f: f32) -> SensorFrame {
-    SensorFrame {
-        tick: k,
-        encoder_raw: raw,
-        load_cell_n: f,
-        dead_man_closed: true,
-    }
-}
-
 fn encoder() -> Encoder {
     Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap()
 }
@@ -110,7 +101,7 @@ fn impedance_tick<V: VirtualEnvironment>(c: &mut Criterion, ve_name: &str, ve: V
         |b| {
             b.iter(|| {
                 k = k.wrapping_add(1);
-                let out = s.tick(&frame(k, black_box(k % 1000), 0.0));
+                let out = s.tick(&SensorFrame::held(k, black_box(k % 1000), 0.0));
                 black_box(&out);
             })
         },
@@ -142,7 +133,11 @@ fn servos(c: &mut Criterion) {
         |b| {
             b.iter(|| {
                 k = k.wrapping_add(1);
-                let out = a.tick(&frame(k, 0, black_box(((k % 40) as f32 - 20.0) * 0.1)));
+                let out = a.tick(&SensorFrame::held(
+                    k,
+                    0,
+                    black_box(((k % 40) as f32 - 20.0) * 0.1),
+                ));
                 black_box(&out);
             })
         },

@@ -40,17 +40,28 @@ fn arm() -> impl Strategy<Value = Arm> {
 }
 
 fn ve() -> impl Strategy<Value = VeSpec> {
+    ve_within(20.0, (0.1, 1e4))
+}
+
+/// A cursor of 0.25 kg to `max_mass_kg`, a spring (100 N/m to 10 MN/m)
+/// whose damping is log-uniform over `damping_nspm`, or a bilateral
+/// constraint.
+fn ve_within(max_mass_kg: f64, damping_nspm: (f64, f64)) -> impl Strategy<Value = VeSpec> {
     prop_oneof![
-        log_uniform(0.25, 20.0).prop_map(|mass_kg| VeSpec::Cursor {
+        log_uniform(0.25, max_mass_kg).prop_map(|mass_kg| VeSpec::Cursor {
             mass_kg,
             integration: Integration::Implicit
         }),
-        (log_uniform(1e2, 1e7), log_uniform(0.1, 1e4)).prop_map(|(k, b)| VeSpec::Spring {
-            anchor_m: -0.001,
-            stiffness_npm: k,
-            damping_nspm: b,
-            discretization: Default::default()
-        }),
+        (
+            log_uniform(1e2, 1e7),
+            log_uniform(damping_nspm.0, damping_nspm.1)
+        )
+            .prop_map(|(k, b)| VeSpec::Spring {
+                anchor_m: -0.001,
+                stiffness_npm: k,
+                damping_nspm: b,
+                discretization: Default::default()
+            }),
         Just(VeSpec::Bilateral),
     ]
 }
@@ -70,19 +81,7 @@ fn tuned_case(f_hz: f64) -> impl Strategy<Value = Case> {
             damping_nspm: b,
             stiffness_npm: m * (r * w) * (r * w),
         });
-    let ve = prop_oneof![
-        log_uniform(0.25, 50.0).prop_map(|mass_kg| VeSpec::Cursor {
-            mass_kg,
-            integration: Integration::Implicit
-        }),
-        (log_uniform(1e2, 1e7), log_uniform(0.001, 10.0)).prop_map(|(k, b)| VeSpec::Spring {
-            anchor_m: -0.001,
-            stiffness_npm: k,
-            damping_nspm: b,
-            discretization: Default::default()
-        }),
-        Just(VeSpec::Bilateral),
-    ];
+    let ve = ve_within(50.0, (0.001, 10.0));
     (arm.prop_map(Some), any::<bool>(), ve, -30.0..30.0f64).prop_map(
         |(arm, grasp_max, ve, push_n)| Case {
             arm,

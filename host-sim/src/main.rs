@@ -262,6 +262,19 @@ fn bar(len: u64, msg: String) -> ProgressBar {
     b
 }
 
+/// `study` over the scene files in `dir`, with a progress bar of them.
+fn over_cases<T>(
+    dir: &Path,
+    what: &str,
+    study: impl FnOnce(&Path, &mut dyn FnMut()) -> Result<T, String>,
+) -> Result<T, String> {
+    let n = table1::case_files(dir)?.len();
+    let b = bar(n as u64, what.into());
+    let out = study(dir, &mut || b.inc(1));
+    b.finish_and_clear();
+    out
+}
+
 fn sweep(a: &SweepArgs) -> Result<(), String> {
     if !(a.tol > 0.0 && a.tol < 1.0) {
         return Err(format!("--tol {}: must be between 0 and 1", a.tol));
@@ -294,10 +307,7 @@ fn sweep(a: &SweepArgs) -> Result<(), String> {
 /// The passivity layer's table: each scene off, on, and at its passive
 /// reference.
 fn passivity(a: &PassivityArgs) -> Result<(), String> {
-    let n = table1::case_files(&a.scenes)?.len();
-    let b = bar(n as u64, "passivity scenes".into());
-    let rows = passivity::table(&a.scenes, &mut || b.inc(1))?;
-    b.finish_and_clear();
+    let rows = over_cases(&a.scenes, "passivity scenes", passivity::table)?;
     if a.json {
         println!("{}", json!({ "rows": rows }));
     } else {
@@ -309,10 +319,7 @@ fn passivity(a: &PassivityArgs) -> Result<(), String> {
 /// Table I: every VE state x grasp at the theoretical gains, then the
 /// boundaries swept as the paper did.
 fn table1(a: &Table1Args) -> Result<(), String> {
-    let n = table1::case_files(&a.scenes)?.len();
-    let b = bar(n as u64, "Table I".into());
-    let t = table1::table1(&a.scenes, &mut || b.inc(1))?;
-    b.finish_and_clear();
+    let t = over_cases(&a.scenes, "Table I", table1::table1)?;
     let rows: Vec<serde_json::Value> = t
         .cases
         .iter()

@@ -9,20 +9,19 @@ fn scene() -> Scene {
     Scene::load(Path::new("../scenes/stiff_wall.toml"), &[]).unwrap()
 }
 
+/// `ticks` of the stiff wall with the in-process Excalibur board.
+fn run(ticks: u64, faults: Faults) -> pil::Run {
+    pil::run(scene(), ticks, LocalBoard::excalibur().unwrap(), faults).unwrap()
+}
+
 #[test]
 fn corrupted_frames_are_dropped_and_the_loop_goes_on() {
-    let clean = pil::run(
-        scene(),
-        3000,
-        LocalBoard::excalibur().unwrap(),
-        Faults::default(),
-    )
-    .unwrap();
+    let clean = run(3000, Faults::default());
     let faults = Faults {
         corrupt_every: 7,
         link_loss_at: None,
     };
-    let noisy = pil::run(scene(), 3000, LocalBoard::excalibur().unwrap(), faults).unwrap();
+    let noisy = run(3000, faults);
     assert!(noisy.corrupted_sent > 800);
     assert_eq!(
         u64::from(noisy.board_stats.rx.dropped()),
@@ -48,7 +47,7 @@ fn link_loss_gives_zero_force_within_the_watchdog_deadline() {
             corrupt_every: 0,
             link_loss_at: Some(t0),
         };
-        let r = pil::run(scene(), 4500, LocalBoard::excalibur().unwrap(), faults).unwrap();
+        let r = run(4500, faults);
         assert!(r.duties[t0 as usize - 1] != 0, "force before the loss");
         let z = r.zero_after_loss_ticks.unwrap();
         assert!(z <= deadline, "zero after {z} ticks, deadline {deadline}");
@@ -62,13 +61,7 @@ fn the_board_loop_matches_the_scenes_own_servo_within_pwm_resolution() {
     // goes to the plant unquantised and it has no enable ramp or link;
     // the board's goes through the 16-bit duty (6.1 mN steps) after a 100 ms
     // ramp-in. Away from the start the trajectories agree closely.
-    let r = pil::run(
-        scene(),
-        6000,
-        LocalBoard::excalibur().unwrap(),
-        Faults::default(),
-    )
-    .unwrap();
+    let r = run(6000, Faults::default());
     let mut sim = Simulation::new(scene()).unwrap();
     let mut worst = 0.0f64;
     for s in &r.samples {

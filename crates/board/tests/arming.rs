@@ -148,6 +148,27 @@ fn tick(b: &mut TestBoard, io: &mut Bench) {
     b.flush(io);
 }
 
+/// A board whose homing ends on an index mark at -12 mm, 8 mm above its
+/// stop at -20 mm.
+fn board_homing_to_an_index() -> TestBoard {
+    let mut cfg = HomingConfig::gentle(Position::from_nm(-20_000_000), T);
+    cfg.index_position = Some(Position::from_nm(-12_000_000));
+    board().with_homing(cfg)
+}
+
+/// One tick at power-on, then the host asks the board to home.
+fn start_homing(b: &mut TestBoard, io: &mut Bench) {
+    tick(b, io);
+    io.say(Message::Home);
+}
+
+/// Ask the board to arm and tick once; what it answered.
+fn ask_to_arm(b: &mut TestBoard, io: &mut Bench) -> Vec<Message> {
+    io.say(Message::Arm);
+    tick(b, io);
+    io.heard()
+}
+
 fn refused(msgs: &[Message]) -> Vec<(ModeRequest, ModeRefusal)> {
     msgs.iter()
         .filter_map(|m| match m {
@@ -174,19 +195,15 @@ fn boots_disarmed_with_outputs_off_and_names_why_it_will_not_arm() {
     assert!(!b.outputs_on() && !b.calibrated());
     // Before any tick the dead-man is unknown; before calibration it may
     // not arm at all. The first reason that holds is the one named.
-    io.say(Message::Arm);
-    tick(&mut b, &mut io);
     assert_eq!(
-        refused(&io.heard()),
+        refused(&ask_to_arm(&mut b, &mut io)),
         [(ModeRequest::Arm, ModeRefusal::NotCalibrated)]
     );
     io.say(Message::Calibrate { position_pm: 0 });
     io.dead_man_closed = false;
     tick(&mut b, &mut io);
-    io.say(Message::Arm);
-    tick(&mut b, &mut io);
     assert_eq!(
-        refused(&io.heard()),
+        refused(&ask_to_arm(&mut b, &mut io)),
         [(ModeRequest::Arm, ModeRefusal::DeadManOpen)]
     );
     // Displaced 1 mm from the constraint it was calibrated at, the
@@ -199,9 +216,7 @@ fn boots_disarmed_with_outputs_off_and_names_why_it_will_not_arm() {
     assert!(io.outputs_calls.is_empty());
     io.dead_man_closed = true;
     tick(&mut b, &mut io);
-    io.say(Message::Arm);
-    tick(&mut b, &mut io);
-    let msgs = io.heard();
+    let msgs = ask_to_arm(&mut b, &mut io);
     assert_eq!(refused(&msgs), []);
     assert_eq!(
         statuses(&msgs),
@@ -222,10 +237,8 @@ fn gains_outside_the_proven_region_never_arm() {
     let mut io = Bench::new(None);
     io.say(Message::Calibrate { position_pm: 0 });
     tick(&mut b, &mut io);
-    io.say(Message::Arm);
-    tick(&mut b, &mut io);
     assert_eq!(
-        refused(&io.heard()),
+        refused(&ask_to_arm(&mut b, &mut io)),
         [(ModeRequest::Arm, ModeRefusal::GainsNotProven)]
     );
     assert_eq!(b.mode(), Mode::Disarmed);
@@ -266,10 +279,8 @@ fn any_fault_disarms_and_latches_until_cleared_and_re_armed() {
     assert_eq!(Faults(s[0].faults), Faults::DEAD_MAN);
     assert_eq!(Faults(s[0].faults).to_string(), "dead-man switch released");
     io.dead_man_closed = true;
-    io.say(Message::Arm);
-    tick(&mut b, &mut io);
     assert_eq!(
-        refused(&io.heard()),
+        refused(&ask_to_arm(&mut b, &mut io)),
         [(
             ModeRequest::Arm,
             ModeRefusal::Faulted {
@@ -294,8 +305,7 @@ fn any_fault_disarms_and_latches_until_cleared_and_re_armed() {
 fn homing_finds_the_stop_gently_and_calibrates_the_encoder() {
     let mut b = board();
     let mut io = Bench::new(Some(-0.015));
-    tick(&mut b, &mut io);
-    io.say(Message::Home);
+    start_homing(&mut b, &mut io);
     let mut ticks = 0;
     loop {
         tick(&mut b, &mut io);
@@ -338,8 +348,7 @@ fn homing_without_a_stop_times_out_as_a_named_fault() {
     cfg.timeout_s = 0.5;
     let mut b = board().with_homing(cfg);
     let mut io = Bench::new(None);
-    tick(&mut b, &mut io);
-    io.say(Message::Home);
+    start_homing(&mut b, &mut io);
     for _ in 0..600 {
         tick(&mut b, &mut io);
     }
@@ -361,8 +370,7 @@ fn homing_without_a_stop_times_out_as_a_named_fault() {
 fn calibrate_and_home_need_a_disarmed_board_and_disarm_stops_homing() {
     let mut b = board();
     let mut io = Bench::new(Some(-0.015));
-    tick(&mut b, &mut io);
-    io.say(Message::Home);
+    start_homing(&mut b, &mut io);
     tick(&mut b, &mut io);
     assert_eq!(b.mode(), Mode::Homing);
     io.say(Message::Calibrate { position_pm: 0 });
@@ -402,13 +410,10 @@ fn calibrate_and_home_need_a_disarmed_board_and_disarm_stops_homing() {
 /// the pulse latched, to the count, long before the stop (15 mm down).
 #[test]
 fn homing_on_an_index_pulse_calibrates_to_the_count_before_the_stop() {
-    let mut cfg = HomingConfig::gentle(Position::from_nm(-20_000_000), T);
-    cfg.index_position = Some(Position::from_nm(-12_000_000));
-    let mut b = board().with_homing(cfg);
+    let mut b = board_homing_to_an_index();
     let mut io = Bench::new(Some(-0.015));
     io.index_m = Some(-0.006);
-    tick(&mut b, &mut io);
-    io.say(Message::Home);
+    start_homing(&mut b, &mut io);
     let mut ticks = 0;
     while ticks < 5000 {
         tick(&mut b, &mut io);
@@ -433,12 +438,9 @@ fn homing_on_an_index_pulse_calibrates_to_the_count_before_the_stop() {
 /// failure, not a calibration.
 #[test]
 fn homing_on_an_index_that_never_pulses_fails_at_the_stop() {
-    let mut cfg = HomingConfig::gentle(Position::from_nm(-20_000_000), T);
-    cfg.index_position = Some(Position::from_nm(-12_000_000));
-    let mut b = board().with_homing(cfg);
+    let mut b = board_homing_to_an_index();
     let mut io = Bench::new(Some(-0.015));
-    tick(&mut b, &mut io);
-    io.say(Message::Home);
+    start_homing(&mut b, &mut io);
     for _ in 0..3000 {
         tick(&mut b, &mut io);
     }

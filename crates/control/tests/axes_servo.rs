@@ -5,28 +5,16 @@
 
 use twoport_control::safety::AxisError;
 use twoport_control::servo::{AxesFrame, AxesServo, LawsRef, SensorFrame};
-use twoport_control::ve::{CursorMass, Solid, UnilateralWall, VeTransfer, VirtualEnvironment};
+use twoport_control::ve::{CursorMass, VeTransfer, VirtualEnvironment};
 use twoport_control::world::{PerAxis, World};
 use twoport_control::{
-    AdmittanceGains, Complex64, Encoder, Faults, Gains, GainsError, ImpedanceGains, Position,
-    SafetyConfig, Servo, SineProbe,
+    AdmittanceGains, Complex64, Faults, Gains, GainsError, ImpedanceGains, Position, SafetyConfig,
+    Servo, SineProbe,
 };
 
-const T: f32 = 1.0e-3;
+mod common;
 
-/// 16-bit counter, 1 µm per count.
-fn encoder() -> Encoder {
-    Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap()
-}
-
-/// The 16-bit count of `x_um` micrometres.
-fn raw(x_um: i32) -> u32 {
-    x_um as u32 & 0xFFFF
-}
-
-fn wall(k_npm: f32) -> UnilateralWall {
-    UnilateralWall::new(k_npm, 50.0, Position::ZERO, Solid::Above, T, Position::ZERO).unwrap()
-}
+use common::{encoder, raw, wall, T};
 
 fn cursor(m_kg: f32) -> CursorMass {
     CursorMass::new(m_kg, T, Position::ZERO).unwrap()
@@ -141,6 +129,14 @@ fn impedance_of(t: VeTransfer, z: Complex64) -> Complex64 {
     }
 }
 
+fn assert_response(axis: usize, p: usize, got: Complex64, want: Complex64) {
+    let err = (got - want).norm() / want.norm();
+    assert!(
+        err <= 1e-4,
+        "axis {axis} bin {p}: measured {got}, composed {want}"
+    );
+}
+
 /// Impedance display, three axes with their own gains against three
 /// cursors: each axis in turn is driven with a sinusoid while the others
 /// hold 1 mm off, and its force per position is its own
@@ -182,11 +178,7 @@ fn impedance_axes_each_match_their_composed_z_form() {
             };
             let (zc, ye) = (c.tf().eval(z), impedance_of(s.world().tf(axis), z).inv());
             let want = zc / (1.0 + zc * ye) * (1.0 - z.inv()) / T as f64;
-            let got = probe.response();
-            assert!(
-                (got - want).norm() <= 1e-4 * want.norm(),
-                "axis {axis} bin {p}: measured {got}, composed {want}"
-            );
+            assert_response(axis, p, probe.response(), want);
         }
     }
 }
@@ -237,11 +229,7 @@ fn admittance_axes_each_match_their_composed_z_form() {
             let integ = T as f64 / (1.0 - z.inv());
             let zw = impedance_of(s.world().tf(axis), z);
             let want = -regulator.tf().eval(z) * integ / (coupling.tf().eval(z) + zw);
-            let got = probe.response();
-            assert!(
-                (got - want).norm() <= 1e-4 * want.norm(),
-                "axis {axis} bin {p}: measured {got}, composed {want}"
-            );
+            assert_response(axis, p, probe.response(), want);
         }
     }
 }

@@ -3,39 +3,14 @@
 //! z-domain forms, and every sensor fault gives zero force in the same tick.
 
 use twoport_control::servo::{LawsRef, SensorFrame};
-use twoport_control::ve::{CursorMass, Solid, UnilateralWall, VeTransfer, VirtualEnvironment};
+use twoport_control::ve::{CursorMass, VeTransfer, VirtualEnvironment};
 use twoport_control::{
-    AdmittanceGains, Complex64, Encoder, Faults, ImpedanceGains, Position, SafetyConfig, Servo,
-    SineProbe,
+    AdmittanceGains, Complex64, Faults, ImpedanceGains, Position, SafetyConfig, Servo, SineProbe,
 };
 
-const T: f32 = 1.0e-3;
+mod common;
 
-fn encoder() -> Encoder {
-    // 16-bit counter, 1 um per count.
-    Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap()
-}
-
-fn frame(tick: u32, raw: u32, load_cell_n: f32) -> SensorFrame {
-    SensorFrame {
-        tick,
-        encoder_raw: raw,
-        load_cell_n,
-        dead_man_closed: true,
-    }
-}
-
-fn wall() -> UnilateralWall {
-    UnilateralWall::new(
-        20_000.0,
-        50.0,
-        Position::ZERO,
-        Solid::Above,
-        T,
-        Position::ZERO,
-    )
-    .unwrap()
-}
+use common::{encoder, wall, T};
 
 /// Device held still, load cell 20 +- 5 N into a wall: the actuator force
 /// per measured force is `-K_p T/(1 - z^-1) / (Z_cA + Z_wall)`.
@@ -46,7 +21,7 @@ fn admittance_display_tick_matches_its_composed_z_domain_form() {
             AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into(),
             encoder(),
             SafetyConfig::excalibur(),
-            wall(),
+            wall(20_000.0),
         )
         .unwrap();
         s.enable().unwrap();
@@ -54,7 +29,7 @@ fn admittance_display_tick_matches_its_composed_z_domain_form() {
         let mut probe = SineProbe::new(th.cos(), th.sin());
         for k in 0..7000u32 {
             let f = (20.0 + 5.0 * probe.excitation()) as f32;
-            let out = s.tick(&frame(k, 0, f));
+            let out = s.tick(&SensorFrame::held(k, 0, f));
             assert!(out.faults.is_empty());
             if k >= 3000 {
                 probe.record(f as f64, out.actuator_force_n as f64);
@@ -92,22 +67,22 @@ fn bad_sensor_readings_give_zero_force_in_the_same_tick() {
     let bad: [(&str, SensorFrame, Faults); 4] = [
         (
             "NaN load cell",
-            frame(0, 0, f32::NAN),
+            SensorFrame::held(0, 0, f32::NAN),
             Faults::SENSOR_NOT_FINITE,
         ),
         (
             "infinite load cell",
-            frame(0, 0, f32::NEG_INFINITY),
+            SensorFrame::held(0, 0, f32::NEG_INFINITY),
             Faults::SENSOR_NOT_FINITE,
         ),
         (
             "load cell at rail",
-            frame(0, 0, 1.0e4),
+            SensorFrame::held(0, 0, 1.0e4),
             Faults::SENSOR_OUT_OF_RANGE,
         ),
         (
             "encoder wider than 16 bits",
-            frame(0, 0x1_0000, 20.0),
+            SensorFrame::held(0, 0x1_0000, 20.0),
             Faults::ENCODER_INVALID,
         ),
     ];
@@ -124,7 +99,7 @@ fn bad_sensor_readings_give_zero_force_in_the_same_tick() {
         // Push 20 N for half a second: the regulator is working.
         let mut last = 0.0;
         for _ in 0..500 {
-            last = s.tick(&frame(tick, 0, 20.0)).actuator_force_n;
+            last = s.tick(&SensorFrame::held(tick, 0, 20.0)).actuator_force_n;
             tick += 1;
         }
         assert!(last.abs() > 1.0, "{what}: regulator idle ({last} N)");
@@ -134,13 +109,13 @@ fn bad_sensor_readings_give_zero_force_in_the_same_tick() {
         assert_eq!(out.actuator_force_n, 0.0, "{what}");
         assert!(out.faults.contains(fault), "{what}: {}", out.faults);
         for _ in 0..20 {
-            let out = s.tick(&frame(tick, 0, 20.0));
+            let out = s.tick(&SensorFrame::held(tick, 0, 20.0));
             tick += 1;
             assert_eq!(out.actuator_force_n, 0.0, "{what}: latched");
         }
         assert!(s.enable().is_err());
         s.clear();
-        let out = s.tick(&frame(tick, 0, 20.0));
+        let out = s.tick(&SensorFrame::held(tick, 0, 20.0));
         assert!(out.faults.is_empty(), "{what}: {}", out.faults);
         // Re-aligned: the position command restarts at the device, so the
         // first force after clear is small and ramped.
@@ -156,7 +131,7 @@ fn impedance_display_renders_the_series_of_coupling_and_wall() {
         ImpedanceGains::new(51_000.0, 90.0).into(),
         encoder(),
         SafetyConfig::excalibur(),
-        wall(),
+        wall(20_000.0),
     )
     .unwrap();
     s.enable().unwrap();
@@ -164,7 +139,7 @@ fn impedance_display_renders_the_series_of_coupling_and_wall() {
     for k in 0..3000u32 {
         // Move to +2 mm (2000 counts) over the first second, then hold.
         let raw = k.min(1000) * 2;
-        out = s.tick(&frame(k, raw, 0.0));
+        out = s.tick(&SensorFrame::held(k, raw, 0.0));
     }
     let series = 1.0 / (1.0 / 51_000.0 + 1.0 / 20_000.0);
     let want = series * 2e-3;

@@ -100,20 +100,18 @@ fn zrange_json_runs_from_a_tenth_of_a_hertz_to_nyquist() {
     }
 }
 
+/// A command line's words.
+fn words(line: &str) -> Vec<&str> {
+    line.split_whitespace().collect()
+}
+
 #[test]
 fn bad_inputs_are_named() {
     let e = TWOPORT.failure(&["check", "impedance", "--k", "-3", "--b", "90"]);
     assert!(e.contains("--k -3"), "{e}");
-    let e = TWOPORT.failure(&[
-        "check",
-        "impedance",
-        "--k",
-        "1e4",
-        "--b",
-        "90",
-        "--model",
-        "no/such.toml",
-    ]);
+    let e = TWOPORT.failure(&words(
+        "check impedance --k 1e4 --b 90 --model no/such.toml",
+    ));
     assert!(
         e.contains("no/such.toml") && e.contains("cannot read"),
         "{e}"
@@ -284,14 +282,9 @@ fn several_poses_design_for_all() {
 fn a_device_without_a_force_sensor() {
     let e = TWOPORT.failure(&["design", "admittance", "--model", "models/capstan.toml"]);
     assert!(e.contains("no force sensor"), "{e}");
-    let v = TWOPORT.json(&[
-        "design",
-        "impedance",
-        "--no-human",
-        "--model",
-        "models/capstan.toml",
-        "--json",
-    ]);
+    let v = TWOPORT.json(&words(
+        "design impedance --no-human --model models/capstan.toml --json",
+    ));
     let k = v["k_c"].as_f64().unwrap();
     assert_eq!(v["b_c"], 0.0);
     assert!((k - 2.0 * 2.0 / 1e-3).abs() < 0.002 * k, "{v}");

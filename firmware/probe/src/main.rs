@@ -100,15 +100,6 @@ fn admittance_coupling_with_cursor(t: &mut Tally) {
     t.check("Fig. 7(d) loop solved exactly on target", worst <= 1e-4);
 }
 
-fn frame(tick: u32, raw: u32, load_cell_n: f32) -> SensorFrame {
-    SensorFrame {
-        tick,
-        encoder_raw: raw,
-        load_cell_n,
-        dead_man_closed: true,
-    }
-}
-
 fn servo_wall_and_fault(t: &mut Tally) {
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let wall = UnilateralWall::new(
@@ -125,7 +116,9 @@ fn servo_wall_and_fault(t: &mut Tally) {
     let mut f = 0.0;
     let mut k = 0u32;
     while k < 3000 {
-        f = s.tick(&frame(k, k.min(1000) * 2, 0.0)).actuator_force_n;
+        f = s
+            .tick(&SensorFrame::held(k, k.min(1000) * 2, 0.0))
+            .actuator_force_n;
         k += 1;
     }
     let want = 2e-3 / (1.0 / 51_000.0 + 1.0 / 20_000.0);
@@ -133,7 +126,7 @@ fn servo_wall_and_fault(t: &mut Tally) {
         "wall renders the series stiffness",
         libm::fabsf(f - want) < 1e-3 * want,
     );
-    let out = s.tick(&frame(k, 0x1_0000, 0.0));
+    let out = s.tick(&SensorFrame::held(k, 0x1_0000, 0.0));
     t.check(
         "invalid encoder value gives zero force in the same tick",
         out.actuator_force_n == 0.0 && out.faults.contains(Faults::ENCODER_INVALID),
@@ -174,7 +167,7 @@ fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
     syst.clear_current();
     syst.enable_counter();
     let (per_tick, empty) = counts_per_call(1000, |k| {
-        let f = frame(k, core::hint::black_box(k % 1000 * 2), 0.0);
+        let f = SensorFrame::held(k, core::hint::black_box(k % 1000 * 2), 0.0);
         s.tick(&f).actuator_force_n
     });
     hprintln!("  empty loop: {} instructions per iteration", empty / 1.6);
@@ -204,20 +197,20 @@ fn tick_cost_layered(t: &mut Tally) {
     };
     let mut s = layered(0);
     let (pressing, _) = counts_per_call(1000, |k| {
-        let f = frame(k, core::hint::black_box(k * 2), 0.0);
+        let f = SensorFrame::held(k, core::hint::black_box(k * 2), 0.0);
         s.tick(&f).actuator_force_n
     });
     let passive = s.layer().damping_nspm() == 0.0 && s.safety().faults().is_empty();
     let mut s = layered(2000);
     let (withdrawing, _) = counts_per_call(1000, |k| {
-        let f = frame(k, core::hint::black_box(2000 - k * 2), 0.0);
+        let f = SensorFrame::held(k, core::hint::black_box(2000 - k * 2), 0.0);
         s.tick(&f).actuator_force_n
     });
     // The same sweep again, untimed, to count the ticks the layer damped.
     let mut s = layered(2000);
     let mut damped = 0u32;
     for k in 0..1000 {
-        s.tick(&frame(k, 2000 - k * 2, 0.0));
+        s.tick(&SensorFrame::held(k, 2000 - k * 2, 0.0));
         damped += (s.layer().damping_nspm() > 0.0) as u32;
     }
     hprintln!(
@@ -254,7 +247,7 @@ fn tick_cost_ve_port(t: &mut Tally) {
         let _ = s.enable();
         s
     };
-    let sweep = |k: u32| frame(k, core::hint::black_box(k % 1000 * 2), 0.0);
+    let sweep = |k: u32| SensorFrame::held(k, core::hint::black_box(k % 1000 * 2), 0.0);
     let mut s = servo();
     let (per_tick, _) = counts_per_call(1000, |k| s.tick(&sweep(k)).actuator_force_n);
     let mut s = servo();

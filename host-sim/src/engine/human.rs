@@ -139,19 +139,17 @@ impl Human {
         for (i, e) in events.iter().enumerate() {
             let bad = |what: &str| Err(format!("human.script[{i}]: {what}"));
             let finite = |v: f64| v.is_finite();
+            // (A NaN fails each comparison.)
+            let start = |t: f64| finite(t) && t >= 0.0;
+            let span = |t: f64| finite(t) && t > 0.0;
             match *e {
                 Event::Move { at_s, to_m, over_s } => {
-                    if !(finite(at_s)
-                        && at_s >= 0.0
-                        && finite(to_m)
-                        && finite(over_s)
-                        && over_s > 0.0)
-                    {
+                    if !(start(at_s) && finite(to_m) && span(over_s)) {
                         return bad("move needs at_s >= 0, a finite to_m and over_s > 0");
                     }
                 }
                 Event::Grip { at_s, .. } => {
-                    if !(finite(at_s) && at_s >= 0.0) {
+                    if !start(at_s) {
                         return bad("grip needs at_s >= 0");
                     }
                 }
@@ -161,14 +159,7 @@ impl Human {
                     frequency_hz,
                     for_s,
                 } => {
-                    if !(finite(at_s)
-                        && at_s >= 0.0
-                        && finite(amplitude_m)
-                        && finite(frequency_hz)
-                        && frequency_hz > 0.0
-                        && finite(for_s)
-                        && for_s > 0.0)
-                    {
+                    if !(start(at_s) && finite(amplitude_m) && span(frequency_hz) && span(for_s)) {
                         return bad("shake needs at_s >= 0, a finite amplitude_m, frequency_hz > 0 and for_s > 0");
                     }
                 }
@@ -177,12 +168,7 @@ impl Human {
                     force_n,
                     for_s,
                 } => {
-                    if !(finite(at_s)
-                        && at_s >= 0.0
-                        && finite(force_n)
-                        && finite(for_s)
-                        && for_s > 0.0)
-                    {
+                    if !(start(at_s) && finite(force_n) && span(for_s)) {
                         return bad("force needs at_s >= 0, a finite force_n and for_s > 0");
                     }
                 }

@@ -682,6 +682,14 @@ impl Scene {
                 Err(format!("{name} = {v} must be finite and >= 0"))
             }
         };
+        // A spring VE anchored at `at` (m, named `at_name`).
+        let spring = |at_name: &str, at: f64, k: f64, b: f64| {
+            if !at.is_finite() {
+                return Err(format!("{at_name} = {at} must be finite"));
+            }
+            nonneg("ve.stiffness_npm", k)?;
+            nonneg("ve.damping_nspm", b)
+        };
         pos("duration_s", self.duration_s)?;
         if let Some(t) = self.period_s {
             if !(t.is_finite() && (1e-6..=0.1).contains(&t)) {
@@ -738,30 +746,18 @@ impl Scene {
         match &self.ve {
             VeSpec::Cursor { mass_kg, .. } => pos("ve.mass_kg", *mass_kg)?,
             VeSpec::Wall {
-                position_m,
-                stiffness_npm,
-                damping_nspm,
+                position_m: at,
+                stiffness_npm: k,
+                damping_nspm: b,
                 ..
-            } => {
-                if !position_m.is_finite() {
-                    return Err(format!("ve.position_m = {position_m} must be finite"));
-                }
-                nonneg("ve.stiffness_npm", *stiffness_npm)?;
-                nonneg("ve.damping_nspm", *damping_nspm)?;
-            }
+            } => spring("ve.position_m", *at, *k, *b)?,
             VeSpec::Bilateral => {}
             VeSpec::Spring {
-                anchor_m,
-                stiffness_npm,
-                damping_nspm,
+                anchor_m: at,
+                stiffness_npm: k,
+                damping_nspm: b,
                 ..
-            } => {
-                if !anchor_m.is_finite() {
-                    return Err(format!("ve.anchor_m = {anchor_m} must be finite"));
-                }
-                nonneg("ve.stiffness_npm", *stiffness_npm)?;
-                nonneg("ve.damping_nspm", *damping_nspm)?;
-            }
+            } => spring("ve.anchor_m", *at, *k, *b)?,
             VeSpec::Blocks {
                 cursor_mass_kg,
                 blocks,

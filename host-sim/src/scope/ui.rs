@@ -199,42 +199,35 @@ fn speed(ui: &mut Ui, s: &mut ScopeState) {
 pub fn gains(ui: &mut Ui, s: &mut ScopeState) {
     ui.heading("Coupling");
     let mut g = s.gains;
+    // (Every slider is drawn, whichever changed.)
     let changed = match &mut g {
-        Gains::Impedance(g) => {
-            let (k, b) = (&mut g.k_npm, &mut g.b_nspm);
-            let a = ui
-                .add(egui::Slider::new(k, 0.0..=150_000.0).text("k_c (N/m)"))
-                .changed();
-            let c = ui
-                .add(egui::Slider::new(b, 0.0..=500.0).text("b_c (N s/m)"))
-                .changed();
-            a || c
-        }
-        Gains::Admittance(g) => {
-            let (kp, bp, m, b) = (&mut g.kp_npm, &mut g.bp_nspm, &mut g.m_kg, &mut g.b_nspm);
-            let a = ui
-                .add(egui::Slider::new(kp, 0.0..=150_000.0).text("K_p stiffness (N/m)"))
-                .changed();
-            let c = ui
-                .add(egui::Slider::new(bp, 0.0..=1000.0).text("K_p damping (N s/m)"))
-                .changed();
-            let d = ui
-                .add(
-                    egui::Slider::new(m, 0.05..=50.0)
-                        .logarithmic(true)
-                        .text("m_c (kg)"),
-                )
-                .changed();
-            let e = ui
-                .add(egui::Slider::new(b, 1.0..=2000.0).text("b_c (N s/m)"))
-                .changed();
-            a || c || d || e
-        }
+        Gains::Impedance(g) => [
+            slider(ui, &mut g.k_npm, 0.0..=150_000.0, "k_c (N/m)"),
+            slider(ui, &mut g.b_nspm, 0.0..=500.0, "b_c (N s/m)"),
+        ]
+        .contains(&true),
+        Gains::Admittance(g) => [
+            slider(ui, &mut g.kp_npm, 0.0..=150_000.0, "K_p stiffness (N/m)"),
+            slider(ui, &mut g.bp_nspm, 0.0..=1000.0, "K_p damping (N s/m)"),
+            ui.add(
+                egui::Slider::new(&mut g.m_kg, 0.05..=50.0)
+                    .logarithmic(true)
+                    .text("m_c (kg)"),
+            )
+            .changed(),
+            slider(ui, &mut g.b_nspm, 1.0..=2000.0, "b_c (N s/m)"),
+        ]
+        .contains(&true),
     };
     if changed {
         s.set_gains(g);
     }
     light(ui, s);
+}
+
+/// A linear slider over `range`; whether the user moved it.
+fn slider(ui: &mut Ui, v: &mut f32, range: std::ops::RangeInclusive<f32>, text: &str) -> bool {
+    ui.add(egui::Slider::new(v, range).text(text)).changed()
 }
 
 fn light(ui: &mut Ui, s: &ScopeState) {

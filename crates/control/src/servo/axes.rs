@@ -83,7 +83,8 @@ enum AxesLaws<R, const N: usize> {
 /// let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap(); // 1 µm counts
 /// let gains = ImpedanceGains::new(51_000.0, 90.0).into();
 /// let world = PerAxis([BilateralConstraint::new(Position::ZERO); 3]);
-/// let mut s = AxesServo::new([gains; 3], [enc; 3], [SafetyConfig::excalibur(); 3], world)?;
+/// // (A bilateral constraint computes in any float: name the servo's.)
+/// let mut s = AxesServo::<_, f32, 3>::new([gains; 3], [enc; 3], [SafetyConfig::excalibur(); 3], world)?;
 /// s.enable().unwrap();
 /// // 1 mm along y, the other axes at the constraint: only y pushes back.
 /// let frame = |tick| AxesFrame {
@@ -108,23 +109,12 @@ pub struct AxesServo<W, R = f32, const N: usize = 3> {
     world: W,
 }
 
-impl<W: World<f32, N>, const N: usize> AxesServo<W, f32, N> {
-    /// A disabled f32 servo: each axis's gains, encoder and limits, and the
-    /// world they all couple to. Every axis runs the same display; the
-    /// error names the axis and what is wrong with it.
-    pub fn new(
-        gains: [Gains; N],
-        encoders: [Encoder; N],
-        safety: [SafetyConfig; N],
-        world: W,
-    ) -> Result<Self, AxisError<GainsError>> {
-        Self::new_in(gains, encoders, safety, world)
-    }
-}
-
 impl<W: World<R, N>, R: Real, const N: usize> AxesServo<W, R, N> {
-    /// [`AxesServo::new`] computing in `R`.
-    pub fn new_in(
+    /// A disabled servo: each axis's gains, encoder and limits, and the
+    /// world they all couple to, computing in `R` (the world's float:
+    /// `f32` on the board). Every axis runs the same display; the error
+    /// names the axis and what is wrong with it.
+    pub fn new(
         gains: [Gains; N],
         encoders: [Encoder; N],
         safety: [SafetyConfig; N],

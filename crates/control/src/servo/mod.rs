@@ -31,6 +31,19 @@ pub struct SensorFrame<R = f32> {
     pub dead_man_closed: bool,
 }
 
+impl<R> SensorFrame<R> {
+    /// Tick `tick`'s encoder count and load-cell force (N), with the
+    /// dead-man switch closed: the operator holds the handle.
+    pub const fn held(tick: u32, encoder_raw: u32, load_cell_n: R) -> Self {
+        SensorFrame {
+            tick,
+            encoder_raw,
+            load_cell_n,
+            dead_man_closed: true,
+        }
+    }
+}
+
 /// The result of one tick.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ServoOutput<R = f32> {
