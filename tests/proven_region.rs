@@ -8,7 +8,7 @@ use twoport_control::{Encoder, ImpedanceGains, Position, SafetyConfig, Servo};
 use twoport_design::design::*;
 use twoport_design::twoport::HumanBound;
 
-use twoport_link::{encode, Decoder, Gains, GainsReply, Message, MAX_FRAME};
+use twoport_link::{encode, Axes, Decoder, Gains, GainsReply, Message, MAX_FRAME};
 
 const N: usize = 16;
 
@@ -47,7 +47,7 @@ fn the_board_accepts_only_what_the_designer_proves() {
                 b_nspm: damping,
             };
             let mut buf = [0u8; MAX_FRAME];
-            let n = encode(0, &Message::SetGains(g), &mut buf).unwrap();
+            let n = encode(0, &Message::SetGains(Axes::one(g)), &mut buf).unwrap();
             board.on_bytes(&buf[..n]);
             let mut reply = None;
             Decoder::new().feed(&board.pop_tx().unwrap(), |e| reply = Some(e.msg));

@@ -20,9 +20,12 @@ use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::ve::UnilateralWall;
 use twoport_control::Faults as BoardFaults;
 use twoport_link::{
-    encode, ConfigSource, Decoder, LinkStats, Message, Mode, ModeRequest, Role,
+    encode, Axes, ConfigSource, Decoder, LinkStats, Message, Mode, ModeRequest, Role,
     SensorFrame as LinkSensors, Status, Telemetry, MAX_FRAME,
 };
+
+/// The axes this host drives: a scene's device is one axis.
+const AXES: u8 = 1;
 
 /// How far a homed board's position may be from the plant's: the stop's
 /// give under the homing force (25 µm on the scenes' 2e5 N/m stop) and a
@@ -423,24 +426,26 @@ impl<P: BoardPort> Session<P> {
     fn handshake(&mut self) -> Result<(), String> {
         let deadline = Instant::now() + ANSWER_TIMEOUT;
         loop {
-            self.send(&Message::hello(Role::Host))?;
+            self.send(&Message::hello(Role::Host, AXES))?;
             self.pump(Duration::from_millis(100))?;
             if let Some(i) = self
                 .inbox
                 .iter()
                 .position(|m| matches!(m, Message::HelloAck { .. }))
             {
-                return match self.inbox.remove(i) {
-                    Message::HelloAck { accepted: true, .. } => Ok(()),
-                    Message::HelloAck { version, .. } => Err(format!(
-                        "the board speaks protocol {version}, this host {}",
-                        twoport_link::PROTOCOL_VERSION
-                    )),
-                    _ => Err("unreachable".into()),
-                };
+                return self
+                    .inbox
+                    .remove(i)
+                    .accept_ack(AXES)
+                    .map_err(|e| e.to_string());
             }
             if Instant::now() > deadline {
-                return Err("no handshake answer from the board".into());
+                // (A board of another protocol may answer in a form this
+                // host cannot decode.)
+                return Err(format!(
+                    "no handshake answer from the board (this host speaks protocol {})",
+                    twoport_link::PROTOCOL_VERSION
+                ));
             }
         }
     }
@@ -498,10 +503,10 @@ impl<P: BoardPort> Session<P> {
     fn exchange(&mut self, tick: u64, f: &SensorFrame) -> Result<i16, String> {
         let sensors = Message::Sensors(LinkSensors {
             tick: f.tick,
-            encoder_raw: f.encoder_raw,
-            load_cell_raw: self.io.load_cell_counts(f.load_cell_n),
+            encoder_raw: Axes::one(f.encoder_raw),
+            load_cell_raw: Axes::one(self.io.load_cell_counts(f.load_cell_n)),
             dead_man_closed: f.dead_man_closed,
-            index_raw: self.index_crossing(f.encoder_raw),
+            index_raw: Axes::one(self.index_crossing(f.encoder_raw)),
         });
         let good = self.frame(&sensors)?;
         let every = self.faults.corrupt_every;
@@ -519,7 +524,7 @@ impl<P: BoardPort> Session<P> {
         self.port.send(&good)?;
         let want = f.tick;
         self.wait(&format!("tick {want}"), |m| match m {
-            Message::Actuator(a) if a.tick == want => Some(a.duty),
+            Message::Actuator(a) if a.tick == want => Some(a.duty[0]),
             _ => None,
         })
     }
@@ -638,7 +643,7 @@ pub fn run<P: BoardPort>(scene: Scene, ticks: u64, port: P, faults: Faults) -> R
         // the tick before.
         if let Some(t) = r.telemetry.iter().find(|t| u64::from(t.tick) > *n) {
             if let Some(s) = r.samples.get(t.tick as usize - 1) {
-                *err = t.position_pm as f64 * 1e-12 - s.handle_m;
+                *err = t.position_pm[0] as f64 * 1e-12 - s.handle_m;
             }
         }
     }

@@ -12,12 +12,16 @@ use twoport_control::servo::{Direct, Gains, PortLayer, SensorFrame, Servo, Servo
 use twoport_control::ve::VirtualEnvironment;
 use twoport_control::{Faults, Position};
 use twoport_link::{
-    encode, ActuatorFrame, Decoder, GainsReply, LinkStats, Message, Mode, Refusal, Stats,
-    Telemetry, MAX_FRAME,
+    encode, ActuatorFrame, Axes, AxisRefusal, Decoder, GainsReply, LinkStats, Message, Mode,
+    Refusal, Stats, Telemetry, MAX_FRAME,
 };
 
 /// One encoded frame, delimiter included.
 pub type Frame = Vec<u8, MAX_FRAME>;
+/// The axes this loop drives, as its handshake declares them: one, until
+/// the N-axis servo runs here.
+pub const AXES: u8 = 1;
+
 /// Frames each outgoing queue holds: replies and fault reports in one,
 /// telemetry in the other, so a telemetry flood never crowds out an answer.
 pub const TX_FRAMES: usize = 8;
@@ -162,7 +166,8 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
         self
     }
 
-    /// Sensor frames ignored because this board reads its own sensors.
+    /// Sensor frames ignored: this board reads its own sensors, or the
+    /// frame's axes are not this board's.
     pub fn pil_refused(&self) -> u32 {
         self.pil_refused
     }
@@ -243,18 +248,26 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     }
 
     fn handle(&mut self, msg: Message) {
-        if let Some(ack) = msg.answer() {
+        if let Some(ack) = msg.answer(AXES) {
             self.queue(ack);
             return;
         }
         match msg {
             Message::Heartbeat => self.servo.heartbeat(),
-            Message::GetGains => self.queue(Message::Gains(self.servo.gains().into())),
+            Message::GetGains => self.queue(Message::Gains(Axes::one(self.servo.gains().into()))),
             Message::SetGains(g) => {
-                let g = Gains::from(g);
-                let reply = match self.check(&g) {
-                    Ok(()) => self.apply(g),
-                    Err(why) => GainsReply::Refused(why),
+                let reply = match g.to_array::<1>() {
+                    Some([g]) => {
+                        let g = Gains::from(g);
+                        match self.check(&g) {
+                            Ok(()) => self.apply(g),
+                            Err(why) => GainsReply::Refused(AxisRefusal { axis: 0, why }),
+                        }
+                    }
+                    None => GainsReply::Refused(AxisRefusal {
+                        axis: 0,
+                        why: Refusal::WrongAxisCount { axes: AXES },
+                    }),
                 };
                 self.queue(Message::GainsReply(reply));
             }
@@ -279,12 +292,17 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             Message::Sensors(_) if !self.pil => {
                 self.pil_refused = self.pil_refused.saturating_add(1);
             }
+            // (The handshake agreed on the axes, so a frame of another
+            // count is a host's error: it is counted and never ticks.)
+            Message::Sensors(s) if s.encoder_raw.len() != 1 || s.load_cell_raw.len() != 1 => {
+                self.pil_refused = self.pil_refused.saturating_add(1);
+            }
             Message::Sensors(s) => {
-                self.pending_index = s.index_raw;
+                self.pending_index = s.index_raw[0];
                 self.pending = Some(SensorFrame {
                     tick: s.tick,
-                    encoder_raw: s.encoder_raw,
-                    load_cell_n: self.io.load_cell_n(s.load_cell_raw),
+                    encoder_raw: s.encoder_raw[0],
+                    load_cell_n: self.io.load_cell_n(s.load_cell_raw[0]),
                     dead_man_closed: s.dead_man_closed,
                 });
             }
@@ -334,8 +352,11 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
 
     fn apply(&mut self, g: Gains) -> GainsReply {
         match self.servo.set_gains(g) {
-            Ok(()) => GainsReply::Accepted(self.servo.gains().into()),
-            Err(_) => GainsReply::Refused(Refusal::OutOfRange),
+            Ok(()) => GainsReply::Accepted(Axes::one(self.servo.gains().into())),
+            Err(_) => GainsReply::Refused(AxisRefusal {
+                axis: 0,
+                why: Refusal::OutOfRange,
+            }),
         }
     }
 
@@ -430,7 +451,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
         if self.pil {
             self.queue(Message::Actuator(ActuatorFrame {
                 tick: frame.tick,
-                duty,
+                duty: Axes::one(duty),
             }));
         }
         let end = io.cycles();
@@ -463,12 +484,12 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
                 self.since_telemetry = 0;
                 self.queue(Message::Telemetry(Telemetry {
                     tick: frame.tick,
-                    position_pm: out.position.nm() as i64 * 1000,
-                    velocity_mps: out.velocity_mps,
-                    load_cell_n: frame.load_cell_n,
-                    commanded_n: out.commanded_force_n,
-                    actuator_n: out.actuator_force_n,
-                    ve_position_pm: self.servo.ve().position().nm() as i64 * 1000,
+                    position_pm: Axes::one(out.position.nm() as i64 * 1000),
+                    velocity_mps: Axes::one(out.velocity_mps),
+                    load_cell_n: Axes::one(frame.load_cell_n),
+                    commanded_n: Axes::one(out.commanded_force_n),
+                    actuator_n: Axes::one(out.actuator_force_n),
+                    ve_position_pm: Axes::one(self.servo.ve().position().nm() as i64 * 1000),
                     faults: out.faults.0,
                     loop_cycles: self.loop_cycles,
                     mode: self.mode,

@@ -6,7 +6,7 @@ use twoport_config::record::{encode, MAX_RECORD};
 use twoport_config::{Config, RamFlash, Store};
 use twoport_control::SafetyConfig;
 use twoport_link::{
-    encode as frame, ConfigFallback, ConfigSource, Decoder, Gains, GainsReply, Message, Mode,
+    encode as frame, Axes, ConfigFallback, ConfigSource, Decoder, Gains, GainsReply, Message, Mode,
     ModeRefusal, ModeRequest, MAX_FRAME,
 };
 
@@ -64,11 +64,11 @@ fn saved_gains_come_back_at_the_next_boot() {
         k_npm: 45_000.0,
         b_nspm: 60.0,
     };
-    say(&mut b, Message::SetGains(tuned));
+    say(&mut b, Message::SetGains(Axes::one(tuned)));
     say(&mut b, Message::SaveConfig);
     b.service_config(&mut st);
     let msgs = heard(&mut b);
-    assert!(msgs.contains(&Message::GainsReply(GainsReply::Accepted(tuned))));
+    assert!(msgs.contains(&Message::GainsReply(GainsReply::Accepted(Axes::one(tuned)))));
     assert_eq!(
         msgs.last(),
         Some(&Message::Config(ConfigSource::Stored { seq: 1 }))
@@ -102,10 +102,10 @@ fn saved_gains_come_back_at_the_next_boot() {
     say(&mut again, Message::Disarm);
     say(
         &mut again,
-        Message::SetGains(Gains::Impedance {
+        Message::SetGains(Axes::one(Gains::Impedance {
             k_npm: 40_000.0,
             b_nspm: 60.0,
-        }),
+        })),
     );
     say(&mut again, Message::SaveConfig);
     heard(&mut again);

@@ -5,7 +5,8 @@ use twoport_control::servo::SensorFrame;
 use twoport_control::ve::BilateralConstraint;
 use twoport_control::{AdmittanceGains, Encoder, Faults, Position, SafetyConfig, Servo};
 use twoport_link::{
-    encode, Decoder, Gains, GainsReply, Message, Mode, Refusal, Role, MAX_FRAME, PROTOCOL_VERSION,
+    encode, Axes, AxisRefusal, Decoder, Gains, GainsReply, Message, Mode, Refusal, Role, MAX_FRAME,
+    PROTOCOL_VERSION,
 };
 
 mod common;
@@ -56,23 +57,51 @@ fn frame(tick: u32, raw: u32) -> SensorFrame {
     }
 }
 
+/// A one-axis board's acceptance of `g`.
+fn accepted(g: Gains) -> Message {
+    Message::GainsReply(GainsReply::Accepted(Axes::one(g)))
+}
+
+/// A one-axis board's refusal of its axis's gains.
+fn refused(why: Refusal) -> Message {
+    Message::GainsReply(GainsReply::Refused(AxisRefusal { axis: 0, why }))
+}
+
 #[test]
 fn handshake_and_gain_queries() {
     let mut b = board();
-    send(&mut b, 0, Message::hello(Role::Host));
+    send(&mut b, 0, Message::hello(Role::Host, 1));
     send(&mut b, 1, Message::GetGains);
+    // A host that drives three axes hears that this board has one.
+    send(&mut b, 2, Message::hello(Role::Host, 3));
+    let ack = |accepted| Message::HelloAck {
+        version: PROTOCOL_VERSION,
+        accepted,
+        axes: 1,
+    };
     assert_eq!(
         replies(&mut b),
         vec![
-            Message::HelloAck {
-                version: PROTOCOL_VERSION,
-                accepted: true
-            },
-            Message::Gains(Gains::Impedance {
+            ack(true),
+            Message::Gains(Axes::one(Gains::Impedance {
                 k_npm: 51_000.0,
                 b_nspm: 90.0
-            }),
+            })),
+            ack(false),
         ]
+    );
+    // Gains for three axes are refused whole, by count.
+    let g = Gains::Impedance {
+        k_npm: 1e4,
+        b_nspm: 10.0,
+    };
+    send(&mut b, 3, Message::SetGains(Axes::new([g; 3]).unwrap()));
+    assert_eq!(
+        replies(&mut b),
+        vec![Message::GainsReply(GainsReply::Refused(AxisRefusal {
+            axis: 0,
+            why: Refusal::WrongAxisCount { axes: 1 }
+        }))]
     );
 }
 
@@ -137,25 +166,21 @@ fn gains_outside_the_proven_region_are_refused() {
         ),
     ];
     for (i, (g, refusal)) in cases.iter().enumerate() {
-        send(&mut b, i as u16, Message::SetGains(*g));
+        send(&mut b, i as u16, Message::SetGains(Axes::one(*g)));
         let r = replies(&mut b);
         match refusal {
-            None => assert_eq!(r, vec![Message::GainsReply(GainsReply::Accepted(*g))]),
-            Some(why) => assert_eq!(
-                r,
-                vec![Message::GainsReply(GainsReply::Refused(*why))],
-                "{g:?}"
-            ),
+            None => assert_eq!(r, vec![accepted(*g)]),
+            Some(why) => assert_eq!(r, vec![refused(*why)], "{g:?}"),
         }
     }
     // The one accepted change is in force; the refusals changed nothing.
     send(&mut b, 99, Message::GetGains);
     assert_eq!(
         replies(&mut b),
-        vec![Message::Gains(Gains::Impedance {
+        vec![Message::Gains(Axes::one(Gains::Impedance {
             k_npm: 50_000.0,
             b_nspm: 90.0
-        })]
+        }))]
     );
 }
 
@@ -206,10 +231,10 @@ fn corrupted_frames_do_not_stop_the_loop() {
     let mut good = [0u8; MAX_FRAME];
     let n = encode(
         7,
-        &Message::SetGains(Gains::Impedance {
+        &Message::SetGains(Axes::one(Gains::Impedance {
             k_npm: 40_000.0,
             b_nspm: 60.0,
-        }),
+        })),
         &mut good,
     )
     .unwrap();
@@ -230,12 +255,10 @@ fn corrupted_frames_do_not_stop_the_loop() {
     assert!(s.dropped() >= 20, "{s:?}");
     assert_eq!(s.frames, 1);
     let msgs = replies(&mut b);
-    assert!(msgs.contains(&Message::GainsReply(GainsReply::Accepted(
-        Gains::Impedance {
-            k_npm: 40_000.0,
-            b_nspm: 60.0
-        }
-    ))));
+    assert!(msgs.contains(&accepted(Gains::Impedance {
+        k_npm: 40_000.0,
+        b_nspm: 60.0
+    })));
 }
 
 /// A host that never reads cannot grow the board's memory: telemetry keeps
@@ -298,33 +321,30 @@ fn admittance_gains_need_the_proven_regulator() {
         b_nspm: 500.0,
     };
     for (g, want) in [
-        (ok, GainsReply::Accepted(ok)),
+        (ok, accepted(ok)),
         (
             stiffer,
-            GainsReply::Refused(Refusal::NotProvenStable { limit: 51_000.0 }),
+            refused(Refusal::NotProvenStable { limit: 51_000.0 }),
         ),
-        (
-            lighter,
-            GainsReply::Refused(Refusal::NotProvenStable { limit: 5.0 }),
-        ),
+        (lighter, refused(Refusal::NotProvenStable { limit: 5.0 })),
     ] {
         let mut buf = [0u8; MAX_FRAME];
-        let n = encode(0, &Message::SetGains(g), &mut buf).unwrap();
+        let n = encode(0, &Message::SetGains(Axes::one(g)), &mut buf).unwrap();
         b.on_bytes(&buf[..n]);
         let f = b.pop_tx().unwrap();
         let mut got = None;
         Decoder::new().feed(&f, |e| got = Some(e.msg));
-        assert_eq!(got, Some(Message::GainsReply(want)));
+        assert_eq!(got, Some(want));
     }
 }
 
 fn sensors(tick: u32, raw: u32) -> Message {
     Message::Sensors(twoport_link::SensorFrame {
         tick,
-        encoder_raw: raw,
-        load_cell_raw: 0,
+        encoder_raw: Axes::one(raw),
+        load_cell_raw: Axes::one(0),
         dead_man_closed: true,
-        index_raw: None,
+        index_raw: Axes::one(None),
     })
 }
 
@@ -412,7 +432,7 @@ impl Io {
 fn a_pil_board_ticks_once_per_sensor_frame_and_answers_with_the_duty() {
     let mut b = board().with_pil(true);
     let mut io = Io::default();
-    io.queue(0, Message::hello(Role::Host));
+    io.queue(0, Message::hello(Role::Host, 1));
     io.queue(1, Message::Calibrate { position_pm: 0 });
     // Armed once the first tick has seen the dead-man closed.
     for k in 0..30u16 {
@@ -444,7 +464,7 @@ fn a_pil_board_ticks_once_per_sensor_frame_and_answers_with_the_duty() {
     assert_eq!(acts.len(), 30);
     for (k, a) in acts.iter().enumerate() {
         assert_eq!(a.tick, k as u32);
-        assert_eq!(a.duty, io.duties[k]);
+        assert_eq!(a.duty, Axes::one(io.duties[k]));
     }
     assert!(io.duties.iter().any(|d| *d != 0));
     assert_eq!(io.samples, 0);
@@ -508,7 +528,9 @@ fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
         telemetry.iter().map(|t| t.tick).collect::<Vec<_>>(),
         (9..120).step_by(10).collect::<Vec<u32>>()
     );
-    assert!(telemetry.iter().all(|t| (t.load_cell_n - 1.5).abs() < 1e-6));
+    assert!(telemetry
+        .iter()
+        .all(|t| (t.load_cell_n[0] - 1.5).abs() < 1e-6));
     // Three stages (sensors, law, drive), one step of the clock each.
     assert!(telemetry
         .iter()

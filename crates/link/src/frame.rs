@@ -4,8 +4,9 @@ use crate::crc::crc16;
 use crate::Message;
 use serde::{Deserialize, Serialize};
 
-/// Largest postcard-encoded envelope (bytes).
-pub const MAX_PAYLOAD: usize = 96;
+/// Largest postcard-encoded envelope (bytes): a three-axis telemetry
+/// message at its widest takes about 160.
+pub const MAX_PAYLOAD: usize = 192;
 /// Largest frame on the wire, delimiter included (bytes).
 pub const MAX_FRAME: usize = cobs::max_encoding_length(MAX_PAYLOAD + 2) + 1;
 

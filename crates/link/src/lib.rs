@@ -3,13 +3,16 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+mod axes;
 mod crc;
 mod frame;
 mod message;
 
+pub use axes::{Axes, MAX_AXES};
 pub use crc::crc16;
 pub use frame::{encode, Decoder, Envelope, FrameError, Stats, MAX_FRAME, MAX_PAYLOAD};
 pub use message::{
-    ActuatorFrame, ConfigFallback, ConfigSource, Gains, GainsReply, LinkStats, Message, Mode,
-    ModeRefusal, ModeRequest, Refusal, Role, SensorFrame, Status, Telemetry, PROTOCOL_VERSION,
+    ActuatorFrame, AxisRefusal, ConfigFallback, ConfigSource, Gains, GainsReply, HandshakeError,
+    LinkStats, Message, Mode, ModeRefusal, ModeRequest, Refusal, Role, SensorFrame, Status,
+    Telemetry, PROTOCOL_VERSION,
 };

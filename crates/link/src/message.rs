@@ -3,10 +3,12 @@
 //! so today's boards send multiples of 1000; the wire has room for finer).
 
 use crate::frame::Stats;
+use crate::Axes;
 use serde::{Deserialize, Serialize};
 
 /// The protocol version both ends must share (checked by the handshake).
-pub const PROTOCOL_VERSION: u16 = 3;
+/// Version 4 carries every axis of a board in its frames.
+pub const PROTOCOL_VERSION: u16 = 4;
 
 /// Which end is speaking in a handshake.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -17,23 +19,24 @@ pub enum Role {
     Host,
 }
 
-/// The board's state each telemetry period.
+/// The board's state each telemetry period; per-axis values carry every
+/// axis the board has.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Telemetry {
     /// Control tick.
     pub tick: u32,
-    /// Actuator position (pm).
-    pub position_pm: i64,
-    /// Actuator velocity (m/s).
-    pub velocity_mps: f32,
-    /// Load-cell force (N).
-    pub load_cell_n: f32,
-    /// Force the law commanded (N).
-    pub commanded_n: f32,
-    /// Force sent to the amplifier after the safety layer (N).
-    pub actuator_n: f32,
-    /// VE position (pm).
-    pub ve_position_pm: i64,
+    /// Each actuator's position (pm).
+    pub position_pm: Axes<i64>,
+    /// Each actuator's velocity (m/s).
+    pub velocity_mps: Axes<f32>,
+    /// Each load-cell force (N).
+    pub load_cell_n: Axes<f32>,
+    /// The force each axis's law commanded (N).
+    pub commanded_n: Axes<f32>,
+    /// The force sent to each amplifier after the safety layer (N).
+    pub actuator_n: Axes<f32>,
+    /// The VE point each axis's coupling holds (pm).
+    pub ve_position_pm: Axes<i64>,
     /// Latched fault bits (`twoport_control::Faults`).
     pub faults: u16,
     /// Cycles (or instructions, in QEMU) the last tick took.
@@ -180,7 +183,16 @@ pub enum Gains {
     },
 }
 
-/// Why the board refused gains.
+/// Why the board refused gains, and for which axis.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AxisRefusal {
+    /// The axis whose gains were refused (0 is x).
+    pub axis: u8,
+    /// Why.
+    pub why: Refusal,
+}
+
+/// Why the board refused an axis's gains.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Refusal {
     /// A gain is NaN or infinite.
@@ -195,40 +207,47 @@ pub enum Refusal {
     },
     /// Gains for the other display type.
     WrongDisplay,
+    /// Not one set of gains per axis of the board (protocol 4).
+    WrongAxisCount {
+        /// The board's axes.
+        axes: u8,
+    },
 }
 
-/// The board's answer to `SetGains`.
+/// The board's answer to `SetGains`: every axis's gains change, or none.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum GainsReply {
-    /// In force from the next tick.
-    Accepted(Gains),
-    /// Not applied; the old gains stay.
-    Refused(Refusal),
+    /// In force from the next tick, one per axis.
+    Accepted(Axes<Gains>),
+    /// Not applied; the old gains stay on every axis.
+    Refused(AxisRefusal),
 }
 
-/// Processor-in-the-loop: the simulated sensors for one tick (host to board).
+/// Processor-in-the-loop: the simulated sensors for one tick (host to
+/// board), every axis sampled at one instant.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct SensorFrame {
     /// Tick this frame is for.
     pub tick: u32,
-    /// Raw encoder counter.
-    pub encoder_raw: u32,
-    /// Raw load-cell ADC reading (counts).
-    pub load_cell_raw: i32,
-    /// Dead-man switch closed.
+    /// Each axis's raw encoder counter.
+    pub encoder_raw: Axes<u32>,
+    /// Each axis's raw load-cell ADC reading (counts).
+    pub load_cell_raw: Axes<i32>,
+    /// Dead-man switch closed (one for the device).
     pub dead_man_closed: bool,
-    /// The encoder count its index pulse latched this tick, if it passed
-    /// (protocol 3).
-    pub index_raw: Option<u32>,
+    /// The encoder count each axis's index pulse latched this tick, if it
+    /// passed (protocol 3).
+    pub index_raw: Axes<Option<u32>>,
 }
 
-/// Processor-in-the-loop: the actuator command for one tick (board to host).
+/// Processor-in-the-loop: the actuator command for one tick (board to
+/// host), every axis updated together.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ActuatorFrame {
     /// Tick this command answers.
     pub tick: u32,
-    /// Signed PWM duty, full scale ±32767 = ± peak force.
-    pub duty: i16,
+    /// Each axis's signed PWM duty, full scale ±32767 = ± peak force.
+    pub duty: Axes<i16>,
 }
 
 /// Every message.
@@ -240,13 +259,17 @@ pub enum Message {
         version: u16,
         /// Sender's role.
         role: Role,
+        /// How many axes the sender drives (protocol 4).
+        axes: u8,
     },
     /// Handshake answer.
     HelloAck {
         /// Answerer's version.
         version: u16,
-        /// Whether the versions match.
+        /// Whether the versions and the axis counts match.
         accepted: bool,
+        /// How many axes the answerer has (protocol 4).
+        axes: u8,
     },
     /// The host is alive (feeds the board's link watchdog).
     Heartbeat,
@@ -254,10 +277,10 @@ pub enum Message {
     Telemetry(Telemetry),
     /// Ask for the gains in force.
     GetGains,
-    /// The gains in force.
-    Gains(Gains),
-    /// Ask for new gains.
-    SetGains(Gains),
+    /// The gains in force, one per axis.
+    Gains(Axes<Gains>),
+    /// Ask for new gains, one per axis.
+    SetGains(Axes<Gains>),
     /// Answer to `SetGains`.
     GainsReply(GainsReply),
     /// Latched faults (and the first one).
@@ -321,22 +344,81 @@ pub struct LinkStats {
 }
 
 impl Message {
-    /// This side's handshake opener.
-    pub const fn hello(role: Role) -> Message {
+    /// This side's handshake opener, for a sender that drives `axes` axes.
+    pub const fn hello(role: Role, axes: u8) -> Message {
         Message::Hello {
             version: PROTOCOL_VERSION,
             role,
+            axes,
         }
     }
 
-    /// The answer to a `Hello`; `None` for any other message.
-    pub fn answer(&self) -> Option<Message> {
+    /// The answer of a board with `axes` axes to a `Hello`: accepted when
+    /// the versions and the axis counts match; `None` for any other
+    /// message.
+    pub fn answer(&self, axes: u8) -> Option<Message> {
         match *self {
-            Message::Hello { version, .. } => Some(Message::HelloAck {
+            Message::Hello {
+                version, axes: a, ..
+            } => Some(Message::HelloAck {
                 version: PROTOCOL_VERSION,
-                accepted: version == PROTOCOL_VERSION,
+                accepted: version == PROTOCOL_VERSION && a == axes,
+                axes,
             }),
             _ => None,
+        }
+    }
+
+    /// What a host that drives `axes` axes makes of the board's answer to
+    /// its `Hello`: `Ok` when both sides agree, otherwise why not, in
+    /// words for the user.
+    pub fn accept_ack(&self, axes: u8) -> Result<(), HandshakeError> {
+        match *self {
+            Message::HelloAck { version, .. } if version != PROTOCOL_VERSION => {
+                Err(HandshakeError::Version { board: version })
+            }
+            Message::HelloAck { axes: board, .. } if board != axes => {
+                Err(HandshakeError::Axes { board, host: axes })
+            }
+            Message::HelloAck { accepted: true, .. } => Ok(()),
+            _ => Err(HandshakeError::NotAnAnswer),
+        }
+    }
+}
+
+/// Why a host will not drive a board.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HandshakeError {
+    /// The board speaks another protocol version.
+    Version {
+        /// The board's version.
+        board: u16,
+    },
+    /// The board has another number of axes than this host drives.
+    Axes {
+        /// The board's axes.
+        board: u8,
+        /// This host's.
+        host: u8,
+    },
+    /// The message is no accepting answer to a `Hello`.
+    NotAnAnswer,
+}
+
+impl core::fmt::Display for HandshakeError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            HandshakeError::Version { board } => write!(
+                f,
+                "the board speaks protocol {board} and this host {PROTOCOL_VERSION}: \
+                 flash a matching image"
+            ),
+            HandshakeError::Axes { board, host } => write!(
+                f,
+                "the board has {board} axes and this host drives {host}: \
+                 use a scene (or a host) built for {board}"
+            ),
+            HandshakeError::NotAnAnswer => f.write_str("the board did not accept the handshake"),
         }
     }
 }

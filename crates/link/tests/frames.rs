@@ -16,20 +16,21 @@ fn all_messages() -> Vec<Message> {
         b_nspm: 500.0,
     };
     vec![
-        Message::hello(Role::Host),
+        Message::hello(Role::Host, 3),
         Message::HelloAck {
             version: PROTOCOL_VERSION,
             accepted: true,
+            axes: MAX_AXES as u8,
         },
         Message::Heartbeat,
         Message::Telemetry(Telemetry {
             tick: u32::MAX,
-            position_pm: i64::MIN,
-            velocity_mps: -1.5,
-            load_cell_n: f32::MAX,
-            commanded_n: 199.9,
-            actuator_n: -200.0,
-            ve_position_pm: i64::MAX,
+            position_pm: Axes::new([i64::MIN, 0, i64::MAX]).unwrap(),
+            velocity_mps: Axes::new([-1.5, 0.25, 1.0]).unwrap(),
+            load_cell_n: Axes::new([f32::MAX, f32::MIN, 0.0]).unwrap(),
+            commanded_n: Axes::new([199.9, -0.5, 3.0]).unwrap(),
+            actuator_n: Axes::new([-200.0, 200.0, 0.0]).unwrap(),
+            ve_position_pm: Axes::new([i64::MAX, i64::MIN, -1]).unwrap(),
             faults: 0xFFFF,
             loop_cycles: 1234,
             mode: Mode::Homing,
@@ -38,11 +39,16 @@ fn all_messages() -> Vec<Message> {
             worst_jitter_cycles: u32::MAX,
         }),
         Message::GetGains,
-        Message::Gains(gi),
-        Message::SetGains(ga),
-        Message::GainsReply(GainsReply::Accepted(gi)),
-        Message::GainsReply(GainsReply::Refused(Refusal::NotProvenStable {
-            limit: 51_074.0,
+        Message::Gains(Axes::new([gi, gi, gi]).unwrap()),
+        Message::SetGains(Axes::one(ga)),
+        Message::GainsReply(GainsReply::Accepted(Axes::new([gi, gi]).unwrap())),
+        Message::GainsReply(GainsReply::Refused(AxisRefusal {
+            axis: 2,
+            why: Refusal::NotProvenStable { limit: 51_074.0 },
+        })),
+        Message::GainsReply(GainsReply::Refused(AxisRefusal {
+            axis: 0,
+            why: Refusal::WrongAxisCount { axes: 3 },
         })),
         Message::FaultReport {
             faults: 0x0101,
@@ -78,14 +84,21 @@ fn all_messages() -> Vec<Message> {
         },
         Message::Sensors(SensorFrame {
             tick: 7,
-            encoder_raw: 65_535,
-            load_cell_raw: -2048,
+            encoder_raw: Axes::new([65_535, u32::MAX, 0]).unwrap(),
+            load_cell_raw: Axes::new([-2048, i32::MIN, i32::MAX]).unwrap(),
             dead_man_closed: true,
-            index_raw: Some(u32::MAX),
+            index_raw: Axes::new([Some(u32::MAX), None, Some(0)]).unwrap(),
+        }),
+        Message::Sensors(SensorFrame {
+            tick: 8,
+            encoder_raw: Axes::one(1),
+            load_cell_raw: Axes::one(-1),
+            dead_man_closed: false,
+            index_raw: Axes::one(None),
         }),
         Message::Actuator(ActuatorFrame {
             tick: 7,
-            duty: -32_767,
+            duty: Axes::new([-32_767, 32_767, 0]).unwrap(),
         }),
     ]
 }
@@ -137,7 +150,7 @@ fn every_single_byte_corruption_is_dropped_and_survived() {
         1,
         &Message::Telemetry(Telemetry {
             tick: 42,
-            position_pm: 123_456_789,
+            position_pm: Axes::new([123_456_789, -5, 0]).unwrap(),
             ..Default::default()
         }),
     );
@@ -173,10 +186,10 @@ fn every_single_byte_corruption_is_dropped_and_survived() {
 fn truncated_and_overlong_frames_are_dropped() {
     let good = frame(
         5,
-        &Message::SetGains(Gains::Impedance {
+        &Message::SetGains(Axes::one(Gains::Impedance {
             k_npm: 1e4,
             b_nspm: 10.0,
-        }),
+        })),
     );
     let mut stream = good[..good.len() / 2].to_vec();
     stream.push(0);
@@ -201,26 +214,48 @@ fn sequence_gaps_are_counted() {
 }
 
 #[test]
-fn handshake_accepts_only_the_same_version() {
-    assert_eq!(
-        Message::hello(Role::Host).answer(),
+fn handshake_accepts_only_the_same_version_and_axes() {
+    let ack = |accepted, axes| {
         Some(Message::HelloAck {
             version: PROTOCOL_VERSION,
-            accepted: true
+            accepted,
+            axes,
         })
-    );
-    let old = Message::Hello {
+    };
+    // A three-axis board answers a three-axis host, and a one-axis one.
+    assert_eq!(Message::hello(Role::Host, 3).answer(3), ack(true, 3));
+    assert_eq!(Message::hello(Role::Host, 1).answer(3), ack(false, 3));
+    let newer = Message::Hello {
         version: PROTOCOL_VERSION + 1,
         role: Role::Host,
+        axes: 1,
     };
+    assert_eq!(newer.answer(1), ack(false, 1));
+    assert_eq!(Message::Heartbeat.answer(1), None);
+
+    // The host refuses a board of another count, and says so in words.
+    let board = Message::hello(Role::Host, 1).answer(3).unwrap();
+    let e = board.accept_ack(1).unwrap_err();
+    assert_eq!(e, HandshakeError::Axes { board: 3, host: 1 });
     assert_eq!(
-        old.answer(),
-        Some(Message::HelloAck {
-            version: PROTOCOL_VERSION,
-            accepted: false
-        })
+        e.to_string(),
+        "the board has 3 axes and this host drives 1: use a scene (or a host) built for 3"
     );
-    assert_eq!(Message::Heartbeat.answer(), None);
+    let old = Message::HelloAck {
+        version: 3,
+        accepted: false,
+        axes: 1,
+    };
+    assert!(old
+        .accept_ack(1)
+        .unwrap_err()
+        .to_string()
+        .contains("protocol 3"));
+    assert_eq!(ack(true, 1).unwrap().accept_ack(1), Ok(()));
+    assert_eq!(
+        Message::Heartbeat.accept_ack(1),
+        Err(HandshakeError::NotAnAnswer)
+    );
 }
 
 proptest! {
@@ -251,8 +286,10 @@ proptest! {
     }
 
     #[test]
-    fn telemetry_round_trips(tick in any::<u32>(), pos in any::<i64>(), v in -10.0f32..10.0, faults in any::<u16>()) {
-        let m = Message::Telemetry(Telemetry { tick, position_pm: pos, velocity_mps: v, faults, ..Default::default() });
+    fn telemetry_round_trips(tick in any::<u32>(), pos in proptest::collection::vec(any::<i64>(), 1..=MAX_AXES), v in -10.0f32..10.0, faults in any::<u16>()) {
+        let position_pm = Axes::from_slice(&pos).unwrap();
+        let velocity_mps = position_pm.map(|_| v);
+        let m = Message::Telemetry(Telemetry { tick, position_pm, velocity_mps, faults, ..Default::default() });
         let (got, _) = decode_all(&frame(tick as u16, &m));
         prop_assert_eq!(got, vec![Envelope { seq: tick as u16, msg: m }]);
     }

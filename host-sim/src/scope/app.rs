@@ -15,7 +15,7 @@ use twoport_design::design::{self, Analysis, Check, GridSpec};
 use twoport_design::plot::Figure;
 use twoport_design::twoport::HumanBound;
 use twoport_design::Plant;
-use twoport_link::{GainsReply, Message, Status, Telemetry};
+use twoport_link::{Axes, GainsReply, Message, Status, Telemetry};
 
 /// Samples each signal's ring holds: 20 s at 1 kHz.
 pub const RING_SAMPLES: usize = 20_000;
@@ -170,10 +170,10 @@ impl BoardSignal {
 
     fn of(self, t: &Telemetry) -> f64 {
         match self {
-            BoardSignal::Position => t.position_pm as f64 * 1e-12,
-            BoardSignal::Commanded => t.commanded_n as f64,
-            BoardSignal::Actuator => t.actuator_n as f64,
-            BoardSignal::VePosition => t.ve_position_pm as f64 * 1e-12,
+            BoardSignal::Position => t.position_pm[0] as f64 * 1e-12,
+            BoardSignal::Commanded => t.commanded_n[0] as f64,
+            BoardSignal::Actuator => t.actuator_n[0] as f64,
+            BoardSignal::VePosition => t.ve_position_pm[0] as f64 * 1e-12,
             BoardSignal::LoopCycles => t.loop_cycles as f64,
             BoardSignal::SenseCycles => t.stage_cycles[0] as f64,
             BoardSignal::LawCycles => t.stage_cycles[1] as f64,
@@ -549,8 +549,8 @@ impl ScopeState {
                 Message::GainsReply(GainsReply::Accepted(_)) => {
                     b.reply = Some("accepted".into());
                 }
-                Message::GainsReply(GainsReply::Refused(why)) => {
-                    b.reply = Some(format!("refused: {why:?}"));
+                Message::GainsReply(GainsReply::Refused(r)) => {
+                    b.reply = Some(format!("refused on axis {}: {:?}", r.axis, r.why));
                 }
                 Message::FaultReport { faults, .. } => b.faults = Some(faults),
                 Message::Status(st) => {
@@ -575,7 +575,7 @@ impl ScopeState {
         }
         self.gains = g;
         if let Some(b) = self.board.as_mut() {
-            if let Err(e) = b.session.send(&Message::SetGains(g.into())) {
+            if let Err(e) = b.session.send(&Message::SetGains(Axes::one(g.into()))) {
                 self.message = Some(format!("board: {e}"));
             }
         }
