@@ -643,7 +643,7 @@ pub fn run<P: BoardPort>(scene: Scene, ticks: u64, port: P, faults: Faults) -> R
         // the tick before.
         if let Some(t) = r.telemetry.iter().find(|t| u64::from(t.tick) > *n) {
             if let Some(s) = r.samples.get(t.tick as usize - 1) {
-                *err = t.position_pm[0] as f64 * 1e-12 - s.handle_m;
+                *err = t.axes[0].position_pm as f64 * 1e-12 - s.handle_m;
             }
         }
     }

@@ -186,7 +186,7 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
         t.stage_cycles
     );
     // The hand, led to 30 mm, is held at the board's wall at 10 mm.
-    let x_board = t.position_pm[0] as f64 * 1e-12;
+    let x_board = t.axes[0].position_pm as f64 * 1e-12;
     assert!(
         (0.0095..0.0106).contains(&x_board),
         "the hand has pushed into the wall: {x_board} m"

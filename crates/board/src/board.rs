@@ -12,8 +12,8 @@ use twoport_control::servo::{Direct, Gains, PortLayer, SensorFrame, Servo, Servo
 use twoport_control::ve::VirtualEnvironment;
 use twoport_control::{Faults, Position};
 use twoport_link::{
-    encode, ActuatorFrame, Axes, AxisRefusal, Decoder, GainsReply, LinkStats, Message, Mode,
-    Refusal, Stats, Telemetry, MAX_FRAME,
+    encode, ActuatorFrame, Axes, AxisRefusal, AxisTelemetry, Decoder, GainsReply, LinkStats,
+    Message, Mode, Refusal, Stats, Telemetry, MAX_FRAME,
 };
 
 /// One encoded frame, delimiter included.
@@ -484,12 +484,14 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
                 self.since_telemetry = 0;
                 self.queue(Message::Telemetry(Telemetry {
                     tick: frame.tick,
-                    position_pm: Axes::one(out.position.nm() as i64 * 1000),
-                    velocity_mps: Axes::one(out.velocity_mps),
-                    load_cell_n: Axes::one(frame.load_cell_n),
-                    commanded_n: Axes::one(out.commanded_force_n),
-                    actuator_n: Axes::one(out.actuator_force_n),
-                    ve_position_pm: Axes::one(self.servo.ve().position().nm() as i64 * 1000),
+                    axes: Axes::one(AxisTelemetry {
+                        position_pm: out.position.nm() as i64 * 1000,
+                        velocity_mps: out.velocity_mps,
+                        load_cell_n: frame.load_cell_n,
+                        commanded_n: out.commanded_force_n,
+                        actuator_n: out.actuator_force_n,
+                        ve_position_pm: self.servo.ve().position().nm() as i64 * 1000,
+                    }),
                     faults: out.faults.0,
                     loop_cycles: self.loop_cycles,
                     mode: self.mode,

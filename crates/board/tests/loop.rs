@@ -530,7 +530,7 @@ fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
     );
     assert!(telemetry
         .iter()
-        .all(|t| (t.load_cell_n[0] - 1.5).abs() < 1e-6));
+        .all(|t| (t.axes[0].load_cell_n - 1.5).abs() < 1e-6));
     // Three stages (sensors, law, drive), one step of the clock each.
     assert!(telemetry
         .iter()

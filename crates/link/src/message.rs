@@ -19,24 +19,30 @@ pub enum Role {
     Host,
 }
 
-/// The board's state each telemetry period; per-axis values carry every
-/// axis the board has.
+/// One axis's state in a telemetry frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct AxisTelemetry {
+    /// Actuator position (pm).
+    pub position_pm: i64,
+    /// Actuator velocity (m/s).
+    pub velocity_mps: f32,
+    /// Load-cell force (N).
+    pub load_cell_n: f32,
+    /// Force the law commanded (N).
+    pub commanded_n: f32,
+    /// Force sent to the amplifier after the safety layer (N).
+    pub actuator_n: f32,
+    /// The VE point the axis's coupling holds (pm).
+    pub ve_position_pm: i64,
+}
+
+/// The board's state each telemetry period, every axis of it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Telemetry {
     /// Control tick.
     pub tick: u32,
-    /// Each actuator's position (pm).
-    pub position_pm: Axes<i64>,
-    /// Each actuator's velocity (m/s).
-    pub velocity_mps: Axes<f32>,
-    /// Each load-cell force (N).
-    pub load_cell_n: Axes<f32>,
-    /// The force each axis's law commanded (N).
-    pub commanded_n: Axes<f32>,
-    /// The force sent to each amplifier after the safety layer (N).
-    pub actuator_n: Axes<f32>,
-    /// The VE point each axis's coupling holds (pm).
-    pub ve_position_pm: Axes<i64>,
+    /// Each axis's state (protocol 4).
+    pub axes: Axes<AxisTelemetry>,
     /// Latched fault bits (`twoport_control::Faults`).
     pub faults: u16,
     /// Cycles (or instructions, in QEMU) the last tick took.

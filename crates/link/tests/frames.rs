@@ -25,12 +25,15 @@ fn all_messages() -> Vec<Message> {
         Message::Heartbeat,
         Message::Telemetry(Telemetry {
             tick: u32::MAX,
-            position_pm: Axes::new([i64::MIN, 0, i64::MAX]).unwrap(),
-            velocity_mps: Axes::new([-1.5, 0.25, 1.0]).unwrap(),
-            load_cell_n: Axes::new([f32::MAX, f32::MIN, 0.0]).unwrap(),
-            commanded_n: Axes::new([199.9, -0.5, 3.0]).unwrap(),
-            actuator_n: Axes::new([-200.0, 200.0, 0.0]).unwrap(),
-            ve_position_pm: Axes::new([i64::MAX, i64::MIN, -1]).unwrap(),
+            axes: Axes::new([i64::MIN, i64::MAX, -1].map(|x| AxisTelemetry {
+                position_pm: x,
+                velocity_mps: -1.5,
+                load_cell_n: f32::MAX,
+                commanded_n: 199.9,
+                actuator_n: -200.0,
+                ve_position_pm: -x.saturating_add(1),
+            }))
+            .unwrap(),
             faults: 0xFFFF,
             loop_cycles: 1234,
             mode: Mode::Homing,
@@ -150,7 +153,10 @@ fn every_single_byte_corruption_is_dropped_and_survived() {
         1,
         &Message::Telemetry(Telemetry {
             tick: 42,
-            position_pm: Axes::new([123_456_789, -5, 0]).unwrap(),
+            axes: Axes::one(AxisTelemetry {
+                position_pm: 123_456_789,
+                ..Default::default()
+            }),
             ..Default::default()
         }),
     );
@@ -287,9 +293,9 @@ proptest! {
 
     #[test]
     fn telemetry_round_trips(tick in any::<u32>(), pos in proptest::collection::vec(any::<i64>(), 1..=MAX_AXES), v in -10.0f32..10.0, faults in any::<u16>()) {
-        let position_pm = Axes::from_slice(&pos).unwrap();
-        let velocity_mps = position_pm.map(|_| v);
-        let m = Message::Telemetry(Telemetry { tick, position_pm, velocity_mps, faults, ..Default::default() });
+        let axes = pos.iter().map(|&position_pm| AxisTelemetry { position_pm, velocity_mps: v, ..Default::default() });
+        let axes = Axes::from_slice(&axes.collect::<Vec<_>>()).unwrap();
+        let m = Message::Telemetry(Telemetry { tick, axes, faults, ..Default::default() });
         let (got, _) = decode_all(&frame(tick as u16, &m));
         prop_assert_eq!(got, vec![Envelope { seq: tick as u16, msg: m }]);
     }

@@ -170,10 +170,10 @@ impl BoardSignal {
 
     fn of(self, t: &Telemetry) -> f64 {
         match self {
-            BoardSignal::Position => t.position_pm[0] as f64 * 1e-12,
-            BoardSignal::Commanded => t.commanded_n[0] as f64,
-            BoardSignal::Actuator => t.actuator_n[0] as f64,
-            BoardSignal::VePosition => t.ve_position_pm[0] as f64 * 1e-12,
+            BoardSignal::Position => t.axes[0].position_pm as f64 * 1e-12,
+            BoardSignal::Commanded => t.axes[0].commanded_n as f64,
+            BoardSignal::Actuator => t.axes[0].actuator_n as f64,
+            BoardSignal::VePosition => t.axes[0].ve_position_pm as f64 * 1e-12,
             BoardSignal::LoopCycles => t.loop_cycles as f64,
             BoardSignal::SenseCycles => t.stage_cycles[0] as f64,
             BoardSignal::LawCycles => t.stage_cycles[1] as f64,
