@@ -2,6 +2,7 @@
 #![forbid(unsafe_code)]
 
 pub mod design;
+pub mod device;
 #[cfg(feature = "plot")]
 pub mod figures;
 pub mod linalg;
@@ -14,5 +15,6 @@ pub mod sampled;
 pub mod twoport;
 pub mod verify;
 
+pub use device::{Device, DeviceAxis};
 pub use model::{DeviceModel, ModelError};
 pub use plant::{Plant, PlantPoint};

@@ -2,13 +2,15 @@
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use serde_json::{json, Value};
+use std::cell::RefCell;
 use std::f64::consts::PI;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::rc::Rc;
 use twoport_control::ZTransfer;
 use twoport_design::design::{self, Analysis, GridSpec};
 use twoport_design::twoport::HumanBound;
-use twoport_design::{figures, plot, DeviceModel, Plant};
+use twoport_design::{figures, plot, Device, DeviceModel, Plant};
 
 const DEFAULT_MODEL: &str = twoport_design::model::EXCALIBUR_PATH;
 
@@ -29,6 +31,14 @@ struct Common {
     /// is then proven for all of them.
     #[arg(long, default_value = DEFAULT_MODEL, action = clap::ArgAction::Append)]
     model: Vec<PathBuf>,
+    /// Device file (TOML): a device of several axes, each with its own
+    /// model (or poses). The command runs on every axis, and its JSON is
+    /// one object with an entry per axis. In place of --model.
+    #[arg(long, conflicts_with = "model")]
+    device: Option<PathBuf>,
+    /// The axis of a device file this run is for (set by `each_axis`).
+    #[arg(skip)]
+    axis: Option<AxisRun>,
     /// Sample period (s); the model's by default.
     #[arg(long, allow_negative_numbers = true)]
     period: Option<f64>,
@@ -62,7 +72,7 @@ enum Cmd {
     Verify(Display<ImpedanceGains, AdmittanceGains>),
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 struct RegionGrid {
     /// Smallest coupling damping (N s/m).
     #[arg(long, default_value_t = 10.0)]
@@ -79,7 +89,7 @@ struct RegionGrid {
     rust: bool,
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 struct RegionImpedance {
     #[command(flatten)]
     grid: RegionGrid,
@@ -87,7 +97,7 @@ struct RegionImpedance {
     common: Common,
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 struct RegionAdmittance {
     /// Regulator stiffness k_p (N/m) the region is proven for.
     #[arg(long, allow_negative_numbers = true)]
@@ -101,7 +111,7 @@ struct RegionAdmittance {
     common: Common,
 }
 
-#[derive(Subcommand)]
+#[derive(Subcommand, Clone)]
 enum Display<I: Args, A: Args> {
     /// Impedance display: measure motion, command force.
     Impedance(I),
@@ -109,7 +119,7 @@ enum Display<I: Args, A: Args> {
     Admittance(A),
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 struct DesignImpedance {
     /// Coupling damping b_cI (N s/m); without it, the best (k, b) pair.
     #[arg(long, allow_negative_numbers = true)]
@@ -118,7 +128,7 @@ struct DesignImpedance {
     common: Common,
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 struct DesignAdmittance {
     /// Regulator stiffness k_p (N/m); with --bp. Default: the impedance design (eq 30).
     #[arg(long, requires = "bp", allow_negative_numbers = true)]
@@ -133,7 +143,7 @@ struct DesignAdmittance {
     common: Common,
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 struct ImpedanceGains {
     /// Coupling stiffness k_cI (N/m).
     #[arg(long, allow_negative_numbers = true)]
@@ -145,7 +155,7 @@ struct ImpedanceGains {
     common: Common,
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 struct AdmittanceGains {
     /// Regulator stiffness k_p (N/m).
     #[arg(long, allow_negative_numbers = true)]
@@ -163,7 +173,7 @@ struct AdmittanceGains {
     common: Common,
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 struct ZrangeImpedance {
     #[command(flatten)]
     gains: ImpedanceGains,
@@ -172,7 +182,7 @@ struct ZrangeImpedance {
     points: usize,
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 struct ZrangeAdmittance {
     #[command(flatten)]
     gains: AdmittanceGains,
@@ -191,7 +201,7 @@ enum Fig {
     Fig10,
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 struct PlotArgs {
     /// Which figure.
     figure: Fig,
@@ -208,6 +218,97 @@ struct PlotArgs {
     common: Common,
 }
 
+/// One axis of a device file, as one run of a command sees it.
+#[derive(Clone, Debug)]
+struct AxisRun {
+    name: String,
+    /// The axis's models (its poses), read once with the device file.
+    models: Vec<(PathBuf, DeviceModel)>,
+    /// Where a JSON run puts its object, for the device's one object.
+    out: Rc<RefCell<Vec<Value>>>,
+}
+
+/// What a command's arguments share.
+trait HasCommon {
+    fn common(&mut self) -> &mut Common;
+}
+
+macro_rules! has_common {
+    ($($t:ty),*) => {$(
+        impl HasCommon for $t {
+            fn common(&mut self) -> &mut Common {
+                &mut self.common
+            }
+        }
+    )*};
+}
+has_common!(
+    PlotArgs,
+    DesignImpedance,
+    DesignAdmittance,
+    ImpedanceGains,
+    AdmittanceGains,
+    RegionImpedance,
+    RegionAdmittance
+);
+
+impl HasCommon for ZrangeImpedance {
+    fn common(&mut self) -> &mut Common {
+        self.gains.common()
+    }
+}
+
+impl HasCommon for ZrangeAdmittance {
+    fn common(&mut self) -> &mut Common {
+        self.gains.common()
+    }
+}
+
+impl<I: Args + HasCommon, A: Args + HasCommon> HasCommon for Display<I, A> {
+    fn common(&mut self) -> &mut Common {
+        match self {
+            Display::Impedance(i) => i.common(),
+            Display::Admittance(a) => a.common(),
+        }
+    }
+}
+
+/// `run` on `args`, or, given a device file, on each of its axes in turn:
+/// the text under a heading per axis, the JSON as one object.
+fn each_axis<A: HasCommon + Clone>(
+    args: &A,
+    run: fn(&A) -> Result<(), String>,
+) -> Result<(), String> {
+    let mut a = args.clone();
+    let Some(path) = a.common().device.clone() else {
+        return run(args);
+    };
+    let device = Device::load(&path).map_err(|e| e.to_string())?;
+    let out = Rc::new(RefCell::new(Vec::new()));
+    let json = a.common().json;
+    for axis in &device.axes {
+        let c = a.common();
+        c.axis = Some(AxisRun {
+            name: axis.name.clone(),
+            models: axis
+                .model_paths
+                .iter()
+                .cloned()
+                .zip(axis.models.iter().cloned())
+                .collect(),
+            out: out.clone(),
+        });
+        if !json {
+            println!("axis {}:", axis.name);
+        }
+        run(&a).map_err(|e| format!("{}, axis {}: {e}", path.display(), axis.name))?;
+    }
+    if json {
+        println!("{}", json!({"device": device.name, "axes": out.take()}));
+    }
+    Ok(())
+}
+
 /// One pose of the device: its model, the plant at the period, and the
 /// design grid.
 struct Pose {
@@ -221,15 +322,22 @@ struct Session {
     poses: Vec<Pose>,
     human: Option<HumanBound>,
     json: bool,
+    axis: Option<AxisRun>,
 }
 
 impl Session {
     fn open(c: &Common) -> Result<Self, String> {
-        let mut models = Vec::with_capacity(c.model.len());
-        for path in &c.model {
-            let m = DeviceModel::load_or_excalibur(path).map_err(|e| e.to_string())?;
-            models.push((path, m));
-        }
+        let models = match &c.axis {
+            Some(a) => a.models.clone(),
+            None => {
+                let mut models = Vec::with_capacity(c.model.len());
+                for path in &c.model {
+                    let m = DeviceModel::load_or_excalibur(path).map_err(|e| e.to_string())?;
+                    models.push((path.clone(), m));
+                }
+                models
+            }
+        };
         let period = match c.period {
             Some(p) => p,
             None => {
@@ -268,6 +376,7 @@ impl Session {
             poses,
             human: (!c.no_human).then_some(HumanBound::PAPER),
             json: c.json,
+            axis: c.axis.clone(),
         })
     }
 
@@ -393,11 +502,14 @@ impl Session {
         );
     }
 
-    fn emit(&self, v: Value, text: impl FnOnce()) {
-        if self.json {
-            println!("{v}");
-        } else {
-            text();
+    fn emit(&self, mut v: Value, text: impl FnOnce()) {
+        match (&self.axis, self.json) {
+            (Some(a), true) => {
+                v["axis"] = json!(a.name);
+                a.out.borrow_mut().push(v);
+            }
+            (None, true) => println!("{v}"),
+            (_, false) => text(),
         }
     }
 }
@@ -936,16 +1048,30 @@ fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
     Ok(())
 }
 
+/// `run` on `args`, refusing a device file: the command draws one axis.
+fn one_axis<A: HasCommon + Clone>(
+    args: &A,
+    run: fn(&A) -> Result<(), String>,
+) -> Result<(), String> {
+    match args.clone().common().device.clone() {
+        Some(p) => Err(format!(
+            "--device {}: this command draws one axis; give that axis's --model",
+            p.display()
+        )),
+        None => run(args),
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let r = match &cli.cmd {
-        Cmd::Design(Display::Impedance(a)) => design_impedance(a),
-        Cmd::Design(Display::Admittance(a)) => design_admittance(a),
-        Cmd::Check(d) => check(d),
-        Cmd::Zrange(d) => zrange(d),
-        Cmd::Plot(p) => plot_fig(p),
-        Cmd::Region(d) => region(d),
-        Cmd::Verify(d) => verify(d),
+        Cmd::Design(Display::Impedance(a)) => each_axis(a, design_impedance),
+        Cmd::Design(Display::Admittance(a)) => each_axis(a, design_admittance),
+        Cmd::Check(d) => each_axis(d, check),
+        Cmd::Zrange(d) => one_axis(d, zrange),
+        Cmd::Plot(p) => one_axis(p, plot_fig),
+        Cmd::Region(d) => each_axis(d, region),
+        Cmd::Verify(d) => each_axis(d, verify),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,

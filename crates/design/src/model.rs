@@ -84,6 +84,18 @@ struct RawModel {
     delay_samples: Option<u32>,
 }
 
+/// A file's text and its name for messages.
+pub(crate) fn read(path: &Path) -> Result<(String, String), ModelError> {
+    let source = path.display().to_string();
+    match std::fs::read_to_string(path) {
+        Ok(text) => Ok((text, source)),
+        Err(e) => Err(ModelError {
+            source,
+            message: format!("cannot read: {e}"),
+        }),
+    }
+}
+
 /// The filter pole a model without a force sensor is given (rad/s).
 pub const DEFAULT_LOAD_CELL_POLE_RAD_S: f64 = 235.0;
 
@@ -115,11 +127,7 @@ impl DeviceModel {
 
     /// Read and check a model file.
     pub fn load(path: &Path) -> Result<Self, ModelError> {
-        let source = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ModelError {
-            source: source.clone(),
-            message: format!("cannot read: {e}"),
-        })?;
+        let (text, source) = read(path)?;
         Self::from_toml(&text, &source)
     }
 

@@ -291,3 +291,67 @@ fn a_device_without_a_force_sensor() {
     assert_eq!(v["binding_bound"], "sampled-data");
     assert!(v["paper_k_c"].as_f64().unwrap() > 1.1 * k, "{v}");
 }
+
+/// A device file designs each axis on its own model: the shipped
+/// three-axis Excalibur gives each axis the x axis's coupling, and a
+/// device whose y axis is the rigid capstan gives y the capstan's own.
+#[test]
+fn a_device_file_designs_every_axis_on_its_own_model() {
+    let design = |args: &str| TWOPORT.json(&words(args));
+    let one = design("design impedance --b 90 --json");
+    let xyz = design("design impedance --b 90 --device models/devices/excalibur_xyz.toml --json");
+    let axes = xyz["axes"].as_array().unwrap();
+    assert_eq!(axes.len(), 3);
+    for (a, name) in axes.iter().zip(["x", "y", "z"]) {
+        assert_eq!(a["axis"], name);
+        assert_eq!(a["k_c"], one["k_c"], "axis {name}");
+    }
+
+    let dir = std::env::temp_dir().join(format!("twoport-device-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let models = concat!(env!("CARGO_MANIFEST_DIR"), "/../../models");
+    let write = |file: &str, text: String| {
+        let p = dir.join(file);
+        std::fs::write(&p, text).unwrap();
+        p.display().to_string()
+    };
+    let axis = |name: &str, model: &str| {
+        format!("[[axis]]\nname = \"{name}\"\nmodels = [\"{models}/{model}\"]\n")
+    };
+    let mixed = write(
+        "mixed.toml",
+        axis("x", "excalibur.toml") + &axis("y", "capstan.toml"),
+    );
+    let v = design(&format!("design impedance --b 90 --device {mixed} --json"));
+    let capstan = design("design impedance --b 90 --model models/capstan.toml --json");
+    let (x, y) = (&v["axes"][0], &v["axes"][1]);
+    assert_eq!(y["k_c"], capstan["k_c"]);
+    assert!(
+        x["k_c"].as_f64().unwrap() > 2.0 * y["k_c"].as_f64().unwrap(),
+        "{v}"
+    );
+
+    // Bad device files are refused by name: the file, the axis, the fault.
+    let four = write(
+        "four.toml",
+        ["a", "b", "c", "d"]
+            .map(|n| axis(n, "excalibur.toml"))
+            .concat(),
+    );
+    let missing = write(
+        "missing.toml",
+        axis("x", "excalibur.toml") + &axis("y", "no_such.toml"),
+    );
+    for (file, want) in [
+        (&four, "4 [[axis]] tables: a device has 1 to 3"),
+        (&missing, "axis 1 (y): "),
+    ] {
+        let e = TWOPORT.failure(&words(&format!("design impedance --device {file}")));
+        assert!(e.contains(file.as_str()) && e.contains(want), "{e}");
+    }
+    let e = TWOPORT.failure(&words(
+        "zrange impedance --k 5e4 --b 90 --device models/devices/excalibur_xyz.toml",
+    ));
+    assert!(e.contains("give that axis's --model"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
