@@ -12,6 +12,8 @@
 //! force applied *to* the world along the axis (N), `v` its velocity along
 //! the axis (m/s). Axis 0 is x, 1 is y, 2 is z.
 
+pub mod vbb;
+
 use crate::ve::{Port, VeOutput, VeTransfer, VirtualEnvironment};
 use crate::{Position, Real};
 

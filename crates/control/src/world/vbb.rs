@@ -1,0 +1,461 @@
+//! The virtual building-block world of the paper's Excalibur demonstration,
+//! in 3-D: a cursor and up to `B` box blocks on a floor, under gravity. The
+//! user grabs the block the cursor touches and moves it; the other blocks
+//! are obstacles its faces slide on, with Coulomb friction; a released block
+//! falls onto the floor or onto the blocks below it.
+//!
+//! The coupled body (the cursor, or the cursor with the block it holds) is
+//! a mass stepped by backward Euler against every axis's coupling port and
+//! its contacts in one implicit solve: a contact stops the body exactly at
+//! the face it would cross this tick (a speculative contact, no
+//! penetration, no bounce), and friction on the other axes is the implicit
+//! Coulomb law, sticking while the port's pull is inside the cone. Each of
+//! these takes energy out or stores it (gravity), so the world is passive
+//! at its ports: whatever the couplings do, it never gives back more than
+//! it was given.
+//!
+//! Axes: 0 is x, 1 is y, 2 is z, up; gravity acts along -z. Positions are
+//! integer nanometres ([`Position`]); a block is its lowest corner and its
+//! size.
+
+use super::World;
+use crate::ve::{Port, VeOutput, VeTransfer};
+use crate::{param, Integrator, ParamError, Position, Real, ZTransfer};
+
+/// Standard gravity (m/s²).
+pub const G_MPS2: f32 = 9.806_65;
+
+/// One box block.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Block {
+    /// The lowest corner (x, y, z).
+    pub min: [Position; 3],
+    /// The size along each axis (nm), > 0.
+    pub size_nm: [i32; 3],
+    /// Mass (kg), > 0.
+    pub mass_kg: f32,
+}
+
+impl Block {
+    /// A block of `size_m` (m, per axis) and `mass_kg` (kg) whose lowest
+    /// corner is at `min_m` (m); `None` for a size, mass or corner out of
+    /// range.
+    pub fn new(min_m: [f32; 3], size_m: [f32; 3], mass_kg: f32) -> Option<Block> {
+        let mut b = Block {
+            min: [Position::ZERO; 3],
+            size_nm: [0; 3],
+            mass_kg,
+        };
+        for a in 0..3 {
+            b.min[a] = Position::from_m(min_m[a])?;
+            let s = Position::from_m(size_m[a])?.nm();
+            if s <= 0 {
+                return None;
+            }
+            b.size_nm[a] = s;
+        }
+        (mass_kg.is_finite() && mass_kg > 0.0).then_some(b)
+    }
+
+    /// The far corner along `axis` (nm).
+    fn max_nm(&self, axis: usize) -> i64 {
+        self.min[axis].nm() as i64 + self.size_nm[axis] as i64
+    }
+}
+
+/// The world's constants.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VbbConfig {
+    /// Sample period `T` (s).
+    pub period_s: f32,
+    /// The cursor's mass (kg): the paper's explicit cursor needed 0.25 kg,
+    /// the implicit one here is passive at any mass.
+    pub cursor_mass_kg: f32,
+    /// The cursor's half-width (nm): it touches blocks as a small cube.
+    pub cursor_half_nm: i32,
+    /// Coulomb friction coefficient between a held block (or the cursor)
+    /// and what it slides on.
+    pub friction: f32,
+    /// Whether the held block's weight is felt.
+    pub held_weight: bool,
+    /// The workspace's lowest and highest corners: walls, and the floor at
+    /// the lowest z.
+    pub workspace: [[Position; 3]; 2],
+}
+
+impl VbbConfig {
+    /// The paper's Excalibur workspace, 300 x 300 x 200 mm with the floor
+    /// at z = 0, a 0.25 kg cursor 2 mm across, friction 0.3, the held
+    /// block's weight felt, at period `period_s` (s).
+    pub fn excalibur(period_s: f32) -> Self {
+        let p = Position::from_nm;
+        VbbConfig {
+            period_s,
+            cursor_mass_kg: 0.25,
+            cursor_half_nm: 1_000_000,
+            friction: 0.3,
+            held_weight: true,
+            workspace: [
+                [p(-150_000_000), p(-150_000_000), p(0)],
+                [p(150_000_000), p(150_000_000), p(200_000_000)],
+            ],
+        }
+    }
+}
+
+/// A body's extent along the three axes (nm, lowest and highest).
+#[derive(Clone, Copy, Debug)]
+struct Extent {
+    lo: [i64; 3],
+    hi: [i64; 3],
+}
+
+impl Extent {
+    /// Whether `self` and `o` overlap (by more than touching) on every axis
+    /// but `axis`.
+    fn faces(&self, o: &Extent, axis: usize) -> bool {
+        (0..3).all(|b| b == axis || (self.lo[b] < o.hi[b] && o.lo[b] < self.hi[b]))
+    }
+}
+
+fn extent_of(b: &Block) -> Extent {
+    let lo = b.min.map(|p| p.nm() as i64);
+    Extent {
+        lo,
+        hi: [0, 1, 2].map(|a| b.max_nm(a)),
+    }
+}
+
+/// The building-block world, for [`AxesServo`](crate::servo::AxesServo)'s
+/// three axes, holding up to `B` blocks.
+///
+/// # Examples
+///
+/// ```
+/// use twoport_control::world::vbb::{Block, Vbb, VbbConfig};
+/// use twoport_control::world::World;
+/// use twoport_control::ve::Port;
+/// // A 30 mm cube on the floor, the cursor resting on its top.
+/// let cube = Block::new([0.0, 0.0, 0.0], [0.03; 3], 0.1).unwrap();
+/// let mut w = Vbb::<f32, 4>::new(VbbConfig::excalibur(1e-3), &[cube])?;
+/// w.place_cursor([0.015, 0.015, 0.031]);
+/// // Push down with 5 N: the cube's top holds the cursor.
+/// let push = [0.0, 0.0, -5.0].map(|f0_n| Port { f0_n, z_nspm: 100.0 });
+/// for _ in 0..100 {
+///     w.step(&push);
+/// }
+/// assert!(w.cursor()[2].nm() >= 31_000_000 - 1_000_000);
+/// // Grab it and pull up with 5 N: the block comes along, its 0.98 N of
+/// // weight felt.
+/// assert!(w.grab());
+/// let lift = [0.0, 0.0, 5.0].map(|f0_n| Port { f0_n, z_nspm: 100.0 });
+/// for _ in 0..100 {
+///     w.step(&lift);
+/// }
+/// assert!(w.blocks()[0].min[2].nm() > 1_000_000);
+/// # Ok::<(), twoport_control::ParamError>(())
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct Vbb<R, const B: usize> {
+    cfg: VbbConfig,
+    blocks: [Block; B],
+    count: usize,
+    /// Each block's falling velocity (m/s, along z), while it falls.
+    fall_mps: [R; B],
+    held: Option<usize>,
+    /// The held block's corner minus the cursor (nm).
+    grip_nm: [i32; 3],
+    cursor: [Integrator<R>; 3],
+    velocity_mps: [R; 3],
+    t: R,
+    g: R,
+}
+
+impl<R: Real, const B: usize> Vbb<R, B> {
+    /// A world of `blocks` (at most `B`), the cursor at rest at the
+    /// workspace's centre, 10 mm above its floor.
+    pub fn new(cfg: VbbConfig, blocks: &[Block]) -> Result<Self, ParamError> {
+        let t = param::positive("vbb.period_s (s)", cfg.period_s)?;
+        param::positive("vbb.cursor_mass_kg (kg)", cfg.cursor_mass_kg)?;
+        param::non_negative("vbb.friction", cfg.friction)?;
+        if blocks.len() > B {
+            return Err(ParamError {
+                name: "vbb.blocks",
+                value: blocks.len() as f32,
+                problem: "more blocks than the world holds",
+            });
+        }
+        let (lo, hi) = (cfg.workspace[0], cfg.workspace[1]);
+        if (0..3).any(|a| lo[a].nm() >= hi[a].nm()) {
+            return Err(ParamError {
+                name: "vbb.workspace",
+                value: 0.0,
+                problem: "its lowest corner must be below its highest on every axis",
+            });
+        }
+        let filler = Block {
+            min: [Position::ZERO; 3],
+            size_nm: [1; 3],
+            mass_kg: 1.0,
+        };
+        let mut w = Vbb {
+            cfg,
+            blocks: [filler; B],
+            count: blocks.len(),
+            fall_mps: [R::ZERO; B],
+            held: None,
+            grip_nm: [0; 3],
+            cursor: [Integrator::new_in(t, Position::ZERO); 3],
+            velocity_mps: [R::ZERO; 3],
+            t: R::of(t),
+            g: R::of(G_MPS2),
+        };
+        w.blocks[..blocks.len()].copy_from_slice(blocks);
+        let mid =
+            |a: usize| Position::from_nm(((lo[a].nm() as i64 + hi[a].nm() as i64) / 2) as i32);
+        w.place_cursor_at([mid(0), mid(1), lo[2].offset_nm(10_000_000)]);
+        Ok(w)
+    }
+
+    /// Put the cursor at rest at `x_m` (m); a position out of range is
+    /// ignored.
+    pub fn place_cursor(&mut self, x_m: [f32; 3]) {
+        if let (Some(x), Some(y), Some(z)) = (
+            Position::from_m(x_m[0]),
+            Position::from_m(x_m[1]),
+            Position::from_m(x_m[2]),
+        ) {
+            self.place_cursor_at([x, y, z]);
+        }
+    }
+
+    fn place_cursor_at(&mut self, x: [Position; 3]) {
+        for (c, x) in self.cursor.iter_mut().zip(x) {
+            c.reset(x);
+        }
+        self.velocity_mps = [R::ZERO; 3];
+        self.carry_held();
+    }
+
+    /// The blocks.
+    pub fn blocks(&self) -> &[Block] {
+        &self.blocks[..self.count]
+    }
+
+    /// The cursor's position.
+    pub fn cursor(&self) -> [Position; 3] {
+        self.cursor.map(|c| c.position())
+    }
+
+    /// The block the cursor holds, if any.
+    pub fn held(&self) -> Option<usize> {
+        self.held
+    }
+
+    /// Grab the block the cursor touches (within its half-width); whether
+    /// one was there. The block then moves with the cursor.
+    pub fn grab(&mut self) -> bool {
+        if self.held.is_some() {
+            return true;
+        }
+        let c = self.cursor_extent();
+        let near = |e: &Extent| (0..3).all(|a| e.lo[a] <= c.hi[a] && c.lo[a] <= e.hi[a]);
+        let Some(i) = self.blocks().iter().position(|b| near(&extent_of(b))) else {
+            return false;
+        };
+        let x = self.cursor();
+        self.grip_nm = [0, 1, 2].map(|a| self.blocks[i].min[a].nm().saturating_sub(x[a].nm()));
+        // The block at rest joins the moving cursor: momentum is kept, so
+        // the grab takes kinetic energy out rather than adding it.
+        let keep =
+            R::of(self.cfg.cursor_mass_kg / (self.cfg.cursor_mass_kg + self.blocks[i].mass_kg));
+        self.velocity_mps = self.velocity_mps.map(|v| v * keep);
+        self.held = Some(i);
+        self.fall_mps[i] = R::ZERO;
+        true
+    }
+
+    /// Let go of the held block: it falls from where it is.
+    pub fn release(&mut self) {
+        self.held = None;
+    }
+
+    /// The mass the couplings move (kg): the cursor's, plus the held
+    /// block's.
+    pub fn body_mass_kg(&self) -> f32 {
+        self.cfg.cursor_mass_kg + self.held.map_or(0.0, |i| self.blocks[i].mass_kg)
+    }
+
+    fn cursor_extent(&self) -> Extent {
+        let x = self.cursor();
+        let h = self.cfg.cursor_half_nm as i64;
+        Extent {
+            lo: x.map(|p| p.nm() as i64 - h),
+            hi: x.map(|p| p.nm() as i64 + h),
+        }
+    }
+
+    /// The coupled body's extent: the held block's, or the cursor's.
+    fn body_extent(&self) -> Extent {
+        match self.held {
+            Some(i) => extent_of(&self.blocks[i]),
+            None => self.cursor_extent(),
+        }
+    }
+
+    fn carry_held(&mut self) {
+        if let Some(i) = self.held {
+            let x = self.cursor();
+            for ((min, x), grip) in self.blocks[i].min.iter_mut().zip(x).zip(self.grip_nm) {
+                *min = x.offset_nm(grip);
+            }
+        }
+    }
+
+    /// How far (nm, >= 0) `body` may move along `axis` in direction `dir`
+    /// (+1 or -1) before a face of the workspace or of a block other than
+    /// `skip` stops it.
+    fn gap_nm(&self, body: &Extent, axis: usize, dir: i64, skip: Option<usize>) -> i64 {
+        let ws = self.cfg.workspace;
+        let mut gap = if dir > 0 {
+            ws[1][axis].nm() as i64 - body.hi[axis]
+        } else {
+            body.lo[axis] - ws[0][axis].nm() as i64
+        };
+        for (i, b) in self.blocks().iter().enumerate() {
+            if Some(i) == skip {
+                continue;
+            }
+            let e = extent_of(b);
+            if !body.faces(&e, axis) {
+                continue;
+            }
+            let g = if dir > 0 {
+                e.lo[axis] - body.hi[axis]
+            } else {
+                body.lo[axis] - e.hi[axis]
+            };
+            // (A block the body is already inside, as the bare cursor is
+            // in the block it just let go of, does not hold it: it leaves
+            // freely.)
+            if g >= 0 {
+                gap = gap.min(g);
+            }
+        }
+        gap.max(0)
+    }
+
+    /// Drop every free block that has nothing under it.
+    fn settle(&mut self) {
+        for i in 0..self.count {
+            if Some(i) == self.held {
+                continue;
+            }
+            let e = extent_of(&self.blocks[i]);
+            let below = self.gap_nm(&e, 2, -1, Some(i));
+            let v = self.fall_mps[i] - self.g * self.t;
+            let step = -v * self.t * R::NM_PER_M; // nm, > 0
+            let fall = R::from_i64(below);
+            if below == 0 || step >= fall {
+                self.blocks[i].min[2] = self.blocks[i].min[2].offset_nm(-(below as i32));
+                self.fall_mps[i] = R::ZERO;
+            } else {
+                self.blocks[i].min[2] = self.blocks[i].min[2].offset_nm(-step.trunc_i32());
+                self.fall_mps[i] = v;
+            }
+        }
+    }
+}
+
+impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
+    fn step(&mut self, ports: &[Port<R>; 3]) -> [VeOutput<R>; 3] {
+        if !ports
+            .iter()
+            .all(|p| p.f0_n.is_finite() && p.z_nspm.is_finite())
+        {
+            return ports.map(|p| p.at(R::ZERO));
+        }
+        let m = R::of(self.body_mass_kg());
+        let (t, body) = (self.t, self.body_extent());
+        let weight = match self.held {
+            Some(i) if self.cfg.held_weight => -R::of(self.blocks[i].mass_kg) * self.g,
+            _ => R::ZERO,
+        };
+        // The implicit step with no contact: m (v - v0) = T (f0 - z v + w).
+        let mut den = [R::ONE; 3];
+        let mut v = [R::ZERO; 3];
+        for a in 0..3 {
+            let ext = if a == 2 { weight } else { R::ZERO };
+            den[a] = m + t * ports[a].z_nspm;
+            v[a] = (m * self.velocity_mps[a] + t * (ports[a].f0_n + ext)) / den[a];
+        }
+        // Contacts: an axis whose step would cross a face stops at it, and
+        // the face's push on the body is the normal force.
+        let mut normal_n = [R::ZERO; 3];
+        // Where an axis stops at a face: the cursor's exact position there
+        // (the integrator's rounding must not take it a nanometre in).
+        let mut stop: [Option<Position>; 3] = [None; 3];
+        let x = self.cursor();
+        for a in 0..3 {
+            let dir = if v[a] > R::ZERO { 1 } else { -1 };
+            let gap = self.gap_nm(&body, a, dir, self.held);
+            let reach_m = R::from_i64(gap) * R::M_PER_NM;
+            if (v[a] * t).abs() > reach_m {
+                let allowed = if dir > 0 { reach_m / t } else { -reach_m / t };
+                normal_n[a] = (den[a] * (v[a] - allowed) / t).abs();
+                v[a] = allowed;
+                stop[a] = Some(x[a].offset_nm((dir * gap) as i32));
+            }
+        }
+        // Coulomb friction on the other axes, implicit: it holds the body
+        // while the pull is inside the cone, else takes mu N off it.
+        let mu = R::of(self.cfg.friction);
+        for a in 0..3 {
+            let n: R = (0..3)
+                .filter(|&b| b != a)
+                .fold(R::ZERO, |s, b| s + normal_n[b]);
+            if normal_n[a] > R::ZERO || n == R::ZERO {
+                continue;
+            }
+            let dv = t * mu * n / den[a];
+            v[a] = if v[a].abs() <= dv {
+                R::ZERO
+            } else if v[a] > R::ZERO {
+                v[a] - dv
+            } else {
+                v[a] + dv
+            };
+        }
+        for a in 0..3 {
+            self.velocity_mps[a] = v[a];
+            match stop[a] {
+                Some(at) => self.cursor[a].reset(at),
+                None => {
+                    self.cursor[a].step(v[a]);
+                }
+            }
+        }
+        self.carry_held();
+        self.settle();
+        [0, 1, 2].map(|a| ports[a].at(v[a]))
+    }
+
+    fn reset(&mut self, x: &[Position; 3]) {
+        self.place_cursor_at(*x);
+    }
+
+    fn position(&self) -> [Position; 3] {
+        self.cursor()
+    }
+
+    #[inline]
+    fn offset_m(&self, from: &[Position; 3]) -> [R; 3] {
+        [0, 1, 2].map(|a| self.cursor[a].offset_m(from[a]))
+    }
+
+    /// Free space: the body's mass, `(T/m) / (1 - z^-1)`.
+    fn tf(&self, _axis: usize) -> VeTransfer {
+        let t_over_m = self.t.to_f64() / self.body_mass_kg() as f64;
+        VeTransfer::Admittance(ZTransfer::first_order([t_over_m, 0.0], -1.0))
+    }
+}
