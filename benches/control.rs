@@ -9,10 +9,12 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
-use twoport_control::servo::SensorFrame;
+use twoport_control::servo::{AxesFrame, AxesServo, SensorFrame};
 use twoport_control::ve::{
     BilateralConstraint, CursorMass, Port, Solid, UnilateralWall, VirtualEnvironment,
 };
+use twoport_control::world::vbb::{Block, Vbb, VbbConfig};
+use twoport_control::world::{PerAxis, World};
 use twoport_control::{
     AdmittanceCoupling, AdmittanceGains, Encoder, FirstDifference, Gains, ImpedanceCoupling,
     ImpedanceGains, Integrator, Position, PositionRegulator, SafetyConfig, Servo,
@@ -108,17 +110,15 @@ fn impedance_tick<V: VirtualEnvironment>(c: &mut Criterion, ve_name: &str, ve: V
     );
 }
 
+/// The wall the ticks push into: 0.5 mm from the start, so the sweep is
+/// in contact three quarters of the time (as on the board's probe).
+fn wall() -> UnilateralWall {
+    let (surface, start) = (Position::from_nm(500_000), Position::ZERO);
+    UnilateralWall::new(1e5, 50.0, surface, Solid::Above, T, start).unwrap()
+}
+
 fn servos(c: &mut Criterion) {
-    let wall = UnilateralWall::new(
-        1e5,
-        50.0,
-        Position::from_nm(500_000),
-        Solid::Above,
-        T,
-        Position::ZERO,
-    )
-    .unwrap();
-    impedance_tick(c, "wall", wall);
+    impedance_tick(c, "wall", wall());
     // The same tick with the simplest VE: what the wall's contact solve
     // and its own integrator add to the tick.
     impedance_tick(c, "bilateral VE", BilateralConstraint::new(Position::ZERO));
@@ -144,9 +144,90 @@ fn servos(c: &mut Criterion) {
     );
 }
 
+/// 50 blocks of 20 mm in a 10 x 5 grid on the floor, the cursor resting
+/// on the middle one's top.
+fn fifty_blocks() -> (Vbb<f32, 50>, [Position; 3]) {
+    let mut blocks = Vec::with_capacity(50);
+    for i in 0..50 {
+        let (x, y) = (
+            (i % 10) as f32 * 0.025 - 0.125,
+            (i / 10) as f32 * 0.025 - 0.0625,
+        );
+        blocks.push(Block::new([x, y, 0.0], [0.02; 3], 0.1).unwrap());
+    }
+    let w = Vbb::new(VbbConfig::excalibur(T), &blocks).unwrap();
+    let top = blocks[25];
+    let at = |a: usize| top.min[a].offset_nm(top.size_nm[a] / 2);
+    (
+        w,
+        [
+            at(0),
+            at(1),
+            top.min[2].offset_nm(top.size_nm[2] + 1_000_000),
+        ],
+    )
+}
+
+/// The three-axis servo and the building-block world (goal: a world step
+/// of at most 5 µs with 50 blocks).
+fn three_axes(c: &mut Criterion) {
+    let (mut w, rest) = fifty_blocks();
+    w.reset(&rest);
+    let mut k = 0u32;
+    c.bench_function("VBB world step, 50 blocks, cursor on a top", |b| {
+        b.iter(|| {
+            k = k.wrapping_add(1);
+            let f = ((k % 64) as f32 - 40.0) * 0.5;
+            let p = [0.3 * f, -0.2 * f, f].map(|f0_n| Port {
+                f0_n,
+                z_nspm: 140.0,
+            });
+            let out = w.step(black_box(&p));
+            black_box(&out);
+        })
+    });
+    let (mut held, _) = fifty_blocks();
+    held.reset(&rest);
+    assert!(held.grab());
+    c.bench_function("VBB world step, 50 blocks, one held", |b| {
+        b.iter(|| {
+            k = k.wrapping_add(1);
+            let f = ((k % 64) as f32 - 32.0) * 0.5;
+            let p = [f, -f, 2.0].map(|f0_n| Port {
+                f0_n,
+                z_nspm: 140.0,
+            });
+            let out = held.step(black_box(&p));
+            black_box(&out);
+        })
+    });
+    let g: Gains = ImpedanceGains::new(51_000.0, 90.0).into();
+    let mut s = AxesServo::new(
+        [g; 3],
+        [encoder(); 3],
+        [SafetyConfig::excalibur(); 3],
+        PerAxis([wall(); 3]),
+    )
+    .unwrap();
+    s.enable().unwrap();
+    c.bench_function("3-axis impedance servo tick, a wall on each axis", |b| {
+        b.iter(|| {
+            k = k.wrapping_add(1);
+            let raw = black_box(k % 1000 * 2);
+            let out = s.tick(&AxesFrame {
+                tick: k,
+                encoder_raw: [raw; 3],
+                load_cell_n: [0.0; 3],
+                dead_man_closed: true,
+            });
+            black_box(&out);
+        })
+    });
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(30);
-    targets = laws, servos
+    targets = laws, servos, three_axes
 }
 criterion_main!(benches);

@@ -243,3 +243,23 @@ fn the_three_axis_servo_renders_a_blocks_top() {
     assert!((f[2] + 102.0).abs() < 0.5, "{f:?}");
     assert!(f[0].abs() < 1e-3 && f[1].abs() < 1e-3, "{f:?}");
 }
+
+/// A block resting on the held one falls when the held one slides out
+/// from under it, and then rests on the floor.
+#[test]
+fn a_block_falls_when_its_support_is_pulled_away() {
+    let a = cube(0.0, 0.0, 0.0, 0.03, 0.1);
+    let mut b = cube(0.0, 0.0, 0.0, 0.03, 0.1);
+    b.min[2] = Position::from_nm(a.size_nm[2]);
+    let mut w = world(&[a, b]);
+    // The cursor against A's left face, below B.
+    w.place_cursor([-0.001, 0.015, 0.015]);
+    assert!(w.grab());
+    assert_eq!(w.held(), Some(0));
+    drive_to(&mut w, [-0.06, 0.015, 0.015], 1500);
+    assert!(mm(w.blocks()[0].min[0]) < -40.0, "A slid out");
+    for _ in 0..500 {
+        w.step(&ports([0.0; 3], 40.0));
+    }
+    assert_eq!(w.blocks()[1].min[2].nm(), 0, "B fell to the floor");
+}

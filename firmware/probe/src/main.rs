@@ -179,6 +179,69 @@ fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
     t.check("servo tick measured", per_tick > 0.0);
 }
 
+/// The three-axis impedance tick in QEMU: three encoders and couplings,
+/// the safety layer over the force vector, and either a wall on every axis
+/// (the same sweep into each as the one-axis tick's) or the building-block
+/// world of 50 blocks with the cursor pressing into one's top.
+fn tick_cost_axes(t: &mut Tally) {
+    use twoport_control::servo::{AxesFrame, AxesServo};
+    use twoport_control::world::vbb::{Block, Vbb, VbbConfig};
+    use twoport_control::world::PerAxis;
+    let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+    let gains = ImpedanceGains::new(51_000.0, 90.0).into();
+    let safety = [SafetyConfig::excalibur(); 3];
+    let sweep = |k: u32| {
+        let raw = core::hint::black_box(k % 1000 * 2);
+        AxesFrame {
+            tick: k,
+            encoder_raw: [raw; 3],
+            load_cell_n: [0.0; 3],
+            dead_man_closed: true,
+        }
+    };
+    let walls = PerAxis([timing_wall(); 3]);
+    let mut s = AxesServo::new([gains; 3], [enc; 3], safety, walls).unwrap();
+    let _ = s.enable();
+    let (per_tick, _) = counts_per_call(1000, |k| s.tick(&sweep(k)).actuator_force_n[2]);
+    hprintln!(
+        "  3-axis impedance servo tick (a wall on each axis): {} instructions",
+        per_tick / 1.6
+    );
+    // 50 blocks of 20 mm in a 10 x 5 grid on the floor; the cursor rests on
+    // the middle one's top and the device sweeps 2 mm into it along z.
+    let mut blocks = [Block::new([0.0; 3], [0.02; 3], 0.1).unwrap(); 50];
+    for (i, b) in blocks.iter_mut().enumerate() {
+        let (x, y) = (
+            (i % 10) as f32 * 0.025 - 0.125,
+            (i / 10) as f32 * 0.025 - 0.0625,
+        );
+        *b = Block::new([x, y, 0.0], [0.02; 3], 0.1).unwrap();
+    }
+    let mut cfg = VbbConfig::excalibur(T);
+    cfg.held_weight = true;
+    let world = Vbb::<f32, 50>::new(cfg, &blocks).unwrap();
+    let mut s = AxesServo::new([gains; 3], [enc; 3], safety, world).unwrap();
+    let top = blocks[25];
+    let x = |a: usize| top.min[a].offset_nm(top.size_nm[a] / 2);
+    s.calibrate([x(0), x(1), top.min[2].offset_nm(top.size_nm[2] + 1_000_000)]);
+    let _ = s.enable();
+    let down = |k: u32| {
+        let raw = core::hint::black_box((k % 1000 * 2).wrapping_neg() & 0xFFFF);
+        AxesFrame {
+            encoder_raw: [0, 0, raw],
+            ..sweep(k)
+        }
+    };
+    // (100 ticks: 1,000 of them would run SysTick's 24-bit count over.)
+    let (per_tick, _) = counts_per_call(100, |k| s.tick(&down(k)).actuator_force_n[2]);
+    hprintln!(
+        "  3-axis impedance servo tick on the 50-block world: {} instructions (faults: {})",
+        per_tick / 1.6,
+        s.safety().faults()
+    );
+    t.check("3-axis tick measured", per_tick > 0.0);
+}
+
 /// The same tick with the passivity layer (the series damper) between the
 /// device and the coupling, in two sweeps: pressing into the wall (the
 /// element takes energy in, the layer only books it) and withdrawing from
@@ -367,6 +430,7 @@ fn main() -> ! {
         tick_cost(&mut t, &mut p.SYST);
         tick_cost_layered(&mut t);
         tick_cost_ve_port(&mut t);
+        tick_cost_axes(&mut t);
         cost_breakdown();
     }
     hprintln!("{} passed, {} failed", t.passed, t.failed);

@@ -162,6 +162,9 @@ pub struct Vbb<R, const B: usize> {
     count: usize,
     /// Each block's falling velocity (m/s, along z), while it falls.
     fall_mps: [R; B],
+    /// Blocks whose support may have gone: checked each tick until they
+    /// rest, then left alone (a world at rest costs no search for them).
+    awake: [bool; B],
     held: Option<usize>,
     /// The held block's corner minus the cursor (nm).
     grip_nm: [i32; 3],
@@ -203,6 +206,7 @@ impl<R: Real, const B: usize> Vbb<R, B> {
             blocks: [filler; B],
             count: blocks.len(),
             fall_mps: [R::ZERO; B],
+            awake: [true; B],
             held: None,
             grip_nm: [0; 3],
             cursor: [Integrator::new_in(t, Position::ZERO); 3],
@@ -272,12 +276,14 @@ impl<R: Real, const B: usize> Vbb<R, B> {
         self.velocity_mps = self.velocity_mps.map(|v| v * keep);
         self.held = Some(i);
         self.fall_mps[i] = R::ZERO;
+        self.awake = [true; B];
         true
     }
 
     /// Let go of the held block: it falls from where it is.
     pub fn release(&mut self) {
         self.held = None;
+        self.awake = [true; B];
     }
 
     /// The mass the couplings move (kg): the cursor's, plus the held
@@ -345,10 +351,24 @@ impl<R: Real, const B: usize> Vbb<R, B> {
         gap.max(0)
     }
 
-    /// Drop every free block that has nothing under it.
+    /// Wake the blocks resting on the held block's top: it may move out
+    /// from under them.
+    fn wake_above_held(&mut self) {
+        let Some(h) = self.held else { return };
+        let top = extent_of(&self.blocks[h]);
+        for (i, b) in self.blocks[..self.count].iter().enumerate() {
+            let e = extent_of(b);
+            if e.lo[2] == top.hi[2] && top.faces(&e, 2) {
+                self.awake[i] = true;
+            }
+        }
+    }
+
+    /// Drop every awake free block that has nothing under it; one that
+    /// rests goes to sleep.
     fn settle(&mut self) {
         for i in 0..self.count {
-            if Some(i) == self.held {
+            if Some(i) == self.held || !self.awake[i] {
                 continue;
             }
             let e = extent_of(&self.blocks[i]);
@@ -359,6 +379,7 @@ impl<R: Real, const B: usize> Vbb<R, B> {
             if below == 0 || step >= fall {
                 self.blocks[i].min[2] = self.blocks[i].min[2].offset_nm(-(below as i32));
                 self.fall_mps[i] = R::ZERO;
+                self.awake[i] = false;
             } else {
                 self.blocks[i].min[2] = self.blocks[i].min[2].offset_nm(-step.trunc_i32());
                 self.fall_mps[i] = v;
@@ -435,6 +456,7 @@ impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
                 }
             }
         }
+        self.wake_above_held();
         self.carry_held();
         self.settle();
         [0, 1, 2].map(|a| ports[a].at(v[a]))
