@@ -13,8 +13,13 @@ const T: f32 = 1e-3;
 
 type World8 = Vbb<f32, 8>;
 
+/// The Excalibur's world with smooth-topped blocks.
 fn world(blocks: &[Block]) -> World8 {
-    Vbb::new(VbbConfig::excalibur(T), blocks).unwrap()
+    let cfg = VbbConfig {
+        knobs: None,
+        ..VbbConfig::excalibur(T)
+    };
+    Vbb::new(cfg, blocks).unwrap()
 }
 
 fn cube(x_m: f32, y_m: f32, z_m: f32, side_m: f32, mass_kg: f32) -> Block {
@@ -180,7 +185,8 @@ proptest! {
             cube(0.03, 0.0, 0.0, 0.03, 0.5),
             cube(0.0, 0.04, 0.0, 0.03, 0.1),
         ];
-        let mut w = world(&blocks);
+        // (With the knobs: mating and parting change the constraints.)
+        let mut w: World8 = Vbb::new(VbbConfig::excalibur(T), &blocks).unwrap();
         w.place_cursor([0.015, 0.015, 0.031]);
         if holding {
             prop_assert!(w.grab());
@@ -262,4 +268,57 @@ fn a_block_falls_when_its_support_is_pulled_away() {
         w.step(&ports([0.0; 3], 40.0));
     }
     assert_eq!(w.blocks()[1].min[2].nm(), 0, "B fell to the floor");
+}
+
+/// Knobs: a block set on another rests on its knobs; pressed down past the
+/// mating force with the grids aligned it drops onto the top and is held
+/// there, sideways and up, until pulled past the parting force. Off the
+/// grid, no push mates it.
+#[test]
+fn knobs_carry_mate_hold_and_part() {
+    let cfg = VbbConfig::excalibur(T);
+    let k = cfg.knobs.unwrap();
+    let (a, b) = (
+        cube(0.0, 0.0, 0.0, 0.03, 0.1),
+        cube(0.06, 0.0, 0.0, 0.03, 0.1),
+    );
+    let a_top = a.min[2].nm() + a.size_nm[2];
+    for (offset_m, mates) in [(0.0, true), (0.005, false)] {
+        let mut w: World8 = Vbb::new(cfg, &[a, b]).unwrap();
+        w.place_cursor([0.075, 0.015, 0.032]);
+        assert!(w.grab());
+        drive_to(&mut w, [0.075, 0.015, 0.08], 800);
+        drive_to(&mut w, [0.015 + offset_m, 0.015, 0.08], 800);
+        // Lowered with 3 N (and its own 0.98 N): it rests on the knobs.
+        let press = |w: &mut World8, f_n: f32, ticks: u32| {
+            for _ in 0..ticks {
+                let x = w.cursor();
+                let hold = |a: usize, at: f32| 400.0 * (at - x[a].m());
+                let p = [hold(0, 0.015 + offset_m), hold(1, 0.015), f_n];
+                w.step(&p.map(|f0_n| Port { f0_n, z_nspm: 40.0 }));
+            }
+        };
+        press(&mut w, -3.0, 1500);
+        assert_eq!(
+            w.blocks()[1].min[2].nm(),
+            a_top + k.height_nm,
+            "on the knobs"
+        );
+        // Pressed with 6 N: aligned, it mates and drops onto the top.
+        press(&mut w, -6.0, 300);
+        let seated = w.blocks()[1].min[2].nm() == a_top;
+        assert_eq!(seated, mates, "offset {offset_m} m");
+        if !mates {
+            continue;
+        }
+        // Held sideways by the knobs, and up against a 6 N pull.
+        let x0 = w.blocks()[1].min[0];
+        drive_to(&mut w, [0.05, 0.015, 0.03], 300);
+        assert_eq!(w.blocks()[1].min[0], x0, "the knobs hold it sideways");
+        press(&mut w, 6.0, 300);
+        assert_eq!(w.blocks()[1].min[2].nm(), a_top, "held against 6 N");
+        // Pulled with 12 N it parts and lifts.
+        press(&mut w, 12.0, 300);
+        assert!(w.blocks()[1].min[2].nm() > a_top + 5_000_000, "parted");
+    }
 }

@@ -81,6 +81,25 @@ pub struct VbbConfig {
     /// The workspace's lowest and highest corners: walls, and the floor at
     /// the lowest z.
     pub workspace: [[Position; 3]; 2],
+    /// The knobs on every block's top, if the blocks have any.
+    pub knobs: Option<Knobs>,
+}
+
+/// Knobs on a block's top, in a square grid from its corner: a block set
+/// on another rests on them, and mates (drops onto the top, and is held
+/// there) when the grids line up and it is pressed down hard enough.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Knobs {
+    /// The grid's pitch (nm), > 0.
+    pub pitch_nm: i32,
+    /// How far the knobs stand above the top (nm), >= 0.
+    pub height_nm: i32,
+    /// How far off the grid a block may be and still mate (nm).
+    pub tolerance_nm: i32,
+    /// The downward push that mates aligned blocks (N).
+    pub mate_force_n: f32,
+    /// The pull that parts mated blocks (N).
+    pub part_force_n: f32,
 }
 
 impl VbbConfig {
@@ -99,6 +118,13 @@ impl VbbConfig {
                 [p(-150_000_000), p(-150_000_000), p(0)],
                 [p(150_000_000), p(150_000_000), p(200_000_000)],
             ],
+            knobs: Some(Knobs {
+                pitch_nm: 10_000_000,
+                height_nm: 2_000_000,
+                tolerance_nm: 1_000_000,
+                mate_force_n: 5.0,
+                part_force_n: 8.0,
+            }),
         }
     }
 }
@@ -165,6 +191,8 @@ pub struct Vbb<R, const B: usize> {
     /// Blocks whose support may have gone: checked each tick until they
     /// rest, then left alone (a world at rest costs no search for them).
     awake: [bool; B],
+    /// The block each block is mated onto, if any.
+    on: [Option<usize>; B],
     held: Option<usize>,
     /// The held block's corner minus the cursor (nm).
     grip_nm: [i32; 3],
@@ -207,6 +235,7 @@ impl<R: Real, const B: usize> Vbb<R, B> {
             count: blocks.len(),
             fall_mps: [R::ZERO; B],
             awake: [true; B],
+            on: [None; B],
             held: None,
             grip_nm: [0; 3],
             cursor: [Integrator::new_in(t, Position::ZERO); 3],
@@ -263,7 +292,11 @@ impl<R: Real, const B: usize> Vbb<R, B> {
             return true;
         }
         let c = self.cursor_extent();
-        let near = |e: &Extent| (0..3).all(|a| e.lo[a] <= c.hi[a] && c.lo[a] <= e.hi[a]);
+        // (A cursor resting on a block's knobs touches the block.)
+        let knob = self.cfg.knobs.map_or(0, |k| k.height_nm as i64);
+        let near = |e: &Extent| {
+            (0..3).all(|a| e.lo[a] <= c.hi[a] && c.lo[a] <= e.hi[a] + knob * (a == 2) as i64)
+        };
         let Some(i) = self.blocks().iter().position(|b| near(&extent_of(b))) else {
             return false;
         };
@@ -320,16 +353,26 @@ impl<R: Real, const B: usize> Vbb<R, B> {
 
     /// How far (nm, >= 0) `body` may move along `axis` in direction `dir`
     /// (+1 or -1) before a face of the workspace or of a block other than
-    /// `skip` stops it.
-    fn gap_nm(&self, body: &Extent, axis: usize, dir: i64, skip: Option<usize>) -> i64 {
+    /// `me` (the body's own block) stops it, and which block that is. A
+    /// block's top stands its knobs' height higher, except to the block
+    /// mated onto it.
+    fn gap_nm(
+        &self,
+        body: &Extent,
+        axis: usize,
+        dir: i64,
+        me: Option<usize>,
+    ) -> (i64, Option<usize>) {
         let ws = self.cfg.workspace;
         let mut gap = if dir > 0 {
             ws[1][axis].nm() as i64 - body.hi[axis]
         } else {
             body.lo[axis] - ws[0][axis].nm() as i64
         };
+        let mut by = None;
+        let knob = self.cfg.knobs.map_or(0, |k| k.height_nm as i64);
         for (i, b) in self.blocks().iter().enumerate() {
-            if Some(i) == skip {
+            if Some(i) == me {
                 continue;
             }
             let e = extent_of(b);
@@ -338,17 +381,34 @@ impl<R: Real, const B: usize> Vbb<R, B> {
             }
             let g = if dir > 0 {
                 e.lo[axis] - body.hi[axis]
+            } else if axis == 2 && body.lo[2] >= e.hi[2] {
+                // Onto a top: its knobs, unless mated to it; a body already
+                // among the knobs stays where it is.
+                let mated = me.is_some_and(|m| self.on[m] == Some(i));
+                let k = if mated { 0 } else { knob };
+                (body.lo[2] - e.hi[2] - k).max(0)
             } else {
                 body.lo[axis] - e.hi[axis]
             };
             // (A block the body is already inside, as the bare cursor is
             // in the block it just let go of, does not hold it: it leaves
             // freely.)
-            if g >= 0 {
-                gap = gap.min(g);
+            if g >= 0 && g < gap {
+                gap = g;
+                by = Some(i);
             }
         }
-        gap.max(0)
+        (gap.max(0), by)
+    }
+
+    /// Whether blocks `i` and `j` line up on the knob grid.
+    fn aligned(&self, i: usize, j: usize, k: &Knobs) -> bool {
+        let (p, t) = (k.pitch_nm as i64, k.tolerance_nm as i64);
+        (0..2).all(|a| {
+            let d = (self.blocks[i].min[a].nm() as i64 - self.blocks[j].min[a].nm() as i64)
+                .rem_euclid(p);
+            d.min(p - d) <= t
+        })
     }
 
     /// Wake the blocks resting on the held block's top: it may move out
@@ -372,7 +432,10 @@ impl<R: Real, const B: usize> Vbb<R, B> {
                 continue;
             }
             let e = extent_of(&self.blocks[i]);
-            let below = self.gap_nm(&e, 2, -1, Some(i));
+            let (below, _) = self.gap_nm(&e, 2, -1, Some(i));
+            if below > 0 {
+                self.on[i] = None;
+            }
             let v = self.fall_mps[i] - self.g * self.t;
             let step = -v * self.t * R::NM_PER_M; // nm, > 0
             let fall = R::from_i64(below);
@@ -417,15 +480,47 @@ impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
         // (the integrator's rounding must not take it a nanometre in).
         let mut stop: [Option<Position>; 3] = [None; 3];
         let x = self.cursor();
+        // A held block seated on the one it is mated to: the knobs hold it
+        // sideways and down, and up until it is pulled hard enough.
+        let seated = match self.held {
+            Some(h) => self.on[h].filter(|&j| body.lo[2] == extent_of(&self.blocks[j]).hi[2]),
+            None => None,
+        };
+        let mut below = None;
+        let rising = v[2] > R::ZERO;
+        // (Knobs answer a steady push, not the impulse of landing on them.)
+        let resting = self.velocity_mps[2] == R::ZERO;
         for a in 0..3 {
             let dir = if v[a] > R::ZERO { 1 } else { -1 };
-            let gap = self.gap_nm(&body, a, dir, self.held);
+            let (gap, by) = match seated {
+                Some(_) => (0, None),
+                None => self.gap_nm(&body, a, dir, self.held),
+            };
+            if a == 2 && dir < 0 {
+                below = by;
+            }
             let reach_m = R::from_i64(gap) * R::M_PER_NM;
             if (v[a] * t).abs() > reach_m {
                 let allowed = if dir > 0 { reach_m / t } else { -reach_m / t };
                 normal_n[a] = (den[a] * (v[a] - allowed) / t).abs();
                 v[a] = allowed;
                 stop[a] = Some(x[a].offset_nm((dir * gap) as i32));
+            }
+        }
+        if let (Some(h), Some(k)) = (self.held, self.cfg.knobs) {
+            match (seated, below) {
+                // Pulled up hard enough: the knobs let go.
+                (Some(_), _) if rising && normal_n[2] > R::of(k.part_force_n) => {
+                    self.on[h] = None;
+                }
+                // Pressed onto an aligned block's knobs: they give way, and
+                // it drops onto the top from the next tick.
+                (None, Some(j))
+                    if resting && normal_n[2] > R::of(k.mate_force_n) && self.aligned(h, j, &k) =>
+                {
+                    self.on[h] = Some(j);
+                }
+                _ => {}
             }
         }
         // Coulomb friction on the other axes, implicit: it holds the body
