@@ -401,6 +401,19 @@ impl<R: Real, const B: usize> Vbb<R, B> {
         (gap.max(0), by)
     }
 
+    /// Line the held block `h` up exactly on `j`'s knob grid (it moves by
+    /// at most the tolerance, under the cursor): knobs seat square.
+    fn snap_to_grid(&mut self, h: usize, j: usize, k: &Knobs) {
+        let p = k.pitch_nm as i64;
+        for a in 0..2 {
+            let d = (self.blocks[h].min[a].nm() as i64 - self.blocks[j].min[a].nm() as i64)
+                .rem_euclid(p);
+            let shift = if d <= p / 2 { -d } else { p - d };
+            self.grip_nm[a] = self.grip_nm[a].saturating_add(shift as i32);
+        }
+        self.carry_held();
+    }
+
     /// Whether blocks `i` and `j` line up on the knob grid.
     fn aligned(&self, i: usize, j: usize, k: &Knobs) -> bool {
         let (p, t) = (k.pitch_nm as i64, k.tolerance_nm as i64);
@@ -487,14 +500,18 @@ impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
             None => None,
         };
         let mut below = None;
+        let mut snap = None;
+        let mated = self.held.and_then(|h| self.on[h]);
         let rising = v[2] > R::ZERO;
         // (Knobs answer a steady push, not the impulse of landing on them.)
         let resting = self.velocity_mps[2] == R::ZERO;
         for a in 0..3 {
             let dir = if v[a] > R::ZERO { 1 } else { -1 };
-            let (gap, by) = match seated {
-                Some(_) => (0, None),
-                None => self.gap_nm(&body, a, dir, self.held),
+            let (gap, by) = match (mated, a) {
+                // The knobs hold a mated block sideways, and up once seated.
+                (Some(_), 0 | 1) => (0, None),
+                (Some(_), _) if seated.is_some() && dir > 0 => (0, None),
+                _ => self.gap_nm(&body, a, dir, self.held),
             };
             if a == 2 && dir < 0 {
                 below = by;
@@ -519,6 +536,7 @@ impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
                     if resting && normal_n[2] > R::of(k.mate_force_n) && self.aligned(h, j, &k) =>
                 {
                     self.on[h] = Some(j);
+                    snap = Some((h, j, k));
                 }
                 _ => {}
             }
@@ -553,6 +571,9 @@ impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
         }
         self.wake_above_held();
         self.carry_held();
+        if let Some((h, j, k)) = snap {
+            self.snap_to_grid(h, j, &k);
+        }
         self.settle();
         [0, 1, 2].map(|a| ports[a].at(v[a]))
     }
