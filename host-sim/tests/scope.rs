@@ -202,7 +202,7 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
         s.tick();
     }
     let r = s.board.as_ref().unwrap().reply.clone().unwrap();
-    assert!(r.starts_with("refused: NotProvenStable"), "{r}");
+    assert!(r.starts_with("refused on axis 0: NotProvenStable"), "{r}");
     s.disconnect();
     // Free running (a board on its own sensors): the scope only feeds the
     // watchdog and talks; the gain answers still come back.
