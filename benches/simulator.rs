@@ -9,6 +9,7 @@ use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use host_sim::engine::human::GraspKind;
 use host_sim::engine::plant::{Device, Method, Stepper};
 use host_sim::engine::servo::SceneServo;
+use host_sim::engine::xyz::{XyzScene, XyzSimulation};
 use host_sim::{Scene, Simulation};
 use std::hint::black_box;
 use std::path::Path;
@@ -32,12 +33,24 @@ fn scene(sets: &[&str]) -> Scene {
 
 fn one_second(c: &mut Criterion, name: &str, sets: &[&str]) {
     let s = scene(sets);
+    ticks_of(
+        c,
+        name,
+        || Simulation::new(s.clone()).unwrap(),
+        |sim| {
+            black_box(sim.step());
+        },
+    );
+}
+
+/// 1,000 ticks (one simulated second) of fresh simulations from `make`.
+fn ticks_of<S>(c: &mut Criterion, name: &str, make: impl Fn() -> S, mut tick: impl FnMut(&mut S)) {
     c.bench_function(name, |b| {
         b.iter_batched_ref(
-            || Simulation::new(s.clone()).unwrap(),
+            &make,
             |sim| {
                 for _ in 0..1000 {
-                    black_box(sim.step());
+                    tick(sim);
                 }
             },
             BatchSize::LargeInput,
@@ -120,9 +133,37 @@ fn effects(c: &mut Criterion) {
     );
 }
 
+/// One simulated second of a three-axis linear scene (Table I's bilateral
+/// maximum in 3-D: three 5-DOF Excalibur plants, the 3-axis servo; goal
+/// 5,000x real time, 200 us) and of the 50-block world.
+fn three_axes(c: &mut Criterion) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (name, file) in [
+        (
+            "1 s, 3 axes, Table I bilateral maximum in 3-D",
+            "scenes/xyz/table1/bilateral_maximum.toml",
+        ),
+        (
+            "1 s, 3 axes, the 50-block world",
+            "scenes/xyz/fifty_blocks.toml",
+        ),
+    ] {
+        let mut s = XyzScene::load(&root.join(file), &["duration_s=1000".to_string()]).unwrap();
+        s.plant.model = root.join("models/excalibur.toml");
+        ticks_of(
+            c,
+            name,
+            || XyzSimulation::new(s.clone()).unwrap(),
+            |sim| {
+                black_box(sim.step());
+            },
+        );
+    }
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = effects, parts
+    targets = effects, parts, three_axes
 }
 criterion_main!(benches);

@@ -516,11 +516,9 @@ impl Session {
 
 /// Check gains for sign and finiteness before any analysis.
 fn gain(name: &str, v: f64) -> Result<f64, String> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(v)
-    } else {
-        Err(format!("--{name} {v}: must be a finite number >= 0"))
-    }
+    (v.is_finite() && v >= 0.0)
+        .then_some(v)
+        .ok_or_else(|| format!("--{name} {v}: must be a finite number >= 0"))
 }
 
 fn impedance_design_on(

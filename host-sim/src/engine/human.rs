@@ -43,16 +43,18 @@ impl GraspKind {
     }
 }
 
-/// One scripted event, starting at `at_s`.
+/// One scripted event, starting at `at_s`. `V` is a position or force
+/// along the axis (`f64`), or along each of three (`[f64; 3]`, a
+/// three-axis scene's hand).
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-pub enum Event {
+pub enum Event<V = f64> {
     /// Move the hand linearly to `to_m` over `over_s`.
     Move {
         /// Start (s).
         at_s: f64,
         /// Target hand position (m).
-        to_m: f64,
+        to_m: V,
         /// Duration (s), > 0.
         over_s: f64,
     },
@@ -68,7 +70,7 @@ pub enum Event {
         /// Start (s).
         at_s: f64,
         /// Amplitude (m).
-        amplitude_m: f64,
+        amplitude_m: V,
         /// Frequency (Hz).
         frequency_hz: f64,
         /// Duration (s).
@@ -80,10 +82,44 @@ pub enum Event {
         /// Start (s).
         at_s: f64,
         /// Force along +x (N).
-        force_n: f64,
+        force_n: V,
         /// Duration (s).
         for_s: f64,
     },
+}
+
+impl<V: Copy> Event<V> {
+    /// This event along one axis, `pick` reading its value there.
+    pub fn along<U>(&self, pick: impl Fn(V) -> U) -> Event<U> {
+        match *self {
+            Event::Move { at_s, to_m, over_s } => Event::Move {
+                at_s,
+                to_m: pick(to_m),
+                over_s,
+            },
+            Event::Grip { at_s, grasp } => Event::Grip { at_s, grasp },
+            Event::Shake {
+                at_s,
+                amplitude_m,
+                frequency_hz,
+                for_s,
+            } => Event::Shake {
+                at_s,
+                amplitude_m: pick(amplitude_m),
+                frequency_hz,
+                for_s,
+            },
+            Event::Force {
+                at_s,
+                force_n,
+                for_s,
+            } => Event::Force {
+                at_s,
+                force_n: pick(force_n),
+                for_s,
+            },
+        }
+    }
 }
 
 impl Event {

@@ -14,6 +14,9 @@ pub struct Scene {
     /// A name for reports.
     #[serde(default)]
     pub name: String,
+    /// How many axes the device has: 1 here (absent means 1); a scene of
+    /// three is an [`XyzScene`](crate::engine::xyz::XyzScene).
+    pub axes: Option<u8>,
     /// Simulated time (s).
     #[serde(default = "default_duration")]
     pub duration_s: f64,
@@ -574,6 +577,96 @@ fn locate(text: &str, table: &str, message: &str) -> Option<(usize, String)> {
         .and_then(|(i, l)| Some((i + 1, format!("{table}.{}", l.split('=').next()?.trim()))))
 }
 
+/// A scene file's text; the error names the file.
+pub fn read(path: &Path) -> Result<String, SceneError> {
+    std::fs::read_to_string(path)
+        .map_err(|e| SceneError(format!("{}: cannot read: {e}", path.display())))
+}
+
+/// `scene` if `check` passes it; the error names `source`.
+pub fn checked<T>(
+    scene: T,
+    source: &str,
+    check: impl FnOnce(&T) -> Result<(), String>,
+) -> Result<T, SceneError> {
+    check(&scene).map_err(|m| SceneError(format!("{source}: {m}")))?;
+    Ok(scene)
+}
+
+/// Parse TOML scene text into `T`, applying `--set` overrides; an error
+/// names `source`, the line and the key. Both the one-axis and the
+/// three-axis scenes are read through it.
+pub fn parse_toml<T: serde::de::DeserializeOwned>(
+    text: &str,
+    source: &str,
+    sets: &[String],
+) -> Result<T, SceneError> {
+    let line_of = |e: &toml::de::Error| {
+        e.span()
+            .map(|s| {
+                format!(
+                    "line {}: ",
+                    text[..s.start.min(text.len())].matches('\n').count() + 1
+                )
+            })
+            .unwrap_or_default()
+    };
+    let mut table: toml::Table = toml::from_str(text)
+        .map_err(|e| SceneError(format!("{source}: {}{}", line_of(&e), e.message())))?;
+    let value: T = if sets.is_empty() {
+        // serde_path_to_error names the field; toml's span alone points
+        // at the enclosing table for a bad value inside one.
+        let de = toml::Deserializer::parse(text)
+            .map_err(|e| SceneError(format!("{source}: {}{}", line_of(&e), e.message())))?;
+        serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            let (line, key) = locate(text, &path, inner.message())
+                .map(|(l, k)| (format!("line {l}: "), format!("{k}: ")))
+                .unwrap_or_else(|| {
+                    let field = if path.is_empty() || path == "." {
+                        String::new()
+                    } else {
+                        format!("{path}: ")
+                    };
+                    (line_of(&inner), field)
+                });
+            SceneError(format!("{source}: {line}{key}{}", inner.message()))
+        })?
+    } else {
+        for s in sets {
+            apply_set(&mut table, s)?;
+        }
+        // The overridden scene has no lines of its own: name the key.
+        let merged = toml::to_string(&table).map_err(|e| SceneError(format!("{source}: {e}")))?;
+        toml::from_str(&merged).map_err(|e| {
+            let key = e
+                .span()
+                .and_then(|s| {
+                    merged[..s.start.min(merged.len())]
+                        .lines()
+                        .last()
+                        .map(str::to_string)
+                })
+                .unwrap_or_default();
+            let quoted = e.message().split('"').nth(1).unwrap_or("\u{0}");
+            if let Some(set) = sets
+                .iter()
+                .find(|s| s.split_once('=').is_some_and(|(_, v)| v.trim() == quoted))
+            {
+                return SceneError(format!("{source}: --set {set}: {}", e.message()));
+            }
+            let near = if key.trim().is_empty() {
+                String::new()
+            } else {
+                format!(" (at `{}`)", key.trim())
+            };
+            SceneError(format!("{source} with --set: {}{near}", e.message()))
+        })?
+    };
+    Ok(value)
+}
+
 impl Scene {
     /// The control period the scene runs at (s).
     pub fn period(&self) -> f64 {
@@ -589,81 +682,12 @@ impl Scene {
 
     /// Read a scene file, apply `--set` overrides, and check it.
     pub fn load(path: &Path, sets: &[String]) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SceneError(format!("{}: cannot read: {e}", path.display())))?;
-        Self::parse(&text, &path.display().to_string(), sets)
+        Self::parse(&read(path)?, &path.display().to_string(), sets)
     }
 
     /// Parse scene text; `source` names it in errors.
     pub fn parse(text: &str, source: &str, sets: &[String]) -> Result<Self, SceneError> {
-        let line_of = |e: &toml::de::Error| {
-            e.span()
-                .map(|s| {
-                    format!(
-                        "line {}: ",
-                        text[..s.start.min(text.len())].matches('\n').count() + 1
-                    )
-                })
-                .unwrap_or_default()
-        };
-        let mut table: toml::Table = toml::from_str(text)
-            .map_err(|e| SceneError(format!("{source}: {}{}", line_of(&e), e.message())))?;
-        let scene: Scene = if sets.is_empty() {
-            // serde_path_to_error names the field; toml's span alone points
-            // at the enclosing table for a bad value inside one.
-            let de = toml::Deserializer::parse(text)
-                .map_err(|e| SceneError(format!("{source}: {}{}", line_of(&e), e.message())))?;
-            serde_path_to_error::deserialize(de).map_err(|e| {
-                let path = e.path().to_string();
-                let inner = e.into_inner();
-                let (line, key) = locate(text, &path, inner.message())
-                    .map(|(l, k)| (format!("line {l}: "), format!("{k}: ")))
-                    .unwrap_or_else(|| {
-                        let field = if path.is_empty() || path == "." {
-                            String::new()
-                        } else {
-                            format!("{path}: ")
-                        };
-                        (line_of(&inner), field)
-                    });
-                SceneError(format!("{source}: {line}{key}{}", inner.message()))
-            })?
-        } else {
-            for s in sets {
-                apply_set(&mut table, s)?;
-            }
-            // The overridden scene has no lines of its own: name the key.
-            let merged =
-                toml::to_string(&table).map_err(|e| SceneError(format!("{source}: {e}")))?;
-            toml::from_str(&merged).map_err(|e| {
-                let key = e
-                    .span()
-                    .and_then(|s| {
-                        merged[..s.start.min(merged.len())]
-                            .lines()
-                            .last()
-                            .map(str::to_string)
-                    })
-                    .unwrap_or_default();
-                let quoted = e.message().split('"').nth(1).unwrap_or("\u{0}");
-                if let Some(set) = sets
-                    .iter()
-                    .find(|s| s.split_once('=').is_some_and(|(_, v)| v.trim() == quoted))
-                {
-                    return SceneError(format!("{source}: --set {set}: {}", e.message()));
-                }
-                let near = if key.trim().is_empty() {
-                    String::new()
-                } else {
-                    format!(" (at `{}`)", key.trim())
-                };
-                SceneError(format!("{source} with --set: {}{near}", e.message()))
-            })?
-        };
-        scene
-            .check()
-            .map_err(|m| SceneError(format!("{source}: {m}")))?;
-        Ok(scene)
+        checked(parse_toml(text, source, sets)?, source, Self::check)
     }
 
     /// Physical checks beyond the types; the message names the field.
@@ -690,6 +714,11 @@ impl Scene {
             nonneg("ve.stiffness_npm", k)?;
             nonneg("ve.damping_nspm", b)
         };
+        if let Some(n) = self.axes.filter(|&n| n != 1) {
+            return Err(format!(
+                "axes = {n}: a one-axis scene has axes = 1; a three-axis scene is read as one"
+            ));
+        }
         pos("duration_s", self.duration_s)?;
         if let Some(t) = self.period_s {
             if !(t.is_finite() && (1e-6..=0.1).contains(&t)) {

@@ -102,13 +102,13 @@ pub struct Report {
 /// once: one entry when its direction is a unit vector (a handle or an
 /// actuator on one coordinate, the usual case), a dot product otherwise.
 #[derive(Clone, Debug)]
-enum Pick {
+pub(crate) enum Pick {
     At(usize),
     Dot(Vec<f64>),
 }
 
 impl Pick {
-    fn new(dir: &[f64]) -> Self {
+    pub(crate) fn new(dir: &[f64]) -> Self {
         let ones: Vec<usize> = (0..dir.len()).filter(|&i| dir[i] != 0.0).collect();
         match ones[..] {
             [i] if dir[i] == 1.0 => Pick::At(i),
@@ -116,7 +116,7 @@ impl Pick {
         }
     }
 
-    fn of(&self, q: &[f64]) -> f64 {
+    pub(crate) fn of(&self, q: &[f64]) -> f64 {
         match self {
             Pick::At(i) => q[*i],
             Pick::Dot(d) => d.iter().zip(q).map(|(a, b)| a * b).sum(),
