@@ -26,25 +26,36 @@ fn changed(a: &RgbaImage, b: &RgbaImage, (x0, x1): (u32, u32), (y0, y1): (u32, u
     n as f64 / ((x1 - x0) as f64 * (y1 - y0) as f64)
 }
 
-#[test]
-#[ignore = "needs xvfb-run (CI installs xvfb); run with --ignored"]
-fn the_scope_draws_and_its_plots_move() {
-    let dir = std::env::temp_dir().join(format!("twoport-shot-{}", std::process::id()));
+/// The scope on `scene` (under `scenes/`) in Xvfb for `seconds`: its
+/// folder, and the shots at half-time and at the end.
+fn shots(scene: &str, seconds: u32) -> (std::path::PathBuf, RgbaImage, RgbaImage) {
+    let name = scene.replace(['/', '.'], "-");
+    let dir = std::env::temp_dir().join(format!("twoport-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let out = dir.join("scope.png");
+    let out = dir.join("shot.png");
     let status = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 1400x900x24"])
         .arg(env!("CARGO_BIN_EXE_host-sim"))
         .arg("--scene")
-        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/stiff_wall.toml"))
+        .arg(
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../scenes")
+                .join(scene),
+        )
         .arg("--screenshot")
         .arg(&out)
-        .args(["--exit-after", "3"])
+        .args(["--exit-after", &seconds.to_string()])
         .status()
         .expect("xvfb-run runs (install xvfb)");
     assert!(status.success(), "host-sim under Xvfb: {status}");
-    let last = load(&out);
     let first = load(&host_sim::scope::window::first_shot_path(&out));
+    (dir, first, load(&out))
+}
+
+#[test]
+#[ignore = "needs xvfb-run (CI installs xvfb); run with --ignored"]
+fn the_scope_draws_and_its_plots_move() {
+    let (dir, first, last) = shots("stiff_wall.toml", 3);
     assert_eq!(first.dimensions(), last.dimensions());
     let (w, h) = last.dimensions();
     assert!(w >= 800 && h >= 600, "{w} x {h}");
@@ -63,5 +74,23 @@ fn the_scope_draws_and_its_plots_move() {
         controls < plots,
         "controls {controls:.4} vs plots {plots:.4}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The three-axis scope under Xvfb: the stacking scene for three seconds.
+/// The world view is drawn (blocks, cursor, the force plot) and the cursor
+/// and the block it carries moved between the two shots.
+#[test]
+#[ignore = "needs xvfb-run (CI installs xvfb); run with --ignored"]
+fn the_world_view_draws_and_its_blocks_move() {
+    let (dir, first, last) = shots("xyz/stack_three.toml", 6);
+    let (w, h) = last.dimensions();
+    let mut colours: Vec<[u8; 4]> = last.pixels().map(|p| p.0).collect();
+    colours.sort_unstable();
+    colours.dedup();
+    assert!(colours.len() > 30, "{} colours", colours.len());
+    // The projections (the upper half) changed: the block was carried.
+    let world = changed(&first, &last, (0, w), (60, h / 2));
+    assert!(world > 0.001, "world view changed by {world:.4}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -1,6 +1,7 @@
 //! The egui scope: its state apart from its drawing (`app`), the panels
 //! (`ui`), the window (`window`) and the sample rings it draws from
-//! (`rings`).
+//! (`rings`); for a three-axis scene, the world's state (`world`) and view
+//! (`world_ui`).
 
 pub mod app;
 pub mod rings;
@@ -8,3 +9,6 @@ pub mod rings;
 pub mod ui;
 #[cfg(feature = "gui")]
 pub mod window;
+pub mod world;
+#[cfg(feature = "gui")]
+pub mod world_ui;

@@ -29,14 +29,25 @@ pub fn first_shot_path(p: &Path) -> PathBuf {
     ))
 }
 
-struct ScopeApp {
-    state: ScopeState,
-    link: crate::scope::ui::BoardChoice,
+/// A scripted run's clock and the screenshots it has taken.
+struct Shots {
     script: Script,
     started: Instant,
     last_frame: Instant,
     shots: u32,
     saved: Arc<Mutex<Vec<Result<PathBuf, String>>>>,
+}
+
+struct ScopeApp {
+    state: ScopeState,
+    link: crate::scope::ui::BoardChoice,
+    shots: Shots,
+}
+
+/// The scope of a three-axis scene: the world view.
+struct WorldApp {
+    state: crate::scope::world::WorldState,
+    shots: Shots,
 }
 
 fn save_png(img: &egui::ColorImage, path: &Path) -> Result<PathBuf, String> {
@@ -47,7 +58,25 @@ fn save_png(img: &egui::ColorImage, path: &Path) -> Result<PathBuf, String> {
     Ok(path.to_path_buf())
 }
 
-impl ScopeApp {
+impl Shots {
+    fn new(script: Script) -> Self {
+        Shots {
+            script,
+            started: Instant::now(),
+            last_frame: Instant::now(),
+            shots: 0,
+            saved: Arc::new(Mutex::new(Vec::new())),
+        }
+    }
+
+    /// Wall time (s) since the last frame.
+    fn frame(&mut self) -> f64 {
+        let now = Instant::now();
+        let dt = (now - self.last_frame).as_secs_f64();
+        self.last_frame = now;
+        dt
+    }
+
     fn shoot(&mut self, ctx: &egui::Context, path: PathBuf) {
         let saved = self.saved.clone();
         ctx.request_screenshot(move |img| {
@@ -83,12 +112,19 @@ impl ScopeApp {
 impl eframe::App for ScopeApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
-        let now = Instant::now();
-        let dt = (now - self.last_frame).as_secs_f64();
-        self.last_frame = now;
-        self.state.advance(dt);
+        self.state.advance(self.shots.frame());
         crate::scope::ui::scope(ui, &mut self.state, &mut self.link);
-        self.scripted(&ctx);
+        self.shots.scripted(&ctx);
+        ctx.request_repaint();
+    }
+}
+
+impl eframe::App for WorldApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        self.state.advance(self.shots.frame());
+        crate::scope::world_ui::world(ui, &mut self.state);
+        self.shots.scripted(&ctx);
         ctx.request_repaint();
     }
 }
@@ -100,18 +136,23 @@ pub fn display_available() -> bool {
         .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()))
 }
 
-/// Open the scope on `scene`; returns the screenshots saved.
+/// Open the scope on `scene` (the world view for a three-axis scene);
+/// returns the screenshots saved.
 pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, String> {
-    let state = ScopeState::open(scene)?;
-    let saved = Arc::new(Mutex::new(Vec::new()));
-    let app = ScopeApp {
-        state,
-        link: crate::scope::ui::BoardChoice::default(),
-        script,
-        started: Instant::now(),
-        last_frame: Instant::now(),
-        shots: 0,
-        saved: saved.clone(),
+    let shots = Shots::new(script);
+    let saved = shots.saved.clone();
+    let text = std::fs::read_to_string(scene).unwrap_or_default();
+    let app: Box<dyn eframe::App> = if crate::engine::xyz::axes_of(&text) == Some(3) {
+        Box::new(WorldApp {
+            state: crate::scope::world::WorldState::open(scene)?,
+            shots,
+        })
+    } else {
+        Box::new(ScopeApp {
+            state: ScopeState::open(scene)?,
+            link: crate::scope::ui::BoardChoice::default(),
+            shots,
+        })
     };
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
@@ -119,7 +160,7 @@ pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, String> {
             .with_title("twoport scope"),
         ..Default::default()
     };
-    eframe::run_native("twoport scope", options, Box::new(|_cc| Ok(Box::new(app))))
+    eframe::run_native("twoport scope", options, Box::new(|_cc| Ok(app)))
         .map_err(|e| format!("the window would not open: {e}"))?;
     let v = saved.lock().map(|v| v.clone()).unwrap_or_default();
     v.into_iter().collect()

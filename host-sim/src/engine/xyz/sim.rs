@@ -120,6 +120,9 @@ pub struct XyzSimulation {
     detectors: [Detector; 3],
     tick: u64,
     total_ticks: u64,
+    /// The scope's mouse: where it has dragged the hand, beyond the
+    /// script (m).
+    hand_offset_m: [f64; 3],
     failure: Option<String>,
     peak_force: f64,
 }
@@ -229,6 +232,7 @@ impl XyzSimulation {
             detectors: [0, 1, 2].map(|_| Detector::new(total_ticks, quiet, 1000)),
             failure: None,
             peak_force: 0.0,
+            hand_offset_m: [0.0; 3],
             scene,
         })
     }
@@ -236,6 +240,35 @@ impl XyzSimulation {
     /// The running servo and its world.
     pub fn servo(&self) -> &AxesServo<XyzWorld, f32, 3> {
         &self.servo
+    }
+
+    /// Move the hand by `offset_m` (m) beyond where the script has it:
+    /// the scope's mouse dragging it. A grip is needed for it to pull.
+    pub fn set_hand_offset(&mut self, offset_m: [f64; 3]) {
+        if offset_m.iter().all(|x| x.is_finite()) {
+            self.hand_offset_m = offset_m;
+        }
+    }
+
+    /// Grab the block the cursor touches (the scope's button); whether
+    /// one was there.
+    pub fn grab(&mut self) -> bool {
+        match self.servo.world_mut() {
+            XyzWorld::Blocks(w) => w.grab(),
+            XyzWorld::Bilateral(_) => false,
+        }
+    }
+
+    /// Let go of the held block.
+    pub fn release(&mut self) {
+        if let XyzWorld::Blocks(w) = self.servo.world_mut() {
+            w.release();
+        }
+    }
+
+    /// Ticks run so far.
+    pub fn ticks(&self) -> u64 {
+        self.tick
     }
 
     /// Ticks in the scene's duration.
@@ -278,7 +311,8 @@ impl XyzSimulation {
         let total: f64 = f.iter().sum();
         let mut handle_m = [0.0; 3];
         for a in 0..3 {
-            let hand = self.humans[a].at(t);
+            let mut hand = self.humans[a].at(t);
+            hand.position_m += self.hand_offset_m[a];
             let f_a = f[a] + c * (total - f[a]);
             let p = &mut self.plants[a];
             let i = p

@@ -1,0 +1,121 @@
+//! The world view of a three-axis scene: a top (x-y) and a side (x-z)
+//! projection with the blocks, the cursor and the held block, the grab
+//! button, and each axis's force on one time axis. Dragging in a
+//! projection drags the hand along its two axes.
+
+use crate::scope::world::WorldState;
+use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, Ui, Vec2};
+use egui_plot::{Legend, Line, Plot, PlotPoints};
+
+/// The span each projection shows (m): the Excalibur's workspace.
+const SPAN_M: [(f64, f64); 3] = [(-0.15, 0.15), (-0.15, 0.15), (0.0, 0.2)];
+
+/// The whole view.
+pub fn world(ui: &mut Ui, s: &mut WorldState) {
+    ui.heading(s.name().to_string());
+    status(ui, s);
+    ui.horizontal(|ui| {
+        let w = (ui.available_width() / 2.0 - 8.0).max(100.0);
+        projection(ui, s, [0, 1], "top: x right, y up", w);
+        projection(ui, s, [0, 2], "side: x right, z up", w);
+    });
+    forces(ui, s);
+}
+
+fn status(ui: &mut Ui, s: &mut WorldState) {
+    ui.horizontal(|ui| {
+        let t = s.last.map_or(0.0, |l| l.t_s);
+        ui.label(format!("t = {t:.2} s"));
+        let c = s.cursor_m();
+        ui.label(format!(
+            "cursor ({:.1}, {:.1}, {:.1}) mm",
+            c[0] * 1e3,
+            c[1] * 1e3,
+            c[2] * 1e3
+        ));
+        let label = match s.held() {
+            Some(i) => format!("let go of block {i}"),
+            None => "grab".to_string(),
+        };
+        if ui.button(label).clicked() {
+            s.toggle_grab();
+        }
+        if let Some(why) = &s.stopped {
+            ui.label(why.clone());
+        }
+    });
+}
+
+/// One projection onto `axes` (the first drawn right, the second up).
+fn projection(ui: &mut Ui, s: &mut WorldState, axes: [usize; 2], title: &str, width: f32) {
+    ui.vertical(|ui| {
+        ui.label(title);
+        let (resp, painter) = ui.allocate_painter(Vec2::new(width, width * 0.75), Sense::drag());
+        let r = resp.rect;
+        painter.rect_filled(r, 2.0, Color32::from_gray(24));
+        let [(ax0, ax1), (ay0, ay1)] = axes.map(|a| SPAN_M[a]);
+        let to_px = |x: f64, y: f64| {
+            Pos2::new(
+                r.left() + ((x - ax0) / (ax1 - ax0)) as f32 * r.width(),
+                r.bottom() - ((y - ay0) / (ay1 - ay0)) as f32 * r.height(),
+            )
+        };
+        let held = s.held();
+        for (i, b) in s.blocks().iter().enumerate() {
+            let lo = axes.map(|a| b.min[a].nm() as f64 * 1e-9);
+            let hi = [0, 1].map(|k| lo[k] + b.size_nm[axes[k]] as f64 * 1e-9);
+            let rect = Rect::from_two_pos(to_px(lo[0], lo[1]), to_px(hi[0], hi[1]));
+            let fill = if Some(i) == held {
+                Color32::from_rgb(240, 160, 40)
+            } else {
+                Color32::from_rgb(70, 110, 170)
+            };
+            painter.rect_filled(rect, 0.0, fill);
+            painter.rect_stroke(
+                rect,
+                0.0,
+                Stroke::new(1.0, Color32::from_gray(200)),
+                egui::StrokeKind::Inside,
+            );
+        }
+        let c = s.cursor_m();
+        painter.circle_filled(
+            to_px(c[axes[0]], c[axes[1]]),
+            4.0,
+            Color32::from_rgb(230, 60, 60),
+        );
+        if resp.dragged() {
+            let d = resp.drag_delta();
+            let mut m = [0.0; 3];
+            m[axes[0]] = d.x as f64 / r.width() as f64 * (ax1 - ax0);
+            m[axes[1]] = -d.y as f64 / r.height() as f64 * (ay1 - ay0);
+            s.drag(m);
+        }
+    });
+}
+
+/// Each axis's actuator force over the last seconds.
+fn forces(ui: &mut Ui, s: &WorldState) {
+    const COLORS: [Color32; 3] = [
+        Color32::from_rgb(230, 90, 90),
+        Color32::from_rgb(90, 200, 110),
+        Color32::from_rgb(100, 150, 240),
+    ];
+    Plot::new("world-forces")
+        .height(ui.available_height().max(80.0))
+        .legend(Legend::default())
+        .allow_drag(false)
+        .allow_zoom(false)
+        .allow_scroll(false)
+        .show(ui, |p| {
+            for (i, (ring, name)) in s
+                .forces
+                .iter()
+                .zip(["f_x (N)", "f_y (N)", "f_z (N)"])
+                .enumerate()
+            {
+                let pts: Vec<[f64; 2]> = ring.iter().map(|&(t, f)| [t, f]).collect();
+                p.line(Line::new(name, PlotPoints::from(pts)).color(COLORS[i]));
+            }
+        });
+}
