@@ -102,6 +102,10 @@ fn bad_three_axis_scenes_are_refused_by_name() {
             base.replace("over_s = 0.8", "over_s = -1.0"),
             "human.script[0]: move needs",
         ),
+        (
+            base.replace("kind = \"blocks\"", "kind = \"blocks\"\ngrab_at_s = [-1.0]"),
+            "ve.grab_at_s: -1 is not a time",
+        ),
     ] {
         let e = XyzScene::parse(&change, "bad.toml", &[])
             .unwrap_err()

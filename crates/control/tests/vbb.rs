@@ -322,3 +322,23 @@ fn knobs_carry_mate_hold_and_part() {
         assert!(w.blocks()[1].min[2].nm() > a_top + 5_000_000, "parted");
     }
 }
+
+/// A world with knobs of no pitch, a negative friction or more blocks
+/// than it holds is refused by name.
+#[test]
+fn bad_worlds_are_refused_by_name() {
+    let mut cfg = VbbConfig::excalibur(T);
+    if let Some(k) = cfg.knobs.as_mut() {
+        k.pitch_nm = 0;
+    }
+    let e = World8::new(cfg, &[]).unwrap_err();
+    assert_eq!(e.name, "vbb.knobs.pitch_nm");
+    let cfg = VbbConfig {
+        friction: -0.1,
+        ..VbbConfig::excalibur(T)
+    };
+    assert_eq!(World8::new(cfg, &[]).unwrap_err().name, "vbb.friction");
+    let many = [cube(0.0, 0.0, 0.0, 0.01, 0.1); 9];
+    let e = World8::new(VbbConfig::excalibur(T), &many).unwrap_err();
+    assert_eq!(e.name, "vbb.blocks");
+}

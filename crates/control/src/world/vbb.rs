@@ -216,6 +216,13 @@ impl<R: Real, const B: usize> Vbb<R, B> {
                 problem: "more blocks than the world holds",
             });
         }
+        if let Some(k) = cfg.knobs {
+            param::positive("vbb.knobs.pitch_nm", k.pitch_nm as f32)?;
+            param::non_negative("vbb.knobs.height_nm", k.height_nm as f32)?;
+            param::non_negative("vbb.knobs.tolerance_nm", k.tolerance_nm as f32)?;
+            param::non_negative("vbb.knobs.mate_force_n (N)", k.mate_force_n)?;
+            param::non_negative("vbb.knobs.part_force_n (N)", k.part_force_n)?;
+        }
         let (lo, hi) = (cfg.workspace[0], cfg.workspace[1]);
         if (0..3).any(|a| lo[a].nm() >= hi[a].nm()) {
             return Err(ParamError {

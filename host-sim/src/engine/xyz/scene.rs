@@ -194,9 +194,16 @@ impl XyzScene {
             blocks,
             cursor_mass_kg,
             friction,
+            grab_at_s,
+            release_at_s,
             ..
         } = &self.ve
         {
+            for (name, times) in [("grab_at_s", grab_at_s), ("release_at_s", release_at_s)] {
+                if let Some(t) = times.iter().find(|t| !(t.is_finite() && **t >= 0.0)) {
+                    return Err(format!("ve.{name}: {t} is not a time >= 0 (s)"));
+                }
+            }
             if blocks.len() > MAX_BLOCKS {
                 return Err(format!(
                     "ve.blocks: {} blocks, the world holds {MAX_BLOCKS}",
