@@ -113,3 +113,22 @@ fn bad_three_axis_scenes_are_refused_by_name() {
         assert!(e.starts_with("bad.toml: ") && e.contains(want), "{e}");
     }
 }
+
+/// The paper's explicit integration, an option: a 20 g cursor rings with
+/// it where the passive default is stable, and a 0.1 kg one is stable
+/// with both (one axis's lightest stable explicit cursor is 0.093 kg).
+#[test]
+fn the_explicit_world_needs_a_heavier_cursor() {
+    for (explicit, mass, stable) in [
+        ("false", "0.02", true),
+        ("true", "0.02", false),
+        ("true", "0.1", true),
+    ] {
+        let sets = [
+            &format!("ve.explicit={explicit}")[..],
+            &format!("ve.cursor_mass_kg={mass}")[..],
+        ];
+        let (r, _) = run("table1/free_maximum.toml", &sets);
+        assert_eq!(r.stable, stable, "explicit {explicit}, {mass} kg: {r:?}");
+    }
+}

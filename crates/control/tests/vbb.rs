@@ -342,3 +342,53 @@ fn bad_worlds_are_refused_by_name() {
     let e = World8::new(VbbConfig::excalibur(T), &many).unwrap_err();
     assert_eq!(e.name, "vbb.blocks");
 }
+
+/// The paper's explicit scheme against the passive default: a 20 g cursor
+/// pulled 1 mm off the device held still, through the paper's coupling.
+/// Implicit, it settles onto the device; explicit, it rings up until the
+/// amplifier's limit holds the force (the paper's cursor needed 0.25 kg).
+#[test]
+fn the_explicit_scheme_rings_where_the_implicit_one_settles() {
+    use twoport_control::servo::{AxesFrame, AxesServo, ImpedanceGains};
+    use twoport_control::{Encoder, SafetyConfig};
+    // The largest force the coupling asked for over the last 100 of 500
+    // ticks (N).
+    let late_command = |explicit: bool| {
+        let cfg = VbbConfig {
+            cursor_mass_kg: 0.02,
+            explicit,
+            ..VbbConfig::excalibur(T)
+        };
+        let w: World8 = Vbb::new(cfg, &[]).unwrap();
+        let start = w.cursor();
+        let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+        let g = ImpedanceGains::new(51_000.0, 90.0).into();
+        let safety = SafetyConfig {
+            ramp_ticks: 1,
+            ..SafetyConfig::excalibur()
+        };
+        let mut s = AxesServo::new([g; 3], [enc; 3], [safety; 3], w).unwrap();
+        s.calibrate(start);
+        s.enable().unwrap();
+        // (After enable, which re-aligns the world to the device.)
+        s.world_mut().place_cursor([0.001, 0.0, start[2].m()]);
+        let mut worst = 0.0f32;
+        for k in 0..500u32 {
+            let out = s.tick(&AxesFrame {
+                tick: k,
+                encoder_raw: [0; 3],
+                load_cell_n: [0.0; 3],
+                dead_man_closed: true,
+            });
+            assert!(out.faults.is_empty(), "{}", out.faults);
+            if k >= 400 {
+                worst = worst.max(out.commanded_force_n[0].abs());
+            }
+        }
+        worst
+    };
+    let implicit = late_command(false);
+    assert!(implicit < 0.01, "implicit: {implicit} N");
+    let explicit = late_command(true);
+    assert!(explicit > 200.0, "explicit: {explicit} N");
+}

@@ -89,6 +89,9 @@ pub enum XyzVe {
         /// Knobs on the blocks' tops.
         #[serde(default = "default_true")]
         knobs: bool,
+        /// The paper's explicit integration instead of the passive one.
+        #[serde(default)]
+        explicit: bool,
         /// Grab the touched block at these times (s).
         #[serde(default)]
         grab_at_s: Vec<f64>,

@@ -137,9 +137,11 @@ fn world_of(ve: &XyzVe) -> Result<XyzWorld, String> {
             cursor_mass_kg,
             friction,
             knobs,
+            explicit,
             ..
         } => {
             let mut cfg = VbbConfig::excalibur(T as f32);
+            cfg.explicit = *explicit;
             cfg.cursor_mass_kg = *cursor_mass_kg as f32;
             cfg.friction = *friction as f32;
             if !knobs {
