@@ -231,6 +231,11 @@ struct AxisRun {
 /// What a command's arguments share.
 trait HasCommon {
     fn common(&mut self) -> &mut Common;
+    /// Whether the command prints Rust source (a module per axis then,
+    /// with no text heading).
+    fn rust(&self) -> bool {
+        false
+    }
 }
 
 macro_rules! has_common {
@@ -247,10 +252,26 @@ has_common!(
     DesignImpedance,
     DesignAdmittance,
     ImpedanceGains,
-    AdmittanceGains,
-    RegionImpedance,
-    RegionAdmittance
+    AdmittanceGains
 );
+
+impl HasCommon for RegionImpedance {
+    fn common(&mut self) -> &mut Common {
+        &mut self.common
+    }
+    fn rust(&self) -> bool {
+        self.grid.rust
+    }
+}
+
+impl HasCommon for RegionAdmittance {
+    fn common(&mut self) -> &mut Common {
+        &mut self.common
+    }
+    fn rust(&self) -> bool {
+        self.grid.rust
+    }
+}
 
 impl HasCommon for ZrangeImpedance {
     fn common(&mut self) -> &mut Common {
@@ -269,6 +290,12 @@ impl<I: Args + HasCommon, A: Args + HasCommon> HasCommon for Display<I, A> {
         match self {
             Display::Impedance(i) => i.common(),
             Display::Admittance(a) => a.common(),
+        }
+    }
+    fn rust(&self) -> bool {
+        match self {
+            Display::Impedance(i) => i.rust(),
+            Display::Admittance(a) => a.rust(),
         }
     }
 }
@@ -298,7 +325,7 @@ fn each_axis<A: HasCommon + Clone>(
                 .collect(),
             out: out.clone(),
         });
-        if !json {
+        if !json && !args.rust() {
             println!("axis {}:", axis.name);
         }
         run(&a).map_err(|e| format!("{}, axis {}: {e}", path.display(), axis.name))?;
@@ -935,15 +962,35 @@ fn region(d: &Display<RegionImpedance, RegionAdmittance>) -> Result<(), String> 
     };
     if grid.rust {
         let how = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
-        print!(
-            "{}",
-            design::region_rust_source(
-                &rows,
-                bound == "max_stiffness_npm",
-                regulator,
-                &format!("twoport {how}")
-            )
+        let source = design::region_rust_source(
+            &rows,
+            bound == "max_stiffness_npm",
+            regulator,
+            &format!("twoport {how}"),
         );
+        match &s.axis {
+            // A device file: one module per axis, for a board's regions.
+            Some(a) => {
+                let ident: String = a
+                    .name
+                    .chars()
+                    .map(|c| {
+                        if c.is_ascii_alphanumeric() {
+                            c.to_ascii_lowercase()
+                        } else {
+                            '_'
+                        }
+                    })
+                    .collect();
+                println!(
+                    "/// Axis {}'s proven region.\npub mod axis_{ident} {{\nuse super::*;",
+                    a.name
+                );
+                print!("{source}");
+                println!("}}");
+            }
+            None => print!("{source}"),
+        }
         return Ok(());
     }
     let v = json!({"bound": bound, "damping_nspm": rows.iter().map(|r| r.0).collect::<Vec<_>>(),

@@ -349,6 +349,16 @@ fn a_device_file_designs_every_axis_on_its_own_model() {
         let e = TWOPORT.failure(&words(&format!("design impedance --device {file}")));
         assert!(e.contains(file.as_str()) && e.contains(want), "{e}");
     }
+    // A board's regions: one Rust module per axis.
+    let out = TWOPORT.run(&words(
+        "region impedance --b-from 10 --b-to 100 --points 4 --rust --device models/devices/excalibur_xyz.toml",
+    ));
+    let rust = String::from_utf8(out.stdout).unwrap();
+    for axis in ["x", "y", "z"] {
+        assert!(rust.contains(&format!("pub mod axis_{axis} {{")), "{rust}");
+    }
+    assert_eq!(rust.matches("pub const LIMIT").count(), 3);
+    assert_eq!(rust.matches('{').count(), rust.matches('}').count());
     let e = TWOPORT.failure(&words(
         "zrange impedance --k 5e4 --b 90 --device models/devices/excalibur_xyz.toml",
     ));
