@@ -4,7 +4,7 @@ mod arming;
 mod persist;
 
 use crate::io::IoScale;
-use crate::region::{Bound, Region};
+use crate::region::Region;
 use crate::support::BoardSupport;
 use heapless::{Deque, Vec};
 use twoport_control::homing::{Homing, HomingConfig};
@@ -312,42 +312,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
 
     /// Whether `g` is inside the proven region for this board's display.
     fn check(&self, g: &Gains) -> Result<(), Refusal> {
-        if !g.all_finite() {
-            return Err(Refusal::NotFinite);
-        }
-        let r = &self.region;
-        if g.display() != self.servo.display() {
-            return Err(Refusal::WrongDisplay);
-        }
-        let (limit, within) = match *g {
-            Gains::Impedance(g) if r.bound() == Bound::MaxStiffness => {
-                if g.k_npm < 0.0 || g.b_nspm < 0.0 {
-                    return Err(Refusal::OutOfRange);
-                }
-                let limit = r.limit_at(g.b_nspm);
-                (limit, limit.is_some_and(|kmax| g.k_npm <= kmax))
-            }
-            Gains::Admittance(g) if r.bound() == Bound::MinMass => {
-                if g.m_kg <= 0.0 || g.b_nspm <= 0.0 || g.kp_npm < 0.0 || g.bp_nspm < 0.0 {
-                    return Err(Refusal::OutOfRange);
-                }
-                // The region holds for the regulator it was proven with.
-                match r.regulator() {
-                    Some((kp, bp)) if kp == g.kp_npm && bp == g.bp_nspm => {}
-                    Some((kp, _)) => return Err(Refusal::NotProvenStable { limit: kp }),
-                    None => return Err(Refusal::NotProvenStable { limit: 0.0 }),
-                }
-                let limit = r.limit_at(g.b_nspm);
-                (limit, limit.is_some_and(|mmin| g.m_kg >= mmin))
-            }
-            _ => return Err(Refusal::WrongDisplay),
-        };
-        match (within, limit) {
-            (true, _) => Ok(()),
-            (false, limit) => Err(Refusal::NotProvenStable {
-                limit: limit.unwrap_or(0.0),
-            }),
-        }
+        self.region.check(self.servo.display(), g)
     }
 
     fn apply(&mut self, g: Gains) -> GainsReply {

@@ -11,5 +11,5 @@ mod support;
 
 pub use board::{Board, Frame, TX_FRAMES};
 pub use io::{IoScale, DUTY_FULL_SCALE};
-pub use region::{Bound, Region, RegionError};
+pub use region::{check_axes, Bound, Region, RegionError};
 pub use support::{BoardSupport, RawSensors};

@@ -1,5 +1,9 @@
 //! The gains the designer proved absolutely stable, shipped with the
-//! firmware so that the board can refuse anything else.
+//! firmware so that the board can refuse anything else: one region, or one
+//! per axis of a board of several ([`check_axes`]).
+
+use twoport_control::servo::{Display, Gains};
+use twoport_link::{AxisRefusal, Refusal};
 
 /// What a region bounds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,6 +77,46 @@ impl<const N: usize> Region<N> {
         self.regulator
     }
 
+    /// Whether `g` is inside this region, for a servo running `display`;
+    /// the reason when not.
+    pub fn check(&self, display: Display, g: &Gains) -> Result<(), Refusal> {
+        if !g.all_finite() {
+            return Err(Refusal::NotFinite);
+        }
+        if g.display() != display {
+            return Err(Refusal::WrongDisplay);
+        }
+        let (limit, within) = match *g {
+            Gains::Impedance(g) if self.bound() == Bound::MaxStiffness => {
+                if g.k_npm < 0.0 || g.b_nspm < 0.0 {
+                    return Err(Refusal::OutOfRange);
+                }
+                let limit = self.limit_at(g.b_nspm);
+                (limit, limit.is_some_and(|kmax| g.k_npm <= kmax))
+            }
+            Gains::Admittance(g) if self.bound() == Bound::MinMass => {
+                if g.m_kg <= 0.0 || g.b_nspm <= 0.0 || g.kp_npm < 0.0 || g.bp_nspm < 0.0 {
+                    return Err(Refusal::OutOfRange);
+                }
+                // The region holds for the regulator it was proven with.
+                match self.regulator() {
+                    Some((kp, bp)) if kp == g.kp_npm && bp == g.bp_nspm => {}
+                    Some((kp, _)) => return Err(Refusal::NotProvenStable { limit: kp }),
+                    None => return Err(Refusal::NotProvenStable { limit: 0.0 }),
+                }
+                let limit = self.limit_at(g.b_nspm);
+                (limit, limit.is_some_and(|mmin| g.m_kg >= mmin))
+            }
+            _ => return Err(Refusal::WrongDisplay),
+        };
+        match (within, limit) {
+            (true, _) => Ok(()),
+            (false, limit) => Err(Refusal::NotProvenStable {
+                limit: limit.unwrap_or(0.0),
+            }),
+        }
+    }
+
     /// The proven limit at damping `b`, or `None` off the grid.
     pub fn limit_at(&self, b_nspm: f32) -> Option<f32> {
         let g = &self.damping_nspm;
@@ -90,6 +134,37 @@ impl<const N: usize> Region<N> {
             Bound::MinMass => a.max(c) * (1.0 + self.margin),
         })
     }
+}
+
+/// Whether each axis's gains are inside its axis's region, for a servo of
+/// `N` axes running `display`; the first axis that is not, and why.
+///
+/// # Examples
+///
+/// ```
+/// use twoport_board::{check_axes, Bound, Region};
+/// use twoport_control::servo::{Display, Gains, ImpedanceGains};
+/// use twoport_link::Refusal;
+/// let r = Region::new(Bound::MaxStiffness, [10.0, 90.0], [36_385.0, 51_074.0], None).unwrap();
+/// let g = |k| Gains::from(ImpedanceGains::new(k, 90.0));
+/// assert!(check_axes(&[r; 3], Display::Impedance, &[g(50_000.0); 3]).is_ok());
+/// let e = check_axes(&[r; 3], Display::Impedance, &[g(50_000.0), g(50_000.0), g(60_000.0)]);
+/// let e = e.unwrap_err();
+/// assert_eq!(e.axis, 2);
+/// assert!(matches!(e.why, Refusal::NotProvenStable { .. }));
+/// ```
+pub fn check_axes<const G: usize, const N: usize>(
+    regions: &[Region<G>; N],
+    display: Display,
+    gains: &[Gains; N],
+) -> Result<(), AxisRefusal> {
+    for (axis, (r, g)) in regions.iter().zip(gains).enumerate() {
+        r.check(display, g).map_err(|why| AxisRefusal {
+            axis: axis as u8,
+            why,
+        })?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]
