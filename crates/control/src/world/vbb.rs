@@ -588,6 +588,7 @@ impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
                 v[a] + dv
             };
         }
+        let out = [0, 1, 2].map(|a| ports[a].at(v[a]));
         for a in 0..3 {
             // (Explicit: a face or friction that changed the step ends it
             // at rest along that axis, or at the step's own speed.)
@@ -596,7 +597,7 @@ impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
             } else {
                 v[a]
             };
-            self.last_force_n[a] = ports[a].at(v[a]).force_n;
+            self.last_force_n[a] = out[a].force_n;
             match stop[a] {
                 Some(at) => self.cursor[a].reset(at),
                 None => {
@@ -610,7 +611,7 @@ impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
             self.snap_to_grid(h, j, &k);
         }
         self.settle();
-        [0, 1, 2].map(|a| ports[a].at(v[a]))
+        out
     }
 
     fn reset(&mut self, x: &[Position; 3]) {

@@ -179,21 +179,13 @@ impl XyzSimulation {
                 })
                 .collect()
         };
-        let states = 2 * device.n;
-        let plants = [
-            AxisPlant {
-                steppers: grasps(&humans[0])?,
-                x: vec![0.0; states],
-            },
-            AxisPlant {
-                steppers: grasps(&humans[1])?,
-                x: vec![0.0; states],
-            },
-            AxisPlant {
-                steppers: grasps(&humans[2])?,
-                x: vec![0.0; states],
-            },
-        ];
+        let plant = |h: &Human| -> Result<AxisPlant, String> {
+            Ok(AxisPlant {
+                steppers: grasps(h)?,
+                x: vec![0.0; 2 * device.n],
+            })
+        };
+        let plants = [plant(&humans[0])?, plant(&humans[1])?, plant(&humans[2])?];
         let world = world_of(&scene.ve)?;
         let start = world.position();
         // Ideal sensing: 1 nm counts on a 32-bit counter.
