@@ -34,7 +34,7 @@ fn the_board_accepts_only_what_the_designer_proves() {
         BilateralConstraint::new(Position::ZERO),
     )
     .unwrap();
-    let mut board = Board::new(servo, region, 0);
+    let mut board = Board::new(servo, [region], 0);
     let mut accepted = 0;
     for i in 0..60 {
         let damping = 10.0 * 15f32.powf(i as f32 / 59.0); // 10..150, mostly off the grid

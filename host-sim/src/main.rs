@@ -498,8 +498,11 @@ fn pil(a: &PilArgs) -> Result<(), String> {
     if !(a.seconds.is_finite() && a.seconds > 0.0 && a.seconds <= 3600.0) {
         return Err(format!("--seconds {}: must be in (0, 3600]", a.seconds));
     }
-    let scene = load(&a.scene, &[])?;
-    let period = scene.period();
+    let text =
+        std::fs::read_to_string(&a.scene).map_err(|e| format!("{}: {e}", a.scene.display()))?;
+    let xyz = host_sim::engine::xyz::axes_of(&text) == Some(3);
+    // (Every scene ticks at the board's 1 kHz.)
+    let period = 1e-3;
     let ticks = (a.seconds / period).round() as u64;
     let link_loss_at = match a.link_loss_at_s {
         Some(t) if t.is_finite() && t >= 0.0 && t < a.seconds => Some((t / period).round() as u64),
@@ -510,7 +513,33 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         corrupt_every: a.corrupt_every,
         link_loss_at,
     };
+    let port = a.port.as_deref().map(pil::SerialBoard::open).transpose()?;
     let start = std::time::Instant::now();
+    if xyz {
+        if a.passivity {
+            return Err("--passivity: the three-axis image has no passivity build".into());
+        }
+        let scene =
+            host_sim::engine::xyz::XyzScene::load(&a.scene, &[]).map_err(|e| e.to_string())?;
+        let reference = pil::run_xyz(
+            scene.clone(),
+            ticks,
+            pil::LocalBoard::excalibur_xyz()?,
+            faults,
+        )?;
+        let local_s = start.elapsed().as_secs_f64();
+        let run = port
+            .map(|p| pil::run_xyz(scene, ticks, p, faults))
+            .transpose()?;
+        return pil_report(a, ticks, faults, reference, run, local_s, start);
+    }
+    let scene = load(&a.scene, &[])?;
+    if (scene.period() - period).abs() > 1e-12 {
+        return Err(format!(
+            "{}: a PIL scene ticks at the board's 1 kHz",
+            a.scene.display()
+        ));
+    }
     let reference = if a.passivity {
         pil::run(
             scene.clone(),
@@ -522,23 +551,42 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         pil::run(scene.clone(), ticks, pil::LocalBoard::excalibur()?, faults)?
     };
     let local_s = start.elapsed().as_secs_f64();
-    let (run, remote_s) = match &a.port {
-        Some(p) => {
-            let port = pil::SerialBoard::open(p)?;
-            let start = std::time::Instant::now();
-            let r = pil::run(scene, ticks, port, faults)?;
-            (r, start.elapsed().as_secs_f64())
-        }
+    let run = port
+        .map(|p| pil::run(scene, ticks, p, faults))
+        .transpose()?;
+    pil_report(a, ticks, faults, reference, run, local_s, start)
+}
+
+/// A PIL run's report, compared with the in-process `reference`: the
+/// board's `run` over the serial port where there was one.
+fn pil_report<S: host_sim::pil::PilSample>(
+    a: &PilArgs,
+    ticks: u64,
+    faults: host_sim::pil::Faults,
+    reference: host_sim::pil::Run<S>,
+    run: Option<host_sim::pil::Run<S>>,
+    local_s: f64,
+    start: std::time::Instant,
+) -> Result<(), String> {
+    use host_sim::pil;
+    let board = if run.is_some() {
+        "serial"
+    } else {
+        "in-process"
+    };
+    let (run, remote_s) = match run {
+        Some(r) => (r, start.elapsed().as_secs_f64() - local_s),
         None => (reference.clone(), local_s),
     };
     let c = pil::compare(&run, &reference);
     let frames_dropped = run.board_stats.rx.dropped() + run.host_dropped;
     let loop_cycles = run.telemetry.last().map(|t| t.loop_cycles);
-    let board = if a.port.is_some() {
-        "serial"
-    } else {
-        "in-process"
-    };
+    let axes = run.duties.first().map_or(1, |d| d.len());
+    let peak = run
+        .samples
+        .iter()
+        .flat_map(|s| (0..axes).map(|i| s.actuator_n(i).abs()))
+        .fold(0.0, f64::max);
     let v = json!({
         "ticks": c.ticks,
         "max_position_error_m": c.max_position_error_m,
@@ -550,7 +598,8 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         "zero_force_after_link_loss_ticks": run.zero_after_loss_ticks,
         "watchdog_deadline_ticks": twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS,
         "telemetry_frames": run.telemetry.len(),
-        "peak_force_n": run.samples.iter().map(|s| s.actuator_n.abs()).fold(0.0, f64::max),
+        "axes": axes,
+        "peak_force_n": peak,
         "last_loop_cycles": loop_cycles,
         "last_stage_cycles": run.telemetry.last().map(|t| t.stage_cycles),
         "start": run.start,

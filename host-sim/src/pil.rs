@@ -8,24 +8,22 @@
 //! frames and, if asked, corrupted frames and a link loss, so the in-process
 //! run is the reference the firmware must match.
 
+use crate::engine::xyz::{XyzSample, XyzScene, XyzSimulation};
 use crate::{Sample, Scene, Simulation};
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
-use twoport_board::excalibur::{self, REGION_POINTS};
-use twoport_board::{Board, BoardSupport, RawSensors};
+use twoport_board::excalibur::{self, xyz, REGION_POINTS};
+use twoport_board::{Board, BoardSupport, Drive, RawSensors};
 use twoport_config::{RamFlash, Store};
 use twoport_control::passivity::SeriesDamper;
-use twoport_control::servo::{Direct, PortLayer};
 use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::ve::UnilateralWall;
 use twoport_control::Faults as BoardFaults;
+use twoport_control::Servo;
 use twoport_link::{
     encode, Axes, ConfigSource, Decoder, LinkStats, Message, Mode, ModeRequest, Role,
     SensorFrame as LinkSensors, Status, Telemetry, MAX_FRAME,
 };
-
-/// The axes this host drives: a scene's device is one axis.
-const AXES: u8 = 1;
 
 /// How far a homed board's position may be from the plant's: the stop's
 /// give under the homing force (25 µm on the scenes' 2e5 N/m stop) and a
@@ -75,9 +73,10 @@ impl BoardPort for SerialBoard {
 }
 
 /// The Excalibur board image's loop, in this process: the plain image's,
-/// or the passivity image's (`L` the series damper).
-pub struct LocalBoard<L = Direct> {
-    board: Board<UnilateralWall, REGION_POINTS, L>,
+/// the passivity image's (`S` with the series damper), or the three-axis
+/// image's (`N` = 3).
+pub struct LocalBoard<S = Servo<UnilateralWall>, const N: usize = 1> {
+    board: Board<S, REGION_POINTS, N>,
     link: HostLink,
     /// Its stored configuration, in RAM as on the QEMU images.
     store: Store<RamFlash<512, 256>>,
@@ -90,13 +89,13 @@ struct HostLink {
     out: Vec<u8>,
 }
 
-impl BoardSupport for HostLink {
+impl<const N: usize> BoardSupport<N> for HostLink {
     // A processor-in-the-loop board reads no sensors of its own.
-    fn sample(&mut self) -> RawSensors {
+    fn sample(&mut self) -> RawSensors<N> {
         RawSensors::default()
     }
-    // The duty goes back in the board's actuator frame.
-    fn set_duty(&mut self, _: i16) {}
+    // The duties go back in the board's actuator frame.
+    fn set_duty(&mut self, _: [i16; N]) {}
     // So do the outputs: a disarmed board answers zero duty.
     fn set_outputs(&mut self, _: bool) {}
     // The host's loop cannot hang unseen: no watchdog.
@@ -116,9 +115,9 @@ impl BoardSupport for HostLink {
     }
 }
 
-impl<L: PortLayer> LocalBoard<L> {
+impl<S: Drive<N>, const N: usize> LocalBoard<S, N> {
     /// `board`, driven by the link's sensor frames.
-    fn driven(board: Board<UnilateralWall, REGION_POINTS, L>) -> Self {
+    fn driven(board: Board<S, REGION_POINTS, N>) -> Self {
         let mut board = board.with_pil(true);
         // As the QEMU images boot: the configuration from a RAM flash.
         let mut store = Store::new(RamFlash::<512, 256>::new(), 0, 256);
@@ -131,9 +130,10 @@ impl<L: PortLayer> LocalBoard<L> {
     }
 }
 
-impl<L: PortLayer> LocalBoard<L> {
-    /// The same board homing with `cfg` (e.g. on an encoder's index).
-    pub fn with_homing(mut self, cfg: twoport_control::homing::HomingConfig) -> Self {
+impl<S: Drive<N>, const N: usize> LocalBoard<S, N> {
+    /// The same board with each axis homing with its `cfg` (e.g. on an
+    /// encoder's index).
+    pub fn with_homing(mut self, cfg: [twoport_control::homing::HomingConfig; N]) -> Self {
         self.board = self.board.with_homing(cfg);
         self
     }
@@ -148,7 +148,7 @@ impl LocalBoard {
     }
 }
 
-impl LocalBoard<SeriesDamper> {
+impl LocalBoard<Servo<UnilateralWall, f32, SeriesDamper>> {
     /// The passivity image ([`excalibur::stiff_wall_board_with_passivity`]).
     pub fn excalibur_with_passivity() -> Result<Self, String> {
         excalibur::stiff_wall_board_with_passivity()
@@ -157,7 +157,16 @@ impl LocalBoard<SeriesDamper> {
     }
 }
 
-impl<L: PortLayer> BoardPort for LocalBoard<L> {
+impl LocalBoard<xyz::XyzServo, 3> {
+    /// The three-axis image ([`xyz::board`]).
+    pub fn excalibur_xyz() -> Result<Self, String> {
+        xyz::board()
+            .map(Self::driven)
+            .map_err(|e| format!("the three-axis Excalibur image: {e:?}"))
+    }
+}
+
+impl<S: Drive<N>, const N: usize> BoardPort for LocalBoard<S, N> {
     fn send(&mut self, bytes: &[u8]) -> Result<(), String> {
         // What the images do: the control tick runs each sensor frame as
         // it completes, and the main loop sends what was queued.
@@ -195,13 +204,14 @@ pub struct Faults {
     pub link_loss_at: Option<u64>,
 }
 
-/// One PIL run's record.
-#[derive(Clone, Debug, Default)]
-pub struct Run {
+/// One PIL run's record, its samples `S` (the one-axis simulation's by
+/// default, or the three-axis one's [`XyzSample`]).
+#[derive(Clone, Debug)]
+pub struct Run<S = Sample> {
     /// One sample per tick.
-    pub samples: Vec<Sample>,
-    /// The duty the board answered each tick.
-    pub duties: Vec<i16>,
+    pub samples: Vec<S>,
+    /// The duties the board answered each tick, one per axis.
+    pub duties: Vec<Axes<i16>>,
     /// Telemetry received.
     pub telemetry: Vec<Telemetry>,
     /// Frames the host injected corrupted.
@@ -222,6 +232,142 @@ pub struct Run {
     /// Homing: the ticks it took, and how far the board's calibrated
     /// position was from the plant's then (m).
     pub homing: Option<(u64, f64)>,
+}
+
+impl<S> Default for Run<S> {
+    fn default() -> Self {
+        Run {
+            samples: Vec::new(),
+            duties: Vec::new(),
+            telemetry: Vec::new(),
+            corrupted_sent: 0,
+            board_stats: LinkStats::default(),
+            host_dropped: 0,
+            zero_after_loss_ticks: None,
+            start: None,
+            config: None,
+            armed_at_tick: 0,
+            homing: None,
+        }
+    }
+}
+
+/// What a PIL run records of a tick: every axis's handle position and
+/// delivered force.
+pub trait PilSample: Clone {
+    /// Axis `axis`'s handle position (m).
+    fn handle_m(&self, axis: usize) -> f64;
+    /// The force axis `axis`'s actuator delivered (N).
+    fn actuator_n(&self, axis: usize) -> f64;
+}
+
+impl PilSample for Sample {
+    fn handle_m(&self, _: usize) -> f64 {
+        self.handle_m
+    }
+    fn actuator_n(&self, _: usize) -> f64 {
+        self.actuator_n
+    }
+}
+
+impl PilSample for XyzSample {
+    fn handle_m(&self, axis: usize) -> f64 {
+        self.handle_m[axis]
+    }
+    fn actuator_n(&self, axis: usize) -> f64 {
+        self.actuator_n[axis]
+    }
+}
+
+/// A simulated device a PIL run drives through a board: the one-axis
+/// [`Simulation`] or the three-axis [`XyzSimulation`].
+pub trait PilPlant {
+    /// What a tick records.
+    type Sample: PilSample;
+    /// The device's axes.
+    const AXES: u8;
+    /// Whether the scene's device is the board's (its sensors, its world).
+    fn check(&self) -> Result<(), String>;
+    /// How the board gets from disarmed to armed.
+    fn start(&self) -> Start;
+    /// Where each axis stands at rest before the run, as the host tells a
+    /// board it calibrates (pm).
+    fn at_rest_pm(&self) -> Axes<i64>;
+    /// The encoder's index mark (m), if the scene's encoder has one.
+    fn index_m(&self) -> Option<f64>;
+    /// One tick with the board at the other end of `session` as its
+    /// controller: the sample and the duties the board answered.
+    fn step_with<P: BoardPort>(
+        &mut self,
+        session: &mut Session<P>,
+    ) -> Result<(Self::Sample, Axes<i16>), String>;
+}
+
+impl PilPlant for Simulation {
+    type Sample = Sample;
+    const AXES: u8 = 1;
+    fn check(&self) -> Result<(), String> {
+        check_scene(self.scene())
+    }
+    fn start(&self) -> Start {
+        Start::for_scene(self.scene())
+    }
+    fn at_rest_pm(&self) -> Axes<i64> {
+        Axes::one(0)
+    }
+    fn index_m(&self) -> Option<f64> {
+        self.scene().effects.encoder.and_then(|e| e.index_m)
+    }
+    fn step_with<P: BoardPort>(
+        &mut self,
+        session: &mut Session<P>,
+    ) -> Result<(Sample, Axes<i16>), String> {
+        session.step(self).map(|(s, d)| (s, Axes::one(d)))
+    }
+}
+
+impl PilPlant for XyzSimulation {
+    type Sample = XyzSample;
+    const AXES: u8 = 3;
+    fn check(&self) -> Result<(), String> {
+        check_xyz_scene(self.scene())
+    }
+    fn start(&self) -> Start {
+        Start::Calibrate
+    }
+    fn at_rest_pm(&self) -> Axes<i64> {
+        let x = xyz::world().map(|w| w.cursor()).unwrap_or_default();
+        Axes::new(x.map(|p| p.nm() as i64 * 1000)).unwrap_or_default()
+    }
+    fn index_m(&self) -> Option<f64> {
+        None
+    }
+    fn step_with<P: BoardPort>(
+        &mut self,
+        session: &mut Session<P>,
+    ) -> Result<(XyzSample, Axes<i16>), String> {
+        session.tick_heartbeat()?;
+        let io = session.io;
+        let (bits, pm) = excalibur::ENCODER;
+        let mask = (1u64 << bits) - 1;
+        let tick = self.ticks();
+        let mut answer = Ok(Axes::one(0));
+        let mut ctl = |x_m: [f64; 3]| -> [f64; 3] {
+            let raw = x_m.map(|x| ((x * 1e12 / pm as f64).round() as i64 as u64 & mask) as u32);
+            let sensors = LinkSensors {
+                tick: tick as u32,
+                encoder_raw: Axes::new(raw).unwrap_or_default(),
+                load_cell_raw: Axes::new([0; 3]).unwrap_or_default(),
+                dead_man_closed: true,
+                index_raw: Axes::new([None; 3]).unwrap_or_default(),
+            };
+            answer = session.exchange(tick, sensors);
+            let duty = |a: usize| answer.as_ref().ok().and_then(|d| d.get(a).copied());
+            [0, 1, 2].map(|a| io.force_n(duty(a).unwrap_or(0)) as f64)
+        };
+        let sample = self.step_external(&mut ctl);
+        Ok((sample, answer?))
+    }
 }
 
 /// How a run gets its board from disarmed to armed.
@@ -249,6 +395,8 @@ impl Start {
 /// else the board says kept for the caller.
 pub struct Session<P: BoardPort> {
     port: P,
+    /// The axes this host drives.
+    axes: u8,
     seq: u16,
     decoder: Decoder,
     inbox: Vec<Message>,
@@ -263,11 +411,18 @@ pub struct Session<P: BoardPort> {
 }
 
 impl<P: BoardPort> Session<P> {
-    /// Shake hands with the board at `port`. It is disarmed until
+    /// Shake hands with the one-axis board at `port`. It is disarmed until
     /// [`arm`](Self::arm).
     pub fn open(port: P, faults: Faults) -> Result<Self, String> {
+        Self::open_axes(port, faults, 1)
+    }
+
+    /// Shake hands with the board of `axes` axes at `port`: a board of
+    /// another count is refused, with both counts named.
+    pub fn open_axes(port: P, faults: Faults, axes: u8) -> Result<Self, String> {
         let mut s = Session {
             port,
+            axes,
             seq: 0,
             decoder: Decoder::new(),
             inbox: Vec::new(),
@@ -308,9 +463,9 @@ impl<P: BoardPort> Session<P> {
             .retain(|m| !matches!(m, Message::Status(_) | Message::ModeRefused { .. }));
     }
 
-    /// Calibrate a disarmed board: it stands at `position_m` (m).
-    pub fn calibrate(&mut self, position_m: f64) -> Result<Status, String> {
-        let position_pm = (position_m * 1e12).round() as i64;
+    /// Calibrate a disarmed board: each axis stands at its `position_pm`
+    /// (pm).
+    pub fn calibrate(&mut self, position_pm: Axes<i64>) -> Result<Status, String> {
         self.ask(
             Message::Calibrate { position_pm },
             ModeRequest::Calibrate,
@@ -426,7 +581,7 @@ impl<P: BoardPort> Session<P> {
     fn handshake(&mut self) -> Result<(), String> {
         let deadline = Instant::now() + ANSWER_TIMEOUT;
         loop {
-            self.send(&Message::hello(Role::Host, AXES))?;
+            self.send(&Message::hello(Role::Host, self.axes))?;
             self.pump(Duration::from_millis(100))?;
             if let Some(i) = self
                 .inbox
@@ -436,7 +591,7 @@ impl<P: BoardPort> Session<P> {
                 return self
                     .inbox
                     .remove(i)
-                    .accept_ack(AXES)
+                    .accept_ack(self.axes)
                     .map_err(|e| e.to_string());
             }
             if Instant::now() > deadline {
@@ -479,16 +634,18 @@ impl<P: BoardPort> Session<P> {
     /// One tick of `sim` with the board as its controller; returns the
     /// sample and the duty the board answered.
     pub fn step(&mut self, sim: &mut Simulation) -> Result<(Sample, i16), String> {
-        let tick = self.tick;
-        self.tick += 1;
-        let lost = self.faults.link_loss_at.is_some_and(|t| tick >= t);
-        if tick.is_multiple_of(HEARTBEAT_EVERY) && !lost {
-            self.send(&Message::Heartbeat)?;
-        }
+        let tick = self.tick_heartbeat()?;
         let mut answer: Result<i16, String> = Ok(0);
         let io = self.io;
         let mut ctl = |f: &SensorFrame| -> ServoOutput {
-            answer = self.exchange(tick, f);
+            let sensors = LinkSensors {
+                tick: f.tick,
+                encoder_raw: Axes::one(f.encoder_raw),
+                load_cell_raw: Axes::one(io.load_cell_counts(f.load_cell_n)),
+                dead_man_closed: f.dead_man_closed,
+                index_raw: Axes::one(self.index_crossing(f.encoder_raw)),
+            };
+            answer = self.exchange(tick, sensors).map(|d| d[0]);
             let force = io.force_n(*answer.as_ref().unwrap_or(&0));
             ServoOutput {
                 actuator_force_n: force,
@@ -500,15 +657,23 @@ impl<P: BoardPort> Session<P> {
         Ok((sample, answer?))
     }
 
-    fn exchange(&mut self, tick: u64, f: &SensorFrame) -> Result<i16, String> {
-        let sensors = Message::Sensors(LinkSensors {
-            tick: f.tick,
-            encoder_raw: Axes::one(f.encoder_raw),
-            load_cell_raw: Axes::one(self.io.load_cell_counts(f.load_cell_n)),
-            dead_man_closed: f.dead_man_closed,
-            index_raw: Axes::one(self.index_crossing(f.encoder_raw)),
-        });
-        let good = self.frame(&sensors)?;
+    /// The next tick's number, with its heartbeat sent where one is due
+    /// and the link is not lost.
+    fn tick_heartbeat(&mut self) -> Result<u64, String> {
+        let tick = self.tick;
+        self.tick += 1;
+        let lost = self.faults.link_loss_at.is_some_and(|t| tick >= t);
+        if tick.is_multiple_of(HEARTBEAT_EVERY) && !lost {
+            self.send(&Message::Heartbeat)?;
+        }
+        Ok(tick)
+    }
+
+    /// Send tick `tick`'s sensors (and, on schedule, a corrupted copy
+    /// first) and wait for the board's duties.
+    fn exchange(&mut self, tick: u64, sensors: LinkSensors) -> Result<Axes<i16>, String> {
+        let want = sensors.tick;
+        let good = self.frame(&Message::Sensors(sensors))?;
         let every = self.faults.corrupt_every;
         if every > 0 && tick % every == every / 2 {
             let mut bad = good.clone();
@@ -522,17 +687,11 @@ impl<P: BoardPort> Session<P> {
             self.corrupted_sent += 2;
         }
         self.port.send(&good)?;
-        let want = f.tick;
         self.wait(&format!("tick {want}"), |m| match m {
-            Message::Actuator(a) if a.tick == want => Some(a.duty[0]),
+            Message::Actuator(a) if a.tick == want => Some(a.duty),
             _ => None,
         })
     }
-}
-
-/// The scene's encoder index mark (m), if any.
-fn sim_index(sim: &Simulation) -> Option<f64> {
-    sim.scene().effects.encoder.and_then(|e| e.index_m)
 }
 
 /// The scene's sensors must be the board's: the same encoder.
@@ -546,6 +705,48 @@ pub fn check_scene(scene: &Scene) -> Result<(), String> {
             pm as f64 * 1e-6,
             pm as f64 * 1e-12
         )),
+    }
+}
+
+/// The three-axis scene's device must be the three-axis image's: its
+/// world holds the image's blocks, which the board simulates (the scene's
+/// grab and release times cannot reach it over the link).
+pub fn check_xyz_scene(scene: &XyzScene) -> Result<(), String> {
+    use crate::engine::xyz::XyzVe;
+    let want: Vec<_> = xyz::BLOCKS.to_vec();
+    match &scene.ve {
+        XyzVe::Blocks {
+            blocks,
+            grab_at_s,
+            release_at_s,
+            ..
+        } if grab_at_s.is_empty() && release_at_s.is_empty() => {
+            let have: Vec<_> = blocks
+                .iter()
+                .map(|b| {
+                    (
+                        b.at_m.map(|x| x as f32),
+                        b.size_m.map(|x| x as f32),
+                        b.mass_kg as f32,
+                    )
+                })
+                .collect();
+            if have == want {
+                Ok(())
+            } else {
+                Err(format!(
+                    "the scene's blocks must be the three-axis image's (twoport_board::excalibur::xyz::BLOCKS): {want:?}"
+                ))
+            }
+        }
+        XyzVe::Blocks { .. } => Err(
+            "a processor-in-the-loop scene cannot grab or release: the board's world runs there, \
+             and the link carries no grab; remove ve.grab_at_s and ve.release_at_s"
+                .into(),
+        ),
+        _ => Err(
+            "the three-axis image runs the building-block world: set ve.kind = \"blocks\"".into(),
+        ),
     }
 }
 
@@ -564,12 +765,12 @@ pub fn homed(statuses: &[Status]) -> Option<Result<(), String>> {
 }
 
 /// One tick of a run, recorded; returns the statuses the board sent.
-fn record<P: BoardPort>(
+fn record<P: BoardPort, M: PilPlant>(
     session: &mut Session<P>,
-    sim: &mut Simulation,
-    r: &mut Run,
+    sim: &mut M,
+    r: &mut Run<M::Sample>,
 ) -> Result<Vec<Status>, String> {
-    let (s, duty) = session.step(sim)?;
+    let (s, duty) = sim.step_with(session)?;
     r.samples.push(s);
     r.duties.push(duty);
     let mut statuses = Vec::new();
@@ -588,10 +789,32 @@ fn record<P: BoardPort>(
 /// stop) and armed, then the rest.
 pub fn run<P: BoardPort>(scene: Scene, ticks: u64, port: P, faults: Faults) -> Result<Run, String> {
     check_scene(&scene)?;
-    let start = Start::for_scene(&scene);
-    let mut sim = Simulation::new(scene)?;
-    let mut session = Session::open(port, faults)?;
-    session.set_index(sim_index(&sim));
+    run_plant(Simulation::new(scene)?, ticks, port, faults)
+}
+
+/// [`run`] for a three-axis scene against a three-axis board: calibrated
+/// where the scene's device starts (the image's world's start), then armed.
+pub fn run_xyz<P: BoardPort>(
+    scene: XyzScene,
+    ticks: u64,
+    port: P,
+    faults: Faults,
+) -> Result<Run<XyzSample>, String> {
+    check_xyz_scene(&scene)?;
+    run_plant(XyzSimulation::new(scene)?, ticks, port, faults)
+}
+
+/// [`run`] of any simulated device.
+pub fn run_plant<P: BoardPort, M: PilPlant>(
+    mut sim: M,
+    ticks: u64,
+    port: P,
+    faults: Faults,
+) -> Result<Run<M::Sample>, String> {
+    sim.check()?;
+    let start = sim.start();
+    let mut session = Session::open_axes(port, faults, M::AXES)?;
+    session.set_index(sim.index_m());
     let mut r = Run {
         start: Some(start),
         ..Run::default()
@@ -612,7 +835,7 @@ pub fn run<P: BoardPort>(scene: Scene, ticks: u64, port: P, faults: Faults) -> R
     record(&mut session, &mut sim, &mut r)?;
     match start {
         Start::Calibrate => {
-            session.calibrate(0.0)?;
+            session.calibrate(sim.at_rest_pm())?;
         }
         Start::Home => {
             session.home()?;
@@ -643,7 +866,7 @@ pub fn run<P: BoardPort>(scene: Scene, ticks: u64, port: P, faults: Faults) -> R
         // the tick before.
         if let Some(t) = r.telemetry.iter().find(|t| u64::from(t.tick) > *n) {
             if let Some(s) = r.samples.get(t.tick as usize - 1) {
-                *err = t.axes[0].position_pm as f64 * 1e-12 - s.handle_m;
+                *err = t.axes[0].position_pm as f64 * 1e-12 - s.handle_m(0);
             }
         }
     }
@@ -652,7 +875,11 @@ pub fn run<P: BoardPort>(scene: Scene, ticks: u64, port: P, faults: Faults) -> R
     r.corrupted_sent = session.corrupted_sent;
     if let Some(t0) = faults.link_loss_at {
         // The last tick with a non-zero duty after the loss, plus one.
-        let last_nonzero = r.duties.iter().skip(t0 as usize).rposition(|d| *d != 0);
+        let last_nonzero = r
+            .duties
+            .iter()
+            .skip(t0 as usize)
+            .rposition(|d| d.iter().any(|d| *d != 0));
         r.zero_after_loss_ticks = Some(last_nonzero.map_or(0, |i| i as u64 + 1));
     }
     Ok(r)
@@ -673,15 +900,20 @@ pub struct Comparison {
     pub start_differs: bool,
 }
 
-/// Compare a run with its reference, tick by tick.
-pub fn compare(a: &Run, b: &Run) -> Comparison {
+/// Compare a run with its reference, tick by tick, every axis.
+pub fn compare<S: PilSample>(a: &Run<S>, b: &Run<S>) -> Comparison {
     let mut c = Comparison {
         ticks: a.samples.len().min(b.samples.len()) as u64,
         ..Comparison::default()
     };
+    let axes = a.duties.first().map_or(1, |d| d.len());
     for (x, y) in a.samples.iter().zip(&b.samples) {
-        c.max_position_error_m = c.max_position_error_m.max((x.handle_m - y.handle_m).abs());
-        c.max_force_error_n = c.max_force_error_n.max((x.actuator_n - y.actuator_n).abs());
+        for i in 0..axes {
+            let dx = (x.handle_m(i) - y.handle_m(i)).abs();
+            let df = (x.actuator_n(i) - y.actuator_n(i)).abs();
+            c.max_position_error_m = c.max_position_error_m.max(dx);
+            c.max_force_error_n = c.max_force_error_n.max(df);
+        }
     }
     c.start_differs =
         (a.armed_at_tick, a.homing.map(|h| h.0)) != (b.armed_at_tick, b.homing.map(|h| h.0));
@@ -701,8 +933,8 @@ pub fn compare(a: &Run, b: &Run) -> Comparison {
 /// all (bit for bit), where ticks are missing, where it dropped fewer frames
 /// than were corrupted on purpose, or where it was late to zero the force
 /// (or was not pushing before the loss, so the check would prove nothing).
-pub fn failures(
-    run: &Run,
+pub fn failures<S: PilSample>(
+    run: &Run<S>,
     c: &Comparison,
     ticks: u64,
     faults: Faults,
@@ -750,6 +982,7 @@ pub fn failures(
         let io = twoport_board::IoScale::EXCALIBUR;
         let peak = run.duties[..(n as usize + 1).min(run.duties.len())]
             .iter()
+            .flat_map(|d| d.iter())
             .map(|d| io.force_n(*d).abs() as f64)
             .fold(0.0, f64::max);
         if peak > limit + 0.01 {
@@ -758,7 +991,12 @@ pub fn failures(
     }
     if let (Some(t0), Some(z)) = (faults.link_loss_at, run.zero_after_loss_ticks) {
         let before = &run.duties[..(t0 as usize).min(run.duties.len())];
-        if !before.iter().rev().take(10).any(|d| *d != 0) {
+        if !before
+            .iter()
+            .rev()
+            .take(10)
+            .any(|d| d.iter().any(|d| *d != 0))
+        {
             bad.push("no force before the link loss: the check would prove nothing".into());
         }
         if z > deadline_ticks {

@@ -4,6 +4,7 @@
 use host_sim::pil::{self, Faults, LocalBoard};
 use host_sim::{Scene, Simulation};
 use std::path::Path;
+use twoport_link::Axes;
 
 fn scene() -> Scene {
     Scene::load(Path::new("../scenes/stiff_wall.toml"), &[]).unwrap()
@@ -33,7 +34,7 @@ fn corrupted_frames_are_dropped_and_the_loop_goes_on() {
     assert_eq!(c.duty_mismatches, 0);
     assert_eq!(c.max_position_error_m, 0.0);
     assert!(
-        clean.duties.iter().any(|d| d.unsigned_abs() > 1000),
+        clean.duties.iter().any(|d| d[0].unsigned_abs() > 1000),
         "the wall pushes"
     );
 }
@@ -48,10 +49,12 @@ fn link_loss_gives_zero_force_within_the_watchdog_deadline() {
             link_loss_at: Some(t0),
         };
         let r = run(4500, faults);
-        assert!(r.duties[t0 as usize - 1] != 0, "force before the loss");
+        assert!(r.duties[t0 as usize - 1][0] != 0, "force before the loss");
         let z = r.zero_after_loss_ticks.unwrap();
         assert!(z <= deadline, "zero after {z} ticks, deadline {deadline}");
-        assert!(r.duties[(t0 + deadline) as usize..].iter().all(|d| *d == 0));
+        assert!(r.duties[(t0 + deadline) as usize..]
+            .iter()
+            .all(|d| d[0] == 0));
     }
 }
 
@@ -106,12 +109,12 @@ fn a_board_homes_onto_the_hard_stop_then_arms_and_holds_the_wall() {
     let io = twoport_board::IoScale::EXCALIBUR;
     let peak_before = r.duties[..r.armed_at_tick as usize]
         .iter()
-        .map(|d| io.force_n(*d).abs())
+        .map(|d| io.force_n(d[0]).abs())
         .fold(0.0, f32::max);
     assert!(peak_before <= 5.01, "{peak_before} N");
     let peak_after = r.duties[r.armed_at_tick as usize..]
         .iter()
-        .map(|d| io.force_n(*d).abs())
+        .map(|d| io.force_n(d[0]).abs())
         .fold(0.0, f32::max);
     assert!(peak_after > 10.0, "{peak_after} N");
     // The hand, led 10 mm past the wall, is held at its surface (the
@@ -130,7 +133,7 @@ fn an_uncalibrated_board_refuses_to_arm_by_name() {
     session.step(&mut sim).unwrap();
     let e = session.arm().unwrap_err();
     assert!(e.contains("NotCalibrated"), "{e}");
-    session.calibrate(0.0).unwrap();
+    session.calibrate(Axes::one(0)).unwrap();
     assert_eq!(session.arm().unwrap().mode, twoport_link::Mode::Armed);
 }
 
@@ -150,7 +153,7 @@ fn a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed() {
     let mut s = open().unwrap();
     let mut sim = Simulation::new(scene()).unwrap();
     s.step(&mut sim).unwrap();
-    s.calibrate(0.0).unwrap();
+    s.calibrate(Axes::one(0)).unwrap();
     s.arm().unwrap();
     let io = twoport_board::IoScale::EXCALIBUR;
     let (mut last_force, mut hung_at) = (0.0f32, None);
@@ -186,7 +189,7 @@ fn a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed() {
     for _ in 0..20 {
         assert_eq!(s.step(&mut sim).unwrap().1, 0, "zero force after the reset");
     }
-    s.calibrate(0.0).unwrap();
+    s.calibrate(Axes::one(0)).unwrap();
     let e = s.arm().unwrap_err();
     assert!(e.contains("Faulted"), "{e}");
     // Seen and cleared, it arms again.
@@ -202,7 +205,7 @@ fn a_board_homes_on_the_index_pulse_before_the_stop() {
     let s = Scene::load(Path::new("../scenes/homing_index.toml"), &[]).unwrap();
     let mut cfg = twoport_board::excalibur::HOMING;
     cfg.index_position = Some(twoport_control::Position::from_nm(-6_000_000));
-    let board = LocalBoard::excalibur().unwrap().with_homing(cfg);
+    let board = LocalBoard::excalibur().unwrap().with_homing([cfg]);
     let r = pil::run(s, 3000, board, Faults::default()).unwrap();
     let (n, err_m) = r.homing.expect("homed");
     // 6 mm at 20 mm/s and the ramp-in.

@@ -10,7 +10,7 @@ use host_sim::scope::app::{ScopeState, Speed, RING_SAMPLES};
 use host_sim::scope::ui::BoardChoice;
 use std::path::Path;
 use twoport_control::servo::{Gains, ImpedanceGains};
-use twoport_link::{Message, Mode};
+use twoport_link::{Axes, Message, Mode};
 
 fn harness() -> Harness<'static, (ScopeState, BoardChoice)> {
     let state = ScopeState::open(Path::new("../scenes/stiff_wall.toml")).unwrap();
@@ -158,7 +158,9 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
     assert_eq!(b.status.map(|st| st.mode), Some(Mode::Disarmed));
     assert_eq!(b.refusal.as_deref(), Some("Arm refused: NotCalibrated"));
     // Calibrated where it stands (at rest at 0), it arms.
-    s.tell_board(Message::Calibrate { position_pm: 0 });
+    s.tell_board(Message::Calibrate {
+        position_pm: Axes::one(0),
+    });
     s.tell_board(Message::Arm);
     for _ in 5..2000 {
         assert!(s.tick(), "{:?}", s.message);

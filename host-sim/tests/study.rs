@@ -5,7 +5,7 @@ use host_sim::pil::{failures, Comparison, Faults, Run};
 use host_sim::study::{sweep, table1};
 use host_sim::{Scene, Simulation};
 use std::path::Path;
-use twoport_link::{ConfigFallback, ConfigSource};
+use twoport_link::{Axes, ConfigFallback, ConfigSource};
 
 const SCENE: &str = "../scenes/table1/impedance_bilateral_hands_off.toml";
 
@@ -54,7 +54,7 @@ fn table1_every_case_is_stable_at_the_theoretical_gains() {
 
 fn clean(ticks: u64) -> (Run, Comparison) {
     let run = Run {
-        duties: vec![100; ticks as usize],
+        duties: vec![Axes::one(100); ticks as usize],
         config: Some((
             ConfigSource::Defaults {
                 why: ConfigFallback::Missing,
@@ -96,7 +96,7 @@ fn pil_runs_fail_for_any_difference_and_a_late_zero() {
     assert!(failures(&r, &c, 100, loss, 50).is_empty());
     r.zero_after_loss_ticks = Some(51);
     assert!(failures(&r, &c, 100, loss, 50)[0].contains("51 ticks after the link loss"));
-    r.duties = vec![0; 100];
+    r.duties = vec![Axes::one(0); 100];
     r.zero_after_loss_ticks = Some(1);
     assert!(failures(&r, &c, 100, loss, 50)[0].contains("would prove nothing"));
     // Armed at another tick than the in-process loop.
@@ -122,6 +122,6 @@ fn pil_runs_fail_for_any_difference_and_a_late_zero() {
     assert!(failures(&r, &c, 100, Faults::default(), 50)[0].contains("never said"));
     let mut r = run.clone();
     r.homing = Some((50, 0.0));
-    r.duties[10] = 1000; // 6.1 N
+    r.duties[10] = Axes::one(1000); // 6.1 N
     assert!(failures(&r, &c, 100, Faults::default(), 50)[0].contains("homing pushed 6.10 N"));
 }

@@ -202,6 +202,15 @@ fn ci() -> Result<(), String> {
         ];
         pil(&homing.map(String::from))?;
     }
+    // The three-axis image on its building-block world, on the an386.
+    pil(&[
+        "scenes/xyz/pil_blocks.toml".into(),
+        "--seconds".into(),
+        "6".into(),
+        "--link-loss-at-s".into(),
+        "5".into(),
+        "--check".into(),
+    ])?;
     // The passivity image too: the layered tick on the M4F against the
     // same code on the host.
     pil(&[
@@ -360,6 +369,22 @@ fn firmware() -> Result<PathBuf, String> {
     )
     .map_err(|e| format!("copy the defmt image: {e}"))?;
     run(
+        &format!(
+            "build firmware: three-axis STM32F405 image ({})",
+            tc.describe()
+        ),
+        &mut tc.build(
+            &root().join("firmware/stm32f405"),
+            &dir,
+            &["--features", "xyz"],
+        ),
+    )?;
+    std::fs::copy(
+        out.join("twoport-stm32f405"),
+        out.join("twoport-stm32f405-xyz"),
+    )
+    .map_err(|e| format!("copy the three-axis image: {e}"))?;
+    run(
         &format!("build firmware: STM32F405 image ({})", tc.describe()),
         &mut tc.build(&root().join("firmware/stm32f405"), &dir, &[]),
     )?;
@@ -368,6 +393,7 @@ fn firmware() -> Result<PathBuf, String> {
         .args([
             "twoport-stm32f405",
             "twoport-stm32f405-defmt",
+            "twoport-stm32f405-xyz",
             "twoport-an386",
             "twoport-probe",
         ])
@@ -437,24 +463,28 @@ fn host_test_against_an386(what: &str, elf: &Path, file: &str, name: &str) -> Re
     })
 }
 
-/// The STM32F405 image's `qemu` build, for QEMU's netduinoplus2; returns
-/// its ELF, copied aside as the passivity image is.
-fn stm32f405_qemu_image() -> Result<PathBuf, String> {
+/// The STM32F405 image's `qemu` build (three-axis with `xyz`), for QEMU's
+/// netduinoplus2; returns its ELF, copied aside as the passivity image is.
+fn stm32f405_qemu_image(xyz: bool) -> Result<PathBuf, String> {
     let tc = Toolchain::detect()?;
     let dir = cross_target_dir("firmware");
+    let (features, name) = match xyz {
+        true => ("qemu,xyz", "twoport-stm32f405-qemu-xyz"),
+        false => ("qemu", "twoport-stm32f405-qemu"),
+    };
     run(
         &format!(
-            "build firmware: the STM32F405 image for QEMU ({})",
+            "build firmware: the STM32F405 image for QEMU, {features} ({})",
             tc.describe()
         ),
         &mut tc.build(
             &root().join("firmware/stm32f405"),
             &dir,
-            &["--features", "qemu"],
+            &["--features", features],
         ),
     )?;
     let out = dir.join(TARGET).join("release");
-    let elf = out.join("twoport-stm32f405-qemu");
+    let elf = out.join(name);
     std::fs::copy(out.join("twoport-stm32f405"), &elf)
         .map_err(|e| format!("copy the STM32F405 QEMU image: {e}"))?;
     Ok(elf)
@@ -489,10 +519,13 @@ fn pil(extra: &[String]) -> Result<(), String> {
                 .args(&args),
         )
     };
+    let xyz = args.iter().any(|a| declares_three_axes(a));
     match board.as_str() {
         "an386" => {
             let elf = if args.iter().any(|a| a == "--passivity") {
                 passivity_image()?
+            } else if xyz {
+                an386_image_with("xyz")?
             } else {
                 firmware()?.join("twoport-an386")
             };
@@ -504,7 +537,7 @@ fn pil(extra: &[String]) -> Result<(), String> {
             if args.iter().any(|a| a == "--passivity") {
                 return Err("pil: the STM32F405 image has no passivity build".into());
             }
-            let elf = stm32f405_qemu_image()?;
+            let elf = stm32f405_qemu_image(xyz)?;
             let log = cross_target_dir("firmware").join("qemu-unmodelled-stm32f405.log");
             let _ = std::fs::remove_file(&log);
             let mut qemu = qemu_netduino(&elf);
@@ -520,6 +553,18 @@ fn pil(extra: &[String]) -> Result<(), String> {
             "pil: no board image called {other:?} (an386 or stm32f405)"
         )),
     }
+}
+
+/// Whether `arg` names a scene file that declares three axes (`axes = 3`
+/// at its top level), for which the three-axis image runs.
+fn declares_three_axes(arg: &str) -> bool {
+    if !arg.ends_with(".toml") {
+        return false;
+    }
+    let text = std::fs::read_to_string(root().join(arg)).unwrap_or_default();
+    text.lines()
+        .take_while(|l| !l.trim_start().starts_with('['))
+        .any(|l| l.split('#').next().unwrap_or("").replace(' ', "") == "axes=3")
 }
 
 /// What QEMU logged of the image's accesses to devices it does not model:

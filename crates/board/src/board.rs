@@ -3,35 +3,36 @@
 mod arming;
 mod persist;
 
+use crate::drive::Drive;
 use crate::io::IoScale;
-use crate::region::Region;
+use crate::region::{check_axes, Region};
 use crate::support::BoardSupport;
 use heapless::{Deque, Vec};
 use twoport_control::homing::{Homing, HomingConfig};
-use twoport_control::servo::{Direct, Gains, PortLayer, SensorFrame, Servo, ServoOutput};
-use twoport_control::ve::VirtualEnvironment;
+use twoport_control::servo::{AxesFrame, AxesOutput, Gains};
 use twoport_control::{Faults, Position};
 use twoport_link::{
     encode, ActuatorFrame, Axes, AxisRefusal, AxisTelemetry, Decoder, GainsReply, LinkStats,
-    Message, Mode, Refusal, Stats, Telemetry, MAX_FRAME,
+    Message, Mode, Refusal, Stats, Telemetry, MAX_AXES, MAX_FRAME,
 };
 
 /// One encoded frame, delimiter included.
 pub type Frame = Vec<u8, MAX_FRAME>;
-/// The axes this loop drives, as its handshake declares them: one, until
-/// the N-axis servo runs here.
-pub const AXES: u8 = 1;
 
 /// Frames each outgoing queue holds: replies and fault reports in one,
 /// telemetry in the other, so a telemetry flood never crowds out an answer.
 pub const TX_FRAMES: usize = 8;
 
-/// The portable firmware loop, around a servo with port layer `L` (none by
-/// default; the passivity image runs the series damper).
+/// The portable firmware loop around a servo `S` of `N` axes (one by
+/// default): the one-axis [`Servo`](twoport_control::Servo), with or
+/// without a port layer, or the
+/// [`AxesServo`](twoport_control::servo::AxesServo). Each axis has its own
+/// proven region of `R` grid points, load-cell scaling and homing; the
+/// handshake declares `N`.
 #[derive(Clone, Debug)]
-pub struct Board<V, const R: usize, L = Direct> {
-    servo: Servo<V, f32, L>,
-    region: Region<R>,
+pub struct Board<S, const R: usize, const N: usize = 1> {
+    servo: S,
+    regions: [Region<R>; N],
     decoder: Decoder,
     /// Replies and fault reports, sent first.
     control: Deque<Frame, TX_FRAMES>,
@@ -43,23 +44,25 @@ pub struct Board<V, const R: usize, L = Direct> {
     reported: Faults,
     loop_cycles: u32,
     tx_dropped: u32,
-    io: IoScale,
-    last: ServoOutput,
+    io: [IoScale; N],
+    last: AxesOutput<f32, N>,
     /// Whether sensor frames from the link drive ticks (processor in the
     /// loop). A board with real sensors must never let the host move it.
     pil: bool,
     pil_refused: u32,
     /// The host's sensor frame waiting for the next control tick (PIL).
-    pending: Option<SensorFrame>,
+    pending: Option<AxesFrame<f32, N>>,
     /// Ticks run from the board's own sensors (their frame's `tick`).
     ticks: u32,
     /// The state machine: disarmed at boot.
     mode: Mode,
     /// Whether the encoder's offset is known.
     calibrated: bool,
-    /// How to home, and the run in progress (in [`Mode::Homing`]).
-    homing_cfg: HomingConfig,
-    homing: Option<Homing>,
+    /// How each axis homes, and the run in progress (in
+    /// [`Mode::Homing`]): an axis that has homed holds no force while the
+    /// others go on.
+    homing_cfg: [HomingConfig; N],
+    homing: Option<[Option<Homing>; N]>,
     /// The dead-man switch at the last tick (open before the first).
     dead_man_closed: bool,
     /// Whether the amplifier's outputs are on (as last commanded).
@@ -68,10 +71,10 @@ pub struct Board<V, const R: usize, L = Direct> {
     config_source: Option<twoport_link::ConfigSource>,
     /// A `SaveConfig` waiting for the main loop.
     save_pending: bool,
-    /// The encoder count an index pulse latched, for this tick.
-    index: Option<u32>,
-    /// The host's index count waiting with its sensor frame (PIL).
-    pending_index: Option<u32>,
+    /// The encoder counts index pulses latched, for this tick.
+    index: [Option<u32>; N],
+    /// The host's index counts waiting with its sensor frame (PIL).
+    pending_index: [Option<u32>; N],
     /// Loop timing: the last tick's stages, its start, the overruns and
     /// the worst jitter since boot.
     timing: Timing,
@@ -110,17 +113,23 @@ impl Timing {
     }
 }
 
-impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
-    /// A board running `servo`, accepting gain changes inside `region`, and
-    /// sending telemetry every `telemetry_every` ticks (0: never). It
-    /// boots disarmed and uncalibrated, homing toward the negative end
-    /// with [`HomingConfig::gentle`] onto a stop at the origin unless
+impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
+    /// A board running `servo`, accepting gain changes on each axis inside
+    /// its region of `regions`, and sending telemetry every
+    /// `telemetry_every` ticks (0: never). It boots disarmed and
+    /// uncalibrated, each axis homing toward its negative end with
+    /// [`HomingConfig::gentle`] onto a stop at the origin unless
     /// [`with_homing`](Self::with_homing) says otherwise.
-    pub fn new(servo: Servo<V, f32, L>, region: Region<R>, telemetry_every: u32) -> Self {
-        let period_s = servo.safety().config().period_s;
+    ///
+    /// `N` is between 1 and the link's [`MAX_AXES`] (checked at compile
+    /// time).
+    pub fn new(servo: S, regions: [Region<R>; N], telemetry_every: u32) -> Self {
+        const { assert!(N >= 1 && N <= MAX_AXES, "a board has 1 to MAX_AXES axes") };
+        let period_s = servo.period_s();
+        let position = servo.position();
         Board {
             servo,
-            region,
+            regions,
             decoder: Decoder::new(),
             control: Deque::new(),
             telemetry: Deque::new(),
@@ -130,30 +139,30 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             reported: Faults::NONE,
             loop_cycles: 0,
             tx_dropped: 0,
-            io: IoScale::EXCALIBUR,
-            last: ServoOutput::default(),
+            io: [IoScale::EXCALIBUR; N],
+            last: AxesOutput::at_rest(position, [0.0; N]),
             pil: false,
             pil_refused: 0,
             pending: None,
             ticks: 0,
             mode: Mode::Disarmed,
             calibrated: false,
-            homing_cfg: HomingConfig::gentle(Position::ZERO, period_s),
+            homing_cfg: [HomingConfig::gentle(Position::ZERO, period_s); N],
             homing: None,
             dead_man_closed: false,
             outputs_on: false,
             config_source: None,
             save_pending: false,
-            index: None,
-            pending_index: None,
+            index: [None; N],
+            pending_index: [None; N],
             timing: Timing::default(),
         }
     }
 
-    /// The same board homing with `cfg` (its `period_s` must be the
-    /// servo's; [`Message::Home`] refuses a configuration that does not
-    /// validate).
-    pub fn with_homing(mut self, cfg: HomingConfig) -> Self {
+    /// The same board with each axis homing with its `cfg` (whose
+    /// `period_s` must be the servo's; [`Message::Home`] refuses a
+    /// configuration that does not validate).
+    pub fn with_homing(mut self, cfg: [HomingConfig; N]) -> Self {
         self.homing_cfg = cfg;
         self
     }
@@ -172,30 +181,30 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
         self.pil_refused
     }
 
-    /// The same board with `io` scaling its peripherals (default:
+    /// The same board with `io` scaling each axis's peripherals (default:
     /// [`IoScale::EXCALIBUR`]).
-    pub fn with_io(mut self, io: IoScale) -> Self {
+    pub fn with_io(mut self, io: [IoScale; N]) -> Self {
         self.io = io;
         self
     }
 
-    /// How the peripherals scale.
-    pub fn io(&self) -> IoScale {
+    /// How each axis's peripherals scale.
+    pub fn io(&self) -> [IoScale; N] {
         self.io
     }
 
     /// The last tick's output.
-    pub fn last_output(&self) -> &ServoOutput {
+    pub fn last_output(&self) -> &AxesOutput<f32, N> {
         &self.last
     }
 
-    /// The signed PWM duty for the held actuator force.
-    pub fn duty(&self) -> i16 {
-        self.io.duty(self.last.actuator_force_n)
+    /// Each axis's signed PWM duty for its held actuator force.
+    pub fn duty(&self) -> [i16; N] {
+        core::array::from_fn(|i| self.io[i].duty(self.last.actuator_force_n[i]))
     }
 
     /// The servo (gains, safety state).
-    pub fn servo(&self) -> &Servo<V, f32, L> {
+    pub fn servo(&self) -> &S {
         &self.servo
     }
 
@@ -247,26 +256,35 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
         let _ = q.push_back(frame);
     }
 
+    /// Each axis's value, as the link carries them.
+    fn axes<T: Copy>(xs: [T; N]) -> Axes<T> {
+        // (`new` checked 1 <= N <= MAX_AXES.)
+        Axes::from_slice(&xs).unwrap_or(Axes::one(xs[0]))
+    }
+
     fn handle(&mut self, msg: Message) {
-        if let Some(ack) = msg.answer(AXES) {
+        if let Some(ack) = msg.answer(N as u8) {
             self.queue(ack);
             return;
         }
         match msg {
             Message::Heartbeat => self.servo.heartbeat(),
-            Message::GetGains => self.queue(Message::Gains(Axes::one(self.servo.gains().into()))),
+            Message::GetGains => {
+                let g = Self::axes(self.servo.gains().map(Into::into));
+                self.queue(Message::Gains(g));
+            }
             Message::SetGains(g) => {
-                let reply = match g.to_array::<1>() {
-                    Some([g]) => {
-                        let g = Gains::from(g);
+                let reply = match g.to_array::<N>() {
+                    Some(g) => {
+                        let g = g.map(Gains::from);
                         match self.check(&g) {
                             Ok(()) => self.apply(g),
-                            Err(why) => GainsReply::Refused(AxisRefusal { axis: 0, why }),
+                            Err(why) => GainsReply::Refused(why),
                         }
                     }
                     None => GainsReply::Refused(AxisRefusal {
                         axis: 0,
-                        why: Refusal::WrongAxisCount { axes: AXES },
+                        why: Refusal::WrongAxisCount { axes: N as u8 },
                     }),
                 };
                 self.queue(Message::GainsReply(reply));
@@ -292,17 +310,22 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             Message::Sensors(_) if !self.pil => {
                 self.pil_refused = self.pil_refused.saturating_add(1);
             }
-            // (The handshake agreed on the axes, so a frame of another
-            // count is a host's error: it is counted and never ticks.)
-            Message::Sensors(s) if s.encoder_raw.len() != 1 || s.load_cell_raw.len() != 1 => {
-                self.pil_refused = self.pil_refused.saturating_add(1);
-            }
             Message::Sensors(s) => {
-                self.pending_index = s.index_raw[0];
-                self.pending = Some(SensorFrame {
+                // (The handshake agreed on the axes, so a frame of another
+                // count is a host's error: it is counted and never ticks.)
+                let (Some(enc), Some(cells), Some(index)) = (
+                    s.encoder_raw.to_array::<N>(),
+                    s.load_cell_raw.to_array::<N>(),
+                    s.index_raw.to_array::<N>(),
+                ) else {
+                    self.pil_refused = self.pil_refused.saturating_add(1);
+                    return;
+                };
+                self.pending_index = index;
+                self.pending = Some(AxesFrame {
                     tick: s.tick,
-                    encoder_raw: s.encoder_raw[0],
-                    load_cell_n: self.io.load_cell_n(s.load_cell_raw[0]),
+                    encoder_raw: enc,
+                    load_cell_n: core::array::from_fn(|i| self.io[i].load_cell_n(cells[i])),
                     dead_man_closed: s.dead_man_closed,
                 });
             }
@@ -310,16 +333,17 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
         }
     }
 
-    /// Whether `g` is inside the proven region for this board's display.
-    fn check(&self, g: &Gains) -> Result<(), Refusal> {
-        self.region.check(self.servo.display(), g)
+    /// Whether each axis's gains of `g` lie inside its proven region for
+    /// this board's display; the first axis that does not, and why.
+    fn check(&self, g: &[Gains; N]) -> Result<(), AxisRefusal> {
+        check_axes(&self.regions, self.servo.display(), g)
     }
 
-    fn apply(&mut self, g: Gains) -> GainsReply {
+    fn apply(&mut self, g: [Gains; N]) -> GainsReply {
         match self.servo.set_gains(g) {
-            Ok(()) => GainsReply::Accepted(Axes::one(self.servo.gains().into())),
-            Err(_) => GainsReply::Refused(AxisRefusal {
-                axis: 0,
+            Ok(()) => GainsReply::Accepted(Self::axes(self.servo.gains().map(Into::into))),
+            Err(e) => GainsReply::Refused(AxisRefusal {
+                axis: e.axis as u8,
                 why: Refusal::OutOfRange,
             }),
         }
@@ -333,7 +357,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     /// Take the bytes the link has received, stopping early where one
     /// completes a sensor frame (PIL), so that each frame gets its own
     /// tick. Returns whether a sensor frame waits.
-    pub fn poll_link(&mut self, io: &mut impl BoardSupport) -> bool {
+    pub fn poll_link(&mut self, io: &mut impl BoardSupport<N>) -> bool {
         while self.pending.is_none() {
             let Some(b) = io.read_byte() else { break };
             self.on_bytes(&[b]);
@@ -342,7 +366,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     }
 
     /// Send every queued frame (replies first, then telemetry).
-    pub fn flush(&mut self, io: &mut impl BoardSupport) {
+    pub fn flush(&mut self, io: &mut impl BoardSupport<N>) {
         while let Some(f) = self.pop_tx() {
             io.write(&f);
         }
@@ -357,7 +381,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     /// board's ADC conversion amounts to, and answers with the duty. The
     /// time from the sensors to the command, in the support's
     /// [`cycles`](BoardSupport::cycles), goes out in the next telemetry.
-    pub fn control_tick(&mut self, io: &mut impl BoardSupport) -> ServoOutput {
+    pub fn control_tick(&mut self, io: &mut impl BoardSupport<N>) -> AxesOutput<f32, N> {
         self.control_tick_serving(io, |_| {})
     }
 
@@ -367,9 +391,9 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     /// which would otherwise wait for the tick the host is waiting on.
     pub fn control_tick_serving(
         &mut self,
-        io: &mut impl BoardSupport,
+        io: &mut impl BoardSupport<N>,
         serve: impl FnMut(&mut Self),
-    ) -> ServoOutput {
+    ) -> AxesOutput<f32, N> {
         let out = self.control_tick_inner(io, serve);
         // Outputs follow the mode, within the tick that changed it.
         self.drive_outputs(io);
@@ -378,9 +402,9 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
 
     fn control_tick_inner(
         &mut self,
-        io: &mut impl BoardSupport,
+        io: &mut impl BoardSupport<N>,
         mut serve: impl FnMut(&mut Self),
-    ) -> ServoOutput {
+    ) -> AxesOutput<f32, N> {
         let (frame, start) = if self.pil {
             let frame = loop {
                 io.feed_watchdog();
@@ -391,15 +415,17 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
                 serve(self);
                 self.flush(io);
             };
-            self.index = self.pending_index.take();
+            self.index = core::mem::replace(&mut self.pending_index, [None; N]);
             (frame, io.cycles())
         } else {
             let start = io.cycles();
             let raw = io.sample();
-            let frame = SensorFrame {
+            let frame = AxesFrame {
                 tick: self.ticks,
                 encoder_raw: raw.encoder_raw,
-                load_cell_n: self.io.load_cell_n(raw.load_cell_counts),
+                load_cell_n: core::array::from_fn(|i| {
+                    self.io[i].load_cell_n(raw.load_cell_counts[i])
+                }),
                 dead_man_closed: raw.dead_man_closed,
             };
             self.index = raw.index_raw;
@@ -408,7 +434,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
         };
         let sensed = io.cycles();
         let out = self.tick(&frame);
-        self.index = None;
+        self.index = [None; N];
         let ruled = io.cycles();
         let duty = self.duty();
         io.set_duty(duty);
@@ -416,7 +442,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
         if self.pil {
             self.queue(Message::Actuator(ActuatorFrame {
                 tick: frame.tick,
-                duty: Axes::one(duty),
+                duty: Self::axes(duty),
             }));
         }
         let end = io.cycles();
@@ -428,12 +454,9 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
 
     /// One control tick: the law, a fault report when new faults latch,
     /// telemetry on schedule. Returns the held actuator command.
-    pub fn tick(&mut self, frame: &SensorFrame) -> ServoOutput {
+    pub fn tick(&mut self, frame: &AxesFrame<f32, N>) -> AxesOutput<f32, N> {
         self.dead_man_closed = frame.dead_man_closed;
-        let out = match &mut self.homing {
-            Some(h) => self.servo.tick_with(frame, |x, v| h.step(x, v)),
-            None => self.servo.tick(frame),
-        };
+        let out = self.servo.tick(frame, self.homing.as_mut());
         self.last = out;
         self.after_tick(&out);
         if !out.faults.is_empty() && out.faults != self.reported {
@@ -447,16 +470,18 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             self.since_telemetry += 1;
             if self.since_telemetry >= self.telemetry_every {
                 self.since_telemetry = 0;
+                let ve = self.servo.ve_position();
+                let axes = core::array::from_fn(|i| AxisTelemetry {
+                    position_pm: out.position[i].nm() as i64 * 1000,
+                    velocity_mps: out.velocity_mps[i],
+                    load_cell_n: frame.load_cell_n[i],
+                    commanded_n: out.commanded_force_n[i],
+                    actuator_n: out.actuator_force_n[i],
+                    ve_position_pm: ve[i].nm() as i64 * 1000,
+                });
                 self.queue(Message::Telemetry(Telemetry {
                     tick: frame.tick,
-                    axes: Axes::one(AxisTelemetry {
-                        position_pm: out.position.nm() as i64 * 1000,
-                        velocity_mps: out.velocity_mps,
-                        load_cell_n: frame.load_cell_n,
-                        commanded_n: out.commanded_force_n,
-                        actuator_n: out.actuator_force_n,
-                        ve_position_pm: self.servo.ve().position().nm() as i64 * 1000,
-                    }),
+                    axes: Self::axes(axes),
                     faults: out.faults.0,
                     loop_cycles: self.loop_cycles,
                     mode: self.mode,

@@ -44,6 +44,8 @@ impl From<RegionError> for BuildError {
     }
 }
 
+pub mod xyz;
+
 /// The proven region (impedance display, paper human bound, T = 1 ms).
 pub mod region {
     use super::Bound;
@@ -130,22 +132,22 @@ pub fn stiff_wall_servo_with_passivity(
 /// The passivity image's board: [`stiff_wall_board`] with the series
 /// damper between the actuator's port and the coupling.
 pub fn stiff_wall_board_with_passivity(
-) -> Result<Board<UnilateralWall, REGION_POINTS, SeriesDamper>, BuildError> {
+) -> Result<Board<Servo<UnilateralWall, f32, SeriesDamper>, REGION_POINTS>, BuildError> {
     Ok(Board::new(
         stiff_wall_servo_with_passivity()?,
-        proven_region()?,
+        [proven_region()?],
         TELEMETRY_EVERY,
     )
-    .with_io(IoScale::EXCALIBUR)
-    .with_homing(HOMING))
+    .with_io([IoScale::EXCALIBUR])
+    .with_homing([HOMING]))
 }
 
 /// The whole board: servo, region, telemetry rate, I/O scaling. It reads its
 /// own sensors; the processor-in-the-loop images add `.with_pil(true)`.
-pub fn stiff_wall_board() -> Result<Board<UnilateralWall, REGION_POINTS>, BuildError> {
+pub fn stiff_wall_board() -> Result<Board<Servo<UnilateralWall>, REGION_POINTS>, BuildError> {
     Ok(
-        Board::new(stiff_wall_servo()?, proven_region()?, TELEMETRY_EVERY)
-            .with_io(IoScale::EXCALIBUR)
-            .with_homing(HOMING),
+        Board::new(stiff_wall_servo()?, [proven_region()?], TELEMETRY_EVERY)
+            .with_io([IoScale::EXCALIBUR])
+            .with_homing([HOMING]),
     )
 }

@@ -3,36 +3,49 @@
 //! ([`Board::control_tick`](crate::Board::control_tick)) is written once
 //! for every image, and a host test can stand in for the hardware.
 
-/// One tick's sensors as the peripherals give them, before any scaling.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct RawSensors {
-    /// The encoder timer's count (its low `bits` are meaningful).
-    pub encoder_raw: u32,
-    /// The load-cell ADC reading, offset removed (counts; signed).
-    pub load_cell_counts: i32,
+/// One tick's sensors of a device of `N` axes (one by default) as the
+/// peripherals give them, before any scaling, all latched at one instant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RawSensors<const N: usize = 1> {
+    /// Each axis's encoder timer count (its low `bits` are meaningful).
+    pub encoder_raw: [u32; N],
+    /// Each axis's load-cell ADC reading, offset removed (counts; signed).
+    pub load_cell_counts: [i32; N],
     /// Whether the dead-man switch is closed (the hand is on the handle).
     pub dead_man_closed: bool,
-    /// The encoder count latched by its index pulse since the last
-    /// sample, where the encoder has an index and it passed.
-    pub index_raw: Option<u32>,
+    /// The encoder count each axis's index pulse latched since the last
+    /// sample, where its encoder has an index and it passed.
+    pub index_raw: [Option<u32>; N],
 }
 
-/// A board's peripherals, as the loop uses them.
+impl<const N: usize> Default for RawSensors<N> {
+    fn default() -> Self {
+        RawSensors {
+            encoder_raw: [0; N],
+            load_cell_counts: [0; N],
+            dead_man_closed: false,
+            index_raw: [None; N],
+        }
+    }
+}
+
+/// The peripherals of a board of `N` axes (one by default), as the loop
+/// uses them.
 ///
 /// The image owns the timer that calls the control interrupt; the loop
 /// needs only what is below. Every method is called with the board's lock
 /// held, so none of them may wait long: `write` only ever sends a queued
 /// frame, and `sample` waits only for the conversion it started.
-pub trait BoardSupport {
-    /// Latch every sensor at one instant and return the readings: the
-    /// encoder count, the load cell (starting its conversion and waiting
-    /// for it) and the dead-man input.
-    fn sample(&mut self) -> RawSensors;
-    /// Command the amplifier: a signed duty, ±[`DUTY_FULL_SCALE`] at
-    /// full-scale force, 0 for none.
+pub trait BoardSupport<const N: usize = 1> {
+    /// Latch every sensor of every axis at one instant and return the
+    /// readings: the encoder counts, the load cells (starting their
+    /// conversions and waiting for them) and the dead-man input.
+    fn sample(&mut self) -> RawSensors<N>;
+    /// Command the amplifiers, every axis in the same update: a signed
+    /// duty each, ±[`DUTY_FULL_SCALE`] at full-scale force, 0 for none.
     ///
     /// [`DUTY_FULL_SCALE`]: crate::DUTY_FULL_SCALE
-    fn set_duty(&mut self, duty: i16);
+    fn set_duty(&mut self, duty: [i16; N]);
     /// Switch the amplifier's outputs on or off (a gate-driver enable, a
     /// timer's main output enable). Off at boot, before the first call;
     /// the loop turns them on only while homing or armed.

@@ -5,7 +5,9 @@
 use twoport_board::{BoardSupport, IoScale, RawSensors};
 use twoport_control::homing::HomingConfig;
 use twoport_control::{Faults, Position, SafetyConfig};
-use twoport_link::{encode, Decoder, Message, Mode, ModeRefusal, ModeRequest, Status, MAX_FRAME};
+use twoport_link::{
+    encode, Axes, Decoder, Message, Mode, ModeRefusal, ModeRequest, Status, MAX_FRAME,
+};
 
 const T: f32 = 1e-3;
 
@@ -18,7 +20,7 @@ fn board_with(k_npm: f32) -> TestBoard {
         ..SafetyConfig::excalibur()
     };
     common::board(k_npm, safety, 0)
-        .with_homing(HomingConfig::gentle(Position::from_nm(-20_000_000), T))
+        .with_homing([HomingConfig::gentle(Position::from_nm(-20_000_000), T)])
 }
 
 fn board() -> TestBoard {
@@ -113,13 +115,13 @@ impl BoardSupport for Bench {
         });
         self.last_x_m = self.x_m;
         RawSensors {
-            encoder_raw: (counts as u32) & 0xFFFF,
-            load_cell_counts: 0,
+            encoder_raw: [(counts as u32) & 0xFFFF],
+            load_cell_counts: [0],
             dead_man_closed: self.dead_man_closed,
-            index_raw,
+            index_raw: [index_raw],
         }
     }
-    fn set_duty(&mut self, duty: i16) {
+    fn set_duty(&mut self, [duty]: [i16; 1]) {
         self.duty = duty;
     }
     fn set_outputs(&mut self, on: bool) {
@@ -153,7 +155,7 @@ fn tick(b: &mut TestBoard, io: &mut Bench) {
 fn board_homing_to_an_index() -> TestBoard {
     let mut cfg = HomingConfig::gentle(Position::from_nm(-20_000_000), T);
     cfg.index_position = Some(Position::from_nm(-12_000_000));
-    board().with_homing(cfg)
+    board().with_homing([cfg])
 }
 
 /// One tick at power-on, then the host asks the board to home.
@@ -199,7 +201,9 @@ fn boots_disarmed_with_outputs_off_and_names_why_it_will_not_arm() {
         refused(&ask_to_arm(&mut b, &mut io)),
         [(ModeRequest::Arm, ModeRefusal::NotCalibrated)]
     );
-    io.say(Message::Calibrate { position_pm: 0 });
+    io.say(Message::Calibrate {
+        position_pm: Axes::one(0),
+    });
     io.dead_man_closed = false;
     tick(&mut b, &mut io);
     assert_eq!(
@@ -235,7 +239,9 @@ fn gains_outside_the_proven_region_never_arm() {
     // An image built with gains its region does not hold.
     let mut b = board_with(60_000.0);
     let mut io = Bench::new(None);
-    io.say(Message::Calibrate { position_pm: 0 });
+    io.say(Message::Calibrate {
+        position_pm: Axes::one(0),
+    });
     tick(&mut b, &mut io);
     assert_eq!(
         refused(&ask_to_arm(&mut b, &mut io)),
@@ -251,7 +257,9 @@ fn gains_outside_the_proven_region_never_arm() {
 fn any_fault_disarms_and_latches_until_cleared_and_re_armed() {
     let mut b = board();
     let mut io = Bench::new(None);
-    io.say(Message::Calibrate { position_pm: 0 });
+    io.say(Message::Calibrate {
+        position_pm: Axes::one(0),
+    });
     tick(&mut b, &mut io);
     io.say(Message::Arm);
     for k in 0..400 {
@@ -334,7 +342,7 @@ fn homing_finds_the_stop_gently_and_calibrates_the_encoder() {
         io.v_mps = 0.0;
         tick(&mut b, &mut io);
     }
-    let err_nm = b.last_output().position.nm() - -5_000_000;
+    let err_nm = b.last_output().position[0].nm() - -5_000_000;
     assert!(err_nm.abs() <= 30_000, "{err_nm} nm");
     // Homed, it arms.
     io.say(Message::Arm);
@@ -346,7 +354,7 @@ fn homing_finds_the_stop_gently_and_calibrates_the_encoder() {
 fn homing_without_a_stop_times_out_as_a_named_fault() {
     let mut cfg = HomingConfig::gentle(Position::ZERO, T);
     cfg.timeout_s = 0.5;
-    let mut b = board().with_homing(cfg);
+    let mut b = board().with_homing([cfg]);
     let mut io = Bench::new(None);
     start_homing(&mut b, &mut io);
     for _ in 0..600 {
@@ -373,7 +381,9 @@ fn calibrate_and_home_need_a_disarmed_board_and_disarm_stops_homing() {
     start_homing(&mut b, &mut io);
     tick(&mut b, &mut io);
     assert_eq!(b.mode(), Mode::Homing);
-    io.say(Message::Calibrate { position_pm: 0 });
+    io.say(Message::Calibrate {
+        position_pm: Axes::one(0),
+    });
     io.say(Message::Home);
     io.say(Message::Arm);
     tick(&mut b, &mut io);
@@ -395,7 +405,7 @@ fn calibrate_and_home_need_a_disarmed_board_and_disarm_stops_homing() {
     assert_eq!(io.force_n(), 0.0);
     // A position beyond the board's range is refused by name.
     io.say(Message::Calibrate {
-        position_pm: 3_000_000_000_000_000,
+        position_pm: Axes::one(3_000_000_000_000_000),
     });
     tick(&mut b, &mut io);
     assert_eq!(
@@ -430,7 +440,7 @@ fn homing_on_an_index_pulse_calibrates_to_the_count_before_the_stop() {
     // The board's frame is the truth less 6 mm, to the count, from the
     // next tick on.
     tick(&mut b, &mut io);
-    let err_nm = b.last_output().position.nm() - ((io.x_m * 1e9).round() as i32 - 6_000_000);
+    let err_nm = b.last_output().position[0].nm() - ((io.x_m * 1e9).round() as i32 - 6_000_000);
     assert!(err_nm.abs() <= 1_000, "{err_nm} nm");
 }
 

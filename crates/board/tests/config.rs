@@ -76,16 +76,16 @@ fn saved_gains_come_back_at_the_next_boot() {
     // Reboot on the same flash.
     let mut again = board();
     assert_eq!(again.boot_config(&mut st), ConfigSource::Stored { seq: 1 });
-    assert_eq!(again.config().gains, tuned);
+    assert_eq!(again.config()[0].gains, tuned);
 
     // Armed, a save is refused.
-    again.tick(&twoport_control::SensorFrame {
-        tick: 0,
-        encoder_raw: 0,
-        load_cell_n: 0.0,
-        dead_man_closed: true,
-    });
-    say(&mut again, Message::Calibrate { position_pm: 0 });
+    again.tick(&twoport_control::SensorFrame::held(0, 0, 0.0).into());
+    say(
+        &mut again,
+        Message::Calibrate {
+            position_pm: Axes::one(0),
+        },
+    );
     say(&mut again, Message::Arm);
     assert_eq!(again.mode(), Mode::Armed);
     heard(&mut again);
@@ -121,7 +121,7 @@ fn saved_gains_come_back_at_the_next_boot() {
     st.flash_mut().restore_power();
     let mut third = board();
     assert_eq!(third.boot_config(&mut st), ConfigSource::Stored { seq: 1 });
-    assert_eq!(third.config().gains, tuned);
+    assert_eq!(third.config()[0].gains, tuned);
 }
 
 /// A record this image cannot run: gains outside its proven region. The
@@ -130,7 +130,7 @@ fn saved_gains_come_back_at_the_next_boot() {
 fn a_stored_record_with_unproven_gains_is_not_run() {
     let mut b = board();
     let defaults = b.config();
-    let mut cfg = defaults;
+    let [mut cfg] = defaults;
     cfg.gains = Gains::Impedance {
         k_npm: 60_000.0,
         b_nspm: 90.0,
@@ -155,7 +155,7 @@ fn a_stored_record_with_unproven_gains_is_not_run() {
 #[test]
 fn stored_calibration_and_limits_are_put_in_force() {
     let mut b = board();
-    let mut cfg: Config = b.config();
+    let [mut cfg]: [Config; 1] = b.config();
     cfg.load_cell.offset_counts = 2048;
     cfg.limits.peak_force_n = 50.0;
     cfg.limits.continuous_force_n = 20.0;
@@ -164,7 +164,7 @@ fn stored_calibration_and_limits_are_put_in_force() {
     let mut st = store(Flash::new());
     st.save(&cfg).unwrap();
     assert_eq!(b.boot_config(&mut st), ConfigSource::Stored { seq: 1 });
-    assert_eq!(b.io().load_cell_n(2048 + 1000), 1.0);
+    assert_eq!(b.io()[0].load_cell_n(2048 + 1000), 1.0);
     assert_eq!(b.servo().safety().config().peak_force_n, 50.0);
-    assert_eq!(b.config(), cfg);
+    assert_eq!(b.config(), [cfg]);
 }

@@ -19,17 +19,17 @@ fn safety() -> SafetyConfig {
     }
 }
 
-fn board() -> Board<BilateralConstraint, 3> {
+fn board() -> Board<Servo<BilateralConstraint>, 3> {
     common::board(51_000.0, safety(), 10)
 }
 
-fn send(b: &mut Board<BilateralConstraint, 3>, seq: u16, m: Message) {
+fn send(b: &mut Board<Servo<BilateralConstraint>, 3>, seq: u16, m: Message) {
     let mut buf = [0u8; MAX_FRAME];
     let n = encode(seq, &m, &mut buf).unwrap();
     b.on_bytes(&buf[..n]);
 }
 
-fn replies(b: &mut Board<BilateralConstraint, 3>) -> Vec<Message> {
+fn replies(b: &mut Board<Servo<BilateralConstraint>, 3>) -> Vec<Message> {
     let mut d = Decoder::new();
     let mut out = Vec::new();
     while let Some(f) = b.pop_tx() {
@@ -40,9 +40,15 @@ fn replies(b: &mut Board<BilateralConstraint, 3>) -> Vec<Message> {
 
 /// Tick 0 (the board then knows the dead-man is closed), calibrate where
 /// it stands and arm; the next tick is 1.
-fn arm(b: &mut Board<BilateralConstraint, 3>, raw: u32) {
-    b.tick(&frame(0, raw));
-    send(b, 100, Message::Calibrate { position_pm: 0 });
+fn arm(b: &mut Board<Servo<BilateralConstraint>, 3>, raw: u32) {
+    b.tick(&frame(0, raw).into());
+    send(
+        b,
+        100,
+        Message::Calibrate {
+            position_pm: Axes::one(0),
+        },
+    );
     send(b, 101, Message::Arm);
     assert_eq!(b.mode(), Mode::Armed, "{:?}", replies(b));
     replies(b);
@@ -197,17 +203,17 @@ fn link_loss_gives_zero_force_within_the_watchdog_deadline() {
             send(&mut b, seq, Message::Heartbeat);
             seq += 1;
         }
-        let out = b.tick(&frame(k, 100));
+        let out = b.tick(&frame(k, 100).into());
         assert!(out.faults.is_empty(), "tick {k}: {}", out.faults);
     }
     assert!(
-        b.tick(&frame(500, 100)).actuator_force_n.abs() > 1.0,
+        b.tick(&frame(500, 100).into()).actuator_force_n[0].abs() > 1.0,
         "the coupling pulls"
     );
     let mut zero_at = None;
     for k in 501..600u32 {
-        let out = b.tick(&frame(k, 100));
-        if out.actuator_force_n == 0.0 && zero_at.is_none() {
+        let out = b.tick(&frame(k, 100).into());
+        if out.actuator_force_n[0] == 0.0 && zero_at.is_none() {
             zero_at = Some(k);
             assert!(out.faults.contains(Faults::HEARTBEAT_LOST));
         }
@@ -220,7 +226,7 @@ fn link_loss_gives_zero_force_within_the_watchdog_deadline() {
     assert!(replies(&mut b).iter().any(|m| matches!(m, Message::FaultReport { faults, .. } if faults & Faults::HEARTBEAT_LOST.0 != 0)));
     send(&mut b, seq, Message::ClearFaults);
     send(&mut b, seq + 1, Message::Heartbeat);
-    assert!(b.tick(&frame(600, 100)).faults.is_empty());
+    assert!(b.tick(&frame(600, 100).into()).faults.is_empty());
 }
 
 /// Garbage and corrupted frames between good ones: the loop keeps ticking,
@@ -249,7 +255,7 @@ fn corrupted_frames_do_not_stop_the_loop() {
         if k == 555 {
             b.on_bytes(&good[..n]);
         }
-        b.tick(&frame(k, k % 300));
+        b.tick(&frame(k, k % 300).into());
     }
     let s = b.link_stats();
     assert!(s.dropped() >= 20, "{s:?}");
@@ -268,7 +274,7 @@ fn corrupted_frames_do_not_stop_the_loop() {
 fn the_outgoing_queue_is_bounded() {
     let mut b = board();
     for k in 0..10_000u32 {
-        b.tick(&frame(k, 0));
+        b.tick(&frame(k, 0).into());
         if k == 5_000 {
             send(&mut b, 0, Message::GetGains);
         }
@@ -301,7 +307,7 @@ fn admittance_gains_need_the_proven_regulator() {
         BilateralConstraint::new(Position::ZERO),
     )
     .unwrap();
-    let mut b = Board::new(s, region, 0);
+    let mut b = Board::new(s, [region], 0);
     let ok = Gains::Admittance {
         kp_npm: 51_000.0,
         bp_nspm: 90.0,
@@ -353,15 +359,15 @@ fn a_board_with_real_sensors_ignores_sensor_frames_from_the_link() {
     let mut b = board();
     arm(&mut b, 0);
     for k in 1..20u32 {
-        b.tick(&frame(k, k));
+        b.tick(&frame(k, k).into());
     }
-    let before = b.last_output().position;
+    let before = b.last_output().position[0];
     for k in 0..5u16 {
         send(&mut b, 1 + k, sensors(20 + u32::from(k), 5000));
     }
     assert_eq!(b.pil_refused(), 5);
     // No tick ran from the link, and nothing answered.
-    assert_eq!(b.last_output().position, before);
+    assert_eq!(b.last_output().position[0], before);
     assert!(replies(&mut b)
         .iter()
         .all(|m| !matches!(m, Message::Actuator(_))));
@@ -389,7 +395,7 @@ impl BoardSupport for Io {
         self.samples += 1;
         self.sensors
     }
-    fn set_duty(&mut self, duty: i16) {
+    fn set_duty(&mut self, [duty]: [i16; 1]) {
         self.duties.push(duty);
     }
     fn set_outputs(&mut self, _: bool) {}
@@ -433,7 +439,12 @@ fn a_pil_board_ticks_once_per_sensor_frame_and_answers_with_the_duty() {
     let mut b = board().with_pil(true);
     let mut io = Io::default();
     io.queue(0, Message::hello(Role::Host, 1));
-    io.queue(1, Message::Calibrate { position_pm: 0 });
+    io.queue(
+        1,
+        Message::Calibrate {
+            position_pm: Axes::one(0),
+        },
+    );
     // Armed once the first tick has seen the dead-man closed.
     for k in 0..30u16 {
         io.queue(2 + 2 * k, sensors(u32::from(k), u32::from(k) * 10));
@@ -476,14 +487,19 @@ fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
     let mut b = board();
     let mut io = Io {
         sensors: RawSensors {
-            encoder_raw: 0,
-            load_cell_counts: 1_500,
+            encoder_raw: [0],
+            load_cell_counts: [1_500],
             dead_man_closed: true,
-            index_raw: None,
+            index_raw: [None],
         },
         ..Io::default()
     };
-    io.queue(0, Message::Calibrate { position_pm: 0 });
+    io.queue(
+        0,
+        Message::Calibrate {
+            position_pm: Axes::one(0),
+        },
+    );
     // Not a PIL board: nothing the link says makes a tick wait.
     assert!(!b.poll_link(&mut io));
     let mut outs = Vec::new();
@@ -497,7 +513,7 @@ fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
             io.queue(500, Message::Arm);
         }
         if k == 2 {
-            io.sensors.encoder_raw = 30;
+            io.sensors.encoder_raw = [30];
         }
         b.poll_link(&mut io);
         outs.push(b.control_tick(&mut io));
@@ -510,11 +526,11 @@ fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
     // 30 um off the constraint at 51 kN/m is about 1.5 N of pull back;
     // the load cell reads 1.5 N through the scale.
     assert!(
-        outs.last().unwrap().actuator_force_n.abs() > 1.0,
+        outs.last().unwrap().actuator_force_n[0].abs() > 1.0,
         "{:?}",
         outs.last()
     );
-    assert_eq!(*io.duties.last().unwrap(), b.duty());
+    assert_eq!(*io.duties.last().unwrap(), b.duty()[0]);
     let telemetry: Vec<_> = tx
         .into_iter()
         .filter_map(|m| match m {
@@ -558,7 +574,7 @@ fn deadline_misses_and_the_worst_jitter_are_counted_and_reported() {
         ..Io::default()
     };
     // One tick, and the telemetry it sent.
-    let tick = |b: &mut Board<BilateralConstraint, 3>, io: &mut Io| {
+    let tick = |b: &mut Board<Servo<BilateralConstraint>, 3>, io: &mut Io| {
         b.control_tick(io);
         b.flush(io);
         io.messages()

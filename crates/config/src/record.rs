@@ -10,6 +10,9 @@
 //!     12     n  payload: the Config, postcard-encoded
 //!   12+n     4  CRC-32 of bytes 4 .. 12+n, little-endian
 //! ```
+//!
+//! A board of several axes stores one `Config` per axis, one after the
+//! other in the payload; a one-axis record is exactly one.
 
 use crate::crc32::crc32;
 use serde::{Deserialize, Serialize};
@@ -19,8 +22,9 @@ use twoport_link::Gains;
 pub const MAGIC: [u8; 4] = *b"TPCF";
 /// The record format this crate writes and reads.
 pub const FORMAT_VERSION: u16 = 1;
-/// The largest payload (bytes).
-pub const MAX_PAYLOAD: usize = 96;
+/// The largest payload (bytes): room for three axes' configs, and a
+/// whole record fits a 256-byte erase unit.
+pub const MAX_PAYLOAD: usize = 240;
 /// Header bytes before the payload.
 pub const HEADER: usize = 12;
 /// The largest record (bytes).
@@ -90,6 +94,11 @@ pub enum RecordError {
     Payload,
     /// A value is out of range; the field is named.
     Invalid(&'static str),
+    /// The record holds another number of axes than the reader's board.
+    Axes {
+        /// The axes the record holds.
+        found: u8,
+    },
 }
 
 /// Encode `config` as a record numbered `seq` into `buf`, returning its
@@ -99,16 +108,34 @@ pub fn encode(config: &Config, seq: u32, buf: &mut [u8]) -> Option<usize> {
     encode_as(FORMAT_VERSION, config, seq, buf)
 }
 
+/// [`encode`] for a board of `N` axes: each axis's config in turn.
+pub fn encode_axes<const N: usize>(
+    configs: &[Config; N],
+    seq: u32,
+    buf: &mut [u8],
+) -> Option<usize> {
+    encode_axes_as(FORMAT_VERSION, configs, seq, buf)
+}
+
 /// [`encode`] stamped with another format `version`: for migration tools
 /// and for testing how a reader treats records it does not know.
 pub fn encode_as(version: u16, config: &Config, seq: u32, buf: &mut [u8]) -> Option<usize> {
-    config.validate().ok()?;
+    encode_axes_as(version, core::slice::from_ref(config), seq, buf)
+}
+
+fn encode_axes_as(version: u16, configs: &[Config], seq: u32, buf: &mut [u8]) -> Option<usize> {
+    if configs.is_empty() || configs.iter().any(|c| c.validate().is_err()) {
+        return None;
+    }
     if buf.len() < MAX_RECORD {
         return None;
     }
-    let n = postcard::to_slice(config, &mut buf[HEADER..HEADER + MAX_PAYLOAD])
-        .ok()?
-        .len();
+    let mut n = 0;
+    for c in configs {
+        n += postcard::to_slice(c, &mut buf[HEADER + n..HEADER + MAX_PAYLOAD])
+            .ok()?
+            .len();
+    }
     buf[..4].copy_from_slice(&MAGIC);
     buf[4..6].copy_from_slice(&version.to_le_bytes());
     buf[6..8].copy_from_slice(&(n as u16).to_le_bytes());
@@ -122,6 +149,12 @@ pub fn encode_as(version: u16, config: &Config, seq: u32, buf: &mut [u8]) -> Opt
 /// Decode a record from the start of `bytes` (which may run on past it):
 /// its sequence number and config, or why not. Never panics.
 pub fn decode(bytes: &[u8]) -> Result<(u32, Config), RecordError> {
+    decode_axes::<1>(bytes).map(|(seq, [c])| (seq, c))
+}
+
+/// [`decode`] for a board of `N` axes: the record must hold `N` configs
+/// ([`RecordError::Axes`] says how many it holds otherwise).
+pub fn decode_axes<const N: usize>(bytes: &[u8]) -> Result<(u32, [Config; N]), RecordError> {
     if bytes.len() < HEADER + 4 || bytes[..4] != MAGIC {
         return Err(RecordError::Absent);
     }
@@ -140,13 +173,26 @@ pub fn decode(bytes: &[u8]) -> Result<(u32, Config), RecordError> {
         return Err(RecordError::Version(version));
     }
     let seq = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]);
-    let (config, rest) = postcard::take_from_bytes::<Config>(&bytes[HEADER..end])
-        .map_err(|_| RecordError::Payload)?;
-    if !rest.is_empty() {
-        return Err(RecordError::Payload);
+    let mut rest = &bytes[HEADER..end];
+    let mut configs: Option<[Config; N]> = None;
+    let mut found = 0usize;
+    while !rest.is_empty() {
+        let (c, r) = postcard::take_from_bytes::<Config>(rest).map_err(|_| RecordError::Payload)?;
+        c.validate().map_err(RecordError::Invalid)?;
+        let all = configs.get_or_insert([c; N]);
+        if let Some(slot) = all.get_mut(found) {
+            *slot = c;
+        }
+        found += 1;
+        rest = r;
     }
-    config.validate().map_err(RecordError::Invalid)?;
-    Ok((seq, config))
+    match configs {
+        Some(c) if found == N => Ok((seq, c)),
+        Some(_) => Err(RecordError::Axes {
+            found: found.min(u8::MAX as usize) as u8,
+        }),
+        None => Err(RecordError::Payload),
+    }
 }
 
 fn positive(name: &'static str, v: f32) -> Result<(), &'static str> {

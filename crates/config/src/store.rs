@@ -34,6 +34,10 @@ pub struct Store<F> {
     slots: [u32; 2],
 }
 
+/// One copy's state: its sequence number and configs, or why it is not
+/// usable (`None`: the flash could not be read).
+type Copy<const N: usize> = Result<(u32, [Config; N]), Option<RecordError>>;
+
 /// `a` is newer than `b`, across the sequence number's wrap.
 fn newer(a: u32, b: u32) -> bool {
     (a.wrapping_sub(b) as i32) > 0
@@ -58,22 +62,20 @@ impl<F: NorFlash> Store<F> {
         &mut self.flash
     }
 
-    fn read_slot(&mut self, i: usize) -> Result<(u32, Config), Option<RecordError>> {
+    fn read_slot<const N: usize>(&mut self, i: usize) -> Copy<N> {
         let mut buf = [0u8; MAX_RECORD];
         self.flash.read(self.slots[i], &mut buf).map_err(|_| None)?;
-        record::decode(&buf).map_err(Some)
+        record::decode_axes(&buf).map_err(Some)
     }
 
     /// Each copy's state.
-    fn read_both(&mut self) -> [Result<(u32, Config), Option<RecordError>>; 2] {
+    fn read_both<const N: usize>(&mut self) -> [Copy<N>; 2] {
         [self.read_slot(0), self.read_slot(1)]
     }
 
     /// The newest valid copy: its slot, sequence number and config.
-    fn newest(
-        copies: &[Result<(u32, Config), Option<RecordError>>; 2],
-    ) -> Option<(usize, u32, Config)> {
-        let mut best: Option<(usize, u32, Config)> = None;
+    fn newest<const N: usize>(copies: &[Copy<N>; 2]) -> Option<(usize, u32, [Config; N])> {
+        let mut best: Option<(usize, u32, [Config; N])> = None;
         for (i, c) in copies.iter().enumerate() {
             if let Ok((seq, cfg)) = c {
                 if best.is_none_or(|(_, s, _)| newer(*seq, s)) {
@@ -87,7 +89,17 @@ impl<F: NorFlash> Store<F> {
     /// The configuration to run: the newest valid copy, or `defaults`
     /// with the reason none is usable.
     pub fn load(&mut self, defaults: &Config) -> (Config, ConfigSource) {
-        let copies = self.read_both();
+        let ([c], source) = self.load_axes(&[*defaults]);
+        (c, source)
+    }
+
+    /// [`load`](Self::load) for a board of `N` axes: a record of another
+    /// number of axes is not used, and the fallback says so.
+    pub fn load_axes<const N: usize>(
+        &mut self,
+        defaults: &[Config; N],
+    ) -> ([Config; N], ConfigSource) {
+        let copies = self.read_both::<N>();
         if let Some((_, seq, cfg)) = Self::newest(&copies) {
             return (cfg, ConfigSource::Stored { seq });
         }
@@ -100,6 +112,7 @@ impl<F: NorFlash> Store<F> {
                 }
                 Some(RecordError::Version(v)) => (4, ConfigFallback::NewerVersion { found: v }),
                 Some(RecordError::Invalid(_)) => (3, ConfigFallback::Invalid),
+                Some(RecordError::Axes { found }) => (3, ConfigFallback::WrongAxes { found }),
                 Some(RecordError::Absent) => (1, ConfigFallback::Missing),
                 Some(_) => (2, ConfigFallback::Corrupt),
             }
@@ -115,17 +128,26 @@ impl<F: NorFlash> Store<F> {
 
     /// Commit `config` as the newest record; returns its sequence number.
     pub fn save(&mut self, config: &Config) -> Result<u32, SaveError> {
-        config.validate().map_err(SaveError::Invalid)?;
+        self.save_axes(core::array::from_ref(config))
+    }
+
+    /// [`save`](Self::save) for a board of `N` axes: one record holding
+    /// every axis's config. A record of another number of axes already
+    /// there is overwritten in turn, as an invalid one would be.
+    pub fn save_axes<const N: usize>(&mut self, configs: &[Config; N]) -> Result<u32, SaveError> {
+        for c in configs {
+            c.validate().map_err(SaveError::Invalid)?;
+        }
         if F::WRITE_SIZE == 0 || 4 % F::WRITE_SIZE != 0 {
             return Err(SaveError::Unsupported);
         }
-        let copies = self.read_both();
+        let copies = self.read_both::<N>();
         let (target, seq) = match Self::newest(&copies) {
             Some((i, s, _)) => (1 - i, s.wrapping_add(1)),
             None => (0, 1),
         };
         let mut buf = [0xFFu8; MAX_RECORD + 4];
-        let n = record::encode(config, seq, &mut buf).ok_or(SaveError::Invalid("record"))?;
+        let n = record::encode_axes(configs, seq, &mut buf).ok_or(SaveError::Invalid("record"))?;
         // Pad to whole write units; the padding stays erased.
         let padded = n.div_ceil(F::WRITE_SIZE) * F::WRITE_SIZE;
         let at = self.slots[target];
@@ -145,7 +167,7 @@ impl<F: NorFlash> Store<F> {
         }
         self.flash.write(at, &MAGIC).map_err(|_| SaveError::Flash)?;
         match self.read_slot(target) {
-            Ok((s, c)) if s == seq && c == *config => Ok(seq),
+            Ok((s, c)) if s == seq && c == *configs => Ok(seq),
             Err(None) => Err(SaveError::Flash),
             _ => Err(SaveError::Verify),
         }

@@ -217,3 +217,45 @@ proptest! {
         }
     }
 }
+
+/// A three-axis board's record holds every axis; the largest (admittance
+/// gains, an index, extreme values on every axis) fits a 256-byte erase
+/// unit; a reader of another axis count is told how many it holds.
+#[test]
+fn a_three_axis_record_round_trips_and_names_its_axis_count() {
+    let mut big = defaults();
+    big.gains = Gains::Admittance {
+        m_kg: f32::MAX,
+        b_nspm: f32::MAX,
+        kp_npm: f32::MAX,
+        bp_nspm: f32::MAX,
+    };
+    big.load_cell.offset_counts = i32::MIN;
+    big.homing.stop_nm = i32::MIN;
+    big.homing.index_nm = Some(i32::MIN);
+    big.limits.heartbeat_timeout_ticks = u32::MAX;
+    let axes = [big, tuned(40_000.0), big];
+    let mut buf = [0xFFu8; MAX_RECORD + 4];
+    let n = record::encode_axes(&axes, 7, &mut buf).unwrap();
+    assert!(n <= 256, "{n} bytes");
+    assert_eq!(record::decode_axes::<3>(&buf[..n]), Ok((7, axes)));
+    assert_eq!(
+        decode(&buf[..n]),
+        Err(record::RecordError::Axes { found: 3 })
+    );
+    let mut st = Store::new(Flash::new(), 0, 1024);
+    st.save_axes(&axes).unwrap();
+    assert_eq!(
+        st.load_axes(&[defaults(); 3]),
+        (axes, ConfigSource::Stored { seq: 1 })
+    );
+    assert_eq!(
+        st.load(&defaults()),
+        (
+            defaults(),
+            ConfigSource::Defaults {
+                why: ConfigFallback::WrongAxes { found: 3 }
+            }
+        )
+    );
+}

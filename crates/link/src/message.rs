@@ -111,6 +111,11 @@ pub enum ModeRefusal {
     OutOfRange,
     /// The configuration could not be written to flash.
     FlashFailed,
+    /// The request gave another number of axes than the board's.
+    WrongAxisCount {
+        /// The board's axes.
+        axes: u8,
+    },
 }
 
 /// Where the configuration in force came from (protocol 3).
@@ -151,6 +156,11 @@ pub enum ConfigFallback {
     NotProven,
     /// The flash could not be read.
     Unreadable,
+    /// The record holds another number of axes than this board has.
+    WrongAxes {
+        /// The axes the record holds.
+        found: u8,
+    },
 }
 
 /// The board's state, sent on request and whenever it changes.
@@ -305,11 +315,12 @@ pub enum Message {
     Disarm,
     /// Home: find the encoder offset on the hard stop (protocol 3).
     Home,
-    /// Calibrate where the device stands now: it is at `position_pm`
-    /// (a jig, or a simulator that knows). Disarmed only (protocol 3).
+    /// Calibrate where the device stands now: each axis is at its
+    /// `position_pm` (a jig, or a simulator that knows). Disarmed only
+    /// (protocol 3; per axis since 4).
     Calibrate {
-        /// The device's position now (pm).
-        position_pm: i64,
+        /// Each axis's position now (pm).
+        position_pm: Axes<i64>,
     },
     /// Ask for the state machine's [`Status`] (protocol 3).
     GetStatus,

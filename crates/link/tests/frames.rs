@@ -62,7 +62,7 @@ fn all_messages() -> Vec<Message> {
         Message::Disarm,
         Message::Home,
         Message::Calibrate {
-            position_pm: i64::MIN,
+            position_pm: Axes::new([i64::MIN, 0, i64::MAX]).unwrap(),
         },
         Message::GetStatus,
         Message::SaveConfig,

@@ -4,7 +4,9 @@
 //! tick per sensor frame (lockstep with host-sim). Started by
 //! `cargo xtask pil`; a panic or HardFault ends QEMU with a failure code.
 //! With the `passivity` feature the image runs the series damper at the
-//! actuator's port (`cargo xtask pil --passivity`).
+//! actuator's port (`cargo xtask pil --passivity`); with `xyz`, the
+//! three-axis Excalibur image on its building-block world (`cargo xtask
+//! pil scenes/xyz/pil_blocks.toml`).
 
 #![no_std]
 #![no_main]
@@ -25,10 +27,12 @@ const WATCHDOG_MS: u32 = 50;
 
 #[entry]
 fn main() -> ! {
-    #[cfg(not(feature = "passivity"))]
+    #[cfg(not(any(feature = "passivity", feature = "xyz")))]
     let board = excalibur::stiff_wall_board();
     #[cfg(feature = "passivity")]
     let board = excalibur::stiff_wall_board_with_passivity();
+    #[cfg(feature = "xyz")]
+    let board = excalibur::xyz::board();
     let Ok(mut board) = board.map(|b| b.with_pil(true)) else {
         hprintln!("the Excalibur board image would not build");
         exit(false)

@@ -66,13 +66,13 @@ impl Uart {
     }
 }
 
-impl BoardSupport for Uart {
+impl<const N: usize> BoardSupport<N> for Uart {
     // Never called: this image is processor-in-the-loop only.
-    fn sample(&mut self) -> RawSensors {
+    fn sample(&mut self) -> RawSensors<N> {
         RawSensors::default()
     }
-    // The duty goes back to the host in the board's actuator frame.
-    fn set_duty(&mut self, _: i16) {}
+    // The duties go back to the host in the board's actuator frame.
+    fn set_duty(&mut self, _: [i16; N]) {}
     // No amplifier: the host sees the outputs as the duty it is sent,
     // which is zero whenever the board is disarmed.
     fn set_outputs(&mut self, _: bool) {}

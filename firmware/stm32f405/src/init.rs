@@ -61,6 +61,12 @@ pub fn clocks(rcc: &pac::RCC, flash: &pac::FLASH) {
     });
     rcc.apb2enr()
         .modify(|_, w| w.tim1en().set_bit().adc1en().set_bit());
+    #[cfg(feature = "xyz")]
+    {
+        rcc.apb1enr().modify(|_, w| w.tim4en().set_bit());
+        rcc.apb2enr()
+            .modify(|_, w| w.tim8en().set_bit().adc2en().set_bit().adc3en().set_bit());
+    }
 }
 
 /// The pins of the table in the crate docs.
@@ -91,6 +97,49 @@ pub fn pins(a: &pac::GPIOA, b: &pac::GPIOB, c: &pac::GPIOC) {
         .modify(|_, w| w.pupdr4().pull_up().pupdr5().pull_up());
     c.moder().modify(|_, w| w.moder0().input());
     c.pupdr().modify(|_, w| w.pupdr0().pull_up());
+    #[cfg(feature = "xyz")]
+    xyz_pins(a, b, c);
+}
+
+/// The y and z axes' pins: encoders on TIM4 (PB6, PB7, AF2) and TIM8
+/// (PC6, PC7, AF3), drives on TIM1's CH2/CH2N (PA9, PB14) and CH3/CH3N
+/// (PA10, PB15, AF1), load cells on PA1 (ADC2 IN1) and PC2 (ADC3 IN12).
+#[cfg(feature = "xyz")]
+fn xyz_pins(a: &pac::GPIOA, b: &pac::GPIOB, c: &pac::GPIOC) {
+    a.afrh().modify(|_, w| w.afrh9().af1().afrh10().af1());
+    a.moder().modify(|_, w| {
+        w.moder1()
+            .analog()
+            .moder9()
+            .alternate()
+            .moder10()
+            .alternate()
+    });
+    b.afrl().modify(|_, w| w.afrl6().af2().afrl7().af2());
+    b.afrh().modify(|_, w| w.afrh14().af1().afrh15().af1());
+    b.moder().modify(|_, w| {
+        w.moder6()
+            .alternate()
+            .moder7()
+            .alternate()
+            .moder14()
+            .alternate()
+            .moder15()
+            .alternate()
+    });
+    b.pupdr()
+        .modify(|_, w| w.pupdr6().pull_up().pupdr7().pull_up());
+    c.afrl().modify(|_, w| w.afrl6().af3().afrl7().af3());
+    c.moder().modify(|_, w| {
+        w.moder2()
+            .analog()
+            .moder6()
+            .alternate()
+            .moder7()
+            .alternate()
+    });
+    c.pupdr()
+        .modify(|_, w| w.pupdr6().pull_up().pupdr7().pull_up());
 }
 
 /// TIM3 counts the encoder's quadrature edges.
@@ -102,13 +151,48 @@ pub fn encoder(t: &pac::TIM3) {
     t.cr1().modify(|_, w| w.cen().set_bit());
 }
 
-/// TIM1 channel 1 drives the amplifier in locked antiphase.
+/// The y and z axes' encoders: TIM4 and TIM8, as TIM3.
+#[cfg(feature = "xyz")]
+pub fn encoders_yz(t4: &pac::TIM4, t8: &pac::TIM8) {
+    t4.ccmr1_input().write(|w| w.cc1s().ti1().cc2s().ti2());
+    t4.smcr().write(|w| w.sms().encoder_mode_3());
+    t4.arr().write(|w| w.arr().set(0xFFFF));
+    t4.cr1().modify(|_, w| w.cen().set_bit());
+    t8.ccmr1_input().write(|w| w.cc1s().ti1().cc2s().ti2());
+    t8.smcr().write(|w| w.sms().encoder_mode_3());
+    t8.arr().write(|w| w.arr().set(0xFFFF));
+    t8.cr1().modify(|_, w| w.cen().set_bit());
+}
+
+/// TIM1 drives the amplifiers in locked antiphase: channel 1 the x axis's
+/// and, in the three-axis image, channels 2 and 3 the y and z axes'. The
+/// compare registers are preloaded, so a tick's duties all take effect at
+/// the same update event.
 pub fn pwm(t: &pac::TIM1) {
     t.arr().write(|w| w.arr().set(PWM_ARR as u16));
     t.ccr1().write(|w| w.ccr().set((PWM_ARR / 2) as u16));
     t.ccmr1_output()
         .write(|w| w.oc1m().pwm_mode1().oc1pe().set_bit());
     t.ccer().write(|w| w.cc1e().set_bit().cc1ne().set_bit());
+    #[cfg(feature = "xyz")]
+    {
+        t.ccr2().write(|w| w.ccr().set((PWM_ARR / 2) as u16));
+        t.ccr3().write(|w| w.ccr().set((PWM_ARR / 2) as u16));
+        t.ccmr1_output()
+            .modify(|_, w| w.oc2m().pwm_mode1().oc2pe().set_bit());
+        t.ccmr2_output()
+            .write(|w| w.oc3m().pwm_mode1().oc3pe().set_bit());
+        t.ccer().modify(|_, w| {
+            w.cc2e()
+                .set_bit()
+                .cc2ne()
+                .set_bit()
+                .cc3e()
+                .set_bit()
+                .cc3ne()
+                .set_bit()
+        });
+    }
     // SAFETY: DTG = 84 is 500 ns of dead time at 168 MHz, inside the
     // field's 8 bits.
     t.bdtr().write(|w| unsafe { w.dtg().bits(84) });
@@ -122,6 +206,26 @@ pub fn adc(a: &pac::ADC1) {
     // SAFETY: channel 0 is a valid first conversion of the sequence.
     a.sqr3().write(|w| unsafe { w.sq1().bits(0) });
     a.cr2().write(|w| w.adon().set_bit());
+}
+
+/// The three-axis image's load cells: ADC2 converts IN1 and ADC3 IN12 in
+/// triple regular simultaneous mode with ADC1, so that ADC1's start
+/// samples all three cells at the same instant.
+#[cfg(feature = "xyz")]
+pub fn adcs_yz(a2: &pac::ADC2, a3: &pac::ADC3, common: &pac::ADC_COMMON) {
+    a2.smpr2().write(|w| w.smp1().cycles84());
+    // SAFETY: channel 1 is a valid first conversion of the sequence.
+    a2.sqr3().write(|w| unsafe { w.sq1().bits(1) });
+    a2.cr2().write(|w| w.adon().set_bit());
+    a3.smpr1().write(|w| w.smp12().cycles84());
+    // SAFETY: channel 12 is a valid first conversion of the sequence.
+    a3.sqr3().write(|w| unsafe { w.sq1().bits(12) });
+    a3.cr2().write(|w| w.adon().set_bit());
+    // Triple mode, regular simultaneous only (RM0090 13.9: MULTI 10110).
+    // SAFETY: 0b10110 is one of MULTI's defined modes.
+    common
+        .ccr()
+        .modify(|_, w| unsafe { w.multi().bits(0b10110) });
 }
 
 /// USART2 carries the link.

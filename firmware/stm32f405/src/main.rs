@@ -17,8 +17,24 @@
 //! HardFault turns them off again. Loop timing comes from the DWT cycle
 //! counter.
 //!
+//! The `xyz` feature builds the three-axis image (the Excalibur's three
+//! Cartesian axes on the building-block world, `twoport_board::excalibur::xyz`),
+//! with two more of each axis's peripherals:
+//!
+//! | what              | y axis                  | z axis                   |
+//! |-------------------|-------------------------|--------------------------|
+//! | encoder           | TIM4, PB6, PB7 (AF2)    | TIM8, PC6, PC7 (AF3)     |
+//! | force command     | TIM1 CH2/CH2N, PA9, PB14 (AF1) | TIM1 CH3/CH3N, PA10, PB15 (AF1) |
+//! | load cell         | ADC2 channel 1, PA1     | ADC3 channel 12, PC2     |
+//!
+//! One control interrupt samples every axis: one start converts the
+//! three load cells at the same instant (the ADCs in triple simultaneous
+//! mode), the three encoder counters are read back to back while they
+//! convert, and the three duties go into TIM1's preloaded compare
+//! registers, which take effect together at the next PWM update.
+//!
 //! Flash with `cargo run --release` in this folder (probe-rs, see
-//! `.cargo/config.toml`).
+//! `.cargo/config.toml`); add `--features xyz` for the three-axis image.
 //!
 //! The `qemu` feature builds the same image for QEMU's `netduinoplus2`
 //! (an STM32F405 SoC): the same interrupt, the same loop, but the clocks
@@ -43,13 +59,24 @@ use cortex_m::interrupt::Mutex;
 use cortex_m_rt::entry;
 use stm32f4::stm32f405::{self as pac, interrupt};
 use support::Stm32;
-use twoport_board::excalibur::{self, REGION_POINTS};
-use twoport_board::Board;
-use twoport_control::ve::UnilateralWall;
+use twoport_board::excalibur;
 #[cfg(feature = "qemu")]
 use twoport_qemu_exit as _;
 
-type TheBoard = Board<UnilateralWall, REGION_POINTS>;
+/// The axes this image drives.
+#[cfg(not(feature = "xyz"))]
+pub const AXES: usize = 1;
+/// The axes this image drives.
+#[cfg(feature = "xyz")]
+pub const AXES: usize = 3;
+
+#[cfg(not(feature = "xyz"))]
+type TheBoard = twoport_board::Board<
+    twoport_control::Servo<twoport_control::ve::UnilateralWall>,
+    { excalibur::REGION_POINTS },
+>;
+#[cfg(feature = "xyz")]
+type TheBoard = excalibur::xyz::XyzBoard;
 
 /// The loop, shared by the control interrupt (ticks) and the main loop
 /// (link bytes).
@@ -97,6 +124,11 @@ fn main() -> ! {
     init::encoder(&dp.TIM3);
     init::pwm(&dp.TIM1);
     init::adc(&dp.ADC1);
+    #[cfg(feature = "xyz")]
+    {
+        init::encoders_yz(&dp.TIM4, &dp.TIM8);
+        init::adcs_yz(&dp.ADC2, &dp.ADC3, &dp.ADC_COMMON);
+    }
     init::usart(&dp.USART2);
     #[cfg(not(feature = "qemu"))]
     {
@@ -111,9 +143,11 @@ fn main() -> ! {
         init::instruction_counter(&dp.TIM5);
     }
     // A board that cannot build its law never drives the amplifier.
-    let Ok(board) = excalibur::stiff_wall_board() else {
-        halt()
-    };
+    #[cfg(not(feature = "xyz"))]
+    let board = excalibur::stiff_wall_board();
+    #[cfg(feature = "xyz")]
+    let board = excalibur::xyz::board();
+    let Ok(board) = board else { halt() };
     let mut board = board.with_pil(cfg!(feature = "qemu"));
     if init::reset_by_watchdog(&dp.RCC) {
         board.trip(twoport_control::Faults::WATCHDOG_RESET);

@@ -14,32 +14,32 @@
 //! request with a [`Message::ModeRefused`] that names the reason.
 
 use super::Board;
+use crate::drive::Drive;
 use crate::support::BoardSupport;
 use twoport_control::homing::{Homing, HomingState};
-use twoport_control::servo::{PortLayer, ServoOutput};
-use twoport_control::ve::VirtualEnvironment;
+use twoport_control::servo::AxesOutput;
 use twoport_control::{Faults, Position};
-use twoport_link::{Message, Mode, ModeRefusal, ModeRequest, Status};
+use twoport_link::{Axes, Message, Mode, ModeRefusal, ModeRequest, Status};
 
-impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
+impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
     /// Where the state machine is.
     pub fn mode(&self) -> Mode {
         self.mode
     }
 
-    /// Whether the encoder's offset is known (homed or calibrated).
+    /// Whether every axis's encoder offset is known (homed or calibrated).
     pub fn calibrated(&self) -> bool {
         self.calibrated
     }
 
     /// The state the link reports.
     pub fn status(&self) -> Status {
-        let s = self.servo.safety();
+        let (faults, first) = self.servo.faults();
         Status {
             mode: self.mode,
             calibrated: self.calibrated,
-            faults: s.faults().0,
-            first_fault: s.first_fault().0,
+            faults: faults.0,
+            first_fault: first.0,
         }
     }
 
@@ -73,7 +73,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     }
 
     fn latched(&self) -> Option<ModeRefusal> {
-        let f = self.servo.safety().faults();
+        let (f, _) = self.servo.faults();
         (!f.is_empty()).then_some(ModeRefusal::Faulted { faults: f.0 })
     }
 
@@ -112,8 +112,8 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
         self.set_mode(Mode::Disarmed);
     }
 
-    /// `Home`: a disarmed board without faults starts the homing run from
-    /// where it stands.
+    /// `Home`: a disarmed board without faults starts every axis's homing
+    /// run from where it stands.
     pub(super) fn home(&mut self) {
         let why = self.latched().or(match self.mode {
             Mode::Disarmed => None,
@@ -122,7 +122,12 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
         if let Some(why) = why {
             return self.refuse(ModeRequest::Home, why);
         }
-        let Ok(h) = Homing::new(self.homing_cfg, self.servo.position()) else {
+        let x = self.servo.position();
+        let mut runs = [None; N];
+        for (i, r) in runs.iter_mut().enumerate() {
+            *r = Homing::new(self.homing_cfg[i], x[i]).ok();
+        }
+        if runs.iter().any(Option::is_none) {
             // The image's homing constants are wrong: as unsafe as a fault.
             self.servo.trip(Faults::HOMING_FAILED);
             return self.refuse(
@@ -131,56 +136,75 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
                     faults: Faults::HOMING_FAILED.0,
                 },
             );
-        };
+        }
         match self.servo.enable() {
             Ok(()) => {
-                self.homing = Some(h);
+                self.homing = Some(runs);
                 self.set_mode(Mode::Homing);
             }
             Err(f) => self.refuse(ModeRequest::Home, ModeRefusal::Faulted { faults: f.0 }),
         }
     }
 
-    /// `Calibrate`: a disarmed board takes the host's word for where it
-    /// stands.
-    pub(super) fn calibrate(&mut self, position_pm: i64) {
+    /// `Calibrate`: a disarmed board takes the host's word for where each
+    /// axis stands (all of them or, naming why, none).
+    pub(super) fn calibrate(&mut self, position_pm: Axes<i64>) {
         if self.mode != Mode::Disarmed {
             let mode = self.mode;
             return self.refuse(ModeRequest::Calibrate, ModeRefusal::NotDisarmed { mode });
         }
-        let nm = position_pm / 1000;
-        let Ok(nm) = i32::try_from(nm) else {
-            return self.refuse(ModeRequest::Calibrate, ModeRefusal::OutOfRange);
+        let Some(pm) = position_pm.to_array::<N>() else {
+            let why = ModeRefusal::WrongAxisCount { axes: N as u8 };
+            return self.refuse(ModeRequest::Calibrate, why);
         };
-        self.servo.calibrate(Position::from_nm(nm));
+        let mut x = [Position::ZERO; N];
+        for (x, pm) in x.iter_mut().zip(pm) {
+            let Ok(nm) = i32::try_from(pm / 1000) else {
+                return self.refuse(ModeRequest::Calibrate, ModeRefusal::OutOfRange);
+            };
+            *x = Position::from_nm(nm);
+        }
+        for (axis, x) in x.into_iter().enumerate() {
+            self.servo.calibrate_axis(axis, x);
+        }
         self.calibrated = true;
         self.queue_status();
     }
 
-    /// The state machine's part of a tick: a fault disarms, and a homing
-    /// run that has ended calibrates the encoder or latches its failure.
-    pub(super) fn after_tick(&mut self, out: &ServoOutput) {
-        if let Some(h) = self.homing {
-            // Homing on an index: its first pulse calibrates the encoder
-            // from the count it latched.
-            if let (Some(at), Some(raw)) = (h.config().index_position, self.index) {
-                match self.servo.calibrate_at(raw, at) {
-                    Ok(()) => self.calibrated = true,
-                    Err(_) => self.servo.trip(Faults::HOMING_FAILED),
-                }
-                return self.disarm();
-            }
-            match h.state() {
-                HomingState::Seeking => {}
-                HomingState::Found => {
-                    self.servo.calibrate(h.config().stop_position);
-                    self.calibrated = true;
-                    self.disarm();
-                }
-                HomingState::TimedOut => {
+    /// The state machine's part of a tick: a fault disarms, and each
+    /// axis's homing run that has ended calibrates its encoder (the axis
+    /// then holds no force) or latches its failure. The board is
+    /// calibrated when every axis has homed.
+    pub(super) fn after_tick(&mut self, out: &AxesOutput<f32, N>) {
+        if let Some(mut runs) = self.homing {
+            let mut seeking = false;
+            for (axis, run) in runs.iter_mut().enumerate() {
+                let Some(h) = run else { continue };
+                let cfg = *h.config();
+                // Homing on an index: its first pulse calibrates the
+                // encoder from the count it latched.
+                let done = match (cfg.index_position, self.index[axis], h.state()) {
+                    (Some(at), Some(raw), _) => self.servo.calibrate_axis_at(axis, raw, at).is_ok(),
+                    (_, _, HomingState::Seeking) => {
+                        seeking = true;
+                        continue;
+                    }
+                    (_, _, HomingState::Found) => {
+                        self.servo.calibrate_axis(axis, cfg.stop_position);
+                        true
+                    }
+                    (_, _, HomingState::TimedOut) => false,
+                };
+                if !done {
                     self.servo.trip(Faults::HOMING_FAILED);
-                    self.disarm();
+                    return self.disarm();
                 }
+                *run = None;
+            }
+            self.homing = Some(runs);
+            if !seeking {
+                self.calibrated = true;
+                self.disarm();
             }
         }
         if self.mode != Mode::Disarmed && !out.faults.is_empty() {
@@ -189,7 +213,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     }
 
     /// Switch the outputs to follow the mode.
-    pub(super) fn drive_outputs(&mut self, io: &mut impl BoardSupport) {
+    pub(super) fn drive_outputs(&mut self, io: &mut impl BoardSupport<N>) {
         let on = self.mode != Mode::Disarmed;
         if on != self.outputs_on {
             io.set_outputs(on);

@@ -1,27 +1,33 @@
-//! The board's stored configuration: read at boot (falling back to the
-//! image's defaults, with the reason, over the link), saved on the host's
-//! request while disarmed.
+//! The board's stored configuration, one record per axis in one flash
+//! record: read at boot (falling back to the image's defaults, with the
+//! reason, over the link), saved on the host's request while disarmed.
 
 use super::Board;
+use crate::drive::Drive;
 use crate::io::IoScale;
 use embedded_storage::nor_flash::NorFlash;
 use twoport_config::{Config, HomingSetup, Limits, LoadCell, Store};
 use twoport_control::homing::HomingConfig;
-use twoport_control::servo::{Gains, PortLayer};
-use twoport_control::ve::VirtualEnvironment;
+use twoport_control::servo::Gains;
 use twoport_control::{Position, SafetyConfig};
 use twoport_link::{ConfigFallback, ConfigSource, Message, Mode, ModeRefusal, ModeRequest};
 
-impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
-    /// The configuration in force, as a record would store it.
-    pub fn config(&self) -> Config {
-        let s = self.servo.safety().config();
-        let h = &self.homing_cfg;
+impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
+    /// The configuration in force, each axis's as a record would store it.
+    pub fn config(&self) -> [Config; N] {
+        let limits = self.servo.limits();
+        let gains = self.servo.gains();
+        core::array::from_fn(|i| self.axis_config(i, &limits[i], gains[i]))
+    }
+
+    fn axis_config(&self, i: usize, s: &SafetyConfig, gains: Gains) -> Config {
+        let h = &self.homing_cfg[i];
+        let io = &self.io[i];
         Config {
-            gains: self.servo.gains().into(),
+            gains: gains.into(),
             load_cell: LoadCell {
-                offset_counts: self.io.load_cell_offset_counts,
-                n_per_count: self.io.load_cell_n_per_count,
+                offset_counts: io.load_cell_offset_counts,
+                n_per_count: io.load_cell_n_per_count,
             },
             homing: HomingSetup {
                 stop_nm: h.stop_position.nm(),
@@ -44,33 +50,35 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
         self.config_source
     }
 
-    /// Put `cfg` in force, all of it or, with the reason, none: its gains
-    /// must lie in this image's proven region and every value must hold.
-    /// Disarmed only.
-    pub fn apply_config(&mut self, cfg: &Config) -> Result<(), ConfigFallback> {
-        if self.mode != Mode::Disarmed || cfg.validate().is_err() {
+    /// Put `cfg` in force, every axis's all of it or, with the reason,
+    /// none: each axis's gains must lie in its proven region and every
+    /// value must hold. Disarmed only.
+    pub fn apply_config(&mut self, cfg: &[Config; N]) -> Result<(), ConfigFallback> {
+        if self.mode != Mode::Disarmed || cfg.iter().any(|c| c.validate().is_err()) {
             return Err(ConfigFallback::Invalid);
         }
-        let gains = Gains::from(cfg.gains);
+        let gains = cfg.map(|c| Gains::from(c.gains));
         if self.check(&gains).is_err() {
             return Err(ConfigFallback::NotProven);
         }
-        let now = *self.servo.safety().config();
-        let limits = SafetyConfig {
-            peak_force_n: cfg.limits.peak_force_n,
-            continuous_force_n: cfg.limits.continuous_force_n,
-            max_velocity_mps: cfg.limits.max_velocity_mps,
-            heartbeat_timeout_ticks: cfg.limits.heartbeat_timeout_ticks,
-            ..now
-        };
-        let homing = HomingConfig {
-            stop_position: Position::from_nm(cfg.homing.stop_nm),
-            toward_positive: cfg.homing.toward_positive,
-            force_limit_n: cfg.homing.force_limit_n,
-            index_position: cfg.homing.index_nm.map(Position::from_nm),
-            ..self.homing_cfg
-        };
-        if limits.validate().is_err() || homing.validate().is_err() {
+        let now = self.servo.limits();
+        let limits: [SafetyConfig; N] = core::array::from_fn(|i| SafetyConfig {
+            peak_force_n: cfg[i].limits.peak_force_n,
+            continuous_force_n: cfg[i].limits.continuous_force_n,
+            max_velocity_mps: cfg[i].limits.max_velocity_mps,
+            heartbeat_timeout_ticks: cfg[i].limits.heartbeat_timeout_ticks,
+            ..now[i]
+        });
+        let homing: [HomingConfig; N] = core::array::from_fn(|i| HomingConfig {
+            stop_position: Position::from_nm(cfg[i].homing.stop_nm),
+            toward_positive: cfg[i].homing.toward_positive,
+            force_limit_n: cfg[i].homing.force_limit_n,
+            index_position: cfg[i].homing.index_nm.map(Position::from_nm),
+            ..self.homing_cfg[i]
+        });
+        if limits.iter().any(|l| l.validate().is_err())
+            || homing.iter().any(|h| h.validate().is_err())
+        {
             return Err(ConfigFallback::Invalid);
         }
         // Gains first: the only step that can still refuse, and it
@@ -86,11 +94,13 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             return Err(ConfigFallback::Invalid);
         }
         self.homing_cfg = homing;
-        self.io = IoScale {
-            load_cell_offset_counts: cfg.load_cell.offset_counts,
-            load_cell_n_per_count: cfg.load_cell.n_per_count,
-            ..self.io
-        };
+        for (io, c) in self.io.iter_mut().zip(cfg) {
+            *io = IoScale {
+                load_cell_offset_counts: c.load_cell.offset_counts,
+                load_cell_n_per_count: c.load_cell.n_per_count,
+                ..*io
+            };
+        }
         Ok(())
     }
 
@@ -99,7 +109,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
     /// saying which and why.
     pub fn boot_config<F: NorFlash>(&mut self, store: &mut Store<F>) -> ConfigSource {
         let defaults = self.config();
-        let (cfg, mut source) = store.load(&defaults);
+        let (cfg, mut source) = store.load_axes(&defaults);
         if let ConfigSource::Stored { .. } = source {
             if let Err(why) = self.apply_config(&cfg) {
                 let _ = self.apply_config(&defaults);
@@ -130,7 +140,7 @@ impl<V: VirtualEnvironment, const R: usize, L: PortLayer> Board<V, R, L> {
             let mode = self.mode;
             return self.refuse(ModeRequest::SaveConfig, ModeRefusal::NotDisarmed { mode });
         }
-        match store.save(&self.config()) {
+        match store.save_axes(&self.config()) {
             Ok(seq) => {
                 let source = ConfigSource::Stored { seq };
                 self.config_source = Some(source);

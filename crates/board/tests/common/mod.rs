@@ -6,7 +6,7 @@ use twoport_control::ve::BilateralConstraint;
 use twoport_control::{Encoder, ImpedanceGains, Position, SafetyConfig, Servo};
 
 /// The board every test drives.
-pub type TestBoard = Board<BilateralConstraint, 3>;
+pub type TestBoard = Board<Servo<BilateralConstraint>, 3>;
 
 /// A proven region of three damping points (N s/m) and their largest
 /// stiffness (N/m).
@@ -32,5 +32,5 @@ pub fn board(k_npm: f32, safety: SafetyConfig, telemetry_every: u32) -> TestBoar
         BilateralConstraint::new(Position::ZERO),
     )
     .unwrap();
-    Board::new(s, region(), telemetry_every)
+    Board::new(s, [region()], telemetry_every)
 }

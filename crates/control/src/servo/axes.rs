@@ -6,6 +6,7 @@
 
 use super::{
     impedance_gains, load_cell_faults, AdmittanceLaws, Axis, Display, Gains, GainsError, LawsRef,
+    SensorFrame,
 };
 use crate::coupling::ImpedanceCoupling;
 use crate::safety::{AxesInputs, AxisError, Faults, SafeForces, SafetyConfig, SafetyLayer};
@@ -25,6 +26,18 @@ pub struct AxesFrame<R, const N: usize> {
     pub load_cell_n: [R; N],
     /// Dead-man switch closed (operator present); one for the device.
     pub dead_man_closed: bool,
+}
+
+impl<R> From<SensorFrame<R>> for AxesFrame<R, 1> {
+    /// The one-axis servo's frame, as the one axis of an `N = 1` frame.
+    fn from(f: SensorFrame<R>) -> Self {
+        AxesFrame {
+            tick: f.tick,
+            encoder_raw: [f.encoder_raw],
+            load_cell_n: [f.load_cell_n],
+            dead_man_closed: f.dead_man_closed,
+        }
+    }
 }
 
 /// The result of one tick of every axis; each field is the one-axis
@@ -54,6 +67,27 @@ pub struct AxesOutput<R, const N: usize> {
     pub faults: Faults,
     /// Whether the safety layer clipped each axis's force.
     pub limited: [bool; N],
+}
+
+impl<R: Real, const N: usize> AxesOutput<R, N> {
+    /// No force on any axis, the device at `position` moving at
+    /// `velocity_mps` (m/s): a disarmed board's last output before its
+    /// first tick, and a faulted tick's.
+    #[inline(always)]
+    pub fn at_rest(position: [Position; N], velocity_mps: [R; N]) -> Self {
+        AxesOutput {
+            actuator_force_n: [R::ZERO; N],
+            commanded_force_n: [R::ZERO; N],
+            position,
+            velocity_mps,
+            ve_velocity_mps: [R::ZERO; N],
+            ve_force_n: [R::ZERO; N],
+            coupling_force_n: [R::ZERO; N],
+            reference: position,
+            faults: Faults::NONE,
+            limited: [false; N],
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -269,6 +303,26 @@ impl<W: World<R, N>, R: Real, const N: usize> AxesServo<W, R, N> {
         Ok(())
     }
 
+    /// Calibrate axis `axis` alone: where it is now reads as `position`
+    /// (its homing's result), and the laws re-align. Refused, changing
+    /// nothing, for an axis the servo lacks.
+    pub fn calibrate_axis(&mut self, axis: usize, position: Position) -> Result<(), AxisError<()>> {
+        let a = self
+            .axes
+            .get_mut(axis)
+            .ok_or(AxisError { axis, error: () })?;
+        a.encoder.rezero(position);
+        a.position = position;
+        self.realign();
+        Ok(())
+    }
+
+    /// New safety limits for every axis, while disabled (see
+    /// [`SafetyLayer::reconfigure_axes`]).
+    pub fn set_limits(&mut self, cfg: [SafetyConfig; N]) -> Result<(), AxisError> {
+        self.safety.reconfigure_axes(cfg)
+    }
+
     /// The safety layer (limits, latched faults, thermal state per motor).
     pub fn safety(&self) -> &SafetyLayer<R, N> {
         &self.safety
@@ -359,8 +413,9 @@ impl<W: World<R, N>, R: Real, const N: usize> AxesServo<W, R, N> {
         self.world.reset(&x);
     }
 
-    /// One control tick of every axis.
-    pub fn tick(&mut self, frame: &AxesFrame<R, N>) -> AxesOutput<R, N> {
+    /// Every axis's encoder: the velocities and the faults they found.
+    #[inline(always)]
+    fn sense(&mut self, frame: &AxesFrame<R, N>) -> ([R; N], Faults) {
         let mut v = [R::ZERO; N];
         let mut faults = Faults::NONE;
         for ((a, v), raw) in self.axes.iter_mut().zip(&mut v).zip(frame.encoder_raw) {
@@ -368,19 +423,55 @@ impl<W: World<R, N>, R: Real, const N: usize> AxesServo<W, R, N> {
             *v = vel;
             faults = faults.with(f);
         }
+        (v, faults)
+    }
+
+    /// The safety layer's answer to the commands in `out`, filled in.
+    #[inline(always)]
+    fn limit(&mut self, frame: &AxesFrame<R, N>, faults: Faults, out: &mut AxesOutput<R, N>) {
+        let safe: SafeForces<R, N> = self.safety.step_axes(
+            &AxesInputs {
+                tick: frame.tick,
+                dead_man_closed: frame.dead_man_closed,
+                velocity_mps: out.velocity_mps,
+                sensor_faults: faults,
+            },
+            out.commanded_force_n,
+        );
+        out.actuator_force_n = safe.force_n;
+        out.faults = safe.faults;
+        out.limited = safe.limited;
+    }
+
+    /// One control tick of every axis with `law` in place of the laws and
+    /// the world: the same encoders, velocity estimates and safety layer,
+    /// so every limit and fault check holds for it too. `law` gets each
+    /// axis's index, position and velocity (m/s) and answers with its
+    /// actuator force (N, positive resists positive motion); it is not
+    /// called on a faulted tick. Homing runs through this, every axis
+    /// homing at once.
+    pub fn tick_with(
+        &mut self,
+        frame: &AxesFrame<R, N>,
+        mut law: impl FnMut(usize, Position, R) -> R,
+    ) -> AxesOutput<R, N> {
+        let (v, faults) = self.sense(frame);
         let x = self.position();
-        let mut out = AxesOutput {
-            actuator_force_n: [R::ZERO; N],
-            commanded_force_n: [R::ZERO; N],
-            position: x,
-            velocity_mps: v,
-            ve_velocity_mps: [R::ZERO; N],
-            ve_force_n: [R::ZERO; N],
-            coupling_force_n: [R::ZERO; N],
-            reference: x,
-            faults: Faults::NONE,
-            limited: [false; N],
-        };
+        let mut out = AxesOutput::at_rest(x, v);
+        if faults.is_empty() && self.safety.faults().is_empty() {
+            for (i, f) in out.commanded_force_n.iter_mut().enumerate() {
+                *f = law(i, x[i], v[i]);
+            }
+        }
+        self.limit(frame, faults, &mut out);
+        out
+    }
+
+    /// One control tick of every axis.
+    pub fn tick(&mut self, frame: &AxesFrame<R, N>) -> AxesOutput<R, N> {
+        let (v, mut faults) = self.sense(frame);
+        let x = self.position();
+        let mut out = AxesOutput::at_rest(x, v);
         match &mut self.laws {
             AxesLaws::Impedance(c) => {
                 if faults.is_empty() && self.safety.faults().is_empty() {
@@ -418,18 +509,7 @@ impl<W: World<R, N>, R: Real, const N: usize> AxesServo<W, R, N> {
                 }
             }
         }
-        let safe: SafeForces<R, N> = self.safety.step_axes(
-            &AxesInputs {
-                tick: frame.tick,
-                dead_man_closed: frame.dead_man_closed,
-                velocity_mps: v,
-                sensor_faults: faults,
-            },
-            out.commanded_force_n,
-        );
-        out.actuator_force_n = safe.force_n;
-        out.faults = safe.faults;
-        out.limited = safe.limited;
+        self.limit(frame, faults, &mut out);
         out
     }
 }

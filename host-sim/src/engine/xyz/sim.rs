@@ -275,32 +275,32 @@ impl XyzSimulation {
         &self.scene
     }
 
+    /// Each axis's actuator position (m).
+    pub fn actuator_m(&self) -> [f64; 3] {
+        let n = self.n;
+        [0, 1, 2].map(|a| self.actuator.of(&self.plants[a].x[..n]))
+    }
+
     /// Advance one control tick.
     pub fn step(&mut self) -> XyzSample {
+        self.step_inner(None)
+    }
+
+    /// Advance one control tick with `controller` in place of the servo
+    /// (processor in the loop): it gets each axis's actuator position (m)
+    /// and answers with each actuator's force (N). The scene's world does
+    /// not run; the controller's does.
+    pub fn step_external(&mut self, controller: &mut dyn FnMut([f64; 3]) -> [f64; 3]) -> XyzSample {
+        self.step_inner(Some(controller))
+    }
+
+    fn step_inner(&mut self, external: Option<&mut dyn FnMut([f64; 3]) -> [f64; 3]>) -> XyzSample {
         let t = self.tick as f64 * T;
         let n = self.n;
-        let raw = [0, 1, 2].map(|a| {
-            let x = self.actuator.of(&self.plants[a].x[..n]);
-            (x * 1e9).round() as i64 as u32
-        });
-        if let XyzWorld::Blocks(w) = self.servo.world_mut() {
-            if self.grabs.contains(&self.tick) {
-                w.grab();
-            }
-            if self.releases.contains(&self.tick) {
-                w.release();
-            }
-        }
-        let out: AxesOutput<f32, 3> = self.servo.tick(&AxesFrame {
-            tick: self.tick as u32,
-            encoder_raw: raw,
-            load_cell_n: [0.0; 3],
-            dead_man_closed: true,
-        });
-        if !out.faults.is_empty() && self.failure.is_none() {
-            self.failure = Some(format!("the safety layer tripped: {}", out.faults));
-        }
-        let f = out.actuator_force_n.map(f64::from);
+        let f = match external {
+            Some(c) => c(self.actuator_m()),
+            None => self.servo_tick(),
+        };
         let c = self.scene.plant.cross_coupling;
         let total: f64 = f.iter().sum();
         let mut handle_m = [0.0; 3];
@@ -333,6 +333,29 @@ impl XyzSimulation {
             cursor_m: cursor.map(|p| p.nm() as f64 * 1e-9),
             held,
         }
+    }
+
+    /// The board's servo's tick, in the simulation: ideal sensing.
+    fn servo_tick(&mut self) -> [f64; 3] {
+        let raw = self.actuator_m().map(|x| (x * 1e9).round() as i64 as u32);
+        if let XyzWorld::Blocks(w) = self.servo.world_mut() {
+            if self.grabs.contains(&self.tick) {
+                w.grab();
+            }
+            if self.releases.contains(&self.tick) {
+                w.release();
+            }
+        }
+        let out: AxesOutput<f32, 3> = self.servo.tick(&AxesFrame {
+            tick: self.tick as u32,
+            encoder_raw: raw,
+            load_cell_n: [0.0; 3],
+            dead_man_closed: true,
+        });
+        if !out.faults.is_empty() && self.failure.is_none() {
+            self.failure = Some(format!("the safety layer tripped: {}", out.faults));
+        }
+        out.actuator_force_n.map(f64::from)
     }
 
     /// Run to the end; `each` sees every sample.

@@ -1,0 +1,83 @@
+//! The three-axis Excalibur image: every axis the x axis's proven coupling
+//! (the paper designs the worst-case axis, x, and uses it for y and z), its
+//! region on every axis, and the building-block world with the blocks of
+//! [`BLOCKS`] on the floor. The processor-in-the-loop scene that drives it
+//! is `scenes/xyz/pil_blocks.toml`.
+
+use super::{
+    proven_region, safety, BuildError, COUPLING, ENCODER, PERIOD_S, REGION_POINTS, TELEMETRY_EVERY,
+};
+use crate::io::IoScale;
+use crate::Board;
+use twoport_control::homing::HomingConfig;
+use twoport_control::servo::AxesServo;
+use twoport_control::world::vbb::{Block, Vbb, VbbConfig};
+use twoport_control::Position;
+use twoport_control::{Encoder, ParamError};
+
+/// The blocks the image's world starts with: lowest corner (m), size (m),
+/// mass (kg). A 30 mm cube in reach of the start, a 20 mm one beside it,
+/// and a 30 x 30 x 20 mm brick across the workspace.
+pub const BLOCKS: [([f32; 3], [f32; 3], f32); 3] = [
+    ([0.04, -0.015, 0.0], [0.03, 0.03, 0.03], 0.1),
+    ([-0.06, 0.02, 0.0], [0.02, 0.02, 0.02], 0.05),
+    ([0.0, 0.08, 0.0], [0.03, 0.03, 0.02], 0.08),
+];
+
+/// Homing: each axis creeps gently toward its low end onto a stop at the
+/// workspace's lowest corner (x and y at -150 mm, z at the floor).
+pub const HOMING: [HomingConfig; 3] = [
+    HomingConfig::gentle(Position::from_nm(-150_000_000), PERIOD_S),
+    HomingConfig::gentle(Position::from_nm(-150_000_000), PERIOD_S),
+    HomingConfig::gentle(Position::ZERO, PERIOD_S),
+];
+
+/// The world's capacity: the blocks above.
+pub const MAX_BLOCKS: usize = BLOCKS.len();
+
+/// The image's world type.
+pub type World = Vbb<f32, MAX_BLOCKS>;
+
+/// The image's servo type.
+pub type XyzServo = AxesServo<World, f32, 3>;
+
+/// The image's board type.
+pub type XyzBoard = Board<XyzServo, REGION_POINTS, 3>;
+
+/// The image's world, its cursor at rest at the workspace's centre, 10 mm
+/// above the floor.
+pub fn world() -> Result<World, BuildError> {
+    let block =
+        |(at, size, mass): ([f32; 3], [f32; 3], f32)| Block::new(at, size, mass).ok_or(BLOCK);
+    let mut blocks = [block(BLOCKS[0])?; MAX_BLOCKS];
+    for (b, spec) in blocks.iter_mut().zip(BLOCKS) {
+        *b = block(spec)?;
+    }
+    Ok(Vbb::new(VbbConfig::excalibur(PERIOD_S), &blocks)?)
+}
+
+/// A block out of the world's range: a constant above is wrong.
+const BLOCK: BuildError = BuildError::Param(ParamError {
+    name: "excalibur::xyz::BLOCKS",
+    value: 0.0,
+    problem: "a block lies out of the world's range",
+});
+
+/// The three-axis servo: the impedance display on the world, disabled
+/// until the host enables it.
+pub fn servo() -> Result<XyzServo, BuildError> {
+    let (bits, pm) = ENCODER;
+    let enc = Encoder::new(bits, pm, 0, Position::ZERO)?;
+    AxesServo::new([COUPLING.into(); 3], [enc; 3], [safety(); 3], world()?)
+        .map_err(|e| BuildError::Layer(e.error))
+}
+
+/// The whole three-axis board: the x axis's region on every axis, the same
+/// I/O scaling on each, and [`HOMING`]. It reads its own sensors; the
+/// processor-in-the-loop images add `.with_pil(true)`.
+pub fn board() -> Result<XyzBoard, BuildError> {
+    let region = proven_region()?;
+    Ok(Board::new(servo()?, [region; 3], TELEMETRY_EVERY)
+        .with_io([IoScale::EXCALIBUR; 3])
+        .with_homing(HOMING))
+}
