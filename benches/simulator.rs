@@ -161,9 +161,50 @@ fn three_axes(c: &mut Criterion) {
     }
 }
 
+/// The whole 17 s of stacking three blocks (grabs, carries, sets down and
+/// mates), with each thing a world scene can name added one at a time to
+/// a world without friction or knobs: what each costs.
+fn three_axis_effects(c: &mut Criterion) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let bare = ["ve.friction=0.0", "ve.knobs=false"];
+    let with = |set: &str| -> Vec<String> {
+        let key = set.split('=').next().unwrap_or("");
+        bare.iter()
+            .filter(|b| !b.starts_with(key))
+            .chain([&set])
+            .map(|s| s.to_string())
+            .collect()
+    };
+    for (name, sets) in [
+        ("17 s stacking, no friction or knobs", with("")),
+        ("17 s stacking + friction 0.3", with("ve.friction=0.3")),
+        ("17 s stacking + knobs", with("ve.knobs=true")),
+        ("17 s stacking + explicit cursor", with("ve.explicit=true")),
+        (
+            "17 s stacking + 10 % cross-axis coupling",
+            with("plant.cross_coupling=0.1"),
+        ),
+    ] {
+        let sets: Vec<String> = sets.into_iter().filter(|s| !s.is_empty()).collect();
+        let mut s = XyzScene::load(&root.join("scenes/xyz/stack_three.toml"), &sets).unwrap();
+        s.plant.model = root.join("models/excalibur.toml");
+        c.bench_function(name, |b| {
+            b.iter_batched_ref(
+                || XyzSimulation::new(s.clone()).unwrap(),
+                |sim| {
+                    while sim.ticks() < sim.total_ticks() {
+                        black_box(sim.step());
+                    }
+                },
+                BatchSize::LargeInput,
+            )
+        });
+    }
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = effects, parts, three_axes
+    targets = effects, parts, three_axes, three_axis_effects
 }
 criterion_main!(benches);

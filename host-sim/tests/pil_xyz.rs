@@ -45,8 +45,8 @@ fn three_axes_run_in_lockstep_and_all_stop_after_a_link_loss() {
     let mut worst = [0.0f64; 3];
     for s in &r.samples[..5000] {
         let o = own.step();
-        for a in 0..3 {
-            worst[a] = worst[a].max((o.handle_m[a] - s.handle_m[a]).abs());
+        for (a, w) in worst.iter_mut().enumerate() {
+            *w = w.max((o.handle_m[a] - s.handle_m[a]).abs());
         }
     }
     assert!(worst.iter().all(|w| *w < 50e-6), "{worst:?} m apart");

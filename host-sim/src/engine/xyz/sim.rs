@@ -301,13 +301,20 @@ impl XyzSimulation {
             Some(c) => c(self.actuator_m()),
             None => self.servo_tick(),
         };
+        // Each actuator's force, with the part of the others' that couples
+        // across where the scene names it.
         let c = self.scene.plant.cross_coupling;
-        let total: f64 = f.iter().sum();
+        let applied = if c == 0.0 {
+            f
+        } else {
+            let total: f64 = f.iter().sum();
+            f.map(|f| f + c * (total - f))
+        };
         let mut handle_m = [0.0; 3];
         for a in 0..3 {
             let mut hand = self.humans[a].at(t);
             hand.position_m += self.hand_offset_m[a];
-            let f_a = f[a] + c * (total - f[a]);
+            let f_a = applied[a];
             let p = &mut self.plants[a];
             let i = p
                 .steppers
