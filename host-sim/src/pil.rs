@@ -279,6 +279,18 @@ impl PilSample for XyzSample {
     }
 }
 
+/// How a PIL run gets its board going.
+#[derive(Clone, Copy, Debug)]
+pub struct Setup {
+    /// Calibrated or homed, then armed.
+    pub start: Start,
+    /// Where each axis stands at rest before the run, as the host tells a
+    /// board it calibrates (pm).
+    pub at_rest_pm: Axes<i64>,
+    /// The encoder's index mark (m), if the scene's encoder has one.
+    pub index_m: Option<f64>,
+}
+
 /// A simulated device a PIL run drives through a board: the one-axis
 /// [`Simulation`] or the three-axis [`XyzSimulation`].
 pub trait PilPlant {
@@ -286,15 +298,9 @@ pub trait PilPlant {
     type Sample: PilSample;
     /// The device's axes.
     const AXES: u8;
-    /// Whether the scene's device is the board's (its sensors, its world).
-    fn check(&self) -> Result<(), String>;
-    /// How the board gets from disarmed to armed.
-    fn start(&self) -> Start;
-    /// Where each axis stands at rest before the run, as the host tells a
-    /// board it calibrates (pm).
-    fn at_rest_pm(&self) -> Axes<i64>;
-    /// The encoder's index mark (m), if the scene's encoder has one.
-    fn index_m(&self) -> Option<f64>;
+    /// How a run begins, once the scene's device is checked to be the
+    /// board's (its sensors, its world).
+    fn setup(&self) -> Result<Setup, String>;
     /// One tick with the board at the other end of `session` as its
     /// controller: the sample and the duties the board answered.
     fn step_with<P: BoardPort>(
@@ -306,17 +312,13 @@ pub trait PilPlant {
 impl PilPlant for Simulation {
     type Sample = Sample;
     const AXES: u8 = 1;
-    fn check(&self) -> Result<(), String> {
-        check_scene(self.scene())
-    }
-    fn start(&self) -> Start {
-        Start::for_scene(self.scene())
-    }
-    fn at_rest_pm(&self) -> Axes<i64> {
-        Axes::one(0)
-    }
-    fn index_m(&self) -> Option<f64> {
-        self.scene().effects.encoder.and_then(|e| e.index_m)
+    fn setup(&self) -> Result<Setup, String> {
+        check_scene(self.scene())?;
+        Ok(Setup {
+            start: Start::for_scene(self.scene()),
+            at_rest_pm: Axes::one(0),
+            index_m: self.scene().effects.encoder.and_then(|e| e.index_m),
+        })
     }
     fn step_with<P: BoardPort>(
         &mut self,
@@ -329,18 +331,15 @@ impl PilPlant for Simulation {
 impl PilPlant for XyzSimulation {
     type Sample = XyzSample;
     const AXES: u8 = 3;
-    fn check(&self) -> Result<(), String> {
-        check_xyz_scene(self.scene())
-    }
-    fn start(&self) -> Start {
-        Start::Calibrate
-    }
-    fn at_rest_pm(&self) -> Axes<i64> {
+    fn setup(&self) -> Result<Setup, String> {
+        check_xyz_scene(self.scene())?;
+        // Calibrated where the image's world starts its cursor.
         let x = xyz::world().map(|w| w.cursor()).unwrap_or_default();
-        Axes::new(x.map(|p| p.nm() as i64 * 1000)).unwrap_or_default()
-    }
-    fn index_m(&self) -> Option<f64> {
-        None
+        Ok(Setup {
+            start: Start::Calibrate,
+            at_rest_pm: Axes::new(x.map(|p| p.nm() as i64 * 1000)).unwrap_or_default(),
+            index_m: None,
+        })
     }
     fn step_with<P: BoardPort>(
         &mut self,
@@ -788,7 +787,6 @@ fn record<P: BoardPort, M: PilPlant>(
 /// disarmed, then the board calibrated (or homed, for a scene with a hard
 /// stop) and armed, then the rest.
 pub fn run<P: BoardPort>(scene: Scene, ticks: u64, port: P, faults: Faults) -> Result<Run, String> {
-    check_scene(&scene)?;
     run_plant(Simulation::new(scene)?, ticks, port, faults)
 }
 
@@ -800,7 +798,6 @@ pub fn run_xyz<P: BoardPort>(
     port: P,
     faults: Faults,
 ) -> Result<Run<XyzSample>, String> {
-    check_xyz_scene(&scene)?;
     run_plant(XyzSimulation::new(scene)?, ticks, port, faults)
 }
 
@@ -811,10 +808,10 @@ pub fn run_plant<P: BoardPort, M: PilPlant>(
     port: P,
     faults: Faults,
 ) -> Result<Run<M::Sample>, String> {
-    sim.check()?;
-    let start = sim.start();
+    let setup = sim.setup()?;
+    let start = setup.start;
     let mut session = Session::open_axes(port, faults, M::AXES)?;
-    session.set_index(sim.index_m());
+    session.set_index(setup.index_m);
     let mut r = Run {
         start: Some(start),
         ..Run::default()
@@ -835,7 +832,7 @@ pub fn run_plant<P: BoardPort, M: PilPlant>(
     record(&mut session, &mut sim, &mut r)?;
     match start {
         Start::Calibrate => {
-            session.calibrate(sim.at_rest_pm())?;
+            session.calibrate(setup.at_rest_pm)?;
         }
         Start::Home => {
             session.home()?;

@@ -355,38 +355,8 @@ fn firmware() -> Result<PathBuf, String> {
     let out = dir.join(TARGET).join("release");
     // With RTT logging first, copied aside, then the plain image last, so
     // that `twoport-stm32f405` is the plain one.
-    run(
-        &format!(
-            "build firmware: STM32F405 image with defmt ({})",
-            tc.describe()
-        ),
-        &mut tc.build(
-            &root().join("firmware/stm32f405"),
-            &dir,
-            &["--features", "defmt"],
-        ),
-    )?;
-    std::fs::copy(
-        out.join("twoport-stm32f405"),
-        out.join("twoport-stm32f405-defmt"),
-    )
-    .map_err(|e| format!("copy the defmt image: {e}"))?;
-    run(
-        &format!(
-            "build firmware: three-axis STM32F405 image ({})",
-            tc.describe()
-        ),
-        &mut tc.build(
-            &root().join("firmware/stm32f405"),
-            &dir,
-            &["--features", "xyz"],
-        ),
-    )?;
-    std::fs::copy(
-        out.join("twoport-stm32f405"),
-        out.join("twoport-stm32f405-xyz"),
-    )
-    .map_err(|e| format!("copy the three-axis image: {e}"))?;
+    stm32f405_variant("defmt", "twoport-stm32f405-defmt")?;
+    stm32f405_variant("xyz", "twoport-stm32f405-xyz")?;
     run(
         &format!("build firmware: STM32F405 image ({})", tc.describe()),
         &mut tc.build(&root().join("firmware/stm32f405"), &dir, &[]),
@@ -467,17 +437,22 @@ fn host_test_against_an386(what: &str, elf: &Path, file: &str, name: &str) -> Re
 }
 
 /// The STM32F405 image's `qemu` build (three-axis with `xyz`), for QEMU's
-/// netduinoplus2; returns its ELF, copied aside as the passivity image is.
+/// netduinoplus2; returns its ELF.
 fn stm32f405_qemu_image(xyz: bool) -> Result<PathBuf, String> {
+    match xyz {
+        true => stm32f405_variant("qemu,xyz", "twoport-stm32f405-qemu-xyz"),
+        false => stm32f405_variant("qemu", "twoport-stm32f405-qemu"),
+    }
+}
+
+/// The STM32F405 image built with `features`, its ELF copied aside as
+/// `name` (the next build overwrites the plain one); returns that copy.
+fn stm32f405_variant(features: &str, name: &str) -> Result<PathBuf, String> {
     let tc = Toolchain::detect()?;
     let dir = cross_target_dir("firmware");
-    let (features, name) = match xyz {
-        true => ("qemu,xyz", "twoport-stm32f405-qemu-xyz"),
-        false => ("qemu", "twoport-stm32f405-qemu"),
-    };
     run(
         &format!(
-            "build firmware: the STM32F405 image for QEMU, {features} ({})",
+            "build firmware: the STM32F405 image, {features} ({})",
             tc.describe()
         ),
         &mut tc.build(
@@ -489,7 +464,7 @@ fn stm32f405_qemu_image(xyz: bool) -> Result<PathBuf, String> {
     let out = dir.join(TARGET).join("release");
     let elf = out.join(name);
     std::fs::copy(out.join("twoport-stm32f405"), &elf)
-        .map_err(|e| format!("copy the STM32F405 QEMU image: {e}"))?;
+        .map_err(|e| format!("copy the {features} image: {e}"))?;
     Ok(elf)
 }
 

@@ -66,6 +66,31 @@ pub trait Drive<const N: usize> {
     }
 }
 
+/// The methods both servos answer alike, through their own inherent
+/// methods of the same names.
+macro_rules! shared {
+    ($servo:ident) => {
+        fn faults(&self) -> (Faults, Faults) {
+            (self.safety().faults(), self.safety().first_fault())
+        }
+        fn enable(&mut self) -> Result<(), Faults> {
+            $servo::enable(self)
+        }
+        fn disable(&mut self) {
+            $servo::disable(self)
+        }
+        fn clear(&mut self) {
+            $servo::clear(self)
+        }
+        fn heartbeat(&mut self) {
+            $servo::heartbeat(self)
+        }
+        fn trip(&mut self, f: Faults) {
+            $servo::trip(self, f)
+        }
+    };
+}
+
 impl<V: VirtualEnvironment, L: PortLayer> Drive<1> for Servo<V, f32, L> {
     #[inline(always)]
     fn tick(
@@ -112,24 +137,7 @@ impl<V: VirtualEnvironment, L: PortLayer> Drive<1> for Servo<V, f32, L> {
     fn set_limits(&mut self, [c]: [SafetyConfig; 1]) -> Result<(), AxisError<ParamError>> {
         Servo::set_limits(self, c).map_err(|error| AxisError { axis: 0, error })
     }
-    fn faults(&self) -> (Faults, Faults) {
-        (self.safety().faults(), self.safety().first_fault())
-    }
-    fn enable(&mut self) -> Result<(), Faults> {
-        Servo::enable(self)
-    }
-    fn disable(&mut self) {
-        Servo::disable(self)
-    }
-    fn clear(&mut self) {
-        Servo::clear(self)
-    }
-    fn heartbeat(&mut self) {
-        Servo::heartbeat(self)
-    }
-    fn trip(&mut self, f: Faults) {
-        Servo::trip(self, f)
-    }
+    shared!(Servo);
     fn position(&self) -> [Position; 1] {
         [Servo::position(self)]
     }
@@ -176,24 +184,7 @@ impl<W: World<f32, N>, const N: usize> Drive<N> for AxesServo<W, f32, N> {
     fn set_limits(&mut self, c: [SafetyConfig; N]) -> Result<(), AxisError<ParamError>> {
         AxesServo::set_limits(self, c)
     }
-    fn faults(&self) -> (Faults, Faults) {
-        (self.safety().faults(), self.safety().first_fault())
-    }
-    fn enable(&mut self) -> Result<(), Faults> {
-        AxesServo::enable(self)
-    }
-    fn disable(&mut self) {
-        AxesServo::disable(self)
-    }
-    fn clear(&mut self) {
-        AxesServo::clear(self)
-    }
-    fn heartbeat(&mut self) {
-        AxesServo::heartbeat(self)
-    }
-    fn trip(&mut self, f: Faults) {
-        AxesServo::trip(self, f)
-    }
+    shared!(AxesServo);
     fn position(&self) -> [Position; N] {
         AxesServo::position(self)
     }

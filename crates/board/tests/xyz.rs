@@ -125,6 +125,14 @@ fn board() -> XyzBoard {
     xyz::board().unwrap()
 }
 
+/// The image on a bench whose axes reach no stop, after its first tick.
+fn booted() -> (XyzBoard, Bench) {
+    let mut b = board();
+    let mut io = Bench::new([-1.0; 3]);
+    tick(&mut b, &mut io);
+    (b, io)
+}
+
 fn refusals(io: &mut Bench) -> Vec<(ModeRequest, ModeRefusal)> {
     io.heard()
         .into_iter()
@@ -204,9 +212,7 @@ fn every_axis_homes_onto_its_own_stop() {
 
 #[test]
 fn calibration_and_gains_are_refused_per_axis_by_name() {
-    let mut b = board();
-    let mut io = Bench::new([-1.0; 3]);
-    tick(&mut b, &mut io);
+    let (mut b, mut io) = booted();
     io.say(Message::Calibrate {
         position_pm: Axes::one(0),
     });
@@ -258,9 +264,7 @@ fn calibration_and_gains_are_refused_per_axis_by_name() {
 /// zero force on all three in that tick, and disarms.
 #[test]
 fn a_fault_on_one_axis_zeroes_every_axis() {
-    let mut b = board();
-    let mut io = Bench::new([-1.0; 3]);
-    tick(&mut b, &mut io);
+    let (mut b, mut io) = booted();
     io.say(Message::Calibrate {
         position_pm: start_pm(),
     });

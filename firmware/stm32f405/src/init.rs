@@ -142,8 +142,8 @@ fn xyz_pins(a: &pac::GPIOA, b: &pac::GPIOB, c: &pac::GPIOC) {
         .modify(|_, w| w.pupdr6().pull_up().pupdr7().pull_up());
 }
 
-/// TIM3 counts the encoder's quadrature edges.
-pub fn encoder(t: &pac::TIM3) {
+/// TIM3 counts the encoder's quadrature edges (TIM4 too, on three axes).
+pub fn encoder(t: &pac::tim3::RegisterBlock) {
     // Encoder mode 3: count on both edges of both channels.
     t.ccmr1_input().write(|w| w.cc1s().ti1().cc2s().ti2());
     t.smcr().write(|w| w.sms().encoder_mode_3());
@@ -151,13 +151,11 @@ pub fn encoder(t: &pac::TIM3) {
     t.cr1().modify(|_, w| w.cen().set_bit());
 }
 
-/// The y and z axes' encoders: TIM4 and TIM8, as TIM3.
+/// The y and z axes' encoders: TIM4 as TIM3, and the advanced TIM8 in
+/// the same mode.
 #[cfg(feature = "xyz")]
 pub fn encoders_yz(t4: &pac::TIM4, t8: &pac::TIM8) {
-    t4.ccmr1_input().write(|w| w.cc1s().ti1().cc2s().ti2());
-    t4.smcr().write(|w| w.sms().encoder_mode_3());
-    t4.arr().write(|w| w.arr().set(0xFFFF));
-    t4.cr1().modify(|_, w| w.cen().set_bit());
+    encoder(t4);
     t8.ccmr1_input().write(|w| w.cc1s().ti1().cc2s().ti2());
     t8.smcr().write(|w| w.sms().encoder_mode_3());
     t8.arr().write(|w| w.arr().set(0xFFFF));
