@@ -3,11 +3,12 @@
 //! same config. The bytes are tried as they are (which the CRC almost
 //! always refuses) and with their CRC made right, so that the fuzzer
 //! reaches the header checks and the payload's decoder behind it; and
-//! through the two-copy store, as both copies.
+//! through the two-copy store, as both copies. Each is read as a one-axis
+//! and as a three-axis board reads it.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use twoport_config::record::{decode, encode, HEADER, MAX_RECORD};
+use twoport_config::record::{decode, decode_axes, encode, encode_axes, HEADER, MAX_RECORD};
 use twoport_config::{crc32, RamFlash, Store};
 
 fn check(bytes: &[u8]) {
@@ -16,6 +17,12 @@ fn check(bytes: &[u8]) {
         let mut buf = [0u8; MAX_RECORD + 4];
         let n = encode(&cfg, seq, &mut buf).expect("a decoded config re-encodes");
         assert_eq!(decode(&buf[..n]), Ok((seq, cfg)));
+    }
+    if let Ok((seq, cfg)) = decode_axes::<3>(bytes) {
+        assert!(cfg.iter().all(|c| c.validate().is_ok()));
+        let mut buf = [0u8; MAX_RECORD + 4];
+        let n = encode_axes(&cfg, seq, &mut buf).expect("decoded configs re-encode");
+        assert_eq!(decode_axes::<3>(&buf[..n]), Ok((seq, cfg)));
     }
 }
 
@@ -58,5 +65,7 @@ fuzz_target!(|data: &[u8]| {
         };
         let (cfg, _) = store.load(&defaults);
         assert!(cfg.validate().is_ok());
+        let (cfg, _) = store.load_axes(&[defaults; 3]);
+        assert!(cfg.iter().all(|c| c.validate().is_ok()));
     }
 });
