@@ -8,6 +8,7 @@
 //! frames and, if asked, corrupted frames and a link loss, so the in-process
 //! run is the reference the firmware must match.
 
+use crate::engine::sim::round_counts;
 use crate::engine::xyz::{XyzSample, XyzScene, XyzSimulation};
 use crate::{Sample, Scene, Simulation};
 use std::collections::VecDeque;
@@ -348,11 +349,13 @@ impl PilPlant for XyzSimulation {
         session.tick_heartbeat()?;
         let io = session.io;
         let (bits, pm) = excalibur::ENCODER;
-        let mask = (1u64 << bits) - 1;
+        let mask = ((1u64 << bits) - 1) as u32;
         let tick = self.ticks();
         let mut answer = Ok(Axes::one(0));
         let mut ctl = |x_m: [f64; 3]| -> [f64; 3] {
-            let raw = x_m.map(|x| ((x * 1e12 / pm as f64).round() as i64 as u64 & mask) as u32);
+            // The counter keeps the count's low `bits`, as in the one-axis
+            // simulation's sensing.
+            let raw = x_m.map(|x| (round_counts(x * 1e12 / pm as f64) as u32) & mask);
             let sensors = LinkSensors {
                 tick: tick as u32,
                 encoder_raw: Axes::new(raw).unwrap_or_default(),

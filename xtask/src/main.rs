@@ -534,15 +534,18 @@ fn pil(extra: &[String]) -> Result<(), String> {
 }
 
 /// Whether `arg` names a scene file that declares three axes (`axes = 3`
-/// at its top level), for which the three-axis image runs.
+/// at its top level, read as host-sim reads it), for which the three-axis
+/// image runs.
 fn declares_three_axes(arg: &str) -> bool {
     if !arg.ends_with(".toml") {
         return false;
     }
     let text = std::fs::read_to_string(root().join(arg)).unwrap_or_default();
-    text.lines()
-        .take_while(|l| !l.trim_start().starts_with('['))
-        .any(|l| l.split('#').next().unwrap_or("").replace(' ', "") == "axes=3")
+    let axes = text
+        .parse::<toml::Table>()
+        .ok()
+        .and_then(|t| t.get("axes").and_then(toml::Value::as_integer));
+    axes == Some(3)
 }
 
 /// What QEMU logged of the image's accesses to devices it does not model:

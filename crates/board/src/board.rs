@@ -259,7 +259,7 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
     /// Each axis's value, as the link carries them.
     fn axes<T: Copy>(xs: [T; N]) -> Axes<T> {
         // (`new` checked 1 <= N <= MAX_AXES.)
-        Axes::from_slice(&xs).unwrap_or(Axes::one(xs[0]))
+        Axes::new(xs).unwrap_or(Axes::one(xs[0]))
     }
 
     fn handle(&mut self, msg: Message) {

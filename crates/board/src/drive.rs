@@ -50,8 +50,10 @@ pub trait Drive<const N: usize> {
     fn position(&self) -> [Position; N];
     /// Where the virtual environment holds each axis.
     fn ve_position(&self) -> [Position; N];
-    /// Axis `axis` now reads `position` (homing onto a stop, the host's
-    /// word).
+    /// Every axis now reads its `position` (the host's word); the laws
+    /// re-align once.
+    fn calibrate(&mut self, position: [Position; N]);
+    /// Axis `axis` now reads `position` (homing onto a stop).
     fn calibrate_axis(&mut self, axis: usize, position: Position);
     /// Axis `axis`'s counter read `raw` at `position` (an index pulse).
     fn calibrate_axis_at(
@@ -98,29 +100,13 @@ impl<V: VirtualEnvironment, L: PortLayer> Drive<1> for Servo<V, f32, L> {
         frame: &AxesFrame<f32, 1>,
         homing: Option<&mut [Option<Homing>; 1]>,
     ) -> AxesOutput<f32, 1> {
-        let frame = SensorFrame {
-            tick: frame.tick,
-            encoder_raw: frame.encoder_raw[0],
-            load_cell_n: frame.load_cell_n[0],
-            dead_man_closed: frame.dead_man_closed,
-        };
-        let o = match homing {
+        let frame = SensorFrame::from(*frame);
+        let out = match homing {
             Some([Some(h)]) => self.tick_with(&frame, |x, v| h.step(x, v)),
             Some([None]) => self.tick_with(&frame, |_, _| 0.0),
             None => Servo::tick(self, &frame),
         };
-        AxesOutput {
-            actuator_force_n: [o.actuator_force_n],
-            commanded_force_n: [o.commanded_force_n],
-            position: [o.position],
-            velocity_mps: [o.velocity_mps],
-            ve_velocity_mps: [o.ve_velocity_mps],
-            ve_force_n: [o.ve_force_n],
-            coupling_force_n: [o.coupling_force_n],
-            reference: [o.reference],
-            faults: o.faults,
-            limited: [o.limited],
-        }
+        out.into()
     }
     fn display(&self) -> Display {
         Servo::display(self)
@@ -144,8 +130,11 @@ impl<V: VirtualEnvironment, L: PortLayer> Drive<1> for Servo<V, f32, L> {
     fn ve_position(&self) -> [Position; 1] {
         [self.ve().position()]
     }
+    fn calibrate(&mut self, [x]: [Position; 1]) {
+        Servo::calibrate(self, x)
+    }
     fn calibrate_axis(&mut self, _: usize, position: Position) {
-        self.calibrate(position)
+        Servo::calibrate(self, position)
     }
     fn calibrate_axis_at(
         &mut self,
@@ -190,6 +179,9 @@ impl<W: World<f32, N>, const N: usize> Drive<N> for AxesServo<W, f32, N> {
     }
     fn ve_position(&self) -> [Position; N] {
         self.world().position()
+    }
+    fn calibrate(&mut self, position: [Position; N]) {
+        AxesServo::calibrate(self, position)
     }
     fn calibrate_axis(&mut self, axis: usize, position: Position) {
         // (The loop calibrates only axes it has.)

@@ -36,7 +36,7 @@ pub struct Store<F> {
 
 /// One copy's state: its sequence number and configs, or why it is not
 /// usable (`None`: the flash could not be read).
-type Copy<const N: usize> = Result<(u32, [Config; N]), Option<RecordError>>;
+type SlotCopy<const N: usize> = Result<(u32, [Config; N]), Option<RecordError>>;
 
 /// `a` is newer than `b`, across the sequence number's wrap.
 fn newer(a: u32, b: u32) -> bool {
@@ -62,19 +62,19 @@ impl<F: NorFlash> Store<F> {
         &mut self.flash
     }
 
-    fn read_slot<const N: usize>(&mut self, i: usize) -> Copy<N> {
+    fn read_slot<const N: usize>(&mut self, i: usize) -> SlotCopy<N> {
         let mut buf = [0u8; MAX_RECORD];
         self.flash.read(self.slots[i], &mut buf).map_err(|_| None)?;
         record::decode_axes(&buf).map_err(Some)
     }
 
     /// Each copy's state.
-    fn read_both<const N: usize>(&mut self) -> [Copy<N>; 2] {
+    fn read_both<const N: usize>(&mut self) -> [SlotCopy<N>; 2] {
         [self.read_slot(0), self.read_slot(1)]
     }
 
     /// The newest valid copy: its slot, sequence number and config.
-    fn newest<const N: usize>(copies: &[Copy<N>; 2]) -> Option<(usize, u32, [Config; N])> {
+    fn newest<const N: usize>(copies: &[SlotCopy<N>; 2]) -> Option<(usize, u32, [Config; N])> {
         let mut best: Option<(usize, u32, [Config; N])> = None;
         for (i, c) in copies.iter().enumerate() {
             if let Ok((seq, cfg)) = c {

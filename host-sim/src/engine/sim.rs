@@ -166,12 +166,12 @@ pub struct Simulation {
     layer_lowest: f64,
 }
 
-/// Largest stable sub-step for `method` over `poles` (s), by bisection.
 /// Round half away from zero without a libm call.
-fn round_counts(c: f64) -> i64 {
+pub(crate) fn round_counts(c: f64) -> i64 {
     (c + 0.5f64.copysign(c)) as i64
 }
 
+/// Largest stable sub-step for `method` over `poles` (s), by bisection.
 fn max_stable_step(method: Method, poles: &[nalgebra::Complex<f64>]) -> f64 {
     poles
         .iter()

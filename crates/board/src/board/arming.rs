@@ -123,10 +123,8 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
             return self.refuse(ModeRequest::Home, why);
         }
         let x = self.servo.position();
-        let mut runs = [None; N];
-        for (i, r) in runs.iter_mut().enumerate() {
-            *r = Homing::new(self.homing_cfg[i], x[i]).ok();
-        }
+        let runs: [Option<Homing>; N] =
+            core::array::from_fn(|i| Homing::new(self.homing_cfg[i], x[i]).ok());
         if runs.iter().any(Option::is_none) {
             // The image's homing constants are wrong: as unsafe as a fault.
             self.servo.trip(Faults::HOMING_FAILED);
@@ -164,9 +162,7 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
             };
             *x = Position::from_nm(nm);
         }
-        for (axis, x) in x.into_iter().enumerate() {
-            self.servo.calibrate_axis(axis, x);
-        }
+        self.servo.calibrate(x);
         self.calibrated = true;
         self.queue_status();
     }

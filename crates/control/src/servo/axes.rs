@@ -6,7 +6,7 @@
 
 use super::{
     impedance_gains, load_cell_faults, AdmittanceLaws, Axis, Display, Gains, GainsError, LawsRef,
-    SensorFrame,
+    SensorFrame, ServoOutput,
 };
 use crate::coupling::ImpedanceCoupling;
 use crate::safety::{AxesInputs, AxisError, Faults, SafeForces, SafetyConfig, SafetyLayer};
@@ -36,6 +36,36 @@ impl<R> From<SensorFrame<R>> for AxesFrame<R, 1> {
             encoder_raw: [f.encoder_raw],
             load_cell_n: [f.load_cell_n],
             dead_man_closed: f.dead_man_closed,
+        }
+    }
+}
+
+impl<R: Copy> From<AxesFrame<R, 1>> for SensorFrame<R> {
+    /// An `N = 1` frame's one axis, as the one-axis servo's frame.
+    fn from(f: AxesFrame<R, 1>) -> Self {
+        SensorFrame {
+            tick: f.tick,
+            encoder_raw: f.encoder_raw[0],
+            load_cell_n: f.load_cell_n[0],
+            dead_man_closed: f.dead_man_closed,
+        }
+    }
+}
+
+impl<R> From<ServoOutput<R>> for AxesOutput<R, 1> {
+    /// The one-axis servo's output, as the one axis of an `N = 1` output.
+    fn from(o: ServoOutput<R>) -> Self {
+        AxesOutput {
+            actuator_force_n: [o.actuator_force_n],
+            commanded_force_n: [o.commanded_force_n],
+            position: [o.position],
+            velocity_mps: [o.velocity_mps],
+            ve_velocity_mps: [o.ve_velocity_mps],
+            ve_force_n: [o.ve_force_n],
+            coupling_force_n: [o.coupling_force_n],
+            reference: [o.reference],
+            faults: o.faults,
+            limited: [o.limited],
         }
     }
 }
