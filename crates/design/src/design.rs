@@ -23,13 +23,16 @@ pub struct GridSpec {
     pub f_min_hz: f64,
     /// Log-spaced points from `f_min_hz` to Nyquist.
     pub base_points: usize,
-    /// Extra points across each resonance (continuous modes below Nyquist
-    /// and the aliased angles of the discrete poles).
+    /// Points across each resonance (see [`grid`]): linearly spaced over
+    /// its shape, this many in all.
     pub points_per_mode: usize,
+    /// Points per decade of distance from each feature's centre, from a
+    /// hundredth of its half-width out to its shape's edge.
+    pub points_per_decade: usize,
 }
 
 impl GridSpec {
-    /// The default design grid. Doubling both counts moves no design result
+    /// The default design grid. Doubling every count moves no design result
     /// by more than 0.5% (tested). Below its lowest frequency the limit
     /// `ω -> 0` is taken analytically (see [`dc_margin`]), so starting it
     /// lower moves no result either (tested).
@@ -37,6 +40,7 @@ impl GridSpec {
         f_min_hz: 0.05,
         base_points: 1500,
         points_per_mode: 300,
+        points_per_decade: 12,
     };
 
     /// This grid started at `f_min_hz` instead, with the same density.
@@ -57,34 +61,54 @@ impl GridSpec {
         GridSpec {
             base_points: self.base_points * 2,
             points_per_mode: self.points_per_mode * 2,
+            points_per_decade: self.points_per_decade * 2,
             ..self
         }
     }
 }
 
 /// Angular frequencies (rad/s), increasing, in `(0, π/T]`, ending at `π/T`.
+///
+/// A log grid, refined at every [`Feature`](crate::plant::Feature) of the
+/// device: its free modes, its modes with the handle held (still, or by
+/// the stiffest grasp), each folded into the base band, and its discrete
+/// poles. Each term of a design inequality is a sum of terms
+/// `r/(jω - λ)` (or their alias sums, which have the same folded poles), and
+/// such a term changes by a large fraction of itself only within a few
+/// half-widths `|Re λ|` of `Im λ`. So around each feature the grid places
+/// points log-spaced in the distance from its centre, from 1/100 of its
+/// half-width out to its shape's edge (20 half-widths, at least 2% of the
+/// centre): however lightly damped, a mode is resolved on its own scale,
+/// where a fixed spacing would step over a mode narrower than it.
 pub fn grid(plant: &Plant, spec: GridSpec) -> Vec<f64> {
     let nyq = plant.nyquist();
     let lo = (2.0 * PI * spec.f_min_hz).min(nyq / 10.0);
     let mut w = log_grid(lo, nyq, spec.base_points);
-    let mut centres: Vec<(f64, f64)> = plant
-        .modes()
-        .iter()
-        .filter(|m| m.omega_n < nyq)
-        .map(|m| (m.omega_n, m.zeta))
-        .collect();
-    for th in plant.discrete_angles() {
-        centres.push((th / plant.period_s(), 0.0));
-    }
-    for (c, zeta) in centres {
-        // +-20 half-power bandwidths, at least +-2%.
-        let half = (20.0 * zeta.max(0.001)).max(0.02) * c;
+    let mut push = |x: f64| {
+        if x > 0.0 && x <= nyq {
+            w.push(x);
+        }
+    };
+    for f in plant.features() {
+        let (c, beta) = (f.omega, f.half_width.max(1e-12 * f.omega));
+        let edge = (20.0 * beta).max(0.02 * c);
+        // Linear over the shape, as the eye would sample it.
         let k = spec.points_per_mode.max(2);
         for i in 0..k {
-            let x = c - half + 2.0 * half * i as f64 / (k - 1) as f64;
-            if x > 0.0 && x <= nyq {
-                w.push(x);
+            push(c - edge + 2.0 * edge * i as f64 / (k - 1) as f64);
+        }
+        // Log in the distance from the centre, down to 1/100 half-width.
+        push(c);
+        let per = spec.points_per_decade.max(1) as f64;
+        let mut j = 0.0;
+        loop {
+            let u = 0.01 * beta * 10f64.powf(j / per);
+            if u > edge {
+                break;
             }
+            push(c - u);
+            push(c + u);
+            j += 1.0;
         }
     }
     // The exact ends: Nyquist, and twice the lowest frequency for the
@@ -217,16 +241,58 @@ pub fn regulator_tf(kp: f64, bp: f64, t: f64) -> Result<ZTransfer, ParamError> {
     PositionRegulator::new(kp as f32, bp as f32, t as f32).map(|r| r.tf())
 }
 
-/// Smallest `lhs(ω) - bound(ω)` over the grid, or the negative
-/// [`dc_margin`] where the limit toward DC fails.
+/// Smallest `lhs(ω) - bound(ω)` over the grid and between its points (see
+/// [`least`]), or the negative [`dc_margin`] where the limit toward DC
+/// fails.
 fn slack(a: &Analysis, bound: &[f64], lhs: impl Fn(Complex64) -> f64) -> f64 {
-    let grid = a
+    let d: Vec<f64> = a
         .points
         .iter()
         .zip(bound)
         .map(|(p, b)| lhs(p.z) - b)
-        .fold(f64::INFINITY, f64::min);
-    grid.min(dc_margin(a, bound, &lhs).min(0.0))
+        .collect();
+    least(&a.points, &d).0.min(dc_margin(a, bound, &lhs).min(0.0))
+}
+
+/// The least of `v` (a smooth function sampled at `points`) and where
+/// (rad/s), between the points too: at each local minimum of the samples,
+/// the vertex of the parabola through it and its neighbours. The grid
+/// resolves every feature of the design inequality on its own scale (see
+/// [`grid`]), so the function is smooth on the scale of three neighbouring
+/// points and the parabola finds the dip between them; the samples alone
+/// miss it by up to the curvature times the spacing squared (on the
+/// Excalibur at 82 Hz, 8e-6 of the stiffness).
+pub fn least(points: &[PlantPoint], v: &[f64]) -> (f64, f64) {
+    let mut best = (f64::INFINITY, points.first().map_or(0.0, |p| p.omega));
+    for (i, (p, y)) in points.iter().zip(v).enumerate() {
+        if *y < best.0 || y.is_nan() {
+            best = (if y.is_nan() { f64::NEG_INFINITY } else { *y }, p.omega);
+        }
+        if i == 0 || i + 1 >= v.len() || !(*y <= v[i - 1] && *y <= v[i + 1]) {
+            continue;
+        }
+        let (x0, x1, x2) = (points[i - 1].omega, p.omega, points[i + 1].omega);
+        let (y0, y1, y2) = (v[i - 1], *y, v[i + 1]);
+        if !(y0.is_finite() && y1.is_finite() && y2.is_finite()) {
+            continue;
+        }
+        // The parabola's vertex, from its divided differences.
+        let d01 = (y1 - y0) / (x1 - x0);
+        let d12 = (y2 - y1) / (x2 - x1);
+        let c2 = (d12 - d01) / (x2 - x0);
+        if c2 <= 0.0 {
+            continue;
+        }
+        let xv = 0.5 * (x0 + x1) - d01 / (2.0 * c2);
+        if xv <= x0 || xv >= x2 {
+            continue;
+        }
+        let yv = y1 + d01 * (xv - x1) + c2 * (xv - x0) * (xv - x1);
+        if yv < best.0 {
+            best = (yv, xv);
+        }
+    }
+    best
 }
 
 /// The relative margin of `lhs(ω) >= bound(ω)` in the limit `ω -> 0`, taken
@@ -489,14 +555,22 @@ pub fn relative_margin(c: f64, bound: f64) -> f64 {
     }
 }
 
-/// The least relative slack of `lhs(z) >= bound` over the grid, and where.
+/// The least relative slack of `lhs(z) >= bound` over the grid (and
+/// between its points, see [`least`]), and where (Hz).
 fn worst(a: &Analysis, bound: &[f64], lhs: impl Fn(Complex64) -> f64) -> (f64, f64) {
     let dc = (dc_margin(a, bound, &lhs), 0.0);
-    a.points
+    let m: Vec<f64> = a
+        .points
         .iter()
         .zip(bound)
-        .map(|(pt, b)| (relative_margin(lhs(pt.z), *b), pt.omega / (2.0 * PI)))
-        .fold(dc, |acc, x| if x.0 < acc.0 { x } else { acc })
+        .map(|(pt, b)| relative_margin(lhs(pt.z), *b))
+        .collect();
+    let (g, w) = least(&a.points, &m);
+    if g < dc.0 {
+        (g, w / (2.0 * PI))
+    } else {
+        dc
+    }
 }
 
 fn paper_check((m, f): (f64, f64), extra: bool) -> PaperCheck {

@@ -1047,10 +1047,9 @@ fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
         )
         .map_err(|e| format!("{}: {e}", p.model.name))?;
         evaluations += v.evaluations;
-        if worst
-            .as_ref()
-            .is_none_or(|w| v.spectral_radius > w.0.spectral_radius)
-        {
+        if worst.as_ref().is_none_or(|w| {
+            (v.unstable, v.spectral_radius) > (w.0.unstable, w.0.spectral_radius)
+        }) {
             worst = Some((v, &p.model));
         }
     }
@@ -1081,9 +1080,15 @@ fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
         } else {
             "no counterexample found"
         };
+        let growth = if v.growth_per_s > 0.0 {
+            format!("grows by e every {:.3e} s", 1.0 / v.growth_per_s)
+        } else {
+            format!("decays by e every {:.3e} s", -1.0 / v.growth_per_s)
+        };
         println!(
-            "  {verdict}; worst spectral radius {:.6} at {:.2} Hz",
-            v.spectral_radius, v.frequency_hz
+            "  {verdict}; worst spectral radius 1 {:+.3e} at {:.2} Hz ({growth})",
+            v.spectral_radius - 1.0,
+            v.frequency_hz
         );
         println!(
             "  worst termination: {}",
