@@ -251,7 +251,9 @@ fn slack(a: &Analysis, bound: &[f64], lhs: impl Fn(Complex64) -> f64) -> f64 {
         .zip(bound)
         .map(|(p, b)| lhs(p.z) - b)
         .collect();
-    least(&a.points, &d).0.min(dc_margin(a, bound, &lhs).min(0.0))
+    least(&a.points, &d)
+        .0
+        .min(dc_margin(a, bound, &lhs).min(0.0))
 }
 
 /// The least of `v` (a smooth function sampled at `points`) and where

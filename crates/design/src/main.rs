@@ -124,6 +124,11 @@ struct DesignImpedance {
     /// Coupling damping b_cI (N s/m); without it, the best (k, b) pair.
     #[arg(long, allow_negative_numbers = true)]
     b: Option<f64>,
+    /// The recommended gain's margin below the boundary, as a fraction of
+    /// the boundary's gain (a stiffness that much lower, a mass that much
+    /// higher), from 0 to 0.9.
+    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+    margin: f64,
     #[command(flatten)]
     common: Common,
 }
@@ -139,6 +144,11 @@ struct DesignAdmittance {
     /// Coupling damping b_cA (N s/m); without it, the best (m, b) pair.
     #[arg(long, allow_negative_numbers = true)]
     b: Option<f64>,
+    /// The recommended gain's margin below the boundary, as a fraction of
+    /// the boundary's gain (a stiffness that much lower, a mass that much
+    /// higher), from 0 to 0.9.
+    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+    margin: f64,
     #[command(flatten)]
     common: Common,
 }
@@ -541,6 +551,24 @@ impl Session {
     }
 }
 
+/// Check a `--margin` before any analysis.
+fn margin(v: f64) -> Result<f64, String> {
+    (0.0..=0.9)
+        .contains(&v)
+        .then_some(v)
+        .ok_or_else(|| format!("--margin {v}: must be a fraction from 0 to 0.9"))
+}
+
+/// A stiffness (N/m) as published: rounded down, never past its proof.
+fn stiffness_text(k: f64) -> String {
+    format!("{:.0}", k.floor())
+}
+
+/// A mass (kg) as published: rounded up to the gram, never past its proof.
+fn mass_text(m: f64) -> String {
+    format!("{:.3}", (m * 1e3).ceil() / 1e3)
+}
+
 /// Check gains for sign and finiteness before any analysis.
 fn gain(name: &str, v: f64) -> Result<f64, String> {
     (v.is_finite() && v >= 0.0)
@@ -639,6 +667,7 @@ fn binding_text(v: &Value, what: &str, paper: &str, unit: &str) -> String {
 }
 
 fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
+    let margin = margin(a.margin)?;
     let s = Session::open(&a.common)?;
     let r = impedance_design(&s, a.b)?;
     let paper = impedance_design_on(&s, &s.impedance_bounds(true), a.b)?;
@@ -648,6 +677,8 @@ fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
         Some((k, b)) => {
             let c = s.worst_check(|p| design::check_impedance(&p.analysis, k, b, s.human));
             binding_pose(&mut v, &s, c);
+            v["margin"] = json!(margin);
+            v["recommended_k_c"] = json!(k * (1.0 - margin));
         }
         None => {
             let what = ("stiffness", "m/(N s)", design::K_RANGE, "N/m");
@@ -658,10 +689,23 @@ fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
         s.header("Impedance");
         match r {
             Some((k, b)) if a.b.is_some() => {
-                println!("  greatest k_c at b_c = {b} N s/m: {k:.0} N/m")
+                println!(
+                    "  greatest k_c at b_c = {b} N s/m: {} N/m (the boundary)",
+                    stiffness_text(k)
+                )
             }
-            Some((k, b)) => println!("  best coupling: k_c = {k:.0} N/m, b_c = {b:.1} N s/m"),
+            Some((k, b)) => println!(
+                "  best coupling: k_c = {} N/m, b_c = {b:.1} N s/m (the boundary)",
+                stiffness_text(k)
+            ),
             None => println!("  infeasible: {}", v["message"].as_str().unwrap_or("")),
+        }
+        if let Some((k, _)) = r {
+            println!(
+                "  recommended: k_c = {} N/m, {:.0}% below the boundary",
+                stiffness_text(k * (1.0 - margin)),
+                100.0 * margin
+            );
         }
         if let Some(t) = binding_pose_text(&v) {
             println!("{t}");
@@ -703,6 +747,7 @@ fn no_force_sensor(model: &DeviceModel) -> String {
 }
 
 fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
+    let margin = margin(a.margin)?;
     let s = Session::open(&a.common)?;
     s.force_sensor()?;
     let (kp, bp) = match (a.kp, a.bp) {
@@ -734,6 +779,8 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
                 design::check_admittance(&p.plant, &p.analysis, (kp, bp), (m, b), s.human)
             });
             binding_pose(&mut v, &s, c);
+            v["margin"] = json!(margin);
+            v["recommended_m_c"] = json!(m / (1.0 - margin));
         }
         None if radius >= 1.0 => {
             v["message"] = json!(format!(
@@ -751,9 +798,24 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
             "  position regulator K_p = {kp:.0} + {bp:.1} (1 - 1/z)/T (pole radius {radius:.4})"
         );
         match r {
-            Some((m, b)) if a.b.is_some() => println!("  least m_c at b_c = {b} N s/m: {m:.3} kg"),
-            Some((m, b)) => println!("  best coupling: m_c = {m:.3} kg, b_c = {b:.1} N s/m"),
+            Some((m, b)) if a.b.is_some() => {
+                println!(
+                    "  least m_c at b_c = {b} N s/m: {} kg (the boundary)",
+                    mass_text(m)
+                )
+            }
+            Some((m, b)) => println!(
+                "  best coupling: m_c = {} kg, b_c = {b:.1} N s/m (the boundary)",
+                mass_text(m)
+            ),
             None => println!("  infeasible: {}", v["message"].as_str().unwrap_or("")),
+        }
+        if let Some((m, _)) = r {
+            println!(
+                "  recommended: m_c = {} kg, {:.0}% above the boundary",
+                mass_text(m / (1.0 - margin)),
+                100.0 * margin
+            );
         }
         if let Some(t) = binding_pose_text(&v) {
             println!("{t}");
@@ -801,6 +863,22 @@ fn print_check(c: &design::Check) {
     }
 }
 
+/// The gain margin line of `check`: how far inside (or past) the boundary
+/// `boundary` at the same damping the gains are.
+fn print_gain_margin(margin: Option<f64>, boundary: Option<String>) {
+    match (margin, boundary) {
+        (Some(g), Some(b)) if g >= 0.0 => println!(
+            "  gain margin {:.2}%: the boundary at this damping is {b}",
+            100.0 * g
+        ),
+        (Some(g), Some(b)) => println!(
+            "  {:.2}% past the boundary at this damping, {b}",
+            -100.0 * g
+        ),
+        _ => println!("  nothing is proven at this damping"),
+    }
+}
+
 fn check(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
     match d {
         Display::Impedance(g) => {
@@ -816,10 +894,19 @@ fn check(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
             if s.poses.len() > 1 {
                 v["worst_pose"] = json!(pose);
             }
+            // How far below the boundary at this damping: 1 - k/k_max.
+            let boundary = impedance_design(&s, Some(b))?.map(|(k, _)| k);
+            let gain_margin = boundary.map(|kb| 1.0 - k / kb);
+            v["boundary_k_c"] = json!(boundary);
+            v["gain_margin"] = json!(gain_margin);
             s.emit(v, || {
                 s.header("Impedance");
                 println!("  coupling k_c = {k} N/m, b_c = {b} N s/m");
                 print_check(&c);
+                print_gain_margin(
+                    gain_margin,
+                    boundary.map(|k| format!("{} N/m", stiffness_text(k))),
+                );
             });
         }
         Display::Admittance(g) => {
@@ -839,11 +926,23 @@ fn check(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
                 v["worst_pose"] = json!(pose);
             }
             v["regulator_pole_radius"] = json!(c.regulator_pole_radius);
+            // How far above the boundary at this damping: 1 - m_min/m.
+            let k = design::regulator_tf(kp.0, kp.1, s.period()).map_err(|e| e.to_string())?;
+            let boundary = if s.regulated_pole_radius(&k) < 1.0 {
+                let bounds = s.admittance_bounds(&k, false);
+                design::min_mass_poses(&s.with(&bounds), mb.1)
+            } else {
+                None
+            };
+            let gain_margin = boundary.map(|m| 1.0 - m / mb.0);
+            v["boundary_m_c"] = json!(boundary);
+            v["gain_margin"] = json!(gain_margin);
             s.emit(v, || {
                 s.header("Admittance");
                 println!("  regulator k_p = {} N/m, b_p = {} N s/m; coupling m_c = {} kg, b_c = {} N s/m", kp.0, kp.1, mb.0, mb.1);
                 println!("  regulated device pole radius {:.4}", c.regulator_pole_radius);
                 print_check(&c);
+                print_gain_margin(gain_margin, boundary.map(|m| format!("{} kg", mass_text(m))));
             });
         }
     }
@@ -1047,9 +1146,10 @@ fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
         )
         .map_err(|e| format!("{}: {e}", p.model.name))?;
         evaluations += v.evaluations;
-        if worst.as_ref().is_none_or(|w| {
-            (v.unstable, v.spectral_radius) > (w.0.unstable, w.0.spectral_radius)
-        }) {
+        if worst
+            .as_ref()
+            .is_none_or(|w| (v.unstable, v.spectral_radius) > (w.0.unstable, w.0.spectral_radius))
+        {
             worst = Some((v, &p.model));
         }
     }

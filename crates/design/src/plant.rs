@@ -370,7 +370,11 @@ fn features(
     // projected out by L^T g_h = 0.
     if let (Some(nq), Some(l)) = (orthogonal_complement(&c_h), orthogonal_complement(&g_h)) {
         let lt = l.transpose();
-        continuous.extend(oscillating_poles(&(&lt * m * &nq), &(&lt * d * &nq), &(&lt * k * &nq)));
+        continuous.extend(oscillating_poles(
+            &(&lt * m * &nq),
+            &(&lt * d * &nq),
+            &(&lt * k * &nq),
+        ));
     }
     let mut out: Vec<Feature> = continuous
         .into_iter()
@@ -380,10 +384,15 @@ fn features(
             half_width: s.abs(),
         })
         .collect();
-    out.extend(discrete_poles.iter().filter(|l| l.im > 0.0).map(|l| Feature {
-        omega: l.im.atan2(l.re) / period_s,
-        half_width: (-l.norm().ln()).abs() / period_s,
-    }));
+    out.extend(
+        discrete_poles
+            .iter()
+            .filter(|l| l.im > 0.0)
+            .map(|l| Feature {
+                omega: l.im.atan2(l.re) / period_s,
+                half_width: (-l.norm().ln()).abs() / period_s,
+            }),
+    );
     out.retain(|f| f.omega > 0.0);
     out.sort_by(|x, y| x.omega.total_cmp(&y.omega));
     out

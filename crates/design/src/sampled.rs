@@ -187,7 +187,7 @@ fn with_peaks(
     for i in 1..n - 1 {
         let (l, c, r) = (values[i - 1], values[i], values[i + 1]);
         let dc_pair = (points[i].omega - 2.0 * w0).abs() <= 1e-9 * w0;
-        if !(c >= l && c >= r) || !c.is_finite() || dc_pair {
+        if !(c >= l && c >= r && c.is_finite()) || dc_pair {
             continue;
         }
         // Golden section for the greatest value on [ω_{i-1}, ω_{i+1}].

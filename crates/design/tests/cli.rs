@@ -250,10 +250,7 @@ fn several_poses_design_for_all() {
     );
     // The worst pose's limit, to the search's 1e-6.
     let want = ke.min(kt);
-    assert!(
-        (kb - want).abs() <= 2e-6 * want,
-        "{kb} vs {want}: {both}"
-    );
+    assert!((kb - want).abs() <= 2e-6 * want, "{kb} vs {want}: {both}");
     let binding = if ke < kt { "Excalibur" } else { "Two-mass" };
     assert!(
         both["binding_pose"].as_str().unwrap().starts_with(binding),
@@ -364,4 +361,55 @@ fn a_device_file_designs_every_axis_on_its_own_model() {
     ));
     assert!(e.contains("give that axis's --model"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `design` gives the boundary and a recommended gain a chosen margin
+/// inside it; `check` says how far inside (or past) the boundary given
+/// gains are, and the published texts round toward safety.
+#[test]
+fn design_recommends_a_margin_and_check_reports_it() {
+    let d = TWOPORT.json(&[
+        "design",
+        "impedance",
+        "--b",
+        "90",
+        "--margin",
+        "0.2",
+        "--json",
+    ]);
+    let (k, rec) = (
+        d["k_c"].as_f64().unwrap(),
+        d["recommended_k_c"].as_f64().unwrap(),
+    );
+    assert!((rec - 0.8 * k).abs() <= 1e-9 * k, "{d}");
+    let check = |k: f64| {
+        TWOPORT.json(&[
+            "check",
+            "impedance",
+            "--k",
+            &k.to_string(),
+            "--b",
+            "90",
+            "--json",
+        ])
+    };
+    let inside = check(rec);
+    assert_eq!(inside["absolutely_stable"], true, "{inside}");
+    let g = inside["gain_margin"].as_f64().unwrap();
+    assert!((g - 0.2).abs() < 1e-5, "{inside}");
+    let past = check(1.01 * k);
+    assert_eq!(past["absolutely_stable"], false, "{past}");
+    assert!(past["gain_margin"].as_f64().unwrap() < 0.0, "{past}");
+    // The text's boundary, rounded down, is itself proven.
+    let out = TWOPORT.run(&["design", "impedance", "--b", "90"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    let shown: f64 = text
+        .split("b_c = 90 N s/m: ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(shown <= k && shown > k - 1.0, "{shown} vs {k}");
+    let e = TWOPORT.failure(&["design", "impedance", "--margin", "2"]);
+    assert!(e.contains("--margin 2"), "{e}");
 }
