@@ -40,7 +40,7 @@ impl GridSpec {
         f_min_hz: 0.05,
         base_points: 1500,
         points_per_mode: 300,
-        points_per_decade: 12,
+        points_per_decade: 24,
     };
 
     /// This grid started at `f_min_hz` instead, with the same density.

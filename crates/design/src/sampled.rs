@@ -150,72 +150,13 @@ pub fn impedance_bound(
     points: &[PlantPoint],
     human: Option<HumanBound>,
 ) -> Vec<f64> {
-    let at = |p: &PlantPoint| {
-        let paper = design_bound(&impedance_display(p, human));
-        paper + impedance_alias_terms(plant, p, human, paper)
-    };
-    with_peaks(plant, points, points.iter().map(at).collect(), at)
-}
-
-/// `values` (a bound at each of `points`) with each interior local maximum
-/// raised to the bound's greatest value between its neighbours, found by
-/// golden section on `at`: a peak that falls between two grid points is
-/// then checked at the grid point beside it, where the coupling's term
-/// (smooth on the grid's scale) is all but the same. The lowest point and
-/// the next octave's, which the limit toward DC is taken from, are left as
-/// they are.
-fn with_peaks(
-    plant: &Plant,
-    points: &[PlantPoint],
-    mut values: Vec<f64>,
-    at: impl Fn(&PlantPoint) -> f64,
-) -> Vec<f64> {
-    let n = points.len();
-    if n < 3 {
-        return values;
-    }
-    let w0 = points[0].omega;
-    let mut work = plant.scratch();
-    let mut eval = |w: f64| {
-        let v = at(&plant.at(w, &mut work));
-        if v.is_nan() {
-            f64::INFINITY
-        } else {
-            v
-        }
-    };
-    for i in 1..n - 1 {
-        let (l, c, r) = (values[i - 1], values[i], values[i + 1]);
-        let dc_pair = (points[i].omega - 2.0 * w0).abs() <= 1e-9 * w0;
-        if !(c >= l && c >= r && c.is_finite()) || dc_pair {
-            continue;
-        }
-        // Golden section for the greatest value on [ω_{i-1}, ω_{i+1}].
-        let g = 0.5 * (5f64.sqrt() - 1.0);
-        let (mut a, mut b) = (points[i - 1].omega, points[i + 1].omega);
-        let (mut x1, mut x2) = (b - g * (b - a), a + g * (b - a));
-        let (mut f1, mut f2) = (eval(x1), eval(x2));
-        let mut best = c.max(f1).max(f2);
-        for _ in 0..40 {
-            if b - a <= 1e-12 * b {
-                break;
-            }
-            if f1 >= f2 {
-                b = x2;
-                (x2, f2) = (x1, f1);
-                x1 = b - g * (b - a);
-                f1 = eval(x1);
-            } else {
-                a = x1;
-                (x1, f1) = (x2, f2);
-                x2 = a + g * (b - a);
-                f2 = eval(x2);
-            }
-            best = best.max(f1).max(f2);
-        }
-        values[i] = best;
-    }
-    values
+    points
+        .iter()
+        .map(|p| {
+            let paper = design_bound(&impedance_display(p, human));
+            paper + impedance_alias_terms(plant, p, human, paper)
+        })
+        .collect()
 }
 
 /// The admittance-display bound on `Re Z_cA` at each point for the
@@ -227,11 +168,13 @@ pub fn admittance_bound(
     kp: &ZTransfer,
     human: Option<HumanBound>,
 ) -> Vec<f64> {
-    let at = |p: &PlantPoint| match admittance_alias_reach(plant, p, human) {
-        Some(reach) => admittance_point(p, reach, kp, human),
-        None => f64::INFINITY,
-    };
-    with_peaks(plant, points, points.iter().map(at).collect(), at)
+    points
+        .iter()
+        .map(|p| match admittance_alias_reach(plant, p, human) {
+            Some(reach) => admittance_point(p, reach, kp, human),
+            None => f64::INFINITY,
+        })
+        .collect()
 }
 
 /// `Σ |α_k| |w_k| / |1 - z^-1|` and `Σ |φ_k| |w_k| / |1 - z^-1|` over the
