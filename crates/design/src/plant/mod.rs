@@ -2,6 +2,10 @@
 //! complex LU, and the ZOH-exact discrete `X_aa^d(z)`, `F_ma^d(z)` from the
 //! matrix exponential of the block matrix (docs/two-port.md, sampled terms).
 
+mod features;
+
+pub use features::Feature;
+
 use crate::linalg::{balance, expm_balanced, hessenberg_shift_solve, lu_solve};
 use crate::DeviceModel;
 use nalgebra::{Cholesky, DMatrix};
@@ -206,17 +210,6 @@ pub struct Mode {
     pub zeta: f64,
 }
 
-/// A narrow feature of the design inequality's terms, folded into the base
-/// band: a pole of one of them, where the term can change by its whole size
-/// within a few half-widths.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Feature {
-    /// Where it sits in the base band (rad/s, in `(0, π/T]`).
-    pub omega: f64,
-    /// Its half-power half-width (rad/s): the pole's decay rate.
-    pub half_width: f64,
-}
-
 /// The device prepared for analysis at one sample period.
 #[derive(Clone, Debug)]
 pub struct Plant {
@@ -289,115 +282,6 @@ pub(crate) fn zoh(
     ))
 }
 
-/// `ω` (rad/s) folded into the base band `[0, π/T]` as sampling folds it.
-fn fold(omega: f64, period_s: f64) -> f64 {
-    let ws = 2.0 * std::f64::consts::PI / period_s;
-    let r = omega.rem_euclid(ws);
-    r.min(ws - r)
-}
-
-/// The oscillating poles (`Im λ > 0`) of `M q'' + D q' + K q = 0`, where
-/// `M` is invertible: `(ω_d, σ)`, `λ = -σ + jω_d`.
-fn oscillating_poles(m: &DMatrix<f64>, d: &DMatrix<f64>, k: &DMatrix<f64>) -> Vec<(f64, f64)> {
-    let n = m.nrows();
-    let Some(lu) = m.clone().lu().try_inverse() else {
-        return Vec::new();
-    };
-    let (minv_k, minv_d) = (&lu * k, &lu * d);
-    let mut a = DMatrix::<f64>::zeros(2 * n, 2 * n);
-    for i in 0..n {
-        a[(i, n + i)] = 1.0;
-        for j in 0..n {
-            a[(n + i, j)] = -minv_k[(i, j)];
-            a[(n + i, n + j)] = -minv_d[(i, j)];
-        }
-    }
-    if !a.iter().all(|x| x.is_finite()) {
-        return Vec::new();
-    }
-    a.complex_eigenvalues()
-        .iter()
-        .filter(|l| l.im > 0.0)
-        .map(|l| (l.im, -l.re))
-        .collect()
-}
-
-/// A basis (as columns) of the vectors orthogonal to `v`.
-fn orthogonal_complement(v: &[f64]) -> Option<DMatrix<f64>> {
-    let n = v.len();
-    let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-    if n < 2 || norm == 0.0 {
-        return None;
-    }
-    // Householder: H = I - 2 u u^T maps v to ±|v| e_p; its other columns
-    // span v's complement.
-    let p = (0..n).max_by(|&i, &j| v[i].abs().total_cmp(&v[j].abs()))?;
-    let mut u: Vec<f64> = v.iter().map(|x| x / norm).collect();
-    u[p] += u[p].signum();
-    let un = u.iter().map(|x| x * x).sum::<f64>().sqrt();
-    u.iter_mut().for_each(|x| *x /= un);
-    let h = DMatrix::from_fn(n, n, |i, j| f64::from(u8::from(i == j)) - 2.0 * u[i] * u[j]);
-    let cols: Vec<usize> = (0..n).filter(|&j| j != p).collect();
-    Some(h.select_columns(&cols))
-}
-
-/// The features of [`Plant::features`].
-fn features(
-    model: &DeviceModel,
-    a_q: &DMatrix<f64>,
-    discrete_poles: &[Complex64],
-    period_s: f64,
-) -> Vec<Feature> {
-    let mut continuous: Vec<(f64, f64)> = a_q
-        .complex_eigenvalues()
-        .iter()
-        .filter(|l| l.im > 0.0)
-        .map(|l| (l.im, -l.re))
-        .collect();
-    let (m, d, k) = (&model.m, &model.d, &model.k);
-    let c_h: Vec<f64> = model.c_v.row(0).iter().copied().collect();
-    let g_h: Vec<f64> = model.g.column(0).iter().copied().collect();
-    // Held by the paper's stiffest grasp: f_h = -(b v_h + k x_h) through
-    // the handle's force column.
-    let grasp = crate::twoport::HumanBound::PAPER;
-    let gc = DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| g_h[i] * c_h[j]);
-    continuous.extend(oscillating_poles(
-        m,
-        &(d + &gc * grasp.damping_nspm),
-        &(k + &gc * grasp.stiffness_npm),
-    ));
-    // Held still: q = N r with c_h^T N = 0, the constraint force along g_h
-    // projected out by L^T g_h = 0.
-    if let (Some(nq), Some(l)) = (orthogonal_complement(&c_h), orthogonal_complement(&g_h)) {
-        let lt = l.transpose();
-        continuous.extend(oscillating_poles(
-            &(&lt * m * &nq),
-            &(&lt * d * &nq),
-            &(&lt * k * &nq),
-        ));
-    }
-    let mut out: Vec<Feature> = continuous
-        .into_iter()
-        .filter(|(w, s)| w.is_finite() && s.is_finite())
-        .map(|(w, s)| Feature {
-            omega: fold(w, period_s),
-            half_width: s.abs(),
-        })
-        .collect();
-    out.extend(
-        discrete_poles
-            .iter()
-            .filter(|l| l.im > 0.0)
-            .map(|l| Feature {
-                omega: l.im.atan2(l.re) / period_s,
-                half_width: (-l.norm().ln()).abs() / period_s,
-            }),
-    );
-    out.retain(|f| f.omega > 0.0);
-    out.sort_by(|x, y| x.omega.total_cmp(&y.omega));
-    out
-}
-
 fn row_major(a: &DMatrix<f64>) -> Vec<f64> {
     let mut v = Vec::with_capacity(a.len());
     for r in 0..a.nrows() {
@@ -454,8 +338,8 @@ impl Plant {
         let fma = Siso::new(ad.clone(), bd_act, c_fm);
 
         let a_q = a.view((0, 0), (2 * n, 2 * n)).into_owned();
-        let mut modes: Vec<Mode> = a_q
-            .complex_eigenvalues()
+        let free_poles = a_q.complex_eigenvalues();
+        let mut modes: Vec<Mode> = free_poles
             .iter()
             .filter(|l| l.im > 0.0)
             .map(|l| Mode {
@@ -470,7 +354,12 @@ impl Plant {
             .map(|l| l.im.atan2(l.re).abs())
             .filter(|t| *t > 0.0)
             .collect();
-        let features = features(model, &a_q, discrete_poles.as_slice(), period_s);
+        let features = features::of(
+            model,
+            free_poles.as_slice(),
+            discrete_poles.as_slice(),
+            period_s,
+        );
         let mut c_out = DMatrix::<f64>::zeros(3, na);
         for j in 0..n {
             c_out[(0, n + j)] = model.c_v[(0, j)];
@@ -733,7 +622,7 @@ mod tests {
 
     fn excalibur() -> Plant {
         let m =
-            DeviceModel::from_toml(include_str!("../../../models/excalibur.toml"), "x").unwrap();
+            DeviceModel::from_toml(include_str!("../../../../models/excalibur.toml"), "x").unwrap();
         Plant::new(&m, 1e-3).unwrap()
     }
 
