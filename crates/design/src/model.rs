@@ -316,6 +316,20 @@ pub(crate) fn rigid_for_tests(m: f64, b: f64) -> DeviceModel {
     .expect("a valid rigid model")
 }
 
+/// The shipped one-axis models (`models/*.toml`), for the design crate's
+/// unit tests that must hold on every device the project ships.
+#[cfg(test)]
+pub(crate) fn shipped_for_tests() -> Vec<DeviceModel> {
+    [
+        include_str!("../../../models/excalibur.toml"),
+        include_str!("../../../models/capstan.toml"),
+        include_str!("../../../models/two_mass.toml"),
+    ]
+    .into_iter()
+    .map(|text| DeviceModel::from_toml(text, "shipped model").expect("a shipped model is valid"))
+    .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -300,12 +300,7 @@ mod tests {
     /// `|F_mh Y_ha| ω/R` never exceed their value where the sums may stop.
     #[test]
     fn tail_ratios_do_not_grow_past_the_alias_count() {
-        for text in [
-            include_str!("../../../models/excalibur.toml"),
-            include_str!("../../../models/capstan.toml"),
-            include_str!("../../../models/two_mass.toml"),
-        ] {
-            let model = DeviceModel::from_toml(text, "model").unwrap();
+        for model in crate::model::shipped_for_tests() {
             let plant = Plant::new(&model, 1e-3).unwrap();
             let ws = 2.0 * PI / plant.period_s();
             let start = (alias_count(&plant) as f64 - 0.5) * ws;

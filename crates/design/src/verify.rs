@@ -730,12 +730,7 @@ mod tests {
     /// sides of its designs.
     #[test]
     fn oscillating_radii_are_accurate_far_below_the_margin() {
-        for text in [
-            include_str!("../../../models/excalibur.toml"),
-            include_str!("../../../models/capstan.toml"),
-            include_str!("../../../models/two_mass.toml"),
-        ] {
-            let model = DeviceModel::from_toml(text, "model").unwrap();
+        for model in crate::model::shipped_for_tests() {
             for (k, hand_hz, ve) in [
                 (20_000.0, 80.0, Ve::Constraint),
                 (60_000.0, 500.0, Ve::Cursor { mass_kg: 0.1 }),
