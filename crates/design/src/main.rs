@@ -588,6 +588,25 @@ fn impedance_design_on(
     })
 }
 
+/// The admittance design on `bounds` for a regulator whose regulated
+/// device has pole radius `radius`: none where that is unstable.
+fn admittance_design_on(
+    s: &Session,
+    bounds: &[Vec<f64>],
+    radius: f64,
+    b: Option<f64>,
+) -> Result<Option<(f64, f64)>, String> {
+    let poses = s.with(bounds);
+    Ok(if radius >= 1.0 {
+        None
+    } else {
+        match b {
+            Some(b) => design::min_mass_poses(&poses, gain("b", b)?).map(|m| (m, b)),
+            None => design::best_admittance_poses(&poses),
+        }
+    })
+}
+
 fn impedance_design(s: &Session, b: Option<f64>) -> Result<Option<(f64, f64)>, String> {
     impedance_design_on(s, &s.impedance_bounds(false), b)
 }
@@ -757,19 +776,8 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
     };
     let k = design::regulator_tf(kp, bp, s.period()).map_err(|e| e.to_string())?;
     let radius = s.regulated_pole_radius(&k);
-    let design_on = |bounds: &[Vec<f64>]| -> Result<Option<(f64, f64)>, String> {
-        let poses = s.with(bounds);
-        Ok(if radius >= 1.0 {
-            None
-        } else {
-            match a.b {
-                Some(b) => design::min_mass_poses(&poses, gain("b", b)?).map(|m| (m, b)),
-                None => design::best_admittance_poses(&poses),
-            }
-        })
-    };
-    let r = design_on(&s.admittance_bounds(&k, false))?;
-    let paper = design_on(&s.admittance_bounds(&k, true))?;
+    let r = admittance_design_on(&s, &s.admittance_bounds(&k, false), radius, a.b)?;
+    let paper = admittance_design_on(&s, &s.admittance_bounds(&k, true), radius, a.b)?;
     let mut v = json!({"display": "admittance", "feasible": r.is_some(), "kp": kp, "bp": bp,
         "period_s": s.period(), "human_model": s.human.is_some(), "regulator_pole_radius": radius});
     designs(&mut v, "m_c", r, paper, false);
@@ -928,12 +936,9 @@ fn check(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
             v["regulator_pole_radius"] = json!(c.regulator_pole_radius);
             // How far above the boundary at this damping: 1 - m_min/m.
             let k = design::regulator_tf(kp.0, kp.1, s.period()).map_err(|e| e.to_string())?;
-            let boundary = if s.regulated_pole_radius(&k) < 1.0 {
-                let bounds = s.admittance_bounds(&k, false);
-                design::min_mass_poses(&s.with(&bounds), mb.1)
-            } else {
-                None
-            };
+            let bounds = s.admittance_bounds(&k, false);
+            let boundary = admittance_design_on(&s, &bounds, c.regulator_pole_radius, Some(mb.1))?
+                .map(|(m, _)| m);
             let gain_margin = boundary.map(|m| 1.0 - m / mb.0);
             v["boundary_m_c"] = json!(boundary);
             v["gain_margin"] = json!(gain_margin);
