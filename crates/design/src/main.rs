@@ -559,14 +559,59 @@ fn margin(v: f64) -> Result<f64, String> {
         .ok_or_else(|| format!("--margin {v}: must be a fraction from 0 to 0.9"))
 }
 
-/// A stiffness (N/m) as published: rounded down, never past its proof.
-fn stiffness_text(k: f64) -> String {
-    format!("{:.0}", k.floor())
+/// What a design limits: the impedance display's coupling stiffness (more
+/// is bolder) or the admittance display's coupling mass (less is).
+#[derive(Clone, Copy)]
+enum Limit {
+    Stiffness,
+    Mass,
 }
 
-/// A mass (kg) as published: rounded up to the gram, never past its proof.
-fn mass_text(m: f64) -> String {
-    format!("{:.3}", (m * 1e3).ceil() / 1e3)
+impl Limit {
+    /// `x` as published, with its unit: a stiffness rounded down (N/m), a
+    /// mass up to the gram (kg), never past its proof.
+    fn text(self, x: f64) -> String {
+        match self {
+            Limit::Stiffness => format!("{:.0} N/m", x.floor()),
+            Limit::Mass => format!("{:.3} kg", (x * 1e3).ceil() / 1e3),
+        }
+    }
+
+    /// The gain `margin` (a fraction) inside the boundary `x`.
+    fn inside(self, x: f64, margin: f64) -> f64 {
+        match self {
+            Limit::Stiffness => x * (1.0 - margin),
+            Limit::Mass => x / (1.0 - margin),
+        }
+    }
+}
+
+/// The text lines of a design `r` (limit, damping): the boundary, at the
+/// asked damping (`fixed_b`) or the best pair, and the recommended gain
+/// `margin` inside it; `v`'s message where there is none.
+fn print_design(limit: Limit, r: Option<(f64, f64)>, fixed_b: bool, margin: f64, v: &Value) {
+    let (name, most, side) = match limit {
+        Limit::Stiffness => ("k_c", "greatest", "below"),
+        Limit::Mass => ("m_c", "least", "above"),
+    };
+    match r {
+        Some((x, b)) if fixed_b => println!(
+            "  {most} {name} at b_c = {b} N s/m: {} (the boundary)",
+            limit.text(x)
+        ),
+        Some((x, b)) => println!(
+            "  best coupling: {name} = {}, b_c = {b:.1} N s/m (the boundary)",
+            limit.text(x)
+        ),
+        None => println!("  infeasible: {}", v["message"].as_str().unwrap_or("")),
+    }
+    if let Some((x, _)) = r {
+        println!(
+            "  recommended: {name} = {}, {:.0}% {side} the boundary",
+            limit.text(limit.inside(x, margin)),
+            100.0 * margin
+        );
+    }
 }
 
 /// Check gains for sign and finiteness before any analysis.
@@ -697,7 +742,7 @@ fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
             let c = s.worst_check(|p| design::check_impedance(&p.analysis, k, b, s.human));
             binding_pose(&mut v, &s, c);
             v["margin"] = json!(margin);
-            v["recommended_k_c"] = json!(k * (1.0 - margin));
+            v["recommended_k_c"] = json!(Limit::Stiffness.inside(k, margin));
         }
         None => {
             let what = ("stiffness", "m/(N s)", design::K_RANGE, "N/m");
@@ -706,26 +751,7 @@ fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
     }
     s.emit(v.clone(), || {
         s.header("Impedance");
-        match r {
-            Some((k, b)) if a.b.is_some() => {
-                println!(
-                    "  greatest k_c at b_c = {b} N s/m: {} N/m (the boundary)",
-                    stiffness_text(k)
-                )
-            }
-            Some((k, b)) => println!(
-                "  best coupling: k_c = {} N/m, b_c = {b:.1} N s/m (the boundary)",
-                stiffness_text(k)
-            ),
-            None => println!("  infeasible: {}", v["message"].as_str().unwrap_or("")),
-        }
-        if let Some((k, _)) = r {
-            println!(
-                "  recommended: k_c = {} N/m, {:.0}% below the boundary",
-                stiffness_text(k * (1.0 - margin)),
-                100.0 * margin
-            );
-        }
+        print_design(Limit::Stiffness, r, a.b.is_some(), margin, &v);
         if let Some(t) = binding_pose_text(&v) {
             println!("{t}");
         }
@@ -788,7 +814,7 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
             });
             binding_pose(&mut v, &s, c);
             v["margin"] = json!(margin);
-            v["recommended_m_c"] = json!(m / (1.0 - margin));
+            v["recommended_m_c"] = json!(Limit::Mass.inside(m, margin));
         }
         None if radius >= 1.0 => {
             v["message"] = json!(format!(
@@ -805,26 +831,7 @@ fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
         println!(
             "  position regulator K_p = {kp:.0} + {bp:.1} (1 - 1/z)/T (pole radius {radius:.4})"
         );
-        match r {
-            Some((m, b)) if a.b.is_some() => {
-                println!(
-                    "  least m_c at b_c = {b} N s/m: {} kg (the boundary)",
-                    mass_text(m)
-                )
-            }
-            Some((m, b)) => println!(
-                "  best coupling: m_c = {} kg, b_c = {b:.1} N s/m (the boundary)",
-                mass_text(m)
-            ),
-            None => println!("  infeasible: {}", v["message"].as_str().unwrap_or("")),
-        }
-        if let Some((m, _)) = r {
-            println!(
-                "  recommended: m_c = {} kg, {:.0}% above the boundary",
-                mass_text(m / (1.0 - margin)),
-                100.0 * margin
-            );
-        }
+        print_design(Limit::Mass, r, a.b.is_some(), margin, &v);
         if let Some(t) = binding_pose_text(&v) {
             println!("{t}");
         }
@@ -911,10 +918,7 @@ fn check(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
                 s.header("Impedance");
                 println!("  coupling k_c = {k} N/m, b_c = {b} N s/m");
                 print_check(&c);
-                print_gain_margin(
-                    gain_margin,
-                    boundary.map(|k| format!("{} N/m", stiffness_text(k))),
-                );
+                print_gain_margin(gain_margin, boundary.map(|k| Limit::Stiffness.text(k)));
             });
         }
         Display::Admittance(g) => {
@@ -947,7 +951,7 @@ fn check(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
                 println!("  regulator k_p = {} N/m, b_p = {} N s/m; coupling m_c = {} kg, b_c = {} N s/m", kp.0, kp.1, mb.0, mb.1);
                 println!("  regulated device pole radius {:.4}", c.regulator_pole_radius);
                 print_check(&c);
-                print_gain_margin(gain_margin, boundary.map(|m| format!("{} kg", mass_text(m))));
+                print_gain_margin(gain_margin, boundary.map(|m| Limit::Mass.text(m)));
             });
         }
     }
