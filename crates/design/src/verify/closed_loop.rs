@@ -1,0 +1,250 @@
+//! The exact discrete closed loop of one termination: the device and hand
+//! under the zero-order hold, the control crate's laws on the sampled
+//! signals, and the VE; its transition matrix and what its eigenvalues say.
+
+use super::{Gains, Hand, Radius, Termination, Ve, OSCILLATING_MARGIN, UNSTABLE_MARGIN};
+use crate::design::{admittance_coupling_tf, impedance_coupling_tf, regulator_tf};
+use crate::linalg::balance;
+use crate::plant::{augmented, zoh};
+use crate::rational::{add, delayed, from_tf, mul, realise, reduced, scale, Rational};
+use crate::DeviceModel;
+use nalgebra::DMatrix;
+use std::f64::consts::PI;
+use twoport_control::ve::{VeTransfer, VirtualEnvironment};
+use twoport_control::Position;
+
+impl Ve {
+    /// The VE's admittance `V/F` as `(num, den)`, from the board's own law.
+    fn admittance(&self, t: f64) -> Result<Rational, String> {
+        let p = Position::ZERO;
+        let t32 = t as f32;
+        let e = |e: twoport_control::ParamError| e.to_string();
+        let tf = match *self {
+            Ve::Constraint => return Ok((vec![0.0], vec![1.0])),
+            Ve::Cursor { mass_kg } => VirtualEnvironment::<f32>::tf(
+                &twoport_control::ve::CursorMass::new(mass_kg as f32, t32, p).map_err(e)?,
+            ),
+            Ve::Spring {
+                stiffness_npm: k,
+                damping_nspm: b,
+            } => VirtualEnvironment::<f32>::tf(
+                &twoport_control::ve::Spring::new(k as f32, b as f32, p, t32, p).map_err(e)?,
+            ),
+            Ve::TrapezoidalSpring {
+                stiffness_npm: k,
+                damping_nspm: b,
+            } => VirtualEnvironment::<f32>::tf(
+                &twoport_control::ve::TrapezoidalSpring::new(k as f32, b as f32, p, t32, p)
+                    .map_err(e)?,
+            ),
+        };
+        Ok(match tf {
+            VeTransfer::Admittance(y) => from_tf(&y),
+            VeTransfer::Impedance(z) => {
+                let (n, d) = from_tf(&z);
+                (d, n)
+            }
+        })
+    }
+}
+
+/// The device with the hand, discretised under the ZOH from the actuator
+/// force: `(A_d, b_d, c_xa, c_fm)` with outputs the actuator position `x_a`
+/// (m) and the measured force `f_m` (N).
+struct Sampled {
+    ad: DMatrix<f64>,
+    bd: Vec<f64>,
+    c_xa: Vec<f64>,
+    c_fm: Vec<f64>,
+}
+
+fn sampled(model: &DeviceModel, hand: &Hand, t: f64) -> Result<Sampled, String> {
+    let n = model.dof();
+    let grasp = hand.grasp;
+    let nq = n + usize::from(grasp.is_some());
+    let (mut m, mut d, mut k) = (
+        DMatrix::<f64>::zeros(nq, nq),
+        DMatrix::<f64>::zeros(nq, nq),
+        DMatrix::<f64>::zeros(nq, nq),
+    );
+    m.view_mut((0, 0), (n, n)).copy_from(&model.m);
+    d.view_mut((0, 0), (n, n)).copy_from(&model.d);
+    k.view_mut((0, 0), (n, n)).copy_from(&model.k);
+    // The hand acts through f_h's column of G on the handle x_h = C_v[0] q.
+    let gh: Vec<f64> = (0..n).map(|i| model.g[(i, 0)]).collect();
+    let ch: Vec<f64> = (0..n).map(|j| model.c_v[(0, j)]).collect();
+    let (hm, hk, hb) = (hand.mass_kg, hand.stiffness_npm, hand.damping_nspm);
+    match grasp {
+        None => {
+            for i in 0..n {
+                for j in 0..n {
+                    let gc = gh[i] * ch[j];
+                    m[(i, j)] += hm * gc;
+                    k[(i, j)] += hk * gc;
+                    d[(i, j)] += hb * gc;
+                }
+            }
+        }
+        Some(g) => {
+            let y = n;
+            let (kg, bg) = (g.stiffness_npm, g.damping_nspm);
+            m[(y, y)] = hm;
+            for (mat, c, ground) in [(&mut k, kg, hk), (&mut d, bg, hb)] {
+                for i in 0..n {
+                    for j in 0..n {
+                        mat[(i, j)] += c * gh[i] * ch[j];
+                    }
+                    mat[(i, y)] -= c * gh[i];
+                    mat[(y, i)] -= c * ch[i];
+                }
+                mat[(y, y)] += c + ground;
+            }
+        }
+    }
+    let minv = m
+        .clone()
+        .try_inverse()
+        .ok_or("the device with the hand has a singular mass matrix")?;
+    let mut ga = DMatrix::<f64>::zeros(nq, 1);
+    let mut c_f = DMatrix::<f64>::zeros(1, nq);
+    for i in 0..n {
+        ga[(i, 0)] = model.g[(i, 1)];
+        c_f[(0, i)] = model.c_f[(0, i)];
+    }
+    let (a, b) = augmented(
+        &(&minv * &k),
+        &(&minv * &d),
+        &(&minv * &ga),
+        &c_f,
+        model.load_cell_pole_rad_s,
+    );
+    let (ad, bd) = zoh(&a, &b, t)?;
+    let na = ad.nrows();
+    let bd = bd.column(0).iter().copied().collect();
+    let mut c_xa = vec![0.0; na];
+    for (j, c) in c_xa.iter_mut().take(n).enumerate() {
+        // C_v's second row gives -v_a.
+        *c = -model.c_v[(1, j)];
+    }
+    let mut c_fm = vec![0.0; na];
+    c_fm[2 * nq] = 1.0;
+    Ok(Sampled { ad, bd, c_xa, c_fm })
+}
+
+/// The controller as two SISO parts, `f_a = H_x(z) x_a + H_f(z) f_m`.
+fn controller(
+    gains: &Gains,
+    ve: &Ve,
+    t: f64,
+    delay: usize,
+) -> Result<(Rational, Rational), String> {
+    let e = |e: twoport_control::ParamError| e.to_string();
+    let (ny, dy) = ve.admittance(t)?;
+    Ok(match *gains {
+        Gains::Impedance { k_npm, b_nspm } => {
+            let (nc, dc) = from_tf(&impedance_coupling_tf(k_npm, b_nspm, t).map_err(e)?);
+            // f = Z_cI/(1 + Z_cI Y_e) v_c, v_c = (1 - z^-1)/T x_a.
+            let num = delayed(&scale(&mul(&mul(&nc, &dy), &[1.0, -1.0]), 1.0 / t), delay);
+            let den = add(&mul(&dc, &dy), &mul(&nc, &ny));
+            (reduced(num, den), (vec![0.0], vec![1.0]))
+        }
+        Gains::Admittance {
+            kp_npm,
+            bp_nspm,
+            m_kg,
+            b_nspm,
+        } => {
+            let (nk, dk) = from_tf(&regulator_tf(kp_npm, bp_nspm, t).map_err(e)?);
+            let (na, da) = from_tf(&admittance_coupling_tf(m_kg, b_nspm, t).map_err(e)?);
+            // v_c = f_m/(Z_cA + Z_e), x_d = T/(1 - z^-1) v_c,
+            // f_a = K_p (x_a - x_d).
+            let hx = (delayed(&nk, delay), dk.clone());
+            let num = delayed(&scale(&mul(&mul(&nk, &ny), &da), -t), delay);
+            let den = mul(
+                &mul(&dk, &[1.0, -1.0]),
+                &add(&mul(&dy, &da), &mul(&na, &ny)),
+            );
+            (hx, reduced(num, den))
+        }
+    })
+}
+
+/// The closed loop's one-tick transition matrix for one termination,
+/// balanced.
+pub(super) fn closed_loop(
+    model: &DeviceModel,
+    period_s: f64,
+    gains: &Gains,
+    term: &Termination,
+    delay_samples: usize,
+) -> Result<DMatrix<f64>, String> {
+    let plant = sampled(model, &term.hand, period_s)?;
+    let ((nx, dx), (nf, df)) = controller(gains, &term.ve, period_s, delay_samples)?;
+    let (hx, hf) = (realise(&nx, &dx)?, realise(&nf, &df)?);
+    let np = plant.ad.nrows();
+    let (n1, n2) = (hx.a.nrows(), hf.a.nrows());
+    let n = np + n1 + n2;
+    let mut a = DMatrix::<f64>::zeros(n, n);
+    // u = c1 s1 + c2 s2 + (d1 c_xa + d2 c_fm) x
+    let feed: Vec<f64> = (0..np)
+        .map(|j| hx.d * plant.c_xa[j] + hf.d * plant.c_fm[j])
+        .collect();
+    for i in 0..np {
+        for j in 0..np {
+            a[(i, j)] = plant.ad[(i, j)] + plant.bd[i] * feed[j];
+        }
+        for j in 0..n1 {
+            a[(i, np + j)] = plant.bd[i] * hx.c[j];
+        }
+        for j in 0..n2 {
+            a[(i, np + n1 + j)] = plant.bd[i] * hf.c[j];
+        }
+    }
+    for (off, h, c) in [(np, &hx, &plant.c_xa), (np + n1, &hf, &plant.c_fm)] {
+        let m = h.a.nrows();
+        for i in 0..m {
+            for j in 0..np {
+                a[(off + i, j)] = h.b[i] * c[j];
+            }
+            for j in 0..m {
+                a[(off + i, off + j)] = h.a[(i, j)];
+            }
+        }
+    }
+    if a.iter().any(|v| !v.is_finite()) {
+        return Err("the closed loop is not finite".into());
+    }
+    // Balanced first: a light hand's node and the load-cell filter make the
+    // entries span many orders of magnitude, which costs the eigenvalues
+    // near z = 1 (free motion) digits enough to push them past 1.
+    let d = balance(&a);
+    Ok(DMatrix::from_fn(n, n, |i, j| a[(i, j)] * d[j] / d[i]))
+}
+
+/// The radius, and whether a mode grows, of the transition matrix `a`.
+pub(super) fn judge(a: &DMatrix<f64>, period_s: f64) -> Radius {
+    let (mut rho, mut arg, mut score) = (0.0, 0.0, 0.0f64);
+    let mut unstable = false;
+    let slow = 2.0 * PI * 0.1 * period_s;
+    for l in a.complex_eigenvalues().iter() {
+        let th = l.im.atan2(l.re).abs();
+        if l.norm() > rho {
+            (rho, arg) = (l.norm(), th);
+        }
+        if th > slow || l.norm() > 1.0 + UNSTABLE_MARGIN {
+            score = score.max(l.norm());
+        }
+        let margin = if th > slow {
+            OSCILLATING_MARGIN
+        } else {
+            UNSTABLE_MARGIN
+        };
+        unstable |= l.norm() > 1.0 + margin;
+    }
+    Radius {
+        spectral_radius: rho,
+        frequency_hz: arg / (2.0 * PI * period_s),
+        score,
+        unstable,
+    }
+}

@@ -1,0 +1,289 @@
+//! A counterexample search on the exact sampled-data loop, independent of
+//! the two-port analysis that proves a design.
+//!
+//! For one termination — a passive lumped hand at the handle and one of the
+//! board's passive VEs — the whole interface is a linear discrete system:
+//! the device and the hand, continuous, discretised exactly under the
+//! zero-order hold; the control crate's own laws (their z-forms) on the
+//! sampled encoder and load-cell signals. It is stable iff the spectral
+//! radius of its one-tick transition matrix is below 1. [`verify`]
+//! maximises that radius over the terminations' parameters: a sweep of
+//! hand resonances from 1 Hz to well past Nyquist and of VE stiffnesses and
+//! masses, then Nelder-Mead from the worst starts, in log space. It proves
+//! nothing when it finds nothing; what it finds is a real instability.
+
+use crate::twoport::HumanBound;
+use crate::DeviceModel;
+use serde::Serialize;
+
+/// The gains under test (SI: N/m, N s/m, kg).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Gains {
+    /// Impedance display: coupling `Z_cI = b + kTz/(z - 1)`.
+    Impedance {
+        /// Coupling stiffness (N/m).
+        k_npm: f64,
+        /// Coupling damping (N s/m).
+        b_nspm: f64,
+    },
+    /// Admittance display: regulator `K_p`, coupling mass and damper.
+    Admittance {
+        /// Regulator stiffness (N/m).
+        kp_npm: f64,
+        /// Regulator damping (N s/m).
+        bp_nspm: f64,
+        /// Coupling mass (kg).
+        m_kg: f64,
+        /// Coupling damping (N s/m).
+        b_nspm: f64,
+    },
+}
+
+/// One of the board's passive VEs.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Ve {
+    /// The bilateral constraint (`v_e = 0`).
+    Constraint,
+    /// A free cursor mass (backward Euler).
+    Cursor {
+        /// Mass (kg).
+        mass_kg: f64,
+    },
+    /// A spring-damper to an anchor (backward Euler).
+    Spring {
+        /// Stiffness (N/m).
+        stiffness_npm: f64,
+        /// Damping (N s/m).
+        damping_nspm: f64,
+    },
+    /// The lossless trapezoidal spring-damper.
+    TrapezoidalSpring {
+        /// Stiffness (N/m).
+        stiffness_npm: f64,
+        /// Damping (N s/m).
+        damping_nspm: f64,
+    },
+}
+
+/// A passive lumped hand: a mass with a spring and a damper from it to
+/// ground. Without a grasp the mass is held rigidly at the handle; with one
+/// (the paper's Fig. 3, when a human bound is set) it hangs from the handle
+/// through the bound's spring and damper, so the hand's impedance is the
+/// bound `Z_max` in series with the mass-spring-damper.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Hand {
+    /// Mass (kg).
+    pub mass_kg: f64,
+    /// Spring to ground (N/m).
+    pub stiffness_npm: f64,
+    /// Damper to ground (N s/m).
+    pub damping_nspm: f64,
+    /// The grasp in series, `Z_max = b + k/s`, or none.
+    pub grasp: Option<HumanBound>,
+}
+
+/// A hand and a VE.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Termination {
+    /// At the handle.
+    pub hand: Hand,
+    /// At the VE port.
+    pub ve: Ve,
+}
+
+/// The loop's one-tick growth for one termination.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Radius {
+    /// Spectral radius of the closed loop's transition matrix.
+    pub spectral_radius: f64,
+    /// The dominant eigenvalue's frequency, `|arg λ| / (2π T)` (Hz).
+    pub frequency_hz: f64,
+    /// The largest eigenvalue modulus among the oscillating modes (above
+    /// 0.1 Hz) and any mode outside the unit circle: what the search
+    /// climbs, since the slow real modes of free motion (within 1e-5 of
+    /// `z = 1` for a light cursor) would hide every resonance otherwise.
+    #[serde(skip)]
+    pub score: f64,
+    /// Whether a mode grows by more than its numerical error: an
+    /// oscillating mode past `1 + OSCILLATING_MARGIN`, a slow one past
+    /// `1 + UNSTABLE_MARGIN`.
+    pub unstable: bool,
+}
+
+impl Radius {
+    /// The dominant mode's growth rate `ln ρ / T` (1/s): positive grows
+    /// (by e in `1/rate` seconds), negative decays.
+    pub fn growth_per_s(&self, period_s: f64) -> f64 {
+        self.spectral_radius.ln() / period_s
+    }
+}
+
+/// What the search found.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Verdict {
+    /// Whether the worst termination makes the loop unstable: a mode grows
+    /// by more than its numerical error (see [`Radius::unstable`]).
+    pub unstable: bool,
+    /// The worst spectral radius found.
+    pub spectral_radius: f64,
+    /// Its growth rate `ln ρ / T` (1/s; negative decays).
+    pub growth_per_s: f64,
+    /// Its frequency (Hz).
+    pub frequency_hz: f64,
+    /// The termination that gave it.
+    pub termination: Termination,
+    /// Closed loops evaluated.
+    pub evaluations: usize,
+}
+
+/// A slow mode (below 0.1 Hz) this far above 1 counts as unstable: free
+/// translation (a cursor VE with no hand) leaves an eigenvalue at exactly
+/// 1, a double one with some VEs, which rounding splits by the square root
+/// of the working precision's error and may put a few 1e-9 above it.
+pub const UNSTABLE_MARGIN: f64 = 1e-6;
+
+/// An oscillating mode this far above 1 counts as unstable. The loop's
+/// transition matrix is balanced and its oscillating eigenvalues are
+/// simple, so their moduli carry errors of order `n ε ‖A‖ κ`, about 1e-13
+/// for these loops (measured: a radius computed from the matrix and from
+/// its transpose agree to 1e-12 on every shipped device); 1e-10 keeps a
+/// factor of 100 above that and still reports a mode that grows by e in
+/// 10^7 ticks (about 3 hours at 1 kHz).
+pub const OSCILLATING_MARGIN: f64 = 1e-10;
+
+mod closed_loop;
+mod search;
+
+use closed_loop::{closed_loop, judge};
+pub use search::verify;
+
+/// The closed loop's spectral radius for one termination.
+pub fn radius(
+    model: &DeviceModel,
+    period_s: f64,
+    gains: &Gains,
+    term: &Termination,
+    delay_samples: usize,
+) -> Result<Radius, String> {
+    let a = closed_loop(model, period_s, gains, term, delay_samples)?;
+    Ok(judge(&a, period_s))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::DMatrix;
+    use std::f64::consts::PI;
+
+    fn rigid() -> DeviceModel {
+        crate::model::rigid_for_tests(1.0, 20.0)
+    }
+
+    fn hands_off(ve: Ve) -> Termination {
+        Termination {
+            hand: Hand {
+                mass_kg: 0.0,
+                stiffness_npm: 0.0,
+                damping_nspm: 0.0,
+                grasp: None,
+            },
+            ve,
+        }
+    }
+
+    /// Colgate's virtual wall on a rigid device, hands off: the exact loop
+    /// `m x'' + b x' = -f`, `f = K x + B (1 - z^-1)/T x` under the ZOH has
+    /// the closed-form stability boundary `K* = (b²/m)(1 - e^-x)/(1 - (1 +
+    /// x) e^-x)`, `x = bT/m`, at `B = 0`; the radius crosses 1 there.
+    #[test]
+    fn rigid_wall_boundary_is_the_closed_form() {
+        let (m, b, t) = (1.0f64, 20.0f64, 1e-3f64);
+        let x = b * t / m;
+        let k_star = (b * b / m) * (1.0 - (-x).exp()) / (1.0 - (1.0 + x) * (-x).exp());
+        let rho = |k: f64| {
+            radius(
+                &rigid(),
+                t,
+                &Gains::Impedance {
+                    k_npm: k,
+                    b_nspm: 0.0,
+                },
+                &hands_off(Ve::Constraint),
+                0,
+            )
+            .unwrap()
+            .spectral_radius
+        };
+        assert!(rho(0.999 * k_star) < 1.0, "{}", rho(0.999 * k_star));
+        assert!(rho(1.001 * k_star) > 1.0, "{}", rho(1.001 * k_star));
+    }
+
+    /// The oscillating modes' numerical error is far below
+    /// [`OSCILLATING_MARGIN`]: the matrix and its transpose, whose
+    /// eigenvalues are the same but whose rounding is not, give radii that
+    /// agree to 1e-12, on every shipped device, for terminations on both
+    /// sides of its designs.
+    #[test]
+    fn oscillating_radii_are_accurate_far_below_the_margin() {
+        for model in crate::model::shipped_for_tests() {
+            for (k, hand_hz, ve) in [
+                (20_000.0, 80.0, Ve::Constraint),
+                (60_000.0, 500.0, Ve::Cursor { mass_kg: 0.1 }),
+                (
+                    40_000.0,
+                    30.0,
+                    Ve::TrapezoidalSpring {
+                        stiffness_npm: 1e5,
+                        damping_nspm: 0.01,
+                    },
+                ),
+            ] {
+                let w: f64 = 2.0 * PI * hand_hz;
+                let term = Termination {
+                    hand: Hand {
+                        mass_kg: 0.05,
+                        stiffness_npm: 0.05 * w * w,
+                        damping_nspm: 0.01,
+                        grasp: Some(HumanBound::PAPER),
+                    },
+                    ve,
+                };
+                let g = Gains::Impedance {
+                    k_npm: k,
+                    b_nspm: 20.0,
+                };
+                let a = closed_loop(&model, 1e-3, &g, &term, 0).unwrap();
+                let osc = |m: &DMatrix<f64>| {
+                    m.complex_eigenvalues()
+                        .iter()
+                        .filter(|l| l.im.abs() > 1e-3)
+                        .map(|l| l.norm())
+                        .fold(0.0, f64::max)
+                };
+                let (r, rt) = (osc(&a), osc(&a.transpose()));
+                assert!((r - rt).abs() < 1e-12, "{}: {r} vs {rt}", model.name);
+            }
+        }
+    }
+
+    /// The counterexample: at 40,000 N/m and 10 N s/m a passive
+    /// hand (a small mass on a stiff spring, resonant near Nyquist) makes the
+    /// rigid device unstable, though the paper's bound calls it proven.
+    #[test]
+    fn finds_the_rigid_counterexample() {
+        let v = verify(
+            &rigid(),
+            1e-3,
+            &Gains::Impedance {
+                k_npm: 40_000.0,
+                b_nspm: 10.0,
+            },
+            None,
+            0,
+        )
+        .unwrap();
+        assert!(v.unstable, "{v:?}");
+        assert!(v.frequency_hz > 300.0, "{v:?}");
+    }
+}

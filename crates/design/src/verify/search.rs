@@ -1,0 +1,276 @@
+//! The search for the termination that makes given gains least stable:
+//! a sweep of hands and VEs, then Nelder-Mead from the worst starts.
+
+use super::{radius, Gains, Hand, Radius, Termination, Ve, Verdict};
+use crate::twoport::HumanBound;
+use crate::DeviceModel;
+use nalgebra::DMatrix;
+use std::f64::consts::PI;
+
+/// Which VE family a search point belongs to, and its log10 parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum VeKind {
+    Constraint,
+    Cursor,
+    Spring,
+    Trapezoidal,
+}
+
+impl VeKind {
+    fn dims(self) -> usize {
+        match self {
+            VeKind::Constraint => 0,
+            VeKind::Cursor => 1,
+            VeKind::Spring | VeKind::Trapezoidal => 2,
+        }
+    }
+
+    fn build(self, p: &[f64]) -> Ve {
+        let x = |i: usize| 10f64.powf(p[i]);
+        match self {
+            VeKind::Constraint => Ve::Constraint,
+            VeKind::Cursor => Ve::Cursor { mass_kg: x(0) },
+            VeKind::Spring => Ve::Spring {
+                stiffness_npm: x(0),
+                damping_nspm: x(1),
+            },
+            VeKind::Trapezoidal => Ve::TrapezoidalSpring {
+                stiffness_npm: x(0),
+                damping_nspm: x(1),
+            },
+        }
+    }
+
+    /// log10 bounds of each parameter.
+    fn bounds(self) -> &'static [(f64, f64)] {
+        match self {
+            VeKind::Constraint => &[],
+            VeKind::Cursor => &[(-3.0, 3.0)],
+            VeKind::Spring | VeKind::Trapezoidal => &[(1.0, 9.0), (-4.0, 4.0)],
+        }
+    }
+}
+
+/// log10 bounds of the hand's mass (kg), stiffness (N/m), damping (N s/m).
+const HAND_BOUNDS: [(f64, f64); 3] = [(-4.0, 2.0), (-1.0, 10.0), (-4.0, 4.0)];
+
+struct Search<'a> {
+    model: &'a DeviceModel,
+    t: f64,
+    gains: Gains,
+    grasp: Option<HumanBound>,
+    delay: usize,
+    evaluations: usize,
+}
+
+impl Search<'_> {
+    fn termination(&self, kind: VeKind, p: &[f64]) -> Termination {
+        let x = |i: usize| 10f64.powf(p[i]);
+        Termination {
+            hand: Hand {
+                mass_kg: x(0),
+                stiffness_npm: x(1),
+                damping_nspm: x(2),
+                grasp: self.grasp,
+            },
+            ve: kind.build(&p[3..]),
+        }
+    }
+
+    /// The radius at `p` (clamped to the bounds); 0 where the loop cannot
+    /// be built (a VE the board would refuse).
+    fn eval(&mut self, kind: VeKind, p: &mut [f64]) -> Radius {
+        for (x, (lo, hi)) in p.iter_mut().zip(HAND_BOUNDS.iter().chain(kind.bounds())) {
+            *x = x.clamp(*lo, *hi);
+        }
+        self.evaluations += 1;
+        let term = self.termination(kind, p);
+        radius(self.model, self.t, &self.gains, &term, self.delay).unwrap_or(Radius {
+            spectral_radius: 0.0,
+            frequency_hz: 0.0,
+            score: 0.0,
+            unstable: false,
+        })
+    }
+
+    /// Nelder-Mead on `-radius` from `start`.
+    fn refine(&mut self, kind: VeKind, start: &[f64], iters: usize) -> (Vec<f64>, Radius) {
+        let dim = start.len();
+        let mut simplex: Vec<(Vec<f64>, Radius)> = Vec::with_capacity(dim + 1);
+        let mut s0 = start.to_vec();
+        let r0 = self.eval(kind, &mut s0);
+        simplex.push((s0, r0));
+        for i in 0..dim {
+            let mut p = start.to_vec();
+            p[i] += if i == 1 || i == 3 { 0.05 } else { 0.3 };
+            let r = self.eval(kind, &mut p);
+            simplex.push((p, r));
+        }
+        let key = |r: &Radius| -r.score;
+        for _ in 0..iters {
+            simplex.sort_by(|a, b| key(&a.1).total_cmp(&key(&b.1)));
+            let worst = simplex[dim].clone();
+            let centroid: Vec<f64> = (0..dim)
+                .map(|j| simplex[..dim].iter().map(|s| s.0[j]).sum::<f64>() / dim as f64)
+                .collect();
+            let at = |c: f64| -> Vec<f64> {
+                (0..dim)
+                    .map(|j| centroid[j] + c * (worst.0[j] - centroid[j]))
+                    .collect()
+            };
+            let mut xr = at(-1.0);
+            let rr = self.eval(kind, &mut xr);
+            if key(&rr) < key(&simplex[0].1) {
+                let mut xe = at(-2.0);
+                let re = self.eval(kind, &mut xe);
+                simplex[dim] = if key(&re) < key(&rr) {
+                    (xe, re)
+                } else {
+                    (xr, rr)
+                };
+            } else if key(&rr) < key(&simplex[dim - 1].1) {
+                simplex[dim] = (xr, rr);
+            } else {
+                let mut xc = at(0.5);
+                let rc = self.eval(kind, &mut xc);
+                if key(&rc) < key(&worst.1) {
+                    simplex[dim] = (xc, rc);
+                } else {
+                    let best = simplex[0].0.clone();
+                    for s in simplex.iter_mut().skip(1) {
+                        let mut p: Vec<f64> =
+                            s.0.iter().zip(&best).map(|(x, b)| 0.5 * (x + b)).collect();
+                        let r = self.eval(kind, &mut p);
+                        *s = (p, r);
+                    }
+                }
+            }
+        }
+        simplex.sort_by(|a, b| key(&a.1).total_cmp(&key(&b.1)));
+        simplex.swap_remove(0)
+    }
+}
+
+/// The device's inertia seen at the handle at `ω` (kg):
+/// `Im(1/Y_hh(jω))/ω`, 0 where it cannot be had.
+fn handle_inertia(model: &DeviceModel, w: f64) -> f64 {
+    use num_complex::Complex64;
+    let n = model.dof();
+    let s = Complex64::new(0.0, w);
+    let a = DMatrix::from_fn(n, n, |i, j| {
+        model.m[(i, j)] * s * s + model.d[(i, j)] * s + model.k[(i, j)]
+    });
+    let g = DMatrix::from_fn(n, 1, |i, _| Complex64::new(model.g[(i, 0)], 0.0));
+    let Some(x) = a.lu().solve(&g) else {
+        return 0.0;
+    };
+    let y: Complex64 = (0..n)
+        .map(|j| model.c_v[(0, j)] * x[(j, 0)])
+        .sum::<Complex64>()
+        * s;
+    let m = y.inv().im / w;
+    if m.is_finite() && m > 0.0 {
+        m
+    } else {
+        0.0
+    }
+}
+
+/// Search for the termination that makes `gains` least stable on
+/// `model` at `period_s`. With `human`, hands are the bound in series with
+/// a passive mass-spring-damper (the paper's Fig. 3); without, any passive
+/// mass-spring-damper held at the handle.
+pub fn verify(
+    model: &DeviceModel,
+    period_s: f64,
+    gains: &Gains,
+    human: Option<HumanBound>,
+    delay_samples: usize,
+) -> Result<Verdict, String> {
+    if !(period_s.is_finite() && period_s > 0.0) {
+        return Err(format!("period {period_s} s must be finite and > 0"));
+    }
+    let mut s = Search {
+        model,
+        t: period_s,
+        gains: *gains,
+        grasp: human,
+        delay: delay_samples,
+        evaluations: 0,
+    };
+    // Check the loop can be built at all (gains the board accepts).
+    let off = [-4.0, -1.0, -4.0];
+    radius(
+        model,
+        period_s,
+        gains,
+        &s.termination(VeKind::Constraint, &off),
+        delay_samples,
+    )?;
+    let nyq_hz = 0.5 / period_s;
+    let freqs: Vec<f64> = (0..24)
+        .map(|i| (4.0 * nyq_hz).powf(i as f64 / 23.0))
+        .collect();
+    let mut hands: Vec<[f64; 3]> = vec![off];
+    // Resonances across the band, and exactly at multiples of Nyquist,
+    // where the sampled poles of the hand's resonance meet on the real
+    // axis (the narrowest and worst hands): there the spring is tuned to
+    // the hand's mass plus the device's inertia at the handle.
+    let mut tuned: Vec<(f64, bool)> = freqs.iter().map(|f| (*f, false)).collect();
+    tuned.extend((1..=8).map(|j| (j as f64 * nyq_hz, true)));
+    for (f, exact) in tuned {
+        let w = 2.0 * PI * f;
+        let inertia = if exact && human.is_none() {
+            handle_inertia(model, w)
+        } else {
+            0.0
+        };
+        for m in [-3.0, -2.0, -1.0, 0.0] {
+            let k = (10f64.powf(m) + inertia) * w * w;
+            hands.push([m, k.log10(), -2.0]);
+        }
+    }
+    let mut ves: Vec<(VeKind, Vec<f64>)> = vec![(VeKind::Constraint, vec![])];
+    for m in [-2.0, -1.0, 0.0, 1.0] {
+        ves.push((VeKind::Cursor, vec![m]));
+    }
+    for i in 0..13 {
+        let k = 2.0 + 0.5 * i as f64;
+        ves.push((VeKind::Spring, vec![k, -2.0]));
+        ves.push((VeKind::Trapezoidal, vec![k, -2.0]));
+    }
+    let mut starts: Vec<(f64, VeKind, Vec<f64>)> = Vec::new();
+    for h in &hands {
+        for (kind, vp) in &ves {
+            let mut p: Vec<f64> = h.iter().chain(vp).copied().collect();
+            let r = s.eval(*kind, &mut p);
+            starts.push((r.score, *kind, p));
+        }
+    }
+    starts.sort_by(|a, b| b.0.total_cmp(&a.0));
+    // Refine the best starts of each VE family.
+    let mut best: Option<(VeKind, Vec<f64>, Radius)> = None;
+    for kind in [
+        VeKind::Constraint,
+        VeKind::Cursor,
+        VeKind::Spring,
+        VeKind::Trapezoidal,
+    ] {
+        for (_, _, p) in starts.iter().filter(|x| x.1 == kind).take(3) {
+            let (q, r) = s.refine(kind, p, 60 * (3 + kind.dims()));
+            let better = |b: &Radius| r.score > b.score || (r.unstable && !b.unstable);
+            if best.as_ref().is_none_or(|b| better(&b.2)) {
+                best = Some((kind, q, r));
+            }
+        }
+    }
+    let (kind, p, r) = best.ok_or("no termination could be built")?;
+    Ok(Verdict {
+        unstable: r.unstable,
+        growth_per_s: r.growth_per_s(period_s),
+        spectral_radius: r.spectral_radius,
+        frequency_hz: r.frequency_hz,
+        termination: s.termination(kind, &p),
+        evaluations: s.evaluations,
+    })
+}
