@@ -1,0 +1,327 @@
+//! The command line's arguments, the checks on them, and the run over a
+//! device file's axes.
+
+use clap::{Args, Subcommand, ValueEnum};
+use serde_json::{json, Value};
+use std::cell::RefCell;
+use std::path::PathBuf;
+use std::rc::Rc;
+use twoport_design::{Device, DeviceModel};
+
+pub(crate) const DEFAULT_MODEL: &str = twoport_design::model::EXCALIBUR_PATH;
+
+#[derive(Args, Clone)]
+pub(crate) struct Common {
+    /// Device model file (TOML). The default is the paper's Excalibur.
+    /// Give it more than once for a device with several poses: a design
+    /// is then proven for all of them.
+    #[arg(long, default_value = DEFAULT_MODEL, action = clap::ArgAction::Append)]
+    pub(crate) model: Vec<PathBuf>,
+    /// Device file (TOML): a device of several axes, each with its own
+    /// model (or poses). The command runs on every axis, and its JSON is
+    /// one object with an entry per axis. In place of --model.
+    #[arg(long, conflicts_with = "model")]
+    pub(crate) device: Option<PathBuf>,
+    /// The axis of a device file this run is for (set by `each_axis`).
+    #[arg(skip)]
+    pub(crate) axis: Option<AxisRun>,
+    /// Sample period (s); the model's by default.
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) period: Option<f64>,
+    /// Leave out the human bound Z_max = 300 + 1000/s (any passive human).
+    #[arg(long)]
+    pub(crate) no_human: bool,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub(crate) json: bool,
+}
+
+#[derive(Args, Clone)]
+pub(crate) struct RegionGrid {
+    /// Smallest coupling damping (N s/m).
+    #[arg(long, default_value_t = 10.0)]
+    pub(crate) b_from: f64,
+    /// Largest coupling damping (N s/m).
+    #[arg(long, default_value_t = 1000.0)]
+    pub(crate) b_to: f64,
+    /// Grid points (log-spaced).
+    #[arg(long, default_value_t = 32)]
+    pub(crate) points: usize,
+    /// Print Rust source for a board image (twoport-board's `Region`)
+    /// instead of a table.
+    #[arg(long, conflicts_with = "json")]
+    pub(crate) rust: bool,
+}
+
+#[derive(Args, Clone)]
+pub(crate) struct RegionImpedance {
+    #[command(flatten)]
+    pub(crate) grid: RegionGrid,
+    #[command(flatten)]
+    pub(crate) common: Common,
+}
+
+#[derive(Args, Clone)]
+pub(crate) struct RegionAdmittance {
+    /// Regulator stiffness k_p (N/m) the region is proven for.
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) kp: f64,
+    /// Regulator damping b_p (N s/m).
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) bp: f64,
+    #[command(flatten)]
+    pub(crate) grid: RegionGrid,
+    #[command(flatten)]
+    pub(crate) common: Common,
+}
+
+#[derive(Subcommand, Clone)]
+pub(crate) enum Display<I: Args, A: Args> {
+    /// Impedance display: measure motion, command force.
+    Impedance(I),
+    /// Admittance display: measure force, command motion.
+    Admittance(A),
+}
+
+#[derive(Args, Clone)]
+pub(crate) struct DesignImpedance {
+    /// Coupling damping b_cI (N s/m); without it, the best (k, b) pair.
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) b: Option<f64>,
+    /// The recommended gain's margin below the boundary, as a fraction of
+    /// the boundary's gain (a stiffness that much lower, a mass that much
+    /// higher), from 0 to 0.9.
+    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+    pub(crate) margin: f64,
+    #[command(flatten)]
+    pub(crate) common: Common,
+}
+
+#[derive(Args, Clone)]
+pub(crate) struct DesignAdmittance {
+    /// Regulator stiffness k_p (N/m); with --bp. Default: the impedance design (eq 30).
+    #[arg(long, requires = "bp", allow_negative_numbers = true)]
+    pub(crate) kp: Option<f64>,
+    /// Regulator damping b_p (N s/m); with --kp.
+    #[arg(long, requires = "kp", allow_negative_numbers = true)]
+    pub(crate) bp: Option<f64>,
+    /// Coupling damping b_cA (N s/m); without it, the best (m, b) pair.
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) b: Option<f64>,
+    /// The recommended gain's margin below the boundary, as a fraction of
+    /// the boundary's gain (a stiffness that much lower, a mass that much
+    /// higher), from 0 to 0.9.
+    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+    pub(crate) margin: f64,
+    #[command(flatten)]
+    pub(crate) common: Common,
+}
+
+#[derive(Args, Clone)]
+pub(crate) struct ImpedanceGains {
+    /// Coupling stiffness k_cI (N/m).
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) k: f64,
+    /// Coupling damping b_cI (N s/m).
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) b: f64,
+    #[command(flatten)]
+    pub(crate) common: Common,
+}
+
+#[derive(Args, Clone)]
+pub(crate) struct AdmittanceGains {
+    /// Regulator stiffness k_p (N/m).
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) kp: f64,
+    /// Regulator damping b_p (N s/m).
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) bp: f64,
+    /// Coupling mass m_cA (kg).
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) m: f64,
+    /// Coupling damping b_cA (N s/m).
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) b: f64,
+    #[command(flatten)]
+    pub(crate) common: Common,
+}
+
+#[derive(Args, Clone)]
+pub(crate) struct ZrangeImpedance {
+    #[command(flatten)]
+    pub(crate) gains: ImpedanceGains,
+    /// Number of log-spaced frequencies.
+    #[arg(long, default_value_t = 200)]
+    pub(crate) points: usize,
+}
+
+#[derive(Args, Clone)]
+pub(crate) struct ZrangeAdmittance {
+    #[command(flatten)]
+    pub(crate) gains: AdmittanceGains,
+    /// Number of log-spaced frequencies.
+    #[arg(long, default_value_t = 200)]
+    pub(crate) points: usize,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum Fig {
+    /// Impedance-display design bound and coupling.
+    Fig8,
+    /// Admittance-display design bound and coupling.
+    Fig9,
+    /// Impedance range of both displays.
+    Fig10,
+}
+
+#[derive(Args, Clone)]
+pub(crate) struct PlotArgs {
+    /// Which figure.
+    pub(crate) figure: Fig,
+    /// Output file, .png or .svg.
+    #[arg(long)]
+    pub(crate) out: PathBuf,
+    /// Impedance-coupling damping to design at (N s/m).
+    #[arg(long, default_value_t = 90.0)]
+    pub(crate) b_impedance: f64,
+    /// Admittance-coupling damping to design at (N s/m).
+    #[arg(long, default_value_t = 500.0)]
+    pub(crate) b_admittance: f64,
+    #[command(flatten)]
+    pub(crate) common: Common,
+}
+
+/// One axis of a device file, as one run of a command sees it.
+#[derive(Clone, Debug)]
+pub(crate) struct AxisRun {
+    pub(crate) name: String,
+    /// The axis's models (its poses), read once with the device file.
+    pub(crate) models: Vec<(PathBuf, DeviceModel)>,
+    /// Where a JSON run puts its object, for the device's one object.
+    pub(crate) out: Rc<RefCell<Vec<Value>>>,
+}
+
+/// What a command's arguments share.
+pub(crate) trait HasCommon {
+    fn common(&mut self) -> &mut Common;
+    /// Whether the command prints Rust source (a module per axis then,
+    /// with no text heading).
+    fn rust(&self) -> bool {
+        false
+    }
+}
+
+macro_rules! has_common {
+    ($($t:ty),*) => {$(
+        impl HasCommon for $t {
+            fn common(&mut self) -> &mut Common {
+                &mut self.common
+            }
+        }
+    )*};
+}
+
+has_common!(
+    PlotArgs,
+    DesignImpedance,
+    DesignAdmittance,
+    ImpedanceGains,
+    AdmittanceGains
+);
+
+impl HasCommon for RegionImpedance {
+    fn common(&mut self) -> &mut Common {
+        &mut self.common
+    }
+    fn rust(&self) -> bool {
+        self.grid.rust
+    }
+}
+
+impl HasCommon for RegionAdmittance {
+    fn common(&mut self) -> &mut Common {
+        &mut self.common
+    }
+    fn rust(&self) -> bool {
+        self.grid.rust
+    }
+}
+
+impl HasCommon for ZrangeImpedance {
+    fn common(&mut self) -> &mut Common {
+        self.gains.common()
+    }
+}
+
+impl HasCommon for ZrangeAdmittance {
+    fn common(&mut self) -> &mut Common {
+        self.gains.common()
+    }
+}
+
+impl<I: Args + HasCommon, A: Args + HasCommon> HasCommon for Display<I, A> {
+    fn common(&mut self) -> &mut Common {
+        match self {
+            Display::Impedance(i) => i.common(),
+            Display::Admittance(a) => a.common(),
+        }
+    }
+    fn rust(&self) -> bool {
+        match self {
+            Display::Impedance(i) => i.rust(),
+            Display::Admittance(a) => a.rust(),
+        }
+    }
+}
+
+/// `run` on `args`, or, given a device file, on each of its axes in turn:
+/// the text under a heading per axis, the JSON as one object.
+pub(crate) fn each_axis<A: HasCommon + Clone>(
+    args: &A,
+    run: fn(&A) -> Result<(), String>,
+) -> Result<(), String> {
+    let mut a = args.clone();
+    let Some(path) = a.common().device.clone() else {
+        return run(args);
+    };
+    let device = Device::load(&path).map_err(|e| e.to_string())?;
+    let out = Rc::new(RefCell::new(Vec::new()));
+    let json = a.common().json;
+    for axis in &device.axes {
+        let c = a.common();
+        c.axis = Some(AxisRun {
+            name: axis.name.clone(),
+            models: axis
+                .model_paths
+                .iter()
+                .cloned()
+                .zip(axis.models.iter().cloned())
+                .collect(),
+            out: out.clone(),
+        });
+        if !json && !args.rust() {
+            println!("axis {}:", axis.name);
+        }
+        run(&a).map_err(|e| format!("{}, axis {}: {e}", path.display(), axis.name))?;
+    }
+    if json {
+        println!("{}", json!({"device": device.name, "axes": out.take()}));
+    }
+    Ok(())
+}
+
+/// Check a `--margin` before any analysis.
+pub(crate) fn margin(v: f64) -> Result<f64, String> {
+    (0.0..=0.9)
+        .contains(&v)
+        .then_some(v)
+        .ok_or_else(|| format!("--margin {v}: must be a fraction from 0 to 0.9"))
+}
+
+/// Check gains for sign and finiteness before any analysis.
+pub(crate) fn gain(name: &str, v: f64) -> Result<f64, String> {
+    (v.is_finite() && v >= 0.0)
+        .then_some(v)
+        .ok_or_else(|| format!("--{name} {v}: must be a finite number >= 0"))
+}

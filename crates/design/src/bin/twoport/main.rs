@@ -1,0 +1,79 @@
+//! `twoport`: design and check virtual couplings for a haptic device.
+
+mod args;
+mod check;
+mod plots;
+mod region;
+mod session;
+mod synthesis;
+mod verify;
+
+use crate::args::*;
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Design haptic interfaces that are stable by construction: two-port
+/// analysis, Llewellyn's absolute-stability criteria and virtual-coupling
+/// synthesis after Adams & Hannaford (2002).
+#[derive(Parser)]
+#[command(name = "twoport", version, propagate_version = true)]
+pub(crate) struct Cli {
+    #[command(subcommand)]
+    pub(crate) cmd: Cmd,
+}
+
+#[derive(Subcommand)]
+pub(crate) enum Cmd {
+    /// Synthesise a virtual coupling.
+    #[command(subcommand)]
+    Design(Display<DesignImpedance, DesignAdmittance>),
+    /// Check a coupling for absolute stability (Llewellyn).
+    #[command(subcommand)]
+    Check(Display<ImpedanceGains, AdmittanceGains>),
+    /// Impedance range (Z_min, Z_max) over frequency, 0.1 Hz to Nyquist.
+    #[command(subcommand)]
+    Zrange(Display<ZrangeImpedance, ZrangeAdmittance>),
+    /// Draw one of the paper's figures from this designer's results.
+    Plot(PlotArgs),
+    /// The proven region a board ships with: the limit for each damping.
+    #[command(subcommand)]
+    Region(Display<RegionImpedance, RegionAdmittance>),
+    /// Search for a passive hand and VE that make the exact sampled loop
+    /// unstable at these gains (independent of the two-port proof).
+    #[command(subcommand)]
+    Verify(Display<ImpedanceGains, AdmittanceGains>),
+}
+
+/// `run` on `args`, refusing a device file: the command draws one axis.
+pub(crate) fn one_axis<A: HasCommon + Clone>(
+    args: &A,
+    run: fn(&A) -> Result<(), String>,
+) -> Result<(), String> {
+    match args.clone().common().device.clone() {
+        Some(p) => Err(format!(
+            "--device {}: this command draws one axis; give that axis's --model",
+            p.display()
+        )),
+        None => run(args),
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let r = match &cli.cmd {
+        Cmd::Design(Display::Impedance(a)) => each_axis(a, synthesis::design_impedance),
+        Cmd::Design(Display::Admittance(a)) => each_axis(a, synthesis::design_admittance),
+        Cmd::Check(d) => each_axis(d, check::check),
+        Cmd::Zrange(d) => one_axis(d, plots::zrange),
+        Cmd::Plot(p) => one_axis(p, plots::plot_fig),
+        Cmd::Region(d) => each_axis(d, region::region),
+        Cmd::Verify(d) => each_axis(d, verify::verify),
+    };
+    match r {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("twoport: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
