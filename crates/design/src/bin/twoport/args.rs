@@ -83,16 +83,34 @@ pub(crate) enum Display<I: Args, A: Args> {
     Admittance(A),
 }
 
+/// `design`'s margin for the recommended gain.
+#[derive(Args, Clone)]
+pub(crate) struct Margin {
+    /// The recommended gain's margin below the boundary, as a fraction of
+    /// the boundary's gain (a stiffness that much lower, a mass that much
+    /// higher), from 0 to 0.9.
+    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+    margin: f64,
+}
+
+impl Margin {
+    /// The fraction, checked before any analysis.
+    pub(crate) fn fraction(&self) -> Result<f64, String> {
+        let v = self.margin;
+        (0.0..=0.9)
+            .contains(&v)
+            .then_some(v)
+            .ok_or_else(|| format!("--margin {v}: must be a fraction from 0 to 0.9"))
+    }
+}
+
 #[derive(Args, Clone)]
 pub(crate) struct DesignImpedance {
     /// Coupling damping b_cI (N s/m); without it, the best (k, b) pair.
     #[arg(long, allow_negative_numbers = true)]
     pub(crate) b: Option<f64>,
-    /// The recommended gain's margin below the boundary, as a fraction of
-    /// the boundary's gain (a stiffness that much lower, a mass that much
-    /// higher), from 0 to 0.9.
-    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
-    pub(crate) margin: f64,
+    #[command(flatten)]
+    pub(crate) margin: Margin,
     #[command(flatten)]
     pub(crate) common: Common,
 }
@@ -108,11 +126,8 @@ pub(crate) struct DesignAdmittance {
     /// Coupling damping b_cA (N s/m); without it, the best (m, b) pair.
     #[arg(long, allow_negative_numbers = true)]
     pub(crate) b: Option<f64>,
-    /// The recommended gain's margin below the boundary, as a fraction of
-    /// the boundary's gain (a stiffness that much lower, a mass that much
-    /// higher), from 0 to 0.9.
-    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
-    pub(crate) margin: f64,
+    #[command(flatten)]
+    pub(crate) margin: Margin,
     #[command(flatten)]
     pub(crate) common: Common,
 }
@@ -309,14 +324,6 @@ pub(crate) fn each_axis<A: HasCommon + Clone>(
         println!("{}", json!({"device": device.name, "axes": out.take()}));
     }
     Ok(())
-}
-
-/// Check a `--margin` before any analysis.
-pub(crate) fn margin(v: f64) -> Result<f64, String> {
-    (0.0..=0.9)
-        .contains(&v)
-        .then_some(v)
-        .ok_or_else(|| format!("--margin {v}: must be a fraction from 0 to 0.9"))
 }
 
 /// Check gains for sign and finiteness before any analysis.

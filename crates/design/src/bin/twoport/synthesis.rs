@@ -177,7 +177,7 @@ pub(crate) fn binding_text(v: &Value, what: &str, paper: &str, unit: &str) -> St
 }
 
 pub(crate) fn design_impedance(a: &DesignImpedance) -> Result<(), String> {
-    let margin = margin(a.margin)?;
+    let margin = a.margin.fraction()?;
     let s = Session::open(&a.common)?;
     let r = impedance_design(&s, a.b)?;
     let paper = impedance_design_on(&s, &s.impedance_bounds(true), a.b)?;
@@ -230,7 +230,7 @@ pub(crate) fn infeasible(
 }
 
 pub(crate) fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
-    let margin = margin(a.margin)?;
+    let margin = a.margin.fraction()?;
     let s = Session::open(&a.common)?;
     s.force_sensor()?;
     let (kp, bp) = match (a.kp, a.bp) {
