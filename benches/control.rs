@@ -9,7 +9,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
-use twoport_control::servo::{AxesFrame, AxesServo, SensorFrame};
+use twoport_control::servo::SensorFrame;
 use twoport_control::ve::{
     BilateralConstraint, CursorMass, Port, Solid, UnilateralWall, VirtualEnvironment,
 };
@@ -89,7 +89,7 @@ fn encoder() -> Encoder {
 
 /// An enabled servo on Excalibur's limits.
 fn enabled<V: VirtualEnvironment>(gains: Gains, ve: V) -> Servo<V> {
-    let mut s = Servo::new(gains, encoder(), SafetyConfig::excalibur(), ve).unwrap();
+    let mut s = Servo::new([gains], [encoder()], [SafetyConfig::excalibur()], ve).unwrap();
     s.enable().unwrap();
     s
 }
@@ -103,7 +103,7 @@ fn impedance_tick<V: VirtualEnvironment>(c: &mut Criterion, ve_name: &str, ve: V
         |b| {
             b.iter(|| {
                 k = k.wrapping_add(1);
-                let out = s.tick(&SensorFrame::held(k, black_box(k % 1000), 0.0));
+                let out = s.tick(&SensorFrame::held(k, [black_box(k % 1000)], [0.0]));
                 black_box(&out);
             })
         },
@@ -135,8 +135,8 @@ fn servos(c: &mut Criterion) {
                 k = k.wrapping_add(1);
                 let out = a.tick(&SensorFrame::held(
                     k,
-                    0,
-                    black_box(((k % 40) as f32 - 20.0) * 0.1),
+                    [0],
+                    [black_box(((k % 40) as f32 - 20.0) * 0.1)],
                 ));
                 black_box(&out);
             })
@@ -172,7 +172,7 @@ fn fifty_blocks() -> (Vbb<f32, 50>, [Position; 3]) {
 /// of at most 5 µs with 50 blocks).
 fn three_axes(c: &mut Criterion) {
     let (mut w, rest) = fifty_blocks();
-    w.reset(&rest);
+    w.reset_axes(&rest);
     let mut k = 0u32;
     c.bench_function("VBB world step, 50 blocks, cursor on a top", |b| {
         b.iter(|| {
@@ -182,12 +182,12 @@ fn three_axes(c: &mut Criterion) {
                 f0_n,
                 z_nspm: 140.0,
             });
-            let out = w.step(black_box(&p));
+            let out = w.step_axes(black_box(&p));
             black_box(&out);
         })
     });
     let (mut held, _) = fifty_blocks();
-    held.reset(&rest);
+    held.reset_axes(&rest);
     assert!(held.grab());
     c.bench_function("VBB world step, 50 blocks, one held", |b| {
         b.iter(|| {
@@ -197,12 +197,12 @@ fn three_axes(c: &mut Criterion) {
                 f0_n,
                 z_nspm: 140.0,
             });
-            let out = held.step(black_box(&p));
+            let out = held.step_axes(black_box(&p));
             black_box(&out);
         })
     });
     let g: Gains = ImpedanceGains::new(51_000.0, 90.0).into();
-    let mut s = AxesServo::new(
+    let mut s = Servo::new(
         [g; 3],
         [encoder(); 3],
         [SafetyConfig::excalibur(); 3],
@@ -214,7 +214,7 @@ fn three_axes(c: &mut Criterion) {
         b.iter(|| {
             k = k.wrapping_add(1);
             let raw = black_box(k % 1000 * 2);
-            let out = s.tick(&AxesFrame {
+            let out = s.tick(&SensorFrame {
                 tick: k,
                 encoder_raw: [raw; 3],
                 load_cell_n: [0.0; 3],

@@ -84,8 +84,8 @@ fn parts(c: &mut Criterion) {
                 tick = tick.wrapping_add(1);
                 let f = SensorFrame {
                     tick,
-                    encoder_raw: black_box(tick % 64),
-                    load_cell_n: 0.0,
+                    encoder_raw: [black_box(tick % 64)],
+                    load_cell_n: [0.0],
                     dead_man_closed: true,
                 };
                 black_box(servo.tick(&f));

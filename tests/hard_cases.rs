@@ -26,9 +26,9 @@ fn admittance_display_does_not_creep_in_24_hours() {
     let wall =
         UnilateralWall::new(2e4, 50.0, Position::ZERO, Solid::Above, T, Position::ZERO).unwrap();
     let mut s = Servo::new(
-        AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into(),
-        enc,
-        SafetyConfig::excalibur(),
+        [AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into()],
+        [enc],
+        [SafetyConfig::excalibur()],
         wall,
     )
     .unwrap();
@@ -40,17 +40,12 @@ fn admittance_display_does_not_creep_in_24_hours() {
     let hour = 3_600_000u32;
     let (mut at_1h, mut last) = (None, Position::ZERO);
     for k in 0..24 * hour {
-        let out = s.tick(&SensorFrame {
-            tick: k,
-            encoder_raw: 0,
-            load_cell_n: wave[(k % period) as usize],
-            dead_man_closed: true,
-        });
+        let out = s.tick(&SensorFrame::held(k, [0], [wave[(k % period) as usize]]));
         assert!(out.faults.is_empty(), "tick {k}: {}", out.faults);
         if k % period == 0 {
-            last = out.reference;
+            last = out.reference[0];
             if k == hour {
-                at_1h = Some(out.reference);
+                at_1h = Some(out.reference[0]);
             }
         }
     }

@@ -28,9 +28,9 @@ fn the_board_accepts_only_what_the_designer_proves() {
     let region = Region::new(Bound::MaxStiffness, b, k, None).unwrap();
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let servo = Servo::new(
-        ImpedanceGains::new(10_000.0, 50.0).into(),
-        enc,
-        SafetyConfig::excalibur(),
+        [ImpedanceGains::new(10_000.0, 50.0).into()],
+        [enc],
+        [SafetyConfig::excalibur()],
         BilateralConstraint::new(Position::ZERO),
     )
     .unwrap();

@@ -397,14 +397,19 @@ fn the_simulated_ve_port_impedance_is_the_designers() {
                 f: 0.0,
                 x: Integrator::new(1e-3, Position::ZERO),
             };
-            let mut servo =
-                Servo::new(ImpedanceGains::new(k as f32, 90.0).into(), enc, safety, ve).unwrap();
+            let mut servo = Servo::new(
+                [ImpedanceGains::new(k as f32, 90.0).into()],
+                [enc],
+                [safety],
+                ve,
+            )
+            .unwrap();
             servo.enable().unwrap();
             let th = 2.0 * std::f64::consts::PI * bin as f64 / 4000.0;
             let z_net = SineProbe::measure(th.cos(), th.sin(), 6000, 4000, |u| {
-                servo.ve_mut().v = (1e-3 * u) as f32;
+                servo.world_mut().v = (1e-3 * u) as f32;
                 sim.step_external(&mut |frame| servo.tick(frame));
-                (1e-3 * u, -servo.ve().f as f64)
+                (1e-3 * u, -servo.world().f as f64)
             });
             let want = designer_p22(&plant, k, &[f_hz])[0].inv();
             let err = (z_net - want).norm() / want.norm();

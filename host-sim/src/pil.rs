@@ -14,13 +14,13 @@ use crate::{Sample, Scene, Simulation};
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 use twoport_board::excalibur::{self, xyz, REGION_POINTS};
-use twoport_board::{Board, BoardSupport, Drive, RawSensors};
+use twoport_board::{Board, BoardSupport, RawSensors};
 use twoport_config::{RamFlash, Store};
 use twoport_control::passivity::SeriesDamper;
-use twoport_control::servo::{SensorFrame, ServoOutput};
+use twoport_control::servo::{Direct, PortLayer, SensorFrame, ServoOutput};
 use twoport_control::ve::UnilateralWall;
+use twoport_control::world::World;
 use twoport_control::Faults as BoardFaults;
-use twoport_control::Servo;
 use twoport_link::{
     encode, Axes, ConfigSource, Decoder, LinkStats, Message, Mode, ModeRequest, Role,
     SensorFrame as LinkSensors, Status, Telemetry, MAX_FRAME,
@@ -76,8 +76,8 @@ impl BoardPort for SerialBoard {
 /// The Excalibur board image's loop, in this process: the plain image's,
 /// the passivity image's (`S` with the series damper), or the three-axis
 /// image's (`N` = 3).
-pub struct LocalBoard<S = Servo<UnilateralWall>, const N: usize = 1> {
-    board: Board<S, REGION_POINTS, N>,
+pub struct LocalBoard<W = UnilateralWall, const N: usize = 1, L = Direct> {
+    board: Board<W, REGION_POINTS, N, L>,
     link: HostLink,
     /// Its stored configuration, in RAM as on the QEMU images.
     store: Store<RamFlash<512, 256>>,
@@ -116,9 +116,9 @@ impl<const N: usize> BoardSupport<N> for HostLink {
     }
 }
 
-impl<S: Drive<N>, const N: usize> LocalBoard<S, N> {
+impl<W: World<f32, N>, L: PortLayer, const N: usize> LocalBoard<W, N, L> {
     /// `board`, driven by the link's sensor frames.
-    fn driven(board: Board<S, REGION_POINTS, N>) -> Self {
+    fn driven(board: Board<W, REGION_POINTS, N, L>) -> Self {
         let mut board = board.with_pil(true);
         // As the QEMU images boot: the configuration from a RAM flash.
         let mut store = Store::new(RamFlash::<512, 256>::new(), 0, 256);
@@ -131,7 +131,7 @@ impl<S: Drive<N>, const N: usize> LocalBoard<S, N> {
     }
 }
 
-impl<S: Drive<N>, const N: usize> LocalBoard<S, N> {
+impl<W: World<f32, N>, L: PortLayer, const N: usize> LocalBoard<W, N, L> {
     /// The same board with each axis homing with its `cfg` (e.g. on an
     /// encoder's index).
     pub fn with_homing(mut self, cfg: [twoport_control::homing::HomingConfig; N]) -> Self {
@@ -149,7 +149,7 @@ impl LocalBoard {
     }
 }
 
-impl LocalBoard<Servo<UnilateralWall, f32, SeriesDamper>> {
+impl LocalBoard<UnilateralWall, 1, SeriesDamper> {
     /// The passivity image ([`excalibur::stiff_wall_board_with_passivity`]).
     pub fn excalibur_with_passivity() -> Result<Self, String> {
         excalibur::stiff_wall_board_with_passivity()
@@ -158,7 +158,7 @@ impl LocalBoard<Servo<UnilateralWall, f32, SeriesDamper>> {
     }
 }
 
-impl LocalBoard<xyz::XyzServo, 3> {
+impl LocalBoard<xyz::World, 3> {
     /// The three-axis image ([`xyz::board`]).
     pub fn excalibur_xyz() -> Result<Self, String> {
         xyz::board()
@@ -167,7 +167,7 @@ impl LocalBoard<xyz::XyzServo, 3> {
     }
 }
 
-impl<S: Drive<N>, const N: usize> BoardPort for LocalBoard<S, N> {
+impl<W: World<f32, N>, L: PortLayer, const N: usize> BoardPort for LocalBoard<W, N, L> {
     fn send(&mut self, bytes: &[u8]) -> Result<(), String> {
         // What the images do: the control tick runs each sensor frame as
         // it completes, and the main loop sends what was queued.
@@ -642,16 +642,16 @@ impl<P: BoardPort> Session<P> {
         let mut ctl = |f: &SensorFrame| -> ServoOutput {
             let sensors = LinkSensors {
                 tick: f.tick,
-                encoder_raw: Axes::one(f.encoder_raw),
-                load_cell_raw: Axes::one(io.load_cell_counts(f.load_cell_n)),
+                encoder_raw: Axes::one(f.encoder_raw[0]),
+                load_cell_raw: Axes::one(io.load_cell_counts(f.load_cell_n[0])),
                 dead_man_closed: f.dead_man_closed,
-                index_raw: Axes::one(self.index_crossing(f.encoder_raw)),
+                index_raw: Axes::one(self.index_crossing(f.encoder_raw[0])),
             };
             answer = self.exchange(tick, sensors).map(|d| d[0]);
             let force = io.force_n(*answer.as_ref().unwrap_or(&0));
             ServoOutput {
-                actuator_force_n: force,
-                commanded_force_n: force,
+                actuator_force_n: [force],
+                commanded_force_n: [force],
                 ..ServoOutput::default()
             }
         };

@@ -29,7 +29,7 @@ fn table1_in_3d_is_stable_at_the_proven_gains() {
             );
             if state == "unilateral" && grasp != "hands_off" {
                 // The hand reached 20 mm down: the cursor rests on the floor.
-                let z = sim.servo().world().position()[2].nm();
+                let z = sim.servo().world().positions()[2].nm();
                 assert_eq!(z, 1_000_000, "{grasp}: the cursor on the floor");
             }
         }

@@ -3,13 +3,14 @@
 mod arming;
 mod persist;
 
-use crate::drive::Drive;
 use crate::io::IoScale;
 use crate::region::{check_axes, Region};
 use crate::support::BoardSupport;
 use heapless::{Deque, Vec};
 use twoport_control::homing::{Homing, HomingConfig};
-use twoport_control::servo::{AxesFrame, AxesOutput, Gains};
+use twoport_control::servo::PortLayer;
+use twoport_control::servo::{Direct, Gains, SensorFrame, Servo, ServoOutput};
+use twoport_control::world::World;
 use twoport_control::{Faults, Position};
 use twoport_link::{
     encode, ActuatorFrame, Axes, AxisRefusal, AxisTelemetry, Decoder, GainsReply, LinkStats,
@@ -23,15 +24,15 @@ pub type Frame = Vec<u8, MAX_FRAME>;
 /// telemetry in the other, so a telemetry flood never crowds out an answer.
 pub const TX_FRAMES: usize = 8;
 
-/// The portable firmware loop around a servo `S` of `N` axes (one by
-/// default): the one-axis [`Servo`](twoport_control::Servo), with or
-/// without a port layer, or the
-/// [`AxesServo`](twoport_control::servo::AxesServo). Each axis has its own
-/// proven region of `R` grid points, load-cell scaling and homing; the
-/// handshake declares `N`.
+/// The portable firmware loop around a [`Servo`] of `N` axes (one by
+/// default) on the world `W`, with the port layer `L` ([`Direct`]: none).
+/// Each axis has its own proven region of `R` grid points, load-cell
+/// scaling and homing; the handshake declares `N`.
+///
+/// [`Direct`]: twoport_control::servo::Direct
 #[derive(Clone, Debug)]
-pub struct Board<S, const R: usize, const N: usize = 1> {
-    servo: S,
+pub struct Board<W, const R: usize, const N: usize = 1, L = Direct> {
+    servo: Servo<W, f32, N, L>,
     regions: [Region<R>; N],
     decoder: Decoder,
     /// Replies and fault reports, sent first.
@@ -45,13 +46,13 @@ pub struct Board<S, const R: usize, const N: usize = 1> {
     loop_cycles: u32,
     tx_dropped: u32,
     io: [IoScale; N],
-    last: AxesOutput<f32, N>,
+    last: ServoOutput<f32, N>,
     /// Whether sensor frames from the link drive ticks (processor in the
     /// loop). A board with real sensors must never let the host move it.
     pil: bool,
     pil_refused: u32,
     /// The host's sensor frame waiting for the next control tick (PIL).
-    pending: Option<AxesFrame<f32, N>>,
+    pending: Option<SensorFrame<f32, N>>,
     /// Ticks run from the board's own sensors (their frame's `tick`).
     ticks: u32,
     /// The state machine: disarmed at boot.
@@ -113,7 +114,7 @@ impl Timing {
     }
 }
 
-impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
+impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R, N, L> {
     /// A board running `servo`, accepting gain changes on each axis inside
     /// its region of `regions`, and sending telemetry every
     /// `telemetry_every` ticks (0: never). It boots disarmed and
@@ -123,9 +124,9 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
     ///
     /// `N` is between 1 and the link's [`MAX_AXES`] (checked at compile
     /// time).
-    pub fn new(servo: S, regions: [Region<R>; N], telemetry_every: u32) -> Self {
+    pub fn new(servo: Servo<W, f32, N, L>, regions: [Region<R>; N], telemetry_every: u32) -> Self {
         const { assert!(N >= 1 && N <= MAX_AXES, "a board has 1 to MAX_AXES axes") };
-        let period_s = servo.period_s();
+        let period_s = servo.safety().configs()[0].period_s;
         let position = servo.position();
         Board {
             servo,
@@ -140,7 +141,7 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
             loop_cycles: 0,
             tx_dropped: 0,
             io: [IoScale::EXCALIBUR; N],
-            last: AxesOutput::at_rest(position, [0.0; N]),
+            last: ServoOutput::at_rest(position, [0.0; N]),
             pil: false,
             pil_refused: 0,
             pending: None,
@@ -194,7 +195,7 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
     }
 
     /// The last tick's output.
-    pub fn last_output(&self) -> &AxesOutput<f32, N> {
+    pub fn last_output(&self) -> &ServoOutput<f32, N> {
         &self.last
     }
 
@@ -204,7 +205,7 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
     }
 
     /// The servo (gains, safety state).
-    pub fn servo(&self) -> &S {
+    pub fn servo(&self) -> &Servo<W, f32, N, L> {
         &self.servo
     }
 
@@ -322,7 +323,7 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
                     return;
                 };
                 self.pending_index = index;
-                self.pending = Some(AxesFrame {
+                self.pending = Some(SensorFrame {
                     tick: s.tick,
                     encoder_raw: enc,
                     load_cell_n: core::array::from_fn(|i| self.io[i].load_cell_n(cells[i])),
@@ -381,7 +382,7 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
     /// board's ADC conversion amounts to, and answers with the duty. The
     /// time from the sensors to the command, in the support's
     /// [`cycles`](BoardSupport::cycles), goes out in the next telemetry.
-    pub fn control_tick(&mut self, io: &mut impl BoardSupport<N>) -> AxesOutput<f32, N> {
+    pub fn control_tick(&mut self, io: &mut impl BoardSupport<N>) -> ServoOutput<f32, N> {
         self.control_tick_serving(io, |_| {})
     }
 
@@ -393,7 +394,7 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
         &mut self,
         io: &mut impl BoardSupport<N>,
         serve: impl FnMut(&mut Self),
-    ) -> AxesOutput<f32, N> {
+    ) -> ServoOutput<f32, N> {
         let out = self.control_tick_inner(io, serve);
         // Outputs follow the mode, within the tick that changed it.
         self.drive_outputs(io);
@@ -404,7 +405,7 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
         &mut self,
         io: &mut impl BoardSupport<N>,
         mut serve: impl FnMut(&mut Self),
-    ) -> AxesOutput<f32, N> {
+    ) -> ServoOutput<f32, N> {
         let (frame, start) = if self.pil {
             let frame = loop {
                 io.feed_watchdog();
@@ -420,7 +421,7 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
         } else {
             let start = io.cycles();
             let raw = io.sample();
-            let frame = AxesFrame {
+            let frame = SensorFrame {
                 tick: self.ticks,
                 encoder_raw: raw.encoder_raw,
                 load_cell_n: core::array::from_fn(|i| {
@@ -454,9 +455,16 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
 
     /// One control tick: the law, a fault report when new faults latch,
     /// telemetry on schedule. Returns the held actuator command.
-    pub fn tick(&mut self, frame: &AxesFrame<f32, N>) -> AxesOutput<f32, N> {
+    pub fn tick(&mut self, frame: &SensorFrame<f32, N>) -> ServoOutput<f32, N> {
         self.dead_man_closed = frame.dead_man_closed;
-        let out = self.servo.tick(frame, self.homing.as_mut());
+        let out = match self.homing.as_mut() {
+            // Each axis's homing law in place of the display's, through the
+            // same safety layer; an axis that has homed holds no force.
+            Some(h) => self
+                .servo
+                .tick_with(frame, |i, x, v| h[i].as_mut().map_or(0.0, |h| h.step(x, v))),
+            None => self.servo.tick(frame),
+        };
         self.last = out;
         self.after_tick(&out);
         if !out.faults.is_empty() && out.faults != self.reported {
@@ -470,7 +478,7 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
             self.since_telemetry += 1;
             if self.since_telemetry >= self.telemetry_every {
                 self.since_telemetry = 0;
-                let ve = self.servo.ve_position();
+                let ve = self.servo.world().positions();
                 let axes = core::array::from_fn(|i| AxisTelemetry {
                     position_pm: out.position[i].nm() as i64 * 1000,
                     velocity_mps: out.velocity_mps[i],

@@ -12,7 +12,7 @@ use twoport_control::passivity::{PassivityLimits, SeriesDamper};
 use twoport_control::servo::GainsError;
 use twoport_control::ve::{Solid, UnilateralWall};
 use twoport_control::{
-    Encoder, EncoderError, ImpedanceGains, ParamError, Position, SafetyConfig, Servo,
+    AxisError, Encoder, EncoderError, ImpedanceGains, ParamError, Position, SafetyConfig, Servo,
 };
 
 /// Why the board image could not be built (a constant here is wrong).
@@ -24,8 +24,8 @@ pub enum BuildError {
     Encoder(EncoderError),
     /// The shipped region table.
     Region(RegionError),
-    /// A port layer for the other display.
-    Layer(GainsError),
+    /// The servo's gains or port layer, on the axis it names.
+    Servo(AxisError<GainsError>),
 }
 
 impl From<ParamError> for BuildError {
@@ -36,6 +36,11 @@ impl From<ParamError> for BuildError {
 impl From<EncoderError> for BuildError {
     fn from(e: EncoderError) -> Self {
         BuildError::Encoder(e)
+    }
+}
+impl From<AxisError<GainsError>> for BuildError {
+    fn from(e: AxisError<GainsError>) -> Self {
+        BuildError::Servo(e)
     }
 }
 impl From<RegionError> for BuildError {
@@ -108,7 +113,7 @@ pub fn stiff_wall_servo() -> Result<Servo<UnilateralWall>, BuildError> {
         PERIOD_S,
         Position::ZERO,
     )?;
-    Ok(Servo::new(COUPLING.into(), enc, safety(), ve)?)
+    Ok(Servo::new([COUPLING.into()], [enc], [safety()], ve)?)
 }
 
 /// The actuator's port as the passivity layer sees it: the moving mass at
@@ -119,20 +124,18 @@ pub const ACTUATOR_PORT: (f32, f32) = (0.93, 4.0);
 /// The stiff wall's servo with the passivity layer (the series damper) at
 /// the actuator's port: the passivity image's.
 pub fn stiff_wall_servo_with_passivity(
-) -> Result<Servo<UnilateralWall, f32, SeriesDamper>, BuildError> {
+) -> Result<Servo<UnilateralWall, f32, 1, SeriesDamper>, BuildError> {
     let (mass_kg, damping_nspm) = ACTUATOR_PORT;
     let mut limits = PassivityLimits::for_device(mass_kg, PERIOD_S, safety().peak_force_n)?;
     limits.device_damping_nspm = damping_nspm;
     let layer = SeriesDamper::new(limits)?;
-    stiff_wall_servo()?
-        .with_layer(layer)
-        .map_err(BuildError::Layer)
+    Ok(stiff_wall_servo()?.with_layers([layer])?)
 }
 
 /// The passivity image's board: [`stiff_wall_board`] with the series
 /// damper between the actuator's port and the coupling.
 pub fn stiff_wall_board_with_passivity(
-) -> Result<Board<Servo<UnilateralWall, f32, SeriesDamper>, REGION_POINTS>, BuildError> {
+) -> Result<Board<UnilateralWall, REGION_POINTS, 1, SeriesDamper>, BuildError> {
     Ok(Board::new(
         stiff_wall_servo_with_passivity()?,
         [proven_region()?],
@@ -144,7 +147,7 @@ pub fn stiff_wall_board_with_passivity(
 
 /// The whole board: servo, region, telemetry rate, I/O scaling. It reads its
 /// own sensors; the processor-in-the-loop images add `.with_pil(true)`.
-pub fn stiff_wall_board() -> Result<Board<Servo<UnilateralWall>, REGION_POINTS>, BuildError> {
+pub fn stiff_wall_board() -> Result<Board<UnilateralWall, REGION_POINTS>, BuildError> {
     Ok(
         Board::new(stiff_wall_servo()?, [proven_region()?], TELEMETRY_EVERY)
             .with_io([IoScale::EXCALIBUR])

@@ -4,14 +4,12 @@
 #![warn(missing_docs)]
 
 mod board;
-mod drive;
 pub mod excalibur;
 mod io;
 mod region;
 mod support;
 
 pub use board::{Board, Frame, TX_FRAMES};
-pub use drive::Drive;
 pub use io::{IoScale, DUTY_FULL_SCALE};
 pub use region::{check_axes, Bound, Region, RegionError};
 pub use support::{BoardSupport, RawSensors};

@@ -79,7 +79,7 @@ fn saved_gains_come_back_at_the_next_boot() {
     assert_eq!(again.config()[0].gains, tuned);
 
     // Armed, a save is refused.
-    again.tick(&twoport_control::SensorFrame::held(0, 0, 0.0).into());
+    again.tick(&twoport_control::SensorFrame::held(0, [0], [0.0]));
     say(
         &mut again,
         Message::Calibrate {

@@ -19,17 +19,17 @@ fn safety() -> SafetyConfig {
     }
 }
 
-fn board() -> Board<Servo<BilateralConstraint>, 3> {
+fn board() -> Board<BilateralConstraint, 3> {
     common::board(51_000.0, safety(), 10)
 }
 
-fn send(b: &mut Board<Servo<BilateralConstraint>, 3>, seq: u16, m: Message) {
+fn send(b: &mut Board<BilateralConstraint, 3>, seq: u16, m: Message) {
     let mut buf = [0u8; MAX_FRAME];
     let n = encode(seq, &m, &mut buf).unwrap();
     b.on_bytes(&buf[..n]);
 }
 
-fn replies(b: &mut Board<Servo<BilateralConstraint>, 3>) -> Vec<Message> {
+fn replies(b: &mut Board<BilateralConstraint, 3>) -> Vec<Message> {
     let mut d = Decoder::new();
     let mut out = Vec::new();
     while let Some(f) = b.pop_tx() {
@@ -40,8 +40,8 @@ fn replies(b: &mut Board<Servo<BilateralConstraint>, 3>) -> Vec<Message> {
 
 /// Tick 0 (the board then knows the dead-man is closed), calibrate where
 /// it stands and arm; the next tick is 1.
-fn arm(b: &mut Board<Servo<BilateralConstraint>, 3>, raw: u32) {
-    b.tick(&frame(0, raw).into());
+fn arm(b: &mut Board<BilateralConstraint, 3>, raw: u32) {
+    b.tick(&frame(0, raw));
     send(
         b,
         100,
@@ -55,12 +55,7 @@ fn arm(b: &mut Board<Servo<BilateralConstraint>, 3>, raw: u32) {
 }
 
 fn frame(tick: u32, raw: u32) -> SensorFrame {
-    SensorFrame {
-        tick,
-        encoder_raw: raw,
-        load_cell_n: 0.0,
-        dead_man_closed: true,
-    }
+    SensorFrame::held(tick, [raw], [0.0])
 }
 
 /// A one-axis board's acceptance of `g`.
@@ -203,16 +198,16 @@ fn link_loss_gives_zero_force_within_the_watchdog_deadline() {
             send(&mut b, seq, Message::Heartbeat);
             seq += 1;
         }
-        let out = b.tick(&frame(k, 100).into());
+        let out = b.tick(&frame(k, 100));
         assert!(out.faults.is_empty(), "tick {k}: {}", out.faults);
     }
     assert!(
-        b.tick(&frame(500, 100).into()).actuator_force_n[0].abs() > 1.0,
+        b.tick(&frame(500, 100)).actuator_force_n[0].abs() > 1.0,
         "the coupling pulls"
     );
     let mut zero_at = None;
     for k in 501..600u32 {
-        let out = b.tick(&frame(k, 100).into());
+        let out = b.tick(&frame(k, 100));
         if out.actuator_force_n[0] == 0.0 && zero_at.is_none() {
             zero_at = Some(k);
             assert!(out.faults.contains(Faults::HEARTBEAT_LOST));
@@ -226,7 +221,7 @@ fn link_loss_gives_zero_force_within_the_watchdog_deadline() {
     assert!(replies(&mut b).iter().any(|m| matches!(m, Message::FaultReport { faults, .. } if faults & Faults::HEARTBEAT_LOST.0 != 0)));
     send(&mut b, seq, Message::ClearFaults);
     send(&mut b, seq + 1, Message::Heartbeat);
-    assert!(b.tick(&frame(600, 100).into()).faults.is_empty());
+    assert!(b.tick(&frame(600, 100)).faults.is_empty());
 }
 
 /// Garbage and corrupted frames between good ones: the loop keeps ticking,
@@ -255,7 +250,7 @@ fn corrupted_frames_do_not_stop_the_loop() {
         if k == 555 {
             b.on_bytes(&good[..n]);
         }
-        b.tick(&frame(k, k % 300).into());
+        b.tick(&frame(k, k % 300));
     }
     let s = b.link_stats();
     assert!(s.dropped() >= 20, "{s:?}");
@@ -274,7 +269,7 @@ fn corrupted_frames_do_not_stop_the_loop() {
 fn the_outgoing_queue_is_bounded() {
     let mut b = board();
     for k in 0..10_000u32 {
-        b.tick(&frame(k, 0).into());
+        b.tick(&frame(k, 0));
         if k == 5_000 {
             send(&mut b, 0, Message::GetGains);
         }
@@ -301,9 +296,9 @@ fn admittance_gains_need_the_proven_regulator() {
     .unwrap();
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let s = Servo::new(
-        AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into(),
-        enc,
-        safety(),
+        [AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into()],
+        [enc],
+        [safety()],
         BilateralConstraint::new(Position::ZERO),
     )
     .unwrap();
@@ -359,7 +354,7 @@ fn a_board_with_real_sensors_ignores_sensor_frames_from_the_link() {
     let mut b = board();
     arm(&mut b, 0);
     for k in 1..20u32 {
-        b.tick(&frame(k, k).into());
+        b.tick(&frame(k, k));
     }
     let before = b.last_output().position[0];
     for k in 0..5u16 {
@@ -574,7 +569,7 @@ fn deadline_misses_and_the_worst_jitter_are_counted_and_reported() {
         ..Io::default()
     };
     // One tick, and the telemetry it sent.
-    let tick = |b: &mut Board<Servo<BilateralConstraint>, 3>, io: &mut Io| {
+    let tick = |b: &mut Board<BilateralConstraint, 3>, io: &mut Io| {
         b.control_tick(io);
         b.flush(io);
         io.messages()

@@ -14,11 +14,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // A wall 1 mm ahead, 2 MN/m: stiffer than the coupling, which bounds it.
     let wall_at = Position::from_m(1e-3).ok_or("wall position")?;
     let wall = UnilateralWall::new(2.0e6, 50.0, wall_at, Solid::Above, t, Position::ZERO)?;
-    // twoport design impedance --model models/capstan.toml: 27,886 N/m at 147.9 N s/m.
+    // twoport design impedance --model models/capstan.toml: 27,885 N/m at 147.9 N s/m.
     let mut servo = Servo::new(
-        ImpedanceGains::new(27_800.0, 148.0).into(),
-        encoder,
-        safety,
+        [ImpedanceGains::new(27_800.0, 148.0).into()],
+        [encoder],
+        [safety],
         wall,
     )?;
     servo
@@ -27,18 +27,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for tick in 0..400u32 {
         // The hand pushes the handle 1.2 mm in 0.2 s (0.2 mm into the wall).
         let x_m = 1.2e-3 * (tick as f64 * t as f64 / 0.2).min(1.0);
-        let frame = SensorFrame {
-            tick,
-            encoder_raw: ((x_m / 10e-6).round() as u32) & 0x3fff,
-            load_cell_n: 0.0,
-            dead_man_closed: true,
-        };
-        let out = servo.tick(&frame);
+        let raw = ((x_m / 10e-6).round() as u32) & 0x3fff;
+        let frame = SensorFrame::held(tick, [raw], [0.0]);
+        let [force_n] = servo.tick(&frame).actuator_force_n;
         if tick % 50 == 0 {
             println!(
                 "t = {:.3} s  x = {x_m:.4} m  force = {:.2} N",
                 tick as f32 * t,
-                out.actuator_force_n
+                force_n
             );
         }
     }

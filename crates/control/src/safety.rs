@@ -252,6 +252,13 @@ pub struct AxisError<E = ParamError> {
     pub error: E,
 }
 
+impl<E> AxisError<E> {
+    /// `error` on axis `axis`.
+    pub const fn new(axis: usize, error: E) -> Self {
+        AxisError { axis, error }
+    }
+}
+
 impl<E: fmt::Display> fmt::Display for AxisError<E> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "axis {}: {}", self.axis, self.error)
@@ -582,6 +589,27 @@ impl<R: Real, const N: usize> SafetyLayer<R, N> {
         self.latched = self.latched.with(f);
     }
 
+    /// Axis `i`'s finite `command` (N) clipped to its peak force, or to its
+    /// continuous force once its I²t budget is spent.
+    #[inline(always)]
+    fn clip(&self, i: usize, command: R) -> R {
+        let c = &self.cfg[i];
+        let limit = R::of(if self.heat[i] >= R::of(self.budget[i]) {
+            c.continuous_force_n
+        } else {
+            c.peak_force_n
+        });
+        // (Not `clamp`, which carries an assertion on its bounds; the
+        // command is finite here, or a fault would have latched.)
+        if command > limit {
+            limit
+        } else if command < -limit {
+            -limit
+        } else {
+            command
+        }
+    }
+
     /// One tick of every axis: check, latch, limit, ramp. Call exactly once
     /// per tick.
     #[inline(always)]
@@ -622,33 +650,21 @@ impl<R: Real, const N: usize> SafetyLayer<R, N> {
             // (ramp_done <= ramp_ticks always; once ramped in, the force
             // passes with neither a division nor a multiplication.)
             let ramp_ticks = self.cfg[0].ramp_ticks;
-            let mut ramp = None;
             if self.ramp_done < ramp_ticks {
                 self.ramp_done += 1;
-                out.limited = [self.ramp_done < ramp_ticks; N];
-                ramp = Some(R::of(self.ramp_done as f32 / ramp_ticks as f32));
-            }
-            for (i, &command) in command_n.iter().enumerate() {
-                let c = &self.cfg[i];
-                let limit = R::of(if self.heat[i] >= R::of(self.budget[i]) {
-                    c.continuous_force_n
-                } else {
-                    c.peak_force_n
-                });
-                // (Not `clamp`, which carries an assertion on its bounds;
-                // the command is finite here, or a fault would have latched.)
-                let clipped = if command > limit {
-                    limit
-                } else if command < -limit {
-                    -limit
-                } else {
-                    command
-                };
-                out.force_n[i] = match ramp {
-                    Some(fraction) => clipped * fraction,
-                    None => clipped,
-                };
-                out.limited[i] |= clipped != command;
+                let ramping = self.ramp_done < ramp_ticks;
+                let fraction = R::of(self.ramp_done as f32 / ramp_ticks as f32);
+                for (i, &command) in command_n.iter().enumerate() {
+                    let clipped = self.clip(i, command);
+                    out.force_n[i] = clipped * fraction;
+                    out.limited[i] = ramping | (clipped != command);
+                }
+            } else {
+                for (i, &command) in command_n.iter().enumerate() {
+                    let clipped = self.clip(i, command);
+                    out.force_n[i] = clipped;
+                    out.limited[i] = clipped != command;
+                }
             }
         } else {
             self.ramp_done = 0;

@@ -1,10 +1,10 @@
-//! The N-axis servo: with one axis it is the one-axis servo bit for bit;
-//! with three, every axis's tick matches its own laws' z-domain forms while
+//! The servo on several axes: three axes of independent VEs fed the same
+//! frames are each the one-axis servo bit for bit; with three, every axis's tick matches its own laws' z-domain forms while
 //! the others work, and a fault on any axis gives zero force on all of them
 //! in the tick that finds it.
 
 use twoport_control::safety::AxisError;
-use twoport_control::servo::{AxesFrame, AxesServo, LawsRef, SensorFrame};
+use twoport_control::servo::{LawsRef, SensorFrame};
 use twoport_control::ve::{CursorMass, VeTransfer, VirtualEnvironment};
 use twoport_control::world::{PerAxis, World};
 use twoport_control::{
@@ -28,8 +28,8 @@ fn admittance(kp_npm: f32, m_kg: f32) -> Gains {
     AdmittanceGains::new(kp_npm, 90.0, m_kg, 500.0).into()
 }
 
-fn three<W: World<f32, 3>>(gains: [Gains; 3], world: W) -> AxesServo<W, f32, 3> {
-    AxesServo::new(gains, [encoder(); 3], [SafetyConfig::excalibur(); 3], world).unwrap()
+fn three<W: World<f32, 3>>(gains: [Gains; 3], world: W) -> Servo<W, f32, 3> {
+    Servo::new(gains, [encoder(); 3], [SafetyConfig::excalibur(); 3], world).unwrap()
 }
 
 /// A deterministic wandering trajectory (µm) and load (N), with a dead-man
@@ -42,18 +42,20 @@ fn script(k: u32) -> (u32, u32, f32, bool) {
     (tick, raw, f, !(900..905).contains(&k))
 }
 
-/// Both displays: the one-axis `AxesServo` and `Servo` fed the same frames
-/// give the same bits in every output, through faults, clears and enables.
+/// Both displays: a one-axis servo on a VE, and a three-axis one on three
+/// copies of it fed the same frame on every axis, give the same bits in
+/// every output of every axis, through faults, clears and enables.
 #[test]
-fn one_axis_is_the_one_axis_servo_bit_for_bit() {
+fn each_axis_of_independent_axes_is_the_one_axis_servo_bit_for_bit() {
     type Make<V> = fn() -> V;
     fn run<V: VirtualEnvironment + Copy + core::fmt::Debug>(gains: Gains, ve: Make<V>) {
         let safety = SafetyConfig {
             require_dead_man: true,
             ..SafetyConfig::excalibur()
         };
-        let mut one = Servo::new(gains, encoder(), safety, ve()).unwrap();
-        let mut axes = AxesServo::new([gains], [encoder()], [safety], PerAxis([ve()])).unwrap();
+        let mut one = Servo::new([gains], [encoder()], [safety], ve()).unwrap();
+        let mut axes =
+            Servo::new([gains; 3], [encoder(); 3], [safety; 3], PerAxis([ve(); 3])).unwrap();
         let (mut faults_seen, mut forces_seen) = (0, 0);
         for k in 0..4000u32 {
             if k % 700 == 0 {
@@ -64,45 +66,47 @@ fn one_axis_is_the_one_axis_servo_bit_for_bit() {
             let (tick, raw, f, dead_man) = script(k);
             let a = one.tick(&SensorFrame {
                 tick,
-                encoder_raw: raw,
-                load_cell_n: f,
-                dead_man_closed: dead_man,
-            });
-            let b = axes.tick(&AxesFrame {
-                tick,
                 encoder_raw: [raw],
                 load_cell_n: [f],
                 dead_man_closed: dead_man,
             });
-            let bits = |x: f32| x.to_bits();
-            let what = format!("{:?} tick {k}", gains.display());
-            assert_eq!(
-                bits(a.actuator_force_n),
-                bits(b.actuator_force_n[0]),
-                "{what}"
-            );
-            assert_eq!(
-                bits(a.commanded_force_n),
-                bits(b.commanded_force_n[0]),
-                "{what}"
-            );
-            assert_eq!(bits(a.velocity_mps), bits(b.velocity_mps[0]), "{what}");
-            assert_eq!(
-                bits(a.ve_velocity_mps),
-                bits(b.ve_velocity_mps[0]),
-                "{what}"
-            );
-            assert_eq!(bits(a.ve_force_n), bits(b.ve_force_n[0]), "{what}");
-            assert_eq!(
-                bits(a.coupling_force_n),
-                bits(b.coupling_force_n[0]),
-                "{what}"
-            );
-            assert_eq!(a.position, b.position[0], "{what}");
-            assert_eq!(a.reference, b.reference[0], "{what}");
-            assert_eq!((a.faults, a.limited), (b.faults, b.limited[0]), "{what}");
+            let b = axes.tick(&SensorFrame {
+                tick,
+                encoder_raw: [raw; 3],
+                load_cell_n: [f; 3],
+                dead_man_closed: dead_man,
+            });
+            for i in 0..3 {
+                let bits = |x: f32| x.to_bits();
+                let what = format!("{:?} tick {k} axis {i}", gains.display());
+                assert_eq!(
+                    bits(a.actuator_force_n[0]),
+                    bits(b.actuator_force_n[i]),
+                    "{what}"
+                );
+                assert_eq!(
+                    bits(a.commanded_force_n[0]),
+                    bits(b.commanded_force_n[i]),
+                    "{what}"
+                );
+                assert_eq!(bits(a.velocity_mps[0]), bits(b.velocity_mps[i]), "{what}");
+                assert_eq!(
+                    bits(a.ve_velocity_mps[0]),
+                    bits(b.ve_velocity_mps[i]),
+                    "{what}"
+                );
+                assert_eq!(bits(a.ve_force_n[0]), bits(b.ve_force_n[i]), "{what}");
+                assert_eq!(
+                    bits(a.coupling_force_n[0]),
+                    bits(b.coupling_force_n[i]),
+                    "{what}"
+                );
+                assert_eq!(a.position[0], b.position[i], "{what}");
+                assert_eq!(a.reference[0], b.reference[i], "{what}");
+                assert_eq!((a.faults, a.limited[0]), (b.faults, b.limited[i]), "{what}");
+            }
             faults_seen += !a.faults.is_empty() as u32;
-            forces_seen += (a.actuator_force_n.abs() > 0.01) as u32;
+            forces_seen += (a.actuator_force_n[0].abs() > 0.01) as u32;
         }
         // The script exercised both the running and the faulted paths.
         assert!(
@@ -159,7 +163,7 @@ fn impedance_axes_each_match_their_composed_z_form() {
             for k in 0..7000u32 {
                 let mut counts = [1000i32; 3];
                 counts[axis] = (300.0 * probe.excitation()).round() as i32;
-                let out = s.tick(&AxesFrame {
+                let out = s.tick(&SensorFrame {
                     tick: k,
                     encoder_raw: counts.map(raw),
                     load_cell_n: [0.0; 3],
@@ -176,7 +180,10 @@ fn impedance_axes_each_match_their_composed_z_form() {
             let Some(LawsRef::Impedance(c)) = s.laws(axis) else {
                 panic!("an impedance servo");
             };
-            let (zc, ye) = (c.tf().eval(z), impedance_of(s.world().tf(axis), z).inv());
+            let (zc, ye) = (
+                c.tf().eval(z),
+                impedance_of(s.world().axis_tf(axis), z).inv(),
+            );
             let want = zc / (1.0 + zc * ye) * (1.0 - z.inv()) / T as f64;
             assert_response(axis, p, probe.response(), want);
         }
@@ -206,7 +213,7 @@ fn admittance_axes_each_match_their_composed_z_form() {
             for k in 0..7000u32 {
                 let mut f = [10.0f32; 3];
                 f[axis] = (20.0 + 5.0 * probe.excitation()) as f32;
-                let out = s.tick(&AxesFrame {
+                let out = s.tick(&SensorFrame {
                     tick: k,
                     encoder_raw: [0; 3],
                     load_cell_n: f,
@@ -227,7 +234,7 @@ fn admittance_axes_each_match_their_composed_z_form() {
                 panic!("an admittance servo");
             };
             let integ = T as f64 / (1.0 - z.inv());
-            let zw = impedance_of(s.world().tf(axis), z);
+            let zw = impedance_of(s.world().axis_tf(axis), z);
             let want = -regulator.tf().eval(z) * integ / (coupling.tf().eval(z) + zw);
             assert_response(axis, p, probe.response(), want);
         }
@@ -240,7 +247,7 @@ fn admittance_axes_each_match_their_composed_z_form() {
 #[test]
 fn a_fault_on_any_axis_zeroes_every_axis_in_the_same_tick() {
     // (what, the axis whose reading goes bad, the bad frame, the fault)
-    type Spoil = fn(&mut AxesFrame<f32, 3>, usize);
+    type Spoil = fn(&mut SensorFrame<f32, 3>, usize);
     let cases: [(&str, Spoil, Faults); 4] = [
         (
             "encoder value too wide",
@@ -278,7 +285,7 @@ fn a_fault_on_any_axis_zeroes_every_axis_in_the_same_tick() {
             // The device rests 2 mm inside the wall on every axis.
             s.calibrate([Position::from_m(2e-3).unwrap(); 3]);
             s.enable().unwrap();
-            let frame = |tick| AxesFrame {
+            let frame = |tick| SensorFrame {
                 tick,
                 encoder_raw: [0; 3],
                 load_cell_n: press,
@@ -333,7 +340,7 @@ fn each_motor_has_its_own_thermal_budget() {
     for k in 0..4000u32 {
         // The device is held still: the position command runs away from it,
         // and the regulator asks for more than any limit.
-        let out = s.tick(&AxesFrame {
+        let out = s.tick(&SensorFrame {
             tick: k,
             encoder_raw: [0; 3],
             load_cell_n: [50.0, 0.0, 0.0],
@@ -357,7 +364,7 @@ fn each_motor_has_its_own_thermal_budget() {
 fn refusals_name_the_axis_and_change_nothing() {
     let world = || PerAxis([cursor(0.5); 3]);
     let safety = [SafetyConfig::excalibur(); 3];
-    let e = AxesServo::new(
+    let e = Servo::new(
         [
             impedance(1e4, 10.0),
             admittance(1e4, 5.0),
@@ -378,7 +385,7 @@ fn refusals_name_the_axis_and_change_nothing() {
         ),
         "{e}"
     );
-    let e = AxesServo::new(
+    let e = Servo::new(
         [
             impedance(1e4, 10.0),
             impedance(1e4, 10.0),
@@ -393,7 +400,7 @@ fn refusals_name_the_axis_and_change_nothing() {
     assert!(e.to_string().starts_with("axis 2: k_c (N/m) = -1"), "{e}");
     let mut slow = safety;
     slow[1].period_s = 2e-3;
-    let e = AxesServo::new([impedance(1e4, 10.0); 3], [encoder(); 3], slow, world()).unwrap_err();
+    let e = Servo::new([impedance(1e4, 10.0); 3], [encoder(); 3], slow, world()).unwrap_err();
     assert_eq!(e.axis, 1, "{e}");
 
     let mut s = three([impedance(1e4, 10.0); 3], world());

@@ -79,7 +79,7 @@ fn servo_on<V: VirtualEnvironment>(gains: ImpedanceGains, ve: V) -> Servo<V> {
     let enc = Encoder::new(32, 1000, 0, Position::ZERO).unwrap();
     let mut safety = SafetyConfig::new(T as f32, 200.0, 100.0);
     safety.max_velocity_mps = 10.0;
-    Servo::new(gains.into(), enc, safety, ve).unwrap()
+    Servo::new([gains.into()], [enc], [safety], ve).unwrap()
 }
 
 fn servo(gains: ImpedanceGains, m_ve: f32) -> Servo<CursorMass> {
@@ -95,7 +95,7 @@ fn wall(gains: ImpedanceGains) -> Servo<BilateralConstraint> {
 }
 
 fn run<V: VirtualEnvironment, L: PortLayer<f32>>(
-    mut s: Servo<V, f32, L>,
+    mut s: Servo<V, f32, 1, L>,
     mut dev: Device,
     push: impl Fn(f64) -> f64,
     ticks: u32,
@@ -108,20 +108,15 @@ fn run<V: VirtualEnvironment, L: PortLayer<f32>>(
     let mut outputs = Vec::new();
     let mut max_damping = 0.0f32;
     for k in 0..ticks {
-        let out = s.tick(&SensorFrame {
-            tick: k,
-            encoder_raw: dev.raw(),
-            load_cell_n: 0.0,
-            dead_man_closed: true,
-        });
-        if damping(s.layer()) > 0.0 && max_damping == 0.0 {
+        let out = s.tick(&SensorFrame::held(k, [dev.raw()], [0.0]));
+        if damping(&s.layers()[0]) > 0.0 && max_damping == 0.0 {
             eprintln!(
                 "tick {k}: first damping {} true E {energy} at {out:?}",
-                damping(s.layer())
+                damping(&s.layers()[0])
             );
         }
-        max_damping = max_damping.max(damping(s.layer()));
-        let f = out.actuator_force_n as f64;
+        max_damping = max_damping.max(damping(&s.layers()[0]));
+        let f = out.actuator_force_n[0] as f64;
         let x0 = dev.x;
         let dissipated = dev.step(f, push(k as f64 * T));
         // The element exerts -f on the port along +x; it takes in
@@ -135,7 +130,7 @@ fn run<V: VirtualEnvironment, L: PortLayer<f32>>(
         // force.
         quant += 0.5e-9 * (f - last_f).abs();
         // Below the velocity floor the layer does not act, by design.
-        if (out.velocity_mps as f64).abs() < MIN_VELOCITY_MPS {
+        if (out.velocity_mps[0] as f64).abs() < MIN_VELOCITY_MPS {
             slow += w.abs();
         }
         last_f = f;
@@ -185,7 +180,7 @@ proptest! {
         prop_assume!(k_c * T * T / (2.0 * m) <= 0.1);
         let gains = ImpedanceGains::new(k_c as f32, b_c as f32);
         let pc = SeriesDamper::new(limits(m, b_dev)).unwrap();
-        let s = wall(gains).with_layer(pc).unwrap();
+        let s = wall(gains).with_layers([pc]).unwrap();
         let dev = Device { m_kg: m, b_dev, k_h, b_h, x: 0.0, v: 0.0 };
         // The hand starts once the servo has ramped its force in: a
         // spring whose force ramps up while it is stretched gives out more
@@ -223,7 +218,7 @@ fn on_a_passive_loop_the_layer_changes_no_bit() {
     let plain = run(servo(gains, 0.5), dev(), push, 20_000, |_| 0.0);
     let pc = SeriesDamper::new(limits(0.7, 60.0)).unwrap();
     let layered = run(
-        servo(gains, 0.5).with_layer(pc).unwrap(),
+        servo(gains, 0.5).with_layers([pc]).unwrap(),
         dev(),
         push,
         20_000,
@@ -233,8 +228,8 @@ fn on_a_passive_loop_the_layer_changes_no_bit() {
     assert_eq!(layered.max_damping_nspm, 0.0);
     for (k, (a, b)) in plain.outputs.iter().zip(&layered.outputs).enumerate() {
         assert_eq!(
-            a.actuator_force_n.to_bits(),
-            b.actuator_force_n.to_bits(),
+            a.actuator_force_n[0].to_bits(),
+            b.actuator_force_n[0].to_bits(),
             "tick {k}"
         );
     }
@@ -242,7 +237,7 @@ fn on_a_passive_loop_the_layer_changes_no_bit() {
     let peak = plain
         .outputs
         .iter()
-        .map(|o| o.actuator_force_n.abs())
+        .map(|o| o.actuator_force_n[0].abs())
         .fold(0.0, f32::max);
     assert!(peak > 1.0, "peak force {peak} N");
 }
@@ -271,7 +266,7 @@ fn an_over_stiff_wall_gives_energy_out_without_the_layer() {
     );
     let pc = SeriesDamper::new(limits(m, b_dev)).unwrap();
     let layered = run(
-        wall(gains).with_layer(pc).unwrap(),
+        wall(gains).with_layers([pc]).unwrap(),
         dev(),
         push,
         5_000,
@@ -288,7 +283,7 @@ fn an_over_stiff_wall_gives_energy_out_without_the_layer() {
     let late = |r: &Run| {
         r.outputs[4000..]
             .iter()
-            .map(|o| o.actuator_force_n.abs())
+            .map(|o| o.actuator_force_n[0].abs())
             .fold(0.0, f32::max)
     };
     // What is left is a ring of a few micrometres, where the velocity
@@ -307,7 +302,7 @@ fn a_layer_for_the_other_display_is_refused() {
     use twoport_control::passivity::{ParallelDamper, ParallelLimits};
     let pd = ParallelDamper::<f32>::new(ParallelLimits::for_display(0.5, 1e-3, 1.0).unwrap());
     let e = servo(ImpedanceGains::new(20_000.0, 40.0), 0.5)
-        .with_layer(pd.unwrap())
+        .with_layers([pd.unwrap()])
         .unwrap_err();
     assert!(e.to_string().contains("admittance"), "{e}");
 }

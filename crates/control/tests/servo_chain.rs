@@ -18,9 +18,9 @@ use common::{encoder, wall, T};
 fn admittance_display_tick_matches_its_composed_z_domain_form() {
     for p in [1usize, 10, 100, 400, 1000, 1999] {
         let mut s = Servo::new(
-            AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into(),
-            encoder(),
-            SafetyConfig::excalibur(),
+            [AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into()],
+            [encoder()],
+            [SafetyConfig::excalibur()],
             wall(20_000.0),
         )
         .unwrap();
@@ -29,10 +29,10 @@ fn admittance_display_tick_matches_its_composed_z_domain_form() {
         let mut probe = SineProbe::new(th.cos(), th.sin());
         for k in 0..7000u32 {
             let f = (20.0 + 5.0 * probe.excitation()) as f32;
-            let out = s.tick(&SensorFrame::held(k, 0, f));
+            let out = s.tick(&SensorFrame::held(k, [0], [f]));
             assert!(out.faults.is_empty());
             if k >= 3000 {
-                probe.record(f as f64, out.actuator_force_n as f64);
+                probe.record(f as f64, out.actuator_force_n[0] as f64);
             } else {
                 probe.skip();
             }
@@ -41,13 +41,13 @@ fn admittance_display_tick_matches_its_composed_z_domain_form() {
         let LawsRef::Admittance {
             coupling,
             regulator,
-        } = s.laws()
+        } = s.laws(0).unwrap()
         else {
             panic!("an admittance servo");
         };
         let kp = regulator.tf().eval(z);
         let integ = T as f64 / (1.0 - z.inv());
-        let zw = match s.ve().tf() {
+        let zw = match s.world().tf() {
             VeTransfer::Impedance(t) => t.eval(z),
             VeTransfer::Admittance(_) => unreachable!(),
         };
@@ -67,30 +67,30 @@ fn bad_sensor_readings_give_zero_force_in_the_same_tick() {
     let bad: [(&str, SensorFrame, Faults); 4] = [
         (
             "NaN load cell",
-            SensorFrame::held(0, 0, f32::NAN),
+            SensorFrame::held(0, [0], [f32::NAN]),
             Faults::SENSOR_NOT_FINITE,
         ),
         (
             "infinite load cell",
-            SensorFrame::held(0, 0, f32::NEG_INFINITY),
+            SensorFrame::held(0, [0], [f32::NEG_INFINITY]),
             Faults::SENSOR_NOT_FINITE,
         ),
         (
             "load cell at rail",
-            SensorFrame::held(0, 0, 1.0e4),
+            SensorFrame::held(0, [0], [1.0e4]),
             Faults::SENSOR_OUT_OF_RANGE,
         ),
         (
             "encoder wider than 16 bits",
-            SensorFrame::held(0, 0x1_0000, 20.0),
+            SensorFrame::held(0, [0x1_0000], [20.0]),
             Faults::ENCODER_INVALID,
         ),
     ];
     for (what, mut bad_frame, fault) in bad {
         let mut s = Servo::new(
-            AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into(),
-            encoder(),
-            SafetyConfig::excalibur(),
+            [AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0).into()],
+            [encoder()],
+            [SafetyConfig::excalibur()],
             CursorMass::new(0.25, T, Position::ZERO).unwrap(),
         )
         .unwrap();
@@ -99,27 +99,29 @@ fn bad_sensor_readings_give_zero_force_in_the_same_tick() {
         // Push 20 N for half a second: the regulator is working.
         let mut last = 0.0;
         for _ in 0..500 {
-            last = s.tick(&SensorFrame::held(tick, 0, 20.0)).actuator_force_n;
+            last = s
+                .tick(&SensorFrame::held(tick, [0], [20.0]))
+                .actuator_force_n[0];
             tick += 1;
         }
         assert!(last.abs() > 1.0, "{what}: regulator idle ({last} N)");
         bad_frame.tick = tick;
         tick += 1;
         let out = s.tick(&bad_frame);
-        assert_eq!(out.actuator_force_n, 0.0, "{what}");
+        assert_eq!(out.actuator_force_n[0], 0.0, "{what}");
         assert!(out.faults.contains(fault), "{what}: {}", out.faults);
         for _ in 0..20 {
-            let out = s.tick(&SensorFrame::held(tick, 0, 20.0));
+            let out = s.tick(&SensorFrame::held(tick, [0], [20.0]));
             tick += 1;
-            assert_eq!(out.actuator_force_n, 0.0, "{what}: latched");
+            assert_eq!(out.actuator_force_n[0], 0.0, "{what}: latched");
         }
         assert!(s.enable().is_err());
         s.clear();
-        let out = s.tick(&SensorFrame::held(tick, 0, 20.0));
+        let out = s.tick(&SensorFrame::held(tick, [0], [20.0]));
         assert!(out.faults.is_empty(), "{what}: {}", out.faults);
         // Re-aligned: the position command restarts at the device, so the
         // first force after clear is small and ramped.
-        assert!(out.actuator_force_n.abs() < 1.0, "{what}: {out:?}");
+        assert!(out.actuator_force_n[0].abs() < 1.0, "{what}: {out:?}");
     }
 }
 
@@ -128,9 +130,9 @@ fn bad_sensor_readings_give_zero_force_in_the_same_tick() {
 #[test]
 fn impedance_display_renders_the_series_of_coupling_and_wall() {
     let mut s = Servo::new(
-        ImpedanceGains::new(51_000.0, 90.0).into(),
-        encoder(),
-        SafetyConfig::excalibur(),
+        [ImpedanceGains::new(51_000.0, 90.0).into()],
+        [encoder()],
+        [SafetyConfig::excalibur()],
         wall(20_000.0),
     )
     .unwrap();
@@ -139,14 +141,14 @@ fn impedance_display_renders_the_series_of_coupling_and_wall() {
     for k in 0..3000u32 {
         // Move to +2 mm (2000 counts) over the first second, then hold.
         let raw = k.min(1000) * 2;
-        out = s.tick(&SensorFrame::held(k, raw, 0.0));
+        out = s.tick(&SensorFrame::held(k, [raw], [0.0]));
     }
     let series = 1.0 / (1.0 / 51_000.0 + 1.0 / 20_000.0);
     let want = series * 2e-3;
     assert!(
-        ((out.actuator_force_n as f64) - want).abs() < 1e-3 * want,
+        ((out.actuator_force_n[0] as f64) - want).abs() < 1e-3 * want,
         "{} N vs {want} N",
-        out.actuator_force_n
+        out.actuator_force_n[0]
     );
-    assert!(s.ve().position().nm() > 0);
+    assert!(s.world().position().nm() > 0);
 }

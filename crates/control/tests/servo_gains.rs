@@ -4,12 +4,12 @@
 use twoport_control::servo::{Display, GainsError};
 use twoport_control::ve::BilateralConstraint;
 use twoport_control::{AdmittanceGains, Encoder, Gains, ImpedanceGains, Position, SafetyConfig};
-use twoport_control::{ParamError, Servo};
+use twoport_control::{AxisError, ParamError, Servo};
 
 fn servo(g: Gains) -> Servo<BilateralConstraint> {
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let ve = BilateralConstraint::new(Position::ZERO);
-    Servo::new(g, enc, SafetyConfig::excalibur(), ve).unwrap()
+    Servo::new([g], [enc], [SafetyConfig::excalibur()], ve).unwrap()
 }
 
 const IMP: ImpedanceGains = ImpedanceGains::new(51_000.0, 90.0);
@@ -19,7 +19,7 @@ const ADM: AdmittanceGains = AdmittanceGains::new(51_000.0, 90.0, 5.0, 500.0);
 fn gains_round_trip_through_the_servo() {
     for g in [Gains::from(IMP), Gains::from(ADM)] {
         let s = servo(g);
-        assert_eq!(s.gains(), g);
+        assert_eq!(s.gains(), [g]);
         assert_eq!(s.display(), g.display());
     }
 }
@@ -28,13 +28,16 @@ fn gains_round_trip_through_the_servo() {
 fn gains_for_the_other_display_are_refused() {
     let mut s = servo(IMP.into());
     assert_eq!(
-        s.set_gains(ADM.into()),
-        Err(GainsError::WrongDisplay {
-            servo: Display::Impedance,
-            gains: Display::Admittance,
-        })
+        s.set_gains([ADM.into()]),
+        Err(AxisError::new(
+            0,
+            GainsError::WrongDisplay {
+                servo: Display::Impedance,
+                gains: Display::Admittance,
+            }
+        ))
     );
-    assert_eq!(s.gains(), IMP.into());
+    assert_eq!(s.gains(), [IMP.into()]);
 }
 
 #[test]
@@ -47,13 +50,16 @@ fn a_refused_admittance_change_changes_nothing() {
         ..ADM
     };
     assert!(matches!(
-        s.set_gains(bad.into()),
-        Err(GainsError::Param(ParamError { .. }))
+        s.set_gains([bad.into()]),
+        Err(AxisError {
+            axis: 0,
+            error: GainsError::Param(ParamError { .. })
+        })
     ));
-    assert_eq!(s.gains(), ADM.into());
+    assert_eq!(s.gains(), [ADM.into()]);
     let good = AdmittanceGains { m_kg: 6.0, ..ADM };
-    s.set_gains(good.into()).unwrap();
-    assert_eq!(s.gains(), good.into());
+    s.set_gains([good.into()]).unwrap();
+    assert_eq!(s.gains(), [good.into()]);
 }
 
 #[test]
@@ -61,5 +67,5 @@ fn invalid_gains_are_refused_at_construction() {
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let ve = BilateralConstraint::new(Position::ZERO);
     let bad = ImpedanceGains::new(-1.0, -1.0);
-    assert!(Servo::new(bad.into(), enc, SafetyConfig::excalibur(), ve).is_err());
+    assert!(Servo::new([bad.into()], [enc], [SafetyConfig::excalibur()], ve).is_err());
 }

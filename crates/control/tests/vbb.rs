@@ -44,7 +44,7 @@ fn free_space_is_the_cursor_mass_on_every_axis() {
     for k in 0..300 {
         let f = (k as f32 * 0.05).sin() * 3.0;
         let p = ports([f, -f, 0.5 * f], 40.0);
-        let out = w.step(&p);
+        let out = w.step_axes(&p);
         let want = one.step(p[0]);
         let err = (out[0].velocity_mps - want.velocity_mps).abs();
         assert!(err <= 1e-6, "tick {k}: {err} m/s apart");
@@ -62,13 +62,13 @@ fn a_face_stops_the_body_without_penetration_or_bounce() {
     let floor_contact_nm = 1_000_000; // the cursor's half-width
     let mut lowest = i32::MAX;
     for _ in 0..300 {
-        let out = w.step(&ports([0.0, 0.0, -50.0], 10.0));
+        let out = w.step_axes(&ports([0.0, 0.0, -50.0], 10.0));
         lowest = lowest.min(w.cursor()[2].nm());
         assert!(out[2].velocity_mps <= 0.0, "it never bounces up");
     }
     assert_eq!(lowest, floor_contact_nm);
     for _ in 0..50 {
-        let out = w.step(&ports([0.0; 3], 10.0));
+        let out = w.step_axes(&ports([0.0; 3], 10.0));
         assert_eq!(out[2].velocity_mps, 0.0);
     }
     assert_eq!(w.cursor()[2].nm(), floor_contact_nm);
@@ -81,17 +81,17 @@ fn friction_holds_inside_its_cone_and_slides_outside() {
     let mut w = world(&[]);
     w.place_cursor([0.0, 0.0, 0.001]);
     for _ in 0..10 {
-        w.step(&ports([0.0, 0.0, -10.0], 1e-3));
+        w.step_axes(&ports([0.0, 0.0, -10.0], 1e-3));
     }
     let x0 = w.cursor()[0];
     for _ in 0..200 {
-        let out = w.step(&ports([2.0, 0.0, -10.0], 1e-3));
+        let out = w.step_axes(&ports([2.0, 0.0, -10.0], 1e-3));
         assert_eq!(out[0].velocity_mps, 0.0);
     }
     assert_eq!(w.cursor()[0], x0);
     let mut v = 0.0;
     for _ in 0..100 {
-        v = w.step(&ports([5.0, 0.0, -10.0], 1e-3))[0].velocity_mps;
+        v = w.step_axes(&ports([5.0, 0.0, -10.0], 1e-3))[0].velocity_mps;
     }
     // a = (5 - 0.3 x 10) / 0.25 = 8 m/s^2 for 0.1 s.
     assert!((v - 0.8).abs() < 0.01, "{v} m/s");
@@ -106,7 +106,7 @@ fn drive_to(w: &mut World8, target_m: [f32; 3], ticks: u32) {
             f0_n: 400.0 * (target_m[a] - x[a].m()),
             z_nspm: 40.0,
         });
-        w.step(&p);
+        w.step_axes(&p);
     }
 }
 
@@ -151,7 +151,7 @@ fn a_block_is_carried_stacked_on_another_and_dropped() {
     assert!(z0 > 60.0, "{z0} mm");
     w.release();
     for _ in 0..1000 {
-        w.step(&ports([0.0; 3], 40.0));
+        w.step_axes(&ports([0.0; 3], 40.0));
     }
     assert_eq!(w.blocks()[1].min[2].nm(), 0, "on the floor");
 }
@@ -203,7 +203,7 @@ proptest! {
         };
         let mut e_in = 0.0f64;
         for _ in 0..2000 {
-            let out = w.step(&ports([force(), force(), force()], z_n));
+            let out = w.step_axes(&ports([force(), force(), force()], z_n));
             let ke: f64 = out.iter().map(|o| 0.5 * m * (o.velocity_mps as f64).powi(2)).sum();
             e_in += out.iter().map(|o| (o.force_n * o.velocity_mps * T) as f64).sum::<f64>();
             let pe = m_b * G_MPS2 as f64 * (z_of(&w) - z0);
@@ -218,14 +218,14 @@ proptest! {
 /// spring push it up, 51,000 N/m x 2 mm, and nothing sideways.
 #[test]
 fn the_three_axis_servo_renders_a_blocks_top() {
-    use twoport_control::servo::{AxesFrame, AxesServo, ImpedanceGains};
+    use twoport_control::servo::{ImpedanceGains, SensorFrame, Servo};
     use twoport_control::{Encoder, SafetyConfig};
     let top = cube(-0.015, -0.015, 0.0, 0.03, 0.1);
     let top_nm = top.size_nm[2];
     let w = world(&[top]);
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let g = ImpedanceGains::new(51_000.0, 90.0).into();
-    let mut s = AxesServo::new([g; 3], [enc; 3], [SafetyConfig::excalibur(); 3], w).unwrap();
+    let mut s = Servo::new([g; 3], [enc; 3], [SafetyConfig::excalibur(); 3], w).unwrap();
     // The device starts 10 mm above the cursor's contact with the top.
     let contact_nm = top_nm + 1_000_000;
     s.calibrate([0, 0, contact_nm + 10_000_000].map(Position::from_nm));
@@ -235,7 +235,7 @@ fn the_three_axis_servo_renders_a_blocks_top() {
         // Down 12 mm over 1.2 s, then hold: 2 mm below the contact.
         let dz_um = (k as i32).min(1200) * 10;
         let raw = (-dz_um) as u32 & 0xFFFF;
-        out = Some(s.tick(&AxesFrame {
+        out = Some(s.tick(&SensorFrame {
             tick: k,
             encoder_raw: [0, 0, raw],
             load_cell_n: [0.0; 3],
@@ -265,7 +265,7 @@ fn a_block_falls_when_its_support_is_pulled_away() {
     drive_to(&mut w, [-0.06, 0.015, 0.015], 1500);
     assert!(mm(w.blocks()[0].min[0]) < -40.0, "A slid out");
     for _ in 0..500 {
-        w.step(&ports([0.0; 3], 40.0));
+        w.step_axes(&ports([0.0; 3], 40.0));
     }
     assert_eq!(w.blocks()[1].min[2].nm(), 0, "B fell to the floor");
 }
@@ -295,7 +295,7 @@ fn knobs_carry_mate_hold_and_part() {
                 let x = w.cursor();
                 let hold = |a: usize, at: f32| 400.0 * (at - x[a].m());
                 let p = [hold(0, 0.015 + offset_m), hold(1, 0.015), f_n];
-                w.step(&p.map(|f0_n| Port { f0_n, z_nspm: 40.0 }));
+                w.step_axes(&p.map(|f0_n| Port { f0_n, z_nspm: 40.0 }));
             }
         };
         press(&mut w, -3.0, 1500);
@@ -349,7 +349,7 @@ fn bad_worlds_are_refused_by_name() {
 /// amplifier's limit holds the force (the paper's cursor needed 0.25 kg).
 #[test]
 fn the_explicit_scheme_rings_where_the_implicit_one_settles() {
-    use twoport_control::servo::{AxesFrame, AxesServo, ImpedanceGains};
+    use twoport_control::servo::{ImpedanceGains, SensorFrame, Servo};
     use twoport_control::{Encoder, SafetyConfig};
     // The largest force the coupling asked for over the last 100 of 500
     // ticks (N).
@@ -367,14 +367,14 @@ fn the_explicit_scheme_rings_where_the_implicit_one_settles() {
             ramp_ticks: 1,
             ..SafetyConfig::excalibur()
         };
-        let mut s = AxesServo::new([g; 3], [enc; 3], [safety; 3], w).unwrap();
+        let mut s = Servo::new([g; 3], [enc; 3], [safety; 3], w).unwrap();
         s.calibrate(start);
         s.enable().unwrap();
         // (After enable, which re-aligns the world to the device.)
         s.world_mut().place_cursor([0.001, 0.0, start[2].m()]);
         let mut worst = 0.0f32;
         for k in 0..500u32 {
-            let out = s.tick(&AxesFrame {
+            let out = s.tick(&SensorFrame {
                 tick: k,
                 encoder_raw: [0; 3],
                 load_cell_n: [0.0; 3],

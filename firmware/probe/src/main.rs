@@ -117,8 +117,8 @@ fn servo_wall_and_fault(t: &mut Tally) {
     let mut k = 0u32;
     while k < 3000 {
         f = s
-            .tick(&SensorFrame::held(k, k.min(1000) * 2, 0.0))
-            .actuator_force_n;
+            .tick(&SensorFrame::held(k, [k.min(1000) * 2], [0.0]))
+            .actuator_force_n[0];
         k += 1;
     }
     let want = 2e-3 / (1.0 / 51_000.0 + 1.0 / 20_000.0);
@@ -126,10 +126,10 @@ fn servo_wall_and_fault(t: &mut Tally) {
         "wall renders the series stiffness",
         libm::fabsf(f - want) < 1e-3 * want,
     );
-    let out = s.tick(&SensorFrame::held(k, 0x1_0000, 0.0));
+    let out = s.tick(&SensorFrame::held(k, [0x1_0000], [0.0]));
     t.check(
         "invalid encoder value gives zero force in the same tick",
-        out.actuator_force_n == 0.0 && out.faults.contains(Faults::ENCODER_INVALID),
+        out.actuator_force_n[0] == 0.0 && out.faults.contains(Faults::ENCODER_INVALID),
     );
 }
 
@@ -150,7 +150,7 @@ fn timing_wall() -> UnilateralWall {
 /// The impedance display at the paper's coupling on `wall`.
 fn paper_servo(enc: Encoder, wall: UnilateralWall) -> Servo<UnilateralWall> {
     let gains = ImpedanceGains::new(51_000.0, 90.0);
-    Servo::new(gains.into(), enc, SafetyConfig::excalibur(), wall).unwrap()
+    Servo::new([gains.into()], [enc], [SafetyConfig::excalibur()], wall).unwrap()
 }
 
 /// The servo tick's cost in QEMU: SysTick counts the 25 MHz system clock, and
@@ -167,8 +167,8 @@ fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
     syst.clear_current();
     syst.enable_counter();
     let (per_tick, empty) = counts_per_call(1000, |k| {
-        let f = SensorFrame::held(k, core::hint::black_box(k % 1000 * 2), 0.0);
-        s.tick(&f).actuator_force_n
+        let f = SensorFrame::held(k, [core::hint::black_box(k % 1000 * 2)], [0.0]);
+        s.tick(&f).actuator_force_n[0]
     });
     hprintln!("  empty loop: {} instructions per iteration", empty / 1.6);
     hprintln!(
@@ -184,7 +184,6 @@ fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
 /// (the same sweep into each as the one-axis tick's) or the building-block
 /// world of 50 blocks with the cursor pressing into one's top.
 fn tick_cost_axes(t: &mut Tally) {
-    use twoport_control::servo::{AxesFrame, AxesServo};
     use twoport_control::world::vbb::{Block, Vbb, VbbConfig};
     use twoport_control::world::PerAxis;
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
@@ -192,7 +191,7 @@ fn tick_cost_axes(t: &mut Tally) {
     let safety = [SafetyConfig::excalibur(); 3];
     let sweep = |k: u32| {
         let raw = core::hint::black_box(k % 1000 * 2);
-        AxesFrame {
+        SensorFrame {
             tick: k,
             encoder_raw: [raw; 3],
             load_cell_n: [0.0; 3],
@@ -200,7 +199,7 @@ fn tick_cost_axes(t: &mut Tally) {
         }
     };
     let walls = PerAxis([timing_wall(); 3]);
-    let mut s = AxesServo::new([gains; 3], [enc; 3], safety, walls).unwrap();
+    let mut s = Servo::new([gains; 3], [enc; 3], safety, walls).unwrap();
     let _ = s.enable();
     let (per_tick, _) = counts_per_call(1000, |k| s.tick(&sweep(k)).actuator_force_n[2]);
     hprintln!(
@@ -220,14 +219,14 @@ fn tick_cost_axes(t: &mut Tally) {
     let mut cfg = VbbConfig::excalibur(T);
     cfg.held_weight = true;
     let world = Vbb::<f32, 50>::new(cfg, &blocks).unwrap();
-    let mut s = AxesServo::new([gains; 3], [enc; 3], safety, world).unwrap();
+    let mut s = Servo::new([gains; 3], [enc; 3], safety, world).unwrap();
     let top = blocks[25];
     let x = |a: usize| top.min[a].offset_nm(top.size_nm[a] / 2);
     s.calibrate([x(0), x(1), top.min[2].offset_nm(top.size_nm[2] + 1_000_000)]);
     let _ = s.enable();
     let down = |k: u32| {
         let raw = core::hint::black_box((k % 1000 * 2).wrapping_neg() & 0xFFFF);
-        AxesFrame {
+        SensorFrame {
             encoder_raw: [0, 0, raw],
             ..sweep(k)
         }
@@ -254,27 +253,27 @@ fn tick_cost_layered(t: &mut Tally) {
         let origin = Position::from_nm(first_raw as i32 * 1000);
         let enc = Encoder::new(16, 1_000_000, first_raw, origin).unwrap();
         let pc = SeriesDamper::new(limits).unwrap();
-        let mut s = paper_servo(enc, timing_wall()).with_layer(pc).unwrap();
+        let mut s = paper_servo(enc, timing_wall()).with_layers([pc]).unwrap();
         let _ = s.enable();
         s
     };
     let mut s = layered(0);
     let (pressing, _) = counts_per_call(1000, |k| {
-        let f = SensorFrame::held(k, core::hint::black_box(k * 2), 0.0);
-        s.tick(&f).actuator_force_n
+        let f = SensorFrame::held(k, [core::hint::black_box(k * 2)], [0.0]);
+        s.tick(&f).actuator_force_n[0]
     });
-    let passive = s.layer().damping_nspm() == 0.0 && s.safety().faults().is_empty();
+    let passive = s.layers()[0].damping_nspm() == 0.0 && s.safety().faults().is_empty();
     let mut s = layered(2000);
     let (withdrawing, _) = counts_per_call(1000, |k| {
-        let f = SensorFrame::held(k, core::hint::black_box(2000 - k * 2), 0.0);
-        s.tick(&f).actuator_force_n
+        let f = SensorFrame::held(k, [core::hint::black_box(2000 - k * 2)], [0.0]);
+        s.tick(&f).actuator_force_n[0]
     });
     // The same sweep again, untimed, to count the ticks the layer damped.
     let mut s = layered(2000);
     let mut damped = 0u32;
     for k in 0..1000 {
-        s.tick(&SensorFrame::held(k, 2000 - k * 2, 0.0));
-        damped += (s.layer().damping_nspm() > 0.0) as u32;
+        s.tick(&SensorFrame::held(k, [2000 - k * 2], [0.0]));
+        damped += (s.layers()[0].damping_nspm() > 0.0) as u32;
     }
     hprintln!(
         "  impedance servo tick with the passivity layer, pressing (passive): {} instructions",
@@ -306,18 +305,18 @@ fn tick_cost_ve_port(t: &mut Tally) {
         let limits = ParallelLimits::for_display(0.05, T, 1.0).unwrap();
         let ve = PassiveVe::new(cursor, limits).unwrap();
         let gains = ImpedanceGains::new(51_000.0, 90.0);
-        let mut s = Servo::new(gains.into(), enc, SafetyConfig::excalibur(), ve).unwrap();
+        let mut s = Servo::new([gains.into()], [enc], [SafetyConfig::excalibur()], ve).unwrap();
         let _ = s.enable();
         s
     };
-    let sweep = |k: u32| SensorFrame::held(k, core::hint::black_box(k % 1000 * 2), 0.0);
+    let sweep = |k: u32| SensorFrame::held(k, [core::hint::black_box(k % 1000 * 2)], [0.0]);
     let mut s = servo();
-    let (per_tick, _) = counts_per_call(1000, |k| s.tick(&sweep(k)).actuator_force_n);
+    let (per_tick, _) = counts_per_call(1000, |k| s.tick(&sweep(k)).actuator_force_n[0]);
     let mut s = servo();
     let mut acting = 0u32;
     for k in 0..1000 {
         s.tick(&sweep(k));
-        acting += (s.ve().conductance_mpns() > 0.0) as u32;
+        acting += (s.world().conductance_mpns() > 0.0) as u32;
     }
     hprintln!(
         "  impedance servo tick with the passivity layer at the VE (damping on {} of 1000 ticks): {} instructions",
@@ -330,9 +329,9 @@ fn tick_cost_ve_port(t: &mut Tally) {
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let cursor = ExplicitCursor::new_in(0.25, T, Position::ZERO).unwrap();
     let gains = ImpedanceGains::new(51_000.0, 90.0);
-    let mut bare = Servo::new(gains.into(), enc, SafetyConfig::excalibur(), cursor).unwrap();
+    let mut bare = Servo::new([gains.into()], [enc], [SafetyConfig::excalibur()], cursor).unwrap();
     let _ = bare.enable();
-    let (bare_tick, _) = counts_per_call(1000, |k| bare.tick(&sweep(k)).actuator_force_n);
+    let (bare_tick, _) = counts_per_call(1000, |k| bare.tick(&sweep(k)).actuator_force_n[0]);
     hprintln!(
         "  the same tick on a bare explicit cursor (0.25 kg): {} instructions (faults: {})",
         bare_tick / 1.6,

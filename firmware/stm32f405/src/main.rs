@@ -71,10 +71,8 @@ pub const AXES: usize = 1;
 pub const AXES: usize = 3;
 
 #[cfg(not(feature = "xyz"))]
-type TheBoard = twoport_board::Board<
-    twoport_control::Servo<twoport_control::ve::UnilateralWall>,
-    { excalibur::REGION_POINTS },
->;
+type TheBoard =
+    twoport_board::Board<twoport_control::ve::UnilateralWall, { excalibur::REGION_POINTS }>;
 #[cfg(feature = "xyz")]
 type TheBoard = excalibur::xyz::XyzBoard;
 

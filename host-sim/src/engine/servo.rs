@@ -30,7 +30,7 @@ pub enum SceneServo {
 }
 
 /// The board's servo with the scene's port layer, computing in `R`.
-pub type LayeredServo<R> = Servo<SceneVe<R>, R, SceneLayer<R>>;
+pub type LayeredServo<R> = Servo<SceneVe<R>, R, 1, SceneLayer<R>>;
 
 /// `$e` on the servo whatever its variant.
 macro_rules! each_servo {
@@ -64,12 +64,12 @@ fn build<R: Real>(
         }
         _ => ve,
     };
-    Servo::new_in(scene.gains(), encoder, safety, ve).map_err(|e| e.to_string())
+    Servo::new_in([scene.gains()], [encoder], [safety], ve).map_err(|e| e.error.to_string())
 }
 
 fn enabled<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>>(
-    mut s: Servo<V, R, L>,
-) -> Result<Box<Servo<V, R, L>>, String> {
+    mut s: Servo<V, R, 1, L>,
+) -> Result<Box<Servo<V, R, 1, L>>, String> {
     s.enable()
         .map_err(|f| format!("the servo would not enable: {f}"))?;
     Ok(Box::new(s))
@@ -79,7 +79,7 @@ fn layered<R: Real>(
     s: Servo<SceneVe<R>, R>,
     layer: SceneLayer<R>,
 ) -> Result<Box<LayeredServo<R>>, String> {
-    enabled(s.with_layer(layer).map_err(|e| e.to_string())?)
+    enabled(s.with_layers([layer]).map_err(|e| e.error.to_string())?)
 }
 
 fn set_wall<R: Real>(ve: &mut SceneVe<R>, surface: Position, k_npm: f32) -> Result<(), String> {
@@ -97,21 +97,22 @@ pub(crate) fn frame_f32(f: &SensorFrame<f64>) -> SensorFrame {
     SensorFrame {
         tick: f.tick,
         encoder_raw: f.encoder_raw,
-        load_cell_n: f.load_cell_n as f32,
+        load_cell_n: f.load_cell_n.map(|f| f as f32),
         dead_man_closed: f.dead_man_closed,
     }
 }
 
 /// An f32 servo's output, widened.
 pub(crate) fn output_f64(o: ServoOutput) -> ServoOutput<f64> {
+    let wide = |x: [f32; 1]| x.map(f64::from);
     ServoOutput {
-        actuator_force_n: o.actuator_force_n as f64,
-        commanded_force_n: o.commanded_force_n as f64,
+        actuator_force_n: wide(o.actuator_force_n),
+        commanded_force_n: wide(o.commanded_force_n),
         position: o.position,
-        velocity_mps: o.velocity_mps as f64,
-        ve_velocity_mps: o.ve_velocity_mps as f64,
-        ve_force_n: o.ve_force_n as f64,
-        coupling_force_n: o.coupling_force_n as f64,
+        velocity_mps: wide(o.velocity_mps),
+        ve_velocity_mps: wide(o.ve_velocity_mps),
+        ve_force_n: wide(o.ve_force_n),
+        coupling_force_n: wide(o.coupling_force_n),
         reference: o.reference,
         faults: o.faults,
         limited: o.limited,
@@ -147,25 +148,25 @@ impl SceneServo {
 
     /// The VE's position.
     pub fn ve_position(&self) -> Position {
-        each_servo!(self, s => s.ve().position())
+        each_servo!(self, s => s.world().position())
     }
 
     /// The gains in force.
     pub fn gains(&self) -> Gains {
-        each_servo!(self, s => s.gains())
+        each_servo!(self, s => s.gains()[0])
     }
 
     /// The passivity layer, if the scene runs one (at the device's port,
     /// or at the VE's), or its element delay.
     pub fn layer(&self) -> Option<LayerView<'_>> {
         match self {
-            SceneServo::F32Layered(s) => Some(LayerView::Device32(s.layer())),
-            SceneServo::F64Layered(s) => Some(LayerView::Device64(s.layer())),
-            SceneServo::F32(s) => match s.ve() {
+            SceneServo::F32Layered(s) => Some(LayerView::Device32(&s.layers()[0])),
+            SceneServo::F64Layered(s) => Some(LayerView::Device64(&s.layers()[0])),
+            SceneServo::F32(s) => match s.world() {
                 SceneVe::Passive(p) => Some(LayerView::Ve32(p)),
                 _ => None,
             },
-            SceneServo::F64(s) => match s.ve() {
+            SceneServo::F64(s) => match s.world() {
                 SceneVe::Passive(p) => Some(LayerView::Ve64(p)),
                 _ => None,
             },
@@ -175,7 +176,7 @@ impl SceneServo {
     /// Change the gains while running (the scope's sliders); they must be
     /// for the scene's display.
     pub fn set_gains(&mut self, g: Gains) -> Result<(), String> {
-        each_servo!(self, s => s.set_gains(g)).map_err(|e| e.to_string())
+        each_servo!(self, s => s.set_gains([g])).map_err(|e| e.error.to_string())
     }
 
     /// Move the wall and change its stiffness while running (the scope's
@@ -185,7 +186,7 @@ impl SceneServo {
             "wall position {surface_m} m is out of range (±2.147 m)"
         ))?;
         let k = stiffness_npm as f32;
-        each_servo!(self, s => set_wall(s.ve_mut(), x, k))
+        each_servo!(self, s => set_wall(s.world_mut(), x, k))
     }
 }
 

@@ -421,8 +421,8 @@ impl Simulation {
         let f_m = if self.load_cell { self.x[2 * n] } else { 0.0 };
         SensorFrame {
             tick: self.tick as u32,
-            encoder_raw: raw,
-            load_cell_n: self.effects.adc(f_m, timing),
+            encoder_raw: [raw],
+            load_cell_n: [self.effects.adc(f_m, timing)],
             dead_man_closed: true,
         }
     }
@@ -463,7 +463,7 @@ impl Simulation {
             Some(c) => output_f64(c(&frame_f32(&frame))),
             None => self.servo.tick(&frame),
         };
-        let f_a = self.effects.saturate(out.actuator_force_n, timing);
+        let f_a = self.effects.saturate(out.actuator_force_n[0], timing);
         self.held_force = f_a;
         if !out.faults.is_empty() && self.failure.is_none() {
             self.failure = Some(format!("the safety layer tripped: {}", out.faults));
@@ -552,15 +552,15 @@ impl Simulation {
             handle_m: x_h,
             handle_mps: v_h,
             human_n: f_h,
-            commanded_n: out.commanded_force_n,
+            commanded_n: out.commanded_force_n[0],
             actuator_n: f_a,
             ve_m: if is_external {
-                out.reference.m() as f64
+                out.reference[0].m() as f64
             } else {
                 self.servo.ve_position().m() as f64
             },
-            ve_n: out.ve_force_n,
-            coupling_n: out.coupling_force_n,
+            ve_n: out.ve_force_n[0],
+            coupling_n: out.coupling_force_n[0],
             energy_in_j: self.energy_in,
             energy_stored_j: stored,
             layer_energy_j,

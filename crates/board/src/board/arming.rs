@@ -14,14 +14,15 @@
 //! request with a [`Message::ModeRefused`] that names the reason.
 
 use super::Board;
-use crate::drive::Drive;
 use crate::support::BoardSupport;
 use twoport_control::homing::{Homing, HomingState};
-use twoport_control::servo::AxesOutput;
+use twoport_control::servo::PortLayer;
+use twoport_control::servo::ServoOutput;
+use twoport_control::world::World;
 use twoport_control::{Faults, Position};
 use twoport_link::{Axes, Message, Mode, ModeRefusal, ModeRequest, Status};
 
-impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
+impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R, N, L> {
     /// Where the state machine is.
     pub fn mode(&self) -> Mode {
         self.mode
@@ -34,7 +35,8 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
 
     /// The state the link reports.
     pub fn status(&self) -> Status {
-        let (faults, first) = self.servo.faults();
+        let safety = self.servo.safety();
+        let (faults, first) = (safety.faults(), safety.first_fault());
         Status {
             mode: self.mode,
             calibrated: self.calibrated,
@@ -73,7 +75,7 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
     }
 
     fn latched(&self) -> Option<ModeRefusal> {
-        let (f, _) = self.servo.faults();
+        let f = self.servo.safety().faults();
         (!f.is_empty()).then_some(ModeRefusal::Faulted { faults: f.0 })
     }
 
@@ -171,7 +173,7 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
     /// axis's homing run that has ended calibrates its encoder (the axis
     /// then holds no force) or latches its failure. The board is
     /// calibrated when every axis has homed.
-    pub(super) fn after_tick(&mut self, out: &AxesOutput<f32, N>) {
+    pub(super) fn after_tick(&mut self, out: &ServoOutput<f32, N>) {
         if let Some(mut runs) = self.homing {
             let mut seeking = false;
             for (axis, run) in runs.iter_mut().enumerate() {
@@ -186,7 +188,8 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
                         continue;
                     }
                     (_, _, HomingState::Found) => {
-                        self.servo.calibrate_axis(axis, cfg.stop_position);
+                        // (The loop calibrates only axes it has.)
+                        let _ = self.servo.calibrate_axis(axis, cfg.stop_position);
                         true
                     }
                     (_, _, HomingState::TimedOut) => false,

@@ -3,19 +3,20 @@
 //! reason, over the link), saved on the host's request while disarmed.
 
 use super::Board;
-use crate::drive::Drive;
 use crate::io::IoScale;
 use embedded_storage::nor_flash::NorFlash;
 use twoport_config::{Config, HomingSetup, Limits, LoadCell, Store};
 use twoport_control::homing::HomingConfig;
 use twoport_control::servo::Gains;
+use twoport_control::servo::PortLayer;
+use twoport_control::world::World;
 use twoport_control::{Position, SafetyConfig};
 use twoport_link::{ConfigFallback, ConfigSource, Message, Mode, ModeRefusal, ModeRequest};
 
-impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
+impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R, N, L> {
     /// The configuration in force, each axis's as a record would store it.
     pub fn config(&self) -> [Config; N] {
-        let limits = self.servo.limits();
+        let limits = *self.servo.safety().configs();
         let gains = self.servo.gains();
         core::array::from_fn(|i| self.axis_config(i, &limits[i], gains[i]))
     }
@@ -61,7 +62,7 @@ impl<S: Drive<N>, const R: usize, const N: usize> Board<S, R, N> {
         if self.check(&gains).is_err() {
             return Err(ConfigFallback::NotProven);
         }
-        let now = self.servo.limits();
+        let now = *self.servo.safety().configs();
         let limits: [SafetyConfig; N] = core::array::from_fn(|i| SafetyConfig {
             peak_force_n: cfg[i].limits.peak_force_n,
             continuous_force_n: cfg[i].limits.continuous_force_n,

@@ -10,7 +10,7 @@ use super::{
 use crate::io::IoScale;
 use crate::Board;
 use twoport_control::homing::HomingConfig;
-use twoport_control::servo::AxesServo;
+use twoport_control::servo::Servo;
 use twoport_control::world::vbb::{Block, Vbb, VbbConfig};
 use twoport_control::Position;
 use twoport_control::{Encoder, ParamError};
@@ -39,10 +39,10 @@ pub const MAX_BLOCKS: usize = BLOCKS.len();
 pub type World = Vbb<f32, MAX_BLOCKS>;
 
 /// The image's servo type.
-pub type XyzServo = AxesServo<World, f32, 3>;
+pub type XyzServo = Servo<World, f32, 3>;
 
 /// The image's board type.
-pub type XyzBoard = Board<XyzServo, REGION_POINTS, 3>;
+pub type XyzBoard = Board<World, REGION_POINTS, 3>;
 
 /// The image's world, its cursor at rest at the workspace's centre, 10 mm
 /// above the floor.
@@ -68,8 +68,12 @@ const BLOCK: BuildError = BuildError::Param(ParamError {
 pub fn servo() -> Result<XyzServo, BuildError> {
     let (bits, pm) = ENCODER;
     let enc = Encoder::new(bits, pm, 0, Position::ZERO)?;
-    AxesServo::new([COUPLING.into(); 3], [enc; 3], [safety(); 3], world()?)
-        .map_err(|e| BuildError::Layer(e.error))
+    Ok(Servo::new(
+        [COUPLING.into(); 3],
+        [enc; 3],
+        [safety(); 3],
+        world()?,
+    )?)
 }
 
 /// The whole three-axis board: the x axis's region on every axis, the same

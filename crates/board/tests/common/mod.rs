@@ -6,7 +6,7 @@ use twoport_control::ve::BilateralConstraint;
 use twoport_control::{Encoder, ImpedanceGains, Position, SafetyConfig, Servo};
 
 /// The board every test drives.
-pub type TestBoard = Board<Servo<BilateralConstraint>, 3>;
+pub type TestBoard = Board<BilateralConstraint, 3>;
 
 /// A proven region of three damping points (N s/m) and their largest
 /// stiffness (N/m).
@@ -26,9 +26,9 @@ pub fn region() -> Region<3> {
 pub fn board(k_npm: f32, safety: SafetyConfig, telemetry_every: u32) -> TestBoard {
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let s = Servo::new(
-        ImpedanceGains::new(k_npm, 90.0).into(),
-        enc,
-        safety,
+        [ImpedanceGains::new(k_npm, 90.0).into()],
+        [enc],
+        [safety],
         BilateralConstraint::new(Position::ZERO),
     )
     .unwrap();

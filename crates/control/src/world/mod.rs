@@ -1,5 +1,6 @@
-//! Virtual environments of `N` Cartesian axes, for the multi-axis servo
-//! ([`AxesServo`](crate::servo::AxesServo)).
+//! Virtual environments of `N` Cartesian axes, for the
+//! [`Servo`](crate::servo::Servo). On one axis, every
+//! [`VirtualEnvironment`] is a world.
 //!
 //! Each axis has its own coupling, and each coupling hands the world its
 //! law for this tick as a [`Port`] (`f = f0 - z v` along that axis). The
@@ -23,25 +24,55 @@ use crate::{Position, Real};
 /// holds a non-finite number.
 pub trait World<R: Real, const N: usize> {
     /// Solve this tick exactly against every axis's coupling and commit.
-    fn step(&mut self, ports: &[Port<R>; N]) -> [VeOutput<R>; N];
+    fn step_axes(&mut self, ports: &[Port<R>; N]) -> [VeOutput<R>; N];
     /// Put the coupled point at rest at `x`.
-    fn reset(&mut self, x: &[Position; N]);
+    fn reset_axes(&mut self, x: &[Position; N]);
     /// The point each axis's coupling holds, per axis (see
     /// [`VirtualEnvironment::position`]).
-    fn position(&self) -> [Position; N];
-    /// [`position`](Self::position) minus `from`, per axis, in metres, with
-    /// any sub-nanometre part the world carries.
+    fn positions(&self) -> [Position; N];
+    /// [`positions`](Self::positions) minus `from`, per axis, in metres,
+    /// with any sub-nanometre part the world carries.
     #[inline]
-    fn offset_m(&self, from: &[Position; N]) -> [R; N] {
-        let x = self.position();
+    fn offsets_m(&self, from: &[Position; N]) -> [R; N] {
+        let x = self.positions();
         core::array::from_fn(|i| x[i].nm_from::<R>(from[i]) * R::M_PER_NM)
     }
     /// Axis `axis`'s law in the z-domain, the others held still (for a
     /// piecewise law, the piece its documentation names).
-    fn tf(&self, axis: usize) -> VeTransfer;
+    fn axis_tf(&self, axis: usize) -> VeTransfer;
 }
 
-/// `N` one-axis VEs, one per axis, that do not interact: a wall along z and
+/// One axis's world is a one-axis VE.
+impl<R: Real, V: VirtualEnvironment<R>> World<R, 1> for V {
+    #[inline(always)]
+    fn step_axes(&mut self, [port]: &[Port<R>; 1]) -> [VeOutput<R>; 1] {
+        [self.step(*port)]
+    }
+
+    #[inline(always)]
+    fn reset_axes(&mut self, [x]: &[Position; 1]) {
+        self.reset(*x);
+    }
+
+    #[inline(always)]
+    fn positions(&self) -> [Position; 1] {
+        [self.position()]
+    }
+
+    #[inline(always)]
+    fn offsets_m(&self, [from]: &[Position; 1]) -> [R; 1] {
+        [self.offset_m(*from)]
+    }
+
+    fn axis_tf(&self, axis: usize) -> VeTransfer {
+        match axis {
+            0 => self.tf(),
+            _ => VeTransfer::Impedance(crate::ZTransfer::gain(0.0)),
+        }
+    }
+}
+
+/// `N` one-axis VEs (2 to 8), one per axis, that do not interact: a wall along z and
 /// free space along x and y, or the same spring on every axis.
 ///
 /// # Examples
@@ -54,7 +85,7 @@ pub trait World<R: Real, const N: usize> {
 /// let mut w = PerAxis([wall; 3]);
 /// // x pushed into its wall, y pulled away from its own, z left alone.
 /// let ports = [5.0, -5.0, 0.0].map(|f0_n| Port { f0_n, z_nspm: 100.0 });
-/// let out = w.step(&ports);
+/// let out = w.step_axes(&ports);
 /// // Each axis answers as its wall alone would.
 /// for (o, p) in out.iter().zip(ports) {
 ///     assert_eq!(*o, wall.clone().step(p));
@@ -64,38 +95,47 @@ pub trait World<R: Real, const N: usize> {
 #[derive(Clone, Copy, Debug)]
 pub struct PerAxis<V, const N: usize>(pub [V; N]);
 
-impl<R: Real, V: VirtualEnvironment<R>, const N: usize> World<R, N> for PerAxis<V, N> {
-    #[inline(always)]
-    fn step(&mut self, ports: &[Port<R>; N]) -> [VeOutput<R>; N] {
-        let mut out = [VeOutput {
-            velocity_mps: R::ZERO,
-            force_n: R::ZERO,
-        }; N];
-        for ((o, ve), port) in out.iter_mut().zip(&mut self.0).zip(ports) {
-            *o = ve.step(*port);
+// (Two axes and more: on one axis the VE is the world itself, and a
+// blanket impl for every `N` would overlap that one.)
+macro_rules! per_axis {
+    ($($n:literal)*) => {$(
+        impl<R: Real, V: VirtualEnvironment<R>> World<R, $n> for PerAxis<V, $n> {
+            #[inline(always)]
+            fn step_axes(&mut self, ports: &[Port<R>; $n]) -> [VeOutput<R>; $n] {
+                let mut out = [VeOutput {
+                    velocity_mps: R::ZERO,
+                    force_n: R::ZERO,
+                }; $n];
+                for ((o, ve), port) in out.iter_mut().zip(&mut self.0).zip(ports) {
+                    *o = ve.step(*port);
+                }
+                out
+            }
+
+            fn reset_axes(&mut self, x: &[Position; $n]) {
+                for (ve, x) in self.0.iter_mut().zip(x) {
+                    ve.reset(*x);
+                }
+            }
+
+            #[inline(always)]
+            fn positions(&self) -> [Position; $n] {
+                core::array::from_fn(|i| self.0[i].position())
+            }
+
+            #[inline(always)]
+            fn offsets_m(&self, from: &[Position; $n]) -> [R; $n] {
+                core::array::from_fn(|i| self.0[i].offset_m(from[i]))
+            }
+
+            fn axis_tf(&self, axis: usize) -> VeTransfer {
+                match self.0.get(axis) {
+                    Some(ve) => ve.tf(),
+                    None => VeTransfer::Impedance(crate::ZTransfer::gain(0.0)),
+                }
+            }
         }
-        out
-    }
-
-    fn reset(&mut self, x: &[Position; N]) {
-        for (ve, x) in self.0.iter_mut().zip(x) {
-            ve.reset(*x);
-        }
-    }
-
-    fn position(&self) -> [Position; N] {
-        core::array::from_fn(|i| self.0[i].position())
-    }
-
-    #[inline(always)]
-    fn offset_m(&self, from: &[Position; N]) -> [R; N] {
-        core::array::from_fn(|i| self.0[i].offset_m(from[i]))
-    }
-
-    fn tf(&self, axis: usize) -> VeTransfer {
-        match self.0.get(axis) {
-            Some(ve) => ve.tf(),
-            None => VeTransfer::Impedance(crate::ZTransfer::gain(0.0)),
-        }
-    }
+    )*};
 }
+
+per_axis!(2 3 4 5 6 7 8);

@@ -158,7 +158,7 @@ fn extent_of(b: &Block) -> Extent {
     }
 }
 
-/// The building-block world, for [`AxesServo`](crate::servo::AxesServo)'s
+/// The building-block world, for the [`Servo`](crate::servo::Servo)'s
 /// three axes, holding up to `B` blocks.
 ///
 /// # Examples
@@ -174,7 +174,7 @@ fn extent_of(b: &Block) -> Extent {
 /// // Push down with 5 N: the cube's top holds the cursor.
 /// let push = [0.0, 0.0, -5.0].map(|f0_n| Port { f0_n, z_nspm: 100.0 });
 /// for _ in 0..100 {
-///     w.step(&push);
+///     w.step_axes(&push);
 /// }
 /// assert!(w.cursor()[2].nm() >= 31_000_000 - 1_000_000);
 /// // Grab it and pull up with 5 N: the block comes along, its 0.98 N of
@@ -182,7 +182,7 @@ fn extent_of(b: &Block) -> Extent {
 /// assert!(w.grab());
 /// let lift = [0.0, 0.0, 5.0].map(|f0_n| Port { f0_n, z_nspm: 100.0 });
 /// for _ in 0..100 {
-///     w.step(&lift);
+///     w.step_axes(&lift);
 /// }
 /// assert!(w.blocks()[0].min[2].nm() > 1_000_000);
 /// # Ok::<(), twoport_control::ParamError>(())
@@ -482,7 +482,7 @@ impl<R: Real, const B: usize> Vbb<R, B> {
 }
 
 impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
-    fn step(&mut self, ports: &[Port<R>; 3]) -> [VeOutput<R>; 3] {
+    fn step_axes(&mut self, ports: &[Port<R>; 3]) -> [VeOutput<R>; 3] {
         if !ports
             .iter()
             .all(|p| p.f0_n.is_finite() && p.z_nspm.is_finite())
@@ -614,21 +614,21 @@ impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
         out
     }
 
-    fn reset(&mut self, x: &[Position; 3]) {
+    fn reset_axes(&mut self, x: &[Position; 3]) {
         self.place_cursor_at(*x);
     }
 
-    fn position(&self) -> [Position; 3] {
+    fn positions(&self) -> [Position; 3] {
         self.cursor()
     }
 
     #[inline]
-    fn offset_m(&self, from: &[Position; 3]) -> [R; 3] {
+    fn offsets_m(&self, from: &[Position; 3]) -> [R; 3] {
         [0, 1, 2].map(|a| self.cursor[a].offset_m(from[a]))
     }
 
     /// Free space: the body's mass, `(T/m) / (1 - z^-1)`.
-    fn tf(&self, _axis: usize) -> VeTransfer {
+    fn axis_tf(&self, _axis: usize) -> VeTransfer {
         let t_over_m = self.t.to_f64() / self.body_mass_kg() as f64;
         VeTransfer::Admittance(ZTransfer::first_order([t_over_m, 0.0], -1.0))
     }

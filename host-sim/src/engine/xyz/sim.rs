@@ -6,7 +6,7 @@ use crate::engine::plant::{Device, Method, Stepper};
 use crate::engine::sim::Pick;
 use crate::engine::stability::Detector;
 use crate::engine::xyz::scene::{XyzScene, XyzVe, MAX_BLOCKS};
-use twoport_control::servo::{AxesFrame, AxesOutput, AxesServo, ImpedanceGains};
+use twoport_control::servo::{ImpedanceGains, SensorFrame, Servo, ServoOutput};
 use twoport_control::ve::{BilateralConstraint, Port, VeOutput, VeTransfer};
 use twoport_control::world::vbb::{Block, Vbb, VbbConfig};
 use twoport_control::world::{PerAxis, World};
@@ -25,34 +25,34 @@ pub enum XyzWorld {
 }
 
 impl World<f32, 3> for XyzWorld {
-    fn step(&mut self, ports: &[Port; 3]) -> [VeOutput; 3] {
+    fn step_axes(&mut self, ports: &[Port; 3]) -> [VeOutput; 3] {
         match self {
-            XyzWorld::Blocks(w) => w.step(ports),
-            XyzWorld::Bilateral(w) => w.step(ports),
+            XyzWorld::Blocks(w) => w.step_axes(ports),
+            XyzWorld::Bilateral(w) => w.step_axes(ports),
         }
     }
-    fn reset(&mut self, x: &[Position; 3]) {
+    fn reset_axes(&mut self, x: &[Position; 3]) {
         match self {
-            XyzWorld::Blocks(w) => w.reset(x),
-            XyzWorld::Bilateral(w) => World::<f32, 3>::reset(w, x),
+            XyzWorld::Blocks(w) => w.reset_axes(x),
+            XyzWorld::Bilateral(w) => World::<f32, 3>::reset_axes(w, x),
         }
     }
-    fn position(&self) -> [Position; 3] {
+    fn positions(&self) -> [Position; 3] {
         match self {
-            XyzWorld::Blocks(w) => w.position(),
-            XyzWorld::Bilateral(w) => World::<f32, 3>::position(w),
+            XyzWorld::Blocks(w) => w.positions(),
+            XyzWorld::Bilateral(w) => World::<f32, 3>::positions(w),
         }
     }
-    fn offset_m(&self, from: &[Position; 3]) -> [f32; 3] {
+    fn offsets_m(&self, from: &[Position; 3]) -> [f32; 3] {
         match self {
-            XyzWorld::Blocks(w) => w.offset_m(from),
-            XyzWorld::Bilateral(w) => w.offset_m(from),
+            XyzWorld::Blocks(w) => w.offsets_m(from),
+            XyzWorld::Bilateral(w) => w.offsets_m(from),
         }
     }
-    fn tf(&self, axis: usize) -> VeTransfer {
+    fn axis_tf(&self, axis: usize) -> VeTransfer {
         match self {
-            XyzWorld::Blocks(w) => w.tf(axis),
-            XyzWorld::Bilateral(w) => World::<f32, 3>::tf(w, axis),
+            XyzWorld::Blocks(w) => w.axis_tf(axis),
+            XyzWorld::Bilateral(w) => World::<f32, 3>::axis_tf(w, axis),
         }
     }
 }
@@ -113,7 +113,7 @@ pub struct XyzSimulation {
     /// The hand along each axis.
     humans: [Human; 3],
     /// The board's three-axis servo and its world.
-    servo: AxesServo<XyzWorld, f32, 3>,
+    servo: Servo<XyzWorld, f32, 3>,
     /// The ticks the mouse button grabs and lets go.
     grabs: Vec<u64>,
     releases: Vec<u64>,
@@ -187,13 +187,13 @@ impl XyzSimulation {
         };
         let plants = [plant(&humans[0])?, plant(&humans[1])?, plant(&humans[2])?];
         let world = world_of(&scene.ve)?;
-        let start = world.position();
+        let start = world.positions();
         // Ideal sensing: 1 nm counts on a 32-bit counter.
         let enc = Encoder::new(32, 1000, 0, Position::ZERO).map_err(|e| format!("{e:?}"))?;
         let gains = scene
             .couplings()
             .map(|c| ImpedanceGains::new(c.k.unwrap_or(0.0) as f32, c.b as f32).into());
-        let mut servo = AxesServo::new(gains, [enc; 3], [SafetyConfig::excalibur(); 3], world)
+        let mut servo = Servo::new(gains, [enc; 3], [SafetyConfig::excalibur(); 3], world)
             .map_err(|e| format!("coupling: {e}"))?;
         // The device's zero is the world's starting point.
         servo.calibrate(start);
@@ -232,7 +232,7 @@ impl XyzSimulation {
     }
 
     /// The running servo and its world.
-    pub fn servo(&self) -> &AxesServo<XyzWorld, f32, 3> {
+    pub fn servo(&self) -> &Servo<XyzWorld, f32, 3> {
         &self.servo
     }
 
@@ -331,7 +331,7 @@ impl XyzSimulation {
         self.tick += 1;
         let (cursor, held) = match self.servo.world() {
             XyzWorld::Blocks(w) => (w.cursor(), w.held()),
-            XyzWorld::Bilateral(w) => (World::<f32, 3>::position(w), None),
+            XyzWorld::Bilateral(w) => (World::<f32, 3>::positions(w), None),
         };
         XyzSample {
             t_s: self.tick as f64 * T,
@@ -353,7 +353,7 @@ impl XyzSimulation {
                 w.release();
             }
         }
-        let out: AxesOutput<f32, 3> = self.servo.tick(&AxesFrame {
+        let out: ServoOutput<f32, 3> = self.servo.tick(&SensorFrame {
             tick: self.tick as u32,
             encoder_raw: raw,
             load_cell_n: [0.0; 3],
