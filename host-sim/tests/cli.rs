@@ -216,3 +216,36 @@ fn a_screenshot_without_a_display_is_a_clear_error() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("--screenshot needs a window"), "{err}");
 }
+
+/// Every subcommand `host-sim --help` lists has its row in the crate's
+/// README, and the README lists none that is gone.
+#[test]
+fn the_readme_lists_every_subcommand() {
+    let out = Command::new(HOST_SIM.bin).arg("--help").output().unwrap();
+    let help = String::from_utf8_lossy(&out.stdout);
+    let listed: Vec<&str> = help
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|c| *c != "help")
+        .collect();
+    assert!(listed.len() >= 7, "{help}");
+    let readme =
+        std::fs::read_to_string(Path::new(HOST_SIM.root).join("host-sim/README.md")).unwrap();
+    let rows: Vec<&str> = readme
+        .lines()
+        .filter_map(|l| l.strip_prefix("| `"))
+        .filter_map(|l| l.split('`').next())
+        .collect();
+    for c in &listed {
+        assert!(rows.contains(c), "README lacks `{c}`: {rows:?}");
+    }
+    for r in &rows {
+        assert!(
+            listed.contains(r),
+            "README lists `{r}`, which --help does not"
+        );
+    }
+}

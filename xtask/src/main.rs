@@ -15,6 +15,7 @@
 //! - `fuzz [seconds]`: run each cargo-fuzz target (default 60 s each).
 //! - `accuracy`: regenerate docs/accuracy.md and docs/accuracy.png.
 
+mod counts;
 mod toolchain;
 
 use std::path::{Path, PathBuf};
@@ -731,14 +732,29 @@ fn qemu() -> Result<(), String> {
     eprintln!("xtask: run {} in QEMU mps2-an386", elf.display());
     let mut child = qemu_an386(&elf)
         .arg("-nographic")
+        .stdout(Stdio::piped())
         .spawn()
         .map_err(|e| format!("qemu-system-arm: could not start ({e}); install qemu-system-arm"))?;
+    // Echo the probe's lines as they come, and keep them for the counts.
+    let stdout = child.stdout.take().ok_or("qemu: no stdout")?;
+    let reader = std::thread::spawn(move || {
+        use std::io::BufRead;
+        let mut all = String::new();
+        for line in std::io::BufReader::new(stdout)
+            .lines()
+            .map_while(Result::ok)
+        {
+            println!("{line}");
+            all.push_str(&line);
+            all.push('\n');
+        }
+        all
+    });
     // A hung target (a lost exit, a fault loop) must not hang CI.
     let deadline = Instant::now() + Duration::from_secs(300);
-    loop {
+    let status = loop {
         match child.try_wait() {
-            Ok(Some(status)) if status.success() => return Ok(()),
-            Ok(Some(status)) => return Err(format!("on-target tests failed ({status})")),
+            Ok(Some(status)) => break status,
             Ok(None) if Instant::now() > deadline => {
                 let _ = child.kill();
                 return Err("on-target tests timed out after 300 s".into());
@@ -746,5 +762,32 @@ fn qemu() -> Result<(), String> {
             Ok(None) => std::thread::sleep(Duration::from_millis(50)),
             Err(e) => return Err(format!("waiting for qemu: {e}")),
         }
+    };
+    let output = reader
+        .join()
+        .map_err(|_| "qemu: the output reader failed")?;
+    if !status.success() {
+        return Err(format!("on-target tests failed ({status})"));
+    }
+    check_counts(&output)
+}
+
+/// The probe's counts against `firmware/probe/counts.txt`.
+fn check_counts(output: &str) -> Result<(), String> {
+    let path = root().join("firmware/probe/counts.txt");
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let problems = counts::compare(&counts::measured(output)?, &counts::expected(&text, &path)?);
+    if problems.is_empty() {
+        eprintln!(
+            "xtask: every instruction count within its tolerance ({})",
+            path.display()
+        );
+        Ok(())
+    } else {
+        Err(format!(
+            "instruction counts moved (change the code back, or {} with it):\n  {}",
+            path.display(),
+            problems.join("\n  ")
+        ))
     }
 }

@@ -40,6 +40,12 @@ impl Tally {
     }
 }
 
+/// One instruction count, as `COUNT <name> <instructions> <what>`: the
+/// line `cargo xtask qemu` checks against `firmware/probe/counts.txt`.
+fn count(name: &str, instructions: f32, what: &str) {
+    hprintln!("COUNT {} {} {}", name, instructions, what);
+}
+
 fn z_of(p: u32) -> Complex64 {
     let th = 2.0 * core::f64::consts::PI * p as f64 / WINDOW as f64;
     Complex64::new(libm::cos(th), libm::sin(th))
@@ -170,11 +176,11 @@ fn tick_cost(t: &mut Tally, syst: &mut cortex_m::peripheral::SYST) {
         let f = SensorFrame::held(k, [core::hint::black_box(k % 1000 * 2)], [0.0]);
         s.tick(&f).actuator_force_n[0]
     });
-    hprintln!("  empty loop: {} instructions per iteration", empty / 1.6);
-    hprintln!(
-        "  impedance servo tick (encoder, estimator, Z_cI, wall, safety): {} SysTick counts = {} instructions",
-        per_tick,
-        per_tick / 1.6
+    count("empty_loop", empty / 1.6, "an empty loop's iteration");
+    count(
+        "impedance_tick",
+        per_tick / 1.6,
+        "impedance servo tick (encoder, estimator, Z_cI, wall, safety)",
     );
     t.check("servo tick measured", per_tick > 0.0);
 }
@@ -202,9 +208,10 @@ fn tick_cost_axes(t: &mut Tally) {
     let mut s = Servo::new([gains; 3], [enc; 3], safety, walls).unwrap();
     let _ = s.enable();
     let (per_tick, _) = counts_per_call(1000, |k| s.tick(&sweep(k)).actuator_force_n[2]);
-    hprintln!(
-        "  3-axis impedance servo tick (a wall on each axis): {} instructions",
-        per_tick / 1.6
+    count(
+        "xyz_walls_tick",
+        per_tick / 1.6,
+        "3-axis impedance servo tick, a wall on each axis",
     );
     // 50 blocks of 20 mm in a 10 x 5 grid on the floor; the cursor rests on
     // the middle one's top and the device sweeps 2 mm into it along z.
@@ -233,12 +240,15 @@ fn tick_cost_axes(t: &mut Tally) {
     };
     // (100 ticks: 1,000 of them would run SysTick's 24-bit count over.)
     let (per_tick, _) = counts_per_call(100, |k| s.tick(&down(k)).actuator_force_n[2]);
-    hprintln!(
-        "  3-axis impedance servo tick on the 50-block world: {} instructions (faults: {})",
+    count(
+        "xyz_blocks50_tick",
         per_tick / 1.6,
-        s.safety().faults()
+        "3-axis impedance servo tick on the 50-block world",
     );
-    t.check("3-axis tick measured", per_tick > 0.0);
+    t.check(
+        "3-axis tick measured",
+        per_tick > 0.0 && s.safety().faults().is_empty(),
+    );
 }
 
 /// The same tick with the passivity layer (the series damper) between the
@@ -275,15 +285,17 @@ fn tick_cost_layered(t: &mut Tally) {
         s.tick(&SensorFrame::held(k, [2000 - k * 2], [0.0]));
         damped += (s.layers()[0].damping_nspm() > 0.0) as u32;
     }
-    hprintln!(
-        "  impedance servo tick with the passivity layer, pressing (passive): {} instructions",
-        pressing / 1.6
+    count(
+        "series_damper_pressing_tick",
+        pressing / 1.6,
+        "impedance tick with the series damper, pressing (passive)",
     );
-    hprintln!(
-        "  impedance servo tick with the passivity layer, withdrawing (damping on {} of 1000 ticks): {} instructions",
-        damped,
-        withdrawing / 1.6
+    count(
+        "series_damper_withdrawing_tick",
+        withdrawing / 1.6,
+        "impedance tick with the series damper, withdrawing (damping)",
     );
+    hprintln!("  the series damper damped on {} of 1000 ticks", damped);
     t.check("passivity layer idle while pressing", passive);
     t.check(
         "passivity layer damping while withdrawing",
@@ -318,11 +330,12 @@ fn tick_cost_ve_port(t: &mut Tally) {
         s.tick(&sweep(k));
         acting += (s.world().conductance_mpns() > 0.0) as u32;
     }
-    hprintln!(
-        "  impedance servo tick with the passivity layer at the VE (damping on {} of 1000 ticks): {} instructions",
-        acting,
-        per_tick / 1.6
+    count(
+        "ve_port_layer_tick",
+        per_tick / 1.6,
+        "impedance tick with the passivity layer at the VE's port",
     );
+    hprintln!("  the VE-port layer acted on {} of 1000 ticks", acting);
     // The same servo on a bare cursor, for the layer's share. A bare 50 g
     // cursor rings up and trips the safety layer, so this one is the
     // paper's 0.25 kg: the cursor's code is the same for any mass.
@@ -332,10 +345,10 @@ fn tick_cost_ve_port(t: &mut Tally) {
     let mut bare = Servo::new([gains.into()], [enc], [SafetyConfig::excalibur()], cursor).unwrap();
     let _ = bare.enable();
     let (bare_tick, _) = counts_per_call(1000, |k| bare.tick(&sweep(k)).actuator_force_n[0]);
-    hprintln!(
-        "  the same tick on a bare explicit cursor (0.25 kg): {} instructions (faults: {})",
+    count(
+        "explicit_cursor_tick",
         bare_tick / 1.6,
-        bare.safety().faults()
+        "the same tick on a bare explicit cursor (0.25 kg)",
     );
     let mut c = CompensatedSum::<f32>::new();
     let (kahan, _) = counts_per_call(1000, |k| {
@@ -347,10 +360,15 @@ fn tick_cost_ve_port(t: &mut Tally) {
         d += core::hint::black_box(k as f32 * 1e-6) as f64;
         d as f32
     });
-    hprintln!(
-        "  energy sum per term: f32 compensated {} , f64 (soft-float) {} instructions",
+    count(
+        "energy_sum_f32",
         kahan / 1.6,
-        double / 1.6
+        "energy sum per term, f32 compensated",
+    );
+    count(
+        "energy_sum_f64",
+        double / 1.6,
+        "energy sum per term, f64 (soft float)",
     );
     t.check(
         "VE-port layer measured",
@@ -408,12 +426,17 @@ fn cost_breakdown() {
         };
         safety.step(&i, (k % 7) as f32).force_n
     });
-    hprintln!(
-        "  per stage: encoder + estimator {} , coupling + wall {} , safety {} instructions",
+    count(
+        "stage_sense",
         sense / 1.6,
-        law / 1.6,
-        safe / 1.6
+        "tick stage: encoder and estimator",
     );
+    count(
+        "stage_coupling_wall",
+        law / 1.6,
+        "tick stage: coupling and wall",
+    );
+    count("stage_safety", safe / 1.6, "tick stage: safety layer");
 }
 
 #[entry]
