@@ -315,3 +315,45 @@ fn the_design_plot_shows_the_margin_in_decades() {
         light.worst_hz
     );
 }
+
+/// The live design plot draws only what a log axis can show: the human
+/// bound of the default scene is not positive over a band of frequencies
+/// (any coupling meets it there), so it is drawn as separate runs that
+/// stop at that band, no value is drawn below the frame, and the legend
+/// names the band.
+#[test]
+fn the_design_plot_draws_only_what_a_log_axis_can_show() {
+    use host_sim::scope::ui::LogCurve;
+    // A synthetic bound: positive, dipping through zero, positive again.
+    let pts: Vec<(f64, f64)> = (1..=100)
+        .map(|i| {
+            let f = i as f64;
+            (f, (f - 50.0).abs() - 10.0 + 1e-30)
+        })
+        .collect();
+    let c = LogCurve::new(&pts, -3.0);
+    assert_eq!(c.runs.len(), 2, "{:?}", c.not_positive);
+    assert_eq!(c.not_positive, [(41.0, 59.0)]);
+    assert!(c.points().all(|p| p[1] >= -3.0 && p[1].is_finite()));
+    assert_eq!(c.legend("bound"), "bound\n≤ 0 (not drawn) at 41-59 Hz");
+
+    let h = harness();
+    let light = h.state().0.light.as_ref().unwrap();
+    let fig = light.figure.as_ref().unwrap();
+    let bound = &fig.curves[fig.curves.len() - 2];
+    let c = LogCurve::new(&bound.points, -8.0);
+    assert!(!c.not_positive.is_empty(), "{}", bound.label);
+    for (a, b) in &c.not_positive {
+        assert!(*a <= *b && *b < 1000.0, "{a} to {b} Hz");
+    }
+    // The band the filled wedge used to cover, between about 30 and 60 Hz.
+    assert!(
+        c.not_positive.iter().any(|(a, b)| *a < 40.0 && *b > 60.0),
+        "{:?}",
+        c.not_positive
+    );
+    assert!(c.runs.len() >= 2);
+    assert!(c
+        .legend(&bound.label)
+        .contains("≤ 0 (not drawn) at 0.05-11.7, 34.7-80.5 Hz"));
+}

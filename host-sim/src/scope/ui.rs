@@ -256,15 +256,79 @@ fn light(ui: &mut Ui, s: &ScopeState) {
     });
 }
 
+/// A curve of the design figure as a log-log axis can show it: each run of
+/// positive values as its own line of `[log10 f, log10 v]` points, a value
+/// below `floor` (decades) drawn at the floor so that a dive leaves the
+/// plot at its bottom edge, and the spans where the value is not positive
+/// (there any coupling meets the bound), which a log axis cannot draw.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LogCurve {
+    /// The runs of positive values, each a line of its own.
+    pub runs: Vec<Vec<[f64; 2]>>,
+    /// Each span of non-positive values: its first and last frequency (Hz).
+    pub not_positive: Vec<(f64, f64)>,
+}
+
+impl LogCurve {
+    /// `points` (frequency in Hz, value), in rising frequency.
+    pub fn new(points: &[(f64, f64)], floor: f64) -> Self {
+        let mut c = LogCurve::default();
+        let mut run = Vec::new();
+        let mut span: Option<(f64, f64)> = None;
+        for &(f, v) in points.iter().filter(|(f, v)| *f > 0.0 && !v.is_nan()) {
+            if v > 0.0 {
+                if let Some(s) = span.take() {
+                    c.not_positive.push(s);
+                }
+                run.push([f.log10(), v.log10().max(floor)]);
+            } else {
+                if !run.is_empty() {
+                    c.runs.push(std::mem::take(&mut run));
+                }
+                span = Some(span.map_or((f, f), |(a, _)| (a, f)));
+            }
+        }
+        c.runs.extend((!run.is_empty()).then_some(run));
+        c.not_positive.extend(span);
+        c
+    }
+
+    /// Every drawn point, run after run.
+    pub fn points(&self) -> impl Iterator<Item = [f64; 2]> + '_ {
+        self.runs.iter().flatten().copied()
+    }
+
+    /// The curve's legend name: `label`, and where it is not positive.
+    pub fn legend(&self, label: &str) -> String {
+        if self.not_positive.is_empty() {
+            return label.to_string();
+        }
+        let spans: Vec<String> = self
+            .not_positive
+            .iter()
+            .map(|(a, b)| format!("{}-{}", hz(*a), hz(*b)))
+            .collect();
+        // (On a second line: the panel is narrow.)
+        format!("{label}\n≤ 0 (not drawn) at {} Hz", spans.join(", "))
+    }
+}
+
+/// A frequency to three significant figures, without trailing zeros.
+fn hz(f: f64) -> String {
+    let digits = (2 - f.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{f:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 /// A curve of the design figure on log-log axes: `[log10 f, log10 v]`,
 /// leaving out the points where the value is not positive (where the bound
 /// turns negative any coupling meets it), as the paper's figures do.
 pub fn log_log(points: &[(f64, f64)]) -> Vec<[f64; 2]> {
-    points
-        .iter()
-        .filter(|(f, v)| *f > 0.0 && *v > 0.0 && v.is_finite())
-        .map(|(f, v)| [f.log10(), v.log10()])
-        .collect()
+    LogCurve::new(points, f64::NEG_INFINITY).points().collect()
 }
 
 /// A grid line at every decade of an axis in decades (a linear spacer
@@ -297,12 +361,11 @@ pub fn design_panel(ui: &mut Ui, s: &ScopeState) {
         return;
     };
     ui.label(RichText::new(&fig.y_label).small());
-    let curves: Vec<Vec<[f64; 2]>> = fig.curves.iter().map(|c| log_log(&c.points)).collect();
     // Framed on the coupling's decades (the last curve) and one below: the
     // bound's dives at the resonances run off the bottom, as in the paper.
-    let (lo, hi) = curves
-        .last()
-        .into_iter()
+    let coupling = fig.curves.last().map(|c| log_log(&c.points));
+    let (lo, hi) = coupling
+        .iter()
         .flatten()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
             (l.min(p[1]), h.max(p[1]))
@@ -312,9 +375,10 @@ pub fn design_panel(ui: &mut Ui, s: &ScopeState) {
     } else {
         (-6.0, 0.0)
     };
+    let bottom = lo.floor() - 1.0;
     Plot::new("design-bound")
         .height(210.0)
-        .include_y(lo.floor() - 1.0)
+        .include_y(bottom)
         .include_y(hi.ceil() + 0.5)
         .auto_bounds([true, false])
         // The curves rise to the right and dive at the resonances: the
@@ -327,14 +391,19 @@ pub fn design_panel(ui: &mut Ui, s: &ScopeState) {
         .x_grid_spacer(decades)
         .y_grid_spacer(decades)
         .show(ui, |p| {
-            for (i, (c, pts)) in fig.curves.iter().zip(curves).enumerate() {
+            for (i, c) in fig.curves.iter().enumerate() {
                 let color = Color32::from_rgb(c.color.0, c.color.1, c.color.2);
-                p.line(
-                    Line::new(c.label.clone(), PlotPoints::from(pts))
-                        .color(color)
-                        .width(c.width as f32)
-                        .id(("design", i)),
-                );
+                // Just below the frame: a dive leaves through the bottom.
+                let curve = LogCurve::new(&c.points, bottom - 0.5);
+                let name = curve.legend(&c.label);
+                for (j, run) in curve.runs.into_iter().enumerate() {
+                    p.line(
+                        Line::new(name.clone(), PlotPoints::from(run))
+                            .color(color)
+                            .width(c.width as f32)
+                            .id(("design", i, j)),
+                    );
+                }
             }
         });
 }
