@@ -2,6 +2,7 @@
 #![forbid(unsafe_code)]
 
 pub mod engine;
+pub mod link;
 pub mod pil;
 pub mod scope;
 pub mod study;

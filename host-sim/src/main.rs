@@ -4,7 +4,7 @@
 use clap::{Args, Parser, Subcommand};
 use host_sim::engine::scene::Scene;
 use host_sim::study::{passivity, sweep, table1};
-use host_sim::{Report, Sample, Simulation};
+use host_sim::{link, Report, Sample, Simulation};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use std::io::Write;
@@ -509,11 +509,11 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         Some(t) => return Err(format!("--link-loss-at-s {t}: must be in [0, --seconds)")),
         None => None,
     };
-    let faults = pil::Faults {
+    let faults = link::Faults {
         corrupt_every: a.corrupt_every,
         link_loss_at,
     };
-    let port = a.port.as_deref().map(pil::SerialBoard::open).transpose()?;
+    let port = a.port.as_deref().map(link::SerialBoard::open).transpose()?;
     let start = std::time::Instant::now();
     if xyz {
         if a.passivity {
@@ -524,7 +524,7 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         let reference = pil::run_xyz(
             scene.clone(),
             ticks,
-            pil::LocalBoard::excalibur_xyz()?,
+            link::LocalBoard::excalibur_xyz()?,
             faults,
         )?;
         let local_s = start.elapsed().as_secs_f64();
@@ -544,11 +544,11 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         pil::run(
             scene.clone(),
             ticks,
-            pil::LocalBoard::excalibur_with_passivity()?,
+            link::LocalBoard::excalibur_with_passivity()?,
             faults,
         )?
     } else {
-        pil::run(scene.clone(), ticks, pil::LocalBoard::excalibur()?, faults)?
+        pil::run(scene.clone(), ticks, link::LocalBoard::excalibur()?, faults)?
     };
     let local_s = start.elapsed().as_secs_f64();
     let run = port
@@ -562,7 +562,7 @@ fn pil(a: &PilArgs) -> Result<(), String> {
 fn pil_report<S: host_sim::pil::PilSample>(
     a: &PilArgs,
     ticks: u64,
-    faults: host_sim::pil::Faults,
+    faults: host_sim::link::Faults,
     reference: host_sim::pil::Run<S>,
     run: Option<host_sim::pil::Run<S>>,
     local_s: f64,

@@ -10,200 +10,20 @@
 
 use crate::engine::sim::round_counts;
 use crate::engine::xyz::{XyzSample, XyzScene, XyzSimulation};
+use crate::link::{BoardPort, Faults, Session};
 use crate::{Sample, Scene, Simulation};
-use std::collections::VecDeque;
-use std::time::{Duration, Instant};
-use twoport_board::excalibur::{self, xyz, REGION_POINTS};
-use twoport_board::{Board, BoardSupport, RawSensors};
-use twoport_config::{RamFlash, Store};
-use twoport_control::passivity::SeriesDamper;
-use twoport_control::servo::{Direct, PortLayer, SensorFrame, ServoOutput};
-use twoport_control::ve::UnilateralWall;
-use twoport_control::world::World;
+use twoport_board::excalibur::{self, xyz};
+use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::Faults as BoardFaults;
 use twoport_link::{
-    encode, Axes, ConfigSource, Decoder, LinkStats, Message, Mode, ModeRequest, Role,
-    SensorFrame as LinkSensors, Status, Telemetry, MAX_FRAME,
+    Axes, ConfigSource, LinkStats, Message, Mode, ModeRequest, SensorFrame as LinkSensors, Status,
+    Telemetry,
 };
 
 /// How far a homed board's position may be from the plant's: the stop's
 /// give under the homing force (25 µm on the scenes' 2e5 N/m stop) and a
 /// count or two.
 pub const HOMING_TOLERANCE_M: f64 = 50e-6;
-
-/// How long the host waits for the board's answer to one frame.
-pub const ANSWER_TIMEOUT: Duration = Duration::from_secs(5);
-/// Heartbeats go out every this many ticks (the board's watchdog allows
-/// [`excalibur::HEARTBEAT_TIMEOUT_TICKS`]).
-pub const HEARTBEAT_EVERY: u64 = 10;
-
-/// The board end of the link.
-pub trait BoardPort {
-    /// Send bytes to the board.
-    fn send(&mut self, bytes: &[u8]) -> Result<(), String>;
-    /// Bytes from the board: waits up to `timeout` for at least one.
-    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, String>;
-}
-
-/// A serial port: the firmware in QEMU (`-serial pty`) or a real board.
-pub struct SerialBoard(Box<dyn serialport::SerialPort>);
-
-impl SerialBoard {
-    /// Open `path` (115200 8N1; a pty ignores the rate).
-    pub fn open(path: &str) -> Result<Self, String> {
-        serialport::new(path, 115_200)
-            .timeout(Duration::from_millis(20))
-            .open()
-            .map(SerialBoard)
-            .map_err(|e| format!("serial port {path}: {e}"))
-    }
-}
-
-impl BoardPort for SerialBoard {
-    fn send(&mut self, bytes: &[u8]) -> Result<(), String> {
-        std::io::Write::write_all(&mut self.0, bytes).map_err(|e| format!("serial write: {e}"))
-    }
-    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, String> {
-        let _ = self.0.set_timeout(timeout);
-        match std::io::Read::read(&mut self.0, buf) {
-            Ok(n) => Ok(n),
-            Err(e) if e.kind() == std::io::ErrorKind::TimedOut => Ok(0),
-            Err(e) => Err(format!("serial read: {e}")),
-        }
-    }
-}
-
-/// The Excalibur board image's loop, in this process: the plain image's,
-/// the passivity image's (`S` with the series damper), or the three-axis
-/// image's (`N` = 3).
-pub struct LocalBoard<W = UnilateralWall, const N: usize = 1, L = Direct> {
-    board: Board<W, REGION_POINTS, N, L>,
-    link: HostLink,
-    /// Its stored configuration, in RAM as on the QEMU images.
-    store: Store<RamFlash<512, 256>>,
-}
-
-/// The in-process board's only peripheral: its link, as two byte queues.
-#[derive(Default)]
-struct HostLink {
-    rx: VecDeque<u8>,
-    out: Vec<u8>,
-}
-
-impl<const N: usize> BoardSupport<N> for HostLink {
-    // A processor-in-the-loop board reads no sensors of its own.
-    fn sample(&mut self) -> RawSensors<N> {
-        RawSensors::default()
-    }
-    // The duties go back in the board's actuator frame.
-    fn set_duty(&mut self, _: [i16; N]) {}
-    // So do the outputs: a disarmed board answers zero duty.
-    fn set_outputs(&mut self, _: bool) {}
-    // The host's loop cannot hang unseen: no watchdog.
-    fn feed_watchdog(&mut self) {}
-    // The host paces the ticks.
-    fn cycles_per_tick(&self) -> u32 {
-        0
-    }
-    fn read_byte(&mut self) -> Option<u8> {
-        self.rx.pop_front()
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        self.out.extend_from_slice(bytes);
-    }
-    fn cycles(&mut self) -> u32 {
-        0
-    }
-}
-
-impl<W: World<f32, N>, L: PortLayer, const N: usize> LocalBoard<W, N, L> {
-    /// `board`, driven by the link's sensor frames.
-    fn driven(board: Board<W, REGION_POINTS, N, L>) -> Self {
-        let mut board = board.with_pil(true);
-        // As the QEMU images boot: the configuration from a RAM flash.
-        let mut store = Store::new(RamFlash::<512, 256>::new(), 0, 256);
-        board.boot_config(&mut store);
-        LocalBoard {
-            board,
-            link: HostLink::default(),
-            store,
-        }
-    }
-}
-
-impl<W: World<f32, N>, L: PortLayer, const N: usize> LocalBoard<W, N, L> {
-    /// The same board with each axis homing with its `cfg` (e.g. on an
-    /// encoder's index).
-    pub fn with_homing(mut self, cfg: [twoport_control::homing::HomingConfig; N]) -> Self {
-        self.board = self.board.with_homing(cfg);
-        self
-    }
-}
-
-impl LocalBoard {
-    /// The image the firmware ships ([`excalibur::stiff_wall_board`]).
-    pub fn excalibur() -> Result<Self, String> {
-        excalibur::stiff_wall_board()
-            .map(Self::driven)
-            .map_err(|e| format!("the Excalibur board image: {e:?}"))
-    }
-}
-
-impl LocalBoard<UnilateralWall, 1, SeriesDamper> {
-    /// The passivity image ([`excalibur::stiff_wall_board_with_passivity`]).
-    pub fn excalibur_with_passivity() -> Result<Self, String> {
-        excalibur::stiff_wall_board_with_passivity()
-            .map(Self::driven)
-            .map_err(|e| format!("the Excalibur passivity image: {e:?}"))
-    }
-}
-
-impl LocalBoard<xyz::World, 3> {
-    /// The three-axis image ([`xyz::board`]).
-    pub fn excalibur_xyz() -> Result<Self, String> {
-        xyz::board()
-            .map(Self::driven)
-            .map_err(|e| format!("the three-axis Excalibur image: {e:?}"))
-    }
-}
-
-impl<W: World<f32, N>, L: PortLayer, const N: usize> BoardPort for LocalBoard<W, N, L> {
-    fn send(&mut self, bytes: &[u8]) -> Result<(), String> {
-        // What the images do: the control tick runs each sensor frame as
-        // it completes, and the main loop sends what was queued.
-        self.link.rx.extend(bytes);
-        loop {
-            let ready = self.board.poll_link(&mut self.link);
-            if ready {
-                let store = &mut self.store;
-                self.board
-                    .control_tick_serving(&mut self.link, |b| b.service_config(store));
-            }
-            self.board.service_config(&mut self.store);
-            self.board.flush(&mut self.link);
-            if !ready && self.link.rx.is_empty() {
-                return Ok(());
-            }
-        }
-    }
-    fn recv(&mut self, buf: &mut [u8], _: Duration) -> Result<usize, String> {
-        let out = &mut self.link.out;
-        let n = buf.len().min(out.len());
-        buf[..n].copy_from_slice(&out[..n]);
-        out.drain(..n);
-        Ok(n)
-    }
-}
-
-/// What to do to the link during a run.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Faults {
-    /// Every this many ticks, send a corrupted copy of the tick's sensor
-    /// frame (one byte flipped) and a burst of garbage first (0: never).
-    pub corrupt_every: u64,
-    /// Stop the heartbeats from this tick on (a lost host).
-    pub link_loss_at: Option<u64>,
-}
 
 /// One PIL run's record, its samples `S` (the one-axis simulation's by
 /// default, or the three-axis one's [`XyzSample`]).
@@ -372,267 +192,7 @@ impl PilPlant for XyzSimulation {
     }
 }
 
-/// How a run gets its board from disarmed to armed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-pub enum Start {
-    /// Tell the board where it stands: every scene starts at rest at 0.
-    Calibrate,
-    /// Home it onto the scene's hard stop (`effects.hard_stop`).
-    Home,
-}
-
-impl Start {
-    /// Home where the scene has a hard stop, else calibrate.
-    pub fn for_scene(scene: &Scene) -> Start {
-        if scene.effects.hard_stop.is_some() {
-            Start::Home
-        } else {
-            Start::Calibrate
-        }
-    }
-}
-
-/// The host side of a lockstep link to a board: handshake, heartbeats,
-/// one sensor frame out and one actuator frame back per tick, and whatever
-/// else the board says kept for the caller.
-pub struct Session<P: BoardPort> {
-    port: P,
-    /// The axes this host drives.
-    axes: u8,
-    seq: u16,
-    decoder: Decoder,
-    inbox: Vec<Message>,
-    io: twoport_board::IoScale,
-    faults: Faults,
-    tick: u64,
-    /// The encoder's index mark as a count, and the unwrapped count of
-    /// the last frame: the host plays the encoder's index hardware.
-    index: Option<(i64, Option<i64>)>,
-    /// Frames the host injected corrupted.
-    pub corrupted_sent: u64,
-}
-
 impl<P: BoardPort> Session<P> {
-    /// Shake hands with the one-axis board at `port`. It is disarmed until
-    /// [`arm`](Self::arm).
-    pub fn open(port: P, faults: Faults) -> Result<Self, String> {
-        Self::open_axes(port, faults, 1)
-    }
-
-    /// Shake hands with the board of `axes` axes at `port`: a board of
-    /// another count is refused, with both counts named.
-    pub fn open_axes(port: P, faults: Faults, axes: u8) -> Result<Self, String> {
-        let mut s = Session {
-            port,
-            axes,
-            seq: 0,
-            decoder: Decoder::new(),
-            inbox: Vec::new(),
-            io: twoport_board::IoScale::EXCALIBUR,
-            faults,
-            tick: 0,
-            index: None,
-            corrupted_sent: 0,
-        };
-        s.handshake()?;
-        Ok(s)
-    }
-
-    /// Ask for a mode change and wait for the board's status that shows it
-    /// done, or its refusal of it: over a real link, other statuses may
-    /// still be on their way.
-    fn ask(
-        &mut self,
-        msg: Message,
-        asked: ModeRequest,
-        done: fn(&Status) -> bool,
-    ) -> Result<Status, String> {
-        self.drop_stale_statuses();
-        self.send(&msg)?;
-        let what = format!("{asked:?}");
-        let r = self.wait(&what, |m| match m {
-            Message::Status(s) if done(s) => Some(Ok(*s)),
-            Message::ModeRefused { asked: a, why } if *a == asked => Some(Err(*why)),
-            _ => None,
-        })?;
-        r.map_err(|why| format!("the board refused {what}: {why:?}"))
-    }
-
-    /// Statuses and refusals already received answer earlier questions,
-    /// not the next one.
-    fn drop_stale_statuses(&mut self) {
-        self.inbox
-            .retain(|m| !matches!(m, Message::Status(_) | Message::ModeRefused { .. }));
-    }
-
-    /// Calibrate a disarmed board: each axis stands at its `position_pm`
-    /// (pm).
-    pub fn calibrate(&mut self, position_pm: Axes<i64>) -> Result<Status, String> {
-        self.ask(
-            Message::Calibrate { position_pm },
-            ModeRequest::Calibrate,
-            |s| s.calibrated,
-        )
-    }
-
-    /// Arm the board (it must have had a tick, to see its dead-man).
-    pub fn arm(&mut self) -> Result<Status, String> {
-        self.ask(Message::Arm, ModeRequest::Arm, |s| s.mode == Mode::Armed)
-    }
-
-    /// Start homing; the caller runs ticks until [`homed`].
-    pub fn home(&mut self) -> Result<Status, String> {
-        self.ask(Message::Home, ModeRequest::Home, |s| s.mode == Mode::Homing)
-    }
-
-    /// Where the board's configuration came from.
-    pub fn config(&mut self) -> Result<ConfigSource, String> {
-        self.inbox.retain(|m| !matches!(m, Message::Config(_)));
-        self.send(&Message::GetConfig)?;
-        self.wait("GetConfig", |m| match m {
-            Message::Config(c) => Some(*c),
-            _ => None,
-        })
-    }
-
-    /// The scene's encoder has an index mark at `index_m` (m): send the
-    /// count it latches in the sensor frame of each tick that passes it.
-    pub fn set_index(&mut self, index_m: Option<f64>) {
-        let (_, pm) = excalibur::ENCODER;
-        self.index = index_m.map(|m| ((m * 1e12 / pm as f64).round() as i64, None));
-    }
-
-    /// The count the index latched this tick, if the axis passed it
-    /// between the last frame's `raw` and this one.
-    fn index_crossing(&mut self, raw: u32) -> Option<u32> {
-        let (bits, _) = excalibur::ENCODER;
-        let (mark, last) = self.index.as_mut()?;
-        let shift = 32 - u32::from(bits);
-        let now = match *last {
-            // The counter's difference, sign-extended (it wraps).
-            Some(l) => l + (((raw.wrapping_sub(l as u32) << shift) as i32) >> shift) as i64,
-            None => ((raw << shift) as i32 >> shift) as i64,
-        };
-        let crossed = last.is_some_and(|l| (l.min(now) < *mark) && (*mark <= l.max(now)));
-        *last = Some(now);
-        let mask = (1u64 << bits) - 1;
-        crossed.then_some((*mark as u64 & mask) as u32)
-    }
-
-    /// The board's state machine, asked for.
-    pub fn status(&mut self) -> Result<Status, String> {
-        self.drop_stale_statuses();
-        self.send(&Message::GetStatus)?;
-        self.wait("GetStatus", |m| match m {
-            Message::Status(s) => Some(*s),
-            _ => None,
-        })
-    }
-
-    fn frame(&mut self, msg: &Message) -> Result<Vec<u8>, String> {
-        let mut buf = [0u8; MAX_FRAME];
-        let n = encode(self.seq, msg, &mut buf).map_err(|e| format!("encode: {e:?}"))?;
-        self.seq = self.seq.wrapping_add(1);
-        Ok(buf[..n].to_vec())
-    }
-
-    /// Send one message.
-    pub fn send(&mut self, msg: &Message) -> Result<(), String> {
-        let f = self.frame(msg)?;
-        self.port.send(&f)
-    }
-
-    fn pump(&mut self, timeout: Duration) -> Result<(), String> {
-        let mut buf = [0u8; 256];
-        let n = self.port.recv(&mut buf, timeout)?;
-        let inbox = &mut self.inbox;
-        self.decoder.feed(&buf[..n], |env| inbox.push(env.msg));
-        Ok(())
-    }
-
-    /// Read until `want` picks a message out, or time out.
-    pub fn wait<T>(
-        &mut self,
-        what: &str,
-        mut want: impl FnMut(&Message) -> Option<T>,
-    ) -> Result<T, String> {
-        let deadline = Instant::now() + ANSWER_TIMEOUT;
-        loop {
-            if let Some((i, v)) = self
-                .inbox
-                .iter()
-                .enumerate()
-                .find_map(|(i, m)| want(m).map(|v| (i, v)))
-            {
-                self.inbox.remove(i);
-                return Ok(v);
-            }
-            let now = Instant::now();
-            if now > deadline {
-                return Err(format!(
-                    "the board did not answer {what} within {} s",
-                    ANSWER_TIMEOUT.as_secs()
-                ));
-            }
-            self.pump((deadline - now).min(Duration::from_millis(50)))?;
-        }
-    }
-
-    /// Hello until the board answers (a pty drops what is sent before the
-    /// other end opens it).
-    fn handshake(&mut self) -> Result<(), String> {
-        let deadline = Instant::now() + ANSWER_TIMEOUT;
-        loop {
-            self.send(&Message::hello(Role::Host, self.axes))?;
-            self.pump(Duration::from_millis(100))?;
-            if let Some(i) = self
-                .inbox
-                .iter()
-                .position(|m| matches!(m, Message::HelloAck { .. }))
-            {
-                return self
-                    .inbox
-                    .remove(i)
-                    .accept_ack(self.axes)
-                    .map_err(|e| e.to_string());
-            }
-            if Instant::now() > deadline {
-                // (A board of another protocol may answer in a form this
-                // host cannot decode.)
-                return Err(format!(
-                    "no handshake answer from the board (this host speaks protocol {})",
-                    twoport_link::PROTOCOL_VERSION
-                ));
-            }
-        }
-    }
-
-    /// Read whatever the board has sent, waiting at most a millisecond
-    /// (a free-running board: telemetry, replies, fault reports).
-    pub fn poll(&mut self) -> Result<(), String> {
-        self.pump(Duration::from_millis(1))
-    }
-
-    /// Messages the board sent that no one waited for (telemetry, fault
-    /// reports, gain replies), oldest first.
-    pub fn take_messages(&mut self) -> Vec<Message> {
-        std::mem::take(&mut self.inbox)
-    }
-
-    /// The board's link counters.
-    pub fn board_stats(&mut self) -> Result<LinkStats, String> {
-        self.send(&Message::GetStats)?;
-        self.wait("GetStats", |m| match m {
-            Message::Stats(s) => Some(*s),
-            _ => None,
-        })
-    }
-
-    /// Frames from the board this host dropped.
-    pub fn host_dropped(&self) -> u32 {
-        self.decoder.stats().dropped()
-    }
-
     /// One tick of `sim` with the board as its controller; returns the
     /// sample and the duty the board answered.
     pub fn step(&mut self, sim: &mut Simulation) -> Result<(Sample, i16), String> {
@@ -658,41 +218,25 @@ impl<P: BoardPort> Session<P> {
         let sample = sim.step_external(&mut ctl);
         Ok((sample, answer?))
     }
+}
 
-    /// The next tick's number, with its heartbeat sent where one is due
-    /// and the link is not lost.
-    fn tick_heartbeat(&mut self) -> Result<u64, String> {
-        let tick = self.tick;
-        self.tick += 1;
-        let lost = self.faults.link_loss_at.is_some_and(|t| tick >= t);
-        if tick.is_multiple_of(HEARTBEAT_EVERY) && !lost {
-            self.send(&Message::Heartbeat)?;
-        }
-        Ok(tick)
-    }
+/// How a run gets its board from disarmed to armed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum Start {
+    /// Tell the board where it stands: every scene starts at rest at 0.
+    Calibrate,
+    /// Home it onto the scene's hard stop (`effects.hard_stop`).
+    Home,
+}
 
-    /// Send tick `tick`'s sensors (and, on schedule, a corrupted copy
-    /// first) and wait for the board's duties.
-    fn exchange(&mut self, tick: u64, sensors: LinkSensors) -> Result<Axes<i16>, String> {
-        let want = sensors.tick;
-        let good = self.frame(&Message::Sensors(sensors))?;
-        let every = self.faults.corrupt_every;
-        if every > 0 && tick % every == every / 2 {
-            let mut bad = good.clone();
-            let i = bad.len() / 2;
-            bad[i] ^= 0x5A;
-            if bad[i] == 0 {
-                bad[i] = 0x33;
-            }
-            self.port.send(&[0x17, 0xFF, 0x42, 0x00])?;
-            self.port.send(&bad)?;
-            self.corrupted_sent += 2;
+impl Start {
+    /// Home where the scene has a hard stop, else calibrate.
+    pub fn for_scene(scene: &Scene) -> Start {
+        if scene.effects.hard_stop.is_some() {
+            Start::Home
+        } else {
+            Start::Calibrate
         }
-        self.port.send(&good)?;
-        self.wait(&format!("tick {want}"), |m| match m {
-            Message::Actuator(a) if a.tick == want => Some(a.duty),
-            _ => None,
-        })
     }
 }
 

@@ -3,7 +3,8 @@
 //! boards through `cargo xtask pil scenes/xyz/pil_blocks.toml --check`).
 
 use host_sim::engine::xyz::{XyzScene, XyzSimulation};
-use host_sim::pil::{self, Faults, LocalBoard};
+use host_sim::link::{self, Faults, LocalBoard};
+use host_sim::pil;
 use std::path::Path;
 
 const SCENE: &str = "../scenes/xyz/pil_blocks.toml";
@@ -55,7 +56,7 @@ fn three_axes_run_in_lockstep_and_all_stop_after_a_link_loss() {
 #[test]
 fn a_host_of_another_axis_count_is_refused_by_the_board() {
     let board = LocalBoard::excalibur_xyz().unwrap();
-    let e = pil::Session::open(board, Faults::default())
+    let e = link::Session::open(board, Faults::default())
         .err()
         .expect("a one-axis host");
     assert!(e.contains('3') && e.contains('1'), "{e}");

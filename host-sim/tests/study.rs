@@ -1,7 +1,8 @@
 //! The studies as a library: the bisection of a stability boundary, the
 //! paper's Table I, and the rules a processor-in-the-loop run is judged by.
 
-use host_sim::pil::{failures, Comparison, Faults, Run};
+use host_sim::link::Faults;
+use host_sim::pil::{failures, Comparison, Run};
 use host_sim::study::{sweep, table1};
 use host_sim::{Scene, Simulation};
 use std::path::Path;

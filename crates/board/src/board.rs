@@ -14,7 +14,7 @@ use twoport_control::world::World;
 use twoport_control::{Faults, Position};
 use twoport_link::{
     encode, ActuatorFrame, Axes, AxisRefusal, AxisTelemetry, Decoder, GainsReply, LinkStats,
-    Message, Mode, Refusal, Stats, Telemetry, MAX_AXES, MAX_FRAME,
+    Message, Mode, Refusal, Stats, Telemetry, MAX_AXES, MAX_FRAME, NO_SESSION,
 };
 
 /// One encoded frame, delimiter included.
@@ -57,6 +57,9 @@ pub struct Board<W, const R: usize, const N: usize = 1, L = Direct> {
     ticks: u32,
     /// The state machine: disarmed at boot.
     mode: Mode,
+    /// The host's session, stamped on every answer ([`NO_SESSION`] from
+    /// boot until a handshake): a host sees a reset by it.
+    session: u16,
     /// Whether the encoder's offset is known.
     calibrated: bool,
     /// How each axis homes, and the run in progress (in
@@ -147,6 +150,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
             pending: None,
             ticks: 0,
             mode: Mode::Disarmed,
+            session: NO_SESSION,
             calibrated: false,
             homing_cfg: [HomingConfig::gentle(Position::ZERO, period_s); N],
             homing: None,
@@ -264,7 +268,15 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
     }
 
     fn handle(&mut self, msg: Message) {
-        if let Some(ack) = msg.answer(N as u8) {
+        if let Some(ack) = msg.answer(N as u8, self.session) {
+            if let Message::HelloAck { session, .. } = ack {
+                if session != self.session {
+                    // Telemetry queued in the old session would reach the
+                    // host after the answer, stamped with the old number.
+                    self.telemetry.clear();
+                }
+                self.session = session;
+            }
             self.queue(ack);
             return;
         }
@@ -444,6 +456,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
             self.queue(Message::Actuator(ActuatorFrame {
                 tick: frame.tick,
                 duty: Self::axes(duty),
+                session: self.session,
             }));
         }
         let end = io.cycles();
@@ -496,6 +509,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
                     stage_cycles: self.timing.stages,
                     deadline_misses: self.timing.deadline_misses,
                     worst_jitter_cycles: self.timing.worst_jitter,
+                    session: self.session,
                 }));
             }
         }

@@ -229,6 +229,7 @@ fn boots_disarmed_with_outputs_off_and_names_why_it_will_not_arm() {
             calibrated: true,
             faults: 0,
             first_fault: 0,
+            session: twoport_link::NO_SESSION,
         }]
     );
     assert_eq!(io.outputs_calls, [true]);

@@ -71,14 +71,16 @@ fn refused(why: Refusal) -> Message {
 #[test]
 fn handshake_and_gain_queries() {
     let mut b = board();
-    send(&mut b, 0, Message::hello(Role::Host, 1));
+    send(&mut b, 0, Message::hello(Role::Host, 1, 7));
     send(&mut b, 1, Message::GetGains);
-    // A host that drives three axes hears that this board has one.
-    send(&mut b, 2, Message::hello(Role::Host, 3));
+    // A host that drives three axes hears that this board has one, and the
+    // board stays in the session it was in.
+    send(&mut b, 2, Message::hello(Role::Host, 3, 8));
     let ack = |accepted| Message::HelloAck {
         version: PROTOCOL_VERSION,
         accepted,
         axes: 1,
+        session: 7,
     };
     assert_eq!(
         replies(&mut b),
@@ -433,7 +435,7 @@ impl Io {
 fn a_pil_board_ticks_once_per_sensor_frame_and_answers_with_the_duty() {
     let mut b = board().with_pil(true);
     let mut io = Io::default();
-    io.queue(0, Message::hello(Role::Host, 1));
+    io.queue(0, Message::hello(Role::Host, 1, 0xBEEF));
     io.queue(
         1,
         Message::Calibrate {
@@ -471,6 +473,7 @@ fn a_pil_board_ticks_once_per_sensor_frame_and_answers_with_the_duty() {
     for (k, a) in acts.iter().enumerate() {
         assert_eq!(a.tick, k as u32);
         assert_eq!(a.duty, Axes::one(io.duties[k]));
+        assert_eq!(a.session, 0xBEEF, "every answer carries the host's session");
     }
     assert!(io.duties.iter().any(|d| *d != 0));
     assert_eq!(io.samples, 0);

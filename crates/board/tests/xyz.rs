@@ -155,14 +155,14 @@ fn the_board_declares_three_axes_and_a_one_axis_host_is_refused() {
     let mut b = board();
     let mut io = Bench::new([-1.0; 3]);
     let mut ack = |host| {
-        io.say(Message::hello(Role::Host, host));
+        io.say(Message::hello(Role::Host, host, 9));
         tick(&mut b, &mut io);
         io.heard()
             .into_iter()
             .find(|m| matches!(m, Message::HelloAck { .. }))
             .expect("the board answers a hello")
     };
-    assert!(ack(3).accept_ack(3).is_ok());
+    assert!(ack(3).accept_ack(3, 9).is_ok());
     let one = ack(1);
     assert!(matches!(
         one,
@@ -172,7 +172,7 @@ fn the_board_declares_three_axes_and_a_one_axis_host_is_refused() {
             ..
         }
     ));
-    let e = one.accept_ack(1).unwrap_err().to_string();
+    let e = one.accept_ack(1, 9).unwrap_err().to_string();
     assert!(e.contains('3') && e.contains('1'), "{e}");
 }
 

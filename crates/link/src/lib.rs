@@ -14,5 +14,5 @@ pub use frame::{encode, Decoder, Envelope, FrameError, Stats, MAX_FRAME, MAX_PAY
 pub use message::{
     ActuatorFrame, AxisRefusal, AxisTelemetry, ConfigFallback, ConfigSource, Gains, GainsReply,
     HandshakeError, LinkStats, Message, Mode, ModeRefusal, ModeRequest, Refusal, Role, SensorFrame,
-    Status, Telemetry, PROTOCOL_VERSION,
+    Status, Telemetry, NO_SESSION, PROTOCOL_VERSION,
 };

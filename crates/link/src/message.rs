@@ -7,8 +7,17 @@ use crate::Axes;
 use serde::{Deserialize, Serialize};
 
 /// The protocol version both ends must share (checked by the handshake).
-/// Version 4 carries every axis of a board in its frames.
-pub const PROTOCOL_VERSION: u16 = 4;
+/// Version 4 carries every axis of a board in its frames; version 5 a
+/// session number in every answer, so that a host sees a board reset.
+pub const PROTOCOL_VERSION: u16 = 5;
+
+/// The session number of a board no host has shaken hands with since it
+/// booted. A host opens a session with any other number, and a board
+/// stamps that number on every [`ActuatorFrame`], [`Telemetry`] and
+/// [`Status`] it sends: an answer stamped with another number, this one
+/// after a reset, comes from a board that has rebooted since the
+/// handshake, whatever the timing (protocol 5).
+pub const NO_SESSION: u16 = 0;
 
 /// Which end is speaking in a handshake.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -60,6 +69,9 @@ pub struct Telemetry {
     /// time and the period, in the same count (protocol 3; 0 where the
     /// host paces the ticks).
     pub worst_jitter_cycles: u32,
+    /// The session the board is in ([`NO_SESSION`] after a reset;
+    /// protocol 5).
+    pub session: u16,
 }
 
 /// The board's state machine (protocol 3). A board boots disarmed with its
@@ -174,6 +186,9 @@ pub struct Status {
     pub faults: u16,
     /// The first fault to latch, alone (0: none).
     pub first_fault: u16,
+    /// The session the board is in ([`NO_SESSION`] after a reset;
+    /// protocol 5).
+    pub session: u16,
 }
 
 /// Coupling (and regulator) gains.
@@ -264,6 +279,9 @@ pub struct ActuatorFrame {
     pub tick: u32,
     /// Each axis's signed PWM duty, full scale ±32767 = ± peak force.
     pub duty: Axes<i16>,
+    /// The session the board is in ([`NO_SESSION`] after a reset;
+    /// protocol 5).
+    pub session: u16,
 }
 
 /// Every message.
@@ -277,6 +295,9 @@ pub enum Message {
         role: Role,
         /// How many axes the sender drives (protocol 4).
         axes: u8,
+        /// The session the host opens: any number but [`NO_SESSION`]
+        /// (protocol 5).
+        session: u16,
     },
     /// Handshake answer.
     HelloAck {
@@ -286,6 +307,9 @@ pub enum Message {
         accepted: bool,
         /// How many axes the answerer has (protocol 4).
         axes: u8,
+        /// The session the board is in from now on: the `Hello`'s when
+        /// accepted, its old one otherwise (protocol 5).
+        session: u16,
     },
     /// The host is alive (feeds the board's link watchdog).
     Heartbeat,
@@ -361,35 +385,57 @@ pub struct LinkStats {
 }
 
 impl Message {
-    /// This side's handshake opener, for a sender that drives `axes` axes.
-    pub const fn hello(role: Role, axes: u8) -> Message {
+    /// This side's handshake opener, for a sender that drives `axes` axes
+    /// and opens `session` (not [`NO_SESSION`]).
+    pub const fn hello(role: Role, axes: u8, session: u16) -> Message {
         Message::Hello {
             version: PROTOCOL_VERSION,
             role,
             axes,
+            session,
         }
     }
 
-    /// The answer of a board with `axes` axes to a `Hello`: accepted when
-    /// the versions and the axis counts match; `None` for any other
-    /// message.
-    pub fn answer(&self, axes: u8) -> Option<Message> {
+    /// The answer of a board with `axes` axes, now in session `current`,
+    /// to a `Hello`: accepted when the versions and the axis counts match
+    /// and the session is one, and then in the `Hello`'s session; `None`
+    /// for any other message.
+    pub fn answer(&self, axes: u8, current: u16) -> Option<Message> {
         match *self {
             Message::Hello {
-                version, axes: a, ..
-            } => Some(Message::HelloAck {
-                version: PROTOCOL_VERSION,
-                accepted: version == PROTOCOL_VERSION && a == axes,
-                axes,
-            }),
+                version,
+                axes: a,
+                session,
+                ..
+            } => {
+                let accepted = version == PROTOCOL_VERSION && a == axes && session != NO_SESSION;
+                Some(Message::HelloAck {
+                    version: PROTOCOL_VERSION,
+                    accepted,
+                    axes,
+                    session: if accepted { session } else { current },
+                })
+            }
             _ => None,
         }
     }
 
-    /// What a host that drives `axes` axes makes of the board's answer to
-    /// its `Hello`: `Ok` when both sides agree, otherwise why not, in
-    /// words for the user.
-    pub fn accept_ack(&self, axes: u8) -> Result<(), HandshakeError> {
+    /// The session a board's answer is stamped with, for the messages that
+    /// carry one.
+    pub fn session(&self) -> Option<u16> {
+        match self {
+            Message::Actuator(a) => Some(a.session),
+            Message::Telemetry(t) => Some(t.session),
+            Message::Status(s) => Some(s.session),
+            Message::HelloAck { session, .. } => Some(*session),
+            _ => None,
+        }
+    }
+
+    /// What a host that drives `axes` axes and opened `session` makes of
+    /// the board's answer to its `Hello`: `Ok` when both sides agree,
+    /// otherwise why not, in words for the user.
+    pub fn accept_ack(&self, axes: u8, session: u16) -> Result<(), HandshakeError> {
         match *self {
             Message::HelloAck { version, .. } if version != PROTOCOL_VERSION => {
                 Err(HandshakeError::Version { board: version })
@@ -397,7 +443,11 @@ impl Message {
             Message::HelloAck { axes: board, .. } if board != axes => {
                 Err(HandshakeError::Axes { board, host: axes })
             }
-            Message::HelloAck { accepted: true, .. } => Ok(()),
+            Message::HelloAck {
+                accepted: true,
+                session: s,
+                ..
+            } if s == session => Ok(()),
             _ => Err(HandshakeError::NotAnAnswer),
         }
     }

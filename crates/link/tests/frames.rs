@@ -16,11 +16,12 @@ fn all_messages() -> Vec<Message> {
         b_nspm: 500.0,
     };
     vec![
-        Message::hello(Role::Host, 3),
+        Message::hello(Role::Host, 3, u16::MAX),
         Message::HelloAck {
             version: PROTOCOL_VERSION,
             accepted: true,
             axes: MAX_AXES as u8,
+            session: 1,
         },
         Message::Heartbeat,
         Message::Telemetry(Telemetry {
@@ -40,6 +41,7 @@ fn all_messages() -> Vec<Message> {
             stage_cycles: [u32::MAX; 3],
             deadline_misses: u32::MAX,
             worst_jitter_cycles: u32::MAX,
+            session: u16::MAX,
         }),
         Message::GetGains,
         Message::Gains(Axes::new([gi, gi, gi]).unwrap()),
@@ -76,6 +78,7 @@ fn all_messages() -> Vec<Message> {
             calibrated: true,
             faults: 0xFFFF,
             first_fault: 0x8000,
+            session: u16::MAX,
         }),
         Message::ModeRefused {
             asked: ModeRequest::Arm,
@@ -102,6 +105,7 @@ fn all_messages() -> Vec<Message> {
         Message::Actuator(ActuatorFrame {
             tick: 7,
             duty: Axes::new([-32_767, 32_767, 0]).unwrap(),
+            session: 0x5A5A,
         }),
     ]
 }
@@ -221,27 +225,39 @@ fn sequence_gaps_are_counted() {
 
 #[test]
 fn handshake_accepts_only_the_same_version_and_axes() {
-    let ack = |accepted, axes| {
+    let ack = |accepted, axes, session| {
         Some(Message::HelloAck {
             version: PROTOCOL_VERSION,
             accepted,
             axes,
+            session,
         })
     };
-    // A three-axis board answers a three-axis host, and a one-axis one.
-    assert_eq!(Message::hello(Role::Host, 3).answer(3), ack(true, 3));
-    assert_eq!(Message::hello(Role::Host, 1).answer(3), ack(false, 3));
+    // A three-axis board answers a three-axis host, and a one-axis one;
+    // accepted, it is in the host's session, refused in its old one.
+    assert_eq!(
+        Message::hello(Role::Host, 3, 7).answer(3, 0),
+        ack(true, 3, 7)
+    );
+    assert_eq!(
+        Message::hello(Role::Host, 1, 7).answer(3, 4),
+        ack(false, 3, 4)
+    );
     let newer = Message::Hello {
         version: PROTOCOL_VERSION + 1,
         role: Role::Host,
         axes: 1,
+        session: 7,
     };
-    assert_eq!(newer.answer(1), ack(false, 1));
-    assert_eq!(Message::Heartbeat.answer(1), None);
+    assert_eq!(newer.answer(1, 0), ack(false, 1, 0));
+    assert_eq!(Message::Heartbeat.answer(1, 0), None);
+    // A host must open a session: NO_SESSION is what a reset board says.
+    let none = Message::hello(Role::Host, 1, NO_SESSION).answer(1, 0);
+    assert_eq!(none, ack(false, 1, 0));
 
     // The host refuses a board of another count, and says so in words.
-    let board = Message::hello(Role::Host, 1).answer(3).unwrap();
-    let e = board.accept_ack(1).unwrap_err();
+    let board = Message::hello(Role::Host, 1, 7).answer(3, 0).unwrap();
+    let e = board.accept_ack(1, 7).unwrap_err();
     assert_eq!(e, HandshakeError::Axes { board: 3, host: 1 });
     assert_eq!(
         e.to_string(),
@@ -251,15 +267,21 @@ fn handshake_accepts_only_the_same_version_and_axes() {
         version: 3,
         accepted: false,
         axes: 1,
+        session: 0,
     };
     assert!(old
-        .accept_ack(1)
+        .accept_ack(1, 7)
         .unwrap_err()
         .to_string()
         .contains("protocol 3"));
-    assert_eq!(ack(true, 1).unwrap().accept_ack(1), Ok(()));
+    assert_eq!(ack(true, 1, 7).unwrap().accept_ack(1, 7), Ok(()));
+    // An answer for another session is no answer to this host's Hello.
     assert_eq!(
-        Message::Heartbeat.accept_ack(1),
+        ack(true, 1, 8).unwrap().accept_ack(1, 7),
+        Err(HandshakeError::NotAnAnswer)
+    );
+    assert_eq!(
+        Message::Heartbeat.accept_ack(1, 7),
         Err(HandshakeError::NotAnAnswer)
     );
 }

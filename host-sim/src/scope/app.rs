@@ -5,7 +5,7 @@
 
 use crate::engine::human::GraspKind;
 use crate::engine::scene::{Scene, VeSpec};
-use crate::pil::{SerialBoard, Session};
+use crate::link::{SerialBoard, Session};
 use crate::scope::rings::{last_trigger, Edge, Ring};
 use crate::{Sample, Simulation};
 use std::path::{Path, PathBuf};
@@ -654,7 +654,7 @@ impl ScopeState {
         };
         let r = scene_ok
             .and_then(|_| SerialBoard::open(port))
-            .and_then(|p| Session::open(p, crate::pil::Faults::default()))
+            .and_then(|p| Session::open(p, crate::link::Faults::default()))
             .and_then(|mut s| s.send(&Message::GetStatus).map(|_| s));
         match r {
             Ok(session) => {

@@ -42,6 +42,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
             calibrated: self.calibrated,
             faults: faults.0,
             first_fault: first.0,
+            session: self.session,
         }
     }
 

@@ -1,0 +1,136 @@
+//! The Excalibur board images' loop in this process, behind the same
+//! [`BoardPort`] as a serial board: the reference a processor-in-the-loop
+//! run holds the firmware to, bit for bit.
+
+use super::BoardPort;
+use std::collections::VecDeque;
+use std::time::Duration;
+use twoport_board::excalibur::{self, xyz, REGION_POINTS};
+use twoport_board::{Board, BoardSupport, RawSensors};
+use twoport_config::{RamFlash, Store};
+use twoport_control::passivity::SeriesDamper;
+use twoport_control::servo::{Direct, PortLayer};
+use twoport_control::ve::UnilateralWall;
+use twoport_control::world::World;
+
+/// The Excalibur board image's loop, in this process: the plain image's,
+/// the passivity image's (`L`, the series damper), or the three-axis
+/// image's (`N` = 3).
+pub struct LocalBoard<W = UnilateralWall, const N: usize = 1, L = Direct> {
+    board: Board<W, REGION_POINTS, N, L>,
+    link: HostLink,
+    /// Its stored configuration, in RAM as on the QEMU images.
+    store: Store<RamFlash<512, 256>>,
+}
+
+/// The in-process board's only peripheral: its link, as two byte queues.
+#[derive(Default)]
+struct HostLink {
+    rx: VecDeque<u8>,
+    out: Vec<u8>,
+}
+
+impl<const N: usize> BoardSupport<N> for HostLink {
+    // A processor-in-the-loop board reads no sensors of its own.
+    fn sample(&mut self) -> RawSensors<N> {
+        RawSensors::default()
+    }
+    // The duties go back in the board's actuator frame.
+    fn set_duty(&mut self, _: [i16; N]) {}
+    // So do the outputs: a disarmed board answers zero duty.
+    fn set_outputs(&mut self, _: bool) {}
+    // The host's loop cannot hang unseen: no watchdog.
+    fn feed_watchdog(&mut self) {}
+    // The host paces the ticks.
+    fn cycles_per_tick(&self) -> u32 {
+        0
+    }
+    fn read_byte(&mut self) -> Option<u8> {
+        self.rx.pop_front()
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        self.out.extend_from_slice(bytes);
+    }
+    fn cycles(&mut self) -> u32 {
+        0
+    }
+}
+
+impl<W: World<f32, N>, L: PortLayer, const N: usize> LocalBoard<W, N, L> {
+    /// `board`, driven by the link's sensor frames.
+    fn driven(board: Board<W, REGION_POINTS, N, L>) -> Self {
+        let mut board = board.with_pil(true);
+        // As the QEMU images boot: the configuration from a RAM flash.
+        let mut store = Store::new(RamFlash::<512, 256>::new(), 0, 256);
+        board.boot_config(&mut store);
+        LocalBoard {
+            board,
+            link: HostLink::default(),
+            store,
+        }
+    }
+}
+
+impl<W: World<f32, N>, L: PortLayer, const N: usize> LocalBoard<W, N, L> {
+    /// The same board with each axis homing with its `cfg` (e.g. on an
+    /// encoder's index).
+    pub fn with_homing(mut self, cfg: [twoport_control::homing::HomingConfig; N]) -> Self {
+        self.board = self.board.with_homing(cfg);
+        self
+    }
+}
+
+impl LocalBoard {
+    /// The image the firmware ships ([`excalibur::stiff_wall_board`]).
+    pub fn excalibur() -> Result<Self, String> {
+        excalibur::stiff_wall_board()
+            .map(Self::driven)
+            .map_err(|e| format!("the Excalibur board image: {e:?}"))
+    }
+}
+
+impl LocalBoard<UnilateralWall, 1, SeriesDamper> {
+    /// The passivity image ([`excalibur::stiff_wall_board_with_passivity`]).
+    pub fn excalibur_with_passivity() -> Result<Self, String> {
+        excalibur::stiff_wall_board_with_passivity()
+            .map(Self::driven)
+            .map_err(|e| format!("the Excalibur passivity image: {e:?}"))
+    }
+}
+
+impl LocalBoard<xyz::World, 3> {
+    /// The three-axis image ([`xyz::board`]).
+    pub fn excalibur_xyz() -> Result<Self, String> {
+        xyz::board()
+            .map(Self::driven)
+            .map_err(|e| format!("the three-axis Excalibur image: {e:?}"))
+    }
+}
+
+impl<W: World<f32, N>, L: PortLayer, const N: usize> BoardPort for LocalBoard<W, N, L> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), String> {
+        // What the images do: the control tick runs each sensor frame as
+        // it completes, and the main loop sends what was queued.
+        self.link.rx.extend(bytes);
+        loop {
+            let ready = self.board.poll_link(&mut self.link);
+            if ready {
+                let store = &mut self.store;
+                self.board
+                    .control_tick_serving(&mut self.link, |b| b.service_config(store));
+            }
+            self.board.service_config(&mut self.store);
+            self.board.flush(&mut self.link);
+            if !ready && self.link.rx.is_empty() {
+                return Ok(());
+            }
+        }
+    }
+    fn recv(&mut self, buf: &mut [u8], _: Duration) -> Result<usize, String> {
+        let out = &mut self.link.out;
+        let n = buf.len().min(out.len());
+        buf[..n].copy_from_slice(&out[..n]);
+        out.drain(..n);
+        Ok(n)
+    }
+}

@@ -1,0 +1,366 @@
+//! A session with one board: the handshake that opens it, the calls that
+//! ask and wait for answers, the lockstep exchange of a processor-in-the-
+//! loop run, and the link faults a test injects.
+
+use super::BoardPort;
+use std::sync::atomic::{AtomicU16, Ordering};
+use std::time::{Duration, Instant};
+use twoport_board::excalibur;
+use twoport_link::{
+    encode, Axes, ConfigSource, Decoder, LinkStats, Message, Mode, ModeRequest, Role,
+    SensorFrame as LinkSensors, Status, MAX_FRAME, NO_SESSION,
+};
+
+/// How long the host waits for the board's answer to one frame.
+pub const ANSWER_TIMEOUT: Duration = Duration::from_secs(5);
+/// Heartbeats go out every this many ticks (the board's watchdog allows
+/// [`excalibur::HEARTBEAT_TIMEOUT_TICKS`]).
+pub const HEARTBEAT_EVERY: u64 = 10;
+
+/// What to do to the link during a run.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Faults {
+    /// Every this many ticks, send a corrupted copy of the tick's sensor
+    /// frame (one byte flipped) and a burst of garbage first (0: never).
+    pub corrupt_every: u64,
+    /// Stop the heartbeats from this tick on (a lost host).
+    pub link_loss_at: Option<u64>,
+}
+
+/// The host side of a lockstep link to a board: handshake, heartbeats,
+/// one sensor frame out and one actuator frame back per tick, and whatever
+/// else the board says kept for the caller.
+pub struct Session<P: BoardPort> {
+    port: P,
+    /// The axes this host drives.
+    axes: u8,
+    /// The session this host opened (never `NO_SESSION`), and whether the
+    /// handshake is done: from then on every stamped answer must carry it.
+    session: u16,
+    open: bool,
+    seq: u16,
+    decoder: Decoder,
+    inbox: Vec<Message>,
+    pub(crate) io: twoport_board::IoScale,
+    faults: Faults,
+    tick: u64,
+    /// The encoder's index mark as a count, and the unwrapped count of
+    /// the last frame: the host plays the encoder's index hardware.
+    index: Option<(i64, Option<i64>)>,
+    /// Frames the host injected corrupted.
+    pub corrupted_sent: u64,
+}
+
+impl<P: BoardPort> Session<P> {
+    /// Shake hands with the one-axis board at `port`. It is disarmed until
+    /// [`arm`](Self::arm).
+    pub fn open(port: P, faults: Faults) -> Result<Self, String> {
+        Self::open_axes(port, faults, 1)
+    }
+
+    /// Shake hands with the board of `axes` axes at `port`: a board of
+    /// another count is refused, with both counts named.
+    pub fn open_axes(port: P, faults: Faults, axes: u8) -> Result<Self, String> {
+        let mut s = Session {
+            port,
+            axes,
+            session: new_session(),
+            open: false,
+            seq: 0,
+            decoder: Decoder::new(),
+            inbox: Vec::new(),
+            io: twoport_board::IoScale::EXCALIBUR,
+            faults,
+            tick: 0,
+            index: None,
+            corrupted_sent: 0,
+        };
+        s.handshake()?;
+        Ok(s)
+    }
+
+    /// Ask for a mode change and wait for the board's status that shows it
+    /// done, or its refusal of it: over a real link, other statuses may
+    /// still be on their way.
+    fn ask(
+        &mut self,
+        msg: Message,
+        asked: ModeRequest,
+        done: fn(&Status) -> bool,
+    ) -> Result<Status, String> {
+        self.drop_stale_statuses();
+        self.send(&msg)?;
+        let what = format!("{asked:?}");
+        let r = self.wait(&what, |m| match m {
+            Message::Status(s) if done(s) => Some(Ok(*s)),
+            Message::ModeRefused { asked: a, why } if *a == asked => Some(Err(*why)),
+            _ => None,
+        })?;
+        r.map_err(|why| format!("the board refused {what}: {why:?}"))
+    }
+
+    /// Statuses and refusals already received answer earlier questions,
+    /// not the next one.
+    fn drop_stale_statuses(&mut self) {
+        self.inbox
+            .retain(|m| !matches!(m, Message::Status(_) | Message::ModeRefused { .. }));
+    }
+
+    /// Calibrate a disarmed board: each axis stands at its `position_pm`
+    /// (pm).
+    pub fn calibrate(&mut self, position_pm: Axes<i64>) -> Result<Status, String> {
+        self.ask(
+            Message::Calibrate { position_pm },
+            ModeRequest::Calibrate,
+            |s| s.calibrated,
+        )
+    }
+
+    /// Arm the board (it must have had a tick, to see its dead-man).
+    pub fn arm(&mut self) -> Result<Status, String> {
+        self.ask(Message::Arm, ModeRequest::Arm, |s| s.mode == Mode::Armed)
+    }
+
+    /// Start homing; the caller runs ticks until
+    /// [`homed`](crate::pil::homed).
+    pub fn home(&mut self) -> Result<Status, String> {
+        self.ask(Message::Home, ModeRequest::Home, |s| s.mode == Mode::Homing)
+    }
+
+    /// Where the board's configuration came from.
+    pub fn config(&mut self) -> Result<ConfigSource, String> {
+        self.inbox.retain(|m| !matches!(m, Message::Config(_)));
+        self.send(&Message::GetConfig)?;
+        self.wait("GetConfig", |m| match m {
+            Message::Config(c) => Some(*c),
+            _ => None,
+        })
+    }
+
+    /// The scene's encoder has an index mark at `index_m` (m): send the
+    /// count it latches in the sensor frame of each tick that passes it.
+    pub fn set_index(&mut self, index_m: Option<f64>) {
+        let (_, pm) = excalibur::ENCODER;
+        self.index = index_m.map(|m| ((m * 1e12 / pm as f64).round() as i64, None));
+    }
+
+    /// The count the index latched this tick, if the axis passed it
+    /// between the last frame's `raw` and this one.
+    pub(crate) fn index_crossing(&mut self, raw: u32) -> Option<u32> {
+        let (bits, _) = excalibur::ENCODER;
+        let (mark, last) = self.index.as_mut()?;
+        let shift = 32 - u32::from(bits);
+        let now = match *last {
+            // The counter's difference, sign-extended (it wraps).
+            Some(l) => l + (((raw.wrapping_sub(l as u32) << shift) as i32) >> shift) as i64,
+            None => ((raw << shift) as i32 >> shift) as i64,
+        };
+        let crossed = last.is_some_and(|l| (l.min(now) < *mark) && (*mark <= l.max(now)));
+        *last = Some(now);
+        let mask = (1u64 << bits) - 1;
+        crossed.then_some((*mark as u64 & mask) as u32)
+    }
+
+    /// The board's state machine, asked for.
+    pub fn status(&mut self) -> Result<Status, String> {
+        self.drop_stale_statuses();
+        self.send(&Message::GetStatus)?;
+        self.wait("GetStatus", |m| match m {
+            Message::Status(s) => Some(*s),
+            _ => None,
+        })
+    }
+
+    fn frame(&mut self, msg: &Message) -> Result<Vec<u8>, String> {
+        let mut buf = [0u8; MAX_FRAME];
+        let n = encode(self.seq, msg, &mut buf).map_err(|e| format!("encode: {e:?}"))?;
+        self.seq = self.seq.wrapping_add(1);
+        Ok(buf[..n].to_vec())
+    }
+
+    /// Send one message.
+    pub fn send(&mut self, msg: &Message) -> Result<(), String> {
+        let f = self.frame(msg)?;
+        self.port.send(&f)
+    }
+
+    fn pump(&mut self, timeout: Duration) -> Result<(), String> {
+        let mut buf = [0u8; 256];
+        let n = self.port.recv(&mut buf, timeout)?;
+        let inbox = &mut self.inbox;
+        self.decoder.feed(&buf[..n], |env| inbox.push(env.msg));
+        Ok(())
+    }
+
+    /// Read until `want` picks a message out, or time out.
+    pub fn wait<T>(
+        &mut self,
+        what: &str,
+        mut want: impl FnMut(&Message) -> Option<T>,
+    ) -> Result<T, String> {
+        let deadline = Instant::now() + ANSWER_TIMEOUT;
+        loop {
+            self.check_session()?;
+            if let Some((i, v)) = self
+                .inbox
+                .iter()
+                .enumerate()
+                .find_map(|(i, m)| want(m).map(|v| (i, v)))
+            {
+                self.inbox.remove(i);
+                return Ok(v);
+            }
+            let now = Instant::now();
+            if now > deadline {
+                return Err(format!(
+                    "the board did not answer {what} within {} s",
+                    ANSWER_TIMEOUT.as_secs()
+                ));
+            }
+            self.pump((deadline - now).min(Duration::from_millis(50)))?;
+        }
+    }
+
+    /// Hello until the board answers (a pty drops what is sent before the
+    /// other end opens it).
+    fn handshake(&mut self) -> Result<(), String> {
+        let deadline = Instant::now() + ANSWER_TIMEOUT;
+        loop {
+            self.send(&Message::hello(Role::Host, self.axes, self.session))?;
+            self.pump(Duration::from_millis(100))?;
+            if let Some(i) = self
+                .inbox
+                .iter()
+                .position(|m| matches!(m, Message::HelloAck { .. }))
+            {
+                // What came before the answer was said in another session.
+                let ack = self.inbox.remove(i);
+                self.inbox.drain(..i);
+                ack.accept_ack(self.axes, self.session)
+                    .map_err(|e| e.to_string())?;
+                self.open = true;
+                return Ok(());
+            }
+            if Instant::now() > deadline {
+                // (A board of another protocol may answer in a form this
+                // host cannot decode.)
+                return Err(format!(
+                    "no handshake answer from the board (this host speaks protocol {})",
+                    twoport_link::PROTOCOL_VERSION
+                ));
+            }
+        }
+    }
+
+    /// Read whatever the board has sent, waiting at most a millisecond
+    /// (a free-running board: telemetry, replies, fault reports).
+    pub fn poll(&mut self) -> Result<(), String> {
+        self.pump(Duration::from_millis(1))?;
+        self.check_session()
+    }
+
+    /// The session this host opened with the board.
+    pub fn session(&self) -> u16 {
+        self.session
+    }
+
+    /// An error once the board has answered in another session than this
+    /// host's: it has reset since the handshake (or another host has
+    /// opened one).
+    fn check_session(&self) -> Result<(), String> {
+        if !self.open {
+            return Ok(());
+        }
+        let other = self
+            .inbox
+            .iter()
+            .filter_map(Message::session)
+            .find(|s| *s != self.session);
+        match other {
+            None => Ok(()),
+            Some(NO_SESSION) => Err(format!(
+                "the board has reset since the handshake: it answers with no session, \
+                 not this host's {}",
+                self.session
+            )),
+            Some(s) => Err(format!(
+                "another host has opened session {s} with the board since this host's {}",
+                self.session
+            )),
+        }
+    }
+
+    /// Messages the board sent that no one waited for (telemetry, fault
+    /// reports, gain replies), oldest first.
+    pub fn take_messages(&mut self) -> Vec<Message> {
+        std::mem::take(&mut self.inbox)
+    }
+
+    /// The board's link counters.
+    pub fn board_stats(&mut self) -> Result<LinkStats, String> {
+        self.send(&Message::GetStats)?;
+        self.wait("GetStats", |m| match m {
+            Message::Stats(s) => Some(*s),
+            _ => None,
+        })
+    }
+
+    /// Frames from the board this host dropped.
+    pub fn host_dropped(&self) -> u32 {
+        self.decoder.stats().dropped()
+    }
+
+    /// The next tick's number, with its heartbeat sent where one is due
+    /// and the link is not lost.
+    pub(crate) fn tick_heartbeat(&mut self) -> Result<u64, String> {
+        let tick = self.tick;
+        self.tick += 1;
+        let lost = self.faults.link_loss_at.is_some_and(|t| tick >= t);
+        if tick.is_multiple_of(HEARTBEAT_EVERY) && !lost {
+            self.send(&Message::Heartbeat)?;
+        }
+        Ok(tick)
+    }
+
+    /// Send tick `tick`'s sensors (and, on schedule, a corrupted copy
+    /// first) and wait for the board's duties.
+    pub(crate) fn exchange(
+        &mut self,
+        tick: u64,
+        sensors: LinkSensors,
+    ) -> Result<Axes<i16>, String> {
+        let want = sensors.tick;
+        let good = self.frame(&Message::Sensors(sensors))?;
+        let every = self.faults.corrupt_every;
+        if every > 0 && tick % every == every / 2 {
+            let mut bad = good.clone();
+            let i = bad.len() / 2;
+            bad[i] ^= 0x5A;
+            if bad[i] == 0 {
+                bad[i] = 0x33;
+            }
+            self.port.send(&[0x17, 0xFF, 0x42, 0x00])?;
+            self.port.send(&bad)?;
+            self.corrupted_sent += 2;
+        }
+        self.port.send(&good)?;
+        self.wait(&format!("tick {want}"), |m| match m {
+            Message::Actuator(a) if a.tick == want => Some(a.duty),
+            _ => None,
+        })
+    }
+}
+
+/// A session number no other session of this process has had lately and
+/// that is not `NO_SESSION`: the clock's low bits, then one more each time.
+fn new_session() -> u16 {
+    static LAST: AtomicU16 = AtomicU16::new(0);
+    let clock = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(1, |d| d.subsec_nanos() as u16);
+    let mut s = LAST.fetch_add(1, Ordering::Relaxed).wrapping_add(clock);
+    if s == NO_SESSION {
+        s = 1;
+    }
+    s
+}
