@@ -7,11 +7,12 @@
 //! that makes and breaks contact is a nonlinear VE and is not drawn here.
 
 use host_sim::engine::plant::Arm;
-use host_sim::engine::scene::{Display, Integration, VeSpec};
+use host_sim::engine::scene::{Integration, VeSpec};
 use host_sim::{Scene, Simulation};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
 use std::path::Path;
+use twoport_control::servo::Display;
 
 /// One random termination.
 #[derive(Clone, Debug)]

@@ -509,7 +509,7 @@ fn pil(a: &PilArgs) -> Result<(), String> {
         Some(t) => return Err(format!("--link-loss-at-s {t}: must be in [0, --seconds)")),
         None => None,
     };
-    let faults = link::Faults {
+    let faults = link::LinkFaults {
         corrupt_every: a.corrupt_every,
         link_loss_at,
     };
@@ -562,7 +562,7 @@ fn pil(a: &PilArgs) -> Result<(), String> {
 fn pil_report<S: host_sim::pil::PilSample>(
     a: &PilArgs,
     ticks: u64,
-    faults: host_sim::link::Faults,
+    faults: host_sim::link::LinkFaults,
     reference: host_sim::pil::Run<S>,
     run: Option<host_sim::pil::Run<S>>,
     local_s: f64,

@@ -10,14 +10,13 @@
 
 use crate::engine::sim::round_counts;
 use crate::engine::xyz::{XyzSample, XyzScene, XyzSimulation};
-use crate::link::{BoardPort, Faults, Session};
+use crate::link::{BoardPort, LinkFaults, Session};
 use crate::{Sample, Scene, Simulation};
 use twoport_board::excalibur::{self, xyz};
 use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::Faults as BoardFaults;
 use twoport_link::{
-    Axes, ConfigSource, LinkStats, Message, Mode, ModeRequest, SensorFrame as LinkSensors, Status,
-    Telemetry,
+    Axes, ConfigSource, LinkStats, Message, Mode, ModeRequest, PilSensors, Status, Telemetry,
 };
 
 /// How far a homed board's position may be from the plant's: the stop's
@@ -176,7 +175,7 @@ impl PilPlant for XyzSimulation {
             // The counter keeps the count's low `bits`, as in the one-axis
             // simulation's sensing.
             let raw = x_m.map(|x| (round_counts(x * 1e12 / pm as f64) as u32) & mask);
-            let sensors = LinkSensors {
+            let sensors = PilSensors {
                 tick: tick as u32,
                 encoder_raw: Axes::new(raw).unwrap_or_default(),
                 load_cell_raw: Axes::new([0; 3]).unwrap_or_default(),
@@ -200,7 +199,7 @@ impl<P: BoardPort> Session<P> {
         let mut answer: Result<i16, String> = Ok(0);
         let io = self.io;
         let mut ctl = |f: &SensorFrame| -> ServoOutput {
-            let sensors = LinkSensors {
+            let sensors = PilSensors {
                 tick: f.tick,
                 encoder_raw: Axes::one(f.encoder_raw[0]),
                 load_cell_raw: Axes::one(io.load_cell_counts(f.load_cell_n[0])),
@@ -333,7 +332,12 @@ fn record<P: BoardPort, M: PilPlant>(
 /// Run `scene` for `ticks` against the board at `port`: the first tick
 /// disarmed, then the board calibrated (or homed, for a scene with a hard
 /// stop) and armed, then the rest.
-pub fn run<P: BoardPort>(scene: Scene, ticks: u64, port: P, faults: Faults) -> Result<Run, String> {
+pub fn run<P: BoardPort>(
+    scene: Scene,
+    ticks: u64,
+    port: P,
+    faults: LinkFaults,
+) -> Result<Run, String> {
     run_plant(Simulation::new(scene)?, ticks, port, faults)
 }
 
@@ -343,7 +347,7 @@ pub fn run_xyz<P: BoardPort>(
     scene: XyzScene,
     ticks: u64,
     port: P,
-    faults: Faults,
+    faults: LinkFaults,
 ) -> Result<Run<XyzSample>, String> {
     run_plant(XyzSimulation::new(scene)?, ticks, port, faults)
 }
@@ -353,7 +357,7 @@ pub fn run_plant<P: BoardPort, M: PilPlant>(
     mut sim: M,
     ticks: u64,
     port: P,
-    faults: Faults,
+    faults: LinkFaults,
 ) -> Result<Run<M::Sample>, String> {
     let setup = sim.setup()?;
     let start = setup.start;
@@ -481,7 +485,7 @@ pub fn failures<S: PilSample>(
     run: &Run<S>,
     c: &Comparison,
     ticks: u64,
-    faults: Faults,
+    faults: LinkFaults,
     deadline_ticks: u64,
 ) -> Vec<String> {
     let mut bad = Vec::new();

@@ -1,7 +1,7 @@
 //! Processor-in-the-loop against the board loop in-process (CI runs the same
 //! check against the firmware in QEMU through `cargo xtask pil --check`).
 
-use host_sim::link::{self, Faults, LocalBoard};
+use host_sim::link::{self, LinkFaults, LocalBoard};
 use host_sim::pil;
 use host_sim::{Scene, Simulation};
 use std::path::Path;
@@ -12,14 +12,14 @@ fn scene() -> Scene {
 }
 
 /// `ticks` of the stiff wall with the in-process Excalibur board.
-fn run(ticks: u64, faults: Faults) -> pil::Run {
+fn run(ticks: u64, faults: LinkFaults) -> pil::Run {
     pil::run(scene(), ticks, LocalBoard::excalibur().unwrap(), faults).unwrap()
 }
 
 #[test]
 fn corrupted_frames_are_dropped_and_the_loop_goes_on() {
-    let clean = run(3000, Faults::default());
-    let faults = Faults {
+    let clean = run(3000, LinkFaults::default());
+    let faults = LinkFaults {
         corrupt_every: 7,
         link_loss_at: None,
     };
@@ -45,7 +45,7 @@ fn link_loss_gives_zero_force_within_the_watchdog_deadline() {
     let deadline = u64::from(twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS);
     // In the wall (the hand holds it there from 2 s to 6 s).
     for t0 in [3000, 3005, 3999] {
-        let faults = Faults {
+        let faults = LinkFaults {
             corrupt_every: 0,
             link_loss_at: Some(t0),
         };
@@ -65,7 +65,7 @@ fn the_board_loop_matches_the_scenes_own_servo_within_pwm_resolution() {
     // goes to the plant unquantised and it has no enable ramp or link;
     // the board's goes through the 16-bit duty (6.1 mN steps) after a 100 ms
     // ramp-in. Away from the start the trajectories agree closely.
-    let r = run(6000, Faults::default());
+    let r = run(6000, LinkFaults::default());
     let mut sim = Simulation::new(scene()).unwrap();
     let mut worst = 0.0f64;
     for s in &r.samples {
@@ -84,9 +84,14 @@ fn a_scene_with_another_encoder_is_refused_by_name() {
         &["effects.encoder.bits=32".to_string()],
     )
     .unwrap();
-    let e = pil::run(s, 10, LocalBoard::excalibur().unwrap(), Faults::default())
-        .err()
-        .unwrap();
+    let e = pil::run(
+        s,
+        10,
+        LocalBoard::excalibur().unwrap(),
+        LinkFaults::default(),
+    )
+    .err()
+    .unwrap();
     assert!(e.contains("effects.encoder"), "{e}");
 }
 
@@ -96,7 +101,13 @@ fn a_scene_with_another_encoder_is_refused_by_name() {
 #[test]
 fn a_board_homes_onto_the_hard_stop_then_arms_and_holds_the_wall() {
     let s = Scene::load(Path::new("../scenes/homing.toml"), &[]).unwrap();
-    let r = pil::run(s, 4500, LocalBoard::excalibur().unwrap(), Faults::default()).unwrap();
+    let r = pil::run(
+        s,
+        4500,
+        LocalBoard::excalibur().unwrap(),
+        LinkFaults::default(),
+    )
+    .unwrap();
     assert_eq!(r.start, Some(pil::Start::Home));
     let (n, err_m) = r.homing.expect("homed");
     // 20 mm at 20 mm/s, the stall and the ramp-in.
@@ -104,7 +115,7 @@ fn a_board_homes_onto_the_hard_stop_then_arms_and_holds_the_wall() {
     assert!(err_m.abs() < pil::HOMING_TOLERANCE_M, "{err_m} m");
     assert!(r.armed_at_tick > n);
     let c = pil::compare(&r, &r);
-    assert!(pil::failures(&r, &c, 4500, Faults::default(), 50).is_empty());
+    assert!(pil::failures(&r, &c, 4500, LinkFaults::default(), 50).is_empty());
     // Before arming nothing pushes harder than the homing limit; after the
     // hand has pushed the handle into the wall, the wall pushes back hard.
     let io = twoport_board::IoScale::EXCALIBUR;
@@ -129,7 +140,7 @@ fn a_board_homes_onto_the_hard_stop_then_arms_and_holds_the_wall() {
 #[test]
 fn an_uncalibrated_board_refuses_to_arm_by_name() {
     let mut session =
-        link::Session::open(LocalBoard::excalibur().unwrap(), Faults::default()).unwrap();
+        link::Session::open(LocalBoard::excalibur().unwrap(), LinkFaults::default()).unwrap();
     let mut sim = Simulation::new(scene()).unwrap();
     session.step(&mut sim).unwrap();
     let e = session.arm().unwrap_err();
@@ -169,7 +180,7 @@ fn a_rebooted_board_is_seen_by_its_session_not_by_timing() {
         sent: 0,
         after: 40,
     };
-    let mut s = link::Session::open(port, Faults::default()).unwrap();
+    let mut s = link::Session::open(port, LinkFaults::default()).unwrap();
     assert_ne!(s.session(), twoport_link::NO_SESSION);
     let mut sim = Simulation::new(scene()).unwrap();
     let mut failed = None;
@@ -198,7 +209,12 @@ fn a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed() {
     use twoport_control::Faults as F;
     use twoport_link::Mode;
     let pty = std::env::var("TWOPORT_PTY").expect("TWOPORT_PTY names the board's pty");
-    let open = || link::Session::open(link::SerialBoard::open(&pty).unwrap(), Faults::default());
+    let open = || {
+        link::Session::open(
+            link::SerialBoard::open(&pty).unwrap(),
+            LinkFaults::default(),
+        )
+    };
     let mut s = open().unwrap();
     let mut sim = Simulation::new(scene()).unwrap();
     s.step(&mut sim).unwrap();
@@ -266,7 +282,7 @@ fn a_board_homes_on_the_index_pulse_before_the_stop() {
     let mut cfg = twoport_board::excalibur::HOMING;
     cfg.index_position = Some(twoport_control::Position::from_nm(-6_000_000));
     let board = LocalBoard::excalibur().unwrap().with_homing([cfg]);
-    let r = pil::run(s, 3000, board, Faults::default()).unwrap();
+    let r = pil::run(s, 3000, board, LinkFaults::default()).unwrap();
     let (n, err_m) = r.homing.expect("homed");
     // 6 mm at 20 mm/s and the ramp-in.
     assert!((250..600).contains(&n), "{n} ticks");

@@ -3,7 +3,7 @@
 //! boards through `cargo xtask pil scenes/xyz/pil_blocks.toml --check`).
 
 use host_sim::engine::xyz::{XyzScene, XyzSimulation};
-use host_sim::link::{self, Faults, LocalBoard};
+use host_sim::link::{self, LinkFaults, LocalBoard};
 use host_sim::pil;
 use std::path::Path;
 
@@ -21,7 +21,7 @@ fn scene(sets: &[&str]) -> XyzScene {
 /// every axis is at zero force within the watchdog's deadline.
 #[test]
 fn three_axes_run_in_lockstep_and_all_stop_after_a_link_loss() {
-    let faults = Faults {
+    let faults = LinkFaults {
         corrupt_every: 50,
         link_loss_at: Some(5000),
     };
@@ -56,7 +56,7 @@ fn three_axes_run_in_lockstep_and_all_stop_after_a_link_loss() {
 #[test]
 fn a_host_of_another_axis_count_is_refused_by_the_board() {
     let board = LocalBoard::excalibur_xyz().unwrap();
-    let e = link::Session::open(board, Faults::default())
+    let e = link::Session::open(board, LinkFaults::default())
         .err()
         .expect("a one-axis host");
     assert!(e.contains('3') && e.contains('1'), "{e}");
@@ -70,9 +70,9 @@ fn a_scene_the_image_cannot_match_is_refused() {
     let text = std::fs::read_to_string(SCENE).unwrap();
     let heavier = text.replacen("mass_kg = 0.1 }", "mass_kg = 0.2 }", 1);
     let moved = XyzScene::parse(&heavier, SCENE, &[]).unwrap();
-    let e = pil::run_xyz(moved, 10, board(), Faults::default()).unwrap_err();
+    let e = pil::run_xyz(moved, 10, board(), LinkFaults::default()).unwrap_err();
     assert!(e.contains("BLOCKS"), "{e}");
     let grabs = scene(&["ve.grab_at_s=[1.0]"]);
-    let e = pil::run_xyz(grabs, 10, board(), Faults::default()).unwrap_err();
+    let e = pil::run_xyz(grabs, 10, board(), LinkFaults::default()).unwrap_err();
     assert!(e.contains("grab_at_s"), "{e}");
 }

@@ -1,7 +1,7 @@
 //! The studies as a library: the bisection of a stability boundary, the
 //! paper's Table I, and the rules a processor-in-the-loop run is judged by.
 
-use host_sim::link::Faults;
+use host_sim::link::LinkFaults;
 use host_sim::pil::{failures, Comparison, Run};
 use host_sim::study::{sweep, table1};
 use host_sim::{Scene, Simulation};
@@ -74,21 +74,21 @@ fn clean(ticks: u64) -> (Run, Comparison) {
 #[test]
 fn pil_runs_fail_for_any_difference_and_a_late_zero() {
     let (run, c) = clean(100);
-    assert!(failures(&run, &c, 100, Faults::default(), 50).is_empty());
+    assert!(failures(&run, &c, 100, LinkFaults::default(), 50).is_empty());
     // Bit for bit or nothing: one duty, a femtometre, a missing tick.
     let mut d = c;
     d.duty_mismatches = 1;
-    assert!(failures(&run, &d, 100, Faults::default(), 50)[0].contains("differs"));
+    assert!(failures(&run, &d, 100, LinkFaults::default(), 50)[0].contains("differs"));
     let mut d = c;
     d.max_position_error_m = 1e-15;
-    assert!(!failures(&run, &d, 100, Faults::default(), 50).is_empty());
-    assert!(failures(&run, &c, 101, Faults::default(), 50)[0].contains("100 of 101 ticks"));
+    assert!(!failures(&run, &d, 100, LinkFaults::default(), 50).is_empty());
+    assert!(failures(&run, &c, 101, LinkFaults::default(), 50)[0].contains("100 of 101 ticks"));
     // Corrupted frames must all be dropped.
     let mut r = run.clone();
     r.corrupted_sent = 3;
-    assert!(failures(&r, &c, 100, Faults::default(), 50)[0].contains("corrupted"));
+    assert!(failures(&r, &c, 100, LinkFaults::default(), 50)[0].contains("corrupted"));
     // The link lost at tick 60: zero force within the deadline, after force.
-    let loss = Faults {
+    let loss = LinkFaults {
         corrupt_every: 0,
         link_loss_at: Some(60),
     };
@@ -103,26 +103,26 @@ fn pil_runs_fail_for_any_difference_and_a_late_zero() {
     // Armed at another tick than the in-process loop.
     let mut d = c;
     d.start_differs = true;
-    assert!(failures(&run, &d, 100, Faults::default(), 50)[0].contains("armed at tick"));
+    assert!(failures(&run, &d, 100, LinkFaults::default(), 50)[0].contains("armed at tick"));
     // Homing: within the stop's give of the plant, and never above 5 N.
     let mut r = run.clone();
     r.homing = Some((50, 20e-6));
-    assert!(failures(&r, &c, 100, Faults::default(), 50).is_empty());
+    assert!(failures(&r, &c, 100, LinkFaults::default(), 50).is_empty());
     r.homing = Some((50, 80e-6));
-    assert!(failures(&r, &c, 100, Faults::default(), 50)[0].contains("80.0 um off"));
+    assert!(failures(&r, &c, 100, LinkFaults::default(), 50)[0].contains("80.0 um off"));
     r.homing = Some((50, f64::NAN));
-    assert!(!failures(&r, &c, 100, Faults::default(), 50).is_empty());
+    assert!(!failures(&r, &c, 100, LinkFaults::default(), 50).is_empty());
     // A board that booted on a stored record, or never said.
     let mut r = run.clone();
     r.config = Some((
         ConfigSource::Stored { seq: 3 },
         ConfigSource::Stored { seq: 4 },
     ));
-    assert!(failures(&r, &c, 100, Faults::default(), 50)[0].contains("boot on its defaults"));
+    assert!(failures(&r, &c, 100, LinkFaults::default(), 50)[0].contains("boot on its defaults"));
     r.config = None;
-    assert!(failures(&r, &c, 100, Faults::default(), 50)[0].contains("never said"));
+    assert!(failures(&r, &c, 100, LinkFaults::default(), 50)[0].contains("never said"));
     let mut r = run.clone();
     r.homing = Some((50, 0.0));
     r.duties[10] = Axes::one(1000); // 6.1 N
-    assert!(failures(&r, &c, 100, Faults::default(), 50)[0].contains("homing pushed 6.10 N"));
+    assert!(failures(&r, &c, 100, LinkFaults::default(), 50)[0].contains("homing pushed 6.10 N"));
 }

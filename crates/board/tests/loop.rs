@@ -342,7 +342,7 @@ fn admittance_gains_need_the_proven_regulator() {
 }
 
 fn sensors(tick: u32, raw: u32) -> Message {
-    Message::Sensors(twoport_link::SensorFrame {
+    Message::Sensors(twoport_link::PilSensors {
         tick,
         encoder_raw: Axes::one(raw),
         load_cell_raw: Axes::one(0),

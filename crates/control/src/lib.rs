@@ -35,7 +35,9 @@ pub use probe::SineProbe;
 pub use real::Real;
 pub use regulator::PositionRegulator;
 pub use safety::{AxisError, Faults, SafetyConfig, SafetyLayer};
+// (`servo::Display` stays in its module: at the root it would shadow
+// `core::fmt::Display` for anyone who imports the crate whole.)
 pub use servo::{
-    AdmittanceGains, Display, Gains, GainsError, ImpedanceGains, SensorFrame, Servo, ServoOutput,
+    AdmittanceGains, Gains, GainsError, ImpedanceGains, SensorFrame, Servo, ServoOutput,
 };
 pub use tf::ZTransfer;

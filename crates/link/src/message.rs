@@ -257,7 +257,7 @@ pub enum GainsReply {
 /// Processor-in-the-loop: the simulated sensors for one tick (host to
 /// board), every axis sampled at one instant.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub struct SensorFrame {
+pub struct PilSensors {
     /// Tick this frame is for.
     pub tick: u32,
     /// Each axis's raw encoder counter.
@@ -366,7 +366,7 @@ pub enum Message {
         why: ModeRefusal,
     },
     /// PIL sensors in.
-    Sensors(SensorFrame),
+    Sensors(PilSensors),
     /// PIL actuator out.
     Actuator(ActuatorFrame),
     /// Ask for the board's link counters (protocol 2).

@@ -88,14 +88,14 @@ fn all_messages() -> Vec<Message> {
             asked: ModeRequest::Calibrate,
             why: ModeRefusal::NotDisarmed { mode: Mode::Homing },
         },
-        Message::Sensors(SensorFrame {
+        Message::Sensors(PilSensors {
             tick: 7,
             encoder_raw: Axes::new([65_535, u32::MAX, 0]).unwrap(),
             load_cell_raw: Axes::new([-2048, i32::MIN, i32::MAX]).unwrap(),
             dead_man_closed: true,
             index_raw: Axes::new([Some(u32::MAX), None, Some(0)]).unwrap(),
         }),
-        Message::Sensors(SensorFrame {
+        Message::Sensors(PilSensors {
             tick: 8,
             encoder_raw: Axes::one(1),
             load_cell_raw: Axes::one(-1),

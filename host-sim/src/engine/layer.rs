@@ -2,12 +2,12 @@
 //! what the display's element sees, and the books the scope and the report
 //! read (observed energy, added damping, energy dissipated).
 
-use crate::engine::scene::{Display, LayerPort, Scene};
+use crate::engine::scene::{LayerPort, Scene};
 use std::collections::VecDeque;
 use twoport_control::passivity::{
     EnergyObserver, ParallelDamper, ParallelLimits, PassivityLimits, SeriesDamper,
 };
-use twoport_control::servo::{Display as ServoDisplay, PortLayer};
+use twoport_control::servo::{Display, PortLayer};
 use twoport_control::{Position, Real, SafetyConfig};
 
 /// What sits between the simulated device and the scene's element.
@@ -106,10 +106,10 @@ impl<R: Real> SceneLayer<R> {
 }
 
 impl<R: Real> PortLayer<R> for SceneLayer<R> {
-    fn display(&self) -> Option<ServoDisplay> {
+    fn display(&self) -> Option<Display> {
         match (&self.series, &self.parallel) {
-            (Some(_), _) => Some(ServoDisplay::Impedance),
-            (_, Some(_)) => Some(ServoDisplay::Admittance),
+            (Some(_), _) => Some(Display::Impedance),
+            (_, Some(_)) => Some(Display::Admittance),
             _ => None,
         }
     }

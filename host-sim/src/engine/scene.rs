@@ -4,7 +4,7 @@ use crate::engine::human::{Event, GraspKind};
 use crate::engine::plant::Method;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
-use twoport_control::servo::{AdmittanceGains, Gains, ImpedanceGains};
+use twoport_control::servo::{AdmittanceGains, Display, Gains, ImpedanceGains};
 
 /// A scene, as read from TOML. Every section but `display`, `coupling` and
 /// `ve` has defaults; unknown keys are errors.
@@ -188,16 +188,6 @@ impl Default for IntegratorSpec {
             controller: Precision::F32,
         }
     }
-}
-
-/// The display type.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Display {
-    /// Measure motion, command force.
-    Impedance,
-    /// Measure force, command motion.
-    Admittance,
 }
 
 /// Gains. Impedance display: `k`, `b`. Admittance display: `kp`, `bp`, `m`, `b`.

@@ -16,4 +16,4 @@ mod session;
 
 pub use local::LocalBoard;
 pub use port::{BoardPort, SerialBoard};
-pub use session::{Faults, Session, ANSWER_TIMEOUT, HEARTBEAT_EVERY};
+pub use session::{LinkFaults, Session, ANSWER_TIMEOUT, HEARTBEAT_EVERY};

@@ -7,8 +7,8 @@ use std::sync::atomic::{AtomicU16, Ordering};
 use std::time::{Duration, Instant};
 use twoport_board::excalibur;
 use twoport_link::{
-    encode, Axes, ConfigSource, Decoder, LinkStats, Message, Mode, ModeRequest, Role,
-    SensorFrame as LinkSensors, Status, MAX_FRAME, NO_SESSION,
+    encode, Axes, ConfigSource, Decoder, LinkStats, Message, Mode, ModeRequest, PilSensors, Role,
+    Status, MAX_FRAME, NO_SESSION,
 };
 
 /// How long the host waits for the board's answer to one frame.
@@ -19,7 +19,7 @@ pub const HEARTBEAT_EVERY: u64 = 10;
 
 /// What to do to the link during a run.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Faults {
+pub struct LinkFaults {
     /// Every this many ticks, send a corrupted copy of the tick's sensor
     /// frame (one byte flipped) and a burst of garbage first (0: never).
     pub corrupt_every: u64,
@@ -42,7 +42,7 @@ pub struct Session<P: BoardPort> {
     decoder: Decoder,
     inbox: Vec<Message>,
     pub(crate) io: twoport_board::IoScale,
-    faults: Faults,
+    faults: LinkFaults,
     tick: u64,
     /// The encoder's index mark as a count, and the unwrapped count of
     /// the last frame: the host plays the encoder's index hardware.
@@ -54,13 +54,13 @@ pub struct Session<P: BoardPort> {
 impl<P: BoardPort> Session<P> {
     /// Shake hands with the one-axis board at `port`. It is disarmed until
     /// [`arm`](Self::arm).
-    pub fn open(port: P, faults: Faults) -> Result<Self, String> {
+    pub fn open(port: P, faults: LinkFaults) -> Result<Self, String> {
         Self::open_axes(port, faults, 1)
     }
 
     /// Shake hands with the board of `axes` axes at `port`: a board of
     /// another count is refused, with both counts named.
-    pub fn open_axes(port: P, faults: Faults, axes: u8) -> Result<Self, String> {
+    pub fn open_axes(port: P, faults: LinkFaults, axes: u8) -> Result<Self, String> {
         let mut s = Session {
             port,
             axes,
@@ -324,11 +324,7 @@ impl<P: BoardPort> Session<P> {
 
     /// Send tick `tick`'s sensors (and, on schedule, a corrupted copy
     /// first) and wait for the board's duties.
-    pub(crate) fn exchange(
-        &mut self,
-        tick: u64,
-        sensors: LinkSensors,
-    ) -> Result<Axes<i16>, String> {
+    pub(crate) fn exchange(&mut self, tick: u64, sensors: PilSensors) -> Result<Axes<i16>, String> {
         let want = sensors.tick;
         let good = self.frame(&Message::Sensors(sensors))?;
         let every = self.faults.corrupt_every;

@@ -654,7 +654,7 @@ impl ScopeState {
         };
         let r = scene_ok
             .and_then(|_| SerialBoard::open(port))
-            .and_then(|p| Session::open(p, crate::link::Faults::default()))
+            .and_then(|p| Session::open(p, crate::link::LinkFaults::default()))
             .and_then(|mut s| s.send(&Message::GetStatus).map(|_| s));
         match r {
             Ok(session) => {

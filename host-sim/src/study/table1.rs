@@ -2,9 +2,9 @@
 //! then the boundaries swept as the paper did.
 
 use super::sweep::marginal;
-use crate::engine::scene::Display;
 use crate::{Scene, Simulation};
 use std::path::{Path, PathBuf};
+use twoport_control::servo::Display;
 
 /// One case of the table.
 #[derive(Clone, Debug, PartialEq)]

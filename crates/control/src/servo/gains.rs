@@ -4,8 +4,14 @@
 use crate::ParamError;
 use core::fmt;
 
-/// Which display a servo runs (paper Figs. 5 and 6).
+/// Which display a servo runs (paper Figs. 5 and 6). With the `serde`
+/// feature it reads from a file as `impedance` or `admittance`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Deserialize),
+    serde(rename_all = "snake_case")
+)]
 pub enum Display {
     /// Measure motion, command force (Fig. 5).
     Impedance,
