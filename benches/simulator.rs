@@ -20,7 +20,7 @@ use twoport_design::DeviceModel;
 const SCENE: &str = "scenes/table1/impedance_bilateral_maximum.toml";
 
 fn scene(sets: &[&str]) -> Scene {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
     let sets: Vec<String> = sets
         .iter()
         .map(|s| s.to_string())
@@ -137,7 +137,7 @@ fn effects(c: &mut Criterion) {
 /// maximum in 3-D: three 5-DOF Excalibur plants, the 3-axis servo; goal
 /// 5,000x real time, 200 us) and of the 50-block world.
 fn three_axes(c: &mut Criterion) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
     for (name, file) in [
         (
             "1 s, 3 axes, Table I bilateral maximum in 3-D",
@@ -165,7 +165,7 @@ fn three_axes(c: &mut Criterion) {
 /// mates), with each thing a world scene can name added one at a time to
 /// a world without friction or knobs: what each costs.
 fn three_axis_effects(c: &mut Criterion) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
     let bare = ["ve.friction=0.0", "ve.knobs=false"];
     let with = |set: &str| -> Vec<String> {
         let key = set.split('=').next().unwrap_or("");

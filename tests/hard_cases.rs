@@ -3,9 +3,9 @@
 //! refusal; never a NaN, never a panic.
 
 use std::f64::consts::PI;
-use twoport::control::servo::SensorFrame;
-use twoport::control::ve::{Solid, UnilateralWall};
-use twoport::control::{AdmittanceGains, Encoder, Position, SafetyConfig, Servo};
+use twoport_control::servo::SensorFrame;
+use twoport_control::ve::{Solid, UnilateralWall};
+use twoport_control::{AdmittanceGains, Encoder, Position, SafetyConfig, Servo};
 use twoport_design::design::*;
 use twoport_design::twoport::HumanBound;
 use twoport_design::{DeviceModel, Plant};
@@ -92,7 +92,7 @@ fn extreme_gains_are_reported_unstable_never_nan() {
     assert!(!c.absolutely_stable && c.regulator_pole_radius.is_finite());
     // And the simulator: a coupling of 1e9 N/m is unstable, with finite
     // numbers and the force never past the actuator's peak.
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
     let mut s = host_sim::Scene::load(
         &root.join("scenes/table1/impedance_bilateral_maximum.toml"),
         &["coupling.k=1e9".into()],

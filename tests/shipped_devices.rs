@@ -12,7 +12,7 @@ use twoport_design::DeviceModel;
 const T: f64 = 1e-3;
 
 fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
 }
 
 /// Each shipped model with the scene that runs it.

@@ -109,7 +109,7 @@ fn case() -> impl Strategy<Value = Case> {
 }
 
 fn base(display: Display) -> Scene {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
     let file = match display {
         Display::Impedance => "scenes/table1/impedance_bilateral_hands_off.toml",
         Display::Admittance => "scenes/table1/admittance_bilateral_hands_off.toml",

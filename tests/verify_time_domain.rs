@@ -33,7 +33,7 @@ fn scene(k: f64, b: f64, hand: &twoport_design::verify::Hand, ve: &Ve) -> Scene 
 /// An impedance-display scene of the model file `model` (flexible, no
 /// other effect), hands off, with the VE `ve` and one small push.
 fn scene_on(model: &str, k: f64, b: f64, ve: &Ve) -> Scene {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
     let mut s = Scene::load(
         &root.join("scenes/table1/impedance_bilateral_hands_off.toml"),
         &[],
