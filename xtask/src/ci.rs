@@ -1,0 +1,310 @@
+//! Everything CI checks, as a table of named steps: `cargo xtask ci` runs
+//! them all in order, `cargo xtask ci <step>...` only the ones named, and
+//! each step's time is printed at the end (CI must stay under 45 minutes on
+//! a busy machine).
+
+use crate::emulate::{pil, scope_board, watchdog};
+use crate::firmware::thumb;
+use crate::fuzz::fuzz;
+use crate::probe::qemu;
+use crate::{cargo, run};
+use std::process::Stdio;
+use std::time::{Duration, Instant};
+
+/// One named step of CI.
+struct Step {
+    name: &'static str,
+    what: &'static str,
+    run: fn() -> Result<(), String>,
+}
+
+/// The steps, in the order CI runs them: the quick checks first, the
+/// tests' total last, so that a log's last line is the whole count.
+const STEPS: [Step; 12] = [
+    Step {
+        name: "fmt",
+        what: "rustfmt on the workspace, the firmware's two and fuzz's",
+        run: fmt,
+    },
+    Step {
+        name: "clippy",
+        what: "clippy on every target, warnings denied",
+        run: clippy,
+    },
+    Step {
+        name: "doc",
+        what: "the crates' docs (each README is its crate's page), warnings denied",
+        run: doc,
+    },
+    Step {
+        name: "design-lib",
+        what: "the design library without its CLI and plots",
+        run: design_lib,
+    },
+    Step {
+        name: "thumb",
+        what: "the no_std crates for the Cortex-M4F",
+        run: thumb,
+    },
+    Step {
+        name: "probe",
+        what: "the on-target probe in QEMU, its instruction counts checked",
+        run: qemu,
+    },
+    Step {
+        name: "pil",
+        what: "processor in the loop on both boards, bit for bit",
+        run: pil_boards,
+    },
+    Step {
+        name: "pil-passivity",
+        what: "the passivity image in the loop",
+        run: pil_passivity,
+    },
+    Step {
+        name: "scope-board",
+        what: "the scope's board mode against the firmware in QEMU",
+        run: scope_board,
+    },
+    Step {
+        name: "watchdog",
+        what: "a hung loop reset by the watchdog, seen by the host",
+        run: watchdog,
+    },
+    Step {
+        name: "fuzz",
+        what: "each fuzz target for 40 s",
+        run: || fuzz(40),
+    },
+    Step {
+        name: "tests",
+        what: "every test: the release-only hard cases, then the workspace",
+        run: tests,
+    },
+];
+
+/// Run every step, or only those `only` names; a name CI does not have is
+/// an error that lists the names.
+pub(crate) fn ci(only: &[String]) -> Result<(), String> {
+    if let Some(bad) = only.iter().find(|n| !STEPS.iter().any(|s| s.name == *n)) {
+        let names: Vec<&str> = STEPS.iter().map(|s| s.name).collect();
+        return Err(format!(
+            "ci has no step `{bad}`; its steps: {}",
+            names.join(", ")
+        ));
+    }
+    let mut took: Vec<(&str, Duration)> = Vec::new();
+    let chosen = STEPS
+        .iter()
+        .filter(|s| only.is_empty() || only.iter().any(|n| n == s.name));
+    for step in chosen {
+        eprintln!("xtask: ci step `{}`: {}", step.name, step.what);
+        let t = Instant::now();
+        let result = (step.run)();
+        took.push((step.name, t.elapsed()));
+        if let Err(e) = result {
+            report(&took);
+            return Err(format!("ci step `{}`: {e}", step.name));
+        }
+    }
+    report(&took);
+    Ok(())
+}
+
+/// Each step's time, and the total.
+fn report(took: &[(&str, Duration)]) {
+    let total: Duration = took.iter().map(|(_, d)| *d).sum();
+    eprintln!("xtask: ci steps' times");
+    for (name, d) in took {
+        eprintln!("  {name:<14} {:>7.1} s", d.as_secs_f64());
+    }
+    eprintln!("  {:<14} {:>7.1} s", "total", total.as_secs_f64());
+}
+
+fn fmt() -> Result<(), String> {
+    run(
+        "cargo fmt --check",
+        cargo().args(["fmt", "--all", "--", "--check"]),
+    )?;
+    for manifest in [
+        "firmware/Cargo.toml",
+        "firmware/stm32f405/Cargo.toml",
+        "fuzz/Cargo.toml",
+    ] {
+        run(
+            &format!("cargo fmt --check ({manifest})"),
+            cargo().args(["fmt", "--manifest-path", manifest, "--all", "--", "--check"]),
+        )?;
+    }
+    Ok(())
+}
+
+fn clippy() -> Result<(), String> {
+    run(
+        "cargo clippy",
+        cargo().args([
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--",
+            "-D",
+            "warnings",
+        ]),
+    )
+}
+
+fn doc() -> Result<(), String> {
+    run(
+        "cargo doc (warnings denied)",
+        cargo()
+            .args(["doc", "--workspace", "--no-deps"])
+            .env("RUSTDOCFLAGS", "-D warnings"),
+    )
+}
+
+fn design_lib() -> Result<(), String> {
+    run(
+        "twoport-design without its cli and plot features",
+        cargo().args([
+            "check",
+            "-p",
+            "twoport-design",
+            "--no-default-features",
+            "--lib",
+            "--examples",
+        ]),
+    )
+}
+
+/// Processor in the loop, bit for bit against the in-process loop, with
+/// corrupted frames and a link loss, on both boards (for the STM32F405
+/// image, its own loop on QEMU's netduinoplus2, with the log of what it
+/// touches that QEMU does not model): the plain scene, homing onto the
+/// hard stop then armed (the state machine bit for bit too), and the
+/// three-axis image on its building-block world.
+fn pil_boards() -> Result<(), String> {
+    for board in ["an386", "stm32f405"] {
+        let runs: [&[&str]; 3] = [
+            &["--seconds", "4", "--link-loss-at-s", "3", "--check"],
+            &["scenes/homing.toml", "--seconds", "2", "--check"],
+            &[
+                "scenes/xyz/pil_blocks.toml",
+                "--seconds",
+                "4",
+                "--link-loss-at-s",
+                "3",
+                "--check",
+            ],
+        ];
+        for args in runs {
+            let mut all = vec!["--board".to_string(), board.to_string()];
+            all.extend(args.iter().map(|a| a.to_string()));
+            pil(&all)?;
+        }
+    }
+    Ok(())
+}
+
+/// The passivity image: the layered tick on the M4F against the same code
+/// on the host.
+fn pil_passivity() -> Result<(), String> {
+    pil(&["--passivity", "--seconds", "3", "--check"].map(String::from))
+}
+
+/// The tests, closing on the total so that CI reads the whole count rather
+/// than the last crate's doc-test line. The long hard cases (24 h of
+/// ticks, 2 x 10^4 random terminations) are ignored in debug builds and run
+/// here in release, as are the designer's verify searches and the scope in
+/// a real window under Xvfb (screenshots) with an hour of scope buffers.
+fn tests() -> Result<(), String> {
+    let runs: [&[&str]; 4] = [
+        &[
+            "test",
+            "--release",
+            "-p",
+            "twoport-tests",
+            "--test",
+            "hard_cases",
+            "--test",
+            "terminations",
+            "--test",
+            "verify_time_domain",
+            "--test",
+            "shipped_devices",
+            "--",
+            "--ignored",
+        ],
+        &[
+            "test",
+            "--release",
+            "-p",
+            "twoport-design",
+            "--test",
+            "soundness",
+        ],
+        &[
+            "test",
+            "--release",
+            "-p",
+            "host-sim",
+            "--test",
+            "screenshot",
+            "--test",
+            "scope",
+            "--test",
+            "study",
+            "--",
+            "--ignored",
+            "--skip",
+            "board_mode",
+        ],
+        &["test", "--workspace"],
+    ];
+    let (mut passed, mut failed, mut ok) = (0, 0, true);
+    for args in runs {
+        let (p, f, good) = cargo_test_counts(args)?;
+        (passed, failed, ok) = (passed + p, failed + f, ok && good);
+    }
+    println!("tests: {passed} passed, {failed} failed");
+    if ok {
+        Ok(())
+    } else {
+        Err("cargo test: failed".into())
+    }
+}
+
+/// Run `cargo <args>`, passing its output through; returns the passed and
+/// failed counts it reported and whether it succeeded.
+pub(crate) fn cargo_test_counts(args: &[&str]) -> Result<(u64, u64, bool), String> {
+    use std::io::{BufRead, BufReader};
+    eprintln!("xtask: cargo {}", args.join(" "));
+    let mut child = cargo()
+        .args(args)
+        .stdout(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("cargo test: could not start: {e}"))?;
+    let (mut passed, mut failed) = (0u64, 0u64);
+    let out = child.stdout.take().expect("stdout is piped");
+    for line in BufReader::new(out).lines() {
+        let line = line.map_err(|e| format!("cargo test output: {e}"))?;
+        println!("{line}");
+        if let Some(rest) = line.strip_prefix("test result: ") {
+            let count = |word: &str| {
+                rest.split(';')
+                    .find_map(|part| {
+                        part.trim()
+                            .strip_suffix(word)?
+                            .split_whitespace()
+                            .last()?
+                            .parse::<u64>()
+                            .ok()
+                    })
+                    .unwrap_or(0)
+            };
+            passed += count(" passed");
+            failed += count(" failed");
+        }
+    }
+    let status = child.wait().map_err(|e| format!("cargo test: {e}"))?;
+    Ok((passed, failed, status.success()))
+}

@@ -1,0 +1,251 @@
+//! The images in QEMU against the host: processor in the loop, the
+//! scope's board mode and the watchdog, each through a pty.
+
+use crate::firmware::{an386_image_with, firmware, passivity_image, stm32f405_qemu_image};
+use crate::{cargo, cross_target_dir, root, run};
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+/// QEMU's Cortex-M4F board running `elf`, with semihosting (prints and
+/// exit codes) and virtual time from the instruction count, so that the
+/// images' SysTick measurements are deterministic.
+pub(crate) fn qemu_an386(elf: &Path) -> Command {
+    let mut c = Command::new("qemu-system-arm");
+    c.args(["-machine", "mps2-an386", "-cpu", "cortex-m4"])
+        .args(["-icount", "shift=6"])
+        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
+        .arg(elf)
+        .stdin(Stdio::null());
+    c
+}
+
+/// QEMU's netduinoplus2 (an STM32F405 SoC) running `elf`, with
+/// semihosting, and virtual time from the instruction count, 16 ns each
+/// (the image's `ICOUNT_SHIFT`), so that its TIM5 counts instructions and
+/// its TIM2 control interrupt is periodic in them.
+pub(crate) fn qemu_netduino(elf: &Path) -> Command {
+    let mut c = Command::new("qemu-system-arm");
+    c.args(["-machine", "netduinoplus2"])
+        .args(["-icount", "shift=4"])
+        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
+        .arg(elf)
+        .stdin(Stdio::null());
+    c
+}
+
+/// Processor-in-the-loop: start a board image in QEMU with its link on a
+/// pty, point `host-sim pil` at it, and fail if either side fails. The
+/// an386 image by default (`--passivity`: its passivity build); with
+/// `--board stm32f405`, the STM32F405 image's own loop on netduinoplus2,
+/// whose accesses to devices QEMU does not model are logged and summed up.
+pub(crate) fn pil(extra: &[String]) -> Result<(), String> {
+    let mut args = extra.to_vec();
+    let board = match args.iter().position(|a| a == "--board") {
+        Some(i) if i + 1 < args.len() => {
+            let b = args.remove(i + 1);
+            args.remove(i);
+            b
+        }
+        Some(_) => return Err("pil: --board needs a name (an386 or stm32f405)".into()),
+        None => "an386".into(),
+    };
+    run(
+        "build host-sim",
+        cargo().args(["build", "--release", "-q", "-p", "host-sim"]),
+    )?;
+    let host = |pty: &str| {
+        run(
+            "host-sim pil",
+            cargo()
+                .args(["run", "--release", "-q", "-p", "host-sim", "--"])
+                .args(["pil", "--port", pty])
+                .args(&args),
+        )
+    };
+    let xyz = args.iter().any(|a| declares_three_axes(a));
+    match board.as_str() {
+        "an386" => {
+            let elf = if args.iter().any(|a| a == "--passivity") {
+                passivity_image()?
+            } else if xyz {
+                an386_image_with("xyz")?
+            } else {
+                firmware()?.join("twoport-an386")
+            };
+            let mut qemu = qemu_an386(&elf);
+            qemu.args(["-serial", "pty"]);
+            with_board_in_qemu(qemu, host)
+        }
+        "stm32f405" => {
+            if args.iter().any(|a| a == "--passivity") {
+                return Err("pil: the STM32F405 image has no passivity build".into());
+            }
+            let elf = stm32f405_qemu_image(xyz)?;
+            let log = cross_target_dir("firmware").join("qemu-unmodelled-stm32f405.log");
+            let _ = std::fs::remove_file(&log);
+            let mut qemu = qemu_netduino(&elf);
+            // USART2 is the second serial port.
+            qemu.args(["-serial", "null", "-serial", "pty"])
+                .args(["-d", "unimp,guest_errors", "-D"])
+                .arg(&log);
+            let result = with_board_in_qemu(qemu, host);
+            eprint!("{}", unmodelled_summary(&log));
+            result
+        }
+        other => Err(format!(
+            "pil: no board image called {other:?} (an386 or stm32f405)"
+        )),
+    }
+}
+
+/// Whether `arg` names a scene file that declares three axes (`axes = 3`
+/// at its top level, read as host-sim reads it), for which the three-axis
+/// image runs.
+pub(crate) fn declares_three_axes(arg: &str) -> bool {
+    if !arg.ends_with(".toml") {
+        return false;
+    }
+    let text = std::fs::read_to_string(root().join(arg)).unwrap_or_default();
+    let axes = text
+        .parse::<toml::Table>()
+        .ok()
+        .and_then(|t| t.get("axes").and_then(toml::Value::as_integer));
+    axes == Some(3)
+}
+
+/// What QEMU logged of the image's accesses to devices it does not model:
+/// a line per device, with its read and write counts.
+pub(crate) fn unmodelled_summary(log: &Path) -> String {
+    let Ok(text) = std::fs::read_to_string(log) else {
+        return format!("xtask: no QEMU log at {}\n", log.display());
+    };
+    let mut seen: Vec<(String, u64, u64)> = Vec::new();
+    let mut other = 0u64;
+    for line in text.lines() {
+        let Some((device, rest)) = line.split_once(": unimplemented device ") else {
+            other += u64::from(!line.trim().is_empty());
+            continue;
+        };
+        let i = match seen.iter().position(|(d, _, _)| d == device) {
+            Some(i) => i,
+            None => {
+                seen.push((device.to_string(), 0, 0));
+                seen.len() - 1
+            }
+        };
+        if rest.starts_with("read") {
+            seen[i].1 += 1;
+        } else {
+            seen[i].2 += 1;
+        }
+    }
+    let mut s = format!(
+        "xtask: devices the image touches that QEMU does not model (log: {}):\n",
+        log.display()
+    );
+    for (d, r, w) in &seen {
+        s += &format!("  {d:<10} {r:>6} reads {w:>6} writes\n");
+    }
+    if other > 0 {
+        s += &format!("  and {other} other lines (guest errors)\n");
+    }
+    s
+}
+
+/// The scope's board mode against the firmware in QEMU.
+pub(crate) fn scope_board() -> Result<(), String> {
+    let elf = firmware()?.join("twoport-an386");
+    host_test_against_an386(
+        "scope board mode against QEMU",
+        &elf,
+        "scope",
+        "board_mode_shows_telemetry_and_the_boards_gain_answers",
+    )
+}
+
+/// Run `f` with a board image in QEMU (`qemu`, its link on a `-serial
+/// pty`), passing it the pty; fails if the firmware stops (a panic or
+/// HardFault exits QEMU) or `f` fails. QEMU is killed, not asked, to stop:
+/// under `-icount sleep=off` it may not answer a SIGTERM.
+pub(crate) fn with_board_in_qemu(
+    mut qemu: Command,
+    f: impl FnOnce(&str) -> Result<(), String>,
+) -> Result<(), String> {
+    use std::io::{BufRead, BufReader, Read};
+    let mut qemu = qemu
+        .args(["-display", "none", "-monitor", "none"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("qemu-system-arm: could not start ({e}); install qemu-system-arm"))?;
+    // QEMU names the pty on stdout, where the board's semihosting prints go
+    // too; both are kept to show if the run fails.
+    let stdout = qemu.stdout.take().ok_or("qemu's stdout")?;
+    let mut lines = BufReader::new(stdout).lines();
+    let pty = loop {
+        match lines.next() {
+            Some(Ok(l)) => {
+                if let Some(rest) = l.strip_prefix("char device redirected to ") {
+                    break rest.split_whitespace().next().unwrap_or("").to_string();
+                }
+            }
+            _ => {
+                let _ = qemu.kill();
+                return Err("qemu did not say where its serial pty is".into());
+            }
+        }
+    };
+    let board_out = std::thread::spawn(move || lines.map_while(Result::ok).collect::<Vec<_>>());
+    let mut stderr = qemu.stderr.take().ok_or("qemu's stderr")?;
+    std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = stderr.read_to_string(&mut s);
+    });
+    eprintln!("xtask: firmware in QEMU on {pty}");
+    let host = f(&pty);
+    let early_exit = qemu.try_wait().ok().flatten();
+    let _ = qemu.kill();
+    let _ = qemu.wait();
+    let printed = board_out.join().unwrap_or_default().join("\n");
+    if let Some(st) = early_exit {
+        return Err(format!(
+            "the firmware stopped during the run ({st}):\n{printed}"
+        ));
+    }
+    host.map_err(|e| format!("{e}; the board printed:\n{printed}"))
+}
+
+/// The watchdog test: the an386 image that hangs its loop on purpose
+/// after 1,500 armed ticks, against host-sim's check that the CMSDK
+/// watchdog resets it and that it comes back disarmed, outputs off, with
+/// the reset latched as a fault.
+pub(crate) fn watchdog() -> Result<(), String> {
+    let elf = an386_image_with("watchdog-test")?;
+    host_test_against_an386(
+        "watchdog reset in QEMU",
+        &elf,
+        "pil",
+        "a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed",
+    )
+}
+
+/// Run the ignored host-sim test `name` (in test file `file`) against
+/// the an386 image `elf` in QEMU, its link's pty in `TWOPORT_PTY`.
+pub(crate) fn host_test_against_an386(
+    what: &str,
+    elf: &Path,
+    file: &str,
+    name: &str,
+) -> Result<(), String> {
+    let mut qemu = qemu_an386(elf);
+    qemu.args(["-serial", "pty"]);
+    with_board_in_qemu(qemu, |pty| {
+        run(
+            what,
+            cargo()
+                .env("TWOPORT_PTY", pty)
+                .args(["test", "--release", "-p", "host-sim", "--test", file])
+                .args(["--", "--ignored", "--exact", name]),
+        )
+    })
+}
