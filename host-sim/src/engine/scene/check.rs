@@ -1,0 +1,219 @@
+//! The physical checks a scene's types cannot express; each message
+//! names the field.
+
+use super::{LayerPort, Scene, VeSpec};
+use twoport_control::servo::Display;
+
+impl Scene {
+    /// Physical checks beyond the types; the message names the field.
+    pub(super) fn check(&self) -> Result<(), String> {
+        let pos = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{name} = {v} must be finite and > 0"))
+            }
+        };
+        let nonneg = |name: &str, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{name} = {v} must be finite and >= 0"))
+            }
+        };
+        // A spring VE anchored at `at` (m, named `at_name`).
+        let spring = |at_name: &str, at: f64, k: f64, b: f64| {
+            if !at.is_finite() {
+                return Err(format!("{at_name} = {at} must be finite"));
+            }
+            nonneg("ve.stiffness_npm", k)?;
+            nonneg("ve.damping_nspm", b)
+        };
+        if let Some(n) = self.axes.filter(|&n| n != 1) {
+            return Err(format!(
+                "axes = {n}: a one-axis scene has axes = 1; a three-axis scene is read as one"
+            ));
+        }
+        pos("duration_s", self.duration_s)?;
+        if let Some(t) = self.period_s {
+            if !(t.is_finite() && (1e-6..=0.1).contains(&t)) {
+                return Err(format!("period_s = {t} must be between 1e-6 and 0.1 s"));
+            }
+        }
+        pos("plant.rigid_mass_kg", self.plant.rigid_mass_kg)?;
+        nonneg("plant.rigid_damping_nspm", self.plant.rigid_damping_nspm)?;
+        if self.integrator.substeps == 0 || self.integrator.substeps > 100_000 {
+            return Err(format!(
+                "integrator.substeps = {} must be 1..=100000",
+                self.integrator.substeps
+            ));
+        }
+        let c = &self.coupling;
+        match self.display {
+            Display::Impedance => {
+                let k =
+                    c.k.ok_or("coupling.k is required for an impedance display")?;
+                nonneg("coupling.k", k)?;
+                nonneg("coupling.b", c.b)?;
+                for (n, v) in [
+                    ("coupling.m", c.m),
+                    ("coupling.kp", c.kp),
+                    ("coupling.bp", c.bp),
+                ] {
+                    if v.is_some() {
+                        return Err(format!("{n} belongs to an admittance display"));
+                    }
+                }
+            }
+            Display::Admittance => {
+                for (n, v) in [
+                    ("coupling.m", c.m),
+                    ("coupling.kp", c.kp),
+                    ("coupling.bp", c.bp),
+                ] {
+                    let v = v.ok_or(format!("{n} is required for an admittance display"))?;
+                    nonneg(n, v)?;
+                }
+                pos("coupling.m", c.m.unwrap_or(0.0))?;
+                pos("coupling.b", c.b)?;
+                if c.k.is_some() {
+                    return Err("coupling.k belongs to an impedance display (use kp)".into());
+                }
+                if !self.effects.load_cell {
+                    return Err(
+                        "an admittance display measures force: add `load_cell = true` to [effects]"
+                            .into(),
+                    );
+                }
+            }
+        }
+        match &self.ve {
+            VeSpec::Cursor { mass_kg, .. } => pos("ve.mass_kg", *mass_kg)?,
+            VeSpec::Wall {
+                position_m: at,
+                stiffness_npm: k,
+                damping_nspm: b,
+                ..
+            } => spring("ve.position_m", *at, *k, *b)?,
+            VeSpec::Bilateral => {}
+            VeSpec::Spring {
+                anchor_m: at,
+                stiffness_npm: k,
+                damping_nspm: b,
+                ..
+            } => spring("ve.anchor_m", *at, *k, *b)?,
+            VeSpec::Blocks {
+                cursor_mass_kg,
+                blocks,
+                limits_m,
+                stick_force_n,
+                floor_damping_nspm,
+                ..
+            } => {
+                pos("ve.cursor_mass_kg", *cursor_mass_kg)?;
+                nonneg("ve.stick_force_n", *stick_force_n)?;
+                nonneg("ve.floor_damping_nspm", *floor_damping_nspm)?;
+                if !(limits_m[0].is_finite()
+                    && limits_m[1].is_finite()
+                    && limits_m[0] < limits_m[1])
+                {
+                    return Err("ve.limits_m must be [low, high] with low < high".into());
+                }
+                let mut edge = limits_m[0];
+                for (i, b) in blocks.iter().enumerate() {
+                    pos(&format!("ve.blocks[{i}].width_m"), b.width_m)?;
+                    pos(&format!("ve.blocks[{i}].mass_kg"), b.mass_kg)?;
+                    if !(b.at_m.is_finite() && b.at_m >= edge - 1e-12) {
+                        return Err(format!(
+                            "ve.blocks[{i}] overlaps the block or limit to its left"
+                        ));
+                    }
+                    edge = b.at_m + b.width_m;
+                }
+                if edge > limits_m[1] + 1e-12 {
+                    return Err("ve.blocks extend past ve.limits_m[1]".into());
+                }
+            }
+        }
+        let e = &self.effects;
+        if let Some(x) = e.encoder {
+            pos("effects.encoder.resolution_m", x.resolution_m)?;
+            if !(2..=32).contains(&x.bits) {
+                return Err(format!("effects.encoder.bits = {} must be 2..=32", x.bits));
+            }
+            if let Some(m) = x.index_m {
+                if !(m.is_finite() && m.abs() <= 1.0) {
+                    return Err(format!("effects.encoder.index_m = {m} must be within ±1 m"));
+                }
+            }
+        }
+        if let Some(x) = e.hard_stop {
+            if !(x.position_m.is_finite() && x.position_m.abs() <= 1.0) {
+                return Err(format!(
+                    "effects.hard_stop.position_m = {} must be within ±1 m",
+                    x.position_m
+                ));
+            }
+            pos("effects.hard_stop.stiffness_npm", x.stiffness_npm)?;
+            nonneg("effects.hard_stop.damping_nspm", x.damping_nspm)?;
+        }
+        if let Some(x) = e.adc {
+            pos("effects.adc.lsb_n", x.lsb_n)?;
+            nonneg("effects.adc.noise_rms_n", x.noise_rms_n)?;
+        }
+        if let Some(x) = e.saturation {
+            pos("effects.saturation.limit_n", x.limit_n)?;
+        }
+        if let Some(x) = e.coulomb {
+            nonneg("effects.coulomb.force_n", x.force_n)?;
+            pos("effects.coulomb.smoothing_mps", x.smoothing_mps)?;
+        }
+        if let Some(x) = e.cogging {
+            nonneg("effects.cogging.amplitude_n", x.amplitude_n)?;
+            pos("effects.cogging.period_m", x.period_m)?;
+        }
+        if let Some(x) = e.cable_slack {
+            nonneg("effects.cable_slack.width_m", x.width_m)?;
+            if !e.flexibility {
+                return Err("effects.cable_slack needs the flexible model (flexibility = true): the rigid reduction has no cable".into());
+            }
+        }
+        if let Some(x) = e.delay {
+            if x.ticks > 1000 {
+                return Err(format!("effects.delay.ticks = {} must be <= 1000", x.ticks));
+            }
+        }
+        if let Some(x) = e.element_delay {
+            if x.ticks > 1000 {
+                return Err(format!(
+                    "effects.element_delay.ticks = {} must be <= 1000",
+                    x.ticks
+                ));
+            }
+            if self.display != Display::Impedance {
+                return Err("effects.element_delay delays the impedance display's element; an admittance display has none to delay".into());
+            }
+        }
+        if let Some(p) = &self.passivity {
+            if p.port == LayerPort::Ve {
+                if self.display != Display::Impedance {
+                    return Err("passivity.port = \"ve\" is for an impedance display (an admittance display's layer already sits at the load cell)".into());
+                }
+                if !matches!(self.ve, VeSpec::Cursor { .. }) {
+                    return Err("passivity.port = \"ve\" needs a cursor VE (one that takes a force and answers with a velocity)".into());
+                }
+            }
+            if let Some(m) = p.mass_kg {
+                pos("passivity.mass_kg", m)?;
+            }
+            nonneg("passivity.device_damping_nspm", p.device_damping_nspm)?;
+            if let Some(v) = p.min_velocity_mps {
+                pos("passivity.min_velocity_mps", v)?;
+            }
+            if let Some(e) = p.max_reserve_j {
+                nonneg("passivity.max_reserve_j", e)?;
+            }
+        }
+        Ok(())
+    }
+}

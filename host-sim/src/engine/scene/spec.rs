@@ -1,0 +1,307 @@
+//! The scene's sections: plant, integrator, passivity layer, coupling,
+//! VE and human.
+
+use crate::engine::human::{Event, GraspKind};
+use crate::engine::plant::Method;
+use serde::Deserialize;
+use std::path::PathBuf;
+
+/// The passivity layer between the device's port and the display's
+/// element: the series damper on an impedance display, the parallel damper
+/// on an admittance display (see `docs/passivity.md`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PassivitySpec {
+    /// Whether the layer runs (`--set passivity.enabled=false` turns a
+    /// scene's layer off, everything else equal).
+    #[serde(default = "default_true")]
+    pub enabled: bool,
+    /// Which port it watches: `device` (the default: the series damper at
+    /// the encoder) or `ve` (a parallel damper between the coupling and an
+    /// admittance VE, for a VE that is unstable on its own).
+    #[serde(default)]
+    pub port: LayerPort,
+    /// Moving mass at the port (kg), which sets the damping cap; the
+    /// plant's `rigid_mass_kg` by default.
+    pub mass_kg: Option<f64>,
+    /// The device's own viscous damping credited to the element (N s/m):
+    /// a lower bound of it. 0 by default.
+    #[serde(default)]
+    pub device_damping_nspm: f64,
+    /// Velocity floor (m/s); a few encoder counts per tick. 1 mm/s by
+    /// default.
+    pub min_velocity_mps: Option<f64>,
+    /// Energy reserve (J); 0.5 J by default.
+    pub max_reserve_j: Option<f64>,
+    /// The `--set` assignments that make this scene passive without the
+    /// layer (an implicit VE, the proven gains, no delay): the reference
+    /// the layer's transparency cost is measured against.
+    #[serde(default)]
+    pub reference: Vec<String>,
+}
+
+/// Where the passivity layer sits.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LayerPort {
+    /// At the device's port (the encoder).
+    #[default]
+    Device,
+    /// Between the coupling and the VE.
+    Ve,
+}
+
+fn default_true() -> bool {
+    true
+}
+
+/// Which device model.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlantSpec {
+    /// Model file for the flexible plant (with the `flexibility` effect).
+    #[serde(default = "default_model")]
+    pub model: PathBuf,
+    /// Rigid reduction's mass (kg).
+    #[serde(default = "default_rigid_mass")]
+    pub rigid_mass_kg: f64,
+    /// Rigid reduction's damping (N s/m).
+    #[serde(default = "default_rigid_damping")]
+    pub rigid_damping_nspm: f64,
+}
+
+fn default_model() -> PathBuf {
+    PathBuf::from("models/excalibur.toml")
+}
+fn default_rigid_mass() -> f64 {
+    3.9
+}
+fn default_rigid_damping() -> f64 {
+    20.0
+}
+
+impl Default for PlantSpec {
+    fn default() -> Self {
+        PlantSpec {
+            model: default_model(),
+            rigid_mass_kg: default_rigid_mass(),
+            rigid_damping_nspm: default_rigid_damping(),
+        }
+    }
+}
+
+/// Integration method and sub-steps per control tick.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorSpec {
+    /// Method (a linear scene always runs exact ZOH in one step).
+    #[serde(default = "default_method")]
+    pub method: Method,
+    /// Sub-steps per control tick when sub-stepping.
+    #[serde(default = "default_substeps")]
+    pub substeps: u32,
+    /// Use this integrator even for a linear scene (to study its accuracy).
+    #[serde(default)]
+    pub on_linear: bool,
+    /// The controller's float type: `"f32"` (the board's, the default) or
+    /// `"f64"` (the same laws, to see what the board's rounding costs).
+    #[serde(default)]
+    pub controller: Precision,
+}
+
+/// A float type for the controller.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum Precision {
+    /// `f32`, as on the board.
+    #[default]
+    F32,
+    /// `f64`.
+    F64,
+}
+
+impl Precision {
+    /// `"f32"` or `"f64"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+        }
+    }
+}
+
+fn default_method() -> Method {
+    Method::Rk4
+}
+fn default_substeps() -> u32 {
+    20
+}
+
+impl Default for IntegratorSpec {
+    fn default() -> Self {
+        IntegratorSpec {
+            method: default_method(),
+            substeps: default_substeps(),
+            on_linear: false,
+            controller: Precision::F32,
+        }
+    }
+}
+
+/// Gains. Impedance display: `k`, `b`. Admittance display: `kp`, `bp`, `m`, `b`.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Coupling {
+    /// Impedance coupling stiffness (N/m).
+    pub k: Option<f64>,
+    /// Coupling damping (N s/m), both displays.
+    pub b: f64,
+    /// Admittance coupling mass (kg).
+    pub m: Option<f64>,
+    /// Position regulator stiffness (N/m).
+    pub kp: Option<f64>,
+    /// Position regulator damping (N s/m).
+    pub bp: Option<f64>,
+}
+
+/// Which side of a wall is solid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SolidSide {
+    /// Positions above the surface are inside.
+    Above,
+    /// Positions below the surface are inside.
+    Below,
+}
+
+/// One block of the building-block world.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlockSpec {
+    /// Left edge (m).
+    pub at_m: f64,
+    /// Width (m).
+    pub width_m: f64,
+    /// Mass (kg).
+    pub mass_kg: f64,
+}
+
+/// How a spring VE's probe position is integrated on the board.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Discretization {
+    /// `x[k] = x[k-1] + T v[k]`: adds damping `kT/2` at high frequency.
+    #[default]
+    BackwardEuler,
+    /// `x[k] = x[k-1] + T (v[k] + v[k-1])/2`: lossless.
+    Trapezoidal,
+}
+
+/// How a VE body is integrated on the board.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Integration {
+    /// Backward Euler on this tick's force: passive for every mass.
+    #[default]
+    Implicit,
+    /// The paper's building blocks: the velocity from last tick's force
+    /// (forward Euler), the position by the trapezoidal rule. Not passive.
+    Explicit,
+}
+
+/// The virtual environment.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum VeSpec {
+    /// A free cursor mass.
+    Cursor {
+        /// Mass (kg); the paper's minimum is 0.25.
+        mass_kg: f64,
+        /// How the board integrates it: `implicit` (backward Euler,
+        /// passive, the default) or `explicit` (the paper's: Euler
+        /// velocity, trapezoidal position).
+        #[serde(default)]
+        integration: Integration,
+    },
+    /// A unilateral spring-damper wall.
+    Wall {
+        /// Surface position (m).
+        position_m: f64,
+        /// Stiffness (N/m).
+        stiffness_npm: f64,
+        /// Damping (N s/m).
+        damping_nspm: f64,
+        /// Solid side.
+        #[serde(default = "default_solid")]
+        solid: SolidSide,
+    },
+    /// A fixed point.
+    Bilateral,
+    /// A spring-damper to an anchor, pulling and pushing (the wall in
+    /// permanent contact): a linear passive VE.
+    Spring {
+        /// Anchor position (m).
+        anchor_m: f64,
+        /// Stiffness (N/m).
+        stiffness_npm: f64,
+        /// Damping (N s/m).
+        damping_nspm: f64,
+        /// How the board integrates the probe: `backward_euler` (the
+        /// default, like the wall) or `trapezoidal` (a lossless spring).
+        #[serde(default)]
+        discretization: Discretization,
+    },
+    /// The 1-D building-block world.
+    Blocks {
+        /// Cursor mass (kg).
+        cursor_mass_kg: f64,
+        /// The blocks, left to right, not overlapping.
+        blocks: Vec<BlockSpec>,
+        /// World limits (m): blocks stop at these walls.
+        limits_m: [f64; 2],
+        /// Force that separates two touching blocks (N).
+        stick_force_n: f64,
+        /// Viscous drag of free blocks on the floor (N s/m).
+        #[serde(default = "default_floor")]
+        floor_damping_nspm: f64,
+        /// Grab the block under the cursor at this time (s).
+        grab_at_s: Option<f64>,
+        /// Release it at this time (s).
+        release_at_s: Option<f64>,
+    },
+}
+
+fn default_solid() -> SolidSide {
+    SolidSide::Above
+}
+fn default_floor() -> f64 {
+    5.0
+}
+
+/// The human operator section.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HumanSpec {
+    /// Initial grasp.
+    #[serde(default = "default_grasp")]
+    pub grasp: GraspKind,
+    /// Scripted events.
+    #[serde(default)]
+    pub script: Vec<Event>,
+    /// A passive arm behind the grasp (paper Fig. 3's `Z_p`).
+    pub arm: Option<crate::engine::plant::Arm>,
+}
+
+fn default_grasp() -> GraspKind {
+    GraspKind::HandsOff
+}
+
+impl Default for HumanSpec {
+    fn default() -> Self {
+        HumanSpec {
+            grasp: default_grasp(),
+            script: Vec::new(),
+            arm: None,
+        }
+    }
+}
