@@ -107,12 +107,10 @@ fn poses(c: &mut Criterion) {
 }
 
 fn verify(c: &mut Criterion) {
-    use twoport_design::verify::{verify, Gains};
+    use twoport_control::{Gains, ImpedanceGains};
+    use twoport_design::verify::verify;
     let m = excalibur_model();
-    let g = Gains::Impedance {
-        k_npm: 51_074.0,
-        b_nspm: 90.0,
-    };
+    let g = Gains::from(ImpedanceGains::new(51_074.0, 90.0));
     let mut group = c.benchmark_group("verify");
     group.sample_size(10);
     group.bench_function("verify, Excalibur impedance display at the design", |b| {

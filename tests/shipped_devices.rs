@@ -4,9 +4,10 @@
 
 use host_sim::{Scene, Simulation};
 use std::path::Path;
+use twoport_control::{Gains, ImpedanceGains};
 use twoport_design::design::*;
 use twoport_design::twoport::HumanBound;
-use twoport_design::verify::{verify, Gains};
+use twoport_design::verify::verify;
 use twoport_design::DeviceModel;
 
 const T: f64 = 1e-3;
@@ -38,14 +39,14 @@ fn every_model_has_a_scene_here() {
 /// The impedance design with and without the human bound; verify finds
 /// nothing at it and breaks 1.2 times its stiffness.
 #[test]
-#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+#[ignore = "release only: run with --release --ignored (CI does)"]
 fn every_device_design_survives_verify_and_breaks_past_it() {
     for (model, _) in DEVICES {
         let m = DeviceModel::load(&root().join(model)).unwrap();
         let a = Analysis::of(&m).unwrap();
         for human in [Some(HumanBound::PAPER), None] {
             let (k, b) = best_impedance(&a, &a.impedance_bound(human)).unwrap();
-            let g = |k_npm| Gains::Impedance { k_npm, b_nspm: b };
+            let g = |k_npm| Gains::from(ImpedanceGains::new(k_npm as f32, b as f32));
             let d = m.delay_samples as usize;
             let at = verify(&m, T, &g(k), human, d).unwrap();
             assert!(!at.unstable, "{model} {human:?}: ({k}, {b}) broken: {at:?}");
@@ -60,7 +61,7 @@ fn every_device_design_survives_verify_and_breaks_past_it() {
 
 /// Each device's scene runs gains the designer proves, and runs stably.
 #[test]
-#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+#[ignore = "release only: run with --release --ignored (CI does)"]
 fn every_device_scene_is_proven_and_stable() {
     for (model, scene) in DEVICES {
         let s = Scene::load(&root().join(scene), &[]).unwrap();

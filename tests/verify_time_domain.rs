@@ -8,9 +8,10 @@ use host_sim::engine::plant::Arm;
 use host_sim::engine::scene::{Discretization, VeSpec};
 use host_sim::{Scene, Simulation};
 use std::path::Path;
+use twoport_control::{Gains, ImpedanceGains};
 use twoport_design::design::*;
 use twoport_design::twoport::HumanBound;
-use twoport_design::verify::{radius, verify, Gains, Ve};
+use twoport_design::verify::{radius, verify, Ve};
 use twoport_design::DeviceModel;
 
 const T: f64 = 1e-3;
@@ -86,16 +87,13 @@ fn peaks(s: Scene, windows: &[(f64, f64)]) -> Vec<f64> {
 }
 
 #[test]
-#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+#[ignore = "release only: run with --release --ignored (CI does)"]
 fn verifys_counterexample_grows_in_the_simulator_at_its_rate() {
     let model = DeviceModel::excalibur().unwrap();
     let a = Analysis::of(&model).unwrap();
     let human = Some(HumanBound::PAPER);
     let k_max = max_stiffness(&a, &a.impedance_bound(human), 90.0).unwrap();
-    let past = Gains::Impedance {
-        k_npm: 1.2 * k_max,
-        b_nspm: 90.0,
-    };
+    let past = Gains::from(ImpedanceGains::new((1.2 * k_max) as f32, 90.0));
     let v = verify(&model, T, &past, human, 0).unwrap();
     assert!(v.unstable, "{v:?}");
     let (hand, ve) = (v.termination.hand, v.termination.ve);
@@ -110,10 +108,7 @@ fn verifys_counterexample_grows_in_the_simulator_at_its_rate() {
         "simulated x{simulated:.3}/s, verify says x{predicted:.3}/s ({v:?}, peaks {p:?})"
     );
     // The same termination at 90% of the designed stiffness decays.
-    let below = Gains::Impedance {
-        k_npm: 0.9 * k_max,
-        b_nspm: 90.0,
-    };
+    let below = Gains::from(ImpedanceGains::new((0.9 * k_max) as f32, 90.0));
     let r = radius(&model, T, &below, &v.termination, 0).unwrap();
     assert!(r.spectral_radius < 1.0, "{r:?}");
     let p = peaks(scene(0.9 * k_max, 90.0, &hand, &ve), &w);
@@ -126,7 +121,7 @@ fn verifys_counterexample_grows_in_the_simulator_at_its_rate() {
 /// cursor VE, and the simulator agrees for the delayed model and not for
 /// the same device without the delay.
 #[test]
-#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+#[ignore = "release only: run with --release --ignored (CI does)"]
 fn a_declared_delay_enters_the_simulator() {
     let dir = std::env::temp_dir().join(format!("twoport-delay-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -144,10 +139,7 @@ fn a_declared_delay_enters_the_simulator() {
     let a = Analysis::of(&m).unwrap();
     let k_max = max_stiffness(&a, &a.impedance_bound(None), 0.0).unwrap();
     assert!((k_max - 10_000.0).abs() < 50.0, "{k_max}");
-    let past = Gains::Impedance {
-        k_npm: 13_000.0,
-        b_nspm: 0.0,
-    };
+    let past = Gains::from(ImpedanceGains::new(13_000.0, 0.0));
     let v = verify(&m, T, &past, None, 1).unwrap();
     assert!(v.unstable, "{v:?}");
     let run = |path: &Path| {

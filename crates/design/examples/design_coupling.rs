@@ -2,9 +2,10 @@
 //! let `verify` try to break it: `cargo run --example design_coupling
 //! [MODEL.toml]` (the capstan handle by default).
 
+use twoport_control::{Gains, ImpedanceGains};
 use twoport_design::design::{best_impedance, check_impedance, Analysis, GridSpec};
 use twoport_design::twoport::HumanBound;
-use twoport_design::verify::{verify, Gains};
+use twoport_design::verify::verify;
 use twoport_design::{DeviceModel, Plant};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -23,10 +24,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "  least margin {:.4} at {:.1} Hz",
         c.min_margin, c.worst_frequency_hz
     );
-    let gains = Gains::Impedance {
-        k_npm: k,
-        b_nspm: b,
-    };
+    let gains = Gains::from(ImpedanceGains::new(k as f32, b as f32));
     let v = verify(
         &model,
         model.period_s,

@@ -8,9 +8,10 @@
 //! and far longer in a debug build, so the heavy ones are ignored there;
 //! CI runs the whole file in release.
 
+use twoport_control::{AdmittanceGains, Gains, ImpedanceGains};
 use twoport_design::design::*;
 use twoport_design::twoport::HumanBound;
-use twoport_design::verify::{verify, Gains};
+use twoport_design::verify::verify;
 use twoport_design::{DeviceModel, Plant};
 
 const T: f64 = 1e-3;
@@ -143,6 +144,12 @@ fn results_do_not_move_with_the_grids_start() {
     assert!(low_frequency_obstacle(&a, &a.admittance_bound(&kp, HUMAN)).is_none());
 }
 
+/// The board's impedance gains (f32, as its laws are built) for `k` (N/m)
+/// and `b` (N s/m).
+fn imp(k: f64, b: f64) -> Gains {
+    ImpedanceGains::new(k as f32, b as f32).into()
+}
+
 /// A designed gain `verify` cannot break, and one 20% past it that it does.
 fn assert_tight(model: &DeviceModel, designed: Gains, past: Gains, human: Option<HumanBound>) {
     let at = verify(model, T, &designed, human, model.delay_samples as usize).unwrap();
@@ -166,20 +173,12 @@ fn verify_finds_nothing_at_the_excalibur_designs_and_breaks_them_past() {
     let a = analysis(&m, GridSpec::DEFAULT);
     for human in [HUMAN, None] {
         let k = max_stiffness(&a, &a.impedance_bound(human), 90.0).unwrap();
-        let g = |k_npm| Gains::Impedance {
-            k_npm,
-            b_nspm: 90.0,
-        };
+        let g = |k_npm| imp(k_npm, 90.0);
         assert_tight(&m, g(k), g(1.2 * k), human);
     }
     let kp = regulator_tf(51_000.0, 90.0, T).unwrap();
     let mass = min_mass(&a, &a.admittance_bound(&kp, HUMAN), 500.0).unwrap();
-    let g = |m_kg| Gains::Admittance {
-        kp_npm: 51_000.0,
-        bp_nspm: 90.0,
-        m_kg,
-        b_nspm: 500.0,
-    };
+    let g = |m_kg: f64| Gains::from(AdmittanceGains::new(51_000.0, 90.0, m_kg as f32, 500.0));
     assert_tight(&m, g(mass), g(mass / 1.2), HUMAN);
 }
 
@@ -187,7 +186,7 @@ fn verify_finds_nothing_at_the_excalibur_designs_and_breaks_them_past() {
 #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
 fn verify_breaks_the_rigid_counterexample_and_not_the_design() {
     let m = rigid(1.0, 20.0, 0);
-    let g = |k_npm, b_nspm| Gains::Impedance { k_npm, b_nspm };
+    let g = imp;
     let v = verify(&m, T, &g(40_000.0, 10.0), None, 0).unwrap();
     assert!(v.unstable && (v.frequency_hz - 500.0).abs() < 5.0, "{v:?}");
     let a = analysis(&m, GridSpec::DEFAULT);
@@ -261,14 +260,13 @@ fn heavy_actuator(actuator_kg: f64, flexure_hz: f64, handle_damping: f64) -> Dev
 
 /// `design`'s stiffest coupling on `model` (at `b`, or the best pair), or
 /// `None` where it proves none.
-fn designed(model: &DeviceModel, human: Option<HumanBound>, b: Option<f64>) -> Option<Gains> {
+fn designed(model: &DeviceModel, human: Option<HumanBound>, b: Option<f64>) -> Option<(f64, f64)> {
     let a = analysis(model, GridSpec::DEFAULT);
     let bound = a.impedance_bound(human);
-    let (k_npm, b_nspm) = match b {
-        Some(b) => (max_stiffness(&a, &bound, b)?, b),
-        None => best_impedance(&a, &bound)?,
-    };
-    Some(Gains::Impedance { k_npm, b_nspm })
+    match b {
+        Some(b) => Some((max_stiffness(&a, &bound, b)?, b)),
+        None => best_impedance(&a, &bound),
+    }
 }
 
 /// The two devices: the designs that a grid which stepped over
@@ -282,27 +280,21 @@ fn narrow_modes_the_old_grid_missed_are_resolved() {
     let c = check_impedance(&a, 185_963.0, 473.0, HUMAN).unwrap();
     assert!(!c.absolutely_stable, "{c:?}");
     assert!((c.worst_frequency_hz - 420.2).abs() < 1.0, "{c:?}");
-    let old = Gains::Impedance {
-        k_npm: 185_963.0,
-        b_nspm: 473.0,
-    };
+    let old = imp(185_963.0, 473.0);
     assert!(verify(&part, T, &old, HUMAN, 0).unwrap().unstable);
-    let Some(Gains::Impedance { k_npm, b_nspm }) = designed(&part, HUMAN, None) else {
+    let Some((k_npm, b_nspm)) = designed(&part, HUMAN, None) else {
         panic!("the part on its spring: no design")
     };
-    let past = Gains::Impedance {
-        k_npm: 1.01 * k_npm,
-        b_nspm,
-    };
-    assert_tight(&part, Gains::Impedance { k_npm, b_nspm }, past, HUMAN);
+    let past = imp(1.01 * k_npm, b_nspm);
+    assert_tight(&part, imp(k_npm, b_nspm), past, HUMAN);
 
     let heavy = device("heavy_actuator.toml");
-    let Some(Gains::Impedance { k_npm, .. }) = designed(&heavy, None, Some(0.0)) else {
+    let Some((k_npm, _)) = designed(&heavy, None, Some(0.0)) else {
         panic!("the heavy actuator: no design")
     };
     // The exact loop's boundary is 21.6 N/m (the old grid proved 37.65).
     assert!(k_npm < 21.6 && k_npm > 21.0, "{k_npm}");
-    let g = |k_npm| Gains::Impedance { k_npm, b_nspm: 0.0 };
+    let g = |k_npm| imp(k_npm, 0.0);
     assert_tight(&heavy, g(k_npm), g(1.01 * k_npm), None);
 }
 
@@ -332,9 +324,10 @@ fn no_design_in_a_family_of_narrow_modes_is_broken() {
     let mut proven = 0;
     for model in &family {
         for human in [HUMAN, None] {
-            let Some(g) = designed(model, human, None) else {
+            let Some((k, b)) = designed(model, human, None) else {
                 continue;
             };
+            let g = imp(k, b);
             proven += 1;
             let v = verify(model, T, &g, human, 0).unwrap();
             assert!(

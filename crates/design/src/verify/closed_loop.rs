@@ -141,21 +141,19 @@ fn controller(
     let e = |e: twoport_control::ParamError| e.to_string();
     let (ny, dy) = ve.admittance(t)?;
     Ok(match *gains {
-        Gains::Impedance { k_npm, b_nspm } => {
-            let (nc, dc) = from_tf(&impedance_coupling_tf(k_npm, b_nspm, t).map_err(e)?);
+        Gains::Impedance(g) => {
+            let (k, b) = (g.k_npm.into(), g.b_nspm.into());
+            let (nc, dc) = from_tf(&impedance_coupling_tf(k, b, t).map_err(e)?);
             // f = Z_cI/(1 + Z_cI Y_e) v_c, v_c = (1 - z^-1)/T x_a.
             let num = delayed(&scale(&mul(&mul(&nc, &dy), &[1.0, -1.0]), 1.0 / t), delay);
             let den = add(&mul(&dc, &dy), &mul(&nc, &ny));
             (reduced(num, den), (vec![0.0], vec![1.0]))
         }
-        Gains::Admittance {
-            kp_npm,
-            bp_nspm,
-            m_kg,
-            b_nspm,
-        } => {
-            let (nk, dk) = from_tf(&regulator_tf(kp_npm, bp_nspm, t).map_err(e)?);
-            let (na, da) = from_tf(&admittance_coupling_tf(m_kg, b_nspm, t).map_err(e)?);
+        Gains::Admittance(g) => {
+            let (kp, bp) = (g.kp_npm.into(), g.bp_nspm.into());
+            let (m, b) = (g.m_kg.into(), g.b_nspm.into());
+            let (nk, dk) = from_tf(&regulator_tf(kp, bp, t).map_err(e)?);
+            let (na, da) = from_tf(&admittance_coupling_tf(m, b, t).map_err(e)?);
             // v_c = f_m/(Z_cA + Z_e), x_d = T/(1 - z^-1) v_c,
             // f_a = K_p (x_a - x_d).
             let hx = (delayed(&nk, delay), dk.clone());

@@ -15,29 +15,7 @@
 use crate::twoport::HumanBound;
 use crate::DeviceModel;
 use serde::Serialize;
-
-/// The gains under test (SI: N/m, N s/m, kg).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Gains {
-    /// Impedance display: coupling `Z_cI = b + kTz/(z - 1)`.
-    Impedance {
-        /// Coupling stiffness (N/m).
-        k_npm: f64,
-        /// Coupling damping (N s/m).
-        b_nspm: f64,
-    },
-    /// Admittance display: regulator `K_p`, coupling mass and damper.
-    Admittance {
-        /// Regulator stiffness (N/m).
-        kp_npm: f64,
-        /// Regulator damping (N s/m).
-        bp_nspm: f64,
-        /// Coupling mass (kg).
-        m_kg: f64,
-        /// Coupling damping (N s/m).
-        b_nspm: f64,
-    },
-}
+use twoport_control::Gains;
 
 /// One of the board's passive VEs.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -173,6 +151,12 @@ pub fn radius(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The board's impedance gains (f32, as the laws are built) for `k`
+    /// (N/m) and `b` (N s/m).
+    fn imp(k: f64, b: f64) -> Gains {
+        twoport_control::ImpedanceGains::new(k as f32, b as f32).into()
+    }
     use nalgebra::DMatrix;
     use std::f64::consts::PI;
 
@@ -202,18 +186,9 @@ mod tests {
         let x = b * t / m;
         let k_star = (b * b / m) * (1.0 - (-x).exp()) / (1.0 - (1.0 + x) * (-x).exp());
         let rho = |k: f64| {
-            radius(
-                &rigid(),
-                t,
-                &Gains::Impedance {
-                    k_npm: k,
-                    b_nspm: 0.0,
-                },
-                &hands_off(Ve::Constraint),
-                0,
-            )
-            .unwrap()
-            .spectral_radius
+            radius(&rigid(), t, &imp(k, 0.0), &hands_off(Ve::Constraint), 0)
+                .unwrap()
+                .spectral_radius
         };
         assert!(rho(0.999 * k_star) < 1.0, "{}", rho(0.999 * k_star));
         assert!(rho(1.001 * k_star) > 1.0, "{}", rho(1.001 * k_star));
@@ -249,10 +224,7 @@ mod tests {
                     },
                     ve,
                 };
-                let g = Gains::Impedance {
-                    k_npm: k,
-                    b_nspm: 20.0,
-                };
+                let g = imp(k, 20.0);
                 let a = closed_loop(&model, 1e-3, &g, &term, 0).unwrap();
                 let osc = |m: &DMatrix<f64>| {
                     m.complex_eigenvalues()
@@ -272,17 +244,7 @@ mod tests {
     /// rigid device unstable, though the paper's bound calls it proven.
     #[test]
     fn finds_the_rigid_counterexample() {
-        let v = verify(
-            &rigid(),
-            1e-3,
-            &Gains::Impedance {
-                k_npm: 40_000.0,
-                b_nspm: 10.0,
-            },
-            None,
-            0,
-        )
-        .unwrap();
+        let v = verify(&rigid(), 1e-3, &imp(40_000.0, 10.0), None, 0).unwrap();
         assert!(v.unstable, "{v:?}");
         assert!(v.frequency_hz > 300.0, "{v:?}");
     }

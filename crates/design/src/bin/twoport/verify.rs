@@ -6,14 +6,13 @@ use serde_json::json;
 use twoport_design::DeviceModel;
 
 pub(crate) fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
-    use twoport_design::verify::{self, Gains};
+    use twoport_control::{AdmittanceGains as Adm, Gains, ImpedanceGains as Imp};
+    use twoport_design::verify;
+    // The board's f32 gains: the laws are built from them either way.
     let (common, gains) = match d {
         Display::Impedance(g) => (
             &g.common,
-            Gains::Impedance {
-                k_npm: gain("k", g.k)?,
-                b_nspm: gain("b", g.b)?,
-            },
+            Gains::from(Imp::new(gain("k", g.k)? as f32, gain("b", g.b)? as f32)),
         ),
         Display::Admittance(g) => {
             if !(g.m.is_finite() && g.m > 0.0) {
@@ -21,17 +20,17 @@ pub(crate) fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(),
             }
             (
                 &g.common,
-                Gains::Admittance {
-                    kp_npm: gain("kp", g.kp)?,
-                    bp_nspm: gain("bp", g.bp)?,
-                    m_kg: g.m,
-                    b_nspm: gain("b", g.b)?,
-                },
+                Gains::from(Adm::new(
+                    gain("kp", g.kp)? as f32,
+                    gain("bp", g.bp)? as f32,
+                    g.m as f32,
+                    gain("b", g.b)? as f32,
+                )),
             )
         }
     };
     let s = Session::open(common)?;
-    if matches!(gains, Gains::Admittance { .. }) {
+    if matches!(gains, Gains::Admittance(_)) {
         s.force_sensor()?;
     }
     let (period, human) = (s.period(), s.human);
