@@ -1,0 +1,74 @@
+//! `host-sim`: the scope (no subcommand), headless scene runs, sweeps to a
+//! stability boundary, the paper's Table I, and processor-in-the-loop.
+
+mod pil;
+mod run;
+mod scope;
+mod study;
+
+use clap::{Parser, Subcommand};
+use pil::{pil, PilArgs};
+use run::{run, RunArgs};
+use scope::{scope, ScopeArgs};
+use std::process::ExitCode;
+use study::{
+    accuracy, passivity, sweep, table1, AccuracyArgs, PassivityArgs, SweepArgs, Table1Args,
+};
+
+/// Simulate a haptic device around the board's own control code.
+#[derive(Parser)]
+#[command(name = "host-sim", version, args_conflicts_with_subcommands = true)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Option<Cmd>,
+    #[command(flatten)]
+    scope: ScopeArgs,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// The scope window (the same as no subcommand).
+    Scope(ScopeArgs),
+    /// Run one scene and judge its stability.
+    Run(RunArgs),
+    /// Find the marginal value of one parameter by bisection.
+    Sweep(SweepArgs),
+    /// Run the paper's Table I matrix and sweep its boundaries.
+    Table1(Table1Args),
+    /// Measure what accuracy costs: every integrator x sub-step count.
+    Accuracy(AccuracyArgs),
+    /// The passivity layer's scenes: off, on, and at passive settings.
+    Passivity(PassivityArgs),
+    /// Processor-in-the-loop: this plant against a board over a serial port
+    /// (the firmware in QEMU, or a real board), compared with the same
+    /// board loop run in-process.
+    Pil(PilArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let r = match &cli.cmd {
+        None => scope(&cli.scope),
+        Some(Cmd::Scope(a)) => scope(a),
+        Some(c) => subcommand(c),
+    };
+    match r {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("host-sim: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn subcommand(c: &Cmd) -> Result<(), String> {
+    match c {
+        Cmd::Scope(a) => scope(a),
+        Cmd::Run(a) => run(a),
+        Cmd::Sweep(a) => sweep(a),
+        Cmd::Passivity(a) => passivity(a),
+        Cmd::Table1(a) => table1(a),
+        Cmd::Accuracy(a) => accuracy(a),
+        Cmd::Pil(a) => pil(a),
+    }
+}

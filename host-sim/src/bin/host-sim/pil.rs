@@ -1,0 +1,193 @@
+//! `host-sim pil`: this plant against a board, compared with the same
+//! board loop in-process.
+
+use crate::run::load;
+use clap::Args;
+use host_sim::link;
+use serde_json::json;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub(crate) struct PilArgs {
+    /// The board's serial port (QEMU prints its pty at start). Without it,
+    /// only the in-process board loop runs.
+    #[arg(long)]
+    pub(crate) port: Option<String>,
+    /// The scene: plant, hand and effects; the board brings its own law.
+    #[arg(default_value = "scenes/stiff_wall.toml")]
+    pub(crate) scene: PathBuf,
+    /// Simulated time (s).
+    #[arg(long, default_value_t = 10.0)]
+    pub(crate) seconds: f64,
+    /// Every this many ticks, inject a corrupted frame and garbage (0: never).
+    #[arg(long, default_value_t = 100)]
+    pub(crate) corrupt_every: u64,
+    /// Stop sending heartbeats at this time (s) and check the board goes to
+    /// zero force within its watchdog deadline.
+    #[arg(long)]
+    pub(crate) link_loss_at_s: Option<f64>,
+    /// The board runs the passivity image (the series damper at the
+    /// actuator's port): compare it with that image's in-process loop.
+    #[arg(long)]
+    pub(crate) passivity: bool,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub(crate) json: bool,
+    /// Fail unless the board matched the in-process loop bit for bit,
+    /// dropped every corrupted frame and, after a link loss, held zero force
+    /// within its watchdog deadline.
+    #[arg(long)]
+    pub(crate) check: bool,
+}
+
+pub(crate) fn pil(a: &PilArgs) -> Result<(), String> {
+    use host_sim::pil;
+    if !(a.seconds.is_finite() && a.seconds > 0.0 && a.seconds <= 3600.0) {
+        return Err(format!("--seconds {}: must be in (0, 3600]", a.seconds));
+    }
+    let text =
+        std::fs::read_to_string(&a.scene).map_err(|e| format!("{}: {e}", a.scene.display()))?;
+    let xyz = host_sim::engine::xyz::axes_of(&text) == Some(3);
+    // (Every scene ticks at the board's 1 kHz.)
+    let period = 1e-3;
+    let ticks = (a.seconds / period).round() as u64;
+    let link_loss_at = match a.link_loss_at_s {
+        Some(t) if t.is_finite() && t >= 0.0 && t < a.seconds => Some((t / period).round() as u64),
+        Some(t) => return Err(format!("--link-loss-at-s {t}: must be in [0, --seconds)")),
+        None => None,
+    };
+    let faults = link::LinkFaults {
+        corrupt_every: a.corrupt_every,
+        link_loss_at,
+    };
+    let port = a.port.as_deref().map(link::SerialBoard::open).transpose()?;
+    let start = std::time::Instant::now();
+    if xyz {
+        if a.passivity {
+            return Err("--passivity: the three-axis image has no passivity build".into());
+        }
+        let scene =
+            host_sim::engine::xyz::XyzScene::load(&a.scene, &[]).map_err(|e| e.to_string())?;
+        let reference = pil::run_xyz(
+            scene.clone(),
+            ticks,
+            link::LocalBoard::excalibur_xyz()?,
+            faults,
+        )?;
+        let local_s = start.elapsed().as_secs_f64();
+        let run = port
+            .map(|p| pil::run_xyz(scene, ticks, p, faults))
+            .transpose()?;
+        return pil_report(a, ticks, faults, reference, run, local_s, start);
+    }
+    let scene = load(&a.scene, &[])?;
+    if (scene.period() - period).abs() > 1e-12 {
+        return Err(format!(
+            "{}: a PIL scene ticks at the board's 1 kHz",
+            a.scene.display()
+        ));
+    }
+    let reference = if a.passivity {
+        pil::run(
+            scene.clone(),
+            ticks,
+            link::LocalBoard::excalibur_with_passivity()?,
+            faults,
+        )?
+    } else {
+        pil::run(scene.clone(), ticks, link::LocalBoard::excalibur()?, faults)?
+    };
+    let local_s = start.elapsed().as_secs_f64();
+    let run = port
+        .map(|p| pil::run(scene, ticks, p, faults))
+        .transpose()?;
+    pil_report(a, ticks, faults, reference, run, local_s, start)
+}
+
+/// A PIL run's report, compared with the in-process `reference`: the
+/// board's `run` over the serial port where there was one.
+pub(crate) fn pil_report<S: host_sim::pil::PilSample>(
+    a: &PilArgs,
+    ticks: u64,
+    faults: host_sim::link::LinkFaults,
+    reference: host_sim::pil::Run<S>,
+    run: Option<host_sim::pil::Run<S>>,
+    local_s: f64,
+    start: std::time::Instant,
+) -> Result<(), String> {
+    use host_sim::pil;
+    let board = if run.is_some() {
+        "serial"
+    } else {
+        "in-process"
+    };
+    let (run, remote_s) = match run {
+        Some(r) => (r, start.elapsed().as_secs_f64() - local_s),
+        None => (reference.clone(), local_s),
+    };
+    let c = pil::compare(&run, &reference);
+    let frames_dropped = run.board_stats.rx.dropped() + run.host_dropped;
+    let loop_cycles = run.telemetry.last().map(|t| t.loop_cycles);
+    let axes = run.duties.first().map_or(1, |d| d.len());
+    let peak = run
+        .samples
+        .iter()
+        .flat_map(|s| (0..axes).map(|i| s.actuator_n(i).abs()))
+        .fold(0.0, f64::max);
+    let v = json!({
+        "ticks": c.ticks,
+        "max_position_error_m": c.max_position_error_m,
+        "max_force_error_n": c.max_force_error_n,
+        "duty_mismatches": c.duty_mismatches,
+        "frames_dropped": frames_dropped,
+        "corrupted_sent": run.corrupted_sent,
+        "board_frames_received": run.board_stats.rx.frames,
+        "zero_force_after_link_loss_ticks": run.zero_after_loss_ticks,
+        "watchdog_deadline_ticks": twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS,
+        "telemetry_frames": run.telemetry.len(),
+        "axes": axes,
+        "peak_force_n": peak,
+        "last_loop_cycles": loop_cycles,
+        "last_stage_cycles": run.telemetry.last().map(|t| t.stage_cycles),
+        "start": run.start,
+        "config_booted": run.config.map(|c| format!("{:?}", c.0)),
+        "config_saved": run.config.map(|c| format!("{:?}", c.1)),
+        "armed_at_tick": run.armed_at_tick,
+        "homing_ticks": run.homing.map(|h| h.0),
+        "homing_error_m": run.homing.map(|h| h.1),
+        "board": board,
+        "wall_s": remote_s,
+    });
+    if a.json {
+        println!("{v}");
+    } else {
+        println!(
+            "PIL ({board}): {} ticks in {remote_s:.2} s; position error {:.3e} m, force error {:.3e} N, \
+             {} duty mismatches; {} corrupted frames sent, {frames_dropped} dropped",
+            c.ticks, c.max_position_error_m, c.max_force_error_n, c.duty_mismatches,
+            run.corrupted_sent
+        );
+        match run.homing {
+            Some((n, err)) => println!(
+                "  homed onto the hard stop in {n} ticks (calibration {:+.1} um off the plant), armed at tick {}",
+                err * 1e6,
+                run.armed_at_tick
+            ),
+            None => println!("  calibrated at rest, armed at tick {}", run.armed_at_tick),
+        }
+        if let Some(z) = run.zero_after_loss_ticks {
+            println!(
+                "  link loss: zero force after {z} ticks (watchdog deadline {})",
+                twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS
+            );
+        }
+    }
+    if a.check {
+        let deadline = u64::from(twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS);
+        let bad = pil::failures(&run, &c, ticks, faults, deadline);
+        if !bad.is_empty() {
+            return Err(format!("PIL check failed: {}", bad.join("; ")));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,90 @@
+//! `host-sim scope` (and no subcommand): the scope window, or a headless
+//! run of its scene where no window can open.
+
+use crate::run::{run, RunArgs, SceneArgs};
+use clap::Args;
+use std::path::PathBuf;
+
+/// The scope: the default when no subcommand is given.
+#[derive(Args, Clone)]
+pub(crate) struct ScopeArgs {
+    /// The scene to open.
+    #[arg(long, default_value = "scenes/stiff_wall.toml")]
+    pub(crate) scene: PathBuf,
+    /// Save the window to this PNG at --exit-after (and at half that time
+    /// to NAME.first.png), then close.
+    #[arg(long, requires = "exit_after")]
+    pub(crate) screenshot: Option<PathBuf>,
+    /// Close after this many seconds.
+    #[arg(long)]
+    pub(crate) exit_after: Option<f64>,
+    /// Run the scene headless even where a display exists.
+    #[arg(long)]
+    pub(crate) headless: bool,
+}
+
+/// The scope, or where no window can open, a headless run of its scene.
+pub(crate) fn scope(a: &ScopeArgs) -> Result<(), String> {
+    if let Some(t) = a.exit_after {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(format!(
+                "--exit-after {t}: must be a positive number of seconds"
+            ));
+        }
+    }
+    let why_headless = if a.headless {
+        Some("--headless".to_string())
+    } else {
+        open_window(a)?
+    };
+    let Some(why_headless) = why_headless else {
+        return Ok(()); // the window ran and closed
+    };
+    if a.screenshot.is_some() {
+        return Err(format!("--screenshot needs a window: {why_headless}"));
+    }
+    eprintln!(
+        "host-sim: {why_headless}; running {} headless instead",
+        a.scene.display()
+    );
+    run(&RunArgs {
+        scene: SceneArgs {
+            scene: a.scene.clone(),
+            sets: Vec::new(),
+            json: false,
+        },
+        duration: None,
+        csv: None,
+        png: None,
+    })
+}
+
+/// The scope window; `Ok(Some(why))` where none can open.
+#[cfg(feature = "gui")]
+pub(crate) fn open_window(a: &ScopeArgs) -> Result<Option<String>, String> {
+    if !host_sim::scope::window::display_available() {
+        return Ok(Some(
+            "no display (DISPLAY and WAYLAND_DISPLAY are unset)".to_string(),
+        ));
+    }
+    let script = host_sim::scope::window::Script {
+        screenshot: a.screenshot.clone(),
+        exit_after_s: a.exit_after,
+    };
+    match host_sim::scope::window::run(&a.scene, script) {
+        Ok(shots) => {
+            for p in shots {
+                eprintln!("host-sim: saved {}", p.display());
+            }
+            Ok(None)
+        }
+        Err(e) if e.starts_with("the window would not open") => Ok(Some(e)),
+        Err(e) => Err(e),
+    }
+}
+
+/// Built without the `gui` feature: there is no window to open.
+#[cfg(not(feature = "gui"))]
+pub(crate) fn open_window(_: &ScopeArgs) -> Result<Option<String>, String> {
+    Ok(Some("built without the `gui` feature".to_string()))
+}
