@@ -5,8 +5,8 @@
 use eframe::egui::accesskit::Role;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
-use host_sim::scope::app::Signal;
 use host_sim::scope::app::{ScopeState, Speed, RING_SAMPLES};
+use host_sim::scope::signals::{BoardSignal, Signal};
 use host_sim::scope::ui::BoardChoice;
 use std::path::Path;
 use twoport_control::servo::{Gains, ImpedanceGains};
@@ -170,18 +170,10 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
     assert_eq!((st.mode, st.calibrated, st.faults), (Mode::Armed, true, 0));
     let t = b.telemetry.expect("telemetry from the board");
     assert!(t.tick >= 1900, "tick {}", t.tick);
-    assert!(
-        s.board_ring(host_sim::scope::app::BoardSignal::Actuator)
-            .len()
-            >= 150
-    );
+    assert!(s.board_ring(BoardSignal::Actuator).len() >= 150);
     // The loop's timing is plotted: the law and safety layer take a few
     // hundred of the emulated Cortex-M4F's instructions.
-    assert!(
-        s.board_ring(host_sim::scope::app::BoardSignal::LawCycles)
-            .len()
-            >= 150
-    );
+    assert!(s.board_ring(BoardSignal::LawCycles).len() >= 150);
     assert!(
         (100..5000).contains(&t.stage_cycles[1]),
         "{:?}",

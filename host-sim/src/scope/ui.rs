@@ -2,8 +2,9 @@
 //! Nothing here owns simulation state.
 
 use crate::engine::human::GraspKind;
-use crate::scope::app::{list_ports, BoardSignal, ScopeState, Signal, Speed};
+use crate::scope::app::{list_ports, ScopeState, Speed};
 use crate::scope::rings::{minmax, Edge, Ring};
+use crate::scope::signals::{BoardSignal, Signal};
 use eframe::egui::{self, Color32, RichText, Ui};
 use egui_plot::{Legend, Line, Plot, PlotPoints};
 use twoport_control::servo::Gains;
