@@ -38,6 +38,9 @@ pub struct Session<P: BoardPort> {
     /// handshake is done: from then on every stamped answer must carry it.
     session: u16,
     open: bool,
+    /// The first other session a stamped answer carried since the
+    /// handshake, noted as it arrived (so no caller's taking it can hide it).
+    foreign: Option<u16>,
     seq: u16,
     decoder: Decoder,
     inbox: Vec<Message>,
@@ -66,6 +69,7 @@ impl<P: BoardPort> Session<P> {
             axes,
             session: new_session(),
             open: false,
+            foreign: None,
             seq: 0,
             decoder: Decoder::new(),
             inbox: Vec::new(),
@@ -187,8 +191,14 @@ impl<P: BoardPort> Session<P> {
     fn pump(&mut self, timeout: Duration) -> Result<(), String> {
         let mut buf = [0u8; 256];
         let n = self.port.recv(&mut buf, timeout)?;
-        let inbox = &mut self.inbox;
-        self.decoder.feed(&buf[..n], |env| inbox.push(env.msg));
+        let (inbox, foreign) = (&mut self.inbox, &mut self.foreign);
+        let (open, ours) = (self.open, self.session);
+        self.decoder.feed(&buf[..n], |env| {
+            if open && foreign.is_none() {
+                *foreign = env.msg.session().filter(|s| *s != ours);
+            }
+            inbox.push(env.msg);
+        });
         Ok(())
     }
 
@@ -239,6 +249,13 @@ impl<P: BoardPort> Session<P> {
                 ack.accept_ack(self.axes, self.session)
                     .map_err(|e| e.to_string())?;
                 self.open = true;
+                // What came after the answer in the same read is stamped.
+                let ours = self.session;
+                self.foreign = self
+                    .inbox
+                    .iter()
+                    .filter_map(Message::session)
+                    .find(|s| *s != ours);
                 return Ok(());
             }
             if Instant::now() > deadline {
@@ -268,15 +285,7 @@ impl<P: BoardPort> Session<P> {
     /// host's: it has reset since the handshake (or another host has
     /// opened one).
     fn check_session(&self) -> Result<(), String> {
-        if !self.open {
-            return Ok(());
-        }
-        let other = self
-            .inbox
-            .iter()
-            .filter_map(Message::session)
-            .find(|s| *s != self.session);
-        match other {
+        match self.foreign {
             None => Ok(()),
             Some(NO_SESSION) => Err(format!(
                 "the board has reset since the handshake: it answers with no session, \
