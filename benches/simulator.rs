@@ -9,7 +9,7 @@ use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use host_sim::engine::human::GraspKind;
 use host_sim::engine::plant::{Device, Method, Stepper};
 use host_sim::engine::servo::SceneServo;
-use host_sim::engine::xyz::{XyzScene, XyzSimulation};
+
 use host_sim::{Scene, Simulation};
 use std::hint::black_box;
 use std::path::Path;
@@ -141,19 +141,19 @@ fn three_axes(c: &mut Criterion) {
     for (name, file) in [
         (
             "1 s, 3 axes, Table I bilateral maximum in 3-D",
-            "scenes/xyz/table1/bilateral_maximum.toml",
+            "scenes/xyz/table1/impedance_bilateral_maximum.toml",
         ),
         (
             "1 s, 3 axes, the 50-block world",
             "scenes/xyz/fifty_blocks.toml",
         ),
     ] {
-        let mut s = XyzScene::load(&root.join(file), &["duration_s=1000".to_string()]).unwrap();
+        let mut s = Scene::load(&root.join(file), &["duration_s=1000".to_string()]).unwrap();
         s.plant.model = root.join("models/excalibur.toml");
         ticks_of(
             c,
             name,
-            || XyzSimulation::new(s.clone()).unwrap(),
+            || Simulation::<3>::with_axes(s.clone()).unwrap(),
             |sim| {
                 black_box(sim.step());
             },
@@ -186,11 +186,11 @@ fn three_axis_effects(c: &mut Criterion) {
         ),
     ] {
         let sets: Vec<String> = sets.into_iter().filter(|s| !s.is_empty()).collect();
-        let mut s = XyzScene::load(&root.join("scenes/xyz/stack_three.toml"), &sets).unwrap();
+        let mut s = Scene::load(&root.join("scenes/xyz/stack_three.toml"), &sets).unwrap();
         s.plant.model = root.join("models/excalibur.toml");
         c.bench_function(name, |b| {
             b.iter_batched_ref(
-                || XyzSimulation::new(s.clone()).unwrap(),
+                || Simulation::<3>::with_axes(s.clone()).unwrap(),
                 |sim| {
                     while sim.ticks() < sim.total_ticks() {
                         black_box(sim.step());

@@ -101,7 +101,7 @@ fn extreme_gains_are_reported_unstable_never_nan() {
     s.plant.model = root.join("models/excalibur.toml");
     let r = host_sim::Simulation::new(s)
         .unwrap()
-        .run(|x| assert!(x.actuator_n.is_finite() && x.handle_m.is_finite()));
+        .run(|x| assert!(x.actuator_n[0].is_finite() && x.handle_m[0].is_finite()));
     assert!(
         !r.stable && r.peak_force_n <= 200.0 && r.energy_in_j.is_finite(),
         "{r:?}"

@@ -141,7 +141,7 @@ fn stable(display: Display, c: &Case, set: &[(&str, f64)]) -> Result<(), String>
     // A short push on the handle, then the termination alone.
     s.human.script = vec![host_sim::engine::human::Event::Force {
         at_s: 0.1,
-        force_n: c.push_n,
+        force_n: c.push_n.into(),
         for_s: 0.02,
     }];
     let r = Simulation::new(s).unwrap().run(|_| {});
@@ -318,7 +318,7 @@ fn impedance_gains_past_the_bound_meet_the_termination_the_two_port_names() {
         s.human.grasp = host_sim::engine::human::GraspKind::HandsOff;
         s.human.script = vec![host_sim::engine::human::Event::Force {
             at_s: 0.1,
-            force_n: 30.0,
+            force_n: 30.0.into(),
             for_s: 0.005,
         }];
         Simulation::new(s).unwrap().run(|_| {})

@@ -67,7 +67,7 @@ fn scene_on(model: &str, k: f64, b: f64, ve: &Ve) -> Scene {
     };
     s.human.script = vec![Event::Force {
         at_s: 0.05,
-        force_n: 2.0,
+        force_n: 2.0.into(),
         for_s: 0.005,
     }];
     s
@@ -79,7 +79,7 @@ fn peaks(s: Scene, windows: &[(f64, f64)]) -> Vec<f64> {
     Simulation::new(s).unwrap().run(|x| {
         for (o, (a, b)) in out.iter_mut().zip(windows) {
             if x.t_s >= *a && x.t_s < *b {
-                *o = o.max(x.actuator_n.abs());
+                *o = o.max(x.actuator_n[0].abs());
             }
         }
     });

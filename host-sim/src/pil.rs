@@ -8,8 +8,7 @@
 //! frames and, if asked, corrupted frames and a link loss, so the in-process
 //! run is the reference the firmware must match.
 
-use crate::engine::sim::round_counts;
-use crate::engine::xyz::{XyzSample, XyzScene, XyzSimulation};
+use crate::engine::scene::VeSpec;
 use crate::link::{BoardPort, LinkFaults, Session};
 use crate::{Sample, Scene, Simulation};
 use twoport_board::excalibur::{self, xyz};
@@ -24,12 +23,11 @@ use twoport_link::{
 /// count or two.
 pub const HOMING_TOLERANCE_M: f64 = 50e-6;
 
-/// One PIL run's record, its samples `S` (the one-axis simulation's by
-/// default, or the three-axis one's [`XyzSample`]).
+/// One PIL run's record of a device of `N` axes.
 #[derive(Clone, Debug)]
-pub struct Run<S = Sample> {
+pub struct Run<const N: usize = 1> {
     /// One sample per tick.
-    pub samples: Vec<S>,
+    pub samples: Vec<Sample<N>>,
     /// The duties the board answered each tick, one per axis.
     pub duties: Vec<Axes<i16>>,
     /// Telemetry received.
@@ -54,7 +52,7 @@ pub struct Run<S = Sample> {
     pub homing: Option<(u64, f64)>,
 }
 
-impl<S> Default for Run<S> {
+impl<const N: usize> Default for Run<N> {
     fn default() -> Self {
         Run {
             samples: Vec::new(),
@@ -72,33 +70,6 @@ impl<S> Default for Run<S> {
     }
 }
 
-/// What a PIL run records of a tick: every axis's handle position and
-/// delivered force.
-pub trait PilSample: Clone {
-    /// Axis `axis`'s handle position (m).
-    fn handle_m(&self, axis: usize) -> f64;
-    /// The force axis `axis`'s actuator delivered (N).
-    fn actuator_n(&self, axis: usize) -> f64;
-}
-
-impl PilSample for Sample {
-    fn handle_m(&self, _: usize) -> f64 {
-        self.handle_m
-    }
-    fn actuator_n(&self, _: usize) -> f64 {
-        self.actuator_n
-    }
-}
-
-impl PilSample for XyzSample {
-    fn handle_m(&self, axis: usize) -> f64 {
-        self.handle_m[axis]
-    }
-    fn actuator_n(&self, axis: usize) -> f64 {
-        self.actuator_n[axis]
-    }
-}
-
 /// How a PIL run gets its board going.
 #[derive(Clone, Copy, Debug)]
 pub struct Setup {
@@ -111,106 +82,56 @@ pub struct Setup {
     pub index_m: Option<f64>,
 }
 
-/// A simulated device a PIL run drives through a board: the one-axis
-/// [`Simulation`] or the three-axis [`XyzSimulation`].
-pub trait PilPlant {
-    /// What a tick records.
-    type Sample: PilSample;
-    /// The device's axes.
-    const AXES: u8;
-    /// How a run begins, once the scene's device is checked to be the
-    /// board's (its sensors, its world).
-    fn setup(&self) -> Result<Setup, String>;
-    /// One tick with the board at the other end of `session` as its
-    /// controller: the sample and the duties the board answered.
-    fn step_with<P: BoardPort>(
-        &mut self,
-        session: &mut Session<P>,
-    ) -> Result<(Self::Sample, Axes<i16>), String>;
-}
-
-impl PilPlant for Simulation {
-    type Sample = Sample;
-    const AXES: u8 = 1;
-    fn setup(&self) -> Result<Setup, String> {
-        check_scene(self.scene())?;
-        Ok(Setup {
-            start: Start::for_scene(self.scene()),
-            at_rest_pm: Axes::one(0),
-            index_m: self.scene().effects.encoder.and_then(|e| e.index_m),
-        })
-    }
-    fn step_with<P: BoardPort>(
-        &mut self,
-        session: &mut Session<P>,
-    ) -> Result<(Sample, Axes<i16>), String> {
-        session.step(self).map(|(s, d)| (s, Axes::one(d)))
-    }
-}
-
-impl PilPlant for XyzSimulation {
-    type Sample = XyzSample;
-    const AXES: u8 = 3;
-    fn setup(&self) -> Result<Setup, String> {
-        check_xyz_scene(self.scene())?;
-        // Calibrated where the image's world starts its cursor.
-        let x = xyz::world().map(|w| w.cursor()).unwrap_or_default();
-        Ok(Setup {
-            start: Start::Calibrate,
-            at_rest_pm: Axes::new(x.map(|p| p.nm() as i64 * 1000)).unwrap_or_default(),
-            index_m: None,
-        })
-    }
-    fn step_with<P: BoardPort>(
-        &mut self,
-        session: &mut Session<P>,
-    ) -> Result<(XyzSample, Axes<i16>), String> {
-        session.tick_heartbeat()?;
-        let io = session.io;
-        let (bits, pm) = excalibur::ENCODER;
-        let mask = ((1u64 << bits) - 1) as u32;
-        let tick = self.ticks();
-        let mut answer = Ok(Axes::one(0));
-        let mut ctl = |x_m: [f64; 3]| -> [f64; 3] {
-            // The counter keeps the count's low `bits`, as in the one-axis
-            // simulation's sensing.
-            let raw = x_m.map(|x| (round_counts(x * 1e12 / pm as f64) as u32) & mask);
-            let sensors = PilSensors {
-                tick: tick as u32,
-                encoder_raw: Axes::new(raw).unwrap_or_default(),
-                load_cell_raw: Axes::new([0; 3]).unwrap_or_default(),
-                dead_man_closed: true,
-                index_raw: Axes::new([None; 3]).unwrap_or_default(),
-            };
-            answer = session.exchange(tick, sensors);
-            let duty = |a: usize| answer.as_ref().ok().and_then(|d| d.get(a).copied());
-            [0, 1, 2].map(|a| io.force_n(duty(a).unwrap_or(0)) as f64)
+impl Setup {
+    /// How `sim`'s run begins, once its scene's device is checked to be
+    /// the board's (its sensors, its world): calibrated where the device
+    /// starts (the 3-D world's cursor, or 0), or homed onto the scene's
+    /// hard stop.
+    pub fn for_sim<const N: usize>(sim: &Simulation<N>) -> Result<Setup, String> {
+        let scene = sim.scene();
+        check_scene(scene)?;
+        let at_rest: Vec<i64> = match sim.servo().blocks() {
+            Some(w) => w.cursor.iter().map(|p| p.nm() as i64 * 1000).collect(),
+            None => vec![0; N],
         };
-        let sample = self.step_external(&mut ctl);
-        Ok((sample, answer?))
+        Ok(Setup {
+            start: Start::for_scene(scene),
+            at_rest_pm: Axes::from_slice(&at_rest).ok_or("a device of at most 3 axes")?,
+            index_m: scene.effects.encoder.and_then(|e| e.index_m),
+        })
     }
 }
 
 impl<P: BoardPort> Session<P> {
     /// One tick of `sim` with the board as its controller; returns the
-    /// sample and the duty the board answered.
-    pub fn step(&mut self, sim: &mut Simulation) -> Result<(Sample, i16), String> {
+    /// sample and the duties the board answered.
+    pub fn step<const N: usize>(
+        &mut self,
+        sim: &mut Simulation<N>,
+    ) -> Result<(Sample<N>, Axes<i16>), String> {
         let tick = self.tick_heartbeat()?;
-        let mut answer: Result<i16, String> = Ok(0);
+        let mut answer: Result<Axes<i16>, String> = Ok(Axes::default());
         let io = self.io;
-        let mut ctl = |f: &SensorFrame| -> ServoOutput {
+        let mut ctl = |f: &SensorFrame<f32, N>| -> ServoOutput<f32, N> {
+            // The encoder's index is on the first axis.
+            let index = self.index_crossing(f.encoder_raw[0]);
             let sensors = PilSensors {
                 tick: f.tick,
-                encoder_raw: Axes::one(f.encoder_raw[0]),
-                load_cell_raw: Axes::one(io.load_cell_counts(f.load_cell_n[0])),
+                encoder_raw: Axes::new(f.encoder_raw).unwrap_or_default(),
+                load_cell_raw: Axes::new(f.load_cell_n.map(|n| io.load_cell_counts(n)))
+                    .unwrap_or_default(),
                 dead_man_closed: f.dead_man_closed,
-                index_raw: Axes::one(self.index_crossing(f.encoder_raw[0])),
+                index_raw: Axes::new(core::array::from_fn::<_, N, _>(|a| {
+                    index.filter(|_| a == 0)
+                }))
+                .unwrap_or_default(),
             };
-            answer = self.exchange(tick, sensors).map(|d| d[0]);
-            let force = io.force_n(*answer.as_ref().unwrap_or(&0));
+            answer = self.exchange(tick, sensors);
+            let duty = |a: usize| answer.as_ref().ok().and_then(|d| d.get(a).copied());
+            let force = core::array::from_fn(|a| io.force_n(duty(a).unwrap_or(0)));
             ServoOutput {
-                actuator_force_n: [force],
-                commanded_force_n: [force],
+                actuator_force_n: force,
+                commanded_force_n: force,
                 ..ServoOutput::default()
             }
         };
@@ -239,33 +160,35 @@ impl Start {
     }
 }
 
-/// The scene's sensors must be the board's: the same encoder.
+/// The scene's device must be the board's: the same encoder on every
+/// axis and, on three axes, the three-axis image's world, which the board
+/// simulates (the scene's grab and release times cannot reach it over the
+/// link).
 pub fn check_scene(scene: &Scene) -> Result<(), String> {
     let (bits, pm) = excalibur::ENCODER;
     match scene.effects.encoder {
-        Some(e) if e.bits == bits && (e.resolution_m * 1e12).round() as i64 == pm => Ok(()),
-        _ => Err(format!(
-            "the scene's encoder must be the board's ({bits} bits, {} um per count): \
-             set effects.encoder = {{ resolution_m = {:e}, bits = {bits} }}",
-            pm as f64 * 1e-6,
-            pm as f64 * 1e-12
-        )),
+        Some(e) if e.bits == bits && (e.resolution_m * 1e12).round() as i64 == pm => {}
+        _ => {
+            return Err(format!(
+                "the scene's encoder must be the board's ({bits} bits, {} um per count): \
+                 set effects.encoder = {{ resolution_m = {:e}, bits = {bits} }}",
+                pm as f64 * 1e-6,
+                pm as f64 * 1e-12
+            ))
+        }
     }
-}
-
-/// The three-axis scene's device must be the three-axis image's: its
-/// world holds the image's blocks, which the board simulates (the scene's
-/// grab and release times cannot reach it over the link).
-pub fn check_xyz_scene(scene: &XyzScene) -> Result<(), String> {
-    use crate::engine::xyz::XyzVe;
-    let want: Vec<_> = xyz::BLOCKS.to_vec();
-    match &scene.ve {
-        XyzVe::Blocks {
-            blocks,
-            grab_at_s,
-            release_at_s,
-            ..
-        } if grab_at_s.is_empty() && release_at_s.is_empty() => {
+    match (scene.axes, &scene.ve) {
+        (1, _) => Ok(()),
+        (
+            3,
+            VeSpec::World {
+                blocks,
+                grab_at_s,
+                release_at_s,
+                ..
+            },
+        ) if grab_at_s.is_empty() && release_at_s.is_empty() => {
+            let want: Vec<_> = xyz::BLOCKS.to_vec();
             let have: Vec<_> = blocks
                 .iter()
                 .map(|b| {
@@ -284,14 +207,17 @@ pub fn check_xyz_scene(scene: &XyzScene) -> Result<(), String> {
                 ))
             }
         }
-        XyzVe::Blocks { .. } => Err(
+        (3, VeSpec::World { .. }) => Err(
             "a processor-in-the-loop scene cannot grab or release: the board's world runs there, \
              and the link carries no grab; remove ve.grab_at_s and ve.release_at_s"
                 .into(),
         ),
-        _ => Err(
-            "the three-axis image runs the building-block world: set ve.kind = \"blocks\"".into(),
+        (3, _) => Err(
+            "the three-axis image runs the building-block world: set ve.kind = \"world\"".into(),
         ),
+        (n, _) => Err(format!(
+            "no board image runs {n} axes (the images run 1 or 3)"
+        )),
     }
 }
 
@@ -310,12 +236,12 @@ pub fn homed(statuses: &[Status]) -> Option<Result<(), String>> {
 }
 
 /// One tick of a run, recorded; returns the statuses the board sent.
-fn record<P: BoardPort, M: PilPlant>(
+fn record<P: BoardPort, const N: usize>(
     session: &mut Session<P>,
-    sim: &mut M,
-    r: &mut Run<M::Sample>,
+    sim: &mut Simulation<N>,
+    r: &mut Run<N>,
 ) -> Result<Vec<Status>, String> {
-    let (s, duty) = sim.step_with(session)?;
+    let (s, duty) = session.step(sim)?;
     r.samples.push(s);
     r.duties.push(duty);
     let mut statuses = Vec::new();
@@ -329,39 +255,30 @@ fn record<P: BoardPort, M: PilPlant>(
     Ok(statuses)
 }
 
-/// Run `scene` for `ticks` against the board at `port`: the first tick
-/// disarmed, then the board calibrated (or homed, for a scene with a hard
-/// stop) and armed, then the rest.
+/// Run the one-axis `scene` for `ticks` against the board at `port`: the
+/// first tick disarmed, then the board calibrated (or homed, for a scene
+/// with a hard stop) and armed, then the rest.
 pub fn run<P: BoardPort>(
     scene: Scene,
     ticks: u64,
     port: P,
     faults: LinkFaults,
 ) -> Result<Run, String> {
-    run_plant(Simulation::new(scene)?, ticks, port, faults)
+    run_axes(scene, ticks, port, faults)
 }
 
-/// [`run`] for a three-axis scene against a three-axis board: calibrated
-/// where the scene's device starts (the image's world's start), then armed.
-pub fn run_xyz<P: BoardPort>(
-    scene: XyzScene,
+/// [`run`] on a device of `N` axes: the scene's `axes` must be `N`, the
+/// board's.
+pub fn run_axes<P: BoardPort, const N: usize>(
+    scene: Scene,
     ticks: u64,
     port: P,
     faults: LinkFaults,
-) -> Result<Run<XyzSample>, String> {
-    run_plant(XyzSimulation::new(scene)?, ticks, port, faults)
-}
-
-/// [`run`] of any simulated device.
-pub fn run_plant<P: BoardPort, M: PilPlant>(
-    mut sim: M,
-    ticks: u64,
-    port: P,
-    faults: LinkFaults,
-) -> Result<Run<M::Sample>, String> {
-    let setup = sim.setup()?;
+) -> Result<Run<N>, String> {
+    let mut sim = Simulation::<N>::with_axes(scene)?;
+    let setup = Setup::for_sim(&sim)?;
     let start = setup.start;
-    let mut session = Session::open_axes(port, faults, M::AXES)?;
+    let mut session = Session::open_axes(port, faults, N as u8)?;
     session.set_index(setup.index_m);
     let mut r = Run {
         start: Some(start),
@@ -414,7 +331,7 @@ pub fn run_plant<P: BoardPort, M: PilPlant>(
         // the tick before.
         if let Some(t) = r.telemetry.iter().find(|t| u64::from(t.tick) > *n) {
             if let Some(s) = r.samples.get(t.tick as usize - 1) {
-                *err = t.axes[0].position_pm as f64 * 1e-12 - s.handle_m(0);
+                *err = t.axes[0].position_pm as f64 * 1e-12 - s.handle_m[0];
             }
         }
     }
@@ -449,16 +366,15 @@ pub struct Comparison {
 }
 
 /// Compare a run with its reference, tick by tick, every axis.
-pub fn compare<S: PilSample>(a: &Run<S>, b: &Run<S>) -> Comparison {
+pub fn compare<const N: usize>(a: &Run<N>, b: &Run<N>) -> Comparison {
     let mut c = Comparison {
         ticks: a.samples.len().min(b.samples.len()) as u64,
         ..Comparison::default()
     };
-    let axes = a.duties.first().map_or(1, |d| d.len());
     for (x, y) in a.samples.iter().zip(&b.samples) {
-        for i in 0..axes {
-            let dx = (x.handle_m(i) - y.handle_m(i)).abs();
-            let df = (x.actuator_n(i) - y.actuator_n(i)).abs();
+        for i in 0..N {
+            let dx = (x.handle_m[i] - y.handle_m[i]).abs();
+            let df = (x.actuator_n[i] - y.actuator_n[i]).abs();
             c.max_position_error_m = c.max_position_error_m.max(dx);
             c.max_force_error_n = c.max_force_error_n.max(df);
         }
@@ -481,8 +397,8 @@ pub fn compare<S: PilSample>(a: &Run<S>, b: &Run<S>) -> Comparison {
 /// all (bit for bit), where ticks are missing, where it dropped fewer frames
 /// than were corrupted on purpose, or where it was late to zero the force
 /// (or was not pushing before the loss, so the check would prove nothing).
-pub fn failures<S: PilSample>(
-    run: &Run<S>,
+pub fn failures<const N: usize>(
+    run: &Run<N>,
     c: &Comparison,
     ticks: u64,
     faults: LinkFaults,

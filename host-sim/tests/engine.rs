@@ -73,7 +73,7 @@ fn rk4_converges_to_exact_zoh() {
         let mut xs = Vec::new();
         Simulation::new(scene(base, sets))
             .unwrap()
-            .run(|s| xs.push(s.handle_m));
+            .run(|s| xs.push(s.handle_m[0]));
         xs
     };
     let exact = path(&[]);

@@ -19,7 +19,7 @@ fn forces(scene: &str, sets: &[&str]) -> (bool, Vec<u64>) {
     let mut f = Vec::new();
     let r = Simulation::new(s)
         .unwrap()
-        .run(|s| f.push(s.actuator_n.to_bits()));
+        .run(|s| f.push(s.actuator_n[0].to_bits()));
     (r.stable, f)
 }
 

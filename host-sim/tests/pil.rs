@@ -71,7 +71,7 @@ fn the_board_loop_matches_the_scenes_own_servo_within_pwm_resolution() {
     for s in &r.samples {
         let l = sim.step();
         if s.t_s > 0.5 {
-            worst = worst.max((s.handle_m - l.handle_m).abs());
+            worst = worst.max((s.handle_m[0] - l.handle_m[0]).abs());
         }
     }
     assert!(worst < 2e-5, "{worst} m apart");
@@ -131,7 +131,7 @@ fn a_board_homes_onto_the_hard_stop_then_arms_and_holds_the_wall() {
     assert!(peak_after > 10.0, "{peak_after} N");
     // The hand, led 10 mm past the wall, is held at its surface (the
     // board's frame is the plant's to within the homing tolerance).
-    let x = r.samples.last().unwrap().handle_m;
+    let x = r.samples.last().unwrap().handle_m[0];
     assert!((0.0095..0.0106).contains(&x), "handle at {x} m");
 }
 
@@ -227,7 +227,7 @@ fn a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed() {
     let (mut last_force, mut first_failed, mut reset_at) = (0.0f32, None, None);
     for k in 1..3000u32 {
         match s.step(&mut sim) {
-            Ok((_, duty)) => last_force = io.force_n(duty),
+            Ok((_, duty)) => last_force = io.force_n(duty[0]),
             Err(e) if e.contains("did not answer") => {
                 first_failed.get_or_insert(k);
             }
@@ -263,7 +263,11 @@ fn a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed() {
     );
     let mut sim = Simulation::new(scene()).unwrap();
     for _ in 0..20 {
-        assert_eq!(s.step(&mut sim).unwrap().1, 0, "zero force after the reset");
+        assert_eq!(
+            s.step(&mut sim).unwrap().1[0],
+            0,
+            "zero force after the reset"
+        );
     }
     s.calibrate(Axes::one(0)).unwrap();
     let e = s.arm().unwrap_err();
@@ -290,7 +294,7 @@ fn a_board_homes_on_the_index_pulse_before_the_stop() {
     assert!(err_m.abs() < 2e-6, "{err_m} m");
     let lowest = r.samples[..n as usize]
         .iter()
-        .map(|s| s.handle_m)
+        .map(|s| s.handle_m[0])
         .fold(0.0, f64::min);
     assert!(lowest > -0.008, "went down to {lowest} m");
     assert!(r.armed_at_tick > n);

@@ -2,16 +2,16 @@
 //! in-process (CI runs the same check against the firmware in QEMU on both
 //! boards through `cargo xtask pil scenes/xyz/pil_blocks.toml --check`).
 
-use host_sim::engine::xyz::{XyzScene, XyzSimulation};
 use host_sim::link::{self, LinkFaults, LocalBoard};
 use host_sim::pil;
+use host_sim::{Scene, Simulation};
 use std::path::Path;
 
 const SCENE: &str = "../scenes/xyz/pil_blocks.toml";
 
-fn scene(sets: &[&str]) -> XyzScene {
+fn scene(sets: &[&str]) -> Scene {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    XyzScene::load(Path::new(SCENE), &sets).unwrap()
+    Scene::load(Path::new(SCENE), &sets).unwrap()
 }
 
 /// The board's loop drives the plant as the scene's own servo does: the
@@ -26,7 +26,7 @@ fn three_axes_run_in_lockstep_and_all_stop_after_a_link_loss() {
         link_loss_at: Some(5000),
     };
     let board = LocalBoard::excalibur_xyz().unwrap();
-    let r = pil::run_xyz(scene(&[]), 6000, board, faults).unwrap();
+    let r = pil::run_axes::<_, 3>(scene(&[]), 6000, board, faults).unwrap();
     let c = pil::compare(&r, &r);
     assert!(pil::failures(&r, &c, 6000, faults, 50).is_empty());
     assert_eq!(u64::from(r.board_stats.rx.dropped()), r.corrupted_sent);
@@ -42,7 +42,7 @@ fn three_axes_run_in_lockstep_and_all_stop_after_a_link_loss() {
     }
     assert!(r.duties[5050..].iter().all(|d| d.iter().all(|d| *d == 0)));
 
-    let mut own = XyzSimulation::new(scene(&[])).unwrap();
+    let mut own = Simulation::<3>::with_axes(scene(&[])).unwrap();
     let mut worst = [0.0f64; 3];
     for s in &r.samples[..5000] {
         let o = own.step();
@@ -69,10 +69,10 @@ fn a_scene_the_image_cannot_match_is_refused() {
     let board = || LocalBoard::excalibur_xyz().unwrap();
     let text = std::fs::read_to_string(SCENE).unwrap();
     let heavier = text.replacen("mass_kg = 0.1 }", "mass_kg = 0.2 }", 1);
-    let moved = XyzScene::parse(&heavier, SCENE, &[]).unwrap();
-    let e = pil::run_xyz(moved, 10, board(), LinkFaults::default()).unwrap_err();
+    let moved = Scene::parse(&heavier, SCENE, &[]).unwrap();
+    let e = pil::run_axes::<_, 3>(moved, 10, board(), LinkFaults::default()).unwrap_err();
     assert!(e.contains("BLOCKS"), "{e}");
     let grabs = scene(&["ve.grab_at_s=[1.0]"]);
-    let e = pil::run_xyz(grabs, 10, board(), LinkFaults::default()).unwrap_err();
+    let e = pil::run_axes::<_, 3>(grabs, 10, board(), LinkFaults::default()).unwrap_err();
     assert!(e.contains("grab_at_s"), "{e}");
 }

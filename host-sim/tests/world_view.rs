@@ -6,16 +6,16 @@
 
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
-use host_sim::engine::xyz::XyzScene;
 use host_sim::scope::world::WorldState;
+use host_sim::Scene;
 use std::path::Path;
 
 /// The pick-block scene, run by its script to 2.4 s: the hand has pressed
 /// the cursor onto the cube's knobs, and the script's grab is still to
 /// come (it is taken out, so the button does it).
 fn harness() -> Harness<'static, WorldState> {
-    let mut scene = XyzScene::load(Path::new("../scenes/xyz/pick_block.toml"), &[]).unwrap();
-    if let host_sim::engine::xyz::XyzVe::Blocks {
+    let mut scene = Scene::load(Path::new("../scenes/xyz/pick_block.toml"), &[]).unwrap();
+    if let host_sim::engine::scene::VeSpec::World {
         grab_at_s,
         release_at_s,
         ..

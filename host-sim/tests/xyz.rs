@@ -1,47 +1,138 @@
-//! The three-axis engine on the shipped scenes: Table I's states in 3-D
+//! The simulator on three axes, on the shipped scenes: Table I's states in 3-D
 //! run stably at the proven coupling and 4x past it does not; a block is
 //! picked and set down, three are stacked knob on knob, and the 50-block
 //! world runs; bad scene files are refused by name.
 
-use host_sim::engine::xyz::{XyzReport, XyzScene, XyzSimulation};
+use host_sim::engine::human::AxisValue;
+use host_sim::{Report, Scene, Simulation};
 use std::path::Path;
-use twoport_control::world::World;
 
-fn run(file: &str, sets: &[&str]) -> (XyzReport, XyzSimulation) {
+fn run(file: &str, sets: &[&str]) -> (Report, Simulation<3>) {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    let scene = XyzScene::load(&Path::new("../scenes/xyz").join(file), &sets).unwrap();
-    let mut sim = XyzSimulation::new(scene).unwrap();
+    let scene = Scene::load(&Path::new("../scenes/xyz").join(file), &sets).unwrap();
+    let mut sim = Simulation::with_axes(scene).unwrap();
     let r = sim.run(|_| {});
     (r, sim)
 }
 
-/// Each of the nine Table I cases in 3-D is stable at the x axis's proven
-/// coupling on every axis; at 4x its stiffness the bilateral case is not.
+/// Each of the eighteen Table I cases in 3-D (both displays) is stable at
+/// the x axis's proven design on every axis; at 4x its stiffness (the
+/// impedance coupling's `k`, the admittance regulator's `kp`) the
+/// bilateral case is not.
 #[test]
 fn table1_in_3d_is_stable_at_the_proven_gains() {
-    for state in ["free", "unilateral", "bilateral"] {
-        for grasp in ["hands_off", "relaxed", "maximum"] {
-            let (r, sim) = run(&format!("table1/{state}_{grasp}.toml"), &[]);
-            assert!(r.stable, "{state} {grasp}: {r:?}");
-            assert!(
-                r.peak_force_n > 1.0,
-                "{state} {grasp}: the scene did something"
-            );
-            if state == "unilateral" && grasp != "hands_off" {
-                // The hand reached 20 mm down: the cursor rests on the floor.
-                let z = sim.servo().world().positions()[2].nm();
-                assert_eq!(z, 1_000_000, "{grasp}: the cursor on the floor");
+    for display in ["impedance", "admittance"] {
+        for state in ["free", "unilateral", "bilateral"] {
+            for grasp in ["hands_off", "relaxed", "maximum"] {
+                let case = format!("table1/{display}_{state}_{grasp}.toml");
+                let (r, sim) = run(&case, &[]);
+                assert!(r.stable, "{case}: {r:?}");
+                assert!(r.peak_force_n > 1.0, "{case}: the scene did something");
+                if state == "unilateral" && grasp != "hands_off" {
+                    // The hand reached 20 mm down: the cursor rests on the
+                    // floor.
+                    let z = sim.servo().ve_position()[2].nm();
+                    assert_eq!(z, 1_000_000, "{case}: the cursor on the floor");
+                }
             }
         }
     }
-    let (r, _) = run("table1/bilateral_maximum.toml", &["coupling.k=204000"]);
-    assert!(!r.stable, "4x the proven stiffness: {r:?}");
+    for (display, stiffer) in [
+        ("impedance", "coupling.k=204000"),
+        ("admittance", "coupling.kp=204000"),
+    ] {
+        let (r, _) = run(
+            &format!("table1/{display}_bilateral_maximum.toml"),
+            &[stiffer],
+        );
+        assert!(!r.stable, "{display}, 4x the proven stiffness: {r:?}");
+    }
 }
 
-/// The cube is carried 90 mm along -x and set down on the floor there.
+/// A one-axis scene made three-axis: every number of its script given on
+/// each axis.
+fn on_three_axes(mut scene: Scene) -> Scene {
+    scene.axes = 3;
+    for e in &mut scene.human.script {
+        *e = e.along(|v| AxisValue::Each(vec![v.on(0); 3]));
+    }
+    scene
+}
+
+fn bits(samples: &[[f64; 2]]) -> Vec<[u64; 2]> {
+    samples.iter().map(|s| s.map(f64::to_bits)).collect()
+}
+
+/// The N-axis engine has one code path: a one-axis scene run on each of
+/// three independent axes moves every axis exactly as the one-axis run
+/// moves its one, bit for bit, on both displays (the admittance display
+/// through the load cell), and with every one-axis effect on every axis
+/// (encoder, ADC, saturation, Coulomb friction, cogging, cable slack,
+/// delay, hard stop).
+#[test]
+fn each_of_three_axes_runs_as_the_one_axis_scene() {
+    let effects = [
+        "effects.encoder={resolution_m=1e-6,bits=16}",
+        "effects.saturation={limit_n=25.0}",
+        "effects.coulomb={force_n=0.5,smoothing_mps=1e-3}",
+        "effects.cogging={amplitude_n=0.2,period_m=0.002}",
+        "effects.cable_slack={width_m=1e-5}",
+        "effects.delay={ticks=1}",
+        "effects.hard_stop={position_m=-0.02,solid=\"below\",stiffness_npm=2e5,damping_nspm=50.0}",
+        "effects.load_cell=true",
+        "effects.adc={lsb_n=0.01,noise_rms_n=0.0,seed=7}",
+        "duration_s=2.0",
+    ];
+    for (file, sets) in [
+        ("impedance_bilateral_maximum.toml", &[][..]),
+        ("admittance_bilateral_maximum.toml", &[][..]),
+        ("impedance_unilateral_maximum.toml", &effects[..]),
+        ("admittance_unilateral_relaxed.toml", &effects[..]),
+    ] {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let scene = Scene::load(&Path::new("../scenes/table1").join(file), &sets).unwrap();
+        let mut one = Vec::new();
+        let r1 = Simulation::new(scene.clone())
+            .unwrap()
+            .run(|s| one.push([s.handle_m[0], s.actuator_n[0]]));
+        let mut three = [Vec::new(), Vec::new(), Vec::new()];
+        let r3 = Simulation::<3>::with_axes(on_three_axes(scene))
+            .unwrap()
+            .run(|s| {
+                for (a, v) in three.iter_mut().enumerate() {
+                    v.push([s.handle_m[a], s.actuator_n[a]]);
+                }
+            });
+        assert!(r1.peak_force_n > 1.0, "{file}: the scene did something");
+        assert_eq!(r1.stable, r3.stable, "{file}");
+        assert_eq!(r3.effects.len(), r1.effects.len(), "{file}");
+        for (a, v) in three.iter().enumerate() {
+            assert!(
+                bits(v) == bits(&one),
+                "{file}: axis {a} differs from the one-axis run"
+            );
+        }
+    }
+}
+
+/// The hand reaches over the cube and presses the cursor onto its knobs
+/// (the device's zero is where the world's cursor starts, 10 mm above
+/// the floor); the cube is carried 90 mm along -x and set down on the
+/// floor there.
 #[test]
 fn a_block_is_picked_carried_and_set_down() {
-    let (r, _) = run("pick_block.toml", &[]);
+    let scene = Scene::load(Path::new("../scenes/xyz/pick_block.toml"), &[]).unwrap();
+    let mut sim = Simulation::<3>::with_axes(scene).unwrap();
+    let mut pressed = None;
+    let r = sim.run(|s| {
+        if (s.t_s - 2.5).abs() < 1e-9 {
+            pressed = Some(s.ve_m);
+        }
+    });
+    let [x, _, z] = pressed.expect("a sample at 2.5 s");
+    // On the cube's 30 mm top, on its 2 mm knobs, at the hand's x.
+    assert!((x - 0.055).abs() < 1e-3, "cursor at x = {x} m");
+    assert!((0.0315..0.0335).contains(&z), "cursor at z = {z} m");
     assert!(r.stable, "{r:?}");
     let b = r.blocks_m[0];
     assert!((b[0] + 0.05).abs() < 1e-4 && b[2] == 0.0, "{b:?}");
@@ -85,13 +176,13 @@ fn the_fifty_block_world_runs() {
 /// script event is refused with the file and what is wrong.
 #[test]
 fn bad_three_axis_scenes_are_refused_by_name() {
-    let base = std::fs::read_to_string("../scenes/xyz/table1/free_relaxed.toml").unwrap();
+    let base = std::fs::read_to_string("../scenes/xyz/table1/impedance_free_relaxed.toml").unwrap();
     let block = "{ at_m = [0.0, 0.05, 0.0], size_m = [0.01, 0.01, 0.01], mass_kg = 0.1 },";
-    let many = format!("kind = \"blocks\"\nblocks = [{}]", block.repeat(51));
+    let many = format!("kind = \"world\"\nblocks = [{}]", block.repeat(51));
     for (change, want) in [
-        (base.replace("axes = 3", "axes = 2"), "axes = 2"),
+        (base.replace("axes = 3", "axes = 4"), "axes = 4"),
         (
-            base.replace("kind = \"blocks\"", &many),
+            base.replace("kind = \"world\"", &many),
             "51 blocks, the world holds 50",
         ),
         (
@@ -103,11 +194,11 @@ fn bad_three_axis_scenes_are_refused_by_name() {
             "human.script[0]: move needs",
         ),
         (
-            base.replace("kind = \"blocks\"", "kind = \"blocks\"\ngrab_at_s = [-1.0]"),
+            base.replace("kind = \"world\"", "kind = \"world\"\ngrab_at_s = [-1.0]"),
             "ve.grab_at_s: -1 is not a time",
         ),
     ] {
-        let e = XyzScene::parse(&change, "bad.toml", &[])
+        let e = Scene::parse(&change, "bad.toml", &[])
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("bad.toml: ") && e.contains(want), "{e}");
@@ -128,7 +219,7 @@ fn the_explicit_world_needs_a_heavier_cursor() {
             &format!("ve.explicit={explicit}")[..],
             &format!("ve.cursor_mass_kg={mass}")[..],
         ];
-        let (r, _) = run("table1/free_maximum.toml", &sets);
+        let (r, _) = run("table1/impedance_free_maximum.toml", &sets);
         assert_eq!(r.stable, stable, "explicit {explicit}, {mass} kg: {r:?}");
     }
 }

@@ -144,19 +144,20 @@ impl Rng {
     }
 }
 
-/// The load cell's ADC: Gaussian noise, then quantisation.
+/// The load cells' ADC: Gaussian noise, then quantisation; each axis's
+/// noise has its own stream.
 #[derive(Clone, Debug)]
-struct Adc {
+struct Adc<const N: usize> {
     noise_rms_n: f64,
     lsb_n: f64,
-    rng: Rng,
+    rng: [Rng; N],
 }
 
 /// A delay line of sensor frames.
 #[derive(Clone, Debug)]
-struct Delay {
+struct Delay<const N: usize> {
     ticks: usize,
-    frames: VecDeque<SensorFrame<f64>>,
+    frames: VecDeque<SensorFrame<f64, N>>,
 }
 
 /// The nonlinear forces, evaluated inside the integrator's sub-steps.
@@ -218,20 +219,21 @@ impl Forces {
     }
 }
 
-/// The per-tick pipeline: sensing (ADC), the delay line, the amplifier's
-/// limit, and the nonlinear forces.
+/// The per-tick pipeline of a device of `N` axes: sensing (ADC), the
+/// delay line, the amplifier's limit, and the nonlinear forces, each with
+/// the scene's parameters on every axis.
 #[derive(Clone, Debug)]
-pub struct Pipeline {
+pub struct Pipeline<const N: usize = 1> {
     encoder_timed: bool,
-    adc: Option<Adc>,
-    delay: Option<Delay>,
+    adc: Option<Adc<N>>,
+    delay: Option<Delay<N>>,
     saturation_n: Option<f64>,
     forces: Option<Forces>,
     /// What each effect cost.
     pub costs: Costs,
 }
 
-impl Pipeline {
+impl<const N: usize> Pipeline<N> {
     /// Compile `e`; `cable_k` is the device's cable stiffness (N/m).
     pub fn new(e: &Effects, cable_k: f64) -> Self {
         let mut names = [Effect::Coulomb; 4];
@@ -268,7 +270,8 @@ impl Pipeline {
             adc: e.adc.map(|a| Adc {
                 noise_rms_n: a.noise_rms_n,
                 lsb_n: a.lsb_n,
-                rng: Rng(a.seed.max(1)),
+                // Axis 0 keeps the scene's seed; each other its own stream.
+                rng: core::array::from_fn(|i| Rng(a.seed.wrapping_add(i as u64).max(1))),
             }),
             delay: e.delay.map(|d| Delay {
                 ticks: d.ticks as usize,
@@ -286,18 +289,18 @@ impl Pipeline {
         self.encoder_timed
     }
 
-    /// The load cell's reading of the force `f_n` (N).
-    pub fn adc(&mut self, f_n: f64, timing: bool) -> f64 {
+    /// Axis `axis`'s load cell's reading of the force `f_n` (N).
+    pub fn adc(&mut self, axis: usize, f_n: f64, timing: bool) -> f64 {
         let Some(adc) = &mut self.adc else { return f_n };
         let t0 = timing.then(Instant::now);
-        let f = f_n + adc.noise_rms_n * adc.rng.gaussian();
+        let f = f_n + adc.noise_rms_n * adc.rng[axis].gaussian();
         let f = (f / adc.lsb_n).round() * adc.lsb_n;
         self.costs.charge(&[Effect::Adc], t0);
         f
     }
 
     /// The frame the controller sees this tick.
-    pub fn delay(&mut self, frame: SensorFrame<f64>, timing: bool) -> SensorFrame<f64> {
+    pub fn delay(&mut self, frame: SensorFrame<f64, N>, timing: bool) -> SensorFrame<f64, N> {
         let Some(d) = &mut self.delay else {
             return frame;
         };
@@ -350,7 +353,7 @@ mod tests {
             ..Effects::default()
         };
         let force = |e: &Effects, x: f64, v: f64| {
-            let mut p = Pipeline::new(e, 0.0);
+            let mut p = Pipeline::<1>::new(e, 0.0);
             let (forces, _) = p.forces().expect("a hard stop is a nonlinear force");
             let mut f = [0.0];
             forces.add(1, &[1.0], &[x, v], &mut f);

@@ -44,8 +44,7 @@ impl GraspKind {
 }
 
 /// One scripted event, starting at `at_s`. `V` is a position or force
-/// along the axis (`f64`), or along each of three (`[f64; 3]`, a
-/// three-axis scene's hand).
+/// along the axis (`f64`), or an [`AxisValue`] as a scene file gives it.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Event<V = f64> {
@@ -88,37 +87,101 @@ pub enum Event<V = f64> {
     },
 }
 
-impl<V: Copy> Event<V> {
+impl<V> Event<V> {
     /// This event along one axis, `pick` reading its value there.
-    pub fn along<U>(&self, pick: impl Fn(V) -> U) -> Event<U> {
-        match *self {
+    pub fn along<U>(&self, pick: impl Fn(&V) -> U) -> Event<U> {
+        match self {
             Event::Move { at_s, to_m, over_s } => Event::Move {
-                at_s,
+                at_s: *at_s,
                 to_m: pick(to_m),
-                over_s,
+                over_s: *over_s,
             },
-            Event::Grip { at_s, grasp } => Event::Grip { at_s, grasp },
+            Event::Grip { at_s, grasp } => Event::Grip {
+                at_s: *at_s,
+                grasp: *grasp,
+            },
             Event::Shake {
                 at_s,
                 amplitude_m,
                 frequency_hz,
                 for_s,
             } => Event::Shake {
-                at_s,
+                at_s: *at_s,
                 amplitude_m: pick(amplitude_m),
-                frequency_hz,
-                for_s,
+                frequency_hz: *frequency_hz,
+                for_s: *for_s,
             },
             Event::Force {
                 at_s,
                 force_n,
                 for_s,
             } => Event::Force {
-                at_s,
+                at_s: *at_s,
                 force_n: pick(force_n),
-                for_s,
+                for_s: *for_s,
             },
         }
+    }
+
+    /// The values this event carries (none for a grip).
+    pub fn values(&self) -> Option<&V> {
+        match self {
+            Event::Move { to_m: v, .. }
+            | Event::Shake { amplitude_m: v, .. }
+            | Event::Force { force_n: v, .. } => Some(v),
+            Event::Grip { .. } => None,
+        }
+    }
+}
+
+/// A scripted value in a scene of any number of axes: a number on a
+/// one-axis device, or an array of one number per axis, x first.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(
+    untagged,
+    expecting = "a number, or an array of one number per axis (x first)"
+)]
+pub enum AxisValue {
+    /// One number: a one-axis scene's.
+    One(f64),
+    /// One number per axis.
+    Each(Vec<f64>),
+}
+
+impl AxisValue {
+    /// How many axes it gives a value for.
+    pub fn len(&self) -> usize {
+        match self {
+            AxisValue::One(_) => 1,
+            AxisValue::Each(v) => v.len(),
+        }
+    }
+
+    /// Whether it gives none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Its value along `axis` (0 past its end, which a checked scene
+    /// never asks for).
+    pub fn on(&self, axis: usize) -> f64 {
+        match self {
+            AxisValue::One(x) if axis == 0 => *x,
+            AxisValue::One(_) => 0.0,
+            AxisValue::Each(v) => v.get(axis).copied().unwrap_or(0.0),
+        }
+    }
+}
+
+impl From<f64> for AxisValue {
+    fn from(x: f64) -> Self {
+        AxisValue::One(x)
+    }
+}
+
+impl From<Vec<f64>> for AxisValue {
+    fn from(v: Vec<f64>) -> Self {
+        AxisValue::Each(v)
     }
 }
 

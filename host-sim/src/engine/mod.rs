@@ -13,4 +13,4 @@ pub mod servo;
 pub mod sim;
 pub mod stability;
 pub mod ve;
-pub mod xyz;
+pub mod world;

@@ -1,4 +1,4 @@
-//! The scene's servo: the control crate's [`Servo`] on the scene's VE, in
+//! The scene's servo: the control crate's [`Servo`] on the scene's world, in
 //! the float type the scene names (the board's f32, or f64 to take the
 //! laws' rounding out of a study).
 
@@ -8,29 +8,33 @@ use crate::engine::scene::{
     Discretization, Integration, LayerPort, Precision, Scene, SolidSide, VeSpec,
 };
 use crate::engine::ve::SceneVe;
+use crate::engine::world::SceneWorld;
 use twoport_control::passivity::{ParallelLimits, PassiveVe};
 use twoport_control::servo::{Gains, PortLayer, SensorFrame, Servo, ServoOutput};
 use twoport_control::ve::{
     BilateralConstraint, CursorMass, ExplicitCursor, Solid, Spring, TrapezoidalSpring,
-    UnilateralWall, VirtualEnvironment,
+    UnilateralWall,
 };
+use twoport_control::world::vbb::Block as Block3;
+use twoport_control::world::World;
 use twoport_control::{Encoder, Position, Real, SafetyConfig};
 
-/// The board's code for the scene's display, enabled.
+/// The board's code for the scene's display on `N` axes, enabled.
 #[derive(Clone, Debug)]
-pub enum SceneServo {
+pub enum SceneServo<const N: usize = 1> {
     /// The board's f32 laws.
-    F32(Box<Servo<SceneVe<f32>, f32>>),
+    F32(Box<Servo<SceneWorld<f32, N>, f32, N>>),
     /// The same laws computing in f64.
-    F64(Box<Servo<SceneVe<f64>, f64>>),
+    F64(Box<Servo<SceneWorld<f64, N>, f64, N>>),
     /// The f32 laws with the scene's port layer (passivity, element delay).
-    F32Layered(Box<LayeredServo<f32>>),
+    F32Layered(Box<LayeredServo<f32, N>>),
     /// The f64 laws with the scene's port layer.
-    F64Layered(Box<LayeredServo<f64>>),
+    F64Layered(Box<LayeredServo<f64, N>>),
 }
 
-/// The board's servo with the scene's port layer, computing in `R`.
-pub type LayeredServo<R> = Servo<SceneVe<R>, R, 1, SceneLayer<R>>;
+/// The board's servo with the scene's port layer on each axis, computing
+/// in `R`.
+pub type LayeredServo<R, const N: usize = 1> = Servo<SceneWorld<R, N>, R, N, SceneLayer<R>>;
 
 /// `$e` on the servo whatever its variant.
 macro_rules! each_servo {
@@ -44,13 +48,42 @@ macro_rules! each_servo {
     };
 }
 
-fn build<R: Real>(
+/// `N` copies of `x`.
+fn each<T: Clone, const N: usize>(x: T) -> [T; N] {
+    core::array::from_fn(|_| x.clone())
+}
+
+fn build<R: Real, const N: usize>(
     scene: &Scene,
     encoder: Encoder,
     safety: SafetyConfig,
-) -> Result<Servo<SceneVe<R>, R>, String> {
+) -> Result<Servo<SceneWorld<R, N>, R, N>, String>
+where
+    SceneWorld<R, N>: World<R, N>,
+{
+    let world = SceneWorld::new(scene, safety.period_s, |_| axis_ve(scene, &safety))?;
+    // The device's zero is where the world starts its point (the 3-D
+    // world's cursor; 0 for every one-axis VE).
+    let start = world.positions();
+    let gains = core::array::from_fn(|a| scene.gains_of(a));
+    let mut servo = Servo::new_in(gains, [encoder; N], [safety; N], world).map_err(|e| {
+        if N == 1 {
+            e.error.to_string()
+        } else {
+            e.to_string()
+        }
+    })?;
+    if matches!(scene.ve, VeSpec::World { .. }) {
+        servo.calibrate(start);
+    }
+    Ok(servo)
+}
+
+/// One axis's VE: the scene's, behind the passivity layer at its port
+/// where the scene puts one there.
+fn axis_ve<R: Real>(scene: &Scene, safety: &SafetyConfig) -> Result<SceneVe<R>, String> {
     let ve = scene_ve(scene, safety.period_s)?;
-    let ve = match (&scene.passivity, &scene.ve) {
+    Ok(match (&scene.passivity, &scene.ve) {
         (Some(p), VeSpec::Cursor { mass_kg, .. }) if p.enabled && p.port == LayerPort::Ve => {
             let limits = ParallelLimits::for_display(
                 *mass_kg as f32,
@@ -63,23 +96,28 @@ fn build<R: Real>(
             ))
         }
         _ => ve,
-    };
-    Servo::new_in([scene.gains()], [encoder], [safety], ve).map_err(|e| e.error.to_string())
+    })
 }
 
-fn enabled<V: VirtualEnvironment<R>, R: Real, L: PortLayer<R>>(
-    mut s: Servo<V, R, 1, L>,
-) -> Result<Box<Servo<V, R, 1, L>>, String> {
+fn enabled<W: World<R, N>, R: Real, L: PortLayer<R>, const N: usize>(
+    mut s: Servo<W, R, N, L>,
+) -> Result<Box<Servo<W, R, N, L>>, String> {
     s.enable()
         .map_err(|f| format!("the servo would not enable: {f}"))?;
     Ok(Box::new(s))
 }
 
-fn layered<R: Real>(
-    s: Servo<SceneVe<R>, R>,
+fn layered<R: Real, const N: usize>(
+    s: Servo<SceneWorld<R, N>, R, N>,
     layer: SceneLayer<R>,
-) -> Result<Box<LayeredServo<R>>, String> {
-    enabled(s.with_layers([layer]).map_err(|e| e.error.to_string())?)
+) -> Result<Box<LayeredServo<R, N>>, String>
+where
+    SceneWorld<R, N>: World<R, N>,
+{
+    enabled(
+        s.with_layers(each(layer))
+            .map_err(|e| e.error.to_string())?,
+    )
 }
 
 fn set_wall<R: Real>(ve: &mut SceneVe<R>, surface: Position, k_npm: f32) -> Result<(), String> {
@@ -93,7 +131,7 @@ fn set_wall<R: Real>(ve: &mut SceneVe<R>, surface: Position, k_npm: f32) -> Resu
 }
 
 /// The sensors as the f32 board reads them.
-pub(crate) fn frame_f32(f: &SensorFrame<f64>) -> SensorFrame {
+pub(crate) fn frame_f32<const N: usize>(f: &SensorFrame<f64, N>) -> SensorFrame<f32, N> {
     SensorFrame {
         tick: f.tick,
         encoder_raw: f.encoder_raw,
@@ -103,8 +141,8 @@ pub(crate) fn frame_f32(f: &SensorFrame<f64>) -> SensorFrame {
 }
 
 /// An f32 servo's output, widened.
-pub(crate) fn output_f64(o: ServoOutput) -> ServoOutput<f64> {
-    let wide = |x: [f32; 1]| x.map(f64::from);
+pub(crate) fn output_f64<const N: usize>(o: ServoOutput<f32, N>) -> ServoOutput<f64, N> {
+    let wide = |x: [f32; N]| x.map(f64::from);
     ServoOutput {
         actuator_force_n: wide(o.actuator_force_n),
         commanded_force_n: wide(o.commanded_force_n),
@@ -119,9 +157,9 @@ pub(crate) fn output_f64(o: ServoOutput) -> ServoOutput<f64> {
     }
 }
 
-impl SceneServo {
-    /// The scene's display, gains, VE and port layer, in the scene's float
-    /// type.
+impl<const N: usize> SceneServo<N> {
+    /// The scene's display, gains, world and port layer on `N` axes, in
+    /// the scene's float type.
     pub fn new(scene: &Scene, encoder: Encoder, safety: SafetyConfig) -> Result<Self, String> {
         Ok(match scene.integrator.controller {
             Precision::F32 => match SceneLayer::for_scene(scene, &safety)? {
@@ -137,7 +175,8 @@ impl SceneServo {
 
     /// One tick on sensors given in f64 (rounded to f32 for the board's
     /// laws).
-    pub fn tick(&mut self, f: &SensorFrame<f64>) -> ServoOutput<f64> {
+    #[inline]
+    pub fn tick(&mut self, f: &SensorFrame<f64, N>) -> ServoOutput<f64, N> {
         match self {
             SceneServo::F32(s) => output_f64(s.tick(&frame_f32(f))),
             SceneServo::F64(s) => s.tick(f),
@@ -146,48 +185,96 @@ impl SceneServo {
         }
     }
 
-    /// The VE's position.
-    pub fn ve_position(&self) -> Position {
-        each_servo!(self, s => s.world().position())
+    /// The point each axis's coupling holds in the world.
+    pub fn ve_position(&self) -> [Position; N] {
+        each_servo!(self, s => s.world().positions())
     }
 
-    /// The gains in force.
-    pub fn gains(&self) -> Gains {
-        each_servo!(self, s => s.gains()[0])
+    /// The gains in force on each axis.
+    pub fn gains(&self) -> [Gains; N] {
+        each_servo!(self, s => s.gains())
     }
 
-    /// The passivity layer, if the scene runs one (at the device's port,
-    /// or at the VE's), or its element delay.
-    pub fn layer(&self) -> Option<LayerView<'_>> {
+    /// The 3-D building-block world, where the scene runs it, as the
+    /// board's f32 world sees it: its blocks, the one held, the cursor.
+    pub fn blocks(&self) -> Option<WorldView> {
+        fn view<R: Real, const N: usize>(w: &SceneWorld<R, N>) -> Option<WorldView>
+        where
+            SceneWorld<R, N>: World<R, N>,
+        {
+            w.blocks().map(|b| WorldView {
+                blocks: b.blocks().to_vec(),
+                held: b.held(),
+                cursor: b.cursor(),
+            })
+        }
+        each_servo!(self, s => view(s.world()))
+    }
+
+    /// Grab the block the world's cursor touches (the scope's button);
+    /// whether one was there.
+    pub fn grab(&mut self) -> bool {
+        each_servo!(self, s => s.world_mut().blocks_mut().is_some_and(|w| w.grab()))
+    }
+
+    /// Let go of the world's held block.
+    pub fn release(&mut self) {
+        each_servo!(self, s => {
+            if let Some(w) = s.world_mut().blocks_mut() {
+                w.release();
+            }
+        })
+    }
+
+    /// Axis `axis`'s passivity layer, if the scene runs one (at the
+    /// device's port, or at the VE's), or its element delay.
+    pub fn layer(&self, axis: usize) -> Option<LayerView<'_>> {
         match self {
-            SceneServo::F32Layered(s) => Some(LayerView::Device32(&s.layers()[0])),
-            SceneServo::F64Layered(s) => Some(LayerView::Device64(&s.layers()[0])),
-            SceneServo::F32(s) => match s.world() {
-                SceneVe::Passive(p) => Some(LayerView::Ve32(p)),
+            SceneServo::F32Layered(s) => s.layers().get(axis).map(LayerView::Device32),
+            SceneServo::F64Layered(s) => s.layers().get(axis).map(LayerView::Device64),
+            SceneServo::F32(s) => match s.world().axis_ve(axis) {
+                Some(SceneVe::Passive(p)) => Some(LayerView::Ve32(p)),
                 _ => None,
             },
-            SceneServo::F64(s) => match s.world() {
-                SceneVe::Passive(p) => Some(LayerView::Ve64(p)),
+            SceneServo::F64(s) => match s.world().axis_ve(axis) {
+                Some(SceneVe::Passive(p)) => Some(LayerView::Ve64(p)),
                 _ => None,
             },
         }
     }
 
-    /// Change the gains while running (the scope's sliders); they must be
-    /// for the scene's display.
-    pub fn set_gains(&mut self, g: Gains) -> Result<(), String> {
-        each_servo!(self, s => s.set_gains([g])).map_err(|e| e.error.to_string())
+    /// Change every axis's gains while running (the scope's sliders); they
+    /// must be for the scene's display.
+    pub fn set_gains(&mut self, g: [Gains; N]) -> Result<(), String> {
+        each_servo!(self, s => s.set_gains(g)).map_err(|e| e.error.to_string())
     }
 
-    /// Move the wall and change its stiffness while running (the scope's
-    /// controls); an error if the scene's VE is not a wall.
+    /// Move the wall and change its stiffness on every axis while running
+    /// (the scope's controls); an error if the scene's VE is not a wall.
     pub fn set_wall(&mut self, surface_m: f64, stiffness_npm: f64) -> Result<(), String> {
         let x = Position::from_m_f64(surface_m).ok_or(format!(
             "wall position {surface_m} m is out of range (±2.147 m)"
         ))?;
         let k = stiffness_npm as f32;
-        each_servo!(self, s => set_wall(s.world_mut(), x, k))
+        each_servo!(self, s => {
+            let ves = s.world_mut().axis_ves_mut();
+            if ves.is_empty() {
+                return Err("the scene's VE is not a wall".into());
+            }
+            ves.iter_mut().try_for_each(|ve| set_wall(ve, x, k))
+        })
     }
+}
+
+/// The 3-D building-block world at one instant.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldView {
+    /// The blocks.
+    pub blocks: Vec<Block3>,
+    /// The block the cursor holds.
+    pub held: Option<usize>,
+    /// The cursor.
+    pub cursor: [Position; 3],
 }
 
 /// A scene servo's passivity layer, where it sits and in its float type.
@@ -295,6 +382,9 @@ fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, String> {
                         .map_err(|e| e.to_string())?,
                 ),
             }
+        }
+        VeSpec::World { .. } => {
+            return Err("ve.kind = \"world\" is a 3-D world, not one axis's VE".into())
         }
         VeSpec::Blocks {
             cursor_mass_kg,

@@ -159,7 +159,7 @@ impl ScopeState {
                 let a = Analysis::new(&p, GridSpec::DEFAULT);
                 (p, a)
             }),
-            gains: scene.gains(),
+            gains: scene.gains_of(0),
             wall: wall_of(&scene),
             scene,
             sim,
@@ -225,7 +225,7 @@ impl ScopeState {
 
     /// The gains the running simulation uses.
     pub fn running_gains(&self) -> Gains {
-        self.sim.servo().gains()
+        self.sim.servo().gains()[0]
     }
 
     /// The scene in force.
@@ -235,7 +235,7 @@ impl ScopeState {
 
     /// Whether the scene runs a passivity layer (its plot is shown).
     pub fn has_layer(&self) -> bool {
-        self.sim.servo().layer().is_some()
+        self.sim.servo().layer(0).is_some()
     }
 
     /// Simulated time (s).
@@ -343,7 +343,7 @@ impl ScopeState {
         self.debt_s -= self.sim.period();
         for (sig, ring) in Signal::ALL.iter().zip(&mut self.rings) {
             // A scene without a passivity layer has no layer signals.
-            let v = sig.of(&s);
+            let v = sig.of(&s, 0);
             if !v.is_nan() {
                 ring.push(s.t_s, v);
             }
@@ -413,7 +413,7 @@ impl ScopeState {
     /// New gains for the running simulation (and the board, which may
     /// refuse them); the light follows.
     pub fn set_gains(&mut self, g: Gains) {
-        if let Err(e) = self.sim.servo_mut().set_gains(g) {
+        if let Err(e) = self.sim.servo_mut().set_gains([g]) {
             self.message = Some(format!("gains not applied: {e}"));
             return;
         }
@@ -476,7 +476,7 @@ impl ScopeState {
     /// The mouse push (N).
     pub fn set_push(&mut self, f: f64) {
         self.push_n = f;
-        self.sim.set_push(f);
+        self.sim.set_push([f]);
     }
 
     /// Move the wall and set its stiffness.

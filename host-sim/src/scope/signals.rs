@@ -69,20 +69,22 @@ impl Signal {
         }
     }
 
-    pub(crate) fn of(self, s: &Sample) -> f64 {
+    /// Its value on axis `axis` (a total for the energies).
+    pub(crate) fn of<const N: usize>(self, s: &Sample<N>, axis: usize) -> f64 {
+        let at = |v: &[f64; N]| v.get(axis).copied().unwrap_or(f64::NAN);
         match self {
-            Signal::HandlePosition => s.handle_m,
-            Signal::HandleVelocity => s.handle_mps,
-            Signal::HumanForce => s.human_n,
-            Signal::CommandedForce => s.commanded_n,
-            Signal::ActuatorForce => s.actuator_n,
-            Signal::VePosition => s.ve_m,
-            Signal::VeForce => s.ve_n,
-            Signal::CouplingForce => s.coupling_n,
+            Signal::HandlePosition => at(&s.handle_m),
+            Signal::HandleVelocity => at(&s.handle_mps),
+            Signal::HumanForce => at(&s.human_n),
+            Signal::CommandedForce => at(&s.commanded_n),
+            Signal::ActuatorForce => at(&s.actuator_n),
+            Signal::VePosition => at(&s.ve_m),
+            Signal::VeForce => at(&s.ve_n),
+            Signal::CouplingForce => at(&s.coupling_n),
             Signal::EnergyIn => s.energy_in_j,
             Signal::EnergyStored => s.energy_stored_j,
-            Signal::LayerEnergy => s.layer_energy_j,
-            Signal::LayerAdded => s.layer_added,
+            Signal::LayerEnergy => at(&s.layer_energy_j),
+            Signal::LayerAdded => at(&s.layer_added),
         }
     }
 

@@ -141,10 +141,10 @@ pub fn display_available() -> bool {
 pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, String> {
     let shots = Shots::new(script);
     let saved = shots.saved.clone();
-    let text = std::fs::read_to_string(scene).unwrap_or_default();
-    let app: Box<dyn eframe::App> = if crate::engine::xyz::axes_of(&text) == Some(3) {
+    let parsed = crate::Scene::load(scene, &[]).map_err(|e| e.to_string())?;
+    let app: Box<dyn eframe::App> = if parsed.axes == 3 {
         Box::new(WorldApp {
-            state: crate::scope::world::WorldState::open(scene)?,
+            state: crate::scope::world::WorldState::new(parsed)?,
             shots,
         })
     } else {

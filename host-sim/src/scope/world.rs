@@ -2,8 +2,9 @@
 //! simulation runs in real time; the last seconds of each axis's force are
 //! kept for the plots; the mouse drags the hand and the button grabs.
 
-use crate::engine::xyz::{XyzSample, XyzScene, XyzSimulation, XyzWorld};
+use crate::engine::servo::WorldView;
 use crate::scope::rings::Ring;
+use crate::{Sample, Scene, Simulation};
 use std::path::Path;
 use twoport_control::world::vbb::Block;
 
@@ -12,11 +13,13 @@ const HISTORY_S: f64 = 5.0;
 
 /// What the world view shows and the plots draw.
 pub struct WorldState {
-    sim: XyzSimulation,
+    sim: Simulation<3>,
     /// Each axis's actuator force over the last seconds (N).
     pub forces: [Ring; 3],
     /// The last sample.
-    pub last: Option<XyzSample>,
+    pub last: Option<Sample<3>>,
+    /// The 3-D world after the last tick (none for a VE on each axis).
+    world: Option<WorldView>,
     /// Where the mouse has dragged the hand, beyond the script (m).
     pub hand_offset_m: [f64; 3],
     /// Why the run stopped, if it has.
@@ -27,15 +30,17 @@ pub struct WorldState {
 impl WorldState {
     /// The scope on a three-axis scene file.
     pub fn open(path: &Path) -> Result<Self, String> {
-        let scene = XyzScene::load(path, &[]).map_err(|e| e.to_string())?;
+        let scene = Scene::load(path, &[]).map_err(|e| e.to_string())?;
         Self::new(scene)
     }
 
     /// The scope on `scene`.
-    pub fn new(scene: XyzScene) -> Result<Self, String> {
+    pub fn new(scene: Scene) -> Result<Self, String> {
         let n = (HISTORY_S * 1000.0) as usize;
+        let sim = Simulation::with_axes(scene)?;
         Ok(WorldState {
-            sim: XyzSimulation::new(scene)?,
+            world: sim.servo().blocks(),
+            sim,
             forces: [Ring::new(n), Ring::new(n), Ring::new(n)],
             last: None,
             hand_offset_m: [0.0; 3],
@@ -68,6 +73,7 @@ impl WorldState {
                 self.stopped = Some("the handle left the workspace".into());
             }
             self.last = Some(s);
+            self.world = self.sim.servo().blocks();
         }
     }
 
@@ -81,31 +87,26 @@ impl WorldState {
     /// Grab the touched block, or let go of the held one.
     pub fn toggle_grab(&mut self) {
         match self.held() {
-            Some(_) => self.sim.release(),
+            Some(_) => self.sim.servo_mut().release(),
             None => {
-                self.sim.grab();
+                self.sim.servo_mut().grab();
             }
         }
+        self.world = self.sim.servo().blocks();
     }
 
     /// The world's blocks (none for a constraint).
     pub fn blocks(&self) -> &[Block] {
-        match self.sim.servo().world() {
-            XyzWorld::Blocks(w) => w.blocks(),
-            XyzWorld::Bilateral(_) => &[],
-        }
+        self.world.as_ref().map_or(&[], |w| &w.blocks)
     }
 
     /// The block the cursor holds.
     pub fn held(&self) -> Option<usize> {
-        match self.sim.servo().world() {
-            XyzWorld::Blocks(w) => w.held(),
-            XyzWorld::Bilateral(_) => None,
-        }
+        self.world.as_ref().and_then(|w| w.held)
     }
 
     /// The cursor (m).
     pub fn cursor_m(&self) -> [f64; 3] {
-        self.last.map_or([0.0; 3], |s| s.cursor_m)
+        self.last.map_or([0.0; 3], |s| s.ve_m)
     }
 }

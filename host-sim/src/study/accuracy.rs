@@ -61,7 +61,7 @@ fn path(scene: &Scene) -> Result<(Vec<f64>, f64, Option<String>), String> {
         let mut sim = Simulation::new(scene.clone())?;
         let mut xs = Vec::with_capacity(sim.total_ticks() as usize);
         let t0 = Instant::now();
-        let r = sim.run(|s| xs.push(s.handle_m));
+        let r = sim.run(|s| xs.push(s.handle_m[0]));
         best = best.min(t0.elapsed().as_secs_f64());
         let note = r.reason.clone().or(r.integrator_warning.clone());
         out = (xs, note);

@@ -43,7 +43,7 @@ fn outcome(r: &crate::engine::sim::Report) -> Outcome {
     Outcome {
         stable: r.stable,
         reason: r.reason.clone(),
-        late_rms_n: r.late_rms_n,
+        late_rms_n: r.late_rms_n[0],
         peak_force_n: r.peak_force_n,
     }
 }
@@ -53,7 +53,7 @@ fn outcome(r: &crate::engine::sim::Report) -> Outcome {
 fn run(path: &Path, sets: &[String]) -> Result<(crate::engine::sim::Report, Vec<f64>), String> {
     let scene = Scene::load(path, sets).map_err(|e| e.to_string())?;
     let mut forces = Vec::new();
-    let report = Simulation::new(scene)?.run(|s| forces.push(s.actuator_n));
+    let report = Simulation::new(scene)?.run(|s| forces.push(s.actuator_n[0]));
     Ok((report, forces))
 }
 

@@ -4,8 +4,8 @@ use crate::Sample;
 use plotters::prelude::*;
 use std::path::Path;
 
-/// Draw `samples` to `out` (PNG).
-pub fn png(samples: &[Sample], title: &str, out: &Path) -> Result<(), String> {
+/// Draw the first axis of `samples` to `out` (PNG).
+pub fn png<const N: usize>(samples: &[Sample<N>], title: &str, out: &Path) -> Result<(), String> {
     let _ =
         plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
     if samples.is_empty() {
@@ -17,7 +17,7 @@ pub fn png(samples: &[Sample], title: &str, out: &Path) -> Result<(), String> {
     let root = root.titled(title, ("sans-serif", 22)).map_err(e)?;
     let (top, bottom) = root.split_vertically(340);
     let t1 = samples.last().map_or(1.0, |s| s.t_s);
-    let range = |f: &dyn Fn(&Sample) -> f64| {
+    let range = |f: &dyn Fn(&Sample<N>) -> f64| {
         let (lo, hi) = samples
             .iter()
             .map(f)
@@ -28,10 +28,10 @@ pub fn png(samples: &[Sample], title: &str, out: &Path) -> Result<(), String> {
         let pad = ((hi - lo) * 0.05).max(1e-9);
         (lo - pad)..(hi + pad)
     };
-    type Series<'a> = (&'a str, RGBColor, &'a dyn Fn(&Sample) -> f64);
+    type Series<'a, const M: usize> = (&'a str, RGBColor, &'a dyn Fn(&Sample<M>) -> f64);
     let panel = |area: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
                  y_desc: &str,
-                 series: &[Series]|
+                 series: &[Series<N>]|
      -> Result<(), String> {
         let lo = series
             .iter()
@@ -79,15 +79,18 @@ pub fn png(samples: &[Sample], title: &str, out: &Path) -> Result<(), String> {
     panel(
         &top,
         "position (m)",
-        &[("handle", BLUE, &|s| s.handle_m), ("VE", RED, &|s| s.ve_m)],
+        &[
+            ("handle", BLUE, &|s| s.handle_m[0]),
+            ("VE", RED, &|s| s.ve_m[0]),
+        ],
     )?;
     panel(
         &bottom,
         "force (N)",
         &[
-            ("human", GREEN, &|s| s.human_n),
-            ("actuator (delivered)", BLUE, &|s| s.actuator_n),
-            ("VE", RED, &|s| s.ve_n),
+            ("human", GREEN, &|s| s.human_n[0]),
+            ("actuator (delivered)", BLUE, &|s| s.actuator_n[0]),
+            ("VE", RED, &|s| s.ve_n[0]),
         ],
     )?;
     root.present().map_err(e)

@@ -45,9 +45,7 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), String> {
     if !(a.seconds.is_finite() && a.seconds > 0.0 && a.seconds <= 3600.0) {
         return Err(format!("--seconds {}: must be in (0, 3600]", a.seconds));
     }
-    let text =
-        std::fs::read_to_string(&a.scene).map_err(|e| format!("{}: {e}", a.scene.display()))?;
-    let xyz = host_sim::engine::xyz::axes_of(&text) == Some(3);
+    let scene = load(&a.scene, &[])?;
     // (Every scene ticks at the board's 1 kHz.)
     let period = 1e-3;
     let ticks = (a.seconds / period).round() as u64;
@@ -62,13 +60,17 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), String> {
     };
     let port = a.port.as_deref().map(link::SerialBoard::open).transpose()?;
     let start = std::time::Instant::now();
-    if xyz {
+    if (scene.period() - period).abs() > 1e-12 {
+        return Err(format!(
+            "{}: a PIL scene ticks at the board's 1 kHz",
+            a.scene.display()
+        ));
+    }
+    if scene.axes == 3 {
         if a.passivity {
             return Err("--passivity: the three-axis image has no passivity build".into());
         }
-        let scene =
-            host_sim::engine::xyz::XyzScene::load(&a.scene, &[]).map_err(|e| e.to_string())?;
-        let reference = pil::run_xyz(
+        let reference = pil::run_axes::<_, 3>(
             scene.clone(),
             ticks,
             link::LocalBoard::excalibur_xyz()?,
@@ -76,16 +78,9 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), String> {
         )?;
         let local_s = start.elapsed().as_secs_f64();
         let run = port
-            .map(|p| pil::run_xyz(scene, ticks, p, faults))
+            .map(|p| pil::run_axes::<_, 3>(scene, ticks, p, faults))
             .transpose()?;
         return pil_report(a, ticks, faults, reference, run, local_s, start);
-    }
-    let scene = load(&a.scene, &[])?;
-    if (scene.period() - period).abs() > 1e-12 {
-        return Err(format!(
-            "{}: a PIL scene ticks at the board's 1 kHz",
-            a.scene.display()
-        ));
     }
     let reference = if a.passivity {
         pil::run(
@@ -106,12 +101,12 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), String> {
 
 /// A PIL run's report, compared with the in-process `reference`: the
 /// board's `run` over the serial port where there was one.
-pub(crate) fn pil_report<S: host_sim::pil::PilSample>(
+pub(crate) fn pil_report<const N: usize>(
     a: &PilArgs,
     ticks: u64,
     faults: host_sim::link::LinkFaults,
-    reference: host_sim::pil::Run<S>,
-    run: Option<host_sim::pil::Run<S>>,
+    reference: host_sim::pil::Run<N>,
+    run: Option<host_sim::pil::Run<N>>,
     local_s: f64,
     start: std::time::Instant,
 ) -> Result<(), String> {
@@ -132,7 +127,7 @@ pub(crate) fn pil_report<S: host_sim::pil::PilSample>(
     let peak = run
         .samples
         .iter()
-        .flat_map(|s| (0..axes).map(|i| s.actuator_n(i).abs()))
+        .flat_map(|s| s.actuator_n.iter().map(|f| f.abs()))
         .fold(0.0, f64::max);
     let v = json!({
         "ticks": c.ticks,

@@ -37,9 +37,24 @@ pub(crate) fn load(path: &Path, sets: &[String]) -> Result<Scene, String> {
     Scene::load(path, sets).map_err(|e| e.to_string())
 }
 
-pub(crate) fn run_scene(scene: Scene, mut sink: impl FnMut(&Sample)) -> Result<Report, String> {
-    let mut sim = Simulation::new(scene)?;
-    Ok(sim.run(&mut sink))
+/// `$body` with `N` the scene's axis count, a constant.
+macro_rules! with_axes {
+    ($scene:expr, $n:ident => $body:expr) => {
+        match $scene.axes {
+            1 => {
+                const $n: usize = 1;
+                $body
+            }
+            2 => {
+                const $n: usize = 2;
+                $body
+            }
+            _ => {
+                const $n: usize = 3;
+                $body
+            }
+        }
+    };
 }
 
 pub(crate) fn run(a: &RunArgs) -> Result<(), String> {
@@ -47,40 +62,70 @@ pub(crate) fn run(a: &RunArgs) -> Result<(), String> {
     if let Some(d) = a.duration {
         sets.push(format!("duration_s={d}"));
     }
-    let path = &a.scene.scene;
-    let text = std::fs::read_to_string(path).unwrap_or_default();
-    if host_sim::engine::xyz::axes_of(&text) == Some(3) {
-        return run_xyz(a, &sets);
+    let scene = load(&a.scene.scene, &sets)?;
+    with_axes!(scene, N => run_axes::<N>(a, scene))
+}
+
+/// The CSV's columns: each quantity once on one axis, once per axis
+/// (`_x`, `_y`, `_z`) on several.
+fn csv_header(axes: usize) -> String {
+    const COLUMNS: [(&str, &str); 7] = [
+        ("handle_position", "m"),
+        ("handle_velocity", "mps"),
+        ("human_force", "n"),
+        ("commanded_force", "n"),
+        ("actuator_force", "n"),
+        ("ve_position", "m"),
+        ("ve_force", "n"),
+    ];
+    let mut h = String::from("t_s");
+    for (name, unit) in COLUMNS {
+        if axes == 1 {
+            h += &format!(",{name}_{unit}");
+        } else {
+            for axis in ["x", "y", "z"].iter().take(axes) {
+                h += &format!(",{name}_{axis}_{unit}");
+            }
+        }
     }
-    let scene = load(path, &sets)?;
+    h
+}
+
+fn run_axes<const N: usize>(a: &RunArgs, scene: Scene) -> Result<(), String> {
+    if a.png.is_some() && N != 1 {
+        return Err(format!(
+            "--png draws a one-axis scene; give this {N}-axis one --csv"
+        ));
+    }
     let name = scene.name.clone();
-    let mut csv = csv_file(
-        a.csv.as_deref(),
-        "t_s,handle_position_m,handle_velocity_mps,human_force_n,commanded_force_n,actuator_force_n,ve_position_m,ve_force_n",
-    )?;
-    let mut kept: Vec<Sample> = Vec::new();
+    let mut sim = Simulation::<N>::with_axes(scene)?;
+    let mut csv = csv_file(a.csv.as_deref(), &csv_header(N))?;
+    let mut kept: Vec<Sample<N>> = Vec::new();
     let mut csv_err = None;
-    let report = run_scene(scene, |s| {
+    let report = sim.run(|s| {
         if let Some(w) = csv.as_mut() {
-            if let Err(e) = writeln!(
-                w,
-                "{},{},{},{},{},{},{},{}",
-                s.t_s,
-                s.handle_m,
-                s.handle_mps,
-                s.human_n,
-                s.commanded_n,
-                s.actuator_n,
-                s.ve_m,
-                s.ve_n
-            ) {
+            let mut row = s.t_s.to_string();
+            for v in [
+                &s.handle_m,
+                &s.handle_mps,
+                &s.human_n,
+                &s.commanded_n,
+                &s.actuator_n,
+                &s.ve_m,
+                &s.ve_n,
+            ] {
+                for x in v {
+                    row += &format!(",{x}");
+                }
+            }
+            if let Err(e) = writeln!(w, "{row}") {
                 csv_err.get_or_insert(e);
             }
         }
         if a.png.is_some() {
             kept.push(*s);
         }
-    })?;
+    });
     finish_csv(csv, csv_err)?;
     if let Some(p) = &a.png {
         host_sim::study::plot::png(&kept, &name, p)?;
@@ -122,55 +167,6 @@ pub(crate) fn finish_csv(
     }
 }
 
-/// A three-axis scene, headless: the report, and each tick in a CSV.
-pub(crate) fn run_xyz(a: &RunArgs, sets: &[String]) -> Result<(), String> {
-    use host_sim::engine::xyz::{XyzScene, XyzSimulation};
-    if a.png.is_some() {
-        return Err("--png draws a one-axis scene; give a three-axis one --csv".into());
-    }
-    let scene = XyzScene::load(&a.scene.scene, sets).map_err(|e| e.to_string())?;
-    let mut sim = XyzSimulation::new(scene)?;
-    let mut csv = csv_file(
-        a.csv.as_deref(),
-        "t_s,handle_x_m,handle_y_m,handle_z_m,force_x_n,force_y_n,force_z_n,cursor_x_m,cursor_y_m,cursor_z_m,held",
-    )?;
-    let mut csv_err = None;
-    let r = sim.run(|s| {
-        if let Some(w) = csv.as_mut() {
-            let [hx, hy, hz] = s.handle_m;
-            let [fx, fy, fz] = s.actuator_n;
-            let [cx, cy, cz] = s.cursor_m;
-            let held = s.held.map_or(-1, |i| i as i64);
-            if let Err(e) = writeln!(
-                w,
-                "{},{hx},{hy},{hz},{fx},{fy},{fz},{cx},{cy},{cz},{held}",
-                s.t_s
-            ) {
-                csv_err.get_or_insert(e);
-            }
-        }
-    });
-    finish_csv(csv, csv_err)?;
-    if a.scene.json {
-        println!("{}", serde_json::to_string(&r).map_err(|e| e.to_string())?);
-    } else {
-        print_verdict(&r.scene, &r.reason);
-        println!(
-            "  peak force {:.1} N, {:.1} s simulated in {:.3} s ({:.0}x real time)",
-            r.peak_force_n, r.sim_seconds, r.wall_seconds, r.realtime_factor
-        );
-        for (i, b) in r.blocks_m.iter().enumerate() {
-            println!(
-                "  block {i} at ({:.1}, {:.1}, {:.1}) mm",
-                b[0] * 1e3,
-                b[1] * 1e3,
-                b[2] * 1e3
-            );
-        }
-    }
-    Ok(())
-}
-
 /// A run's first lines: the scene, stable or not, and why not.
 pub(crate) fn print_verdict(scene: &str, reason: &Option<String>) {
     match reason {
@@ -191,5 +187,13 @@ pub(crate) fn print_report(r: &Report) {
     }
     for e in &r.effects {
         println!("  effect {:<12} {:>8.1} ns/tick", e.name, e.ns_per_tick);
+    }
+    for (i, b) in r.blocks_m.iter().enumerate() {
+        println!(
+            "  block {i} at ({:.1}, {:.1}, {:.1}) mm",
+            b[0] * 1e3,
+            b[1] * 1e3,
+            b[2] * 1e3
+        );
     }
 }

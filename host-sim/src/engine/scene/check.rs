@@ -1,7 +1,8 @@
 //! The physical checks a scene's types cannot express; each message
 //! names the field.
 
-use super::{LayerPort, Scene, VeSpec};
+use super::{Coupling, LayerPort, Scene, VeSpec, MAX_AXES, MAX_BLOCKS};
+use crate::engine::human::AxisValue;
 use twoport_control::servo::Display;
 
 impl Scene {
@@ -29,10 +30,21 @@ impl Scene {
             nonneg("ve.stiffness_npm", k)?;
             nonneg("ve.damping_nspm", b)
         };
-        if let Some(n) = self.axes.filter(|&n| n != 1) {
+        if !(1..=MAX_AXES).contains(&self.axes) {
             return Err(format!(
-                "axes = {n}: a one-axis scene has axes = 1; a three-axis scene is read as one"
+                "axes = {}: the simulator runs devices of 1 to {MAX_AXES} axes",
+                self.axes
             ));
+        }
+        let cc = self.plant.cross_coupling;
+        if !(cc.is_finite() && (0.0..0.5).contains(&cc)) {
+            return Err(format!("plant.cross_coupling = {cc} must be in [0, 0.5)"));
+        }
+        if cc != 0.0 && self.axes == 1 {
+            return Err(
+                "plant.cross_coupling couples the axes of a device of several; this one has one"
+                    .into(),
+            );
         }
         pos("duration_s", self.duration_s)?;
         if let Some(t) = self.period_s {
@@ -48,45 +60,27 @@ impl Scene {
                 self.integrator.substeps
             ));
         }
-        let c = &self.coupling;
-        match self.display {
-            Display::Impedance => {
-                let k =
-                    c.k.ok_or("coupling.k is required for an impedance display")?;
-                nonneg("coupling.k", k)?;
-                nonneg("coupling.b", c.b)?;
-                for (n, v) in [
-                    ("coupling.m", c.m),
-                    ("coupling.kp", c.kp),
-                    ("coupling.bp", c.bp),
-                ] {
-                    if v.is_some() {
-                        return Err(format!("{n} belongs to an admittance display"));
-                    }
+        match &self.coupling_per_axis {
+            None => self.check_coupling("coupling", &self.coupling)?,
+            Some(each) => {
+                if each.len() != self.axis_count() {
+                    return Err(format!(
+                        "coupling_per_axis has {} couplings for {} axes",
+                        each.len(),
+                        self.axes
+                    ));
                 }
-            }
-            Display::Admittance => {
-                for (n, v) in [
-                    ("coupling.m", c.m),
-                    ("coupling.kp", c.kp),
-                    ("coupling.bp", c.bp),
-                ] {
-                    let v = v.ok_or(format!("{n} is required for an admittance display"))?;
-                    nonneg(n, v)?;
-                }
-                pos("coupling.m", c.m.unwrap_or(0.0))?;
-                pos("coupling.b", c.b)?;
-                if c.k.is_some() {
-                    return Err("coupling.k belongs to an impedance display (use kp)".into());
-                }
-                if !self.effects.load_cell {
-                    return Err(
-                        "an admittance display measures force: add `load_cell = true` to [effects]"
-                            .into(),
-                    );
+                for (a, c) in each.iter().enumerate() {
+                    self.check_coupling(&format!("coupling_per_axis[{a}]"), c)?;
                 }
             }
         }
+        if self.display == Display::Admittance && !self.effects.load_cell {
+            return Err(
+                "an admittance display measures force: add `load_cell = true` to [effects]".into(),
+            );
+        }
+        self.check_script()?;
         match &self.ve {
             VeSpec::Cursor { mass_kg, .. } => pos("ve.mass_kg", *mass_kg)?,
             VeSpec::Wall {
@@ -133,6 +127,47 @@ impl Scene {
                 if edge > limits_m[1] + 1e-12 {
                     return Err("ve.blocks extend past ve.limits_m[1]".into());
                 }
+            }
+            VeSpec::World {
+                blocks,
+                cursor_mass_kg,
+                friction,
+                grab_at_s,
+                release_at_s,
+                ..
+            } => {
+                if self.axes != 3 {
+                    return Err(format!(
+                        "ve.kind = \"world\" is a 3-D world: it needs axes = 3, not {}",
+                        self.axes
+                    ));
+                }
+                for (name, times) in [("grab_at_s", grab_at_s), ("release_at_s", release_at_s)] {
+                    if let Some(t) = times.iter().find(|t| !(t.is_finite() && **t >= 0.0)) {
+                        return Err(format!("ve.{name}: {t} is not a time >= 0 (s)"));
+                    }
+                }
+                if blocks.len() > MAX_BLOCKS {
+                    return Err(format!(
+                        "ve.blocks: {} blocks, the world holds {MAX_BLOCKS}",
+                        blocks.len()
+                    ));
+                }
+                for (i, b) in blocks.iter().enumerate() {
+                    let ok = b.at_m.iter().all(|x| x.is_finite() && x.abs() < 2.0)
+                        && b.size_m
+                            .iter()
+                            .all(|s| s.is_finite() && *s > 0.0 && *s < 2.0)
+                        && b.mass_kg.is_finite()
+                        && b.mass_kg > 0.0;
+                    if !ok {
+                        return Err(format!(
+                            "ve.blocks[{i}]: at_m within 2 m, size_m in (0, 2) m and mass_kg > 0"
+                        ));
+                    }
+                }
+                pos("ve.cursor_mass_kg", *cursor_mass_kg)?;
+                nonneg("ve.friction", *friction)?;
             }
         }
         let e = &self.effects;
@@ -215,5 +250,68 @@ impl Scene {
             }
         }
         Ok(())
+    }
+
+    /// One axis's coupling, named `name` in errors, for the scene's
+    /// display.
+    fn check_coupling(&self, name: &str, c: &Coupling) -> Result<(), String> {
+        let nonneg = |field: &str, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{name}.{field} = {v} must be finite and >= 0"))
+            }
+        };
+        let admittance = [("m", c.m), ("kp", c.kp), ("bp", c.bp)];
+        match self.display {
+            Display::Impedance => {
+                let k =
+                    c.k.ok_or(format!("{name}.k is required for an impedance display"))?;
+                nonneg("k", k)?;
+                nonneg("b", c.b)?;
+                if let Some((n, _)) = admittance.iter().find(|(_, v)| v.is_some()) {
+                    return Err(format!("{name}.{n} belongs to an admittance display"));
+                }
+            }
+            Display::Admittance => {
+                for (n, v) in admittance {
+                    let v = v.ok_or(format!("{name}.{n} is required for an admittance display"))?;
+                    nonneg(n, v)?;
+                }
+                for (n, v) in [("m", c.m.unwrap_or(0.0)), ("b", c.b)] {
+                    if !(v.is_finite() && v > 0.0) {
+                        return Err(format!("{name}.{n} = {v} must be finite and > 0"));
+                    }
+                }
+                if c.k.is_some() {
+                    return Err(format!("{name}.k belongs to an impedance display (use kp)"));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The script's positions and forces: numbers on a one-axis device,
+    /// one per axis on a device of several.
+    fn check_script(&self) -> Result<(), String> {
+        let n = self.axis_count();
+        for (i, e) in self.human.script.iter().enumerate() {
+            let Some(v) = e.values() else { continue };
+            let fits = match v {
+                AxisValue::One(_) => n == 1,
+                AxisValue::Each(v) => v.len() == n,
+            };
+            if !fits {
+                return Err(if n == 1 {
+                    format!("human.script[{i}]: a one-axis scene's values are numbers (or arrays of one)")
+                } else {
+                    format!(
+                        "human.script[{i}]: give one value per axis, {n} in all (x first), not {}",
+                        v.len()
+                    )
+                });
+            }
+        }
+        self.humans().map(|_| ())
     }
 }

@@ -9,6 +9,7 @@ pub use effects::*;
 pub use parse::{apply_set, checked, parse_toml, read, SceneError};
 pub use spec::*;
 
+use crate::engine::human::Human;
 use serde::Deserialize;
 use std::path::Path;
 use twoport_control::servo::{AdmittanceGains, Display, Gains, ImpedanceGains};
@@ -21,9 +22,11 @@ pub struct Scene {
     /// A name for reports.
     #[serde(default)]
     pub name: String,
-    /// How many axes the device has: 1 here (absent means 1); a scene of
-    /// three is an [`XyzScene`](crate::engine::xyz::XyzScene).
-    pub axes: Option<u8>,
+    /// How many Cartesian axes the device has (1 to [`MAX_AXES`]; 1 when
+    /// absent). Every axis runs the same device model, VE kind, effects
+    /// and hand, each with its own state.
+    #[serde(default = "one_axis")]
+    pub axes: u8,
     /// Simulated time (s).
     #[serde(default = "default_duration")]
     pub duration_s: f64,
@@ -37,8 +40,11 @@ pub struct Scene {
     pub integrator: IntegratorSpec,
     /// Impedance or admittance display.
     pub display: Display,
-    /// Coupling (and regulator) gains.
+    /// Coupling (and regulator) gains, the same on every axis unless
+    /// `coupling_per_axis` gives each its own.
     pub coupling: Coupling,
+    /// Each axis's coupling, x first: one per axis.
+    pub coupling_per_axis: Option<Vec<Coupling>>,
     /// The virtual environment.
     pub ve: VeSpec,
     /// The human operator.
@@ -73,6 +79,18 @@ impl Scene {
     pub fn parse(text: &str, source: &str, sets: &[String]) -> Result<Self, SceneError> {
         checked(parse_toml(text, source, sets)?, source, Self::check)
     }
+
+    /// The hand along each axis: the script's events with each axis's
+    /// values (checked; the error names `human.script[i]`).
+    pub fn humans(&self) -> Result<Vec<Human>, String> {
+        (0..self.axis_count())
+            .map(|a| {
+                let events = self.human.script.iter().map(|e| e.along(|v| v.on(a)));
+                Human::new(self.human.grasp, events.collect())?.with_arm(self.human.arm)
+            })
+            .collect()
+    }
+
     /// Whether any effect makes the plant nonlinear (and so sub-stepped).
     pub fn nonlinear(&self) -> bool {
         let e = &self.effects;
@@ -84,11 +102,26 @@ impl Scene {
 }
 
 impl Scene {
-    /// The servo's gains: the one reading of `[coupling]` (checked by
-    /// validation, so a missing gain cannot reach here from a loaded scene;
-    /// it reads as zero, which the laws refuse where zero is invalid).
-    pub fn gains(&self) -> Gains {
-        let c = &self.coupling;
+    /// How many axes the scene's device has.
+    pub fn axis_count(&self) -> usize {
+        usize::from(self.axes)
+    }
+
+    /// Axis `axis`'s coupling: its own in `coupling_per_axis`, else
+    /// `coupling`.
+    pub fn coupling_of(&self, axis: usize) -> &Coupling {
+        self.coupling_per_axis
+            .as_ref()
+            .and_then(|c| c.get(axis))
+            .unwrap_or(&self.coupling)
+    }
+
+    /// Axis `axis`'s servo gains: the one reading of its coupling (checked
+    /// by validation, so a missing gain cannot reach here from a loaded
+    /// scene; it reads as zero, which the laws refuse where zero is
+    /// invalid).
+    pub fn gains_of(&self, axis: usize) -> Gains {
+        let c = self.coupling_of(axis);
         let g = |v: Option<f64>| v.unwrap_or(0.0) as f32;
         match self.display {
             Display::Impedance => ImpedanceGains::new(g(c.k), c.b as f32).into(),
@@ -97,6 +130,13 @@ impl Scene {
             }
         }
     }
+}
+
+/// The most axes a scene's device may have.
+pub const MAX_AXES: u8 = 3;
+
+fn one_axis() -> u8 {
+    1
 }
 
 fn default_duration() -> f64 {

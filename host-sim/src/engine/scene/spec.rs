@@ -1,7 +1,7 @@
 //! The scene's sections: plant, integrator, passivity layer, coupling,
 //! VE and human.
 
-use crate::engine::human::{Event, GraspKind};
+use crate::engine::human::{AxisValue, Event, GraspKind};
 use crate::engine::plant::Method;
 use serde::Deserialize;
 use std::path::PathBuf;
@@ -68,6 +68,11 @@ pub struct PlantSpec {
     /// Rigid reduction's damping (N s/m).
     #[serde(default = "default_rigid_damping")]
     pub rigid_damping_nspm: f64,
+    /// Cross-axis coupling on a device of several axes: the fraction of
+    /// each actuator's force that also pushes every other axis's actuator
+    /// (0, the default: independent axes).
+    #[serde(default)]
+    pub cross_coupling: f64,
 }
 
 fn default_model() -> PathBuf {
@@ -86,6 +91,7 @@ impl Default for PlantSpec {
             model: default_model(),
             rigid_mass_kg: default_rigid_mass(),
             rigid_damping_nspm: default_rigid_damping(),
+            cross_coupling: 0.0,
         }
     }
 }
@@ -269,6 +275,55 @@ pub enum VeSpec {
         /// Release it at this time (s).
         release_at_s: Option<f64>,
     },
+    /// The building-block world in 3-D, on a three-axis device: a cursor,
+    /// blocks on a floor, gravity. With no blocks it is a free cursor over
+    /// a floor. The device's zero is where the cursor starts (the
+    /// workspace's centre, 10 mm above the floor).
+    World {
+        /// The blocks, at most 50.
+        #[serde(default)]
+        blocks: Vec<WorldBlock>,
+        /// Cursor mass (kg).
+        #[serde(default = "default_cursor")]
+        cursor_mass_kg: f64,
+        /// Friction coefficient of the faces.
+        #[serde(default = "default_friction")]
+        friction: f64,
+        /// Knobs on the blocks' tops.
+        #[serde(default = "default_true")]
+        knobs: bool,
+        /// The paper's explicit integration instead of the passive one.
+        #[serde(default)]
+        explicit: bool,
+        /// Grab the touched block at these times (s).
+        #[serde(default)]
+        grab_at_s: Vec<f64>,
+        /// Let go at these times (s).
+        #[serde(default)]
+        release_at_s: Vec<f64>,
+    },
+}
+
+/// One block of the 3-D world.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WorldBlock {
+    /// Its lowest corner (m).
+    pub at_m: [f64; 3],
+    /// Its size (m).
+    pub size_m: [f64; 3],
+    /// Its mass (kg).
+    pub mass_kg: f64,
+}
+
+/// The most blocks the 3-D world holds.
+pub const MAX_BLOCKS: usize = 50;
+
+fn default_cursor() -> f64 {
+    0.25
+}
+fn default_friction() -> f64 {
+    0.3
 }
 
 fn default_solid() -> SolidSide {
@@ -285,10 +340,12 @@ pub struct HumanSpec {
     /// Initial grasp.
     #[serde(default = "default_grasp")]
     pub grasp: GraspKind,
-    /// Scripted events.
+    /// Scripted events; their positions and forces are numbers on a
+    /// one-axis device, arrays of one per axis on a device of several.
     #[serde(default)]
-    pub script: Vec<Event>,
-    /// A passive arm behind the grasp (paper Fig. 3's `Z_p`).
+    pub script: Vec<Event<AxisValue>>,
+    /// A passive arm behind the grasp (paper Fig. 3's `Z_p`), on every
+    /// axis.
     pub arm: Option<crate::engine::plant::Arm>,
 }
 
