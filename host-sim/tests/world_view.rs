@@ -67,3 +67,52 @@ fn the_grab_button_and_the_drag_move_the_block() {
     assert_eq!(h.state().blocks()[0].min[2].nm(), 0);
     assert!(h.state().forces[2].len() > 3000, "the force history grows");
 }
+
+/// Board mode on three axes: the three-axis image, in-process (the bytes
+/// the firmware gets over its serial link), drives the world scene's plant
+/// in lockstep. Refused until calibrated, then calibrated where the
+/// world's cursor starts and armed, it pushes on every axis as the hand
+/// presses the cube and the floor; the view plots its telemetry on every
+/// axis and shows its state.
+#[test]
+fn board_mode_drives_a_three_axis_board_and_plots_every_axis() {
+    use host_sim::link::LocalBoard;
+    use twoport_link::{Message, Mode};
+    let scene = Scene::load(Path::new("../scenes/xyz/pil_blocks.toml"), &[]).unwrap();
+    let mut s = WorldState::new(scene).unwrap();
+    let board = LocalBoard::excalibur_xyz().unwrap();
+    s.connect_port(Box::new(board), "in-process", true);
+    assert!(s.board.is_some(), "{:?}", s.message);
+    s.tell_board(Message::Arm);
+    s.advance(0.01);
+    let b = s.board.as_ref().unwrap();
+    assert_eq!(b.refusal.as_deref(), Some("Arm refused: NotCalibrated"));
+    let at_rest = s.at_rest_pm().unwrap();
+    s.tell_board(Message::Calibrate {
+        position_pm: at_rest,
+    });
+    s.tell_board(Message::Arm);
+    for _ in 0..50 {
+        s.advance(0.1);
+    }
+    assert_eq!(s.message, None);
+    let b = s.board.as_ref().unwrap();
+    assert_eq!(b.status.map(|st| st.mode), Some(Mode::Armed));
+    assert_eq!(b.telemetry.expect("telemetry").axes.len(), 3);
+    let peak = |r: &host_sim::scope::rings::Ring| r.iter().map(|p| p.1.abs()).fold(0.0, f64::max);
+    for a in 0..3 {
+        assert!(
+            peak(&s.board_forces[a]) > 2.0,
+            "axis {a}: the board's force"
+        );
+        assert!(peak(&s.forces[a]) > 2.0, "axis {a}: the plant's force");
+    }
+    let mut h = Harness::new_ui_state(host_sim::scope::world_ui::world, s);
+    h.set_size(eframe::egui::vec2(1280.0, 860.0));
+    h.run();
+    let _ = h.get_by_label_contains("board: in-process (lockstep)");
+    let _ = h.get_by_label_contains("Armed, calibrated");
+    h.get_by_label("disconnect").click();
+    h.run();
+    assert!(h.state().board.is_none());
+}

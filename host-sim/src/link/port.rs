@@ -11,6 +11,17 @@ pub trait BoardPort {
     fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, String>;
 }
 
+/// Any port, chosen at run time (the scope's: a serial port, or a board
+/// in-process).
+impl BoardPort for Box<dyn BoardPort> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), String> {
+        (**self).send(bytes)
+    }
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, String> {
+        (**self).recv(buf, timeout)
+    }
+}
+
 /// A serial port: the firmware in QEMU (`-serial pty`) or a real board.
 pub struct SerialBoard(Box<dyn serialport::SerialPort>);
 

@@ -5,7 +5,8 @@
 
 use crate::engine::human::GraspKind;
 use crate::engine::scene::{Scene, VeSpec};
-use crate::link::{SerialBoard, Session};
+use crate::link::{BoardPort, SerialBoard};
+use crate::scope::board::BoardLink;
 use crate::scope::rings::{last_trigger, Edge, Ring};
 use crate::scope::signals::{BoardSignal, Signal};
 use crate::{Sample, Simulation};
@@ -16,7 +17,7 @@ use twoport_design::design::{self, Analysis, Check, GridSpec};
 use twoport_design::plot::Figure;
 use twoport_design::twoport::HumanBound;
 use twoport_design::Plant;
-use twoport_link::{Axes, GainsReply, Message, Status, Telemetry};
+use twoport_link::{Axes, Message};
 
 /// Samples each signal's ring holds: 20 s at 1 kHz.
 pub const RING_SAMPLES: usize = 20_000;
@@ -58,27 +59,6 @@ pub struct Light {
     pub worst_hz: f64,
     /// The design bound and the coupling's response (Fig. 8 or 9).
     pub figure: Option<Figure>,
-}
-
-/// A connected board.
-pub struct BoardLink {
-    session: Session<SerialBoard>,
-    /// Port path.
-    pub port: String,
-    /// Lockstep: this simulation is the board's plant (processor in the
-    /// loop, the QEMU image). Otherwise the board runs on its own sensors
-    /// and clock and the scope only watches and talks to it.
-    pub lockstep: bool,
-    /// The last telemetry.
-    pub telemetry: Option<Telemetry>,
-    /// The board's last answer to a gain request.
-    pub reply: Option<String>,
-    /// Latched faults the board reported.
-    pub faults: Option<u16>,
-    /// The board's state machine, as it last said.
-    pub status: Option<Status>,
-    /// Its last refusal of a mode change.
-    pub refusal: Option<String>,
 }
 
 /// Everything the scope shows and controls.
@@ -329,8 +309,8 @@ impl ScopeState {
             return false;
         }
         let s = match self.board.as_mut().filter(|b| b.lockstep) {
-            Some(b) => match b.session.step(&mut self.sim) {
-                Ok((s, _)) => s,
+            Some(b) => match b.step(&mut self.sim) {
+                Ok(s) => s,
                 Err(e) => {
                     self.message = Some(format!("board link lost: {e}"));
                     self.board = None;
@@ -359,11 +339,7 @@ impl ScopeState {
         let Some(b) = self.board.as_mut().filter(|b| !b.lockstep) else {
             return;
         };
-        let r = b
-            .session
-            .send(&Message::Heartbeat)
-            .and_then(|_| b.session.poll());
-        if let Err(e) = r {
+        if let Err(e) = b.watch() {
             self.message = Some(format!("board link lost: {e}"));
             self.board = None;
             return;
@@ -375,37 +351,16 @@ impl ScopeState {
         let Some(b) = self.board.as_mut() else {
             return;
         };
-        for m in b.session.take_messages() {
-            match m {
-                Message::Telemetry(t) => {
-                    // Lockstep: the board's tick is the simulation's. Free
-                    // running: shown when it arrives.
-                    let ts = if b.lockstep {
-                        t.tick as f64 * self.sim.period()
-                    } else {
-                        self.last.map_or(0.0, |s| s.t_s)
-                    };
-                    for (sig, ring) in BoardSignal::ALL.iter().zip(&mut self.board_rings) {
-                        ring.push(ts, sig.of(&t));
-                    }
-                    b.telemetry = Some(t);
-                }
-                Message::GainsReply(GainsReply::Accepted(_)) => {
-                    b.reply = Some("accepted".into());
-                }
-                Message::GainsReply(GainsReply::Refused(r)) => {
-                    b.reply = Some(format!("refused on axis {}: {:?}", r.axis, r.why));
-                }
-                Message::FaultReport { faults, .. } => b.faults = Some(faults),
-                Message::Status(st) => {
-                    b.faults = (st.faults != 0).then_some(st.faults);
-                    b.status = Some(st);
-                    b.refusal = None;
-                }
-                Message::ModeRefused { asked, why } => {
-                    b.refusal = Some(format!("{asked:?} refused: {why:?}"));
-                }
-                _ => {}
+        for t in b.take_telemetry() {
+            // Lockstep: the board's tick is the simulation's. Free running:
+            // shown when it arrives.
+            let ts = if b.lockstep {
+                t.tick as f64 * self.sim.period()
+            } else {
+                self.last.map_or(0.0, |s| s.t_s)
+            };
+            for (sig, ring) in BoardSignal::ALL.iter().zip(&mut self.board_rings) {
+                ring.push(ts, sig.of(&t));
             }
         }
     }
@@ -419,7 +374,7 @@ impl ScopeState {
         }
         self.gains = g;
         if let Some(b) = self.board.as_mut() {
-            if let Err(e) = b.session.send(&Message::SetGains(Axes::one(g.into()))) {
+            if let Err(e) = b.tell(&Message::SetGains(Axes::one(g.into()))) {
                 self.message = Some(format!("board: {e}"));
             }
         }
@@ -491,37 +446,27 @@ impl ScopeState {
     /// simulation is its plant (processor in the loop), without it the
     /// board runs on its own sensors and the scope watches.
     pub fn connect(&mut self, port: &str, lockstep: bool) {
-        let scene_ok = if lockstep {
-            crate::pil::check_scene(&self.scene)
-        } else {
-            Ok(())
-        };
-        let r = scene_ok
-            .and_then(|_| SerialBoard::open(port))
-            .and_then(|p| Session::open(p, crate::link::LinkFaults::default()))
-            .and_then(|mut s| s.send(&Message::GetStatus).map(|_| s));
-        match r {
-            Ok(session) => {
-                self.board = Some(BoardLink {
-                    session,
-                    port: port.to_string(),
-                    lockstep,
-                    telemetry: None,
-                    reply: None,
-                    faults: None,
-                    status: None,
-                    refusal: None,
-                });
+        match SerialBoard::open(port) {
+            Ok(p) => self.connect_port(Box::new(p), port, lockstep),
+            Err(e) => self.message = Some(format!("board at {port}: {e}")),
+        }
+    }
+
+    /// [`connect`](Self::connect) through any port (a board in-process).
+    pub fn connect_port(&mut self, port: Box<dyn BoardPort>, name: &str, lockstep: bool) {
+        match BoardLink::connect(port, name, lockstep, &self.scene) {
+            Ok(b) => {
+                self.board = Some(b);
                 self.message = None;
             }
-            Err(e) => self.message = Some(format!("board at {port}: {e}")),
+            Err(e) => self.message = Some(format!("board at {name}: {e}")),
         }
     }
 
     /// Leave board mode, disarming the board.
     pub fn disconnect(&mut self) {
-        if let Some(mut b) = self.board.take() {
-            let _ = b.session.send(&Message::Disarm);
+        if let Some(b) = self.board.take() {
+            b.disconnect();
         }
     }
 
@@ -529,7 +474,7 @@ impl ScopeState {
     /// comes back as a status or a refusal.
     pub fn tell_board(&mut self, msg: Message) {
         if let Some(b) = self.board.as_mut() {
-            if let Err(e) = b.session.send(&msg) {
+            if let Err(e) = b.tell(&msg) {
                 self.message = Some(format!("board: {e}"));
             }
         }

@@ -1,9 +1,11 @@
 //! The egui scope: its state apart from its drawing (`app`), the panels
-//! (`ui`), the window (`window`) and the sample rings it draws from
-//! (`rings`) of the signals it records (`signals`); for a three-axis scene, the world's state (`world`) and view
-//! (`world_ui`).
+//! (`ui`), the window (`window`), the sample rings it draws from (`rings`)
+//! of the signals it records (`signals`), and its link to a board of any
+//! number of axes (`board`); for a three-axis scene, the world's state
+//! (`world`) and view (`world_ui`).
 
 pub mod app;
+pub mod board;
 pub mod rings;
 pub mod signals;
 #[cfg(feature = "gui")]

@@ -3,6 +3,7 @@
 
 use crate::engine::human::GraspKind;
 use crate::scope::app::{list_ports, ScopeState, Speed};
+use crate::scope::board::{BoardChoice, BoardLink};
 use crate::scope::rings::{minmax, Edge, Ring};
 use crate::scope::signals::{BoardSignal, Signal};
 use eframe::egui::{self, Color32, RichText, Ui};
@@ -510,7 +511,9 @@ pub fn board(ui: &mut Ui, s: &mut ScopeState, link: &mut BoardChoice) {
             "free running on its own sensors"
         };
         ui.label(format!("connected: {} ({how})", b.port));
-        board_state(ui, s);
+        if let Some(m) = board_state(ui, b) {
+            s.tell_board(m);
+        }
         let Some(b) = &s.board else { return };
         if let Some(t) = &b.telemetry {
             ui.label(format!(
@@ -535,6 +538,14 @@ pub fn board(ui: &mut Ui, s: &mut ScopeState, link: &mut BoardChoice) {
         }
         return;
     }
+    if let Some((port, lockstep)) = board_choice(ui, link) {
+        s.connect(&port, lockstep);
+    }
+}
+
+/// The connect controls: a serial port (listed, or a path) and lockstep;
+/// the port and mode to connect to when the button is pressed.
+pub fn board_choice(ui: &mut Ui, link: &mut BoardChoice) -> Option<(String, bool)> {
     let port = &mut link.port;
     ui.horizontal(|ui| {
         egui::ComboBox::from_label("serial port")
@@ -555,18 +566,15 @@ pub fn board(ui: &mut Ui, s: &mut ScopeState, link: &mut BoardChoice) {
         .on_hover_text(
             "the board takes its sensors from this simulation; off for a board on a real device",
         );
-    if ui.button("connect").clicked() && !link.port.is_empty() {
-        let p = link.port.clone();
-        s.connect(&p, link.lockstep);
-    }
+    (ui.button("connect").clicked() && !link.port.is_empty())
+        .then(|| (link.port.clone(), link.lockstep))
 }
 
 /// The board's state machine: its mode, calibration and latched faults by
-/// name, and the buttons that move it.
-fn board_state(ui: &mut Ui, s: &mut ScopeState) {
+/// name, and the buttons that move it; what a button asks the board.
+pub fn board_state(ui: &mut Ui, b: &BoardLink) -> Option<twoport_link::Message> {
     use twoport_control::Faults;
     use twoport_link::{Message, Mode};
-    let Some(b) = &s.board else { return };
     let st = b.status.unwrap_or_default();
     let mode = b.telemetry.map_or(st.mode, |t| t.mode);
     let colour = match mode {
@@ -614,27 +622,7 @@ fn board_state(ui: &mut Ui, s: &mut ScopeState) {
             say = Some(Message::ClearFaults);
         }
     });
-    if let Some(m) = say {
-        s.tell_board(m);
-    }
-}
-
-/// What the board panel's connect controls hold.
-#[derive(Clone, Debug)]
-pub struct BoardChoice {
-    /// Serial port path.
-    pub port: String,
-    /// Lockstep (processor in the loop) or free running.
-    pub lockstep: bool,
-}
-
-impl Default for BoardChoice {
-    fn default() -> Self {
-        BoardChoice {
-            port: String::new(),
-            lockstep: true,
-        }
-    }
+    say
 }
 
 /// The whole window.

@@ -40,7 +40,7 @@ struct Shots {
 
 struct ScopeApp {
     state: ScopeState,
-    link: crate::scope::ui::BoardChoice,
+    link: crate::scope::board::BoardChoice,
     shots: Shots,
 }
 
@@ -150,7 +150,7 @@ pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, String> {
     } else {
         Box::new(ScopeApp {
             state: ScopeState::open(scene)?,
-            link: crate::scope::ui::BoardChoice::default(),
+            link: crate::scope::board::BoardChoice::default(),
             shots,
         })
     };

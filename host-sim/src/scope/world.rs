@@ -1,12 +1,18 @@
 //! The scope of a three-axis scene: its state, kept apart from drawing. The
 //! simulation runs in real time; the last seconds of each axis's force are
-//! kept for the plots; the mouse drags the hand and the button grabs.
+//! kept for the plots; the mouse drags the hand and the button grabs. In
+//! board mode a three-axis board drives the plant (lockstep) or runs on its
+//! own sensors, and its force on every axis is plotted beside the
+//! simulation's.
 
 use crate::engine::servo::WorldView;
+use crate::link::{BoardPort, SerialBoard};
+use crate::scope::board::{BoardChoice, BoardLink};
 use crate::scope::rings::Ring;
 use crate::{Sample, Scene, Simulation};
 use std::path::Path;
 use twoport_control::world::vbb::Block;
+use twoport_link::Message;
 
 /// Seconds of force history per axis.
 const HISTORY_S: f64 = 5.0;
@@ -24,6 +30,14 @@ pub struct WorldState {
     pub hand_offset_m: [f64; 3],
     /// Why the run stopped, if it has.
     pub stopped: Option<String>,
+    /// The board, in board mode.
+    pub board: Option<BoardLink>,
+    /// What the board panel's connect controls hold.
+    pub link: BoardChoice,
+    /// Each axis's force as the board's telemetry reports it (N).
+    pub board_forces: [Ring; 3],
+    /// The last problem to show (a refused connection, a lost link).
+    pub message: Option<String>,
     debt_s: f64,
 }
 
@@ -45,6 +59,10 @@ impl WorldState {
             last: None,
             hand_offset_m: [0.0; 3],
             stopped: None,
+            board: None,
+            link: BoardChoice::default(),
+            board_forces: [Ring::new(n), Ring::new(n), Ring::new(n)],
+            message: None,
             debt_s: 0.0,
         })
     }
@@ -55,8 +73,13 @@ impl WorldState {
     }
 
     /// Run the simulation for `wall_s` seconds of wall time, in real time,
-    /// until the scene's end.
+    /// until the scene's end; in lockstep, the board is its controller.
     pub fn advance(&mut self, wall_s: f64) {
+        if let Some(b) = self.board.as_mut().filter(|b| !b.lockstep) {
+            if let Err(e) = b.watch() {
+                self.lost(e);
+            }
+        }
         self.debt_s = (self.debt_s + wall_s).min(0.2);
         while self.debt_s >= 1e-3 && self.stopped.is_none() {
             self.debt_s -= 1e-3;
@@ -65,7 +88,16 @@ impl WorldState {
                 break;
             }
             self.sim.set_hand_offset(self.hand_offset_m);
-            let s = self.sim.step();
+            let s = match self.board.as_mut().filter(|b| b.lockstep) {
+                Some(b) => match b.step(&mut self.sim) {
+                    Ok(s) => s,
+                    Err(e) => {
+                        self.lost(e);
+                        break;
+                    }
+                },
+                None => self.sim.step(),
+            };
             for (ring, f) in self.forces.iter_mut().zip(s.actuator_n) {
                 ring.push(s.t_s, f);
             }
@@ -74,7 +106,69 @@ impl WorldState {
             }
             self.last = Some(s);
             self.world = self.sim.servo().blocks();
+            self.board_telemetry();
         }
+    }
+
+    /// The board's telemetry into each axis's board ring: at its own tick
+    /// in lockstep, when it arrives otherwise.
+    fn board_telemetry(&mut self) {
+        let Some(b) = self.board.as_mut() else { return };
+        for t in b.take_telemetry() {
+            let ts = if b.lockstep {
+                t.tick as f64 * self.sim.period()
+            } else {
+                self.last.map_or(0.0, |s| s.t_s)
+            };
+            for (ring, axis) in self.board_forces.iter_mut().zip(t.axes.iter()) {
+                ring.push(ts, axis.actuator_n as f64);
+            }
+        }
+    }
+
+    fn lost(&mut self, why: String) {
+        self.message = Some(format!("board link lost: {why}"));
+        self.board = None;
+    }
+
+    /// Board mode: connect to the three-axis board at `port`; with
+    /// `lockstep` this simulation is its plant (processor in the loop).
+    pub fn connect(&mut self, port: &str, lockstep: bool) {
+        match SerialBoard::open(port) {
+            Ok(p) => self.connect_port(Box::new(p), port, lockstep),
+            Err(e) => self.message = Some(format!("board at {port}: {e}")),
+        }
+    }
+
+    /// [`connect`](Self::connect) through any port (a board in-process).
+    pub fn connect_port(&mut self, port: Box<dyn BoardPort>, name: &str, lockstep: bool) {
+        match BoardLink::connect(port, name, lockstep, self.sim.scene()) {
+            Ok(b) => {
+                self.board = Some(b);
+                self.message = None;
+            }
+            Err(e) => self.message = Some(format!("board at {name}: {e}")),
+        }
+    }
+
+    /// Leave board mode, disarming the board.
+    pub fn disconnect(&mut self) {
+        if let Some(b) = self.board.take() {
+            b.disconnect();
+        }
+    }
+
+    /// Say `msg` to the board.
+    pub fn tell_board(&mut self, msg: Message) {
+        if let Some(Err(e)) = self.board.as_mut().map(|b| b.tell(&msg)) {
+            self.message = Some(format!("board: {e}"));
+        }
+    }
+
+    /// Where the device stands at rest before a run, as a board is told
+    /// when calibrated (pm): where the world's cursor starts.
+    pub fn at_rest_pm(&self) -> Result<twoport_link::Axes<i64>, String> {
+        crate::pil::Setup::for_sim(&self.sim).map(|s| s.at_rest_pm)
     }
 
     /// Drag the hand by `d_m` (m) along each axis.
@@ -105,8 +199,17 @@ impl WorldState {
         self.world.as_ref().and_then(|w| w.held)
     }
 
-    /// The cursor (m).
+    /// The cursor (m): the simulation's, or in board mode the board's
+    /// (its world runs there; the link does not carry its blocks, so the
+    /// blocks drawn are the scene's).
     pub fn cursor_m(&self) -> [f64; 3] {
-        self.last.map_or([0.0; 3], |s| s.ve_m)
+        match self.board.as_ref().and_then(|b| b.telemetry) {
+            Some(t) => core::array::from_fn(|a| {
+                t.axes
+                    .get(a)
+                    .map_or(0.0, |x| x.ve_position_pm as f64 * 1e-12)
+            }),
+            None => self.last.map_or([0.0; 3], |s| s.ve_m),
+        }
     }
 }

@@ -1,11 +1,14 @@
 //! The world view of a three-axis scene: a top (x-y) and a side (x-z)
 //! projection with the blocks, the cursor and the held block, the grab
-//! button, and each axis's force on one time axis. Dragging in a
-//! projection drags the hand along its two axes.
+//! button, each axis's force on one time axis (and the board's, in board
+//! mode), and the board panel. Dragging in a projection drags the hand
+//! along its two axes.
 
+use crate::scope::ui;
 use crate::scope::world::WorldState;
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, Ui, Vec2};
 use egui_plot::{Legend, Line, Plot, PlotPoints};
+use twoport_link::Message;
 
 /// The span each projection shows (m): the Excalibur's workspace.
 const SPAN_M: [(f64, f64); 3] = [(-0.15, 0.15), (-0.15, 0.15), (0.0, 0.2)];
@@ -14,6 +17,7 @@ const SPAN_M: [(f64, f64); 3] = [(-0.15, 0.15), (-0.15, 0.15), (0.0, 0.2)];
 pub fn world(ui: &mut Ui, s: &mut WorldState) {
     ui.heading(s.name().to_string());
     status(ui, s);
+    board(ui, s);
     ui.horizontal(|ui| {
         let w = (ui.available_width() / 2.0 - 8.0).max(100.0);
         projection(ui, s, [0, 1], "top: x right, y up", w);
@@ -44,6 +48,46 @@ fn status(ui: &mut Ui, s: &mut WorldState) {
             ui.label(why.clone());
         }
     });
+}
+
+/// Board mode: connect a three-axis board, its state and buttons
+/// (calibrate where the world's cursor starts, then arm), disconnect.
+fn board(ui: &mut Ui, s: &mut WorldState) {
+    ui.horizontal(|ui| {
+        let Some(b) = &s.board else {
+            ui.label("board:");
+            if let Some((port, lockstep)) = ui::board_choice(ui, &mut s.link) {
+                s.connect(&port, lockstep);
+            }
+            return;
+        };
+        let how = if b.lockstep {
+            "lockstep"
+        } else {
+            "free running"
+        };
+        ui.label(format!("board: {} ({how})", b.port));
+        let mut say = ui::board_state(ui, b);
+        if ui
+            .button("calibrate")
+            .on_hover_text("the device stands where the world's cursor starts")
+            .clicked()
+        {
+            match s.at_rest_pm() {
+                Ok(position_pm) => say = Some(Message::Calibrate { position_pm }),
+                Err(e) => s.message = Some(e),
+            }
+        }
+        if let Some(m) = say {
+            s.tell_board(m);
+        }
+        if ui.button("disconnect").clicked() {
+            s.disconnect();
+        }
+    });
+    if let Some(m) = &s.message {
+        ui.colored_label(Color32::RED, m.clone());
+    }
 }
 
 /// One projection onto `axes` (the first drawn right, the second up).
@@ -116,6 +160,21 @@ fn forces(ui: &mut Ui, s: &WorldState) {
             {
                 let pts: Vec<[f64; 2]> = ring.iter().map(|&(t, f)| [t, f]).collect();
                 p.line(Line::new(name, PlotPoints::from(pts)).color(COLORS[i]));
+            }
+            if s.board.is_some() {
+                for (i, (ring, name)) in s
+                    .board_forces
+                    .iter()
+                    .zip(["board f_x (N)", "board f_y (N)", "board f_z (N)"])
+                    .enumerate()
+                {
+                    let pts: Vec<[f64; 2]> = ring.iter().map(|&(t, f)| [t, f]).collect();
+                    p.line(
+                        Line::new(name, PlotPoints::from(pts))
+                            .color(COLORS[i])
+                            .style(egui_plot::LineStyle::dashed_loose()),
+                    );
+                }
             }
         });
 }

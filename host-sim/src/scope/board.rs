@@ -1,0 +1,131 @@
+//! The scope's link to a board of any number of axes: lockstep (this
+//! simulation is its plant) or free running (it runs on its own sensors and
+//! the scope watches), and what the board last said.
+
+use crate::engine::scene::Scene;
+use crate::link::{BoardPort, LinkFaults, Session};
+use crate::{Sample, Simulation};
+use twoport_link::{GainsReply, Message, Status, Telemetry};
+
+/// A connected board.
+pub struct BoardLink {
+    session: Session<Box<dyn BoardPort>>,
+    /// What it is connected through (a port path, or "in-process").
+    pub port: String,
+    /// Lockstep: this simulation is the board's plant (processor in the
+    /// loop, the QEMU image). Otherwise the board runs on its own sensors
+    /// and clock and the scope only watches and talks to it.
+    pub lockstep: bool,
+    /// The last telemetry.
+    pub telemetry: Option<Telemetry>,
+    /// The board's last answer to a gain request.
+    pub reply: Option<String>,
+    /// Latched faults the board reported.
+    pub faults: Option<u16>,
+    /// The board's state machine, as it last said.
+    pub status: Option<Status>,
+    /// Its last refusal of a mode change.
+    pub refusal: Option<String>,
+}
+
+impl BoardLink {
+    /// Connect to the board at the other end of `port` (named `name`) for
+    /// a device of `axes` axes. In lockstep, `scene`'s device must be the
+    /// board's (see [`crate::pil::check_scene`]); the board is asked for
+    /// its status at once.
+    pub fn connect(
+        port: Box<dyn BoardPort>,
+        name: &str,
+        lockstep: bool,
+        scene: &Scene,
+    ) -> Result<Self, String> {
+        if lockstep {
+            crate::pil::check_scene(scene)?;
+        }
+        let mut session = Session::open_axes(port, LinkFaults::default(), scene.axes)?;
+        session.send(&Message::GetStatus)?;
+        Ok(BoardLink {
+            session,
+            port: name.to_string(),
+            lockstep,
+            telemetry: None,
+            reply: None,
+            faults: None,
+            status: None,
+            refusal: None,
+        })
+    }
+
+    /// One lockstep tick of `sim` with the board as its controller.
+    pub fn step<const N: usize>(&mut self, sim: &mut Simulation<N>) -> Result<Sample<N>, String> {
+        self.session.step(sim).map(|(s, _)| s)
+    }
+
+    /// A free-running board: keep its link watchdog fed and read what it
+    /// sent.
+    pub fn watch(&mut self) -> Result<(), String> {
+        self.session.send(&Message::Heartbeat)?;
+        self.session.poll()
+    }
+
+    /// Say `msg` to the board (a mode change, a fault clear, new gains);
+    /// its answer comes back as a status, a reply or a refusal.
+    pub fn tell(&mut self, msg: &Message) -> Result<(), String> {
+        self.session.send(msg)
+    }
+
+    /// Disarm the board and let it go.
+    pub fn disconnect(mut self) {
+        let _ = self.session.send(&Message::Disarm);
+    }
+
+    /// Take what the board has sent: its statuses, replies and refusals
+    /// are kept here; its telemetry is returned, oldest first, for the
+    /// plots.
+    pub fn take_telemetry(&mut self) -> Vec<Telemetry> {
+        let mut telemetry = Vec::new();
+        for m in self.session.take_messages() {
+            match m {
+                Message::Telemetry(t) => {
+                    self.telemetry = Some(t);
+                    telemetry.push(t);
+                }
+                Message::GainsReply(GainsReply::Accepted(_)) => {
+                    self.reply = Some("accepted".into());
+                }
+                Message::GainsReply(GainsReply::Refused(r)) => {
+                    self.reply = Some(format!("refused on axis {}: {:?}", r.axis, r.why));
+                }
+                Message::FaultReport { faults, .. } => self.faults = Some(faults),
+                Message::Status(st) => {
+                    self.faults = (st.faults != 0).then_some(st.faults);
+                    self.status = Some(st);
+                    self.refusal = None;
+                }
+                Message::ModeRefused { asked, why } => {
+                    self.refusal = Some(format!("{asked:?} refused: {why:?}"));
+                }
+                _ => {}
+            }
+        }
+        telemetry
+    }
+}
+
+/// What the board panel's connect controls hold.
+#[derive(Clone, Debug)]
+pub struct BoardChoice {
+    /// Serial port path.
+    pub port: String,
+    /// Lockstep (processor in the loop) or free running.
+    pub lockstep: bool,
+}
+
+impl Default for BoardChoice {
+    fn default() -> Self {
+        BoardChoice {
+            port: String::new(),
+            lockstep: true,
+        }
+    }
+}
