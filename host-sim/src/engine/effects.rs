@@ -290,6 +290,7 @@ impl<const N: usize> Pipeline<N> {
     }
 
     /// Axis `axis`'s load cell's reading of the force `f_n` (N).
+    #[inline]
     pub fn adc(&mut self, axis: usize, f_n: f64, timing: bool) -> f64 {
         let Some(adc) = &mut self.adc else { return f_n };
         let t0 = timing.then(Instant::now);
@@ -300,6 +301,7 @@ impl<const N: usize> Pipeline<N> {
     }
 
     /// The frame the controller sees this tick.
+    #[inline]
     pub fn delay(&mut self, frame: SensorFrame<f64, N>, timing: bool) -> SensorFrame<f64, N> {
         let Some(d) = &mut self.delay else {
             return frame;
@@ -317,6 +319,7 @@ impl<const N: usize> Pipeline<N> {
     }
 
     /// The force the amplifier delivers for `f_n` (N).
+    #[inline]
     pub fn saturate(&mut self, f_n: f64, timing: bool) -> f64 {
         let Some(limit) = self.saturation_n else {
             return f_n;

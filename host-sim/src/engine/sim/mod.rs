@@ -146,6 +146,7 @@ impl Pick {
         }
     }
 
+    #[inline]
     pub(crate) fn of(&self, q: &[f64]) -> f64 {
         match self {
             Pick::At(i) => q[*i],

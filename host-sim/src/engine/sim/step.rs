@@ -161,6 +161,7 @@ impl<const N: usize> Simulation<N> {
             }
             (s.layer_energy_j[i], s.layer_added[i]) = match self.servo.layer(i) {
                 Some(l) if !is_external => {
+                    // (The scene has a layer: the common case has none.)
                     let (e, a) = (l.energy_in_j(), l.added());
                     axis.layer_active += u64::from(a > 0.0);
                     axis.layer_lowest = axis.layer_lowest.min(e);
