@@ -2,7 +2,9 @@
 #![forbid(unsafe_code)]
 
 pub mod design;
+pub mod designer;
 pub mod device;
+mod error;
 #[cfg(feature = "plot")]
 pub mod figures;
 pub mod linalg;
@@ -15,6 +17,8 @@ pub mod sampled;
 pub mod twoport;
 pub mod verify;
 
+pub use designer::Designer;
 pub use device::{Device, DeviceAxis};
+pub use error::Error;
 pub use model::{DeviceModel, ModelError};
 pub use plant::{Plant, PlantPoint};

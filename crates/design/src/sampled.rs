@@ -30,6 +30,7 @@ use crate::twoport::{admittance_display, design_bound, impedance_display, HumanB
 use crate::{Plant, PlantPoint};
 use num_complex::Complex64;
 use std::f64::consts::PI;
+use std::sync::Mutex;
 use twoport_control::ZTransfer;
 
 /// From how many aliases either side of the base band the sums may stop:
@@ -53,7 +54,57 @@ struct Alias {
     omega: f64,
     re_yhh: f64,
     p: Complex64,
-    fy: Complex64,
+    /// `|P|` and `|F_mh Y_ha|`.
+    p_abs: f64,
+    fy_abs: f64,
+}
+
+/// The device's own terms at one alias frequency, before any human:
+/// `ω_k`, `Y_hh`, `P = Y_ah Y_ha` and `F_mh Y_ha`.
+#[derive(Clone, Copy, Debug)]
+struct Raw {
+    omega: f64,
+    yhh: Complex64,
+    p: Complex64,
+    p_abs: f64,
+    fy_abs: f64,
+}
+
+/// The device's terms at each grid point's aliases, evaluated once and
+/// shared by every bound (both displays, any regulator, any human) that
+/// sums them there: the device's continuous response at the aliases is
+/// what the sampled-data bounds spend their time on. A sum that goes
+/// further than the ones before extends its point's list.
+#[derive(Debug, Default)]
+pub struct AliasCache {
+    /// Per point, the alias pairs `ω ± 2πn/T` for `n = 1, 2, ...`.
+    points: Vec<Mutex<Vec<[Raw; 2]>>>,
+}
+
+impl AliasCache {
+    /// An empty cache for `n` points.
+    pub fn new(n: usize) -> Self {
+        AliasCache {
+            points: (0..n).map(|_| Mutex::new(Vec::new())).collect(),
+        }
+    }
+
+    fn point(&self, i: usize) -> Option<std::sync::MutexGuard<'_, Vec<[Raw; 2]>>> {
+        // (A poisoned lock still holds whole pairs: each is pushed at once.)
+        self.points
+            .get(i)
+            .map(|m| m.lock().unwrap_or_else(|e| e.into_inner()))
+    }
+}
+
+impl Clone for AliasCache {
+    fn clone(&self) -> Self {
+        AliasCache {
+            points: (0..self.points.len())
+                .map(|i| Mutex::new(self.point(i).map(|v| v.clone()).unwrap_or_default()))
+                .collect(),
+        }
+    }
 }
 
 /// What a sum does after a pair of aliases.
@@ -62,36 +113,58 @@ enum Flow {
     Stop,
 }
 
-/// Hand `f` the aliases `ω ± 2πn/T` pair by pair, `n = 1, 2, ...`, until it
-/// stops, at most [`MAX_ALIASES`] pairs; false where a term is unbounded
-/// (a lossless handle at an alias).
+/// Hand `f` the aliases `ω ± 2πn/T` of point `i` (`p`) pair by pair,
+/// `n = 1, 2, ...`, until it stops, at most [`MAX_ALIASES`] pairs; false
+/// where a term is unbounded (a lossless handle at an alias). The device's
+/// terms come from `cache` where an earlier sum evaluated them.
 fn each_alias_pair(
     plant: &Plant,
-    p: &PlantPoint,
+    (i, p): (usize, &PlantPoint),
     human: Option<HumanBound>,
+    cache: &AliasCache,
     mut f: impl FnMut(&[Alias; 2], usize) -> Flow,
 ) -> bool {
     let mut work = plant.scratch();
     let ws = 2.0 * PI / p.period_s;
-    let mut at = |k: f64| {
+    let mut raw = |k: f64| {
         let omega = p.omega + ws * k;
         let (mut y, mut fm) = plant.continuous(omega.abs(), &mut work);
         if omega < 0.0 {
             y = y.map(|r| r.map(|v| v.conj()));
             fm = fm.map(|v| v.conj());
         }
-        let h = human.map_or(Complex64::new(0.0, 0.0), |h| {
-            h.admittance(Complex64::new(0.0, omega))
-        });
-        Alias {
+        let p = y[1][0] * y[0][1];
+        Raw {
             omega,
-            re_yhh: (y[0][0] + h).re,
-            p: y[1][0] * y[0][1],
-            fy: fm[0] * y[0][1],
+            yhh: y[0][0],
+            p,
+            p_abs: p.norm(),
+            fy_abs: (fm[0] * y[0][1]).norm(),
         }
     };
+    let with_human = |r: Raw| {
+        let h = human.map_or(Complex64::new(0.0, 0.0), |h| {
+            h.admittance(Complex64::new(0.0, r.omega))
+        });
+        Alias {
+            omega: r.omega,
+            re_yhh: (r.yhh + h).re,
+            p: r.p,
+            p_abs: r.p_abs,
+            fy_abs: r.fy_abs,
+        }
+    };
+    let mut own = Vec::new();
+    let mut cached = cache.point(i);
+    if let Some(c) = cached.as_deref_mut() {
+        c.reserve(alias_count(plant).saturating_sub(c.len()));
+    }
+    let pairs = cached.as_deref_mut().unwrap_or(&mut own);
     for n in 1..=MAX_ALIASES {
-        let pair = [at(n as f64), at(-(n as f64))];
+        if pairs.len() < n {
+            pairs.push([raw(n as f64), raw(-(n as f64))]);
+        }
+        let pair = pairs[n - 1].map(with_human);
         if pair.iter().any(|a| a.re_yhh.is_nan() || a.re_yhh <= 0.0) {
             return false;
         }
@@ -111,8 +184,9 @@ fn tail_sum(n: usize) -> f64 {
 /// aliased hand adds to the paper's bound `paper` on `Re(1/Z_cI)`.
 fn impedance_alias_terms(
     plant: &Plant,
-    p: &PlantPoint,
+    (i, p): (usize, &PlantPoint),
     human: Option<HumanBound>,
+    cache: &AliasCache,
     paper: f64,
 ) -> f64 {
     let n_min = alias_count(plant);
@@ -122,12 +196,12 @@ fn impedance_alias_terms(
     // e^{-jθ} from the hold and the first difference, times the delay.
     let rot = Complex64::from_polar(1.0, -th) * p.delay;
     let (mut sum, mut tail) = (0.0, 0.0);
-    let bounded = each_alias_pair(plant, p, human, |pair, n| {
+    let bounded = each_alias_pair(plant, (i, p), human, cache, |pair, n| {
         let mut ratio = 0.0f64;
         for a in pair {
             let wt = a.omega * t;
-            sum += s2 / (wt * wt) * (a.p.norm() + (rot * a.p).re) / (2.0 * a.re_yhh);
-            ratio = ratio.max(a.p.norm() / a.re_yhh);
+            sum += s2 / (wt * wt) * (a.p_abs + (rot * a.p).re) / (2.0 * a.re_yhh);
+            ratio = ratio.max(a.p_abs / a.re_yhh);
         }
         tail = ratio * s2 * tail_sum(n);
         if n >= n_min && tail <= TAIL_SHARE * (paper.abs() + sum) {
@@ -150,11 +224,23 @@ pub fn impedance_bound(
     points: &[PlantPoint],
     human: Option<HumanBound>,
 ) -> Vec<f64> {
+    impedance_bound_with(plant, points, human, &AliasCache::default())
+}
+
+/// [`impedance_bound`], the device's alias terms kept in `cache` (made
+/// for `points`).
+pub fn impedance_bound_with(
+    plant: &Plant,
+    points: &[PlantPoint],
+    human: Option<HumanBound>,
+    cache: &AliasCache,
+) -> Vec<f64> {
     points
         .iter()
-        .map(|p| {
+        .enumerate()
+        .map(|(i, p)| {
             let paper = design_bound(&impedance_display(p, human));
-            paper + impedance_alias_terms(plant, p, human, paper)
+            paper + impedance_alias_terms(plant, (i, p), human, cache, paper)
         })
         .collect()
 }
@@ -168,12 +254,27 @@ pub fn admittance_bound(
     kp: &ZTransfer,
     human: Option<HumanBound>,
 ) -> Vec<f64> {
+    admittance_bound_with(plant, points, kp, human, &AliasCache::default())
+}
+
+/// [`admittance_bound`], the device's alias terms kept in `cache` (made
+/// for `points`).
+pub fn admittance_bound_with(
+    plant: &Plant,
+    points: &[PlantPoint],
+    kp: &ZTransfer,
+    human: Option<HumanBound>,
+    cache: &AliasCache,
+) -> Vec<f64> {
     points
         .iter()
-        .map(|p| match admittance_alias_reach(plant, p, human) {
-            Some(reach) => admittance_point(p, reach, kp, human),
-            None => f64::INFINITY,
-        })
+        .enumerate()
+        .map(
+            |(i, p)| match admittance_alias_reach(plant, (i, p), human, cache) {
+                Some(reach) => admittance_point(p, reach, kp, human),
+                None => f64::INFINITY,
+            },
+        )
         .collect()
 }
 
@@ -182,20 +283,21 @@ pub fn admittance_bound(
 /// `-x_a*` and `f_m*` per unit held force. `None` where unbounded.
 fn admittance_alias_reach(
     plant: &Plant,
-    p: &PlantPoint,
+    (i, p): (usize, &PlantPoint),
     human: Option<HumanBound>,
+    cache: &AliasCache,
 ) -> Option<(f64, f64)> {
     let n_min = alias_count(plant);
     let t = p.period_s;
     let (mut rx, mut rf, mut tx, mut tf) = (0.0, 0.0, 0.0, 0.0);
-    let bounded = each_alias_pair(plant, p, human, |pair, n| {
+    let bounded = each_alias_pair(plant, (i, p), human, cache, |pair, n| {
         let (mut ratio_x, mut ratio_f) = (0.0f64, 0.0f64);
         for a in pair {
             let w = a.omega.abs();
-            rx += a.p.norm() / (t * w * w * a.re_yhh);
-            rf += a.fy.norm() / (t * w * a.re_yhh);
-            ratio_x = ratio_x.max(a.p.norm() / a.re_yhh);
-            ratio_f = ratio_f.max(a.fy.norm() * w / a.re_yhh);
+            rx += a.p_abs / (t * w * w * a.re_yhh);
+            rf += a.fy_abs / (t * w * a.re_yhh);
+            ratio_x = ratio_x.max(a.p_abs / a.re_yhh);
+            ratio_f = ratio_f.max(a.fy_abs * w / a.re_yhh);
         }
         // Σ_{|k|>N} 1/(T ω_k²) = T Σ 1/(θ + 2πk)².
         (tx, tf) = (ratio_x * t * tail_sum(n), ratio_f * t * tail_sum(n));
@@ -347,7 +449,7 @@ mod tests {
             let paper = design_bound(&admittance_display(p, &kp, h));
             let none = admittance_point(p, (0.0, 0.0), &kp, h);
             assert!((none - paper).abs() <= 1e-12 * paper.abs().max(1.0));
-            let reach = admittance_alias_reach(&plant, p, h).unwrap();
+            let reach = admittance_alias_reach(&plant, (0, p), h, &AliasCache::default()).unwrap();
             assert!(admittance_point(p, reach, &kp, h) >= paper);
         }
     }

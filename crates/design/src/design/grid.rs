@@ -122,6 +122,8 @@ pub struct Analysis {
     /// The index of twice the lowest frequency, where the grid has it: with
     /// the lowest, the pair the limit toward DC is taken from.
     pub(super) dc_pair: Option<usize>,
+    /// The device's terms at each point's aliases, shared by every bound.
+    aliases: sampled::AliasCache,
 }
 
 impl Analysis {
@@ -168,6 +170,7 @@ impl Analysis {
                 .position(|p| (p.omega - 2.0 * p1.omega).abs() <= 1e-12 * p.omega)
         });
         Analysis {
+            aliases: sampled::AliasCache::new(points.len()),
             points,
             period_s: plant.period_s(),
             plant: plant.clone(),
@@ -184,13 +187,13 @@ impl Analysis {
     /// sound for the sampled-data loop (aliasing at the handle port
     /// included, see [`crate::sampled`]): what designs and checks use.
     pub fn impedance_bound(&self, human: Option<HumanBound>) -> Vec<f64> {
-        sampled::impedance_bound(&self.plant, &self.points, human)
+        sampled::impedance_bound_with(&self.plant, &self.points, human, &self.aliases)
     }
 
     /// The admittance-display bound on `Re Z_cA` at each grid point, for
     /// the regulator `kp`, sound for the sampled-data loop.
     pub fn admittance_bound(&self, kp: &ZTransfer, human: Option<HumanBound>) -> Vec<f64> {
-        sampled::admittance_bound(&self.plant, &self.points, kp, human)
+        sampled::admittance_bound_with(&self.plant, &self.points, kp, human, &self.aliases)
     }
 
     /// The paper's impedance-display bound (eq 25 as corrected): the handle

@@ -4,7 +4,7 @@ mod args;
 mod check;
 mod plots;
 mod region;
-mod session;
+mod run;
 mod synthesis;
 mod verify;
 

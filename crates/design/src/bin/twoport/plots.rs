@@ -2,7 +2,7 @@
 //! paper's figures.
 
 use crate::args::*;
-use crate::session::*;
+use crate::run::*;
 use serde_json::json;
 use std::f64::consts::PI;
 use twoport_design::design::{self, Analysis};
@@ -17,8 +17,8 @@ pub(crate) fn zrange(d: &Display<ZrangeImpedance, ZrangeAdmittance>) -> Result<(
     if points < 2 {
         return Err(format!("--points {points}: need at least 2"));
     }
-    let s = Session::open(common)?;
-    let pose = s.single("zrange")?;
+    let s = designer(common)?;
+    let pose = single(&s, "zrange")?;
     let nyq = pose.plant.nyquist();
     let lo = 2.0 * PI * 0.1;
     let omegas = design::log_grid(lo, nyq, points);
@@ -45,22 +45,20 @@ pub(crate) fn zrange(d: &Display<ZrangeImpedance, ZrangeAdmittance>) -> Result<(
         "z_min": range.iter().map(|r| pair(r.0)).collect::<Vec<_>>(),
         "z_max": range.iter().map(|r| pair(r.1)).collect::<Vec<_>>(),
     });
-    s.emit(v, || {
-        println!(
-            "{:>12} {:>14} {:>14}",
-            "freq (Hz)", "|Z_min| N s/m", "|Z_max| N s/m"
-        );
-        for (f, r) in freq.iter().zip(&range) {
-            println!("{f:>12.3} {:>14.4e} {:>14.4e}", r.0.norm(), r.1.norm());
-        }
-    });
-    Ok(())
+    let mut text = format!(
+        "{:>12} {:>14} {:>14}",
+        "freq (Hz)", "|Z_min| N s/m", "|Z_max| N s/m"
+    );
+    for (f, r) in freq.iter().zip(&range) {
+        text += &format!("\n{f:>12.3} {:>14.4e} {:>14.4e}", r.0.norm(), r.1.norm());
+    }
+    emit(common, &Printed(v, text))
 }
 
 pub(crate) fn plot_fig(p: &PlotArgs) -> Result<(), String> {
-    let s = Session::open(&p.common)?;
-    let a = &s.single("plot")?.analysis;
-    let t = s.period();
+    let s = designer(&p.common)?;
+    let a = &single(&s, "plot")?.analysis;
+    let t = s.period_s();
     let bi = a.impedance_bound(Some(HumanBound::PAPER));
     let (k, b) = design::max_stiffness(a, &bi, gain("b-impedance", p.b_impedance)?)
         .map(|k| (k, p.b_impedance))
@@ -75,15 +73,11 @@ pub(crate) fn plot_fig(p: &PlotArgs) -> Result<(), String> {
         Fig::Fig10 => figures::fig10(a, (k, b), (k, b), (m, p.b_admittance)),
     }?;
     plot::render(&fig, &p.out)?;
-    s.emit(
-        json!({"out": p.out, "k_c": k, "b_c": b, "m_c": m, "b_cA": p.b_admittance}),
-        || {
-            println!(
-                "wrote {} (k_c = {k:.0} N/m, b_c = {b} N s/m, m_c = {m:.3} kg, b_cA = {} N s/m)",
-                p.out.display(),
-                p.b_admittance
-            )
-        },
+    let v = json!({"out": p.out, "k_c": k, "b_c": b, "m_c": m, "b_cA": p.b_admittance});
+    let text = format!(
+        "wrote {} (k_c = {k:.0} N/m, b_c = {b} N s/m, m_c = {m:.3} kg, b_cA = {} N s/m)",
+        p.out.display(),
+        p.b_admittance
     );
-    Ok(())
+    emit(&p.common, &Printed(v, text))
 }

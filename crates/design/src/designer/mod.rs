@@ -1,0 +1,550 @@
+//! The designer: a device in one or several poses at one sample period,
+//! with or without the human bound, answering what the `twoport` command
+//! line asks (a design, a check, the proven region, the counterexample
+//! search) as reports that serialise to JSON and display as text.
+//!
+//! Each pose's sound impedance bound is computed once and shared by every
+//! question; an admittance bound is computed once per regulator asked for.
+//!
+//! ```
+//! use twoport_design::designer::Designer;
+//! use twoport_design::twoport::HumanBound;
+//! use twoport_design::DeviceModel;
+//! let d = Designer::new(vec![DeviceModel::excalibur()?], None, Some(HumanBound::PAPER))?;
+//! let r = d.design_impedance(Some(90.0), 0.1)?;
+//! let (k, _) = r.coupling.expect("the paper's device has a design");
+//! assert!((k - 51_000.0).abs() < 0.03 * 51_000.0);
+//! println!("{r}");
+//! # Ok::<(), twoport_design::Error>(())
+//! ```
+
+mod report;
+
+pub use report::*;
+
+use crate::design::{self, Analysis, Check, GridSpec, Poses};
+use crate::twoport::HumanBound;
+use crate::{DeviceModel, Error, Plant};
+use std::sync::{Mutex, OnceLock};
+use twoport_control::{Gains, ZTransfer};
+
+/// One pose of the device: its model, the plant at the period, and the
+/// design grid.
+#[derive(Clone, Debug)]
+pub struct Pose {
+    /// The model.
+    pub model: DeviceModel,
+    /// The model discretised at the designer's period.
+    pub plant: Plant,
+    /// Its responses on the design grid.
+    pub analysis: Analysis,
+}
+
+/// A device's poses at one period, and the bounds every question shares.
+#[derive(Debug)]
+pub struct Designer {
+    poses: Vec<Pose>,
+    human: Option<HumanBound>,
+    /// Each pose's sound and paper impedance bounds.
+    impedance: OnceLock<BoundPair>,
+    /// Each pose's sound and paper admittance bounds, per regulator
+    /// `(k_p, b_p)` asked for.
+    admittance: Mutex<Vec<((f64, f64), BoundPair)>>,
+}
+
+/// Each pose's sound bound and the paper's, at every grid point.
+type BoundPair = [Vec<Vec<f64>>; 2];
+
+/// Which of a display's bounds: the sound one, or the paper's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Bound {
+    Sound = 0,
+    Paper = 1,
+}
+
+impl Designer {
+    /// The device in the poses `models` (at least one), at `period_s` (the
+    /// models' own, which must then agree, when `None`), with the human
+    /// bound `human` (`None`: any passive human).
+    pub fn new(
+        models: Vec<DeviceModel>,
+        period_s: Option<f64>,
+        human: Option<HumanBound>,
+    ) -> Result<Self, Error> {
+        let first = models.first().ok_or(Error::NoPose)?;
+        let period = match period_s {
+            Some(p) => p,
+            None => {
+                if let Some(m) = models.iter().find(|m| m.period_s != first.period_s) {
+                    return Err(Error::PeriodsDiffer {
+                        first: (first.name.clone(), first.period_s),
+                        other: (m.name.clone(), m.period_s),
+                    });
+                }
+                first.period_s
+            }
+        };
+        if !(period.is_finite() && period > 0.0) {
+            return Err(Error::Period(period));
+        }
+        let mut poses = Vec::with_capacity(models.len());
+        for model in models {
+            let plant = Plant::new(&model, period).map_err(|why| Error::Dynamics {
+                model: model.name.clone(),
+                why,
+            })?;
+            let analysis = Analysis::new(&plant, GridSpec::DEFAULT);
+            poses.push(Pose {
+                model,
+                plant,
+                analysis,
+            });
+        }
+        Ok(Designer {
+            poses,
+            human,
+            impedance: OnceLock::new(),
+            admittance: Mutex::new(Vec::new()),
+        })
+    }
+
+    /// The poses.
+    pub fn poses(&self) -> &[Pose] {
+        &self.poses
+    }
+
+    /// The human bound the proofs assume (`None`: any passive human).
+    pub fn human(&self) -> Option<HumanBound> {
+        self.human
+    }
+
+    /// The sample period (s).
+    pub fn period_s(&self) -> f64 {
+        self.poses[0].plant.period_s()
+    }
+
+    /// The device's name: its model's, or its poses'.
+    pub fn name(&self) -> String {
+        match self.poses.as_slice() {
+            [p] => p.model.name.clone(),
+            ps => format!(
+                "{} poses ({})",
+                ps.len(),
+                ps.iter()
+                    .map(|p| p.model.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ),
+        }
+    }
+
+    /// What every report's heading says of the device.
+    fn context(&self, display: DisplayKind) -> Context {
+        Context {
+            display,
+            device: self.name(),
+            period_s: self.period_s(),
+            human_model: self.human.is_some(),
+        }
+    }
+
+    /// An admittance display needs a force sensor in every pose.
+    fn force_sensor(&self) -> Result<(), Error> {
+        match self.poses.iter().find(|p| !p.model.force_sensor) {
+            Some(p) => Err(Error::NoForceSensor(p.model.name.clone())),
+            None => Ok(()),
+        }
+    }
+
+    fn impedance_bounds(&self, which: Bound) -> &[Vec<f64>] {
+        &self.impedance.get_or_init(|| {
+            let each = |paper: bool| {
+                self.poses
+                    .iter()
+                    .map(|p| {
+                        if paper {
+                            p.analysis.paper_impedance_bound(self.human)
+                        } else {
+                            p.analysis.impedance_bound(self.human)
+                        }
+                    })
+                    .collect()
+            };
+            [each(false), each(true)]
+        })[which as usize]
+    }
+
+    /// The admittance bounds for the regulator `(k_p, b_p)` (its transfer
+    /// function `k`), computed the first time they are asked for.
+    fn admittance_bounds(&self, kp: (f64, f64), k: &ZTransfer, which: Bound) -> Vec<Vec<f64>> {
+        let mut cache = self.admittance.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, b)) = cache.iter().find(|(g, _)| *g == kp) {
+            return b[which as usize].clone();
+        }
+        let each = |paper: bool| {
+            self.poses
+                .iter()
+                .map(|p| {
+                    if paper {
+                        p.analysis.paper_admittance_bound(k, self.human)
+                    } else {
+                        p.analysis.admittance_bound(k, self.human)
+                    }
+                })
+                .collect::<Vec<_>>()
+        };
+        let b = [each(false), each(true)];
+        let out = b[which as usize].clone();
+        cache.push((kp, b));
+        out
+    }
+
+    /// Each pose's analysis beside its bound.
+    fn with<'a>(&'a self, bounds: &'a [Vec<f64>]) -> Vec<(&'a Analysis, &'a [f64])> {
+        self.poses
+            .iter()
+            .zip(bounds)
+            .map(|(p, b)| (&p.analysis, b.as_slice()))
+            .collect()
+    }
+
+    /// The regulated device's worst pole radius over the poses.
+    fn regulated_pole_radius(&self, k: &ZTransfer) -> f64 {
+        self.poses
+            .iter()
+            .map(|p| p.plant.regulated_pole_radius(k))
+            .fold(0.0, f64::max)
+    }
+
+    /// The check over every pose: stable where every pose is, with the
+    /// least margin and the pose that has it (the paper's figures likewise).
+    fn worst_check(&self, check: impl Fn(&Pose) -> Option<Check>) -> Option<(Check, &str)> {
+        let mut all = Vec::with_capacity(self.poses.len());
+        for p in &self.poses {
+            all.push((check(p)?, p.model.name.as_str()));
+        }
+        let least = |key: fn(&Check) -> f64| {
+            all.iter()
+                .copied()
+                .min_by(|a, b| key(&a.0).total_cmp(&key(&b.0)))
+        };
+        let (mut c, name) = least(|c| c.min_margin)?;
+        let (paper, _) = least(|c| c.paper.min_margin)?;
+        c.absolutely_stable = all.iter().all(|x| x.0.absolutely_stable);
+        c.regulator_pole_radius = all
+            .iter()
+            .map(|x| x.0.regulator_pole_radius)
+            .fold(0.0, f64::max);
+        c.paper = paper.paper;
+        c.paper.absolutely_stable = all.iter().all(|x| x.0.paper.absolutely_stable);
+        Some((c, name))
+    }
+
+    /// The pose a check binds in, where there are several.
+    fn pose_name(&self, name: &str) -> Option<String> {
+        (self.poses.len() > 1).then(|| name.to_string())
+    }
+
+    fn impedance_on(&self, poses: &Poses, b: Option<f64>) -> Option<(f64, f64)> {
+        match b {
+            Some(b) => design::max_stiffness_poses(poses, b).map(|k| (k, b)),
+            None => design::best_impedance_poses(poses),
+        }
+    }
+
+    fn admittance_on(&self, poses: &Poses, radius: f64, b: Option<f64>) -> Option<(f64, f64)> {
+        if radius >= 1.0 {
+            return None;
+        }
+        match b {
+            Some(b) => design::min_mass_poses(poses, b).map(|m| (m, b)),
+            None => design::best_admittance_poses(poses),
+        }
+    }
+
+    /// Why no coupling `what` meets `bounds`: the limit toward DC, or the
+    /// range searched.
+    fn infeasible(&self, bounds: &[Vec<f64>], what: Infeasible, b: Option<f64>) -> String {
+        let (what, bound_unit, (lo, hi), unit) = match what {
+            Infeasible::Stiffness => ("stiffness", "m/(N s)", design::K_RANGE, "N/m"),
+            Infeasible::Mass => ("mass", "N s/m", design::M_RANGE, "kg"),
+        };
+        let at = b
+            .map(|b| format!(" at b_c = {b} N s/m"))
+            .unwrap_or_default();
+        match self
+            .with(bounds)
+            .iter()
+            .find_map(|(a, b)| design::low_frequency_obstacle(a, b))
+        {
+            Some(limit) => format!(
+                "no finite coupling {what} is absolutely stable: toward DC the bound stays positive (its limit is {limit:.4e} {bound_unit}), while the coupling's real part goes to zero as the frequency does"
+            ),
+            None => format!("no coupling {what} from {lo} to {hi} {unit} meets the bound{at}"),
+        }
+    }
+
+    /// The impedance display's boundary coupling stiffness at damping `b`
+    /// (N s/m), or the best `(k, b)` pair without it, and the gain
+    /// `margin` (a fraction) inside it.
+    pub fn design_impedance(&self, b: Option<f64>, margin: f64) -> Result<Design, Error> {
+        let margin = fraction(margin)?;
+        if let Some(b) = b {
+            gain("b", b)?;
+        }
+        let sound = self.impedance_bounds(Bound::Sound);
+        let coupling = self.impedance_on(&self.with(sound), b);
+        let paper = self.impedance_on(&self.with(self.impedance_bounds(Bound::Paper)), b);
+        let binding = coupling.and_then(|(k, b)| {
+            self.worst_check(|p| design::check_impedance(&p.analysis, k, b, self.human))
+                .map(|(c, name)| (c.worst_frequency_hz, self.pose_name(name)))
+        });
+        let message = coupling
+            .is_none()
+            .then(|| self.infeasible(sound, Infeasible::Stiffness, b));
+        Ok(Design::new(
+            self.context(DisplayKind::Impedance),
+            Limit::Stiffness,
+            [coupling, paper],
+            b.is_some(),
+            margin,
+            binding,
+            message,
+        ))
+    }
+
+    /// The admittance display's boundary coupling mass at damping `b` (N
+    /// s/m), or the best `(m, b)` pair without it, for the regulator
+    /// `(k_p, b_p)` (the impedance design's best pair when `None`, the
+    /// paper's eq 30), and the gain `margin` inside it.
+    pub fn design_admittance(
+        &self,
+        regulator: Option<(f64, f64)>,
+        b: Option<f64>,
+        margin: f64,
+    ) -> Result<Design, Error> {
+        let margin = fraction(margin)?;
+        self.force_sensor()?;
+        if let Some(b) = b {
+            gain("b", b)?;
+        }
+        let (kp, bp) = match regulator {
+            Some((kp, bp)) => (gain("kp", kp)?, gain("bp", bp)?),
+            None => self
+                .impedance_on(&self.with(self.impedance_bounds(Bound::Sound)), None)
+                .ok_or(Error::NoRegulator)?,
+        };
+        let k = design::regulator_tf(kp, bp, self.period_s())?;
+        let radius = self.regulated_pole_radius(&k);
+        let sound = self.admittance_bounds((kp, bp), &k, Bound::Sound);
+        let paper = self.admittance_bounds((kp, bp), &k, Bound::Paper);
+        let coupling = self.admittance_on(&self.with(&sound), radius, b);
+        let paper = self.admittance_on(&self.with(&paper), radius, b);
+        let binding = coupling.and_then(|(m, b)| {
+            self.worst_check(|p| {
+                design::check_admittance(&p.plant, &p.analysis, (kp, bp), (m, b), self.human)
+            })
+            .map(|(c, name)| (c.worst_frequency_hz, self.pose_name(name)))
+        });
+        let message = match coupling {
+            Some(_) => None,
+            None if radius >= 1.0 => Some(format!(
+                "the regulator k_p = {kp}, b_p = {bp} does not stabilise the device (pole radius {radius:.4})"
+            )),
+            None => Some(self.infeasible(&sound, Infeasible::Mass, b)),
+        };
+        let mut d = Design::new(
+            self.context(DisplayKind::Admittance),
+            Limit::Mass,
+            [coupling, paper],
+            b.is_some(),
+            margin,
+            binding,
+            message,
+        );
+        d.regulator = Some(Regulator {
+            kp,
+            bp,
+            pole_radius: radius,
+        });
+        Ok(d)
+    }
+
+    /// Whether the impedance coupling `k` (N/m), `b` (N s/m) is proven, by
+    /// how much, and how far inside the boundary at its damping.
+    pub fn check_impedance(&self, k: f64, b: f64) -> Result<CheckReport, Error> {
+        let (k, b) = (gain("k", k)?, gain("b", b)?);
+        let (c, pose) = self
+            .worst_check(|p| design::check_impedance(&p.analysis, k, b, self.human))
+            .ok_or(Error::Coupling(format!(
+                "--k {k} --b {b}: not a valid coupling (k T + b must be > 0)"
+            )))?;
+        let boundary = self
+            .impedance_on(&self.with(self.impedance_bounds(Bound::Sound)), Some(b))
+            .map(|(k, _)| k);
+        Ok(CheckReport::new(
+            self.context(DisplayKind::Impedance),
+            Gains::from(twoport_control::ImpedanceGains::new(k as f32, b as f32)),
+            (k, b, None),
+            &c,
+            self.pose_name(pose),
+            boundary,
+        ))
+    }
+
+    /// Whether the admittance design (regulator `(k_p, b_p)`, coupling
+    /// mass `m` (kg) and damping `b`) is proven, by how much, and how far
+    /// above the boundary at its damping.
+    pub fn check_admittance(
+        &self,
+        (kp, bp): (f64, f64),
+        m: f64,
+        b: f64,
+    ) -> Result<CheckReport, Error> {
+        self.force_sensor()?;
+        let kp = (gain("kp", kp)?, gain("bp", bp)?);
+        let b = gain("b", b)?;
+        if !(m.is_finite() && m > 0.0) {
+            return Err(Error::Coupling(format!(
+                "--m {m}: must be a finite mass > 0 kg"
+            )));
+        }
+        let (c, pose) = self
+            .worst_check(|p| {
+                design::check_admittance(&p.plant, &p.analysis, kp, (m, b), self.human)
+            })
+            .ok_or(Error::Coupling(
+                "--b must be > 0 for the admittance coupling".into(),
+            ))?;
+        let k = design::regulator_tf(kp.0, kp.1, self.period_s())?;
+        let bounds = self.admittance_bounds(kp, &k, Bound::Sound);
+        let boundary = self
+            .admittance_on(&self.with(&bounds), c.regulator_pole_radius, Some(b))
+            .map(|(m, _)| m);
+        Ok(CheckReport::new(
+            self.context(DisplayKind::Admittance),
+            Gains::from(twoport_control::AdmittanceGains::new(
+                kp.0 as f32,
+                kp.1 as f32,
+                m as f32,
+                b as f32,
+            )),
+            (m, b, Some(kp)),
+            &c,
+            self.pose_name(pose),
+            boundary,
+        ))
+    }
+
+    /// The impedance display's proven region: the greatest stiffness at
+    /// each of `points` log-spaced dampings over `range` (N s/m).
+    pub fn region_impedance(&self, range: (f64, f64), points: usize) -> Result<Region, Error> {
+        let range = region_range(range, points)?;
+        let rows = design::region_impedance(
+            &self.with(self.impedance_bounds(Bound::Sound)),
+            range,
+            points,
+        );
+        Ok(Region {
+            context: self.context(DisplayKind::Impedance),
+            bound: RegionBound::MaxStiffness,
+            rows,
+            regulator: None,
+        })
+    }
+
+    /// The admittance display's proven region for the regulator `(k_p,
+    /// b_p)`: the least mass at each of `points` log-spaced dampings.
+    pub fn region_admittance(
+        &self,
+        (kp, bp): (f64, f64),
+        range: (f64, f64),
+        points: usize,
+    ) -> Result<Region, Error> {
+        let range = region_range(range, points)?;
+        self.force_sensor()?;
+        let (kp, bp) = (gain("kp", kp)?, gain("bp", bp)?);
+        let k = design::regulator_tf(kp, bp, self.period_s())?;
+        let bounds = self.admittance_bounds((kp, bp), &k, Bound::Sound);
+        Ok(Region {
+            context: self.context(DisplayKind::Admittance),
+            bound: RegionBound::MinMass,
+            rows: design::region_admittance(&self.with(&bounds), range, points),
+            regulator: Some((kp, bp)),
+        })
+    }
+
+    /// Search every pose for a passive hand and VE that make the exact
+    /// sampled loop unstable at `gains`; the worst pose's verdict, with the
+    /// closed loops searched over all of them.
+    pub fn verify(&self, gains: &Gains) -> Result<VerifyReport, Error> {
+        let display = match gains {
+            Gains::Impedance(_) => DisplayKind::Impedance,
+            Gains::Admittance(_) => {
+                self.force_sensor()?;
+                DisplayKind::Admittance
+            }
+        };
+        let mut worst: Option<(crate::verify::Verdict, &str)> = None;
+        let mut evaluations = 0;
+        for p in &self.poses {
+            let v = crate::verify::verify(
+                &p.model,
+                self.period_s(),
+                gains,
+                self.human,
+                p.model.delay_samples as usize,
+            )
+            .map_err(|why| Error::Verify {
+                model: p.model.name.clone(),
+                why,
+            })?;
+            evaluations += v.evaluations;
+            let worse = worst.as_ref().is_none_or(|w| {
+                (v.unstable, v.spectral_radius) > (w.0.unstable, w.0.spectral_radius)
+            });
+            if worse {
+                worst = Some((v, &p.model.name));
+            }
+        }
+        let (mut verdict, pose) = worst.ok_or(Error::NoPose)?;
+        verdict.evaluations = evaluations;
+        Ok(VerifyReport {
+            context: self.context(display),
+            verdict,
+            worst_pose: self.pose_name(pose),
+        })
+    }
+}
+
+/// What an infeasible design could not find.
+#[derive(Clone, Copy)]
+enum Infeasible {
+    Stiffness,
+    Mass,
+}
+
+/// A gain checked for sign and finiteness before any analysis.
+fn gain(name: &'static str, v: f64) -> Result<f64, Error> {
+    (v.is_finite() && v >= 0.0)
+        .then_some(v)
+        .ok_or(Error::Gain { name, value: v })
+}
+
+/// A design margin: a fraction from 0 to 0.9.
+fn fraction(v: f64) -> Result<f64, Error> {
+    (0.0..=0.9)
+        .contains(&v)
+        .then_some(v)
+        .ok_or(Error::Margin(v))
+}
+
+/// A region's damping range and point count, checked.
+fn region_range((lo, hi): (f64, f64), points: usize) -> Result<(f64, f64), Error> {
+    let (lo, hi) = (gain("b-from", lo)?, gain("b-to", hi)?);
+    if lo > 0.0 && hi > lo && (2..=1000).contains(&points) {
+        Ok((lo, hi))
+    } else {
+        Err(Error::RegionGrid)
+    }
+}

@@ -1,0 +1,67 @@
+//! The designer's one error type.
+
+use thiserror::Error;
+
+/// Why the designer refused a question, naming the input that is wrong.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum Error {
+    /// A model file could not be read or is not a device.
+    #[error(transparent)]
+    Model(#[from] crate::ModelError),
+    /// A law's parameter is out of its range.
+    #[error("{0}")]
+    Param(#[from] twoport_control::ParamError),
+    /// No pose was given.
+    #[error("no device model was given")]
+    NoPose,
+    /// Poses of one board with different periods.
+    #[error("{} has period_s = {} but {} has {}: poses share one board, give --period", .other.0, .other.1, .first.0, .first.1)]
+    PeriodsDiffer {
+        /// The first pose's model name and period (s).
+        first: (String, f64),
+        /// The first that differs.
+        other: (String, f64),
+    },
+    /// A period that is not a positive time.
+    #[error("--period {0}: must be a positive number of seconds")]
+    Period(f64),
+    /// A model whose dynamics do not discretise.
+    #[error("{model}: {why}")]
+    Dynamics {
+        /// The model's name.
+        model: String,
+        /// What its dynamics refused.
+        why: String,
+    },
+    /// An admittance display asked of a device without a force sensor.
+    #[error("{0}: the model has no force sensor (no C_f), and an admittance display needs one to measure the hand's force; design an impedance display instead")]
+    NoForceSensor(String),
+    /// An admittance design with no impedance design to take `K_p` from.
+    #[error("no impedance design exists to take K_p from (eq 30); give --kp and --bp")]
+    NoRegulator,
+    /// A gain that is negative or not finite.
+    #[error("--{name} {value}: must be a finite number >= 0")]
+    Gain {
+        /// The gain's name (its command-line flag).
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// A design margin out of range.
+    #[error("--margin {0}: must be a fraction from 0 to 0.9")]
+    Margin(f64),
+    /// A region's damping range or point count out of range.
+    #[error("need 0 < --b-from < --b-to and 2..=1000 --points")]
+    RegionGrid,
+    /// Gains that make no coupling.
+    #[error("{0}")]
+    Coupling(String),
+    /// The counterexample search could not run on a pose.
+    #[error("{model}: {why}")]
+    Verify {
+        /// The pose's model name.
+        model: String,
+        /// Why.
+        why: String,
+    },
+}

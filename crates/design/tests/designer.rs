@@ -1,0 +1,98 @@
+//! The designer's reports: what the JSON says is what the text says and
+//! what the report holds, and bad questions are refused by name.
+
+use twoport_design::designer::{Binding, Designer, Limit};
+use twoport_design::twoport::HumanBound;
+use twoport_design::{DeviceModel, Error};
+
+fn excalibur() -> Designer {
+    Designer::new(
+        vec![DeviceModel::excalibur().unwrap()],
+        None,
+        Some(HumanBound::PAPER),
+    )
+    .unwrap()
+}
+
+/// The impedance design's JSON carries the boundary and the recommended
+/// stiffness the text prints, and the admittance design asked next on the
+/// same designer takes its regulator from it (eq 30).
+#[test]
+fn a_designs_json_and_text_say_the_same() {
+    let d = excalibur();
+    let r = d.design_impedance(Some(90.0), 0.1).unwrap();
+    let (k, b) = r.coupling.expect("a design");
+    let v = serde_json::to_value(&r).unwrap();
+    assert_eq!(v["k_c"].as_f64(), Some(k));
+    assert_eq!(v["b_c"].as_f64(), Some(b));
+    assert_eq!(v["feasible"], true);
+    let rec = r.recommended().unwrap();
+    assert!((rec - 0.9 * k).abs() < 1e-9 * k);
+    assert_eq!(v["recommended_k_c"].as_f64(), Some(rec));
+    let text = r.to_string();
+    assert!(text.contains(&Limit::Stiffness.text(k)), "{text}");
+    assert!(text.contains(&Limit::Stiffness.text(rec)), "{text}");
+    assert_eq!(
+        r.binding == Binding::SampledData,
+        v["binding_bound"] == "sampled-data"
+    );
+
+    let a = d.design_admittance(None, Some(500.0), 0.1).unwrap();
+    let best = d.design_impedance(None, 0.1).unwrap().coupling.unwrap();
+    let reg = a.regulator.unwrap();
+    assert_eq!((reg.kp, reg.bp), best);
+    let v = serde_json::to_value(&a).unwrap();
+    assert_eq!(v["kp"].as_f64(), Some(best.0));
+    assert_eq!(v["m_c"].as_f64(), a.coupling.map(|c| c.0));
+}
+
+/// A check inside the boundary has a positive gain margin, one past it a
+/// negative one, and both say so in JSON and text.
+#[test]
+fn a_check_reports_its_margin_to_the_boundary() {
+    let d = excalibur();
+    let (k, _) = d
+        .design_impedance(Some(90.0), 0.0)
+        .unwrap()
+        .coupling
+        .unwrap();
+    let inside = d.check_impedance(0.8 * k, 90.0).unwrap();
+    let past = d.check_impedance(1.2 * k, 90.0).unwrap();
+    assert!(inside.check.absolutely_stable && !past.check.absolutely_stable);
+    assert!((inside.gain_margin.unwrap() - 0.2).abs() < 1e-9);
+    assert!((past.gain_margin.unwrap() + 0.2).abs() < 1e-9);
+    assert_eq!(
+        serde_json::to_value(&past).unwrap()["boundary_k_c"].as_f64(),
+        Some(k)
+    );
+    assert!(past.to_string().contains("past the boundary"), "{past}");
+}
+
+/// Bad questions are refused by name before any analysis: a margin out
+/// of range, a negative gain, a region grid that is no grid, an
+/// admittance display on a device without a force sensor, and no pose.
+#[test]
+fn bad_questions_are_refused_by_name() {
+    let d = excalibur();
+    assert_eq!(
+        d.design_impedance(None, 2.0).unwrap_err(),
+        Error::Margin(2.0)
+    );
+    let e = d.check_impedance(-1.0, 90.0).unwrap_err();
+    assert_eq!(e.to_string(), "--k -1: must be a finite number >= 0");
+    assert_eq!(
+        d.region_impedance((100.0, 10.0), 8).unwrap_err(),
+        Error::RegionGrid
+    );
+    let mut no_sensor = DeviceModel::excalibur().unwrap();
+    no_sensor.force_sensor = false;
+    let e = Designer::new(vec![no_sensor], None, None)
+        .unwrap()
+        .design_admittance(None, None, 0.1)
+        .unwrap_err();
+    assert!(matches!(e, Error::NoForceSensor(_)), "{e}");
+    assert_eq!(
+        Designer::new(vec![], None, None).unwrap_err(),
+        Error::NoPose
+    );
+}
