@@ -9,6 +9,7 @@ mod error;
 pub mod figures;
 pub mod linalg;
 pub mod model;
+mod par;
 pub mod plant;
 #[cfg(feature = "plot")]
 pub mod plot;

@@ -128,18 +128,20 @@ fn each_alias_pair(
     let ws = 2.0 * PI / p.period_s;
     let mut raw = |k: f64| {
         let omega = p.omega + ws * k;
-        let (mut y, mut fm) = plant.continuous(omega.abs(), &mut work);
+        let mut h = plant.hand_terms(omega.abs(), &mut work);
         if omega < 0.0 {
-            y = y.map(|r| r.map(|v| v.conj()));
-            fm = fm.map(|v| v.conj());
+            h = h.map(|v| v.conj());
         }
-        let p = y[1][0] * y[0][1];
+        let [yhh, yha, yah, fmh] = h;
+        let p = yah * yha;
         Raw {
             omega,
-            yhh: y[0][0],
+            yhh,
             p,
-            p_abs: p.norm(),
-            fy_abs: (fm[0] * y[0][1]).norm(),
+            // (Moduli without libm's hypot, its slowest part: these are
+            // far from overflow, and a rounding's difference is 1e-16.)
+            p_abs: p.norm_sqr().sqrt(),
+            fy_abs: (fmh * yha).norm_sqr().sqrt(),
         }
     };
     let with_human = |r: Raw| {
@@ -235,14 +237,11 @@ pub fn impedance_bound_with(
     human: Option<HumanBound>,
     cache: &AliasCache,
 ) -> Vec<f64> {
-    points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let paper = design_bound(&impedance_display(p, human));
-            paper + impedance_alias_terms(plant, (i, p), human, cache, paper)
-        })
-        .collect()
+    crate::par::map(points.len(), |i| {
+        let p = &points[i];
+        let paper = design_bound(&impedance_display(p, human));
+        paper + impedance_alias_terms(plant, (i, p), human, cache, paper)
+    })
 }
 
 /// The admittance-display bound on `Re Z_cA` at each point for the
@@ -266,16 +265,13 @@ pub fn admittance_bound_with(
     human: Option<HumanBound>,
     cache: &AliasCache,
 ) -> Vec<f64> {
-    points
-        .iter()
-        .enumerate()
-        .map(
-            |(i, p)| match admittance_alias_reach(plant, (i, p), human, cache) {
-                Some(reach) => admittance_point(p, reach, kp, human),
-                None => f64::INFINITY,
-            },
-        )
-        .collect()
+    crate::par::map(points.len(), |i| {
+        let p = &points[i];
+        match admittance_alias_reach(plant, (i, p), human, cache) {
+            Some(reach) => admittance_point(p, reach, kp, human),
+            None => f64::INFINITY,
+        }
+    })
 }
 
 /// `Σ |α_k| |w_k| / |1 - z^-1|` and `Σ |φ_k| |w_k| / |1 - z^-1|` over the

@@ -160,6 +160,18 @@ impl Modal {
         Some(Modal { poles, residues })
     }
 
+    /// [`eval`](Self::eval)'s `[Y_hh, Y_ha, Y_ah, F_mh]` alone.
+    fn eval_hand(&self, s: Complex64) -> [Complex64; 4] {
+        let mut out = [Complex64::new(0.0, 0.0); 4];
+        for (l, r) in self.poles.iter().zip(&self.residues) {
+            let g = (s - l).inv();
+            for (o, ri) in out.iter_mut().zip([r[0], r[1], r[2], r[4]]) {
+                *o += ri * g;
+            }
+        }
+        out
+    }
+
     fn eval(&self, s: Complex64) -> [Complex64; 6] {
         let mut out = [Complex64::new(0.0, 0.0); 6];
         for (l, r) in self.poles.iter().zip(&self.residues) {
@@ -483,6 +495,19 @@ impl Plant {
         }
     }
 
+    /// The hand-side terms at `ω` (rad/s, > 0): `[Y_hh, Y_ha, Y_ah,
+    /// F_mh]`, what the sampled-data bounds sum at every alias (the modal
+    /// form's four of six residues, or the LU's).
+    pub fn hand_terms(&self, omega: f64, work: &mut Scratch) -> [Complex64; 4] {
+        match &self.modal {
+            Some(m) => m.eval_hand(Complex64::new(0.0, omega)),
+            None => {
+                let (y, f) = self.continuous_lu(omega, work);
+                [y[0][0], y[0][1], y[1][0], f[0]]
+            }
+        }
+    }
+
     /// `Y(jω)` and `F(jω)` by one complex LU of `M s^2 + D s + K`.
     pub fn continuous_lu(
         &self,
@@ -611,8 +636,7 @@ impl Plant {
 
     /// All terms on a grid of angular frequencies (rad/s).
     pub fn response(&self, omegas: &[f64]) -> Vec<PlantPoint> {
-        let mut work = self.scratch();
-        omegas.iter().map(|&w| self.at(w, &mut work)).collect()
+        crate::par::map(omegas.len(), |i| self.at(omegas[i], &mut self.scratch()))
     }
 }
 
