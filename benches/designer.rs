@@ -7,9 +7,9 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 use std::hint::black_box;
-use twoport_design::design::*;
+use twoport_design::analysis::*;
+use twoport_design::network::HumanBound;
 use twoport_design::plant::Scratch;
-use twoport_design::twoport::HumanBound;
 use twoport_design::{DeviceModel, Plant};
 
 fn excalibur() -> Plant {

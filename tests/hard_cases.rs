@@ -6,8 +6,8 @@ use std::f64::consts::PI;
 use twoport_control::servo::SensorFrame;
 use twoport_control::ve::{Solid, UnilateralWall};
 use twoport_control::{AdmittanceGains, Encoder, Position, SafetyConfig, Servo};
-use twoport_design::design::*;
-use twoport_design::twoport::HumanBound;
+use twoport_design::analysis::*;
+use twoport_design::network::HumanBound;
 use twoport_design::{DeviceModel, Plant};
 
 const T: f32 = 1e-3;

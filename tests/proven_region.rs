@@ -5,8 +5,8 @@
 use twoport_board::{Board, Bound, Region};
 use twoport_control::ve::BilateralConstraint;
 use twoport_control::{Encoder, ImpedanceGains, Position, SafetyConfig, Servo};
-use twoport_design::design::*;
-use twoport_design::twoport::HumanBound;
+use twoport_design::analysis::*;
+use twoport_design::network::HumanBound;
 
 use twoport_link::{encode, Axes, Decoder, Gains, GainsReply, Message, MAX_FRAME};
 

@@ -5,8 +5,8 @@
 use host_sim::{Scene, Simulation};
 use std::path::Path;
 use twoport_control::{Gains, ImpedanceGains};
-use twoport_design::design::*;
-use twoport_design::twoport::HumanBound;
+use twoport_design::analysis::*;
+use twoport_design::network::HumanBound;
 use twoport_design::verify::verify;
 use twoport_design::DeviceModel;
 

@@ -4,8 +4,8 @@
 //! inside it.
 
 use twoport_board::excalibur;
-use twoport_design::design::*;
-use twoport_design::twoport::HumanBound;
+use twoport_design::analysis::*;
+use twoport_design::network::HumanBound;
 
 #[test]
 fn the_shipped_region_is_the_designers() {

@@ -230,7 +230,7 @@ fn admittance_gains_past_the_bound_meet_an_unstable_termination() {
 
 /// The designer's Excalibur at T = 1 ms.
 fn excalibur_plant() -> twoport_design::Plant {
-    twoport_design::design::Analysis::excalibur()
+    twoport_design::analysis::Analysis::excalibur()
         .plant()
         .clone()
 }
@@ -243,8 +243,8 @@ fn designer_p22(
     k: f64,
     f_hz: &[f64],
 ) -> Vec<num_complex::Complex64> {
-    use twoport_design::design::*;
-    use twoport_design::twoport::*;
+    use twoport_design::analysis::*;
+    use twoport_design::network::*;
     let omegas: Vec<f64> = f_hz
         .iter()
         .map(|f| 2.0 * std::f64::consts::PI * f)
@@ -272,8 +272,8 @@ fn designer_p22(
 /// same VE at the designed gain decays.
 #[test]
 fn impedance_gains_past_the_bound_meet_the_termination_the_two_port_names() {
-    use twoport_design::design::*;
-    use twoport_design::twoport::HumanBound;
+    use twoport_design::analysis::*;
+    use twoport_design::network::HumanBound;
     let plant = excalibur_plant();
     let t = plant.period_s();
     let a = Analysis::new(&plant, GridSpec::DEFAULT);

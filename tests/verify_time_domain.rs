@@ -9,8 +9,8 @@ use host_sim::engine::scene::{Discretization, VeSpec};
 use host_sim::{Scene, Simulation};
 use std::path::Path;
 use twoport_control::{Gains, ImpedanceGains};
-use twoport_design::design::*;
-use twoport_design::twoport::HumanBound;
+use twoport_design::analysis::*;
+use twoport_design::network::HumanBound;
 use twoport_design::verify::{radius, verify, Ve};
 use twoport_design::DeviceModel;
 

@@ -13,6 +13,11 @@
 //!
 //! A board of several axes stores one `Config` per axis, one after the
 //! other in the payload; a one-axis record is exactly one.
+//!
+//! The gains are the link's [`Gains`]: a record and a frame are both bytes
+//! that must stay readable across versions, so they share one encoding,
+//! and the board converts to the control crate's gains once (see the
+//! crate's README).
 
 use crate::crc32::crc32;
 use serde::{Deserialize, Serialize};

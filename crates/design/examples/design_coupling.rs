@@ -3,8 +3,8 @@
 //! [MODEL.toml]` (the capstan handle by default).
 
 use twoport_control::{Gains, ImpedanceGains};
-use twoport_design::design::{best_impedance, check_impedance, Analysis, GridSpec};
-use twoport_design::twoport::HumanBound;
+use twoport_design::analysis::{best_impedance, check_impedance, Analysis, GridSpec};
+use twoport_design::network::HumanBound;
 use twoport_design::verify::verify;
 use twoport_design::{DeviceModel, Plant};
 

@@ -1,11 +1,11 @@
 //! The data of the paper's Figs 8-10, from the designer's own results.
 
-use crate::design::{
+use crate::analysis::{
     admittance_coupling_tf, impedance_coupling_tf, impedance_range_admittance,
     impedance_range_impedance, regulator_tf, Analysis,
 };
+use crate::network::HumanBound;
 use crate::plot::{Curve, Figure};
-use crate::twoport::HumanBound;
 use plotters::style::RGBColor;
 use std::f64::consts::PI;
 

@@ -1,7 +1,8 @@
 #![doc = include_str!("../README.md")]
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
-pub mod design;
+pub mod analysis;
 pub mod designer;
 pub mod device;
 mod error;
@@ -9,13 +10,13 @@ mod error;
 pub mod figures;
 pub mod linalg;
 pub mod model;
+pub mod network;
 mod par;
 pub mod plant;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod rational;
 pub mod sampled;
-pub mod twoport;
 pub mod verify;
 
 pub use designer::Designer;

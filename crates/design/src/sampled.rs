@@ -26,7 +26,7 @@
 //! grow no further beyond `N` (true above the device's modes, where the
 //! handle's inertia dominates).
 
-use crate::twoport::{admittance_display, design_bound, impedance_display, HumanBound};
+use crate::network::{admittance_display, design_bound, impedance_display, HumanBound};
 use crate::{Plant, PlantPoint};
 use num_complex::Complex64;
 use std::f64::consts::PI;
@@ -361,7 +361,7 @@ mod tests {
     fn rigid_device_bound_is_colgates() {
         for (m, b) in [(1.0, 20.0), (0.1, 5.0), (10.0, 200.0)] {
             let plant = rigid(m, b);
-            let omegas = crate::design::log_grid(1.0, plant.nyquist(), 60);
+            let omegas = crate::analysis::log_grid(1.0, plant.nyquist(), 60);
             let pts = plant.response(&omegas);
             let exact = impedance_bound(&plant, &pts, None);
             let paper: Vec<f64> = pts
@@ -438,8 +438,8 @@ mod tests {
     fn admittance_bound_without_aliases_is_the_papers() {
         let model = DeviceModel::excalibur().unwrap();
         let plant = Plant::new(&model, 1e-3).unwrap();
-        let kp = crate::design::regulator_tf(51_000.0, 90.0, 1e-3).unwrap();
-        let pts = plant.response(&crate::design::log_grid(1.0, plant.nyquist(), 40));
+        let kp = crate::analysis::regulator_tf(51_000.0, 90.0, 1e-3).unwrap();
+        let pts = plant.response(&crate::analysis::log_grid(1.0, plant.nyquist(), 40));
         for p in &pts {
             let h = Some(HumanBound::PAPER);
             let paper = design_bound(&admittance_display(p, &kp, h));

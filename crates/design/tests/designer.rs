@@ -2,7 +2,7 @@
 //! what the report holds, and bad questions are refused by name.
 
 use twoport_design::designer::{Binding, Designer, Limit};
-use twoport_design::twoport::HumanBound;
+use twoport_design::network::HumanBound;
 use twoport_design::{DeviceModel, Error};
 
 fn excalibur() -> Designer {

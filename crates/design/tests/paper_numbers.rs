@@ -3,8 +3,8 @@
 
 use std::f64::consts::PI;
 use std::sync::OnceLock;
-use twoport_design::design::*;
-use twoport_design::twoport::HumanBound;
+use twoport_design::analysis::*;
+use twoport_design::network::HumanBound;
 use twoport_design::Plant;
 
 const HUMAN: Option<HumanBound> = Some(HumanBound::PAPER);

@@ -9,8 +9,8 @@
 //! CI runs the whole file in release.
 
 use twoport_control::{AdmittanceGains, Gains, ImpedanceGains};
-use twoport_design::design::*;
-use twoport_design::twoport::HumanBound;
+use twoport_design::analysis::*;
+use twoport_design::network::HumanBound;
 use twoport_design::verify::verify;
 use twoport_design::{DeviceModel, Plant};
 

@@ -13,9 +13,9 @@ use crate::{Sample, Simulation};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 use twoport_control::servo::Gains;
-use twoport_design::design::{self, Analysis, Check, GridSpec};
+use twoport_design::analysis::{self, Analysis, Check, GridSpec};
+use twoport_design::network::HumanBound;
 use twoport_design::plot::Figure;
-use twoport_design::twoport::HumanBound;
 use twoport_design::Plant;
 use twoport_link::{Axes, Message};
 
@@ -391,7 +391,7 @@ impl ScopeState {
             Gains::Impedance(g) => {
                 let (k, b) = (g.k_npm as f64, g.b_nspm as f64);
                 (
-                    design::check_impedance(a, k, b, h),
+                    analysis::check_impedance(a, k, b, h),
                     twoport_design::figures::fig8(a, k, b).ok(),
                 )
             }
@@ -399,7 +399,7 @@ impl ScopeState {
                 let kp = (g.kp_npm as f64, g.bp_nspm as f64);
                 let c = (g.m_kg as f64, g.b_nspm as f64);
                 (
-                    design::check_admittance(plant, a, kp, c, h),
+                    analysis::check_admittance(plant, a, kp, c, h),
                     twoport_design::figures::fig9(a, kp, c).ok(),
                 )
             }

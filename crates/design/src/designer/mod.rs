@@ -8,7 +8,7 @@
 //!
 //! ```
 //! use twoport_design::designer::Designer;
-//! use twoport_design::twoport::HumanBound;
+//! use twoport_design::network::HumanBound;
 //! use twoport_design::DeviceModel;
 //! let d = Designer::new(vec![DeviceModel::excalibur()?], None, Some(HumanBound::PAPER))?;
 //! let r = d.design_impedance(Some(90.0), 0.1)?;
@@ -22,8 +22,8 @@ mod report;
 
 pub use report::*;
 
-use crate::design::{self, Analysis, Check, GridSpec, Poses};
-use crate::twoport::HumanBound;
+use crate::analysis::{self, Analysis, Check, GridSpec, Poses};
+use crate::network::HumanBound;
 use crate::{DeviceModel, Error, Plant};
 use std::sync::{Mutex, OnceLock};
 use twoport_control::{Gains, ZTransfer};
@@ -247,8 +247,8 @@ impl Designer {
 
     fn impedance_on(&self, poses: &Poses, b: Option<f64>) -> Option<(f64, f64)> {
         match b {
-            Some(b) => design::max_stiffness_poses(poses, b).map(|k| (k, b)),
-            None => design::best_impedance_poses(poses),
+            Some(b) => analysis::max_stiffness_poses(poses, b).map(|k| (k, b)),
+            None => analysis::best_impedance_poses(poses),
         }
     }
 
@@ -257,8 +257,8 @@ impl Designer {
             return None;
         }
         match b {
-            Some(b) => design::min_mass_poses(poses, b).map(|m| (m, b)),
-            None => design::best_admittance_poses(poses),
+            Some(b) => analysis::min_mass_poses(poses, b).map(|m| (m, b)),
+            None => analysis::best_admittance_poses(poses),
         }
     }
 
@@ -266,8 +266,8 @@ impl Designer {
     /// range searched.
     fn infeasible(&self, bounds: &[Vec<f64>], what: Infeasible, b: Option<f64>) -> String {
         let (what, bound_unit, (lo, hi), unit) = match what {
-            Infeasible::Stiffness => ("stiffness", "m/(N s)", design::K_RANGE, "N/m"),
-            Infeasible::Mass => ("mass", "N s/m", design::M_RANGE, "kg"),
+            Infeasible::Stiffness => ("stiffness", "m/(N s)", analysis::K_RANGE, "N/m"),
+            Infeasible::Mass => ("mass", "N s/m", analysis::M_RANGE, "kg"),
         };
         let at = b
             .map(|b| format!(" at b_c = {b} N s/m"))
@@ -275,7 +275,7 @@ impl Designer {
         match self
             .with(bounds)
             .iter()
-            .find_map(|(a, b)| design::low_frequency_obstacle(a, b))
+            .find_map(|(a, b)| analysis::low_frequency_obstacle(a, b))
         {
             Some(limit) => format!(
                 "no finite coupling {what} is absolutely stable: toward DC the bound stays positive (its limit is {limit:.4e} {bound_unit}), while the coupling's real part goes to zero as the frequency does"
@@ -296,7 +296,7 @@ impl Designer {
         let coupling = self.impedance_on(&self.with(sound), b);
         let paper = self.impedance_on(&self.with(self.impedance_bounds(Bound::Paper)), b);
         let binding = coupling.and_then(|(k, b)| {
-            self.worst_check(|p| design::check_impedance(&p.analysis, k, b, self.human))
+            self.worst_check(|p| analysis::check_impedance(&p.analysis, k, b, self.human))
                 .map(|(c, name)| (c.worst_frequency_hz, self.pose_name(name)))
         });
         let message = coupling
@@ -334,7 +334,7 @@ impl Designer {
                 .impedance_on(&self.with(self.impedance_bounds(Bound::Sound)), None)
                 .ok_or(Error::NoRegulator)?,
         };
-        let k = design::regulator_tf(kp, bp, self.period_s())?;
+        let k = analysis::regulator_tf(kp, bp, self.period_s())?;
         let radius = self.regulated_pole_radius(&k);
         let sound = self.admittance_bounds((kp, bp), &k, Bound::Sound);
         let paper = self.admittance_bounds((kp, bp), &k, Bound::Paper);
@@ -342,7 +342,7 @@ impl Designer {
         let paper = self.admittance_on(&self.with(&paper), radius, b);
         let binding = coupling.and_then(|(m, b)| {
             self.worst_check(|p| {
-                design::check_admittance(&p.plant, &p.analysis, (kp, bp), (m, b), self.human)
+                analysis::check_admittance(&p.plant, &p.analysis, (kp, bp), (m, b), self.human)
             })
             .map(|(c, name)| (c.worst_frequency_hz, self.pose_name(name)))
         });
@@ -375,7 +375,7 @@ impl Designer {
     pub fn check_impedance(&self, k: f64, b: f64) -> Result<CheckReport, Error> {
         let (k, b) = (gain("k", k)?, gain("b", b)?);
         let (c, pose) = self
-            .worst_check(|p| design::check_impedance(&p.analysis, k, b, self.human))
+            .worst_check(|p| analysis::check_impedance(&p.analysis, k, b, self.human))
             .ok_or(Error::Coupling(format!(
                 "--k {k} --b {b}: not a valid coupling (k T + b must be > 0)"
             )))?;
@@ -411,12 +411,12 @@ impl Designer {
         }
         let (c, pose) = self
             .worst_check(|p| {
-                design::check_admittance(&p.plant, &p.analysis, kp, (m, b), self.human)
+                analysis::check_admittance(&p.plant, &p.analysis, kp, (m, b), self.human)
             })
             .ok_or(Error::Coupling(
                 "--b must be > 0 for the admittance coupling".into(),
             ))?;
-        let k = design::regulator_tf(kp.0, kp.1, self.period_s())?;
+        let k = analysis::regulator_tf(kp.0, kp.1, self.period_s())?;
         let bounds = self.admittance_bounds(kp, &k, Bound::Sound);
         let boundary = self
             .admittance_on(&self.with(&bounds), c.regulator_pole_radius, Some(b))
@@ -440,7 +440,7 @@ impl Designer {
     /// each of `points` log-spaced dampings over `range` (N s/m).
     pub fn region_impedance(&self, range: (f64, f64), points: usize) -> Result<Region, Error> {
         let range = region_range(range, points)?;
-        let rows = design::region_impedance(
+        let rows = analysis::region_impedance(
             &self.with(self.impedance_bounds(Bound::Sound)),
             range,
             points,
@@ -464,12 +464,12 @@ impl Designer {
         let range = region_range(range, points)?;
         self.force_sensor()?;
         let (kp, bp) = (gain("kp", kp)?, gain("bp", bp)?);
-        let k = design::regulator_tf(kp, bp, self.period_s())?;
+        let k = analysis::regulator_tf(kp, bp, self.period_s())?;
         let bounds = self.admittance_bounds((kp, bp), &k, Bound::Sound);
         Ok(Region {
             context: self.context(DisplayKind::Admittance),
             bound: RegionBound::MinMass,
-            rows: design::region_admittance(&self.with(&bounds), range, points),
+            rows: analysis::region_admittance(&self.with(&bounds), range, points),
             regulator: Some((kp, bp)),
         })
     }

@@ -1,7 +1,7 @@
 //! What the designer answers: each report serialises to the JSON the
 //! command line prints with `--json` and displays as its text.
 
-use crate::design::Check;
+use crate::analysis::Check;
 use serde::ser::{SerializeMap, Serializer};
 use serde::Serialize;
 use std::fmt;

@@ -1,7 +1,7 @@
 //! Where the design inequality's terms change fast: the poles of every
 //! transfer function it is built from, folded into the base band, each
 //! with the half-width over which it acts. The frequency grid is refined
-//! around them ([`crate::design::grid`]).
+//! around them ([`crate::analysis::grid`]).
 
 use super::augmented;
 use crate::DeviceModel;
@@ -85,7 +85,7 @@ pub(super) fn of(
     let g_h: Vec<f64> = model.g.column(0).iter().copied().collect();
     // Held by the paper's stiffest grasp: f_h = -(b v_h + k x_h) through
     // the handle's force column.
-    let grasp = crate::twoport::HumanBound::PAPER;
+    let grasp = crate::network::HumanBound::PAPER;
     let gc = DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| g_h[i] * c_h[j]);
     continuous.extend(oscillating_poles(
         m,

@@ -410,7 +410,7 @@ impl Plant {
     fn keep_modal_if_exact(&mut self) {
         let Some(modal) = &self.modal else { return };
         let nyq = self.nyquist();
-        let mut checks = crate::design::log_grid(0.1, nyq, 40);
+        let mut checks = crate::analysis::log_grid(0.1, nyq, 40);
         checks.extend(self.modes.iter().map(|m| m.omega_n).filter(|w| *w < nyq));
         let mut work = self.scratch();
         let exact = checks.iter().all(|&w| {
@@ -465,7 +465,7 @@ impl Plant {
     /// (where `Re Y_hh` dips), each folded from wherever it sits, and the
     /// sampled device's discrete poles. A frequency grid that resolves each
     /// of these on the scale of its own half-width misses no dip of the
-    /// inequality (see [`crate::design::grid`]).
+    /// inequality (see [`crate::analysis::grid`]).
     pub fn features(&self) -> &[Feature] {
         &self.features
     }

@@ -3,7 +3,7 @@
 //! signals, and the VE; its transition matrix and what its eigenvalues say.
 
 use super::{Gains, Hand, Radius, Termination, Ve, OSCILLATING_MARGIN, UNSTABLE_MARGIN};
-use crate::design::{admittance_coupling_tf, impedance_coupling_tf, regulator_tf};
+use crate::analysis::{admittance_coupling_tf, impedance_coupling_tf, regulator_tf};
 use crate::linalg::balance;
 use crate::plant::{augmented, zoh};
 use crate::rational::{add, delayed, from_tf, mul, realise, reduced, scale, Rational};

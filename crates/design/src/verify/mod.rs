@@ -12,7 +12,7 @@
 //! masses, then Nelder-Mead from the worst starts, in log space. It proves
 //! nothing when it finds nothing; what it finds is a real instability.
 
-use crate::twoport::HumanBound;
+use crate::network::HumanBound;
 use crate::DeviceModel;
 use serde::Serialize;
 use twoport_control::Gains;

@@ -2,7 +2,7 @@
 //! a sweep of hands and VEs, then Nelder-Mead from the worst starts.
 
 use super::{radius, Gains, Hand, Radius, Termination, Ve, Verdict};
-use crate::twoport::HumanBound;
+use crate::network::HumanBound;
 use crate::DeviceModel;
 use nalgebra::DMatrix;
 use std::f64::consts::PI;

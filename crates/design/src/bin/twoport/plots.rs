@@ -5,8 +5,8 @@ use crate::args::*;
 use crate::run::*;
 use serde_json::json;
 use std::f64::consts::PI;
-use twoport_design::design::{self, Analysis};
-use twoport_design::twoport::HumanBound;
+use twoport_design::analysis::{self, Analysis};
+use twoport_design::network::HumanBound;
 use twoport_design::{figures, plot};
 
 pub(crate) fn zrange(d: &Display<ZrangeImpedance, ZrangeAdmittance>) -> Result<(), String> {
@@ -21,16 +21,16 @@ pub(crate) fn zrange(d: &Display<ZrangeImpedance, ZrangeAdmittance>) -> Result<(
     let pose = single(&s, "zrange")?;
     let nyq = pose.plant.nyquist();
     let lo = 2.0 * PI * 0.1;
-    let omegas = design::log_grid(lo, nyq, points);
+    let omegas = analysis::log_grid(lo, nyq, points);
     let a = Analysis::on(&pose.plant, &omegas);
     let range = match d {
         Display::Impedance(z) => {
             let (k, b) = (gain("k", z.gains.k)?, gain("b", z.gains.b)?);
-            design::impedance_range_impedance(&a, k, b)
+            analysis::impedance_range_impedance(&a, k, b)
         }
         Display::Admittance(z) => {
             let g = &z.gains;
-            design::impedance_range_admittance(
+            analysis::impedance_range_admittance(
                 &a,
                 (gain("kp", g.kp)?, gain("bp", g.bp)?),
                 (g.m, gain("b", g.b)?),
@@ -60,12 +60,12 @@ pub(crate) fn plot_fig(p: &PlotArgs) -> Result<(), String> {
     let a = &single(&s, "plot")?.analysis;
     let t = s.period_s();
     let bi = a.impedance_bound(Some(HumanBound::PAPER));
-    let (k, b) = design::max_stiffness(a, &bi, gain("b-impedance", p.b_impedance)?)
+    let (k, b) = analysis::max_stiffness(a, &bi, gain("b-impedance", p.b_impedance)?)
         .map(|k| (k, p.b_impedance))
         .ok_or("no impedance coupling meets the bound at --b-impedance")?;
-    let kp = design::regulator_tf(k, b, t).map_err(|e| e.to_string())?;
+    let kp = analysis::regulator_tf(k, b, t).map_err(|e| e.to_string())?;
     let ba = a.admittance_bound(&kp, Some(HumanBound::PAPER));
-    let m = design::min_mass(a, &ba, gain("b-admittance", p.b_admittance)?)
+    let m = analysis::min_mass(a, &ba, gain("b-admittance", p.b_admittance)?)
         .ok_or("no admittance coupling meets the bound at --b-admittance")?;
     let fig = match p.figure {
         Fig::Fig8 => figures::fig8(a, k, b),

@@ -2,7 +2,7 @@
 
 use crate::args::*;
 use crate::run::*;
-use twoport_design::design;
+use twoport_design::analysis;
 use twoport_design::designer::RegionBound;
 
 pub(crate) fn region(d: &Display<RegionImpedance, RegionAdmittance>) -> Result<(), String> {
@@ -21,7 +21,7 @@ pub(crate) fn region(d: &Display<RegionImpedance, RegionAdmittance>) -> Result<(
         return emit(common, &r);
     }
     let how = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
-    let source = design::region_rust_source(
+    let source = analysis::region_rust_source(
         &r.rows,
         r.bound == RegionBound::MaxStiffness,
         r.regulator,

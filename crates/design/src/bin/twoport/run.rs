@@ -6,7 +6,7 @@ use serde::Serialize;
 use serde_json::json;
 use std::fmt::Display;
 use twoport_design::designer::Pose;
-use twoport_design::twoport::HumanBound;
+use twoport_design::network::HumanBound;
 use twoport_design::{Designer, DeviceModel};
 
 /// The designer on the command's poses: its `--model` files, or the axis

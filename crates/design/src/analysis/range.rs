@@ -2,7 +2,7 @@
 
 use super::check::admittance_laws;
 use super::{impedance_coupling_tf, Analysis};
-use crate::twoport::{admittance_display, impedance_display};
+use crate::network::{admittance_display, impedance_display};
 use num_complex::Complex64;
 
 /// The impedance range (eqs 32, 33) at each grid point: `(Z_min, Z_max)`

@@ -4,7 +4,7 @@
 use super::{
     admittance_coupling_tf, dc_margin, impedance_coupling_tf, least, regulator_tf, Analysis,
 };
-use crate::twoport::{
+use crate::network::{
     admittance_display, impedance_display, llewellyn_margin, with_admittance_coupling,
     with_impedance_coupling, HumanBound,
 };

@@ -1,7 +1,7 @@
 //! The frequency grid a design is checked on, and the device's responses
 //! on it.
 
-use crate::twoport::{admittance_display, design_bound, impedance_display, HumanBound};
+use crate::network::{admittance_display, design_bound, impedance_display, HumanBound};
 use crate::{sampled, Plant, PlantPoint};
 use std::f64::consts::PI;
 use twoport_control::ZTransfer;
@@ -132,8 +132,8 @@ impl Analysis {
     /// # Examples
     ///
     /// ```
-    /// use twoport_design::design::{max_stiffness, Analysis, GridSpec};
-    /// use twoport_design::twoport::HumanBound;
+    /// use twoport_design::analysis::{max_stiffness, Analysis, GridSpec};
+    /// use twoport_design::network::HumanBound;
     /// use twoport_design::{DeviceModel, Plant};
     /// let m = DeviceModel::excalibur()?;
     /// let a = Analysis::new(&Plant::new(&m, 1e-3)?, GridSpec::DEFAULT);
