@@ -143,7 +143,7 @@ fn scaled(from: &str, to: &str) -> Result<(Plant, Analysis), String> {
     assert!(EXCALIBUR.contains(from), "{from}");
     let m = DeviceModel::from_toml(&EXCALIBUR.replacen(from, to, 1), "ill")
         .map_err(|e| e.to_string())?;
-    let p = Plant::new(&m, 1e-3)?;
+    let p = Plant::new(&m, 1e-3).map_err(|e| e.to_string())?;
     let a = Analysis::new(&p, GridSpec::DEFAULT);
     Ok((p, a))
 }
@@ -220,6 +220,7 @@ fn a_model_whose_dynamics_overflow_is_refused() {
     let Err(e) = Plant::new(&m, 1e-3) else {
         panic!("a model whose dynamics overflow must be refused");
     };
+    let e = e.to_string();
     assert!(
         e.contains("not finite") || e.contains("far faster than the sample period"),
         "{e}"

@@ -56,6 +56,15 @@ pub enum Error {
     /// Gains that make no coupling.
     #[error("{0}")]
     Coupling(String),
+    /// A controller transfer function whose leading denominator term is 0.
+    #[error("a controller transfer function is not causal")]
+    NotCausal,
+    /// A figure could not be computed from the design.
+    #[error("{0}")]
+    Figure(String),
+    /// A figure could not be drawn or written.
+    #[error("{0}")]
+    Plot(String),
     /// The counterexample search could not run on a pose.
     #[error("{model}: {why}")]
     Verify {

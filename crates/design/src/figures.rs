@@ -36,8 +36,8 @@ fn curve(
 
 /// Fig. 8: the impedance-display bound on `Re(1/Z_cI)` without (dashed)
 /// and with (thin) the human model, and the coupling `(k, b)` (bold).
-pub fn fig8(a: &Analysis, k: f64, b: f64) -> Result<Figure, String> {
-    let tf = impedance_coupling_tf(k, b, a.period_s).map_err(|e| e.to_string())?;
+pub fn fig8(a: &Analysis, k: f64, b: f64) -> Result<Figure, crate::Error> {
+    let tf = impedance_coupling_tf(k, b, a.period_s)?;
     let coupling = a.points.iter().map(|p| tf.eval(p.z).inv().re).collect();
     Ok(Figure {
         title: "Fig. 8  Impedance display virtual coupling design".into(),
@@ -74,9 +74,13 @@ pub fn fig8(a: &Analysis, k: f64, b: f64) -> Result<Figure, String> {
 /// Fig. 9: the admittance-display bound on `Re Z_cA` for the regulator
 /// `(kp, bp)` without (dashed) and with (thin) the human model, and the
 /// coupling `(m, b)` (bold).
-pub fn fig9(a: &Analysis, (kp, bp): (f64, f64), (m, b): (f64, f64)) -> Result<Figure, String> {
-    let k = regulator_tf(kp, bp, a.period_s).map_err(|e| e.to_string())?;
-    let tf = admittance_coupling_tf(m, b, a.period_s).map_err(|e| e.to_string())?;
+pub fn fig9(
+    a: &Analysis,
+    (kp, bp): (f64, f64),
+    (m, b): (f64, f64),
+) -> Result<Figure, crate::Error> {
+    let k = regulator_tf(kp, bp, a.period_s)?;
+    let tf = admittance_coupling_tf(m, b, a.period_s)?;
     let coupling = a.points.iter().map(|p| tf.eval(p.z).re).collect();
     Ok(Figure {
         title: format!("Fig. 9  Admittance display virtual coupling design (K_p = {kp:.0} + {bp:.0}(1 - 1/z)/T)"),
@@ -103,9 +107,11 @@ pub fn fig10(
     (k, b): (f64, f64),
     kp: (f64, f64),
     (m, ba): (f64, f64),
-) -> Result<Figure, String> {
-    let imp = impedance_range_impedance(a, k, b).ok_or("invalid impedance coupling")?;
-    let adm = impedance_range_admittance(a, kp, (m, ba)).ok_or("invalid admittance coupling")?;
+) -> Result<Figure, crate::Error> {
+    let imp = impedance_range_impedance(a, k, b)
+        .ok_or(crate::Error::Figure("invalid impedance coupling".into()))?;
+    let adm = impedance_range_admittance(a, kp, (m, ba))
+        .ok_or(crate::Error::Figure("invalid admittance coupling".into()))?;
     let mag = |r: &[(num_complex::Complex64, num_complex::Complex64)], hi: bool| -> Vec<f64> {
         r.iter()
             .map(|(lo, up)| if hi { up.norm() } else { lo.norm() })

@@ -39,7 +39,11 @@ fn register_font() {
 }
 
 /// Draw `fig` to `out`; the extension (.png or .svg) picks the format.
-pub fn render(fig: &Figure, out: &Path) -> Result<(), String> {
+pub fn render(fig: &Figure, out: &Path) -> Result<(), crate::Error> {
+    render_to(fig, out).map_err(crate::Error::Plot)
+}
+
+fn render_to(fig: &Figure, out: &Path) -> Result<(), String> {
     register_font();
     let ext = out
         .extension()

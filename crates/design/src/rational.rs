@@ -84,10 +84,10 @@ pub struct Ss {
 }
 
 /// `num/den` in transposed direct form II; an error where `den[0]` is 0.
-pub fn realise(num: &[f64], den: &[f64]) -> Result<Ss, String> {
-    let a0 = den[0];
+pub fn realise(num: &[f64], den: &[f64]) -> Result<Ss, crate::Error> {
+    let a0 = den.first().copied().unwrap_or(0.0);
     if a0 == 0.0 || !a0.is_finite() {
-        return Err("a controller transfer function is not causal".into());
+        return Err(crate::Error::NotCausal);
     }
     let n = num.len().max(den.len()) - 1;
     let at = |p: &[f64], i: usize| p.get(i).copied().unwrap_or(0.0) / a0;

@@ -147,7 +147,7 @@ impl Analysis {
 
     /// `model` at its own period on the default grid: where most designs
     /// start. The error names what the model's dynamics refused.
-    pub fn of(model: &crate::DeviceModel) -> Result<Self, String> {
+    pub fn of(model: &crate::DeviceModel) -> Result<Self, crate::Error> {
         Plant::new(model, model.period_s).map(|p| Analysis::new(&p, GridSpec::DEFAULT))
     }
 

@@ -89,10 +89,7 @@ impl Designer {
         }
         let mut poses = Vec::with_capacity(models.len());
         for model in models {
-            let plant = Plant::new(&model, period).map_err(|why| Error::Dynamics {
-                model: model.name.clone(),
-                why,
-            })?;
+            let plant = Plant::new(&model, period)?;
             let analysis = Analysis::new(&plant, GridSpec::DEFAULT);
             poses.push(Pose {
                 model,
@@ -494,11 +491,7 @@ impl Designer {
                 gains,
                 self.human,
                 p.model.delay_samples as usize,
-            )
-            .map_err(|why| Error::Verify {
-                model: p.model.name.clone(),
-                why,
-            })?;
+            )?;
             evaluations += v.evaluations;
             let worse = worst.as_ref().is_none_or(|w| {
                 (v.unstable, v.spectral_radius) > (w.0.unstable, w.0.spectral_radius)

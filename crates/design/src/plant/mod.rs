@@ -317,7 +317,14 @@ impl Plant {
     /// assert!(Plant::new(&DeviceModel::excalibur()?, 0.0).is_err());
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
-    pub fn new(model: &DeviceModel, period_s: f64) -> Result<Self, String> {
+    pub fn new(model: &DeviceModel, period_s: f64) -> Result<Self, crate::Error> {
+        Self::build(model, period_s).map_err(|why| crate::Error::Dynamics {
+            model: model.name.clone(),
+            why,
+        })
+    }
+
+    fn build(model: &DeviceModel, period_s: f64) -> Result<Self, String> {
         if !(period_s.is_finite() && period_s > 0.0) {
             return Err(format!("period {period_s} s must be finite and > 0"));
         }

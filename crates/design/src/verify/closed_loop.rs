@@ -178,7 +178,8 @@ pub(super) fn closed_loop(
 ) -> Result<DMatrix<f64>, String> {
     let plant = sampled(model, &term.hand, period_s)?;
     let ((nx, dx), (nf, df)) = controller(gains, &term.ve, period_s, delay_samples)?;
-    let (hx, hf) = (realise(&nx, &dx)?, realise(&nf, &df)?);
+    let realised = |n: &[f64], d: &[f64]| realise(n, d).map_err(|e| e.to_string());
+    let (hx, hf) = (realised(&nx, &dx)?, realised(&nf, &df)?);
     let np = plant.ad.nrows();
     let (n1, n2) = (hx.a.nrows(), hf.a.nrows());
     let n = np + n1 + n2;

@@ -143,8 +143,13 @@ pub fn radius(
     gains: &Gains,
     term: &Termination,
     delay_samples: usize,
-) -> Result<Radius, String> {
-    let a = closed_loop(model, period_s, gains, term, delay_samples)?;
+) -> Result<Radius, crate::Error> {
+    let a = closed_loop(model, period_s, gains, term, delay_samples).map_err(|why| {
+        crate::Error::Verify {
+            model: model.name.clone(),
+            why,
+        }
+    })?;
     Ok(judge(&a, period_s))
 }
 

@@ -186,9 +186,12 @@ pub fn verify(
     gains: &Gains,
     human: Option<HumanBound>,
     delay_samples: usize,
-) -> Result<Verdict, String> {
+) -> Result<Verdict, crate::Error> {
     if !(period_s.is_finite() && period_s > 0.0) {
-        return Err(format!("period {period_s} s must be finite and > 0"));
+        return Err(crate::Error::Verify {
+            model: model.name.clone(),
+            why: format!("period {period_s} s must be finite and > 0"),
+        });
     }
     let mut s = Search {
         model,
@@ -264,7 +267,10 @@ pub fn verify(
             }
         }
     }
-    let (kind, p, r) = best.ok_or("no termination could be built")?;
+    let (kind, p, r) = best.ok_or_else(|| crate::Error::Verify {
+        model: model.name.clone(),
+        why: "no termination could be built".into(),
+    })?;
     Ok(Verdict {
         unstable: r.unstable,
         growth_per_s: r.growth_per_s(period_s),

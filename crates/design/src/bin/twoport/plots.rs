@@ -71,8 +71,9 @@ pub(crate) fn plot_fig(p: &PlotArgs) -> Result<(), String> {
         Fig::Fig8 => figures::fig8(a, k, b),
         Fig::Fig9 => figures::fig9(a, (k, b), (m, p.b_admittance)),
         Fig::Fig10 => figures::fig10(a, (k, b), (k, b), (m, p.b_admittance)),
-    }?;
-    plot::render(&fig, &p.out)?;
+    }
+    .map_err(|e| e.to_string())?;
+    plot::render(&fig, &p.out).map_err(|e| e.to_string())?;
     let v = json!({"out": p.out, "k_c": k, "b_c": b, "m_c": m, "b_cA": p.b_admittance});
     let text = format!(
         "wrote {} (k_c = {k:.0} N/m, b_c = {b} N s/m, m_c = {m:.3} kg, b_cA = {} N s/m)",
