@@ -13,10 +13,19 @@ fuzz_target!(|data: &[u8]| {
         if scene.integrator.substeps > 64 {
             return; // legal, but slow: not what this target is for
         }
-        if let Ok(mut sim) = Simulation::new(scene) {
-            for _ in 0..100.min(sim.total_ticks()) {
-                sim.step();
-            }
+        match scene.axes {
+            1 => run::<1>(scene),
+            2 => run::<2>(scene),
+            _ => run::<3>(scene),
         }
     }
 });
+
+/// A hundred ticks of a scene of `N` axes, if it builds.
+fn run<const N: usize>(scene: Scene) {
+    if let Ok(mut sim) = Simulation::<N>::with_axes(scene) {
+        for _ in 0..100.min(sim.total_ticks()) {
+            sim.step();
+        }
+    }
+}

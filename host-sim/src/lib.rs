@@ -2,7 +2,22 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+/// An [`Error::Pil`] with a `format!` message.
+macro_rules! pil_err {
+    ($($t:tt)*) => {
+        $crate::Error::Pil(format!($($t)*))
+    };
+}
+
+/// An [`Error::Sim`] with a `format!` message.
+macro_rules! sim_err {
+    ($($t:tt)*) => {
+        $crate::Error::Sim(format!($($t)*))
+    };
+}
+
 pub mod engine;
+mod error;
 pub mod link;
 pub mod pil;
 pub mod scope;
@@ -10,3 +25,4 @@ pub mod study;
 
 pub use engine::scene::Scene;
 pub use engine::sim::{Report, Sample, Simulation};
+pub use error::Error;

@@ -10,6 +10,7 @@
 
 use crate::engine::scene::VeSpec;
 use crate::link::{BoardPort, LinkFaults, Session};
+use crate::Error;
 use crate::{Sample, Scene, Simulation};
 use twoport_board::excalibur::{self, xyz};
 use twoport_control::servo::{SensorFrame, ServoOutput};
@@ -87,7 +88,7 @@ impl Setup {
     /// the board's (its sensors, its world): calibrated where the device
     /// starts (the 3-D world's cursor, or 0), or homed onto the scene's
     /// hard stop.
-    pub fn for_sim<const N: usize>(sim: &Simulation<N>) -> Result<Setup, String> {
+    pub fn for_sim<const N: usize>(sim: &Simulation<N>) -> Result<Setup, Error> {
         let scene = sim.scene();
         check_scene(scene)?;
         let at_rest: Vec<i64> = match sim.servo().blocks() {
@@ -108,9 +109,9 @@ impl<P: BoardPort> Session<P> {
     pub fn step<const N: usize>(
         &mut self,
         sim: &mut Simulation<N>,
-    ) -> Result<(Sample<N>, Axes<i16>), String> {
+    ) -> Result<(Sample<N>, Axes<i16>), Error> {
         let tick = self.tick_heartbeat()?;
-        let mut answer: Result<Axes<i16>, String> = Ok(Axes::default());
+        let mut answer: Result<Axes<i16>, Error> = Ok(Axes::default());
         let io = self.io;
         let mut ctl = |f: &SensorFrame<f32, N>| -> ServoOutput<f32, N> {
             // The encoder's index is on the first axis.
@@ -126,7 +127,7 @@ impl<P: BoardPort> Session<P> {
                 }))
                 .unwrap_or_default(),
             };
-            answer = self.exchange(tick, sensors);
+            answer = self.exchange(tick, sensors).map_err(Error::from);
             let duty = |a: usize| answer.as_ref().ok().and_then(|d| d.get(a).copied());
             let force = core::array::from_fn(|a| io.force_n(duty(a).unwrap_or(0)));
             ServoOutput {
@@ -164,12 +165,12 @@ impl Start {
 /// axis and, on three axes, the three-axis image's world, which the board
 /// simulates (the scene's grab and release times cannot reach it over the
 /// link).
-pub fn check_scene(scene: &Scene) -> Result<(), String> {
+pub fn check_scene(scene: &Scene) -> Result<(), Error> {
     let (bits, pm) = excalibur::ENCODER;
     match scene.effects.encoder {
         Some(e) if e.bits == bits && (e.resolution_m * 1e12).round() as i64 == pm => {}
         _ => {
-            return Err(format!(
+            return Err(pil_err!(
                 "the scene's encoder must be the board's ({bits} bits, {} um per count): \
                  set effects.encoder = {{ resolution_m = {:e}, bits = {bits} }}",
                 pm as f64 * 1e-6,
@@ -202,20 +203,20 @@ pub fn check_scene(scene: &Scene) -> Result<(), String> {
             if have == want {
                 Ok(())
             } else {
-                Err(format!(
+                Err(pil_err!(
                     "the scene's blocks must be the three-axis image's (twoport_board::excalibur::xyz::BLOCKS): {want:?}"
                 ))
             }
         }
-        (3, VeSpec::World { .. }) => Err(
+        (3, VeSpec::World { .. }) => Err(Error::Pil(
             "a processor-in-the-loop scene cannot grab or release: the board's world runs there, \
              and the link carries no grab; remove ve.grab_at_s and ve.release_at_s"
                 .into(),
-        ),
-        (3, _) => Err(
+        )),
+        (3, _) => Err(Error::Pil(
             "the three-axis image runs the building-block world: set ve.kind = \"world\"".into(),
-        ),
-        (n, _) => Err(format!(
+        )),
+        (n, _) => Err(pil_err!(
             "no board image runs {n} axes (the images run 1 or 3)"
         )),
     }
@@ -223,15 +224,15 @@ pub fn check_scene(scene: &Scene) -> Result<(), String> {
 
 /// How homing has ended, from the statuses a board sent: `None` while it
 /// goes on, the error where it failed.
-pub fn homed(statuses: &[Status]) -> Option<Result<(), String>> {
+pub fn homed(statuses: &[Status]) -> Option<Result<(), Error>> {
     statuses.iter().find_map(|s| match s.mode {
         Mode::Homing => None,
-        _ if s.faults != 0 => Some(Err(format!(
+        _ if s.faults != 0 => Some(Err(pil_err!(
             "homing ended with faults: {}",
             BoardFaults(s.faults)
         ))),
         _ if s.calibrated => Some(Ok(())),
-        m => Some(Err(format!("homing ended uncalibrated, in mode {m:?}"))),
+        m => Some(Err(pil_err!("homing ended uncalibrated, in mode {m:?}"))),
     })
 }
 
@@ -240,7 +241,7 @@ fn record<P: BoardPort, const N: usize>(
     session: &mut Session<P>,
     sim: &mut Simulation<N>,
     r: &mut Run<N>,
-) -> Result<Vec<Status>, String> {
+) -> Result<Vec<Status>, Error> {
     let (s, duty) = session.step(sim)?;
     r.samples.push(s);
     r.duties.push(duty);
@@ -263,7 +264,7 @@ pub fn run<P: BoardPort>(
     ticks: u64,
     port: P,
     faults: LinkFaults,
-) -> Result<Run, String> {
+) -> Result<Run, Error> {
     run_axes(scene, ticks, port, faults)
 }
 
@@ -274,7 +275,7 @@ pub fn run_axes<P: BoardPort, const N: usize>(
     ticks: u64,
     port: P,
     faults: LinkFaults,
-) -> Result<Run<N>, String> {
+) -> Result<Run<N>, Error> {
     let mut sim = Simulation::<N>::with_axes(scene)?;
     let setup = Setup::for_sim(&sim)?;
     let start = setup.start;
@@ -293,7 +294,10 @@ pub fn run_axes<P: BoardPort, const N: usize>(
         Message::ModeRefused {
             asked: ModeRequest::SaveConfig,
             why,
-        } => Some(Err(format!("the board refused SaveConfig: {why:?}"))),
+        } => Some(Err(Error::Link(crate::link::LinkError::Refused {
+            asked: "SaveConfig".into(),
+            why: format!("{why:?}"),
+        }))),
         _ => None,
     })??;
     r.config = Some((booted, saved));
@@ -311,7 +315,7 @@ pub fn run_axes<P: BoardPort, const N: usize>(
                     break;
                 }
                 if r.samples.len() as u64 >= ticks {
-                    return Err(format!("the board had not homed after {ticks} ticks"));
+                    return Err(pil_err!("the board had not homed after {ticks} ticks"));
                 }
             }
             r.homing = Some((r.samples.len() as u64 - 1, f64::NAN));

@@ -92,7 +92,8 @@ fn a_scene_with_another_encoder_is_refused_by_name() {
     )
     .err()
     .unwrap();
-    assert!(e.contains("effects.encoder"), "{e}");
+    assert!(matches!(e, host_sim::Error::Pil(_)), "{e:?}");
+    assert!(e.to_string().contains("effects.encoder"), "{e}");
 }
 
 /// The homing scene: the board refuses nothing, homes onto the hard stop
@@ -144,7 +145,10 @@ fn an_uncalibrated_board_refuses_to_arm_by_name() {
     let mut sim = Simulation::new(scene()).unwrap();
     session.step(&mut sim).unwrap();
     let e = session.arm().unwrap_err();
-    assert!(e.contains("NotCalibrated"), "{e}");
+    assert!(
+        matches!(&e, link::LinkError::Refused { why, .. } if why == "NotCalibrated"),
+        "{e}"
+    );
     session.calibrate(Axes::one(0)).unwrap();
     assert_eq!(session.arm().unwrap().mode, twoport_link::Mode::Armed);
 }
@@ -158,14 +162,14 @@ struct Rebooting {
 }
 
 impl link::BoardPort for Rebooting {
-    fn send(&mut self, bytes: &[u8]) -> Result<(), String> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), link::LinkError> {
         self.sent += 1;
         if self.sent == self.after {
             self.board = LocalBoard::excalibur()?;
         }
         self.board.send(bytes)
     }
-    fn recv(&mut self, buf: &mut [u8], t: std::time::Duration) -> Result<usize, String> {
+    fn recv(&mut self, buf: &mut [u8], t: std::time::Duration) -> Result<usize, link::LinkError> {
         self.board.recv(buf, t)
     }
 }
@@ -191,10 +195,15 @@ fn a_rebooted_board_is_seen_by_its_session_not_by_timing() {
         }
     }
     let (k, e) = failed.expect("the reboot went unseen");
-    assert!(e.contains("the board has reset"), "{e}");
+    let ours = s.session();
+    assert_eq!(
+        e,
+        host_sim::Error::Link(link::LinkError::Reset(ours)),
+        "{e}"
+    );
     // (The handshake took one frame, and heartbeats go out every 10 ticks.)
     assert!((30..40).contains(&k), "seen at tick {k}");
-    assert!(s.status().unwrap_err().contains("the board has reset"));
+    assert_eq!(s.status().unwrap_err(), link::LinkError::Reset(ours));
 }
 
 /// The watchdog in QEMU: `cargo xtask watchdog` runs the an386 image that
@@ -228,11 +237,15 @@ fn a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed() {
     for k in 1..3000u32 {
         match s.step(&mut sim) {
             Ok((_, duty)) => last_force = io.force_n(duty[0]),
-            Err(e) if e.contains("did not answer") => {
+            Err(host_sim::Error::Link(link::LinkError::Timeout { .. })) => {
                 first_failed.get_or_insert(k);
             }
             Err(e) => {
-                assert!(e.contains("the board has reset"), "{e}");
+                assert_eq!(
+                    e,
+                    host_sim::Error::Link(link::LinkError::Reset(s.session())),
+                    "{e}"
+                );
                 first_failed.get_or_insert(k);
                 reset_at = Some(k);
                 break;
@@ -271,7 +284,10 @@ fn a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed() {
     }
     s.calibrate(Axes::one(0)).unwrap();
     let e = s.arm().unwrap_err();
-    assert!(e.contains("Faulted"), "{e}");
+    assert!(
+        matches!(&e, link::LinkError::Refused { why, .. } if why == "Faulted"),
+        "{e}"
+    );
     // Seen and cleared, it arms again.
     s.send(&twoport_link::Message::ClearFaults).unwrap();
     assert_eq!(s.status().unwrap().faults, 0);

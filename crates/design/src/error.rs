@@ -56,6 +56,10 @@ pub enum Error {
     /// Gains that make no coupling.
     #[error("{0}")]
     Coupling(String),
+    /// A matrix exponential that cannot be taken (a non-finite or huge
+    /// argument: dynamics far faster than the sample period).
+    #[error("{0}")]
+    Exponential(String),
     /// A controller transfer function whose leading denominator term is 0.
     #[error("a controller transfer function is not causal")]
     NotCausal,

@@ -150,16 +150,17 @@ pub fn balance(a: &DMatrix<f64>) -> Vec<f64> {
 /// would never finish (the model-file fuzzer found one), and a norm that
 /// large means time constants a million million times shorter than the
 /// step, which no sampled model of a device has.
-pub fn expm_balanced(a: &DMatrix<f64>) -> Result<DMatrix<f64>, String> {
+pub fn expm_balanced(a: &DMatrix<f64>) -> Result<DMatrix<f64>, crate::Error> {
+    let bad = |why: String| Err(crate::Error::Exponential(why));
     let n = a.nrows();
     if a.iter().any(|v| !v.is_finite()) {
-        return Err("the matrix exponential's argument is not finite".into());
+        return bad("the matrix exponential's argument is not finite".into());
     }
     let norm = (0..n)
         .map(|j| a.column(j).iter().map(|v| v.abs()).sum::<f64>())
         .fold(0.0, f64::max);
     if norm > EXPM_MAX_NORM {
-        return Err(format!(
+        return bad(format!(
             "the matrix exponential's argument has norm {norm:.3e} (> {EXPM_MAX_NORM:e}): \
              the model's dynamics are far faster than the sample period"
         ));
@@ -169,7 +170,7 @@ pub fn expm_balanced(a: &DMatrix<f64>) -> Result<DMatrix<f64>, String> {
     let e = b.exp();
     let out = DMatrix::from_fn(n, n, |i, j| e[(i, j)] * d[i] / d[j]);
     if out.iter().any(|v| !v.is_finite()) {
-        return Err("the matrix exponential is not finite".into());
+        return bad("the matrix exponential is not finite".into());
     }
     Ok(out)
 }

@@ -2,6 +2,7 @@
 //! blocks on a line between two walls, grab one, push others, and mated
 //! blocks that stick until pulled apart.
 
+use crate::Error;
 use twoport_control::ve::{Causality, CursorMass, Port, VeOutput, VeTransfer, VirtualEnvironment};
 use twoport_control::{Position, ZTransfer};
 
@@ -57,7 +58,7 @@ impl Blocks {
         floor_nspm: f32,
         grab_at_s: Option<f64>,
         release_at_s: Option<f64>,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, Error> {
         let cursor =
             CursorMass::new(cursor_mass_kg, period_s, Position::ZERO).map_err(|e| e.to_string())?;
         let tick = |t: f64| (t / period_s as f64).round() as u64;

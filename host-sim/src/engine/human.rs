@@ -2,6 +2,7 @@
 //! a hand whose motion (and grip) follows a script.
 
 use crate::engine::plant::{Arm, Grasp};
+use crate::Error;
 use serde::Deserialize;
 
 /// Grasp presets. The paper bounds the human by `Z_max = 300 + 1000/s`
@@ -234,9 +235,9 @@ pub struct Human {
 impl Human {
     /// A human with `grasp` and `events` (checked: times >= 0, durations
     /// > 0, finite numbers); the error names the event.
-    pub fn new(grasp: GraspKind, mut events: Vec<Event>) -> Result<Self, String> {
+    pub fn new(grasp: GraspKind, mut events: Vec<Event>) -> Result<Self, Error> {
         for (i, e) in events.iter().enumerate() {
-            let bad = |what: &str| Err(format!("human.script[{i}]: {what}"));
+            let bad = |what: &str| Err(sim_err!("human.script[{i}]: {what}"));
             let finite = |v: f64| v.is_finite();
             // (A NaN fails each comparison.)
             let start = |t: f64| finite(t) && t >= 0.0;
@@ -283,7 +284,7 @@ impl Human {
 
     /// Put a passive arm behind every grasp but hands-off; the hand then
     /// stays still and only `force` events act (on the handle).
-    pub fn with_arm(mut self, arm: Option<Arm>) -> Result<Self, String> {
+    pub fn with_arm(mut self, arm: Option<Arm>) -> Result<Self, Error> {
         if let Some(a) = arm {
             let ok = |v: f64| v.is_finite() && v >= 0.0;
             if !(a.mass_kg.is_finite()
@@ -441,6 +442,6 @@ mod tests {
             }],
         )
         .unwrap_err();
-        assert!(e.starts_with("human.script[0]: move"), "{e}");
+        assert!(e.to_string().starts_with("human.script[0]: move"), "{e}");
     }
 }

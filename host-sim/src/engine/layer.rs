@@ -3,6 +3,7 @@
 //! read (observed energy, added damping, energy dissipated).
 
 use crate::engine::scene::{LayerPort, Scene};
+use crate::Error;
 use std::collections::VecDeque;
 use twoport_control::passivity::{
     EnergyObserver, ParallelDamper, ParallelLimits, PassivityLimits, SeriesDamper,
@@ -30,7 +31,7 @@ pub struct SceneLayer<R: Real> {
 impl<R: Real> SceneLayer<R> {
     /// The scene's layer, or `None` when it has neither a passivity table
     /// nor an element delay (the servo then runs with no layer at all).
-    pub fn for_scene(scene: &Scene, safety: &SafetyConfig) -> Result<Option<Self>, String> {
+    pub fn for_scene(scene: &Scene, safety: &SafetyConfig) -> Result<Option<Self>, Error> {
         let delay_ticks = scene.effects.element_delay.map_or(0, |d| d.ticks as usize);
         let spec = scene
             .passivity

@@ -7,6 +7,7 @@
 //! (N) and the held actuator force (N, positive resisting actuator motion).
 //! `F_nl` is a force vector on the coordinates from nonlinear effects.
 
+use crate::Error;
 use nalgebra::{Cholesky, DMatrix};
 use twoport_design::DeviceModel;
 
@@ -69,7 +70,7 @@ pub struct Device {
 
 impl Device {
     /// The flexible model of a designer model file.
-    pub fn flexible(model: &DeviceModel) -> Result<Self, String> {
+    pub fn flexible(model: &DeviceModel) -> Result<Self, Error> {
         let n = model.dof();
         let minv = Cholesky::new(model.m.clone())
             .ok_or("M is not positive definite")?
@@ -368,7 +369,7 @@ fn column_major(m: &DMatrix<f64>) -> Vec<f64> {
 
 impl Stepper {
     /// A stepper for `sys` with method `method` and sub-step `h` (s).
-    pub fn new(sys: &System, method: Method, h: f64) -> Result<Self, String> {
+    pub fn new(sys: &System, method: Method, h: f64) -> Result<Self, Error> {
         let (ns, n) = (sys.states(), sys.n);
         let (a, b, e) = match method {
             Method::ExactZoh => {

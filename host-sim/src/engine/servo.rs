@@ -9,6 +9,7 @@ use crate::engine::scene::{
 };
 use crate::engine::ve::SceneVe;
 use crate::engine::world::SceneWorld;
+use crate::Error;
 use twoport_control::passivity::{ParallelLimits, PassiveVe};
 use twoport_control::servo::{Gains, PortLayer, SensorFrame, Servo, ServoOutput};
 use twoport_control::ve::{
@@ -57,7 +58,7 @@ fn build<R: Real, const N: usize>(
     scene: &Scene,
     encoder: Encoder,
     safety: SafetyConfig,
-) -> Result<Servo<SceneWorld<R, N>, R, N>, String>
+) -> Result<Servo<SceneWorld<R, N>, R, N>, Error>
 where
     SceneWorld<R, N>: World<R, N>,
 {
@@ -81,7 +82,7 @@ where
 
 /// One axis's VE: the scene's, behind the passivity layer at its port
 /// where the scene puts one there.
-fn axis_ve<R: Real>(scene: &Scene, safety: &SafetyConfig) -> Result<SceneVe<R>, String> {
+fn axis_ve<R: Real>(scene: &Scene, safety: &SafetyConfig) -> Result<SceneVe<R>, Error> {
     let ve = scene_ve(scene, safety.period_s)?;
     Ok(match (&scene.passivity, &scene.ve) {
         (Some(p), VeSpec::Cursor { mass_kg, .. }) if p.enabled && p.port == LayerPort::Ve => {
@@ -101,7 +102,7 @@ fn axis_ve<R: Real>(scene: &Scene, safety: &SafetyConfig) -> Result<SceneVe<R>, 
 
 fn enabled<W: World<R, N>, R: Real, L: PortLayer<R>, const N: usize>(
     mut s: Servo<W, R, N, L>,
-) -> Result<Box<Servo<W, R, N, L>>, String> {
+) -> Result<Box<Servo<W, R, N, L>>, Error> {
     s.enable()
         .map_err(|f| format!("the servo would not enable: {f}"))?;
     Ok(Box::new(s))
@@ -110,7 +111,7 @@ fn enabled<W: World<R, N>, R: Real, L: PortLayer<R>, const N: usize>(
 fn layered<R: Real, const N: usize>(
     s: Servo<SceneWorld<R, N>, R, N>,
     layer: SceneLayer<R>,
-) -> Result<Box<LayeredServo<R, N>>, String>
+) -> Result<Box<LayeredServo<R, N>>, Error>
 where
     SceneWorld<R, N>: World<R, N>,
 {
@@ -120,7 +121,7 @@ where
     )
 }
 
-fn set_wall<R: Real>(ve: &mut SceneVe<R>, surface: Position, k_npm: f32) -> Result<(), String> {
+fn set_wall<R: Real>(ve: &mut SceneVe<R>, surface: Position, k_npm: f32) -> Result<(), Error> {
     let SceneVe::Wall(w) = ve else {
         return Err("the scene's VE is not a wall".into());
     };
@@ -160,7 +161,7 @@ pub(crate) fn output_f64<const N: usize>(o: ServoOutput<f32, N>) -> ServoOutput<
 impl<const N: usize> SceneServo<N> {
     /// The scene's display, gains, world and port layer on `N` axes, in
     /// the scene's float type.
-    pub fn new(scene: &Scene, encoder: Encoder, safety: SafetyConfig) -> Result<Self, String> {
+    pub fn new(scene: &Scene, encoder: Encoder, safety: SafetyConfig) -> Result<Self, Error> {
         Ok(match scene.integrator.controller {
             Precision::F32 => match SceneLayer::for_scene(scene, &safety)? {
                 None => SceneServo::F32(enabled(build(scene, encoder, safety)?)?),
@@ -245,13 +246,13 @@ impl<const N: usize> SceneServo<N> {
 
     /// Change every axis's gains while running (the scope's sliders); they
     /// must be for the scene's display.
-    pub fn set_gains(&mut self, g: [Gains; N]) -> Result<(), String> {
-        each_servo!(self, s => s.set_gains(g)).map_err(|e| e.error.to_string())
+    pub fn set_gains(&mut self, g: [Gains; N]) -> Result<(), Error> {
+        each_servo!(self, s => s.set_gains(g)).map_err(|e| Error::Sim(e.error.to_string()))
     }
 
     /// Move the wall and change its stiffness on every axis while running
     /// (the scope's controls); an error if the scene's VE is not a wall.
-    pub fn set_wall(&mut self, surface_m: f64, stiffness_npm: f64) -> Result<(), String> {
+    pub fn set_wall(&mut self, surface_m: f64, stiffness_npm: f64) -> Result<(), Error> {
         let x = Position::from_m_f64(surface_m).ok_or(format!(
             "wall position {surface_m} m is out of range (±2.147 m)"
         ))?;
@@ -325,7 +326,7 @@ impl LayerView<'_> {
 }
 
 /// The scene's VE, computing in `R`.
-fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, String> {
+fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, Error> {
     let pos = |m: f64| {
         Position::from_m_f64(m).ok_or(format!("position {m} m is out of range (±2.147 m)"))
     };
@@ -405,7 +406,7 @@ fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, String> {
                         velocity_mps: 0.0,
                     })
                 })
-                .collect::<Result<Vec<_>, String>>()?;
+                .collect::<Result<Vec<_>, Error>>()?;
             SceneVe::Blocks(Box::new(Blocks::new(
                 t32,
                 *cursor_mass_kg as f32,

@@ -3,6 +3,7 @@
 
 use crate::engine::scene::{Scene, VeSpec, MAX_BLOCKS};
 use crate::engine::ve::SceneVe;
+use crate::Error;
 use twoport_control::ve::{Port, VeOutput, VeTransfer, VirtualEnvironment};
 use twoport_control::world::vbb::{Block, Vbb, VbbConfig};
 use twoport_control::world::World;
@@ -50,8 +51,8 @@ impl<R: Real, const N: usize> SceneWorld<R, N> {
     pub fn new(
         scene: &Scene,
         period_s: f32,
-        each: impl Fn(usize) -> Result<SceneVe<R>, String>,
-    ) -> Result<Self, String> {
+        each: impl Fn(usize) -> Result<SceneVe<R>, Error>,
+    ) -> Result<Self, Error> {
         let VeSpec::World {
             blocks,
             cursor_mass_kg,
@@ -69,10 +70,10 @@ impl<R: Real, const N: usize> SceneWorld<R, N> {
             return ves
                 .try_into()
                 .map(SceneWorld::Each)
-                .map_err(|_| "one VE per axis".to_string());
+                .map_err(|_| Error::sim("one VE per axis"));
         };
         if N != 3 {
-            return Err(format!("ve.kind = \"world\" needs axes = 3, not {N}"));
+            return Err(sim_err!("ve.kind = \"world\" needs axes = 3, not {N}"));
         }
         let mut cfg = VbbConfig::excalibur(period_s);
         cfg.explicit = *explicit;

@@ -2,7 +2,7 @@
 //! [`BoardPort`] as a serial board: the reference a processor-in-the-loop
 //! run holds the firmware to, bit for bit.
 
-use super::BoardPort;
+use super::{BoardPort, LinkError};
 use std::collections::VecDeque;
 use std::time::Duration;
 use twoport_board::excalibur::{self, xyz, REGION_POINTS};
@@ -82,33 +82,33 @@ impl<W: World<f32, N>, L: PortLayer, const N: usize> LocalBoard<W, N, L> {
 
 impl LocalBoard {
     /// The image the firmware ships ([`excalibur::stiff_wall_board`]).
-    pub fn excalibur() -> Result<Self, String> {
+    pub fn excalibur() -> Result<Self, LinkError> {
         excalibur::stiff_wall_board()
             .map(Self::driven)
-            .map_err(|e| format!("the Excalibur board image: {e:?}"))
+            .map_err(|e| LinkError::Image(format!("the Excalibur board image: {e:?}")))
     }
 }
 
 impl LocalBoard<UnilateralWall, 1, SeriesDamper> {
     /// The passivity image ([`excalibur::stiff_wall_board_with_passivity`]).
-    pub fn excalibur_with_passivity() -> Result<Self, String> {
+    pub fn excalibur_with_passivity() -> Result<Self, LinkError> {
         excalibur::stiff_wall_board_with_passivity()
             .map(Self::driven)
-            .map_err(|e| format!("the Excalibur passivity image: {e:?}"))
+            .map_err(|e| LinkError::Image(format!("the Excalibur passivity image: {e:?}")))
     }
 }
 
 impl LocalBoard<xyz::World, 3> {
     /// The three-axis image ([`xyz::board`]).
-    pub fn excalibur_xyz() -> Result<Self, String> {
+    pub fn excalibur_xyz() -> Result<Self, LinkError> {
         xyz::board()
             .map(Self::driven)
-            .map_err(|e| format!("the three-axis Excalibur image: {e:?}"))
+            .map_err(|e| LinkError::Image(format!("the three-axis Excalibur image: {e:?}")))
     }
 }
 
 impl<W: World<f32, N>, L: PortLayer, const N: usize> BoardPort for LocalBoard<W, N, L> {
-    fn send(&mut self, bytes: &[u8]) -> Result<(), String> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
         // What the images do: the control tick runs each sensor frame as
         // it completes, and the main loop sends what was queued.
         self.link.rx.extend(bytes);
@@ -126,7 +126,7 @@ impl<W: World<f32, N>, L: PortLayer, const N: usize> BoardPort for LocalBoard<W,
             }
         }
     }
-    fn recv(&mut self, buf: &mut [u8], _: Duration) -> Result<usize, String> {
+    fn recv(&mut self, buf: &mut [u8], _: Duration) -> Result<usize, LinkError> {
         let out = &mut self.link.out;
         let n = buf.len().min(out.len());
         buf[..n].copy_from_slice(&out[..n]);

@@ -10,10 +10,12 @@
 //! handshake (it answers with [`twoport_link::NO_SESSION`]) is seen by
 //! protocol, whatever the timing, and every call after it fails saying so.
 
+mod error;
 mod local;
 mod port;
 mod session;
 
+pub use error::LinkError;
 pub use local::LocalBoard;
 pub use port::{BoardPort, SerialBoard};
 pub use session::{LinkFaults, Session, ANSWER_TIMEOUT, HEARTBEAT_EVERY};

@@ -1,23 +1,24 @@
 //! The transport to a board: a serial port (the firmware in QEMU through a
 //! pty, or a real board), or anything else that moves the link's bytes.
 
+use super::LinkError;
 use std::time::Duration;
 
 /// The board end of the link.
 pub trait BoardPort {
     /// Send bytes to the board.
-    fn send(&mut self, bytes: &[u8]) -> Result<(), String>;
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError>;
     /// Bytes from the board: waits up to `timeout` for at least one.
-    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, String>;
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError>;
 }
 
 /// Any port, chosen at run time (the scope's: a serial port, or a board
 /// in-process).
 impl BoardPort for Box<dyn BoardPort> {
-    fn send(&mut self, bytes: &[u8]) -> Result<(), String> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
         (**self).send(bytes)
     }
-    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, String> {
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError> {
         (**self).recv(buf, timeout)
     }
 }
@@ -27,25 +28,29 @@ pub struct SerialBoard(Box<dyn serialport::SerialPort>);
 
 impl SerialBoard {
     /// Open `path` (115200 8N1; a pty ignores the rate).
-    pub fn open(path: &str) -> Result<Self, String> {
+    pub fn open(path: &str) -> Result<Self, LinkError> {
         serialport::new(path, 115_200)
             .timeout(Duration::from_millis(20))
             .open()
             .map(SerialBoard)
-            .map_err(|e| format!("serial port {path}: {e}"))
+            .map_err(|e| LinkError::Open {
+                path: path.to_string(),
+                why: e.to_string(),
+            })
     }
 }
 
 impl BoardPort for SerialBoard {
-    fn send(&mut self, bytes: &[u8]) -> Result<(), String> {
-        std::io::Write::write_all(&mut self.0, bytes).map_err(|e| format!("serial write: {e}"))
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        std::io::Write::write_all(&mut self.0, bytes)
+            .map_err(|e| LinkError::Transport(format!("write: {e}")))
     }
-    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, String> {
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError> {
         let _ = self.0.set_timeout(timeout);
         match std::io::Read::read(&mut self.0, buf) {
             Ok(n) => Ok(n),
             Err(e) if e.kind() == std::io::ErrorKind::TimedOut => Ok(0),
-            Err(e) => Err(format!("serial read: {e}")),
+            Err(e) => Err(LinkError::Transport(format!("read: {e}"))),
         }
     }
 }

@@ -2,7 +2,7 @@
 //! ask and wait for answers, the lockstep exchange of a processor-in-the-
 //! loop run, and the link faults a test injects.
 
-use super::BoardPort;
+use super::{BoardPort, LinkError};
 use std::sync::atomic::{AtomicU16, Ordering};
 use std::time::{Duration, Instant};
 use twoport_board::excalibur;
@@ -57,13 +57,13 @@ pub struct Session<P: BoardPort> {
 impl<P: BoardPort> Session<P> {
     /// Shake hands with the one-axis board at `port`. It is disarmed until
     /// [`arm`](Self::arm).
-    pub fn open(port: P, faults: LinkFaults) -> Result<Self, String> {
+    pub fn open(port: P, faults: LinkFaults) -> Result<Self, LinkError> {
         Self::open_axes(port, faults, 1)
     }
 
     /// Shake hands with the board of `axes` axes at `port`: a board of
     /// another count is refused, with both counts named.
-    pub fn open_axes(port: P, faults: LinkFaults, axes: u8) -> Result<Self, String> {
+    pub fn open_axes(port: P, faults: LinkFaults, axes: u8) -> Result<Self, LinkError> {
         let mut s = Session {
             port,
             axes,
@@ -91,7 +91,7 @@ impl<P: BoardPort> Session<P> {
         msg: Message,
         asked: ModeRequest,
         done: fn(&Status) -> bool,
-    ) -> Result<Status, String> {
+    ) -> Result<Status, LinkError> {
         self.drop_stale_statuses();
         self.send(&msg)?;
         let what = format!("{asked:?}");
@@ -100,7 +100,10 @@ impl<P: BoardPort> Session<P> {
             Message::ModeRefused { asked: a, why } if *a == asked => Some(Err(*why)),
             _ => None,
         })?;
-        r.map_err(|why| format!("the board refused {what}: {why:?}"))
+        r.map_err(|why| LinkError::Refused {
+            asked: what,
+            why: format!("{why:?}"),
+        })
     }
 
     /// Statuses and refusals already received answer earlier questions,
@@ -112,7 +115,7 @@ impl<P: BoardPort> Session<P> {
 
     /// Calibrate a disarmed board: each axis stands at its `position_pm`
     /// (pm).
-    pub fn calibrate(&mut self, position_pm: Axes<i64>) -> Result<Status, String> {
+    pub fn calibrate(&mut self, position_pm: Axes<i64>) -> Result<Status, LinkError> {
         self.ask(
             Message::Calibrate { position_pm },
             ModeRequest::Calibrate,
@@ -121,18 +124,18 @@ impl<P: BoardPort> Session<P> {
     }
 
     /// Arm the board (it must have had a tick, to see its dead-man).
-    pub fn arm(&mut self) -> Result<Status, String> {
+    pub fn arm(&mut self) -> Result<Status, LinkError> {
         self.ask(Message::Arm, ModeRequest::Arm, |s| s.mode == Mode::Armed)
     }
 
     /// Start homing; the caller runs ticks until
     /// [`homed`](crate::pil::homed).
-    pub fn home(&mut self) -> Result<Status, String> {
+    pub fn home(&mut self) -> Result<Status, LinkError> {
         self.ask(Message::Home, ModeRequest::Home, |s| s.mode == Mode::Homing)
     }
 
     /// Where the board's configuration came from.
-    pub fn config(&mut self) -> Result<ConfigSource, String> {
+    pub fn config(&mut self) -> Result<ConfigSource, LinkError> {
         self.inbox.retain(|m| !matches!(m, Message::Config(_)));
         self.send(&Message::GetConfig)?;
         self.wait("GetConfig", |m| match m {
@@ -166,7 +169,7 @@ impl<P: BoardPort> Session<P> {
     }
 
     /// The board's state machine, asked for.
-    pub fn status(&mut self) -> Result<Status, String> {
+    pub fn status(&mut self) -> Result<Status, LinkError> {
         self.drop_stale_statuses();
         self.send(&Message::GetStatus)?;
         self.wait("GetStatus", |m| match m {
@@ -175,20 +178,20 @@ impl<P: BoardPort> Session<P> {
         })
     }
 
-    fn frame(&mut self, msg: &Message) -> Result<Vec<u8>, String> {
+    fn frame(&mut self, msg: &Message) -> Result<Vec<u8>, LinkError> {
         let mut buf = [0u8; MAX_FRAME];
-        let n = encode(self.seq, msg, &mut buf).map_err(|e| format!("encode: {e:?}"))?;
+        let n = encode(self.seq, msg, &mut buf).map_err(|e| LinkError::Encode(format!("{e:?}")))?;
         self.seq = self.seq.wrapping_add(1);
         Ok(buf[..n].to_vec())
     }
 
     /// Send one message.
-    pub fn send(&mut self, msg: &Message) -> Result<(), String> {
+    pub fn send(&mut self, msg: &Message) -> Result<(), LinkError> {
         let f = self.frame(msg)?;
         self.port.send(&f)
     }
 
-    fn pump(&mut self, timeout: Duration) -> Result<(), String> {
+    fn pump(&mut self, timeout: Duration) -> Result<(), LinkError> {
         let mut buf = [0u8; 256];
         let n = self.port.recv(&mut buf, timeout)?;
         let (inbox, foreign) = (&mut self.inbox, &mut self.foreign);
@@ -207,7 +210,7 @@ impl<P: BoardPort> Session<P> {
         &mut self,
         what: &str,
         mut want: impl FnMut(&Message) -> Option<T>,
-    ) -> Result<T, String> {
+    ) -> Result<T, LinkError> {
         let deadline = Instant::now() + ANSWER_TIMEOUT;
         loop {
             self.check_session()?;
@@ -222,10 +225,10 @@ impl<P: BoardPort> Session<P> {
             }
             let now = Instant::now();
             if now > deadline {
-                return Err(format!(
-                    "the board did not answer {what} within {} s",
-                    ANSWER_TIMEOUT.as_secs()
-                ));
+                return Err(LinkError::Timeout {
+                    what: what.to_string(),
+                    seconds: ANSWER_TIMEOUT.as_secs(),
+                });
             }
             self.pump((deadline - now).min(Duration::from_millis(50)))?;
         }
@@ -233,7 +236,7 @@ impl<P: BoardPort> Session<P> {
 
     /// Hello until the board answers (a pty drops what is sent before the
     /// other end opens it).
-    fn handshake(&mut self) -> Result<(), String> {
+    fn handshake(&mut self) -> Result<(), LinkError> {
         let deadline = Instant::now() + ANSWER_TIMEOUT;
         loop {
             self.send(&Message::hello(Role::Host, self.axes, self.session))?;
@@ -247,7 +250,7 @@ impl<P: BoardPort> Session<P> {
                 let ack = self.inbox.remove(i);
                 self.inbox.drain(..i);
                 ack.accept_ack(self.axes, self.session)
-                    .map_err(|e| e.to_string())?;
+                    .map_err(|e| LinkError::Handshake(e.to_string()))?;
                 self.open = true;
                 // What came after the answer in the same read is stamped.
                 let ours = self.session;
@@ -261,17 +264,14 @@ impl<P: BoardPort> Session<P> {
             if Instant::now() > deadline {
                 // (A board of another protocol may answer in a form this
                 // host cannot decode.)
-                return Err(format!(
-                    "no handshake answer from the board (this host speaks protocol {})",
-                    twoport_link::PROTOCOL_VERSION
-                ));
+                return Err(LinkError::NoHandshake(twoport_link::PROTOCOL_VERSION));
             }
         }
     }
 
     /// Read whatever the board has sent, waiting at most a millisecond
     /// (a free-running board: telemetry, replies, fault reports).
-    pub fn poll(&mut self) -> Result<(), String> {
+    pub fn poll(&mut self) -> Result<(), LinkError> {
         self.pump(Duration::from_millis(1))?;
         self.check_session()
     }
@@ -284,18 +284,14 @@ impl<P: BoardPort> Session<P> {
     /// An error once the board has answered in another session than this
     /// host's: it has reset since the handshake (or another host has
     /// opened one).
-    fn check_session(&self) -> Result<(), String> {
+    fn check_session(&self) -> Result<(), LinkError> {
         match self.foreign {
             None => Ok(()),
-            Some(NO_SESSION) => Err(format!(
-                "the board has reset since the handshake: it answers with no session, \
-                 not this host's {}",
-                self.session
-            )),
-            Some(s) => Err(format!(
-                "another host has opened session {s} with the board since this host's {}",
-                self.session
-            )),
+            Some(NO_SESSION) => Err(LinkError::Reset(self.session)),
+            Some(found) => Err(LinkError::Foreign {
+                found,
+                ours: self.session,
+            }),
         }
     }
 
@@ -306,7 +302,7 @@ impl<P: BoardPort> Session<P> {
     }
 
     /// The board's link counters.
-    pub fn board_stats(&mut self) -> Result<LinkStats, String> {
+    pub fn board_stats(&mut self) -> Result<LinkStats, LinkError> {
         self.send(&Message::GetStats)?;
         self.wait("GetStats", |m| match m {
             Message::Stats(s) => Some(*s),
@@ -321,7 +317,7 @@ impl<P: BoardPort> Session<P> {
 
     /// The next tick's number, with its heartbeat sent where one is due
     /// and the link is not lost.
-    pub(crate) fn tick_heartbeat(&mut self) -> Result<u64, String> {
+    pub(crate) fn tick_heartbeat(&mut self) -> Result<u64, LinkError> {
         let tick = self.tick;
         self.tick += 1;
         let lost = self.faults.link_loss_at.is_some_and(|t| tick >= t);
@@ -333,7 +329,11 @@ impl<P: BoardPort> Session<P> {
 
     /// Send tick `tick`'s sensors (and, on schedule, a corrupted copy
     /// first) and wait for the board's duties.
-    pub(crate) fn exchange(&mut self, tick: u64, sensors: PilSensors) -> Result<Axes<i16>, String> {
+    pub(crate) fn exchange(
+        &mut self,
+        tick: u64,
+        sensors: PilSensors,
+    ) -> Result<Axes<i16>, LinkError> {
         let want = sensors.tick;
         let good = self.frame(&Message::Sensors(sensors))?;
         let every = self.faults.corrupt_every;

@@ -9,6 +9,7 @@ use crate::link::{BoardPort, SerialBoard};
 use crate::scope::board::BoardLink;
 use crate::scope::rings::{last_trigger, Edge, Ring};
 use crate::scope::signals::{BoardSignal, Signal};
+use crate::Error;
 use crate::{Sample, Simulation};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -127,8 +128,8 @@ pub fn list_scenes(dir: &Path) -> Vec<PathBuf> {
 
 impl ScopeState {
     /// The scope on `scene_path`, listing the scenes beside it.
-    pub fn open(scene_path: &Path) -> Result<Self, String> {
-        let scene = Scene::load(scene_path, &[]).map_err(|e| e.to_string())?;
+    pub fn open(scene_path: &Path) -> Result<Self, Error> {
+        let scene = Scene::load(scene_path, &[])?;
         let sim = Simulation::new(scene.clone())?;
         let dir = scene_path.parent().unwrap_or(Path::new("."));
         let mut s = ScopeState {
@@ -438,7 +439,7 @@ impl ScopeState {
     pub fn set_wall(&mut self, x_m: f64, k_npm: f64) {
         match self.sim.servo_mut().set_wall(x_m, k_npm) {
             Ok(()) => self.wall = Some((x_m, k_npm)),
-            Err(e) => self.message = Some(e),
+            Err(e) => self.message = Some(e.to_string()),
         }
     }
 

@@ -4,6 +4,7 @@
 
 use crate::engine::scene::Scene;
 use crate::link::{BoardPort, LinkFaults, Session};
+use crate::Error;
 use crate::{Sample, Simulation};
 use twoport_link::{GainsReply, Message, Status, Telemetry};
 
@@ -38,7 +39,7 @@ impl BoardLink {
         name: &str,
         lockstep: bool,
         scene: &Scene,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, Error> {
         if lockstep {
             crate::pil::check_scene(scene)?;
         }
@@ -57,21 +58,21 @@ impl BoardLink {
     }
 
     /// One lockstep tick of `sim` with the board as its controller.
-    pub fn step<const N: usize>(&mut self, sim: &mut Simulation<N>) -> Result<Sample<N>, String> {
+    pub fn step<const N: usize>(&mut self, sim: &mut Simulation<N>) -> Result<Sample<N>, Error> {
         self.session.step(sim).map(|(s, _)| s)
     }
 
     /// A free-running board: keep its link watchdog fed and read what it
     /// sent.
-    pub fn watch(&mut self) -> Result<(), String> {
+    pub fn watch(&mut self) -> Result<(), Error> {
         self.session.send(&Message::Heartbeat)?;
-        self.session.poll()
+        Ok(self.session.poll()?)
     }
 
     /// Say `msg` to the board (a mode change, a fault clear, new gains);
     /// its answer comes back as a status, a reply or a refusal.
-    pub fn tell(&mut self, msg: &Message) -> Result<(), String> {
-        self.session.send(msg)
+    pub fn tell(&mut self, msg: &Message) -> Result<(), Error> {
+        Ok(self.session.send(msg)?)
     }
 
     /// Disarm the board and let it go.

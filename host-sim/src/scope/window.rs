@@ -3,6 +3,7 @@
 //! window twice (half-way and at `--exit-after`) and closes.
 
 use crate::scope::app::ScopeState;
+use crate::Error;
 use eframe::egui;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -35,7 +36,7 @@ struct Shots {
     started: Instant,
     last_frame: Instant,
     shots: u32,
-    saved: Arc<Mutex<Vec<Result<PathBuf, String>>>>,
+    saved: Arc<Mutex<Vec<Result<PathBuf, Error>>>>,
 }
 
 struct ScopeApp {
@@ -50,7 +51,7 @@ struct WorldApp {
     shots: Shots,
 }
 
-fn save_png(img: &egui::ColorImage, path: &Path) -> Result<PathBuf, String> {
+fn save_png(img: &egui::ColorImage, path: &Path) -> Result<PathBuf, Error> {
     let [w, h] = img.size;
     let bytes: Vec<u8> = img.pixels.iter().flat_map(|c| c.to_array()).collect();
     image::save_buffer(path, &bytes, w as u32, h as u32, image::ColorType::Rgba8)
@@ -138,10 +139,10 @@ pub fn display_available() -> bool {
 
 /// Open the scope on `scene` (the world view for a three-axis scene);
 /// returns the screenshots saved.
-pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, String> {
+pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, Error> {
     let shots = Shots::new(script);
     let saved = shots.saved.clone();
-    let parsed = crate::Scene::load(scene, &[]).map_err(|e| e.to_string())?;
+    let parsed = crate::Scene::load(scene, &[])?;
     let app: Box<dyn eframe::App> = if parsed.axes == 3 {
         Box::new(WorldApp {
             state: crate::scope::world::WorldState::new(parsed)?,
@@ -161,7 +162,7 @@ pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, String> {
         ..Default::default()
     };
     eframe::run_native("twoport scope", options, Box::new(|_cc| Ok(app)))
-        .map_err(|e| format!("the window would not open: {e}"))?;
+        .map_err(|e| Error::NoWindow(e.to_string()))?;
     let v = saved.lock().map(|v| v.clone()).unwrap_or_default();
     v.into_iter().collect()
 }

@@ -9,6 +9,7 @@ use crate::engine::servo::WorldView;
 use crate::link::{BoardPort, SerialBoard};
 use crate::scope::board::{BoardChoice, BoardLink};
 use crate::scope::rings::Ring;
+use crate::Error;
 use crate::{Sample, Scene, Simulation};
 use std::path::Path;
 use twoport_control::world::vbb::Block;
@@ -43,13 +44,13 @@ pub struct WorldState {
 
 impl WorldState {
     /// The scope on a three-axis scene file.
-    pub fn open(path: &Path) -> Result<Self, String> {
-        let scene = Scene::load(path, &[]).map_err(|e| e.to_string())?;
+    pub fn open(path: &Path) -> Result<Self, Error> {
+        let scene = Scene::load(path, &[])?;
         Self::new(scene)
     }
 
     /// The scope on `scene`.
-    pub fn new(scene: Scene) -> Result<Self, String> {
+    pub fn new(scene: Scene) -> Result<Self, Error> {
         let n = (HISTORY_S * 1000.0) as usize;
         let sim = Simulation::with_axes(scene)?;
         Ok(WorldState {
@@ -126,7 +127,7 @@ impl WorldState {
         }
     }
 
-    fn lost(&mut self, why: String) {
+    fn lost(&mut self, why: crate::Error) {
         self.message = Some(format!("board link lost: {why}"));
         self.board = None;
     }
@@ -167,7 +168,7 @@ impl WorldState {
 
     /// Where the device stands at rest before a run, as a board is told
     /// when calibrated (pm): where the world's cursor starts.
-    pub fn at_rest_pm(&self) -> Result<twoport_link::Axes<i64>, String> {
+    pub fn at_rest_pm(&self) -> Result<twoport_link::Axes<i64>, Error> {
         crate::pil::Setup::for_sim(&self.sim).map(|s| s.at_rest_pm)
     }
 

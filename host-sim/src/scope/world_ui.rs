@@ -75,7 +75,7 @@ fn board(ui: &mut Ui, s: &mut WorldState) {
         {
             match s.at_rest_pm() {
                 Ok(position_pm) => say = Some(Message::Calibrate { position_pm }),
-                Err(e) => s.message = Some(e),
+                Err(e) => s.message = Some(e.to_string()),
             }
         }
         if let Some(m) = say {

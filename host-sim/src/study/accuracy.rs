@@ -7,6 +7,7 @@
 
 use crate::engine::plant::Method;
 use crate::engine::scene::Precision;
+use crate::Error;
 use crate::{Scene, Simulation};
 use std::path::Path;
 use std::time::Instant;
@@ -54,7 +55,7 @@ fn with(scene: &Scene, method: Method, substeps: u32, controller: Precision) -> 
 }
 
 /// Handle path and the best wall time of three runs.
-fn path(scene: &Scene) -> Result<(Vec<f64>, f64, Option<String>), String> {
+fn path(scene: &Scene) -> Result<(Vec<f64>, f64, Option<String>), Error> {
     let mut best = f64::INFINITY;
     let mut out = (Vec::new(), None);
     for _ in 0..3 {
@@ -73,7 +74,7 @@ fn path(scene: &Scene) -> Result<(Vec<f64>, f64, Option<String>), String> {
 }
 
 /// Run the study on one scene against `reference`.
-pub fn study(label: &str, scene: &Scene, reference: (Method, u32)) -> Result<Vec<Cell>, String> {
+pub fn study(label: &str, scene: &Scene, reference: (Method, u32)) -> Result<Vec<Cell>, Error> {
     let (want, _, _) = path(&with(scene, reference.0, reference.1, Precision::F64))?;
     let peak = want.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-12);
     let sim_ms = scene.duration_s * 1e3;
@@ -120,12 +121,12 @@ pub struct StudyScene {
 }
 
 /// The two scenes of the study, from the repository root.
-pub fn scenes(root: &Path) -> Result<Vec<StudyScene>, String> {
+pub fn scenes(root: &Path) -> Result<Vec<StudyScene>, Error> {
     let load = |f: &str, sets: &[&str]| {
         let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
         let mut s = Scene::load(&root.join(f), &sets).map_err(|e| e.to_string())?;
         s.plant.model = root.join("models/excalibur.toml");
-        Ok::<Scene, String>(s)
+        Ok::<Scene, Error>(s)
     };
     Ok(vec![
         StudyScene {

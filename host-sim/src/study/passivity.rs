@@ -2,6 +2,7 @@
 //! the layer off, on, and at the scene's passive reference settings.
 
 use super::table1::case_files;
+use crate::Error;
 use crate::{Scene, Simulation};
 use std::path::Path;
 
@@ -50,8 +51,8 @@ fn outcome(r: &crate::engine::sim::Report) -> Outcome {
 
 /// Run the scene at `path` with `sets`, returning the report and the
 /// delivered force of every tick.
-fn run(path: &Path, sets: &[String]) -> Result<(crate::engine::sim::Report, Vec<f64>), String> {
-    let scene = Scene::load(path, sets).map_err(|e| e.to_string())?;
+fn run(path: &Path, sets: &[String]) -> Result<(crate::engine::sim::Report, Vec<f64>), Error> {
+    let scene = Scene::load(path, sets)?;
     let mut forces = Vec::new();
     let report = Simulation::new(scene)?.run(|s| forces.push(s.actuator_n[0]));
     Ok((report, forces))
@@ -59,8 +60,8 @@ fn run(path: &Path, sets: &[String]) -> Result<(crate::engine::sim::Report, Vec<
 
 /// One scene: off, on, reference. An error if the scene has no
 /// `[passivity]` table.
-pub fn row(path: &Path) -> Result<Row, String> {
-    let scene = Scene::load(path, &[]).map_err(|e| e.to_string())?;
+pub fn row(path: &Path) -> Result<Row, Error> {
+    let scene = Scene::load(path, &[])?;
     let spec = scene.passivity.ok_or(format!(
         "{}: no [passivity] table to compare",
         path.display()
@@ -91,7 +92,7 @@ pub fn row(path: &Path) -> Result<Row, String> {
 }
 
 /// Every scene in `folder`; `step` is called after each.
-pub fn table(folder: &Path, step: &mut dyn FnMut()) -> Result<Vec<Row>, String> {
+pub fn table(folder: &Path, step: &mut dyn FnMut()) -> Result<Vec<Row>, Error> {
     case_files(folder)?
         .iter()
         .map(|f| {

@@ -1,18 +1,19 @@
 //! A PNG of a run: handle position over time, and the forces.
 
+use crate::Error;
 use crate::Sample;
 use plotters::prelude::*;
 use std::path::Path;
 
 /// Draw the first axis of `samples` to `out` (PNG).
-pub fn png<const N: usize>(samples: &[Sample<N>], title: &str, out: &Path) -> Result<(), String> {
+pub fn png<const N: usize>(samples: &[Sample<N>], title: &str, out: &Path) -> Result<(), Error> {
     let _ =
         plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
     if samples.is_empty() {
         return Err("no samples to plot".into());
     }
     let root = BitMapBackend::new(out, (1100, 720)).into_drawing_area();
-    let e = |e: DrawingAreaErrorKind<_>| format!("{}: {e}", out.display());
+    let e = |e: DrawingAreaErrorKind<_>| Error::Output(format!("{}: {e}", out.display()));
     root.fill(&WHITE).map_err(e)?;
     let root = root.titled(title, ("sans-serif", 22)).map_err(e)?;
     let (top, bottom) = root.split_vertically(340);
@@ -32,7 +33,7 @@ pub fn png<const N: usize>(samples: &[Sample<N>], title: &str, out: &Path) -> Re
     let panel = |area: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
                  y_desc: &str,
                  series: &[Series<N>]|
-     -> Result<(), String> {
+     -> Result<(), Error> {
         let lo = series
             .iter()
             .map(|s| range(s.2).start)
@@ -98,11 +99,11 @@ pub fn png<const N: usize>(samples: &[Sample<N>], title: &str, out: &Path) -> Re
 
 /// The accuracy study as a PNG: error against cost, one line per method,
 /// a panel per scene.
-pub fn accuracy_png(cells: &[crate::study::accuracy::Cell], out: &Path) -> Result<(), String> {
+pub fn accuracy_png(cells: &[crate::study::accuracy::Cell], out: &Path) -> Result<(), Error> {
     let _ =
         plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
     let root = BitMapBackend::new(out, (1200, 560)).into_drawing_area();
-    let e = |e: DrawingAreaErrorKind<_>| format!("{}: {e}", out.display());
+    let e = |e: DrawingAreaErrorKind<_>| Error::Output(format!("{}: {e}", out.display()));
     root.fill(&WHITE).map_err(e)?;
     let root = root
         .titled(

@@ -1,14 +1,15 @@
 //! The boundary of stability along one scene parameter, by bisection.
 
+use crate::Error;
 use crate::{Scene, Simulation};
 use std::path::Path;
 
 /// Whether the scene at `path` (with `sets` overrides) is stable with
 /// `param = value`.
-pub fn stable_at(path: &Path, sets: &[String], param: &str, value: f64) -> Result<bool, String> {
+pub fn stable_at(path: &Path, sets: &[String], param: &str, value: f64) -> Result<bool, Error> {
     let mut s = sets.to_vec();
     s.push(format!("{param}={value}"));
-    let scene = Scene::load(path, &s).map_err(|e| e.to_string())?;
+    let scene = Scene::load(path, &s)?;
     Ok(Simulation::new(scene)?.run(|_| {}).stable)
 }
 
@@ -23,16 +24,16 @@ pub fn marginal(
     (from, to): (f64, f64),
     tol: f64,
     step: &mut dyn FnMut(),
-) -> Result<f64, String> {
+) -> Result<f64, Error> {
     if !(tol > 0.0 && tol < 1.0) {
-        return Err(format!("tolerance {tol}: must be between 0 and 1"));
+        return Err(sim_err!("tolerance {tol}: must be between 0 and 1"));
     }
     let (s_from, s_to) = (
         stable_at(path, sets, param, from)?,
         stable_at(path, sets, param, to)?,
     );
     if s_from == s_to {
-        return Err(format!(
+        return Err(sim_err!(
             "{param}: {} at both {from} and {to}; widen the range",
             if s_from { "stable" } else { "unstable" }
         ));

@@ -2,6 +2,7 @@
 //! then the boundaries swept as the paper did.
 
 use super::sweep::marginal;
+use crate::Error;
 use crate::{Scene, Simulation};
 use std::path::{Path, PathBuf};
 use twoport_control::servo::Display;
@@ -39,7 +40,7 @@ impl Table1 {
 }
 
 /// The `.toml` scenes in `folder`, sorted.
-pub fn case_files(folder: &Path) -> Result<Vec<PathBuf>, String> {
+pub fn case_files(folder: &Path) -> Result<Vec<PathBuf>, Error> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
         .map_err(|e| format!("{}: {e}", folder.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -47,18 +48,18 @@ pub fn case_files(folder: &Path) -> Result<Vec<PathBuf>, String> {
         .collect();
     files.sort();
     if files.is_empty() {
-        return Err(format!("{}: no scenes", folder.display()));
+        return Err(sim_err!("{}: no scenes", folder.display()));
     }
     Ok(files)
 }
 
 /// Run the table over the scenes in `folder`; `step` is called after each
 /// case.
-pub fn table1(folder: &Path, step: &mut dyn FnMut()) -> Result<Table1, String> {
+pub fn table1(folder: &Path, step: &mut dyn FnMut()) -> Result<Table1, Error> {
     let mut cases = Vec::new();
     let (mut k_bound, mut m_bound) = (f64::INFINITY, 0.0f64);
     for f in case_files(folder)? {
-        let scene = Scene::load(&f, &[]).map_err(|e| e.to_string())?;
+        let scene = Scene::load(&f, &[])?;
         let display = scene.display;
         let report = Simulation::new(scene)?.run(|_| {});
         let m = match display {

@@ -287,7 +287,7 @@ pub(crate) fn zoh(
     let mut blk = DMatrix::<f64>::zeros(na + m, na + m);
     blk.view_mut((0, 0), (na, na)).copy_from(&(a * t));
     blk.view_mut((0, na), (na, m)).copy_from(&(b * t));
-    let e = expm_balanced(&blk)?;
+    let e = expm_balanced(&blk).map_err(|e| e.to_string())?;
     Ok((
         e.view((0, 0), (na, na)).into_owned(),
         e.view((0, na), (na, m)).into_owned(),

@@ -1,12 +1,20 @@
 //! `host-sim`: the scope (no subcommand), headless scene runs, sweeps to a
 //! stability boundary, the paper's Table I, and processor-in-the-loop.
 
+/// A [`host_sim::Error::Sim`] with a `format!` message.
+macro_rules! err {
+    ($($t:tt)*) => {
+        host_sim::Error::Sim(format!($($t)*))
+    };
+}
+
 mod pil;
 mod run;
 mod scope;
 mod study;
 
 use clap::{Parser, Subcommand};
+use host_sim::Error;
 use pil::{pil, PilArgs};
 use run::{run, RunArgs};
 use scope::{scope, ScopeArgs};
@@ -61,7 +69,7 @@ fn main() -> ExitCode {
     }
 }
 
-fn subcommand(c: &Cmd) -> Result<(), String> {
+fn subcommand(c: &Cmd) -> Result<(), Error> {
     match c {
         Cmd::Scope(a) => scope(a),
         Cmd::Run(a) => run(a),

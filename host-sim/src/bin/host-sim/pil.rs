@@ -4,6 +4,7 @@
 use crate::run::load;
 use clap::Args;
 use host_sim::link;
+use host_sim::Error;
 use serde_json::json;
 use std::path::PathBuf;
 
@@ -40,10 +41,10 @@ pub(crate) struct PilArgs {
     pub(crate) check: bool,
 }
 
-pub(crate) fn pil(a: &PilArgs) -> Result<(), String> {
+pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
     use host_sim::pil;
     if !(a.seconds.is_finite() && a.seconds > 0.0 && a.seconds <= 3600.0) {
-        return Err(format!("--seconds {}: must be in (0, 3600]", a.seconds));
+        return Err(err!("--seconds {}: must be in (0, 3600]", a.seconds));
     }
     let scene = load(&a.scene, &[])?;
     // (Every scene ticks at the board's 1 kHz.)
@@ -51,7 +52,7 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), String> {
     let ticks = (a.seconds / period).round() as u64;
     let link_loss_at = match a.link_loss_at_s {
         Some(t) if t.is_finite() && t >= 0.0 && t < a.seconds => Some((t / period).round() as u64),
-        Some(t) => return Err(format!("--link-loss-at-s {t}: must be in [0, --seconds)")),
+        Some(t) => return Err(err!("--link-loss-at-s {t}: must be in [0, --seconds)")),
         None => None,
     };
     let faults = link::LinkFaults {
@@ -61,7 +62,7 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), String> {
     let port = a.port.as_deref().map(link::SerialBoard::open).transpose()?;
     let start = std::time::Instant::now();
     if (scene.period() - period).abs() > 1e-12 {
-        return Err(format!(
+        return Err(err!(
             "{}: a PIL scene ticks at the board's 1 kHz",
             a.scene.display()
         ));
@@ -109,7 +110,7 @@ pub(crate) fn pil_report<const N: usize>(
     run: Option<host_sim::pil::Run<N>>,
     local_s: f64,
     start: std::time::Instant,
-) -> Result<(), String> {
+) -> Result<(), Error> {
     use host_sim::pil;
     let board = if run.is_some() {
         "serial"
@@ -181,7 +182,7 @@ pub(crate) fn pil_report<const N: usize>(
         let deadline = u64::from(twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS);
         let bad = pil::failures(&run, &c, ticks, faults, deadline);
         if !bad.is_empty() {
-            return Err(format!("PIL check failed: {}", bad.join("; ")));
+            return Err(err!("PIL check failed: {}", bad.join("; ")));
         }
     }
     Ok(())

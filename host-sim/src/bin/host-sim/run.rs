@@ -2,6 +2,7 @@
 
 use clap::Args;
 use host_sim::engine::scene::Scene;
+use host_sim::Error;
 use host_sim::{Report, Sample, Simulation};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -33,8 +34,8 @@ pub(crate) struct RunArgs {
     pub(crate) png: Option<PathBuf>,
 }
 
-pub(crate) fn load(path: &Path, sets: &[String]) -> Result<Scene, String> {
-    Scene::load(path, sets).map_err(|e| e.to_string())
+pub(crate) fn load(path: &Path, sets: &[String]) -> Result<Scene, Error> {
+    Ok(Scene::load(path, sets)?)
 }
 
 /// `$body` with `N` the scene's axis count, a constant.
@@ -57,7 +58,7 @@ macro_rules! with_axes {
     };
 }
 
-pub(crate) fn run(a: &RunArgs) -> Result<(), String> {
+pub(crate) fn run(a: &RunArgs) -> Result<(), Error> {
     let mut sets = a.scene.sets.clone();
     if let Some(d) = a.duration {
         sets.push(format!("duration_s={d}"));
@@ -91,9 +92,9 @@ fn csv_header(axes: usize) -> String {
     h
 }
 
-fn run_axes<const N: usize>(a: &RunArgs, scene: Scene) -> Result<(), String> {
+fn run_axes<const N: usize>(a: &RunArgs, scene: Scene) -> Result<(), Error> {
     if a.png.is_some() && N != 1 {
-        return Err(format!(
+        return Err(err!(
             "--png draws a one-axis scene; give this {N}-axis one --csv"
         ));
     }
@@ -145,7 +146,7 @@ fn run_axes<const N: usize>(a: &RunArgs, scene: Scene) -> Result<(), String> {
 pub(crate) fn csv_file(
     path: Option<&Path>,
     header: &str,
-) -> Result<Option<std::io::BufWriter<std::fs::File>>, String> {
+) -> Result<Option<std::io::BufWriter<std::fs::File>>, Error> {
     let Some(p) = path else { return Ok(None) };
     let f = std::fs::File::create(p).map_err(|e| format!("{}: {e}", p.display()))?;
     let mut w = std::io::BufWriter::new(f);
@@ -157,12 +158,12 @@ pub(crate) fn csv_file(
 pub(crate) fn finish_csv(
     csv: Option<std::io::BufWriter<std::fs::File>>,
     row_err: Option<std::io::Error>,
-) -> Result<(), String> {
+) -> Result<(), Error> {
     if let Some(e) = row_err {
-        return Err(format!("writing the CSV: {e}"));
+        return Err(err!("writing the CSV: {e}"));
     }
     match csv {
-        Some(mut w) => w.flush().map_err(|e| format!("writing the CSV: {e}")),
+        Some(mut w) => w.flush().map_err(|e| err!("writing the CSV: {e}")),
         None => Ok(()),
     }
 }

@@ -3,6 +3,7 @@
 
 use crate::run::{run, RunArgs, SceneArgs};
 use clap::Args;
+use host_sim::Error;
 use std::path::PathBuf;
 
 /// The scope: the default when no subcommand is given.
@@ -24,10 +25,10 @@ pub(crate) struct ScopeArgs {
 }
 
 /// The scope, or where no window can open, a headless run of its scene.
-pub(crate) fn scope(a: &ScopeArgs) -> Result<(), String> {
+pub(crate) fn scope(a: &ScopeArgs) -> Result<(), Error> {
     if let Some(t) = a.exit_after {
         if !(t.is_finite() && t > 0.0) {
-            return Err(format!(
+            return Err(err!(
                 "--exit-after {t}: must be a positive number of seconds"
             ));
         }
@@ -41,7 +42,7 @@ pub(crate) fn scope(a: &ScopeArgs) -> Result<(), String> {
         return Ok(()); // the window ran and closed
     };
     if a.screenshot.is_some() {
-        return Err(format!("--screenshot needs a window: {why_headless}"));
+        return Err(err!("--screenshot needs a window: {why_headless}"));
     }
     eprintln!(
         "host-sim: {why_headless}; running {} headless instead",
@@ -61,7 +62,7 @@ pub(crate) fn scope(a: &ScopeArgs) -> Result<(), String> {
 
 /// The scope window; `Ok(Some(why))` where none can open.
 #[cfg(feature = "gui")]
-pub(crate) fn open_window(a: &ScopeArgs) -> Result<Option<String>, String> {
+pub(crate) fn open_window(a: &ScopeArgs) -> Result<Option<String>, Error> {
     if !host_sim::scope::window::display_available() {
         return Ok(Some(
             "no display (DISPLAY and WAYLAND_DISPLAY are unset)".to_string(),
@@ -78,13 +79,13 @@ pub(crate) fn open_window(a: &ScopeArgs) -> Result<Option<String>, String> {
             }
             Ok(None)
         }
-        Err(e) if e.starts_with("the window would not open") => Ok(Some(e)),
+        Err(e @ Error::NoWindow(_)) => Ok(Some(e.to_string())),
         Err(e) => Err(e),
     }
 }
 
 /// Built without the `gui` feature: there is no window to open.
 #[cfg(not(feature = "gui"))]
-pub(crate) fn open_window(_: &ScopeArgs) -> Result<Option<String>, String> {
+pub(crate) fn open_window(_: &ScopeArgs) -> Result<Option<String>, Error> {
     Ok(Some("built without the `gui` feature".to_string()))
 }

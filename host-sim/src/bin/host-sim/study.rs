@@ -4,6 +4,7 @@
 use crate::run::SceneArgs;
 use clap::Args;
 use host_sim::study::{passivity, sweep, table1};
+use host_sim::Error;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -67,8 +68,8 @@ pub(crate) fn bar(len: u64, msg: String) -> ProgressBar {
 pub(crate) fn over_cases<T>(
     dir: &Path,
     what: &str,
-    study: impl FnOnce(&Path, &mut dyn FnMut()) -> Result<T, String>,
-) -> Result<T, String> {
+    study: impl FnOnce(&Path, &mut dyn FnMut()) -> Result<T, Error>,
+) -> Result<T, Error> {
     let n = table1::case_files(dir)?.len();
     let b = bar(n as u64, what.into());
     let out = study(dir, &mut || b.inc(1));
@@ -76,9 +77,9 @@ pub(crate) fn over_cases<T>(
     out
 }
 
-pub(crate) fn sweep(a: &SweepArgs) -> Result<(), String> {
+pub(crate) fn sweep(a: &SweepArgs) -> Result<(), Error> {
     if !(a.tol > 0.0 && a.tol < 1.0) {
-        return Err(format!("--tol {}: must be between 0 and 1", a.tol));
+        return Err(err!("--tol {}: must be between 0 and 1", a.tol));
     }
     let b = bar(
         sweep::steps(a.from, a.to, a.tol),
@@ -107,7 +108,7 @@ pub(crate) fn sweep(a: &SweepArgs) -> Result<(), String> {
 
 /// The passivity layer's table: each scene off, on, and at its passive
 /// reference.
-pub(crate) fn passivity(a: &PassivityArgs) -> Result<(), String> {
+pub(crate) fn passivity(a: &PassivityArgs) -> Result<(), Error> {
     let rows = over_cases(&a.scenes, "passivity scenes", passivity::table)?;
     if a.json {
         println!("{}", json!({ "rows": rows }));
@@ -119,7 +120,7 @@ pub(crate) fn passivity(a: &PassivityArgs) -> Result<(), String> {
 
 /// Table I: every VE state x grasp at the theoretical gains, then the
 /// boundaries swept as the paper did.
-pub(crate) fn table1(a: &Table1Args) -> Result<(), String> {
+pub(crate) fn table1(a: &Table1Args) -> Result<(), Error> {
     let t = over_cases(&a.scenes, "Table I", table1::table1)?;
     let rows: Vec<serde_json::Value> = t
         .cases
@@ -181,7 +182,7 @@ pub(crate) fn table1(a: &Table1Args) -> Result<(), String> {
     Ok(())
 }
 
-pub(crate) fn accuracy(a: &AccuracyArgs) -> Result<(), String> {
+pub(crate) fn accuracy(a: &AccuracyArgs) -> Result<(), Error> {
     std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
     let scenes = host_sim::study::accuracy::scenes(Path::new("."))?;
     let b = bar(scenes.len() as u64, "accuracy study".into());

@@ -3,42 +3,43 @@
 
 use super::{Coupling, LayerPort, Scene, VeSpec, MAX_AXES, MAX_BLOCKS};
 use crate::engine::human::AxisValue;
+use crate::Error;
 use twoport_control::servo::Display;
 
 impl Scene {
     /// Physical checks beyond the types; the message names the field.
-    pub(super) fn check(&self) -> Result<(), String> {
+    pub(super) fn check(&self) -> Result<(), Error> {
         let pos = |name: &str, v: f64| {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(format!("{name} = {v} must be finite and > 0"))
+                Err(sim_err!("{name} = {v} must be finite and > 0"))
             }
         };
         let nonneg = |name: &str, v: f64| {
             if v.is_finite() && v >= 0.0 {
                 Ok(())
             } else {
-                Err(format!("{name} = {v} must be finite and >= 0"))
+                Err(sim_err!("{name} = {v} must be finite and >= 0"))
             }
         };
         // A spring VE anchored at `at` (m, named `at_name`).
         let spring = |at_name: &str, at: f64, k: f64, b: f64| {
             if !at.is_finite() {
-                return Err(format!("{at_name} = {at} must be finite"));
+                return Err(sim_err!("{at_name} = {at} must be finite"));
             }
             nonneg("ve.stiffness_npm", k)?;
             nonneg("ve.damping_nspm", b)
         };
         if !(1..=MAX_AXES).contains(&self.axes) {
-            return Err(format!(
+            return Err(sim_err!(
                 "axes = {}: the simulator runs devices of 1 to {MAX_AXES} axes",
                 self.axes
             ));
         }
         let cc = self.plant.cross_coupling;
         if !(cc.is_finite() && (0.0..0.5).contains(&cc)) {
-            return Err(format!("plant.cross_coupling = {cc} must be in [0, 0.5)"));
+            return Err(sim_err!("plant.cross_coupling = {cc} must be in [0, 0.5)"));
         }
         if cc != 0.0 && self.axes == 1 {
             return Err(
@@ -49,13 +50,13 @@ impl Scene {
         pos("duration_s", self.duration_s)?;
         if let Some(t) = self.period_s {
             if !(t.is_finite() && (1e-6..=0.1).contains(&t)) {
-                return Err(format!("period_s = {t} must be between 1e-6 and 0.1 s"));
+                return Err(sim_err!("period_s = {t} must be between 1e-6 and 0.1 s"));
             }
         }
         pos("plant.rigid_mass_kg", self.plant.rigid_mass_kg)?;
         nonneg("plant.rigid_damping_nspm", self.plant.rigid_damping_nspm)?;
         if self.integrator.substeps == 0 || self.integrator.substeps > 100_000 {
-            return Err(format!(
+            return Err(sim_err!(
                 "integrator.substeps = {} must be 1..=100000",
                 self.integrator.substeps
             ));
@@ -64,7 +65,7 @@ impl Scene {
             None => self.check_coupling("coupling", &self.coupling)?,
             Some(each) => {
                 if each.len() != self.axis_count() {
-                    return Err(format!(
+                    return Err(sim_err!(
                         "coupling_per_axis has {} couplings for {} axes",
                         each.len(),
                         self.axes
@@ -118,7 +119,7 @@ impl Scene {
                     pos(&format!("ve.blocks[{i}].width_m"), b.width_m)?;
                     pos(&format!("ve.blocks[{i}].mass_kg"), b.mass_kg)?;
                     if !(b.at_m.is_finite() && b.at_m >= edge - 1e-12) {
-                        return Err(format!(
+                        return Err(sim_err!(
                             "ve.blocks[{i}] overlaps the block or limit to its left"
                         ));
                     }
@@ -137,18 +138,18 @@ impl Scene {
                 ..
             } => {
                 if self.axes != 3 {
-                    return Err(format!(
+                    return Err(sim_err!(
                         "ve.kind = \"world\" is a 3-D world: it needs axes = 3, not {}",
                         self.axes
                     ));
                 }
                 for (name, times) in [("grab_at_s", grab_at_s), ("release_at_s", release_at_s)] {
                     if let Some(t) = times.iter().find(|t| !(t.is_finite() && **t >= 0.0)) {
-                        return Err(format!("ve.{name}: {t} is not a time >= 0 (s)"));
+                        return Err(sim_err!("ve.{name}: {t} is not a time >= 0 (s)"));
                     }
                 }
                 if blocks.len() > MAX_BLOCKS {
-                    return Err(format!(
+                    return Err(sim_err!(
                         "ve.blocks: {} blocks, the world holds {MAX_BLOCKS}",
                         blocks.len()
                     ));
@@ -161,7 +162,7 @@ impl Scene {
                         && b.mass_kg.is_finite()
                         && b.mass_kg > 0.0;
                     if !ok {
-                        return Err(format!(
+                        return Err(sim_err!(
                             "ve.blocks[{i}]: at_m within 2 m, size_m in (0, 2) m and mass_kg > 0"
                         ));
                     }
@@ -174,17 +175,19 @@ impl Scene {
         if let Some(x) = e.encoder {
             pos("effects.encoder.resolution_m", x.resolution_m)?;
             if !(2..=32).contains(&x.bits) {
-                return Err(format!("effects.encoder.bits = {} must be 2..=32", x.bits));
+                return Err(sim_err!("effects.encoder.bits = {} must be 2..=32", x.bits));
             }
             if let Some(m) = x.index_m {
                 if !(m.is_finite() && m.abs() <= 1.0) {
-                    return Err(format!("effects.encoder.index_m = {m} must be within ±1 m"));
+                    return Err(sim_err!(
+                        "effects.encoder.index_m = {m} must be within ±1 m"
+                    ));
                 }
             }
         }
         if let Some(x) = e.hard_stop {
             if !(x.position_m.is_finite() && x.position_m.abs() <= 1.0) {
-                return Err(format!(
+                return Err(sim_err!(
                     "effects.hard_stop.position_m = {} must be within ±1 m",
                     x.position_m
                 ));
@@ -215,12 +218,15 @@ impl Scene {
         }
         if let Some(x) = e.delay {
             if x.ticks > 1000 {
-                return Err(format!("effects.delay.ticks = {} must be <= 1000", x.ticks));
+                return Err(sim_err!(
+                    "effects.delay.ticks = {} must be <= 1000",
+                    x.ticks
+                ));
             }
         }
         if let Some(x) = e.element_delay {
             if x.ticks > 1000 {
-                return Err(format!(
+                return Err(sim_err!(
                     "effects.element_delay.ticks = {} must be <= 1000",
                     x.ticks
                 ));
@@ -254,12 +260,12 @@ impl Scene {
 
     /// One axis's coupling, named `name` in errors, for the scene's
     /// display.
-    fn check_coupling(&self, name: &str, c: &Coupling) -> Result<(), String> {
+    fn check_coupling(&self, name: &str, c: &Coupling) -> Result<(), Error> {
         let nonneg = |field: &str, v: f64| {
             if v.is_finite() && v >= 0.0 {
                 Ok(())
             } else {
-                Err(format!("{name}.{field} = {v} must be finite and >= 0"))
+                Err(sim_err!("{name}.{field} = {v} must be finite and >= 0"))
             }
         };
         let admittance = [("m", c.m), ("kp", c.kp), ("bp", c.bp)];
@@ -270,7 +276,7 @@ impl Scene {
                 nonneg("k", k)?;
                 nonneg("b", c.b)?;
                 if let Some((n, _)) = admittance.iter().find(|(_, v)| v.is_some()) {
-                    return Err(format!("{name}.{n} belongs to an admittance display"));
+                    return Err(sim_err!("{name}.{n} belongs to an admittance display"));
                 }
             }
             Display::Admittance => {
@@ -280,11 +286,13 @@ impl Scene {
                 }
                 for (n, v) in [("m", c.m.unwrap_or(0.0)), ("b", c.b)] {
                     if !(v.is_finite() && v > 0.0) {
-                        return Err(format!("{name}.{n} = {v} must be finite and > 0"));
+                        return Err(sim_err!("{name}.{n} = {v} must be finite and > 0"));
                     }
                 }
                 if c.k.is_some() {
-                    return Err(format!("{name}.k belongs to an impedance display (use kp)"));
+                    return Err(sim_err!(
+                        "{name}.k belongs to an impedance display (use kp)"
+                    ));
                 }
             }
         }
@@ -293,7 +301,7 @@ impl Scene {
 
     /// The script's positions and forces: numbers on a one-axis device,
     /// one per axis on a device of several.
-    fn check_script(&self) -> Result<(), String> {
+    fn check_script(&self) -> Result<(), Error> {
         let n = self.axis_count();
         for (i, e) in self.human.script.iter().enumerate() {
             let Some(v) = e.values() else { continue };
@@ -303,9 +311,9 @@ impl Scene {
             };
             if !fits {
                 return Err(if n == 1 {
-                    format!("human.script[{i}]: a one-axis scene's values are numbers (or arrays of one)")
+                    sim_err!("human.script[{i}]: a one-axis scene's values are numbers (or arrays of one)")
                 } else {
-                    format!(
+                    sim_err!(
                         "human.script[{i}]: give one value per axis, {n} in all (x first), not {}",
                         v.len()
                     )

@@ -10,6 +10,7 @@ pub use parse::{apply_set, checked, parse_toml, read, SceneError};
 pub use spec::*;
 
 use crate::engine::human::Human;
+use crate::Error;
 use serde::Deserialize;
 use std::path::Path;
 use twoport_control::servo::{AdmittanceGains, Display, Gains, ImpedanceGains};
@@ -65,9 +66,9 @@ impl Scene {
 
     /// The scene's device model, [`twoport_design::DeviceModel::load_or_excalibur`]; the
     /// error names `plant.model`.
-    pub fn device_model(&self) -> Result<twoport_design::DeviceModel, String> {
+    pub fn device_model(&self) -> Result<twoport_design::DeviceModel, Error> {
         twoport_design::DeviceModel::load_or_excalibur(&self.plant.model)
-            .map_err(|e| format!("plant.model: {e}"))
+            .map_err(|e| sim_err!("plant.model: {e}"))
     }
 
     /// Read a scene file, apply `--set` overrides, and check it.
@@ -82,7 +83,7 @@ impl Scene {
 
     /// The hand along each axis: the script's events with each axis's
     /// values (checked; the error names `human.script[i]`).
-    pub fn humans(&self) -> Result<Vec<Human>, String> {
+    pub fn humans(&self) -> Result<Vec<Human>, Error> {
         (0..self.axis_count())
             .map(|a| {
                 let events = self.human.script.iter().map(|e| e.along(|v| v.on(a)));

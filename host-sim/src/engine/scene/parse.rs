@@ -1,6 +1,7 @@
 //! Reading a scene file: TOML with `--set` overrides, and errors that
 //! name the file and the line or the field.
 
+use crate::Error;
 use std::path::Path;
 
 /// Why a scene was refused: the file, and the line or the field.
@@ -67,7 +68,7 @@ pub fn read(path: &Path) -> Result<String, SceneError> {
 pub fn checked<T>(
     scene: T,
     source: &str,
-    check: impl FnOnce(&T) -> Result<(), String>,
+    check: impl FnOnce(&T) -> Result<(), Error>,
 ) -> Result<T, SceneError> {
     check(&scene).map_err(|m| SceneError(format!("{source}: {m}")))?;
     Ok(scene)

@@ -12,6 +12,7 @@ use crate::engine::plant::{Device, Method, Stepper, System};
 use crate::engine::scene::Scene;
 use crate::engine::servo::SceneServo;
 use crate::engine::stability::Detector;
+use crate::Error;
 use twoport_control::{Encoder, Position, SafetyConfig};
 
 /// One tick's record on a device of `N` axes: each per-axis field holds
@@ -260,16 +261,16 @@ pub fn integrator_warning(sys: &System, method: Method, h: f64) -> Option<String
 
 impl Simulation {
     /// Build a simulation for a one-axis `scene`.
-    pub fn new(scene: Scene) -> Result<Self, String> {
+    pub fn new(scene: Scene) -> Result<Self, Error> {
         Self::with_axes(scene)
     }
 }
 
 impl<const N: usize> Simulation<N> {
     /// Build a simulation for `scene`, whose `axes` must be `N`.
-    pub fn with_axes(mut scene: Scene) -> Result<Self, String> {
+    pub fn with_axes(mut scene: Scene) -> Result<Self, Error> {
         if scene.axis_count() != N {
-            return Err(format!(
+            return Err(sim_err!(
                 "axes = {}: this simulation runs a device of {N}",
                 scene.axes
             ));
@@ -314,7 +315,7 @@ impl<const N: usize> Simulation<N> {
                     .or_else(|| integrator_warning(&sys, method, h));
                 Ok((g, Stepper::new(&sys, method, h)?))
             })
-            .collect::<Result<_, String>>()?;
+            .collect::<Result<_, Error>>()?;
         let (bits, pm_per_count) = match e.encoder {
             Some(enc) => (enc.bits, (enc.resolution_m * 1e12).round()),
             // Ideal sensing: 1 nm counts, the resolution of a Position.
@@ -421,7 +422,7 @@ impl<const N: usize> Simulation<N> {
 
     /// Hold the hand in `grasp` (the scope's grasp control), or give it
     /// back to the script with `None`.
-    pub fn set_grasp(&mut self, grasp: Option<GraspKind>) -> Result<(), String> {
+    pub fn set_grasp(&mut self, grasp: Option<GraspKind>) -> Result<(), Error> {
         if let Some(g) = grasp {
             if !self.steppers.iter().any(|(k, _)| *k == g) {
                 let grasp = self.axes[0].human.grasp_of(g);

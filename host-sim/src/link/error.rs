@@ -1,0 +1,62 @@
+//! What can go wrong on the host's side of a link.
+
+use thiserror::Error;
+
+/// Why a call to a board failed.
+#[derive(Clone, Debug, PartialEq, Eq, Error)]
+pub enum LinkError {
+    /// The serial port would not open.
+    #[error("serial port {path}: {why}")]
+    Open {
+        /// Its path.
+        path: String,
+        /// What the system said.
+        why: String,
+    },
+    /// Reading or writing the transport failed.
+    #[error("serial {0}")]
+    Transport(String),
+    /// A message would not encode into a frame.
+    #[error("encode: {0}")]
+    Encode(String),
+    /// No board image to run in-process.
+    #[error("{0}")]
+    Image(String),
+    /// No answer to the handshake.
+    #[error("no handshake answer from the board (this host speaks protocol {0})")]
+    NoHandshake(u16),
+    /// The board's handshake answer does not fit this host (another
+    /// protocol, another axis count).
+    #[error("{0}")]
+    Handshake(String),
+    /// No answer in time.
+    #[error("the board did not answer {what} within {seconds} s")]
+    Timeout {
+        /// What was asked.
+        what: String,
+        /// How long the host waited (s).
+        seconds: u64,
+    },
+    /// The board refused a mode change or a request, and why.
+    #[error("the board refused {asked}: {why}")]
+    Refused {
+        /// What was asked.
+        asked: String,
+        /// The board's reason.
+        why: String,
+    },
+    /// The board answers with no session: it has reset since the
+    /// handshake.
+    #[error(
+        "the board has reset since the handshake: it answers with no session, not this host's {0}"
+    )]
+    Reset(u16),
+    /// The board answers in another host's session.
+    #[error("another host has opened session {found} with the board since this host's {ours}")]
+    Foreign {
+        /// The session the board answers in.
+        found: u16,
+        /// This host's.
+        ours: u16,
+    },
+}
