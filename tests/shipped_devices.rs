@@ -2,6 +2,7 @@
 //! the design, a counterexample 20% past it) and run in the time domain: the
 //! README's table of shipped devices, row by row.
 
+use host_sim::engine::scene::Coupling;
 use host_sim::{Scene, Simulation};
 use std::path::Path;
 use twoport_control::{Gains, ImpedanceGains};
@@ -72,8 +73,10 @@ fn every_device_scene_is_proven_and_stable() {
             "{scene} runs {model}"
         );
         let a = Analysis::of(&m).unwrap();
-        let k = s.coupling.k.unwrap();
-        let c = check_impedance(&a, k, s.coupling.b, Some(HumanBound::PAPER)).unwrap();
+        let Coupling::Impedance { k, b } = s.coupling else {
+            panic!("{scene}: an impedance coupling");
+        };
+        let c = check_impedance(&a, k, b, Some(HumanBound::PAPER)).unwrap();
         assert!(c.absolutely_stable, "{scene}: {c:?}");
         let mut s = s;
         s.plant.model = root().join(model);

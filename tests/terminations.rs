@@ -7,7 +7,7 @@
 //! that makes and breaks contact is a nonlinear VE and is not drawn here.
 
 use host_sim::engine::plant::Arm;
-use host_sim::engine::scene::{Integration, VeSpec};
+use host_sim::engine::scene::{Coupling, Integration, VeSpec};
 use host_sim::{Scene, Simulation};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
@@ -125,8 +125,16 @@ fn stable(display: Display, c: &Case, set: &[(&str, f64)]) -> Result<(), String>
     let mut s = base(display);
     for (k, v) in set {
         match *k {
-            "k" => s.coupling.k = Some(*v),
-            "m" => s.coupling.m = Some(*v),
+            "k" => {
+                if let Coupling::Impedance { k, .. } = &mut s.coupling {
+                    *k = *v;
+                }
+            }
+            "m" => {
+                if let Coupling::Admittance { m, .. } = &mut s.coupling {
+                    *m = *v;
+                }
+            }
             _ => unreachable!(),
         }
     }
@@ -307,7 +315,9 @@ fn impedance_gains_past_the_bound_meet_the_termination_the_two_port_names() {
     );
     let run = |k_c: f64, discretization| {
         let mut s = base(Display::Impedance);
-        s.coupling.k = Some(k_c);
+        if let Coupling::Impedance { k, .. } = &mut s.coupling {
+            *k = k_c;
+        }
         s.duration_s = 10.0;
         s.ve = VeSpec::Spring {
             anchor_m: 0.0,
@@ -384,7 +394,9 @@ fn the_simulated_ve_port_impedance_is_the_designers() {
         for bin in [320u32, 329, 337] {
             let f_hz = bin as f64 / 4.0;
             let mut s = base(Display::Impedance);
-            s.coupling.k = Some(k);
+            if let Coupling::Impedance { k: k_c, .. } = &mut s.coupling {
+                *k_c = k;
+            }
             s.duration_s = 20.0;
             s.human.script = vec![];
             let mut sim = Simulation::new(s).unwrap();

@@ -5,7 +5,7 @@
 
 use host_sim::engine::human::{Event, GraspKind};
 use host_sim::engine::plant::Arm;
-use host_sim::engine::scene::{Discretization, VeSpec};
+use host_sim::engine::scene::{Coupling, Discretization, VeSpec};
 use host_sim::{Scene, Simulation};
 use std::path::Path;
 use twoport_control::{Gains, ImpedanceGains};
@@ -41,8 +41,7 @@ fn scene_on(model: &str, k: f64, b: f64, ve: &Ve) -> Scene {
     )
     .unwrap();
     s.plant.model = root.join(model);
-    s.coupling.k = Some(k);
-    s.coupling.b = b;
+    s.coupling = Coupling::Impedance { k, b };
     s.duration_s = 6.0;
     let spring = |stiffness_npm, damping_nspm, discretization| VeSpec::Spring {
         anchor_m: 0.0,

@@ -234,6 +234,46 @@ fn bad_scene_files_name_the_line_and_field() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("coupling.m is required"), "{e}");
+    // A coupling is one display's: its keys say which, and a mix, or too
+    // few, is refused with the line and what is wrong.
+    for (set, want) in [
+        (
+            "coupling.m=5.0",
+            "m belongs to an admittance display's coupling",
+        ),
+        (
+            "coupling.k=",
+            "give k and b (impedance display), or kp, bp, m and b",
+        ),
+    ] {
+        let text = if set.ends_with('=') {
+            text.replace("k = 51000.0", "")
+        } else {
+            text.clone()
+        };
+        let sets: Vec<String> = if set.ends_with('=') {
+            vec![]
+        } else {
+            vec![set.into()]
+        };
+        let e = Scene::parse(&text, "w", &sets).unwrap_err().to_string();
+        assert!(e.starts_with("w") && e.contains(want), "{set}: {e}");
+    }
+    let e = Scene::parse(
+        &text,
+        "w",
+        &[
+            "display=\"admittance\"".into(),
+            "coupling={kp=51000.0,bp=90.0,b=500.0}".into(),
+            "effects.load_cell=true".into(),
+        ],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("m is required for an admittance display's coupling"),
+        "{e}"
+    );
     let e = Scene::parse(
         &text,
         "w",

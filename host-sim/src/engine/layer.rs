@@ -2,7 +2,7 @@
 //! what the display's element sees, and the books the scope and the report
 //! read (observed energy, added damping, energy dissipated).
 
-use crate::engine::scene::{LayerPort, Scene};
+use crate::engine::scene::{Coupling, LayerPort, Scene};
 use crate::Error;
 use std::collections::VecDeque;
 use twoport_control::passivity::{
@@ -58,7 +58,11 @@ impl<R: Real> SceneLayer<R> {
                     series = Some(SeriesDamper::new(l).map_err(|e| e.to_string())?);
                 }
                 Display::Admittance => {
-                    let m = scene.coupling.m.unwrap_or(0.0) as f32;
+                    let m = match scene.coupling_of(0) {
+                        Coupling::Admittance { m, .. } => *m as f32,
+                        // (A checked scene's coupling is its display's.)
+                        Coupling::Impedance { .. } => 0.0,
+                    };
                     let mut l = ParallelLimits::for_display(m, t, safety.max_velocity_mps)
                         .map_err(|e| e.to_string())?;
                     if let Some(e) = p.max_reserve_j {

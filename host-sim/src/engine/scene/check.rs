@@ -258,8 +258,8 @@ impl Scene {
         Ok(())
     }
 
-    /// One axis's coupling, named `name` in errors, for the scene's
-    /// display.
+    /// One axis's coupling, named `name` in errors: the scene's display's,
+    /// with gains that make a coupling.
     fn check_coupling(&self, name: &str, c: &Coupling) -> Result<(), Error> {
         let nonneg = |field: &str, v: f64| {
             if v.is_finite() && v >= 0.0 {
@@ -268,35 +268,31 @@ impl Scene {
                 Err(sim_err!("{name}.{field} = {v} must be finite and >= 0"))
             }
         };
-        let admittance = [("m", c.m), ("kp", c.kp), ("bp", c.bp)];
-        match self.display {
-            Display::Impedance => {
-                let k =
-                    c.k.ok_or(format!("{name}.k is required for an impedance display"))?;
+        let pos = |field: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(sim_err!("{name}.{field} = {v} must be finite and > 0"))
+            }
+        };
+        match (*c, self.display) {
+            (Coupling::Impedance { k, b }, Display::Impedance) => {
                 nonneg("k", k)?;
-                nonneg("b", c.b)?;
-                if let Some((n, _)) = admittance.iter().find(|(_, v)| v.is_some()) {
-                    return Err(sim_err!("{name}.{n} belongs to an admittance display"));
-                }
+                nonneg("b", b)
             }
-            Display::Admittance => {
-                for (n, v) in admittance {
-                    let v = v.ok_or(format!("{name}.{n} is required for an admittance display"))?;
-                    nonneg(n, v)?;
-                }
-                for (n, v) in [("m", c.m.unwrap_or(0.0)), ("b", c.b)] {
-                    if !(v.is_finite() && v > 0.0) {
-                        return Err(sim_err!("{name}.{n} = {v} must be finite and > 0"));
-                    }
-                }
-                if c.k.is_some() {
-                    return Err(sim_err!(
-                        "{name}.k belongs to an impedance display (use kp)"
-                    ));
-                }
+            (Coupling::Admittance { kp, bp, m, b }, Display::Admittance) => {
+                nonneg("kp", kp)?;
+                nonneg("bp", bp)?;
+                pos("m", m)?;
+                pos("b", b)
             }
+            (Coupling::Impedance { .. }, Display::Admittance) => Err(sim_err!(
+                "{name}: an admittance display's coupling needs kp, bp, m and b ({name}.m is required; k belongs to an impedance display)"
+            )),
+            (Coupling::Admittance { .. }, Display::Impedance) => Err(sim_err!(
+                "{name}: an impedance display's coupling is k and b (kp, bp and m belong to an admittance display)"
+            )),
         }
-        Ok(())
     }
 
     /// The script's positions and forces: numbers on a one-axis device,

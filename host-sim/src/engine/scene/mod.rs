@@ -13,7 +13,7 @@ use crate::engine::human::Human;
 use crate::Error;
 use serde::Deserialize;
 use std::path::Path;
-use twoport_control::servo::{AdmittanceGains, Display, Gains, ImpedanceGains};
+use twoport_control::servo::{Display, Gains};
 
 /// A scene, as read from TOML. Every section but `display`, `coupling` and
 /// `ve` has defaults; unknown keys are errors.
@@ -117,19 +117,9 @@ impl Scene {
             .unwrap_or(&self.coupling)
     }
 
-    /// Axis `axis`'s servo gains: the one reading of its coupling (checked
-    /// by validation, so a missing gain cannot reach here from a loaded
-    /// scene; it reads as zero, which the laws refuse where zero is
-    /// invalid).
+    /// Axis `axis`'s servo gains.
     pub fn gains_of(&self, axis: usize) -> Gains {
-        let c = self.coupling_of(axis);
-        let g = |v: Option<f64>| v.unwrap_or(0.0) as f32;
-        match self.display {
-            Display::Impedance => ImpedanceGains::new(g(c.k), c.b as f32).into(),
-            Display::Admittance => {
-                AdmittanceGains::new(g(c.kp), g(c.bp), g(c.m), c.b as f32).into()
-            }
-        }
+        self.coupling_of(axis).gains()
     }
 }
 

@@ -5,6 +5,7 @@ use crate::engine::human::{AxisValue, Event, GraspKind};
 use crate::engine::plant::Method;
 use serde::Deserialize;
 use std::path::PathBuf;
+use twoport_control::servo::{AdmittanceGains, Display, Gains, ImpedanceGains};
 
 /// The passivity layer between the device's port and the display's
 /// element: the series damper on an impedance display, the parallel damper
@@ -154,20 +155,101 @@ impl Default for IntegratorSpec {
     }
 }
 
-/// Gains. Impedance display: `k`, `b`. Admittance display: `kp`, `bp`, `m`, `b`.
+/// One axis's coupling as a scene file gives it: `k` and `b` for the
+/// impedance display, `kp`, `bp`, `m` and `b` for the admittance display.
+/// Which one the keys make must be the scene's `display`.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(try_from = "CouplingKeys")]
+pub enum Coupling {
+    /// The impedance display's coupling `Z_cI`.
+    Impedance {
+        /// Stiffness (N/m).
+        k: f64,
+        /// Damping (N s/m).
+        b: f64,
+    },
+    /// The admittance display's regulator `K_p` and coupling `Z_cA`.
+    Admittance {
+        /// Regulator stiffness (N/m).
+        kp: f64,
+        /// Regulator damping (N s/m).
+        bp: f64,
+        /// Coupling mass (kg).
+        m: f64,
+        /// Coupling damping (N s/m).
+        b: f64,
+    },
+}
+
+impl Coupling {
+    /// Which display it is for.
+    pub fn display(&self) -> Display {
+        match self {
+            Coupling::Impedance { .. } => Display::Impedance,
+            Coupling::Admittance { .. } => Display::Admittance,
+        }
+    }
+
+    /// The servo's gains (rounded to the board's f32).
+    pub fn gains(&self) -> Gains {
+        match *self {
+            Coupling::Impedance { k, b } => ImpedanceGains::new(k as f32, b as f32).into(),
+            Coupling::Admittance { kp, bp, m, b } => {
+                AdmittanceGains::new(kp as f32, bp as f32, m as f32, b as f32).into()
+            }
+        }
+    }
+}
+
+/// The keys a `[coupling]` table may hold, before they are read as one
+/// display's coupling.
 #[derive(Clone, Copy, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Coupling {
-    /// Impedance coupling stiffness (N/m).
-    pub k: Option<f64>,
-    /// Coupling damping (N s/m), both displays.
-    pub b: f64,
-    /// Admittance coupling mass (kg).
-    pub m: Option<f64>,
-    /// Position regulator stiffness (N/m).
-    pub kp: Option<f64>,
-    /// Position regulator damping (N s/m).
-    pub bp: Option<f64>,
+struct CouplingKeys {
+    k: Option<f64>,
+    b: f64,
+    m: Option<f64>,
+    kp: Option<f64>,
+    bp: Option<f64>,
+}
+
+impl TryFrom<CouplingKeys> for Coupling {
+    type Error = String;
+
+    fn try_from(c: CouplingKeys) -> Result<Self, String> {
+        let admittance = [("m", c.m), ("kp", c.kp), ("bp", c.bp)];
+        match c.k {
+            Some(k) => match admittance.iter().find(|(_, v)| v.is_some()) {
+                Some((n, _)) => Err(format!(
+                    "coupling: {n} belongs to an admittance display's coupling; an impedance display's has k and b"
+                )),
+                None => Ok(Coupling::Impedance { k, b: c.b }),
+            },
+            None => match admittance {
+                [(_, Some(m)), (_, Some(kp)), (_, Some(bp))] => Ok(Coupling::Admittance {
+                    kp,
+                    bp,
+                    m,
+                    b: c.b,
+                }),
+                _ if admittance.iter().all(|(_, v)| v.is_none()) => Err(
+                    "coupling: give k and b (impedance display), or kp, bp, m and b (admittance display)"
+                        .into(),
+                ),
+                _ => {
+                    let missing: Vec<_> = admittance
+                        .iter()
+                        .filter(|(_, v)| v.is_none())
+                        .map(|(n, _)| *n)
+                        .collect();
+                    Err(format!(
+                        "coupling: {} is required for an admittance display's coupling",
+                        missing.join(" and ")
+                    ))
+                }
+            },
+        }
+    }
 }
 
 /// Which side of a wall is solid.
