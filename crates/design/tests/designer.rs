@@ -96,3 +96,31 @@ fn bad_questions_are_refused_by_name() {
         Error::NoPose
     );
 }
+
+/// An infeasible design names the frequency that binds: on a rigid 1 kg,
+/// 20 N s/m handle without the human bound, a coupling damping past the
+/// device's (25 N s/m) fails at Nyquist for every stiffness, not toward
+/// DC, where the bound vanishes.
+#[test]
+fn an_infeasible_design_names_the_frequency_that_binds() {
+    let rigid = DeviceModel::from_toml(
+        "period_s = 0.001\npeak_force_n = 50.0\ncontinuous_force_n = 20.0\n\
+         M = [[1.0]]\nD = [[20.0]]\nK = [[0.0]]\nG = [[1.0, -1.0]]\nC_v = [[1.0], [-1.0]]\n",
+        "rigid",
+    )
+    .unwrap();
+    let d = Designer::new(vec![rigid], None, None).unwrap();
+    let r = d.design_impedance(Some(25.0), 0.1).unwrap();
+    assert!(r.coupling.is_none());
+    let why = r.message.unwrap();
+    assert!(
+        why.contains("500.00 Hz") && !why.contains("toward DC"),
+        "{why}"
+    );
+    // Below the device's damping there is one.
+    assert!(d
+        .design_impedance(Some(15.0), 0.1)
+        .unwrap()
+        .coupling
+        .is_some());
+}

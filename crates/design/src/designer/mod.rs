@@ -262,22 +262,47 @@ impl Designer {
     /// Why no coupling `what` meets `bounds`: the limit toward DC, or the
     /// range searched.
     fn infeasible(&self, bounds: &[Vec<f64>], what: Infeasible, b: Option<f64>) -> String {
-        let (what, bound_unit, (lo, hi), unit) = match what {
+        let (name, bound_unit, (lo, hi), unit) = match what {
             Infeasible::Stiffness => ("stiffness", "m/(N s)", analysis::K_RANGE, "N/m"),
-            Infeasible::Mass => ("mass", "N s/m", analysis::M_RANGE, "kg"),
+            Infeasible::Mass(_) => ("mass", "N s/m", analysis::M_RANGE, "kg"),
         };
-        let at = b
-            .map(|b| format!(" at b_c = {b} N s/m"))
-            .unwrap_or_default();
-        match self
+        if let Some(limit) = self
             .with(bounds)
             .iter()
             .find_map(|(a, b)| analysis::low_frequency_obstacle(a, b))
         {
-            Some(limit) => format!(
-                "no finite coupling {what} is absolutely stable: toward DC the bound stays positive (its limit is {limit:.4e} {bound_unit}), while the coupling's real part goes to zero as the frequency does"
+            return format!(
+                "no finite coupling {name} is absolutely stable: toward DC the bound stays positive (its limit is {limit:.4e} {bound_unit}), while the coupling's real part goes to zero as the frequency does"
+            );
+        }
+        // Where even the most cautious gain of the search fails (the
+        // softest stiffness, the heaviest mass) at the damping asked for,
+        // or the search's least.
+        let b_c = b.unwrap_or(analysis::B_RANGE.0);
+        let worst = match what {
+            Infeasible::Stiffness => {
+                self.worst_check(|p| analysis::check_impedance(&p.analysis, lo, b_c, self.human))
+            }
+            Infeasible::Mass(kp) => self.worst_check(|p| {
+                analysis::check_admittance(&p.plant, &p.analysis, kp, (hi, b_c), self.human)
+            }),
+        };
+        let at = b
+            .map(|b| format!(" at b_c = {b} N s/m"))
+            .unwrap_or_default();
+        let cautious = match what {
+            Infeasible::Stiffness => format!("{lo} N/m"),
+            Infeasible::Mass(_) => format!("{hi} kg"),
+        };
+        match worst {
+            Some((c, pose)) => format!(
+                "no coupling {name} from {lo} to {hi} {unit} meets the bound{at}: even {cautious} (b_c = {b_c} N s/m) fails, least at {:.2} Hz{}",
+                c.worst_frequency_hz,
+                self.pose_name(pose)
+                    .map(|p| format!(" in pose {p}"))
+                    .unwrap_or_default()
             ),
-            None => format!("no coupling {what} from {lo} to {hi} {unit} meets the bound{at}"),
+            None => format!("no coupling {name} from {lo} to {hi} {unit} meets the bound{at}"),
         }
     }
 
@@ -348,7 +373,7 @@ impl Designer {
             None if radius >= 1.0 => Some(format!(
                 "the regulator k_p = {kp}, b_p = {bp} does not stabilise the device (pole radius {radius:.4})"
             )),
-            None => Some(self.infeasible(&sound, Infeasible::Mass, b)),
+            None => Some(self.infeasible(&sound, Infeasible::Mass((kp, bp)), b)),
         };
         let mut d = Design::new(
             self.context(DisplayKind::Admittance),
@@ -510,11 +535,12 @@ impl Designer {
     }
 }
 
-/// What an infeasible design could not find.
+/// What an infeasible design could not find: a stiffness, or a mass for
+/// the regulator `(k_p, b_p)`.
 #[derive(Clone, Copy)]
 enum Infeasible {
     Stiffness,
-    Mass,
+    Mass((f64, f64)),
 }
 
 /// A gain checked for sign and finiteness before any analysis.
