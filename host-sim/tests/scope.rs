@@ -7,6 +7,7 @@ use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use host_sim::scope::app::{ScopeState, Speed, RING_SAMPLES};
 use host_sim::scope::board::BoardChoice;
+use host_sim::scope::board::BoardMode;
 use host_sim::scope::signals::{BoardSignal, Signal};
 use std::path::Path;
 use twoport_control::servo::{Gains, ImpedanceGains};

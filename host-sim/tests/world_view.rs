@@ -6,6 +6,7 @@
 
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
+use host_sim::scope::board::BoardMode;
 use host_sim::scope::world::WorldState;
 use host_sim::Scene;
 use std::path::Path;

@@ -5,8 +5,7 @@
 
 use crate::engine::human::GraspKind;
 use crate::engine::scene::{Scene, VeSpec};
-use crate::link::{BoardPort, SerialBoard};
-use crate::scope::board::BoardLink;
+use crate::scope::board::{BoardLink, BoardMode};
 use crate::scope::rings::{last_trigger, Edge, Ring};
 use crate::scope::signals::{BoardSignal, Signal};
 use crate::Error;
@@ -442,43 +441,11 @@ impl ScopeState {
             Err(e) => self.message = Some(e.to_string()),
         }
     }
+}
 
-    /// Board mode: connect to the board at `port`; with `lockstep` this
-    /// simulation is its plant (processor in the loop), without it the
-    /// board runs on its own sensors and the scope watches.
-    pub fn connect(&mut self, port: &str, lockstep: bool) {
-        match SerialBoard::open(port) {
-            Ok(p) => self.connect_port(Box::new(p), port, lockstep),
-            Err(e) => self.message = Some(format!("board at {port}: {e}")),
-        }
-    }
-
-    /// [`connect`](Self::connect) through any port (a board in-process).
-    pub fn connect_port(&mut self, port: Box<dyn BoardPort>, name: &str, lockstep: bool) {
-        match BoardLink::connect(port, name, lockstep, &self.scene) {
-            Ok(b) => {
-                self.board = Some(b);
-                self.message = None;
-            }
-            Err(e) => self.message = Some(format!("board at {name}: {e}")),
-        }
-    }
-
-    /// Leave board mode, disarming the board.
-    pub fn disconnect(&mut self) {
-        if let Some(b) = self.board.take() {
-            b.disconnect();
-        }
-    }
-
-    /// Say `msg` to the board (a mode change or a fault clear); its answer
-    /// comes back as a status or a refusal.
-    pub fn tell_board(&mut self, msg: Message) {
-        if let Some(b) = self.board.as_mut() {
-            if let Err(e) = b.tell(&msg) {
-                self.message = Some(format!("board: {e}"));
-            }
-        }
+impl BoardMode for ScopeState {
+    fn board_parts(&mut self) -> (&mut Option<BoardLink>, &mut Option<String>, &Scene) {
+        (&mut self.board, &mut self.message, &self.scene)
     }
 }
 

@@ -3,7 +3,7 @@
 //! the scope watches), and what the board last said.
 
 use crate::engine::scene::Scene;
-use crate::link::{BoardPort, LinkFaults, Session};
+use crate::link::{BoardPort, LinkFaults, SerialBoard, Session};
 use crate::Error;
 use crate::{Sample, Simulation};
 use twoport_link::{GainsReply, Message, Status, Telemetry};
@@ -110,6 +110,52 @@ impl BoardLink {
             }
         }
         telemetry
+    }
+}
+
+/// A scope state with a board mode: the link, where its problems are
+/// said, and the scene whose device a lockstep board must be. Connecting,
+/// leaving and talking to the board are written once, here.
+pub trait BoardMode {
+    /// The link, the state's message line, and its scene.
+    fn board_parts(&mut self) -> (&mut Option<BoardLink>, &mut Option<String>, &Scene);
+
+    /// Board mode: connect to the board at the serial `port`; with
+    /// `lockstep` the simulation is its plant (processor in the loop),
+    /// without it the board runs on its own sensors and the scope watches.
+    fn connect(&mut self, port: &str, lockstep: bool) {
+        match SerialBoard::open(port) {
+            Ok(p) => self.connect_port(Box::new(p), port, lockstep),
+            Err(e) => *self.board_parts().1 = Some(format!("board at {port}: {e}")),
+        }
+    }
+
+    /// [`connect`](Self::connect) through any port (a board in-process).
+    fn connect_port(&mut self, port: Box<dyn BoardPort>, name: &str, lockstep: bool) {
+        let (board, message, scene) = self.board_parts();
+        match BoardLink::connect(port, name, lockstep, scene) {
+            Ok(b) => {
+                *board = Some(b);
+                *message = None;
+            }
+            Err(e) => *message = Some(format!("board at {name}: {e}")),
+        }
+    }
+
+    /// Leave board mode, disarming the board.
+    fn disconnect(&mut self) {
+        if let Some(b) = self.board_parts().0.take() {
+            b.disconnect();
+        }
+    }
+
+    /// Say `msg` to the board (a mode change, a fault clear); its answer
+    /// comes back as a status or a refusal.
+    fn tell_board(&mut self, msg: Message) {
+        let (board, message, _) = self.board_parts();
+        if let Some(Err(e)) = board.as_mut().map(|b| b.tell(&msg)) {
+            *message = Some(format!("board: {e}"));
+        }
     }
 }
 

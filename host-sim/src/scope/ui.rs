@@ -3,6 +3,7 @@
 
 use crate::engine::human::GraspKind;
 use crate::scope::app::{list_ports, ScopeState, Speed};
+use crate::scope::board::BoardMode;
 use crate::scope::board::{BoardChoice, BoardLink};
 use crate::scope::rings::{minmax, Edge, Ring};
 use crate::scope::signals::{BoardSignal, Signal};

@@ -6,14 +6,12 @@
 //! simulation's.
 
 use crate::engine::servo::WorldView;
-use crate::link::{BoardPort, SerialBoard};
-use crate::scope::board::{BoardChoice, BoardLink};
+use crate::scope::board::{BoardChoice, BoardLink, BoardMode};
 use crate::scope::rings::Ring;
 use crate::Error;
 use crate::{Sample, Scene, Simulation};
 use std::path::Path;
 use twoport_control::world::vbb::Block;
-use twoport_link::Message;
 
 /// Seconds of force history per axis.
 const HISTORY_S: f64 = 5.0;
@@ -132,40 +130,6 @@ impl WorldState {
         self.board = None;
     }
 
-    /// Board mode: connect to the three-axis board at `port`; with
-    /// `lockstep` this simulation is its plant (processor in the loop).
-    pub fn connect(&mut self, port: &str, lockstep: bool) {
-        match SerialBoard::open(port) {
-            Ok(p) => self.connect_port(Box::new(p), port, lockstep),
-            Err(e) => self.message = Some(format!("board at {port}: {e}")),
-        }
-    }
-
-    /// [`connect`](Self::connect) through any port (a board in-process).
-    pub fn connect_port(&mut self, port: Box<dyn BoardPort>, name: &str, lockstep: bool) {
-        match BoardLink::connect(port, name, lockstep, self.sim.scene()) {
-            Ok(b) => {
-                self.board = Some(b);
-                self.message = None;
-            }
-            Err(e) => self.message = Some(format!("board at {name}: {e}")),
-        }
-    }
-
-    /// Leave board mode, disarming the board.
-    pub fn disconnect(&mut self) {
-        if let Some(b) = self.board.take() {
-            b.disconnect();
-        }
-    }
-
-    /// Say `msg` to the board.
-    pub fn tell_board(&mut self, msg: Message) {
-        if let Some(Err(e)) = self.board.as_mut().map(|b| b.tell(&msg)) {
-            self.message = Some(format!("board: {e}"));
-        }
-    }
-
     /// Where the device stands at rest before a run, as a board is told
     /// when calibrated (pm): where the world's cursor starts.
     pub fn at_rest_pm(&self) -> Result<twoport_link::Axes<i64>, Error> {
@@ -212,5 +176,11 @@ impl WorldState {
             }),
             None => self.last.map_or([0.0; 3], |s| s.ve_m),
         }
+    }
+}
+
+impl BoardMode for WorldState {
+    fn board_parts(&mut self) -> (&mut Option<BoardLink>, &mut Option<String>, &Scene) {
+        (&mut self.board, &mut self.message, self.sim.scene())
     }
 }
