@@ -295,8 +295,8 @@ pub fn run_axes<P: BoardPort, const N: usize>(
             asked: ModeRequest::SaveConfig,
             why,
         } => Some(Err(Error::Link(crate::link::LinkError::Refused {
-            asked: "SaveConfig".into(),
-            why: format!("{why:?}"),
+            asked: ModeRequest::SaveConfig,
+            why: *why,
         }))),
         _ => None,
     })??;

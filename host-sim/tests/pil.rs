@@ -146,7 +146,13 @@ fn an_uncalibrated_board_refuses_to_arm_by_name() {
     session.step(&mut sim).unwrap();
     let e = session.arm().unwrap_err();
     assert!(
-        matches!(&e, link::LinkError::Refused { why, .. } if why == "NotCalibrated"),
+        matches!(
+            e,
+            link::LinkError::Refused {
+                why: twoport_link::ModeRefusal::NotCalibrated,
+                ..
+            }
+        ),
         "{e}"
     );
     session.calibrate(Axes::one(0)).unwrap();
@@ -285,7 +291,13 @@ fn a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed() {
     s.calibrate(Axes::one(0)).unwrap();
     let e = s.arm().unwrap_err();
     assert!(
-        matches!(&e, link::LinkError::Refused { why, .. } if why == "Faulted"),
+        matches!(
+            e,
+            link::LinkError::Refused {
+                why: twoport_link::ModeRefusal::Faulted { .. },
+                ..
+            }
+        ),
         "{e}"
     );
     // Seen and cleared, it arms again.

@@ -1,6 +1,7 @@
 //! What can go wrong on the host's side of a link.
 
 use thiserror::Error;
+use twoport_link::{ModeRefusal, ModeRequest};
 
 /// Why a call to a board failed.
 #[derive(Clone, Debug, PartialEq, Eq, Error)]
@@ -38,12 +39,12 @@ pub enum LinkError {
         seconds: u64,
     },
     /// The board refused a mode change or a request, and why.
-    #[error("the board refused {asked}: {why}")]
+    #[error("the board refused {asked:?}: {why:?}")]
     Refused {
         /// What was asked.
-        asked: String,
+        asked: ModeRequest,
         /// The board's reason.
-        why: String,
+        why: ModeRefusal,
     },
     /// The board answers with no session: it has reset since the
     /// handshake.

@@ -100,10 +100,7 @@ impl<P: BoardPort> Session<P> {
             Message::ModeRefused { asked: a, why } if *a == asked => Some(Err(*why)),
             _ => None,
         })?;
-        r.map_err(|why| LinkError::Refused {
-            asked: what,
-            why: format!("{why:?}"),
-        })
+        r.map_err(|why| LinkError::Refused { asked, why })
     }
 
     /// Statuses and refusals already received answer earlier questions,
