@@ -8,8 +8,8 @@
 extern crate std;
 
 use crate::ve::{
-    BilateralConstraint, Causality, CursorMass, ExplicitCursor, Port, Solid, Spring,
-    TrapezoidalSpring, UnilateralWall, VeOutput, VeTransfer, VirtualEnvironment,
+    BilateralConstraint, Causality, CursorMass, ExplicitCursor, LosslessCursor, Port, Solid,
+    Spring, TrapezoidalSpring, UnilateralWall, VeOutput, VeTransfer, VirtualEnvironment,
 };
 use crate::*;
 use std::f64::consts::PI;
@@ -172,6 +172,18 @@ fn cursor_mass_ve() {
         let mut ve = CursorMass::new(0.25, T, Position::ZERO).unwrap();
         let got = ve_response(p, &mut ve, 0.0, 10.0);
         assert_close("cursor (T/m)/(1 - z^-1)", p, got, ve_tf(&ve).eval(z_of(p)));
+    }
+}
+
+#[test]
+fn lossless_cursor_ve_matches_its_z_form_and_is_lossless() {
+    // (Its admittance is infinite at DC and 0 at Nyquist: the bins between.)
+    for p in BINS.into_iter().filter(|&p| 2 * p < WINDOW) {
+        let mut ve = LosslessCursor::new(0.25, T, Position::ZERO).unwrap();
+        let got = ve_response(p, &mut ve, 0.0, 10.0);
+        let want = ve_tf(&ve).eval(z_of(p));
+        assert_close("lossless cursor (T/2m)(1 + z^-1)/(1 - z^-1)", p, got, want);
+        assert!(want.re.abs() < 1e-9 * want.norm(), "{want}");
     }
 }
 

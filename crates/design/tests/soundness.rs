@@ -194,6 +194,19 @@ fn verify_breaks_the_rigid_counterexample_and_not_the_design() {
     assert_tight(&m, g(k, b), g(1.2 * k, b), None);
 }
 
+/// One tick late, the rigid device's boundary at `b_c = 0` is exactly
+/// `2 b / (4 T)` = 10,000 N/m, and `verify` breaks it 1% past (a lossless
+/// VE mass on a slow, heavy hand) while finding nothing at the design.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn verify_breaks_the_delayed_rigid_design_one_percent_past() {
+    let m = rigid(1.0, 20.0, 1);
+    let a = analysis(&m, GridSpec::DEFAULT);
+    let k = max_stiffness(&a, &a.impedance_bound(None), 0.0).unwrap();
+    assert!((k - 10_000.0).abs() < 50.0, "{k}");
+    assert_tight(&m, imp(k, 0.0), imp(1.01 * k, 0.0), None);
+}
+
 /// A device from a model file under `tests/devices/`.
 fn device(file: &str) -> DeviceModel {
     let path = format!("{}/tests/devices/{file}", env!("CARGO_MANIFEST_DIR"));

@@ -13,8 +13,8 @@ use crate::Error;
 use twoport_control::passivity::{ParallelLimits, PassiveVe};
 use twoport_control::servo::{Gains, PortLayer, SensorFrame, Servo, ServoOutput};
 use twoport_control::ve::{
-    BilateralConstraint, CursorMass, ExplicitCursor, Solid, Spring, TrapezoidalSpring,
-    UnilateralWall,
+    BilateralConstraint, CursorMass, ExplicitCursor, LosslessCursor, Solid, Spring,
+    TrapezoidalSpring, UnilateralWall,
 };
 use twoport_control::world::vbb::Block as Block3;
 use twoport_control::world::World;
@@ -336,6 +336,13 @@ fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, Error> {
             integration: Integration::Implicit,
         } => SceneVe::Cursor(
             CursorMass::new_in(*mass_kg as f32, t32, Position::ZERO).map_err(|e| e.to_string())?,
+        ),
+        VeSpec::Cursor {
+            mass_kg,
+            integration: Integration::Lossless,
+        } => SceneVe::LosslessCursor(
+            LosslessCursor::new_in(*mass_kg as f32, t32, Position::ZERO)
+                .map_err(|e| e.to_string())?,
         ),
         VeSpec::Cursor {
             mass_kg,

@@ -3,8 +3,8 @@
 use crate::engine::blocks::Blocks;
 use twoport_control::passivity::PassiveVe;
 use twoport_control::ve::{
-    BilateralConstraint, Causality, CursorMass, ExplicitCursor, Port, Spring, TrapezoidalSpring,
-    UnilateralWall, VeOutput, VeTransfer, VirtualEnvironment,
+    BilateralConstraint, Causality, CursorMass, ExplicitCursor, LosslessCursor, Port, Spring,
+    TrapezoidalSpring, UnilateralWall, VeOutput, VeTransfer, VirtualEnvironment,
 };
 use twoport_control::{Position, Real};
 
@@ -16,6 +16,8 @@ pub enum SceneVe<R: Real = f32> {
     Cursor(CursorMass<R>),
     /// A free cursor mass integrated explicitly (the paper's).
     ExplicitCursor(ExplicitCursor<R>),
+    /// A lossless cursor mass (trapezoidal).
+    LosslessCursor(LosslessCursor<R>),
     /// A unilateral wall.
     Wall(UnilateralWall<R>),
     /// A fixed point.
@@ -37,6 +39,7 @@ macro_rules! each {
         match $self {
             SceneVe::Cursor($v) => $e,
             SceneVe::ExplicitCursor($v) => $e,
+            SceneVe::LosslessCursor($v) => $e,
             SceneVe::Wall($v) => $e,
             SceneVe::Bilateral($v) => $e,
             SceneVe::Spring($v) => $e,

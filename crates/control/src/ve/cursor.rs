@@ -99,6 +99,93 @@ impl<R: Real> VirtualEnvironment<R> for CursorMass<R> {
     }
 }
 
+/// A lossless mass `m`: its velocity integrates the force by the
+/// trapezoidal rule, `v[k] = v[k-1] + T (f[k] + f[k-1]) / (2 m)`. Its
+/// admittance `(T/2m)(1 + z^-1)/(1 - z^-1)` is imaginary on the unit
+/// circle: it stores and returns energy and dissipates none, the edge of
+/// the passive masses (backward Euler's [`CursorMass`] dissipates). The
+/// designer's `verify` terminates a loop with it; a scene may run it.
+/// Admittance causality.
+#[derive(Clone, Copy, Debug)]
+pub struct LosslessCursor<R = f32> {
+    mass_kg: f32,
+    /// `T / (2 m)`.
+    h: R,
+    velocity_mps: R,
+    /// Last tick's force (N).
+    force_n: R,
+    x: Integrator<R>,
+}
+
+impl LosslessCursor {
+    /// A lossless mass of `mass_kg` (kg) at rest at `x`, period
+    /// `period_s` (s).
+    pub fn new(mass_kg: f32, period_s: f32, x: Position) -> Result<Self, ParamError> {
+        Self::new_in(mass_kg, period_s, x)
+    }
+}
+
+impl<R: Real> LosslessCursor<R> {
+    /// [`LosslessCursor::new`] computing in `R`.
+    pub fn new_in(mass_kg: f32, period_s: f32, x: Position) -> Result<Self, ParamError> {
+        let m = param::positive("cursor mass (kg)", mass_kg)?;
+        let t = param::positive("T (s)", period_s)?;
+        Ok(LosslessCursor {
+            mass_kg: m,
+            h: R::HALF * R::of(t) / R::of(m),
+            velocity_mps: R::ZERO,
+            force_n: R::ZERO,
+            x: Integrator::new_in(t, x),
+        })
+    }
+
+    /// The mass (kg).
+    pub fn mass_kg(&self) -> f32 {
+        self.mass_kg
+    }
+}
+
+impl<R: Real> VirtualEnvironment<R> for LosslessCursor<R> {
+    fn causality(&self) -> Causality {
+        Causality::Admittance
+    }
+
+    fn step(&mut self, port: Port<R>) -> VeOutput<R> {
+        // v = (v[k-1] + h f[k-1]) + h f[k], met with the port's f = f0 - z v.
+        let out = port.solve_admittance(self.velocity_mps + self.h * self.force_n, self.h);
+        if out.velocity_mps.is_finite() && out.force_n.is_finite() {
+            self.velocity_mps = out.velocity_mps;
+            self.force_n = out.force_n;
+            self.x.step(out.velocity_mps);
+        }
+        out
+    }
+
+    fn reset(&mut self, x: Position) {
+        self.velocity_mps = R::ZERO;
+        self.force_n = R::ZERO;
+        self.x.reset(x);
+    }
+
+    fn position(&self) -> Position {
+        self.x.position()
+    }
+
+    #[inline]
+    fn offset_m(&self, from: Position) -> R {
+        self.x.offset_m(from)
+    }
+
+    /// `V/F = (T/2m)(1 + z^-1)/(1 - z^-1)`.
+    fn tf(&self) -> VeTransfer {
+        let h = self.h.to_f64();
+        VeTransfer::Admittance(ZTransfer {
+            num: [h, h, 0.0],
+            den: [1.0, -1.0, 0.0],
+        })
+    }
+}
+
 /// A free cursor integrated explicitly, as the paper's building blocks
 /// were: the velocity by forward Euler on last tick's force,
 /// `v[k] = v[k-1] + T f[k-1] / m`, the position by the trapezoidal rule,

@@ -19,7 +19,7 @@ mod spring;
 mod tests;
 
 pub use constraint::BilateralConstraint;
-pub use cursor::{CursorMass, ExplicitCursor, PAPER_MIN_CURSOR_MASS_KG};
+pub use cursor::{CursorMass, ExplicitCursor, LosslessCursor, PAPER_MIN_CURSOR_MASS_KG};
 pub use spring::{Solid, Spring, TrapezoidalSpring, UnilateralWall};
 
 use crate::{Position, Real, ZTransfer};

@@ -21,6 +21,9 @@ impl Ve {
         let e = |e: twoport_control::ParamError| e.to_string();
         let tf = match *self {
             Ve::Constraint => return Ok((vec![0.0], vec![1.0])),
+            Ve::LosslessMass { mass_kg } => VirtualEnvironment::<f32>::tf(
+                &twoport_control::ve::LosslessCursor::new(mass_kg as f32, t32, p).map_err(e)?,
+            ),
             Ve::Cursor { mass_kg } => VirtualEnvironment::<f32>::tf(
                 &twoport_control::ve::CursorMass::new(mass_kg as f32, t32, p).map_err(e)?,
             ),

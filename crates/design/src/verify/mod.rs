@@ -35,6 +35,14 @@ pub enum Ve {
         /// Damping (N s/m).
         damping_nspm: f64,
     },
+    /// A lossless mass (the control crate's `LosslessCursor`: the force
+    /// integrated by the trapezoidal rule): passive, its admittance
+    /// imaginary on the unit circle, the edge of the passive masses, which
+    /// the delay cases need.
+    LosslessMass {
+        /// Mass (kg).
+        mass_kg: f64,
+    },
     /// The lossless trapezoidal spring-damper.
     TrapezoidalSpring {
         /// Stiffness (N/m).

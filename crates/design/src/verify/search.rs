@@ -12,6 +12,7 @@ use std::f64::consts::PI;
 enum VeKind {
     Constraint,
     Cursor,
+    LosslessMass,
     Spring,
     Trapezoidal,
 }
@@ -20,7 +21,7 @@ impl VeKind {
     fn dims(self) -> usize {
         match self {
             VeKind::Constraint => 0,
-            VeKind::Cursor => 1,
+            VeKind::Cursor | VeKind::LosslessMass => 1,
             VeKind::Spring | VeKind::Trapezoidal => 2,
         }
     }
@@ -30,6 +31,7 @@ impl VeKind {
         match self {
             VeKind::Constraint => Ve::Constraint,
             VeKind::Cursor => Ve::Cursor { mass_kg: x(0) },
+            VeKind::LosslessMass => Ve::LosslessMass { mass_kg: x(0) },
             VeKind::Spring => Ve::Spring {
                 stiffness_npm: x(0),
                 damping_nspm: x(1),
@@ -45,7 +47,7 @@ impl VeKind {
     fn bounds(self) -> &'static [(f64, f64)] {
         match self {
             VeKind::Constraint => &[],
-            VeKind::Cursor => &[(-3.0, 3.0)],
+            VeKind::Cursor | VeKind::LosslessMass => &[(-3.0, 3.0)],
             VeKind::Spring | VeKind::Trapezoidal => &[(1.0, 9.0), (-4.0, 4.0)],
         }
     }
@@ -236,6 +238,7 @@ pub fn verify(
     let mut ves: Vec<(VeKind, Vec<f64>)> = vec![(VeKind::Constraint, vec![])];
     for m in [-2.0, -1.0, 0.0, 1.0] {
         ves.push((VeKind::Cursor, vec![m]));
+        ves.push((VeKind::LosslessMass, vec![m]));
     }
     for i in 0..13 {
         let k = 2.0 + 0.5 * i as f64;
@@ -256,6 +259,7 @@ pub fn verify(
     for kind in [
         VeKind::Constraint,
         VeKind::Cursor,
+        VeKind::LosslessMass,
         VeKind::Spring,
         VeKind::Trapezoidal,
     ] {

@@ -295,6 +295,10 @@ pub enum Integration {
     /// The paper's building blocks: the velocity from last tick's force
     /// (forward Euler), the position by the trapezoidal rule. Not passive.
     Explicit,
+    /// The force integrated by the trapezoidal rule: lossless, the edge of
+    /// the passive masses (what `twoport verify` may terminate a loop
+    /// with).
+    Lossless,
 }
 
 /// The virtual environment.
