@@ -245,6 +245,25 @@ pub fn verify(
         ves.push((VeKind::Spring, vec![k, -2.0]));
         ves.push((VeKind::Trapezoidal, vec![k, -2.0]));
     }
+    // VEs tuned to resonate with the coupling across the band, as the
+    // hands are: a mass on the impedance display's spring, a spring on the
+    // admittance display's mass (the narrow terminations a coarse sweep
+    // steps over).
+    for f in &freqs {
+        let w2 = (2.0 * PI * f).powi(2);
+        match gains {
+            Gains::Impedance(g) => {
+                let m = (g.k_npm as f64 / w2).log10();
+                ves.push((VeKind::Cursor, vec![m]));
+                ves.push((VeKind::LosslessMass, vec![m]));
+            }
+            Gains::Admittance(g) => {
+                let k = (g.m_kg as f64 * w2).log10();
+                ves.push((VeKind::Spring, vec![k, -4.0]));
+                ves.push((VeKind::Trapezoidal, vec![k, -4.0]));
+            }
+        }
+    }
     let mut starts: Vec<(f64, VeKind, Vec<f64>)> = Vec::new();
     for h in &hands {
         for (kind, vp) in &ves {
