@@ -38,7 +38,8 @@ fn every_model_has_a_scene_here() {
 }
 
 /// The impedance design with and without the human bound; verify finds
-/// nothing at it and breaks 1.2 times its stiffness.
+/// nothing at it and breaks 1.01 times its stiffness: on every shipped
+/// device the bound is tight to 1%.
 #[test]
 #[ignore = "release only: run with --release --ignored (CI does)"]
 fn every_device_design_survives_verify_and_breaks_past_it() {
@@ -51,10 +52,10 @@ fn every_device_design_survives_verify_and_breaks_past_it() {
             let d = m.delay_samples as usize;
             let at = verify(&m, T, &g(k), human, d).unwrap();
             assert!(!at.unstable, "{model} {human:?}: ({k}, {b}) broken: {at:?}");
-            let past = verify(&m, T, &g(1.2 * k), human, d).unwrap();
+            let past = verify(&m, T, &g(1.01 * k), human, d).unwrap();
             assert!(
                 past.unstable,
-                "{model} {human:?}: 1.2 x ({k}, {b}): {past:?}"
+                "{model} {human:?}: 1.01 x ({k}, {b}): {past:?}"
             );
         }
     }
