@@ -64,11 +64,22 @@ fn the_light_turns_red_past_the_bound() {
         light.margin,
         light.worst_hz
     );
-    // And back inside it turns green again.
+    // The margin to the boundary at this damping, read beside the light.
+    let past = light.gain_margin.unwrap();
+    assert!((past + (60_000.0 / 51_073.4 - 1.0)).abs() < 1e-3, "{past}");
+    let _ = h.get_by_label_contains("past the boundary at this damping, 51073 N/m");
+    // And back inside it turns green again, with its margin.
     h.get_by_role_and_label(Role::Slider, "k_c (N/m)")
         .set_value_accesskit(50_000.0);
     h.run();
-    assert!(h.state().0.light.as_ref().unwrap().proven);
+    let light = h.state().0.light.as_ref().unwrap();
+    assert!(light.proven);
+    let inside = light.gain_margin.unwrap();
+    assert!(
+        (inside - (1.0 - 50_000.0 / 51_073.4)).abs() < 1e-3,
+        "{inside}"
+    );
+    let _ = h.get_by_label_contains("gain margin 2.1%: the boundary at this damping is 51073 N/m");
 }
 
 #[test]

@@ -13,10 +13,9 @@ use crate::{Sample, Simulation};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 use twoport_control::servo::Gains;
-use twoport_design::analysis::{self, Analysis, Check, GridSpec};
 use twoport_design::network::HumanBound;
 use twoport_design::plot::Figure;
-use twoport_design::Plant;
+use twoport_design::Designer;
 use twoport_link::{Axes, Message};
 
 /// Samples each signal's ring holds: 20 s at 1 kHz.
@@ -57,6 +56,13 @@ pub struct Light {
     pub margin: f64,
     /// Worst frequency (Hz).
     pub worst_hz: f64,
+    /// How far inside the proven boundary at the same damping the gains
+    /// sit: a stiffness's `1 - k/k_max`, a mass's `1 - m_min/m` (a
+    /// fraction, negative past it); `None` where nothing is proven at this
+    /// damping.
+    pub gain_margin: Option<f64>,
+    /// That boundary, as the designer publishes it (rounded to safety).
+    pub boundary: Option<String>,
     /// The design bound and the coupling's response (Fig. 8 or 9).
     pub figure: Option<Figure>,
 }
@@ -72,7 +78,7 @@ pub struct ScopeState {
     scene: Scene,
     sim: Simulation,
     /// The designer's view of the scene's device (the model file's).
-    design: Option<(Plant, Analysis)>,
+    design: Option<Designer>,
     /// Running or paused.
     pub running: bool,
     /// How fast.
@@ -135,10 +141,7 @@ impl ScopeState {
             scenes: list_scenes(dir),
             scenes_root: dir.to_path_buf(),
             scene_path: scene_path.to_path_buf(),
-            design: analysis_plant(&scene).map(|p| {
-                let a = Analysis::new(&p, GridSpec::DEFAULT);
-                (p, a)
-            }),
+            design: designer(&scene),
             gains: scene.gains_of(0),
             wall: wall_of(&scene),
             scene,
@@ -382,39 +385,43 @@ impl ScopeState {
     }
 
     fn update_light(&mut self) {
-        let Some((plant, a)) = &self.design else {
+        let Some(d) = &self.design else {
             self.light = None;
             return;
         };
-        let h = Some(HumanBound::PAPER);
-        let (check, figure): (Option<Check>, _) = match self.gains {
+        let a = &d.poses()[0].analysis;
+        let (report, figure) = match self.gains {
             Gains::Impedance(g) => {
                 let (k, b) = (g.k_npm as f64, g.b_nspm as f64);
                 (
-                    analysis::check_impedance(a, k, b, h),
+                    d.check_impedance(k, b),
                     twoport_design::figures::fig8(a, k, b).ok(),
                 )
             }
             Gains::Admittance(g) => {
                 let kp = (g.kp_npm as f64, g.bp_nspm as f64);
-                let c = (g.m_kg as f64, g.b_nspm as f64);
+                let (m, b) = (g.m_kg as f64, g.b_nspm as f64);
                 (
-                    analysis::check_admittance(plant, a, kp, c, h),
-                    twoport_design::figures::fig9(a, kp, c).ok(),
+                    d.check_admittance(kp, m, b),
+                    twoport_design::figures::fig9(a, kp, (m, b)).ok(),
                 )
             }
         };
-        self.light = Some(match check {
-            Some(c) => Light {
-                proven: c.absolutely_stable,
-                margin: c.min_margin,
-                worst_hz: c.worst_frequency_hz,
+        self.light = Some(match report {
+            Ok(r) => Light {
+                proven: r.check.absolutely_stable,
+                margin: r.check.min_margin,
+                worst_hz: r.check.worst_frequency_hz,
+                gain_margin: r.gain_margin,
+                boundary: r.boundary_text(),
                 figure,
             },
-            None => Light {
+            Err(_) => Light {
                 proven: false,
                 margin: f64::NEG_INFINITY,
                 worst_hz: 0.0,
+                gain_margin: None,
+                boundary: None,
                 figure,
             },
         });
@@ -462,8 +469,11 @@ fn wall_of(scene: &Scene) -> Option<(f64, f64)> {
 
 /// The designer's plant for the scene's device, at the period the
 /// simulation runs.
-fn analysis_plant(scene: &Scene) -> Option<Plant> {
-    Plant::new(&scene.device_model().ok()?, scene.period()).ok()
+/// The designer on the scene's device at its period, with the paper's
+/// human bound; none where the model does not discretise.
+fn designer(scene: &Scene) -> Option<Designer> {
+    let model = scene.device_model().ok()?;
+    Designer::new(vec![model], Some(scene.period()), Some(HumanBound::PAPER)).ok()
 }
 
 /// Serial ports the system lists (a pty from QEMU is not listed; type its

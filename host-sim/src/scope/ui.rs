@@ -257,6 +257,16 @@ fn light(ui: &mut Ui, s: &ScopeState) {
         ui.painter().circle_filled(rect.center(), 7.0, color);
         ui.label(RichText::new(text).color(color));
     });
+    // How far inside the boundary at this damping: a gain on the boundary
+    // is proven and still rings, so the margin is what to read.
+    ui.label(match (l.gain_margin, &l.boundary) {
+        (Some(g), Some(b)) if g >= 0.0 => format!(
+            "gain margin {:.1}%: the boundary at this damping is {b}",
+            100.0 * g
+        ),
+        (Some(g), Some(b)) => format!("{:.1}% past the boundary at this damping, {b}", -100.0 * g),
+        _ => "nothing is proven at this damping".to_string(),
+    });
 }
 
 /// A curve of the design figure as a log-log axis can show it: each run of

@@ -373,6 +373,12 @@ impl CheckReport {
         }
     }
 
+    /// The boundary at the checked damping as published (rounded to
+    /// safety: a stiffness down, a mass up), where one is proven.
+    pub fn boundary_text(&self) -> Option<String> {
+        self.boundary.map(|l| self.limit().text(l))
+    }
+
     fn limit(&self) -> Limit {
         match self.context.display {
             DisplayKind::Impedance => Limit::Stiffness,
