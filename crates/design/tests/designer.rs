@@ -124,3 +124,29 @@ fn an_infeasible_design_names_the_frequency_that_binds() {
         .coupling
         .is_some());
 }
+
+/// A design that binds at a lightly damped mode says so: the heavy
+/// actuator on a stiff flexure, held still, rings at 150 Hz with a damping
+/// ratio near 2e-6, and its tiny stiffness is explained by it; the
+/// Excalibur's design binds at no such mode.
+#[test]
+fn a_design_limited_by_a_lightly_damped_mode_says_which() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/devices/heavy_actuator.toml"
+    );
+    let m = DeviceModel::load(std::path::Path::new(path)).unwrap();
+    let d = Designer::new(vec![m], None, None).unwrap();
+    let r = d.design_impedance(Some(0.0), 0.1).unwrap();
+    let l = r.limited_by.expect("a lightly damped mode");
+    assert!((l.frequency_hz - 150.4).abs() < 0.5, "{l:?}");
+    assert!(l.damping_ratio < 1e-5, "{l:?}");
+    assert!(
+        r.to_string().contains("limited by a mode at 150.41 Hz"),
+        "{r}"
+    );
+    let v = serde_json::to_value(&r).unwrap();
+    assert!(v["limited_by"]["damping_ratio"].as_f64().unwrap() < 1e-5);
+    let e = excalibur().design_impedance(Some(90.0), 0.1).unwrap();
+    assert_eq!(e.limited_by, None);
+}

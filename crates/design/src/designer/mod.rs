@@ -237,6 +237,23 @@ impl Designer {
         Some((c, name))
     }
 
+    /// The lightly damped mode (damping ratio below 1e-3) of any pose
+    /// within three of its half-widths of `hz`, if one is: what a design
+    /// that binds at `hz` is limited by.
+    fn light_mode_at(&self, hz: f64) -> Option<LightMode> {
+        let w = 2.0 * std::f64::consts::PI * hz;
+        self.poses
+            .iter()
+            .flat_map(|p| p.plant.features().iter())
+            .filter(|f| f.half_width < 1e-3 * f.omega)
+            .filter(|f| (f.omega - w).abs() <= 3.0 * f.half_width + 1e-3 * f.omega)
+            .min_by(|a, b| a.half_width.total_cmp(&b.half_width))
+            .map(|f| LightMode {
+                frequency_hz: f.omega / (2.0 * std::f64::consts::PI),
+                damping_ratio: f.half_width / f.omega,
+            })
+    }
+
     /// The pose a check binds in, where there are several.
     fn pose_name(&self, name: &str) -> Option<String> {
         (self.poses.len() > 1).then(|| name.to_string())
@@ -324,15 +341,17 @@ impl Designer {
         let message = coupling
             .is_none()
             .then(|| self.infeasible(sound, Infeasible::Stiffness, b));
-        Ok(Design::new(
+        let mut d = Design::new(
             self.context(DisplayKind::Impedance),
             Limit::Stiffness,
             [coupling, paper],
             b.is_some(),
             margin,
-            binding,
+            binding.clone(),
             message,
-        ))
+        );
+        d.limited_by = binding.and_then(|(hz, _)| self.light_mode_at(hz));
+        Ok(d)
     }
 
     /// The admittance display's boundary coupling mass at damping `b` (N
@@ -381,9 +400,10 @@ impl Designer {
             [coupling, paper],
             b.is_some(),
             margin,
-            binding,
+            binding.clone(),
             message,
         );
+        d.limited_by = binding.and_then(|(hz, _)| self.light_mode_at(hz));
         d.regulator = Some(Regulator {
             kp,
             bp,

@@ -184,6 +184,19 @@ pub struct Design {
     pub message: Option<String>,
     /// The admittance display's regulator.
     pub regulator: Option<Regulator>,
+    /// A lightly damped mode of the device where the design binds, if it
+    /// binds at one: what limits it.
+    pub limited_by: Option<LightMode>,
+}
+
+/// A lightly damped mode of the device (free, held still, or held by the
+/// stiffest grasp), folded into the base band, that a design binds at.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct LightMode {
+    /// Where it sits in the base band (Hz).
+    pub frequency_hz: f64,
+    /// Its damping ratio (its decay rate over its frequency).
+    pub damping_ratio: f64,
 }
 
 impl Design {
@@ -220,6 +233,7 @@ impl Design {
             aliasing_effect,
             message,
             regulator: None,
+            limited_by: None,
         }
     }
 
@@ -263,6 +277,9 @@ impl Serialize for Design {
         }
         if let Some(msg) = &self.message {
             m.serialize_entry("message", msg)?;
+        }
+        if let Some(l) = &self.limited_by {
+            m.serialize_entry("limited_by", l)?;
         }
         m.end()
     }
@@ -308,6 +325,13 @@ impl fmt::Display for Design {
             Some((hz, Some(p))) => writeln!(f, "  binds at {hz:.2} Hz in pose {p}")?,
             Some((hz, None)) => writeln!(f, "  binds at {hz:.2} Hz")?,
             None => {}
+        }
+        if let Some(l) = &self.limited_by {
+            writeln!(
+                f,
+                "  limited by a mode at {:.2} Hz with damping ratio {:.1e}: so lightly damped a mode bounds what can be proven; damping it, or sensing where it moves, raises the limit",
+                l.frequency_hz, l.damping_ratio
+            )?;
         }
         let by = 100.0 * self.aliasing_effect;
         let (what, unit) = (limit.what(), limit.unit());
