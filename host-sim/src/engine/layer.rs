@@ -29,9 +29,14 @@ pub struct SceneLayer<R: Real> {
 }
 
 impl<R: Real> SceneLayer<R> {
-    /// The scene's layer, or `None` when it has neither a passivity table
-    /// nor an element delay (the servo then runs with no layer at all).
-    pub fn for_scene(scene: &Scene, safety: &SafetyConfig) -> Result<Option<Self>, Error> {
+    /// Axis `axis`'s layer (its own coupling sets an admittance display's
+    /// damper), or `None` when the scene has neither a passivity table nor
+    /// an element delay (the servo then runs with no layer at all).
+    pub fn for_axis(
+        scene: &Scene,
+        safety: &SafetyConfig,
+        axis: usize,
+    ) -> Result<Option<Self>, Error> {
         let delay_ticks = scene.effects.element_delay.map_or(0, |d| d.ticks as usize);
         let spec = scene
             .passivity
@@ -58,7 +63,7 @@ impl<R: Real> SceneLayer<R> {
                     series = Some(SeriesDamper::new(l).map_err(|e| e.to_string())?);
                 }
                 Display::Admittance => {
-                    let m = match scene.coupling_of(0) {
+                    let m = match scene.coupling_of(axis) {
                         Coupling::Admittance { m, .. } => *m as f32,
                         // (A checked scene's coupling is its display's.)
                         Coupling::Impedance { .. } => 0.0,

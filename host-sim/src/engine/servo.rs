@@ -49,9 +49,23 @@ macro_rules! each_servo {
     };
 }
 
-/// `N` copies of `x`.
-fn each<T: Clone, const N: usize>(x: T) -> [T; N] {
-    core::array::from_fn(|_| x.clone())
+/// Each axis's port layer, or `None` where the scene runs none.
+fn scene_layers<R: Real, const N: usize>(
+    scene: &Scene,
+    safety: &SafetyConfig,
+) -> Result<Option<[SceneLayer<R>; N]>, Error> {
+    let mut layers = Vec::with_capacity(N);
+    for a in 0..N {
+        match SceneLayer::for_axis(scene, safety, a)? {
+            Some(l) => layers.push(l),
+            None => return Ok(None),
+        }
+    }
+    Ok(Some(
+        layers
+            .try_into()
+            .map_err(|_| Error::sim("one port layer per axis"))?,
+    ))
 }
 
 fn build<R: Real, const N: usize>(
@@ -110,15 +124,12 @@ fn enabled<W: World<R, N>, R: Real, L: PortLayer<R>, const N: usize>(
 
 fn layered<R: Real, const N: usize>(
     s: Servo<SceneWorld<R, N>, R, N>,
-    layer: SceneLayer<R>,
+    layers: [SceneLayer<R>; N],
 ) -> Result<Box<LayeredServo<R, N>>, Error>
 where
     SceneWorld<R, N>: World<R, N>,
 {
-    enabled(
-        s.with_layers(each(layer))
-            .map_err(|e| e.error.to_string())?,
-    )
+    enabled(s.with_layers(layers).map_err(|e| e.error.to_string())?)
 }
 
 fn set_wall<R: Real>(ve: &mut SceneVe<R>, surface: Position, k_npm: f32) -> Result<(), Error> {
@@ -163,11 +174,11 @@ impl<const N: usize> SceneServo<N> {
     /// the scene's float type.
     pub fn new(scene: &Scene, encoder: Encoder, safety: SafetyConfig) -> Result<Self, Error> {
         Ok(match scene.integrator.controller {
-            Precision::F32 => match SceneLayer::for_scene(scene, &safety)? {
+            Precision::F32 => match scene_layers(scene, &safety)? {
                 None => SceneServo::F32(enabled(build(scene, encoder, safety)?)?),
                 Some(l) => SceneServo::F32Layered(layered(build(scene, encoder, safety)?, l)?),
             },
-            Precision::F64 => match SceneLayer::for_scene(scene, &safety)? {
+            Precision::F64 => match scene_layers(scene, &safety)? {
                 None => SceneServo::F64(enabled(build(scene, encoder, safety)?)?),
                 Some(l) => SceneServo::F64Layered(layered(build(scene, encoder, safety)?, l)?),
             },
