@@ -104,9 +104,10 @@ impl WorldState {
                 self.stopped = Some("the handle left the workspace".into());
             }
             self.last = Some(s);
-            self.world = self.sim.servo().blocks();
             self.board_telemetry();
         }
+        // (The blocks are copied for drawing once a frame, not each tick.)
+        self.world = self.sim.servo().blocks();
     }
 
     /// The board's telemetry into each axis's board ring: at its own tick

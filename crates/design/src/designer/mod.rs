@@ -237,6 +237,16 @@ impl Designer {
         Some((c, name))
     }
 
+    /// Where a design binds, from its worst check: the frequency, the pose
+    /// (with several), and the lightly damped mode there, if one is.
+    fn binding(&self, worst: Option<(Check, &str)>) -> Option<Binds> {
+        worst.map(|(c, name)| Binds {
+            frequency_hz: c.worst_frequency_hz,
+            pose: self.pose_name(name),
+            limited_by: self.light_mode_at(c.worst_frequency_hz),
+        })
+    }
+
     /// The lightly damped mode (damping ratio below 1e-3) of any pose
     /// within three of its half-widths of `hz`, if one is: what a design
     /// that binds at `hz` is limited by.
@@ -334,24 +344,21 @@ impl Designer {
         let sound = self.impedance_bounds(Bound::Sound);
         let coupling = self.impedance_on(&self.with(sound), b);
         let paper = self.impedance_on(&self.with(self.impedance_bounds(Bound::Paper)), b);
-        let binding = coupling.and_then(|(k, b)| {
+        let binding = self.binding(coupling.and_then(|(k, b)| {
             self.worst_check(|p| analysis::check_impedance(&p.analysis, k, b, self.human))
-                .map(|(c, name)| (c.worst_frequency_hz, self.pose_name(name)))
-        });
+        }));
         let message = coupling
             .is_none()
             .then(|| self.infeasible(sound, Infeasible::Stiffness, b));
-        let mut d = Design::new(
+        Ok(Design::new(
             self.context(DisplayKind::Impedance),
             Limit::Stiffness,
             [coupling, paper],
             b.is_some(),
             margin,
-            binding.clone(),
+            binding,
             message,
-        );
-        d.limited_by = binding.and_then(|(hz, _)| self.light_mode_at(hz));
-        Ok(d)
+        ))
     }
 
     /// The admittance display's boundary coupling mass at damping `b` (N
@@ -381,12 +388,11 @@ impl Designer {
         let paper = self.admittance_bounds((kp, bp), &k, Bound::Paper);
         let coupling = self.admittance_on(&self.with(&sound), radius, b);
         let paper = self.admittance_on(&self.with(&paper), radius, b);
-        let binding = coupling.and_then(|(m, b)| {
+        let binding = self.binding(coupling.and_then(|(m, b)| {
             self.worst_check(|p| {
                 analysis::check_admittance(&p.plant, &p.analysis, (kp, bp), (m, b), self.human)
             })
-            .map(|(c, name)| (c.worst_frequency_hz, self.pose_name(name)))
-        });
+        }));
         let message = match coupling {
             Some(_) => None,
             None if radius >= 1.0 => Some(format!(
@@ -400,10 +406,9 @@ impl Designer {
             [coupling, paper],
             b.is_some(),
             margin,
-            binding.clone(),
+            binding,
             message,
         );
-        d.limited_by = binding.and_then(|(hz, _)| self.light_mode_at(hz));
         d.regulator = Some(Regulator {
             kp,
             bp,

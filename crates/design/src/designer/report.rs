@@ -173,9 +173,8 @@ pub struct Design {
     pub fixed_damping: bool,
     /// The recommended gain's margin inside the boundary (a fraction).
     pub margin: f64,
-    /// Where the design binds: the frequency (Hz) and, with several poses,
-    /// the pose.
-    pub binds_at: Option<(f64, Option<String>)>,
+    /// Where the design binds.
+    pub binds_at: Option<Binds>,
     /// Which bound binds.
     pub binding: Binding,
     /// By how much the paper's approximation claims more (a fraction).
@@ -184,8 +183,17 @@ pub struct Design {
     pub message: Option<String>,
     /// The admittance display's regulator.
     pub regulator: Option<Regulator>,
-    /// A lightly damped mode of the device where the design binds, if it
-    /// binds at one: what limits it.
+}
+
+/// Where a design binds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Binds {
+    /// The frequency (Hz).
+    pub frequency_hz: f64,
+    /// The pose, with several.
+    pub pose: Option<String>,
+    /// A lightly damped mode of the device there, if it binds at one: what
+    /// limits the design.
     pub limited_by: Option<LightMode>,
 }
 
@@ -206,7 +214,7 @@ impl Design {
         [coupling, paper]: [Option<(f64, f64)>; 2],
         fixed_damping: bool,
         margin: f64,
-        binds_at: Option<(f64, Option<String>)>,
+        binds_at: Option<Binds>,
         message: Option<String>,
     ) -> Self {
         let (binding, aliasing_effect) = match (coupling, paper) {
@@ -233,8 +241,12 @@ impl Design {
             aliasing_effect,
             message,
             regulator: None,
-            limited_by: None,
         }
+    }
+
+    /// The lightly damped mode the design binds at, if it binds at one.
+    pub fn limited_by(&self) -> Option<&LightMode> {
+        self.binds_at.as_ref().and_then(|b| b.limited_by.as_ref())
     }
 
     /// The recommended gain: `margin` inside the boundary.
@@ -265,9 +277,9 @@ impl Serialize for Design {
         }
         m.serialize_entry("binding_bound", &self.binding)?;
         m.serialize_entry("aliasing_effect", &self.aliasing_effect)?;
-        if let Some((f, pose)) = &self.binds_at {
-            m.serialize_entry("binding_frequency_hz", f)?;
-            if let Some(p) = pose {
+        if let Some(b) = &self.binds_at {
+            m.serialize_entry("binding_frequency_hz", &b.frequency_hz)?;
+            if let Some(p) = &b.pose {
                 m.serialize_entry("binding_pose", p)?;
             }
         }
@@ -278,7 +290,7 @@ impl Serialize for Design {
         if let Some(msg) = &self.message {
             m.serialize_entry("message", msg)?;
         }
-        if let Some(l) = &self.limited_by {
+        if let Some(l) = self.limited_by() {
             m.serialize_entry("limited_by", l)?;
         }
         m.end()
@@ -322,11 +334,17 @@ impl fmt::Display for Design {
             )?;
         }
         match &self.binds_at {
-            Some((hz, Some(p))) => writeln!(f, "  binds at {hz:.2} Hz in pose {p}")?,
-            Some((hz, None)) => writeln!(f, "  binds at {hz:.2} Hz")?,
+            Some(Binds {
+                frequency_hz: hz,
+                pose: Some(p),
+                ..
+            }) => writeln!(f, "  binds at {hz:.2} Hz in pose {p}")?,
+            Some(Binds {
+                frequency_hz: hz, ..
+            }) => writeln!(f, "  binds at {hz:.2} Hz")?,
             None => {}
         }
-        if let Some(l) = &self.limited_by {
+        if let Some(l) = self.limited_by() {
             writeln!(
                 f,
                 "  limited by a mode at {:.2} Hz with damping ratio {:.1e}: so lightly damped a mode bounds what can be proven; damping it, or sensing where it moves, raises the limit",
