@@ -66,12 +66,15 @@ pub struct SafeForces<R, const N: usize> {
 #[derive(Clone, Copy, Debug)]
 pub struct SafetyLayer<R = f32, const N: usize = 1> {
     cfg: [SafetyConfig; N],
+    /// Each motor's I^2 t budget (N^2 ticks).
     budget: [f32; N],
     enabled: bool,
     latched: Faults,
     first: Faults,
     ramp_done: u32,
-    /// Each motor's I^2 t state above its continuous rating (N^2 s), >= 0.
+    /// Each motor's I^2 t state above its continuous rating, >= 0, in
+    /// N^2 ticks (N^2 s over the period: the tick's update is then one
+    /// multiply-add and a subtraction).
     heat: [R; N],
     /// The tick number the next step must bring.
     next_tick: u32,
@@ -80,10 +83,8 @@ pub struct SafetyLayer<R = f32, const N: usize = 1> {
     heartbeat_age: u32,
     /// Largest heartbeat age that is not a fault (`u32::MAX`: unchecked).
     heartbeat_limit: u32,
-    /// Each `continuous_force_n^2` (N^2), the heat a motor sheds per second.
+    /// Each `continuous_force_n^2` (N^2), the heat a motor sheds per tick.
     continuous_sq_n2: [R; N],
-    /// `T` (s).
-    period: R,
 }
 
 impl SafetyLayer {
@@ -175,7 +176,7 @@ impl<R: Real, const N: usize> SafetyLayer<R, N> {
             t => t,
         };
         Ok(SafetyLayer {
-            budget: cfg.map(|c| c.thermal_budget()),
+            budget: cfg.map(|c| c.thermal_budget() / period),
             continuous_sq_n2: cfg
                 .map(|c| R::of(c.continuous_force_n) * R::of(c.continuous_force_n)),
             cfg,
@@ -188,7 +189,6 @@ impl<R: Real, const N: usize> SafetyLayer<R, N> {
             ticking: false,
             heartbeat_age: 0,
             heartbeat_limit,
-            period: R::of(period),
         })
     }
 
@@ -377,9 +377,9 @@ impl<R: Real, const N: usize> SafetyLayer<R, N> {
     }
 
     /// Axis `i`'s finite `command` (N) clipped to its peak force, or to its
-    /// continuous force once its I²t budget is spent.
+    /// continuous force once its I²t budget is spent, and whether it was.
     #[inline(always)]
-    fn clip(&self, i: usize, command: R) -> R {
+    fn clip(&self, i: usize, command: R) -> (R, bool) {
         let c = &self.cfg[i];
         let limit = R::of(if self.heat[i] >= R::of(self.budget[i]) {
             c.continuous_force_n
@@ -389,11 +389,11 @@ impl<R: Real, const N: usize> SafetyLayer<R, N> {
         // (Not `clamp`, which carries an assertion on its bounds; the
         // command is finite here, or a fault would have latched.)
         if command > limit {
-            limit
+            (limit, true)
         } else if command < -limit {
-            -limit
+            (-limit, true)
         } else {
-            command
+            (command, false)
         }
     }
 
@@ -442,15 +442,13 @@ impl<R: Real, const N: usize> SafetyLayer<R, N> {
                 let ramping = self.ramp_done < ramp_ticks;
                 let fraction = R::of(self.ramp_done as f32 / ramp_ticks as f32);
                 for (i, &command) in command_n.iter().enumerate() {
-                    let clipped = self.clip(i, command);
+                    let (clipped, limited) = self.clip(i, command);
                     out.force_n[i] = clipped * fraction;
-                    out.limited[i] = ramping | (clipped != command);
+                    out.limited[i] = ramping | limited;
                 }
             } else {
                 for (i, &command) in command_n.iter().enumerate() {
-                    let clipped = self.clip(i, command);
-                    out.force_n[i] = clipped;
-                    out.limited[i] = clipped != command;
+                    (out.force_n[i], out.limited[i]) = self.clip(i, command);
                 }
             }
         } else {
@@ -462,7 +460,7 @@ impl<R: Real, const N: usize> SafetyLayer<R, N> {
             .zip(&out.force_n)
             .zip(&self.continuous_sq_n2)
         {
-            let h = *heat + (f * f - shed) * self.period;
+            let h = *heat + (f * f - shed);
             // (`f` is finite: a comparison, not `max`'s NaN handling.)
             *heat = if h > R::ZERO { h } else { R::ZERO };
         }
