@@ -41,6 +41,10 @@ pub struct DeviceModel {
     /// Measurement-to-actuation delay in whole ticks (0: the force is held
     /// from the tick that sampled the sensors).
     pub delay_samples: u32,
+    /// The actuator encoder's quantum `Δ` (m at the actuator), if known.
+    pub encoder_quantum_m: Option<f64>,
+    /// The Coulomb friction at the actuator `f_c` (N), if known.
+    pub coulomb_friction_n: Option<f64>,
 }
 
 /// Why a model file was refused. The message names the file, and the line
@@ -82,6 +86,8 @@ struct RawModel {
     #[serde(rename = "C_f")]
     c_f: Option<Vec<Vec<f64>>>,
     delay_samples: Option<u32>,
+    encoder_quantum_m: Option<f64>,
+    coulomb_friction_n: Option<f64>,
 }
 
 /// A file's text and its name for messages.
@@ -202,6 +208,22 @@ impl DeviceModel {
                 }
                 d => d.unwrap_or(0),
             },
+            encoder_quantum_m: raw
+                .encoder_quantum_m
+                .map(|v| scalar("encoder_quantum_m", v))
+                .transpose()
+                .map_err(&err)?,
+            coulomb_friction_n: raw
+                .coulomb_friction_n
+                .map(|v| {
+                    if v.is_finite() && v >= 0.0 {
+                        Ok(v)
+                    } else {
+                        Err(format!("coulomb_friction_n = {v} must be finite and >= 0"))
+                    }
+                })
+                .transpose()
+                .map_err(&err)?,
         };
         model.check().map_err(err)?;
         Ok(model)
@@ -210,6 +232,18 @@ impl DeviceModel {
     /// Number of coordinates `n`.
     pub fn dof(&self) -> usize {
         self.m.nrows()
+    }
+
+    /// The encoder quantum and Coulomb friction, where the model gives
+    /// both (a missing friction is none).
+    pub fn friction(&self) -> Option<crate::limit_cycle::Friction> {
+        let rigid = self.dof() == 1 && self.k[(0, 0)] == 0.0 && self.delay_samples == 0;
+        self.encoder_quantum_m
+            .map(|q| crate::limit_cycle::Friction {
+                encoder_quantum_m: q,
+                coulomb_friction_n: self.coulomb_friction_n.unwrap_or(0.0),
+                rigid_damping_nspm: rigid.then(|| self.d[(0, 0)]),
+            })
     }
 
     /// The physical checks: symmetry, definiteness, limits.
@@ -343,6 +377,26 @@ mod tests {
         assert_eq!(m.m[(2, 3)], 0.2799);
         assert_eq!(m.k[(2, 2)], 5.3954e7);
         assert_eq!(m.c_f[(0, 4)], 5.3236e7);
+    }
+
+    #[test]
+    fn the_encoder_and_friction_are_optional_and_checked() {
+        let m = DeviceModel::from_toml(EXCALIBUR, "x.toml").unwrap();
+        assert_eq!(m.friction(), None);
+        let with = |extra: &str| DeviceModel::from_toml(&format!("{extra}\n{EXCALIBUR}"), "x.toml");
+        let f = with("encoder_quantum_m = 1e-6")
+            .unwrap()
+            .friction()
+            .unwrap();
+        assert_eq!((f.encoder_quantum_m, f.coulomb_friction_n), (1e-6, 0.0));
+        // Five coordinates: not one rigid body.
+        assert_eq!(f.rigid_damping_nspm, None);
+        let e = with("encoder_quantum_m = 0.0").unwrap_err().to_string();
+        assert_eq!(e, "x.toml: encoder_quantum_m = 0 must be finite and > 0");
+        let e = with("encoder_quantum_m = 1e-6\ncoulomb_friction_n = -1.0")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "x.toml: coulomb_friction_n = -1 must be finite and >= 0");
     }
 
     fn broken(from: &str, to: &str) -> String {

@@ -23,6 +23,7 @@ mod report;
 pub use report::*;
 
 use crate::analysis::{self, Analysis, Check, GridSpec, Poses};
+use crate::limit_cycle::{Friction, LimitCycle};
 use crate::network::HumanBound;
 use crate::{DeviceModel, Error, Plant};
 use std::sync::{Mutex, OnceLock};
@@ -350,7 +351,7 @@ impl Designer {
         let message = coupling
             .is_none()
             .then(|| self.infeasible(sound, Infeasible::Stiffness, b));
-        Ok(Design::new(
+        let mut d = Design::new(
             self.context(DisplayKind::Impedance),
             Limit::Stiffness,
             [coupling, paper],
@@ -358,7 +359,12 @@ impl Designer {
             margin,
             binding,
             message,
-        ))
+        );
+        d.limit_cycle = d
+            .recommended()
+            .zip(d.coupling)
+            .and_then(|(k, (_, b))| self.limit_cycle(k, b, true));
+        Ok(d)
     }
 
     /// The admittance display's boundary coupling mass at damping `b` (N
@@ -414,6 +420,7 @@ impl Designer {
             bp,
             pole_radius: radius,
         });
+        d.limit_cycle = self.limit_cycle(kp, bp, false);
         Ok(d)
     }
 
@@ -429,14 +436,16 @@ impl Designer {
         let boundary = self
             .impedance_on(&self.with(self.impedance_bounds(Bound::Sound)), Some(b))
             .map(|(k, _)| k);
-        Ok(CheckReport::new(
+        let mut r = CheckReport::new(
             self.context(DisplayKind::Impedance),
             Gains::from(twoport_control::ImpedanceGains::new(k as f32, b as f32)),
             (k, b, None),
             &c,
             self.pose_name(pose),
             boundary,
-        ))
+        );
+        r.limit_cycle = self.limit_cycle(k, b, true);
+        Ok(r)
     }
 
     /// Whether the admittance design (regulator `(k_p, b_p)`, coupling
@@ -468,7 +477,7 @@ impl Designer {
         let boundary = self
             .admittance_on(&self.with(&bounds), c.regulator_pole_radius, Some(b))
             .map(|(m, _)| m);
-        Ok(CheckReport::new(
+        let mut r = CheckReport::new(
             self.context(DisplayKind::Admittance),
             Gains::from(twoport_control::AdmittanceGains::new(
                 kp.0 as f32,
@@ -480,7 +489,25 @@ impl Designer {
             &c,
             self.pose_name(pose),
             boundary,
-        ))
+        );
+        r.limit_cycle = self.limit_cycle(kp.0, kp.1, false);
+        Ok(r)
+    }
+
+    /// The quantisation's limit cycles for a law of stiffness `k` and
+    /// damping `b` on the encoder (the impedance coupling, or the
+    /// admittance display's regulator), where the model gives a quantum.
+    fn limit_cycle(&self, k: f64, b: f64, impedance: bool) -> Option<LimitCycle> {
+        let pose = self.poses.first()?;
+        let friction = pose.model.friction()?;
+        // With several poses the device is not one rigid body everywhere.
+        let friction = Friction {
+            rigid_damping_nspm: friction
+                .rigid_damping_nspm
+                .filter(|_| self.poses.len() == 1),
+            ..friction
+        };
+        Some(LimitCycle::new(&friction, k, b, self.period_s(), impedance))
     }
 
     /// The impedance display's proven region: the greatest stiffness at

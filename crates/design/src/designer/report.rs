@@ -2,6 +2,7 @@
 //! command line prints with `--json` and displays as its text.
 
 use crate::analysis::Check;
+use crate::limit_cycle::LimitCycle;
 use serde::ser::{SerializeMap, Serializer};
 use serde::Serialize;
 use std::fmt;
@@ -183,6 +184,9 @@ pub struct Design {
     pub message: Option<String>,
     /// The admittance display's regulator.
     pub regulator: Option<Regulator>,
+    /// What the encoder's quantum and the friction allow at the
+    /// recommended gains, where the model gives them.
+    pub limit_cycle: Option<LimitCycle>,
 }
 
 /// Where a design binds.
@@ -241,6 +245,7 @@ impl Design {
             aliasing_effect,
             message,
             regulator: None,
+            limit_cycle: None,
         }
     }
 
@@ -292,6 +297,9 @@ impl Serialize for Design {
         }
         if let Some(l) = self.limited_by() {
             m.serialize_entry("limited_by", l)?;
+        }
+        if let Some(l) = &self.limit_cycle {
+            m.serialize_entry("limit_cycle", l)?;
         }
         m.end()
     }
@@ -364,7 +372,11 @@ impl fmt::Display for Design {
                 "  the paper's approximation gives the same {what} (aliasing moves it by {by:.4}%)"
             ),
             None => write!(f, "  the paper's approximation finds no design either"),
+        }?;
+        if let Some(l) = &self.limit_cycle {
+            write!(f, "\n{l}")?;
         }
+        Ok(())
     }
 }
 
@@ -385,6 +397,9 @@ pub struct CheckReport {
     pub boundary: Option<f64>,
     /// How far inside the boundary (a fraction; negative past it).
     pub gain_margin: Option<f64>,
+    /// What the encoder's quantum and the friction allow at these gains,
+    /// where the model gives them.
+    pub limit_cycle: Option<LimitCycle>,
     /// The coupling's own numbers: `(limit, b_c, regulator)`.
     coupling: (f64, f64, Option<(f64, f64)>),
 }
@@ -411,6 +426,7 @@ impl CheckReport {
             worst_pose,
             boundary,
             gain_margin,
+            limit_cycle: None,
             coupling,
         }
     }
@@ -454,6 +470,9 @@ impl Serialize for CheckReport {
         }
         m.serialize_entry(&format!("boundary_{}", self.limit().key()), &self.boundary)?;
         m.serialize_entry("gain_margin", &self.gain_margin)?;
+        if let Some(l) = &self.limit_cycle {
+            m.serialize_entry("limit_cycle", l)?;
+        }
         m.end()
     }
 }
@@ -515,7 +534,11 @@ impl fmt::Display for CheckReport {
                 -100.0 * g
             ),
             _ => write!(f, "  nothing is proven at this damping"),
+        }?;
+        if let Some(l) = &self.limit_cycle {
+            write!(f, "\n{l}")?;
         }
+        Ok(())
     }
 }
 
