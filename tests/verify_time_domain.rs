@@ -19,8 +19,8 @@ const T: f64 = 1e-3;
 fn scene(k: f64, b: f64, hand: &twoport_design::verify::Hand, ve: &Ve) -> Scene {
     let mut s = scene_on("models/excalibur.toml", k, b, ve);
     assert!(
-        hand.grasp.is_some(),
-        "the simulator's hand is the grasp plus an arm"
+        hand.grasp.is_some() && hand.second.is_none(),
+        "the simulator's hand is the grasp plus an arm of one mass"
     );
     s.human.grasp = GraspKind::Maximum;
     s.human.arm = Some(Arm {
@@ -154,6 +154,7 @@ fn a_declared_delay_enters_the_simulator() {
         stiffness_npm: 0.1,
         damping_nspm: 1e-4,
         grasp: None,
+        second: None,
     };
     let worst = (0..25)
         .flat_map(|i| {

@@ -64,7 +64,8 @@ struct Sampled {
 fn sampled(model: &DeviceModel, hand: &Hand, t: f64) -> Result<Sampled, String> {
     let n = model.dof();
     let grasp = hand.grasp;
-    let nq = n + usize::from(grasp.is_some());
+    let ny = n + usize::from(grasp.is_some());
+    let nq = ny + usize::from(hand.second.is_some());
     let (mut m, mut d, mut k) = (
         DMatrix::<f64>::zeros(nq, nq),
         DMatrix::<f64>::zeros(nq, nq),
@@ -74,35 +75,44 @@ fn sampled(model: &DeviceModel, hand: &Hand, t: f64) -> Result<Sampled, String> 
     d.view_mut((0, 0), (n, n)).copy_from(&model.d);
     k.view_mut((0, 0), (n, n)).copy_from(&model.k);
     // The hand acts through f_h's column of G on the handle x_h = C_v[0] q.
-    let gh: Vec<f64> = (0..n).map(|i| model.g[(i, 0)]).collect();
-    let ch: Vec<f64> = (0..n).map(|j| model.c_v[(0, j)]).collect();
+    let mut gh = vec![0.0; nq];
+    let mut ch = vec![0.0; nq];
+    for i in 0..n {
+        (gh[i], ch[i]) = (model.g[(i, 0)], model.c_v[(0, i)]);
+    }
+    // Where the hand's mass sits: at the handle, or on the grasp's own
+    // coordinate.
+    let (mut gp, mut cp) = (gh.clone(), ch.clone());
+    if grasp.is_some() {
+        (gp, cp) = (vec![0.0; nq], vec![0.0; nq]);
+        (gp[n], cp[n]) = (1.0, 1.0);
+    }
+    // A spring or damper `c` between two points (forces through `g_*`,
+    // positions `c_*`): `c (g_1 - g_2)(c_1 - c_2)^T`.
+    let link = |mat: &mut DMatrix<f64>, c: f64, one: (&[f64], &[f64]), two: (&[f64], &[f64])| {
+        for i in 0..nq {
+            for j in 0..nq {
+                mat[(i, j)] += c * (one.0[i] - two.0[i]) * (one.1[j] - two.1[j]);
+            }
+        }
+    };
+    let none = vec![0.0; nq];
     let (hm, hk, hb) = (hand.mass_kg, hand.stiffness_npm, hand.damping_nspm);
-    match grasp {
-        None => {
-            for i in 0..n {
-                for j in 0..n {
-                    let gc = gh[i] * ch[j];
-                    m[(i, j)] += hm * gc;
-                    k[(i, j)] += hk * gc;
-                    d[(i, j)] += hb * gc;
-                }
-            }
-        }
-        Some(g) => {
-            let y = n;
-            let (kg, bg) = (g.stiffness_npm, g.damping_nspm);
-            m[(y, y)] = hm;
-            for (mat, c, ground) in [(&mut k, kg, hk), (&mut d, bg, hb)] {
-                for i in 0..n {
-                    for j in 0..n {
-                        mat[(i, j)] += c * gh[i] * ch[j];
-                    }
-                    mat[(i, y)] -= c * gh[i];
-                    mat[(y, i)] -= c * ch[i];
-                }
-                mat[(y, y)] += c + ground;
-            }
-        }
+    if let Some(g) = grasp {
+        m[(n, n)] = hm;
+        link(&mut k, g.stiffness_npm, (&gh, &ch), (&gp, &cp));
+        link(&mut d, g.damping_nspm, (&gh, &ch), (&gp, &cp));
+    } else {
+        link(&mut m, hm, (&gp, &cp), (&none, &none));
+    }
+    link(&mut k, hk, (&gp, &cp), (&none, &none));
+    link(&mut d, hb, (&gp, &cp), (&none, &none));
+    if let Some(r) = hand.second {
+        let mut unit = vec![0.0; nq];
+        unit[ny] = 1.0;
+        m[(ny, ny)] = r.mass_kg;
+        link(&mut k, r.stiffness_npm, (&gp, &cp), (&unit, &unit));
+        link(&mut d, r.damping_nspm, (&gp, &cp), (&unit, &unit));
     }
     let minv = m
         .clone()

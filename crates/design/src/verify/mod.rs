@@ -56,7 +56,9 @@ pub enum Ve {
 /// ground. Without a grasp the mass is held rigidly at the handle; with one
 /// (the paper's Fig. 3, when a human bound is set) it hangs from the handle
 /// through the bound's spring and damper, so the hand's impedance is the
-/// bound `Z_max` in series with the mass-spring-damper.
+/// bound `Z_max` in series with the mass-spring-damper. A second mass may
+/// hang from the first on its own spring and damper: a hand with two
+/// resonances.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Hand {
     /// Mass (kg).
@@ -67,6 +69,20 @@ pub struct Hand {
     pub damping_nspm: f64,
     /// The grasp in series, `Z_max = b + k/s`, or none.
     pub grasp: Option<HumanBound>,
+    /// A second mass on a spring and damper from the first, or none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub second: Option<Resonator>,
+}
+
+/// A mass on a spring and a damper in parallel.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Resonator {
+    /// Mass (kg).
+    pub mass_kg: f64,
+    /// Spring (N/m).
+    pub stiffness_npm: f64,
+    /// Damper (N s/m).
+    pub damping_nspm: f64,
 }
 
 /// A hand and a VE.
@@ -184,6 +200,7 @@ mod tests {
                 stiffness_npm: 0.0,
                 damping_nspm: 0.0,
                 grasp: None,
+                second: None,
             },
             ve,
         }
@@ -234,6 +251,7 @@ mod tests {
                         stiffness_npm: 0.05 * w * w,
                         damping_nspm: 0.01,
                         grasp: Some(HumanBound::PAPER),
+                        second: None,
                     },
                     ve,
                 };
@@ -249,6 +267,54 @@ mod tests {
                 let (r, rt) = (osc(&a), osc(&a.transpose()));
                 assert!((r - rt).abs() < 1e-12, "{}: {r} vs {rt}", model.name);
             }
+        }
+    }
+
+    /// A second hand mass on a spring far stiffer than anything in the
+    /// loop moves with the first: the loop is the one-mass hand's with the
+    /// masses summed, with and without the grasp.
+    #[test]
+    fn a_rigidly_held_second_mass_adds_to_the_first() {
+        let model = crate::model::shipped_for_tests().remove(0);
+        for grasp in [None, Some(HumanBound::PAPER)] {
+            let hand = |mass_kg, second| Hand {
+                mass_kg,
+                stiffness_npm: 2e4,
+                damping_nspm: 1.0,
+                grasp,
+                second,
+            };
+            let ve = Ve::Cursor { mass_kg: 0.2 };
+            let rho = |hand| {
+                let r = radius(
+                    &model,
+                    1e-3,
+                    &imp(40_000.0, 20.0),
+                    &Termination { hand, ve },
+                    0,
+                );
+                r.unwrap().spectral_radius
+            };
+            let one = rho(hand(0.3, None));
+            let two = rho(hand(
+                0.1,
+                Some(Resonator {
+                    mass_kg: 0.2,
+                    stiffness_npm: 1e12,
+                    damping_nspm: 0.0,
+                }),
+            ));
+            assert!((one - two).abs() < 1e-6, "{grasp:?}: {one} vs {two}");
+            // And a soft one does not.
+            let soft = rho(hand(
+                0.1,
+                Some(Resonator {
+                    mass_kg: 0.2,
+                    stiffness_npm: 1e3,
+                    damping_nspm: 0.0,
+                }),
+            ));
+            assert!((one - soft).abs() > 1e-5, "{grasp:?}: {one} vs {soft}");
         }
     }
 

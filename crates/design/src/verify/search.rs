@@ -1,7 +1,7 @@
 //! The search for the termination that makes given gains least stable:
 //! a sweep of hands and VEs, then Nelder-Mead from the worst starts.
 
-use super::{radius, Gains, Hand, Radius, Termination, Ve, Verdict};
+use super::{radius, Gains, Hand, Radius, Resonator, Termination, Ve, Verdict};
 use crate::network::HumanBound;
 use crate::DeviceModel;
 use nalgebra::DMatrix;
@@ -63,9 +63,21 @@ struct Search<'a> {
     grasp: Option<HumanBound>,
     delay: usize,
     evaluations: usize,
+    /// Whether the hand has a second resonance (three more parameters
+    /// after the first's).
+    two: bool,
 }
 
 impl Search<'_> {
+    /// Where the VE's parameters start in a search point.
+    fn ve_at(&self) -> usize {
+        if self.two {
+            6
+        } else {
+            3
+        }
+    }
+
     fn termination(&self, kind: VeKind, p: &[f64]) -> Termination {
         let x = |i: usize| 10f64.powf(p[i]);
         Termination {
@@ -74,15 +86,22 @@ impl Search<'_> {
                 stiffness_npm: x(1),
                 damping_nspm: x(2),
                 grasp: self.grasp,
+                second: self.two.then(|| Resonator {
+                    mass_kg: x(3),
+                    stiffness_npm: x(4),
+                    damping_nspm: x(5),
+                }),
             },
-            ve: kind.build(&p[3..]),
+            ve: kind.build(&p[self.ve_at()..]),
         }
     }
 
     /// The radius at `p` (clamped to the bounds); 0 where the loop cannot
     /// be built (a VE the board would refuse).
     fn eval(&mut self, kind: VeKind, p: &mut [f64]) -> Radius {
-        for (x, (lo, hi)) in p.iter_mut().zip(HAND_BOUNDS.iter().chain(kind.bounds())) {
+        let second: &[(f64, f64)] = if self.two { &HAND_BOUNDS } else { &[] };
+        let bounds = HAND_BOUNDS.iter().chain(second).chain(kind.bounds());
+        for (x, (lo, hi)) in p.iter_mut().zip(bounds) {
             *x = x.clamp(*lo, *hi);
         }
         self.evaluations += 1;
@@ -104,7 +123,9 @@ impl Search<'_> {
         simplex.push((s0, r0));
         for i in 0..dim {
             let mut p = start.to_vec();
-            p[i] += if i == 1 || i == 3 { 0.05 } else { 0.3 };
+            // (Small steps in the stiffnesses that tune a resonance.)
+            let tuning = i == 1 || i == self.ve_at() || (self.two && i == 4);
+            p[i] += if tuning { 0.05 } else { 0.3 };
             let r = self.eval(kind, &mut p);
             simplex.push((p, r));
         }
@@ -202,6 +223,7 @@ pub fn verify(
         grasp: human,
         delay: delay_samples,
         evaluations: 0,
+        two: false,
     };
     // Check the loop can be built at all (gains the board accepts).
     let off = [-4.0, -1.0, -4.0];
@@ -275,6 +297,7 @@ pub fn verify(
     starts.sort_by(|a, b| b.0.total_cmp(&a.0));
     // Refine the best starts of each VE family.
     let mut best: Option<(VeKind, Vec<f64>, Radius)> = None;
+    let mut finals: Vec<(f64, VeKind, Vec<f64>, f64)> = Vec::new();
     for kind in [
         VeKind::Constraint,
         VeKind::Cursor,
@@ -284,16 +307,52 @@ pub fn verify(
     ] {
         for (_, _, p) in starts.iter().filter(|x| x.1 == kind).take(3) {
             let (q, r) = s.refine(kind, p, 60 * (3 + kind.dims()));
+            finals.push((r.score, kind, q.clone(), r.frequency_hz));
             let better = |b: &Radius| r.score > b.score || (r.unstable && !b.unstable);
             if best.as_ref().is_none_or(|b| better(&b.2)) {
                 best = Some((kind, q, r));
             }
         }
     }
+    finals.sort_by(|a, b| b.0.total_cmp(&a.0));
     let (kind, p, r) = best.ok_or_else(|| crate::Error::Verify {
         model: model.name.clone(),
         why: "no termination could be built".into(),
     })?;
+    // Then, where nothing was found, hands with two resonances: the best
+    // one-resonance terminations with a second mass tuned to the loop's
+    // worst frequency or one of its aliases (where the sound bound lets
+    // the hand take its worst value at two frequencies at once), refined
+    // in all their parameters. Only a counterexample replaces the first
+    // search's answer: a radius climbed toward 1 by a nearly lossless hand
+    // mode of its own says nothing.
+    let mut best = (kind, p, r, false);
+    if !r.unstable {
+        s.two = true;
+        let fs = 1.0 / period_s;
+        let mut starts: Vec<(f64, VeKind, Vec<f64>)> = Vec::new();
+        for (_, kind, p, f) in finals.iter().take(3) {
+            for f2 in [*f, fs - f, fs + f, 2.0 * fs - f] {
+                let w2 = (2.0 * PI * f2.max(0.1)).powi(2);
+                for m in [-3.0, -2.0, -1.0] {
+                    let k = (10f64.powf(m) * w2).log10();
+                    let mut q: Vec<f64> = p[..3].iter().chain(&[m, k, -4.0]).copied().collect();
+                    q.extend_from_slice(&p[3..]);
+                    let r = s.eval(*kind, &mut q);
+                    starts.push((r.score, *kind, q));
+                }
+            }
+        }
+        starts.sort_by(|a, b| b.0.total_cmp(&a.0));
+        for (_, kind, p) in starts.iter().take(2) {
+            let (q, r) = s.refine(*kind, p, 60 * (6 + kind.dims()));
+            if r.unstable && !best.2.unstable {
+                best = (*kind, q, r, true);
+            }
+        }
+    }
+    let (kind, p, r, two) = best;
+    s.two = two;
     Ok(Verdict {
         unstable: r.unstable,
         growth_per_s: r.growth_per_s(period_s),
