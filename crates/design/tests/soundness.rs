@@ -11,7 +11,7 @@
 use twoport_control::{AdmittanceGains, Gains, ImpedanceGains};
 use twoport_design::analysis::*;
 use twoport_design::network::HumanBound;
-use twoport_design::verify::verify;
+use twoport_design::verify::{verify, Verdict};
 use twoport_design::{Designer, DeviceModel, Plant};
 
 const T: f64 = 1e-3;
@@ -150,20 +150,47 @@ fn imp(k: f64, b: f64) -> Gains {
     ImpedanceGains::new(k as f32, b as f32).into()
 }
 
-/// A designed gain `verify` cannot break, and one 20% past it that it does.
-fn assert_tight(model: &DeviceModel, designed: Gains, past: Gains, human: Option<HumanBound>) {
+/// A designed gain `verify` cannot break, and one past it that it does;
+/// returns what `verify` found past it.
+fn assert_tight(
+    model: &DeviceModel,
+    designed: Gains,
+    past: Gains,
+    human: Option<HumanBound>,
+) -> Verdict {
     let at = verify(model, T, &designed, human, model.delay_samples as usize).unwrap();
     assert!(
         !at.unstable,
         "{}: {designed:?} broken by {at:?}",
         model.name
     );
+    // A design on its boundary may meet a termination with a pole on the
+    // unit circle, never one outside it.
+    if let Some(c) = at.constructed {
+        assert!(c.spectral_radius < 1.0 + 1e-9, "{}: {c:?}", model.name);
+    }
     let over = verify(model, T, &past, human, model.delay_samples as usize).unwrap();
     assert!(
         over.unstable,
         "{}: nothing breaks {past:?}: {over:?}",
         model.name
     );
+    over
+}
+
+/// Past a tight boundary the constructive search agrees with the search:
+/// a lossless hand and VE that put a pole on the unit circle.
+fn assert_constructed(model: &DeviceModel, over: &Verdict) {
+    let c = over
+        .constructed
+        .unwrap_or_else(|| panic!("{}: nothing constructed: {over:?}", model.name));
+    assert!(
+        (c.spectral_radius - 1.0).abs() < 1e-6,
+        "{}: {c:?}",
+        model.name
+    );
+    let h = c.termination.hand;
+    assert!(h.damping_nspm == 0.0 && h.second.is_none(), "{c:?}");
 }
 
 #[test]
@@ -174,7 +201,8 @@ fn verify_finds_nothing_at_the_excalibur_designs_and_breaks_them_past() {
     for human in [HUMAN, None] {
         let k = max_stiffness(&a, &a.impedance_bound(human), 90.0).unwrap();
         let g = |k_npm| imp(k_npm, 90.0);
-        assert_tight(&m, g(k), g(1.01 * k), human);
+        let over = assert_tight(&m, g(k), g(1.01 * k), human);
+        assert_constructed(&m, &over);
     }
     let kp = regulator_tf(51_000.0, 90.0, T).unwrap();
     let mass = min_mass(&a, &a.admittance_bound(&kp, HUMAN), 500.0).unwrap();
@@ -204,7 +232,8 @@ fn verify_breaks_the_delayed_rigid_design_one_percent_past() {
     let a = analysis(&m, GridSpec::DEFAULT);
     let k = max_stiffness(&a, &a.impedance_bound(None), 0.0).unwrap();
     assert!((k - 10_000.0).abs() < 50.0, "{k}");
-    assert_tight(&m, imp(k, 0.0), imp(1.01 * k, 0.0), None);
+    let over = assert_tight(&m, imp(k, 0.0), imp(1.01 * k, 0.0), None);
+    assert_constructed(&m, &over);
 }
 
 /// A device from a model file under `tests/devices/`.
@@ -412,4 +441,22 @@ fn narrow_family() -> Vec<DeviceModel> {
         family.push(heavy_actuator(kg, hz, damping));
     }
     family
+}
+
+/// Where the sound bound is not tight: the rigid device at `b_c = 10`.
+/// It proves 20,000 N/m; neither the search nor the constructive search
+/// breaks 29,000, and both break 30,000. The bound is conservative there
+/// by a factor of about 1.47 (docs/soundness.md).
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn the_rigid_bound_at_b_10_is_conservative_and_by_how_much() {
+    let m = rigid(1.0, 20.0, 0);
+    let a = analysis(&m, GridSpec::DEFAULT);
+    let k = max_stiffness(&a, &a.impedance_bound(None), 10.0).unwrap();
+    assert!((k - 20_000.0).abs() < 20.0, "{k}");
+    let inside = verify(&m, T, &imp(29_000.0, 10.0), None, 0).unwrap();
+    assert!(!inside.unstable && inside.constructed.is_none(), "{inside:?}");
+    let past = verify(&m, T, &imp(30_000.0, 10.0), None, 0).unwrap();
+    assert!(past.unstable, "{past:?}");
+    assert_constructed(&m, &past);
 }

@@ -662,6 +662,16 @@ impl fmt::Display for VerifyReport {
             f,
             "  worst termination: {}",
             serde_json::to_string(&v.termination).unwrap_or_default()
-        )
+        )?;
+        if let Some(c) = &v.constructed {
+            write!(
+                f,
+                "\n  constructed: a lossless hand and VE put a pole on the unit circle at {:.2} Hz (radius 1 {:+.1e}): {}",
+                c.frequency_hz,
+                c.spectral_radius - 1.0,
+                serde_json::to_string(&c.termination).unwrap_or_default()
+            )?;
+        }
+        Ok(())
     }
 }

@@ -15,7 +15,7 @@ use twoport_control::Position;
 
 impl Ve {
     /// The VE's admittance `V/F` as `(num, den)`, from the board's own law.
-    fn admittance(&self, t: f64) -> Result<Rational, String> {
+    pub(super) fn admittance(&self, t: f64) -> Result<Rational, String> {
         let p = Position::ZERO;
         let t32 = t as f32;
         let e = |e: twoport_control::ParamError| e.to_string();
@@ -142,6 +142,29 @@ fn sampled(model: &DeviceModel, hand: &Hand, t: f64) -> Result<Sampled, String> 
     let mut c_fm = vec![0.0; na];
     c_fm[2 * nq] = 1.0;
     Ok(Sampled { ad, bd, c_xa, c_fm })
+}
+
+/// The device with the hand, from the actuator force to the sampled
+/// actuator position, at `z`: `P(z) = c_xa (zI - A_d)^-1 b_d` (m/N).
+pub(super) fn actuator_response(
+    model: &DeviceModel,
+    hand: &Hand,
+    t: f64,
+    z: num_complex::Complex64,
+) -> Result<num_complex::Complex64, String> {
+    use num_complex::Complex64;
+    let p = sampled(model, hand, t)?;
+    let n = p.ad.nrows();
+    let a = DMatrix::from_fn(n, n, |i, j| {
+        let d = if i == j { z } else { Complex64::new(0.0, 0.0) };
+        d - p.ad[(i, j)]
+    });
+    let b = DMatrix::from_fn(n, 1, |i, _| Complex64::new(p.bd[i], 0.0));
+    let x = a
+        .lu()
+        .solve(&b)
+        .ok_or("z is a pole of the sampled device")?;
+    Ok((0..n).map(|i| x[(i, 0)] * p.c_xa[i]).sum())
 }
 
 /// The controller as two SISO parts, `f_a = H_x(z) x_a + H_f(z) f_m`.

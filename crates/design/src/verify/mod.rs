@@ -137,6 +137,12 @@ pub struct Verdict {
     pub termination: Termination,
     /// Closed loops evaluated.
     pub evaluations: usize,
+    /// On the impedance display, a lossless hand and VE built to put a
+    /// pole on the unit circle, where one exists (see [`construct`]):
+    /// proof that the gains are at or past the edge, independent of the
+    /// search.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub constructed: Option<Constructed>,
 }
 
 /// A slow mode (below 0.1 Hz) this far above 1 counts as unstable: free
@@ -155,9 +161,11 @@ pub const UNSTABLE_MARGIN: f64 = 1e-6;
 pub const OSCILLATING_MARGIN: f64 = 1e-10;
 
 mod closed_loop;
+mod construct;
 mod search;
 
 use closed_loop::{closed_loop, judge};
+pub use construct::{construct, Constructed};
 pub use search::verify;
 
 /// The closed loop's spectral radius for one termination.
@@ -316,6 +324,23 @@ mod tests {
             ));
             assert!((one - soft).abs() > 1e-5, "{grasp:?}: {one} vs {soft}");
         }
+    }
+
+    /// The constructed termination puts a pole on the unit circle where a
+    /// lossless hand violates the inequality (the rigid device at the
+    /// paper's 40,000 N/m, near Nyquist, from the search's worst hand),
+    /// and finds none at the design.
+    #[test]
+    fn construct_puts_a_pole_on_the_circle() {
+        let g = twoport_control::ImpedanceGains::new(40_000.0, 10.0);
+        let v = verify(&rigid(), 1e-3, &g.into(), None, 0).unwrap();
+        let seeds = [v.termination.hand];
+        let freqs = [v.frequency_hz, 499.0, 450.0];
+        let c = construct(&rigid(), 1e-3, g, None, 0, &freqs, &seeds).expect("a termination");
+        assert!((c.spectral_radius - 1.0).abs() < 1e-6, "{c:?}");
+        assert_eq!(c.termination.hand.damping_nspm, 0.0);
+        let at = twoport_control::ImpedanceGains::new(19_900.0, 10.0);
+        assert_eq!(construct(&rigid(), 1e-3, at, None, 0, &freqs, &seeds), None);
     }
 
     /// The counterexample: at 40,000 N/m and 10 N s/m a passive

@@ -1,7 +1,7 @@
 //! The search for the termination that makes given gains least stable:
 //! a sweep of hands and VEs, then Nelder-Mead from the worst starts.
 
-use super::{radius, Gains, Hand, Radius, Resonator, Termination, Ve, Verdict};
+use super::{construct, radius, Gains, Hand, Radius, Resonator, Termination, Ve, Verdict};
 use crate::network::HumanBound;
 use crate::DeviceModel;
 use nalgebra::DMatrix;
@@ -353,7 +353,27 @@ pub fn verify(
     }
     let (kind, p, r, two) = best;
     s.two = two;
+    // The constructive search, from the worst hands found and a sweep of
+    // its own, at the frequencies they bind.
+    let constructed = match gains {
+        Gains::Impedance(g) => {
+            let seeds: Vec<Hand> = finals
+                .iter()
+                .take(5)
+                .map(|(_, kind, p, _)| {
+                    s.two = false;
+                    s.termination(*kind, p).hand
+                })
+                .collect();
+            let mut freqs: Vec<f64> = finals.iter().take(5).map(|f| f.3).collect();
+            freqs.push(r.frequency_hz);
+            construct(model, period_s, *g, human, delay_samples, &freqs, &seeds)
+        }
+        Gains::Admittance(_) => None,
+    };
+    s.two = two;
     Ok(Verdict {
+        constructed,
         unstable: r.unstable,
         growth_per_s: r.growth_per_s(period_s),
         spectral_radius: r.spectral_radius,

@@ -1,0 +1,196 @@
+//! A constructive search on the impedance display: at a frequency where
+//! the design inequality fails for a real hand, build the passive hand and
+//! the passive VE whose loop has a pole on the unit circle there.
+//!
+//! With the hand fixed, the loop has a pole at `z` exactly when the VE's
+//! admittance there is `S(z) = z^-d P(z) (1 - z^-1)/T - 1/Z_cI(z)`, `P`
+//! the sampled device-and-hand from the actuator force to the encoder
+//! (the pole condition of the loop `closed_loop` builds). A passive VE can
+//! take that value iff `Re S >= 0`. Lossless hands (a mass, or a mass on a
+//! spring, behind the grasp where there is one) are searched for one with
+//! `Re S > 0`; scaled toward zero, a hand lets go, and the free device
+//! gives `Re S < 0`, so a scale between gives the root `Re S = 0`. There
+//! the VE is lossless too: a lossless
+//! mass or a lossless spring, whose admittance on the unit circle is
+//! imaginary. Both exist on the board, so the termination is realisable,
+//! and the loop it closes has a pole at `e^{jωT}`.
+//!
+//! The search sees each hand exactly, aliases and all, so where it finds
+//! nothing though the sound bound fails, the failure lies in the aliases
+//! the bound lets vary independently: the bound is conservative there.
+
+use super::closed_loop::actuator_response;
+use super::{radius, Hand, Radius, Termination, Ve};
+use crate::analysis::impedance_coupling_tf;
+use crate::network::HumanBound;
+use crate::DeviceModel;
+use num_complex::Complex64;
+use serde::Serialize;
+use std::f64::consts::PI;
+use twoport_control::ImpedanceGains;
+
+/// A termination built to put a pole on the unit circle.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Constructed {
+    /// The frequency of the pole (Hz).
+    pub frequency_hz: f64,
+    /// The hand and VE.
+    pub termination: Termination,
+    /// The loop's radius with them (1 up to rounding, or more).
+    pub spectral_radius: f64,
+}
+
+/// The constructive search's setting.
+struct Setting<'a> {
+    model: &'a DeviceModel,
+    t: f64,
+    gains: ImpedanceGains,
+    grasp: Option<HumanBound>,
+    delay: usize,
+}
+
+impl Setting<'_> {
+    /// The lossless hand of mass `m` (kg) on a spring `k` (N/m) to ground,
+    /// behind the grasp where there is one (which then needs a mass).
+    fn hand(&self, (m, k): (f64, f64)) -> Hand {
+        Hand {
+            mass_kg: if self.grasp.is_some() { m.max(1e-6) } else { m },
+            stiffness_npm: k,
+            damping_nspm: 0.0,
+            grasp: self.grasp,
+            second: None,
+        }
+    }
+
+    /// `S(e^{jωT})` with `hand`.
+    fn s(&self, hand: &Hand, w: f64) -> Option<Complex64> {
+        let z = Complex64::from_polar(1.0, w * self.t);
+        let p = actuator_response(self.model, hand, self.t, z).ok()?;
+        let zc = impedance_coupling_tf(self.gains.k_npm.into(), self.gains.b_nspm.into(), self.t)
+            .ok()?
+            .eval(z);
+        let lag = z.powi(-(self.delay as i32));
+        Some(lag * p * (1.0 - z.inv()) / self.t - zc.inv())
+    }
+
+    /// The lossless hand at `w` with the greatest `Re S`, and `Re S`:
+    /// `seeds` (the search's worst hands, their damping removed), and a
+    /// sweep of masses, springs, and masses on springs resonant across the
+    /// band, where their resonance folds onto `w`, and at multiples of the
+    /// sample rate (where a hand's sampled poles meet on the real axis).
+    fn worst_hand(&self, w: f64, seeds: &[(f64, f64)]) -> Option<((f64, f64), f64)> {
+        let ws = 2.0 * PI / self.t;
+        let mut resonances: Vec<f64> = (0..40)
+            .map(|i| 2.0 * PI * (2.0 * ws / PI).powf(i as f64 / 39.0))
+            .collect();
+        for j in [
+            0.0, 1.0, 2.0, 3.0, 5.0, 8.0, 13.0, 20.0, 32.0, 50.0, 80.0, 128.0,
+        ] {
+            resonances.extend(
+                [w + j * ws, j * ws - w, (j + 1.0) * ws]
+                    .iter()
+                    .filter(|r| **r > 0.0),
+            );
+        }
+        let mut hands: Vec<(f64, f64)> = seeds.to_vec();
+        for i in 0..15 {
+            let m = 10f64.powf(-5.0 + i as f64 / 2.0);
+            hands.push((m, 0.0));
+            hands.extend(resonances.iter().map(|r| (m, m * r * r)));
+        }
+        if self.grasp.is_none() {
+            hands.extend((0..23).map(|i| (0.0, 10f64.powf(i as f64 / 2.0))));
+        }
+        hands
+            .into_iter()
+            .filter_map(|h| self.s(&self.hand(h), w).map(|s| (h, s.re)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+    }
+}
+
+/// Build, on the impedance display, a passive hand and VE that put a pole
+/// of the loop on the unit circle, at the frequency (of `frequencies_hz`)
+/// where a lossless hand (of the sweep, or one of the `seeds`' masses and
+/// springs) violates the design inequality most; `None` where none does
+/// at any of them.
+pub fn construct(
+    model: &DeviceModel,
+    period_s: f64,
+    gains: ImpedanceGains,
+    human: Option<HumanBound>,
+    delay_samples: usize,
+    frequencies_hz: &[f64],
+    seeds: &[Hand],
+) -> Option<Constructed> {
+    let seeds: Vec<(f64, f64)> = seeds
+        .iter()
+        .filter(|h| h.second.is_none())
+        .map(|h| (h.mass_kg, h.stiffness_npm))
+        .collect();
+    let set = Setting {
+        model,
+        t: period_s,
+        gains,
+        grasp: human,
+        delay: delay_samples,
+    };
+    let (w, (m, k), _) = frequencies_hz
+        .iter()
+        .map(|f| 2.0 * PI * f)
+        .filter_map(|w| set.worst_hand(w, &seeds).map(|(h, r)| (w, h, r)))
+        .filter(|(_, _, r)| *r > 0.0)
+        .max_by(|a, b| a.2.total_cmp(&b.2))?;
+    // A root of Re S on a path from there to where Re S < 0: the hand
+    // scaled toward zero (it lets go, and the open device with its
+    // coupling is stable), or, where even the free hand violates it, the
+    // frequency moved off the violation with the hand kept.
+    let re = |scale: f64, w: f64| set.s(&set.hand((m * scale, k * scale)), w).map(|s| s.re);
+    let (scale, w) = if re(1e-12, w)? < 0.0 {
+        let l = root(|l| re(l.exp(), w), (1e-12f64).ln(), 0.0)?;
+        (l.exp(), w)
+    } else {
+        let off = (1..=60)
+            .map(|i| w * (1.0 + 0.002 * f64::from(i / 2) * if i % 2 == 0 { 1.0 } else { -1.0 }))
+            .find(|&v| v > 0.0 && v * period_s <= PI && re(1.0, v).is_some_and(|r| r < 0.0))?;
+        (1.0, root(|v| re(1.0, v), off, w)?)
+    };
+    let hand = set.hand((m * scale, k * scale));
+    let s = set.s(&hand, w)?;
+    let half = 0.5 * w * period_s;
+    // A lossless VE of admittance j Im S: a lossless mass below the real
+    // axis, a lossless spring above it.
+    let ve = if s.im < 0.0 {
+        Ve::LosslessMass {
+            mass_kg: period_s / (2.0 * half.tan() * -s.im),
+        }
+    } else {
+        Ve::TrapezoidalSpring {
+            stiffness_npm: 2.0 * half.tan() / (period_s * s.im),
+            damping_nspm: 0.0,
+        }
+    };
+    let termination = Termination { hand, ve };
+    let r: Radius = radius(model, period_s, &gains.into(), &termination, delay_samples).ok()?;
+    Some(Constructed {
+        frequency_hz: w / (2.0 * PI),
+        termination,
+        spectral_radius: r.spectral_radius,
+    })
+}
+
+/// The root of `f` between `neg` (where `f < 0`) and `pos` (where
+/// `f >= 0`), by bisection; `None` where `f` cannot be evaluated.
+fn root(f: impl Fn(f64) -> Option<f64>, mut neg: f64, mut pos: f64) -> Option<f64> {
+    for _ in 0..200 {
+        let mid = 0.5 * (neg + pos);
+        if f(mid)? >= 0.0 {
+            pos = mid;
+        } else {
+            neg = mid;
+        }
+        if (pos - neg).abs() <= 1e-15 * pos.abs().max(1.0) {
+            break;
+        }
+    }
+    Some(pos)
+}
