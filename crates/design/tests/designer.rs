@@ -127,8 +127,9 @@ fn an_infeasible_design_names_the_frequency_that_binds() {
 
 /// A design that binds at a lightly damped mode says so: the heavy
 /// actuator on a stiff flexure, held still, rings at 150 Hz with a damping
-/// ratio near 2e-6, and its tiny stiffness is explained by it; the
-/// Excalibur's design binds at no such mode.
+/// ratio near 2e-6, which holds it to 21 N/m: too soft to be useful, so it
+/// is refused with that reason, not given as a number. The Excalibur's
+/// design binds at no such mode.
 #[test]
 fn a_design_limited_by_a_lightly_damped_mode_says_which() {
     let path = concat!(
@@ -141,12 +142,19 @@ fn a_design_limited_by_a_lightly_damped_mode_says_which() {
     let l = *r.limited_by().expect("a lightly damped mode");
     assert!((l.frequency_hz - 150.4).abs() < 0.5, "{l:?}");
     assert!(l.damping_ratio < 1e-5, "{l:?}");
+    assert_eq!(r.coupling, None);
+    let k = r.limited_to.expect("the refused limit");
+    assert!(k > 21.0 && k < 21.6, "{k}");
+    let text = r.to_string();
     assert!(
-        r.to_string().contains("limited by a mode at 150.41 Hz"),
-        "{r}"
+        text.contains("infeasible: nothing useful is proven: a mode at 150.41 Hz"),
+        "{text}"
     );
+    assert!(!text.contains("recommended"), "{text}");
     let v = serde_json::to_value(&r).unwrap();
     assert!(v["limited_by"]["damping_ratio"].as_f64().unwrap() < 1e-5);
+    assert_eq!(v["feasible"], false);
+    assert_eq!(v["limited_to_k_c"].as_f64(), Some(k));
     let e = excalibur().design_impedance(Some(90.0), 0.1).unwrap();
     assert_eq!(e.limited_by(), None);
 }

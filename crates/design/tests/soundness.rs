@@ -455,7 +455,10 @@ fn the_rigid_bound_at_b_10_is_conservative_and_by_how_much() {
     let k = max_stiffness(&a, &a.impedance_bound(None), 10.0).unwrap();
     assert!((k - 20_000.0).abs() < 20.0, "{k}");
     let inside = verify(&m, T, &imp(29_000.0, 10.0), None, 0).unwrap();
-    assert!(!inside.unstable && inside.constructed.is_none(), "{inside:?}");
+    assert!(
+        !inside.unstable && inside.constructed.is_none(),
+        "{inside:?}"
+    );
     let past = verify(&m, T, &imp(30_000.0, 10.0), None, 0).unwrap();
     assert!(past.unstable, "{past:?}");
     assert_constructed(&m, &past);

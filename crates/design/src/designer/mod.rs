@@ -360,6 +360,7 @@ impl Designer {
             binding,
             message,
         );
+        d.refuse_if_useless();
         d.limit_cycle = d
             .recommended()
             .zip(d.coupling)

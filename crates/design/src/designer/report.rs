@@ -187,7 +187,15 @@ pub struct Design {
     /// What the encoder's quantum and the friction allow at the
     /// recommended gains, where the model gives them.
     pub limit_cycle: Option<LimitCycle>,
+    /// Where a lightly damped mode holds the boundary below anything
+    /// useful, the boundary, refused (N/m).
+    pub limited_to: Option<f64>,
 }
+
+/// The least coupling stiffness worth proving (N/m): softer, a spring is
+/// hard to tell from free motion through a handle (a 1 cm push meets
+/// 1 N). A design held below it by a lightly damped mode is refused.
+pub const USEFUL_STIFFNESS_NPM: f64 = 100.0;
 
 /// Where a design binds.
 #[derive(Clone, Debug, PartialEq)]
@@ -246,7 +254,28 @@ impl Design {
             message,
             regulator: None,
             limit_cycle: None,
+            limited_to: None,
         }
+    }
+
+    /// A stiffness limit held below [`USEFUL_STIFFNESS_NPM`] by a lightly
+    /// damped mode is refused: no gains can help, and a number would read
+    /// as a design. The limit stays in [`Design::limited_to`].
+    pub(super) fn refuse_if_useless(&mut self) {
+        let (Some((k, b)), Some(mode)) = (self.coupling, self.limited_by().copied()) else {
+            return;
+        };
+        if self.limit != Limit::Stiffness || k >= USEFUL_STIFFNESS_NPM {
+            return;
+        }
+        self.limited_to = Some(k);
+        self.coupling = None;
+        self.message = Some(format!(
+            "nothing useful is proven: a mode at {:.2} Hz with damping ratio {:.1e} holds every coupling at b_c = {b:.1} N s/m below {} N/m, under the {USEFUL_STIFFNESS_NPM} N/m a hand can tell from free motion; damping that mode, or sensing where it moves, raises the limit",
+            mode.frequency_hz,
+            mode.damping_ratio,
+            Limit::Stiffness.text(k).trim_end_matches(" N/m"),
+        ));
     }
 
     /// The lightly damped mode the design binds at, if it binds at one.
@@ -301,6 +330,9 @@ impl Serialize for Design {
         if let Some(l) = &self.limit_cycle {
             m.serialize_entry("limit_cycle", l)?;
         }
+        if let Some(k) = self.limited_to {
+            m.serialize_entry(&format!("limited_to_{key}"), &k)?;
+        }
         m.end()
     }
 }
@@ -352,7 +384,7 @@ impl fmt::Display for Design {
             }) => writeln!(f, "  binds at {hz:.2} Hz")?,
             None => {}
         }
-        if let Some(l) = self.limited_by() {
+        if let Some(l) = self.limited_by().filter(|_| self.limited_to.is_none()) {
             writeln!(
                 f,
                 "  limited by a mode at {:.2} Hz with damping ratio {:.1e}: so lightly damped a mode bounds what can be proven; damping it, or sensing where it moves, raises the limit",
