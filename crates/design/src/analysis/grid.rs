@@ -2,6 +2,7 @@
 //! on it.
 
 use crate::network::{admittance_display, design_bound, impedance_display, HumanBound};
+use crate::plant::Feature;
 use crate::{sampled, Plant, PlantPoint};
 use std::f64::consts::PI;
 use twoport_control::ZTransfer;
@@ -79,7 +80,19 @@ pub fn grid(plant: &Plant, spec: GridSpec) -> Vec<f64> {
             w.push(x);
         }
     };
-    for f in plant.features() {
+    refine(plant.features(), spec, &mut push);
+    // The exact ends: Nyquist, and twice the lowest frequency for the
+    // limit toward DC.
+    w.push(nyq);
+    w.push(2.0 * lo);
+    w.sort_by(f64::total_cmp);
+    w.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs());
+    w
+}
+
+/// Points around each of `features`, as [`grid`] places them.
+fn refine(features: &[Feature], spec: GridSpec, push: &mut impl FnMut(f64)) {
+    for f in features {
         let (c, beta) = (f.omega, f.half_width.max(1e-12 * f.omega));
         let edge = (20.0 * beta).max(0.02 * c);
         // Linear over the shape, as the eye would sample it.
@@ -101,10 +114,19 @@ pub fn grid(plant: &Plant, spec: GridSpec) -> Vec<f64> {
             j += 1.0;
         }
     }
-    // The exact ends: Nyquist, and twice the lowest frequency for the
-    // limit toward DC.
-    w.push(nyq);
-    w.push(2.0 * lo);
+}
+
+/// Angular frequencies (rad/s), increasing, in `(0, π/T]`: the points
+/// [`grid`] would place around `features` alone (the admittance display's
+/// regulated poles, which depend on the regulator), or none.
+pub fn feature_grid(plant: &Plant, features: &[Feature], spec: GridSpec) -> Vec<f64> {
+    let nyq = plant.nyquist();
+    let mut w = Vec::new();
+    refine(features, spec, &mut |x: f64| {
+        if x > 0.0 && x <= nyq {
+            w.push(x);
+        }
+    });
     w.sort_by(f64::total_cmp);
     w.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs());
     w

@@ -14,7 +14,7 @@ mod region;
 mod synthesis;
 
 pub use check::*;
-pub use grid::{grid, log_grid, Analysis, GridSpec};
+pub use grid::{feature_grid, grid, log_grid, Analysis, GridSpec};
 use num_complex::Complex64;
 pub use range::*;
 pub use region::{region_admittance, region_impedance, region_rust_source};

@@ -18,6 +18,7 @@
 //! # Ok::<(), twoport_design::Error>(())
 //! ```
 
+mod regulated;
 mod report;
 
 pub use report::*;
@@ -26,7 +27,8 @@ use crate::analysis::{self, Analysis, Check, GridSpec, Poses};
 use crate::limit_cycle::{Friction, LimitCycle};
 use crate::network::HumanBound;
 use crate::{DeviceModel, Error, Plant};
-use std::sync::{Mutex, OnceLock};
+use regulated::Regulated;
+use std::sync::{Arc, Mutex, OnceLock};
 use twoport_control::{Gains, ZTransfer};
 
 /// One pose of the device: its model, the plant at the period, and the
@@ -48,9 +50,9 @@ pub struct Designer {
     human: Option<HumanBound>,
     /// Each pose's sound and paper impedance bounds.
     impedance: OnceLock<BoundPair>,
-    /// Each pose's sound and paper admittance bounds, per regulator
+    /// The admittance display's analyses and bounds, per regulator
     /// `(k_p, b_p)` asked for.
-    admittance: Mutex<Vec<((f64, f64), BoundPair)>>,
+    admittance: Mutex<Vec<Arc<Regulated>>>,
 }
 
 /// Each pose's sound bound and the paper's, at every grid point.
@@ -58,7 +60,7 @@ type BoundPair = [Vec<Vec<f64>>; 2];
 
 /// Which of a display's bounds: the sound one, or the paper's.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Bound {
+pub(super) enum Bound {
     Sound = 0,
     Paper = 1,
 }
@@ -172,29 +174,16 @@ impl Designer {
         })[which as usize]
     }
 
-    /// The admittance bounds for the regulator `(k_p, b_p)` (its transfer
-    /// function `k`), computed the first time they are asked for.
-    fn admittance_bounds(&self, kp: (f64, f64), k: &ZTransfer, which: Bound) -> Vec<Vec<f64>> {
+    /// The analyses and bounds for the regulator `(k_p, b_p)` (its
+    /// transfer function `k`), built the first time they are asked for.
+    fn regulated(&self, kp: (f64, f64), k: &ZTransfer) -> Arc<Regulated> {
         let mut cache = self.admittance.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, b)) = cache.iter().find(|(g, _)| *g == kp) {
-            return b[which as usize].clone();
+        if let Some(r) = cache.iter().find(|r| r.kp == kp) {
+            return r.clone();
         }
-        let each = |paper: bool| {
-            self.poses
-                .iter()
-                .map(|p| {
-                    if paper {
-                        p.analysis.paper_admittance_bound(k, self.human)
-                    } else {
-                        p.analysis.admittance_bound(k, self.human)
-                    }
-                })
-                .collect::<Vec<_>>()
-        };
-        let b = [each(false), each(true)];
-        let out = b[which as usize].clone();
-        cache.push((kp, b));
-        out
+        let r = Arc::new(Regulated::new(&self.poses, kp, k, self.human));
+        cache.push(r.clone());
+        r
     }
 
     /// Each pose's analysis beside its bound.
@@ -217,9 +206,19 @@ impl Designer {
     /// The check over every pose: stable where every pose is, with the
     /// least margin and the pose that has it (the paper's figures likewise).
     fn worst_check(&self, check: impl Fn(&Pose) -> Option<Check>) -> Option<(Check, &str)> {
-        let mut all = Vec::with_capacity(self.poses.len());
-        for p in &self.poses {
-            all.push((check(p)?, p.model.name.as_str()));
+        self.worst_of(self.poses.iter().map(|p| (p, &p.analysis)), |p, _| check(p))
+    }
+
+    /// [`Self::worst_check`] over `analyses` (a pose's grid, or more
+    /// points of it).
+    fn worst_of<'a>(
+        &'a self,
+        analyses: impl Iterator<Item = (&'a Pose, &'a Analysis)>,
+        check: impl Fn(&Pose, &Analysis) -> Option<Check>,
+    ) -> Option<(Check, &'a str)> {
+        let mut all = Vec::new();
+        for (p, a) in analyses {
+            all.push((check(p, a)?, p.model.name.as_str()));
         }
         let least = |key: fn(&Check) -> f64| {
             all.iter()
@@ -391,21 +390,21 @@ impl Designer {
         };
         let k = analysis::regulator_tf(kp, bp, self.period_s())?;
         let radius = self.regulated_pole_radius(&k);
-        let sound = self.admittance_bounds((kp, bp), &k, Bound::Sound);
-        let paper = self.admittance_bounds((kp, bp), &k, Bound::Paper);
-        let coupling = self.admittance_on(&self.with(&sound), radius, b);
-        let paper = self.admittance_on(&self.with(&paper), radius, b);
+        let reg = self.regulated((kp, bp), &k);
+        let coupling = self.admittance_on(&reg.with(&self.poses, Bound::Sound), radius, b);
+        let paper = self.admittance_on(&reg.with(&self.poses, Bound::Paper), radius, b);
         let binding = self.binding(coupling.and_then(|(m, b)| {
-            self.worst_check(|p| {
-                analysis::check_admittance(&p.plant, &p.analysis, (kp, bp), (m, b), self.human)
+            self.worst_of(reg.analyses(&self.poses), |p, a| {
+                analysis::check_admittance(&p.plant, a, (kp, bp), (m, b), self.human)
             })
         }));
+        let sound = reg.grid_bounds(Bound::Sound);
         let message = match coupling {
             Some(_) => None,
             None if radius >= 1.0 => Some(format!(
                 "the regulator k_p = {kp}, b_p = {bp} does not stabilise the device (pole radius {radius:.4})"
             )),
-            None => Some(self.infeasible(&sound, Infeasible::Mass((kp, bp)), b)),
+            None => Some(self.infeasible(sound, Infeasible::Mass((kp, bp)), b)),
         };
         let mut d = Design::new(
             self.context(DisplayKind::Admittance),
@@ -466,17 +465,21 @@ impl Designer {
                 "--m {m}: must be a finite mass > 0 kg"
             )));
         }
+        let k = analysis::regulator_tf(kp.0, kp.1, self.period_s())?;
+        let reg = self.regulated(kp, &k);
         let (c, pose) = self
-            .worst_check(|p| {
-                analysis::check_admittance(&p.plant, &p.analysis, kp, (m, b), self.human)
+            .worst_of(reg.analyses(&self.poses), |p, a| {
+                analysis::check_admittance(&p.plant, a, kp, (m, b), self.human)
             })
             .ok_or(Error::Coupling(
                 "--b must be > 0 for the admittance coupling".into(),
             ))?;
-        let k = analysis::regulator_tf(kp.0, kp.1, self.period_s())?;
-        let bounds = self.admittance_bounds(kp, &k, Bound::Sound);
         let boundary = self
-            .admittance_on(&self.with(&bounds), c.regulator_pole_radius, Some(b))
+            .admittance_on(
+                &reg.with(&self.poses, Bound::Sound),
+                c.regulator_pole_radius,
+                Some(b),
+            )
             .map(|(m, _)| m);
         let mut r = CheckReport::new(
             self.context(DisplayKind::Admittance),
@@ -540,11 +543,11 @@ impl Designer {
         self.force_sensor()?;
         let (kp, bp) = (gain("kp", kp)?, gain("bp", bp)?);
         let k = analysis::regulator_tf(kp, bp, self.period_s())?;
-        let bounds = self.admittance_bounds((kp, bp), &k, Bound::Sound);
+        let reg = self.regulated((kp, bp), &k);
         Ok(Region {
             context: self.context(DisplayKind::Admittance),
             bound: RegionBound::MinMass,
-            rows: analysis::region_admittance(&self.with(&bounds), range, points),
+            rows: analysis::region_admittance(&reg.with(&self.poses, Bound::Sound), range, points),
             regulator: Some((kp, bp)),
         })
     }

@@ -110,16 +110,21 @@ pub(super) fn of(
             half_width: s.abs(),
         })
         .collect();
-    out.extend(
-        discrete_poles
-            .iter()
-            .filter(|l| l.im > 0.0)
-            .map(|l| Feature {
-                omega: l.im.atan2(l.re) / period_s,
-                half_width: (-l.norm().ln()).abs() / period_s,
-            }),
-    );
+    out.extend(of_discrete(discrete_poles, period_s));
     out.retain(|f| f.omega > 0.0);
     out.sort_by(|x, y| x.omega.total_cmp(&y.omega));
     out
+}
+
+/// The features of discrete poles `z` (one of each conjugate pair) at
+/// period `period_s` (s): centre `arg z / T`, half-width `-ln |z| / T`.
+pub(crate) fn of_discrete(poles: &[Complex64], period_s: f64) -> Vec<Feature> {
+    poles
+        .iter()
+        .filter(|l| l.im > 0.0)
+        .map(|l| Feature {
+            omega: l.im.atan2(l.re) / period_s,
+            half_width: (-l.norm().ln()).abs() / period_s,
+        })
+        .collect()
 }

@@ -466,15 +466,34 @@ impl Plant {
 
     /// The largest pole radius of the device under the position regulator
     /// `K_p` (the admittance display with the VE port held): the loop is
-    /// stable iff it is < 1. `K_p` is realised from its own z-domain form.
+    /// stable iff it is < 1.
     pub fn regulated_pole_radius(&self, kp: &twoport_control::ZTransfer) -> f64 {
+        match self.regulated_poles(kp) {
+            Some(poles) => poles.iter().map(|l| l.norm()).fold(0.0, f64::max),
+            None => f64::INFINITY,
+        }
+    }
+
+    /// The narrow features the position regulator `K_p` adds to the
+    /// admittance display's bound: its regulated loop's oscillating poles
+    /// (the bound's terms divide by `1 + K_p X_aa^d`, which vanishes at
+    /// them), with damping ratios below 0.05.
+    pub fn regulated_features(&self, kp: &twoport_control::ZTransfer) -> Vec<Feature> {
+        let poles = self.regulated_poles(kp).unwrap_or_default();
+        features::of_discrete(&poles, self.period_s())
+            .into_iter()
+            .filter(|f| f.omega > 0.0 && f.half_width < 0.05 * f.omega)
+            .collect()
+    }
+
+    /// The poles of the device under `K_p`, realised from its own z-domain
+    /// form; `None` where it cannot be realised.
+    fn regulated_poles(&self, kp: &twoport_control::ZTransfer) -> Option<Vec<Complex64>> {
         use crate::rational::{delayed, from_tf, realise};
         let n = self.xaa.n;
         // K_p z^-d in transposed direct form II.
         let (num, den) = from_tf(kp);
-        let Ok(k) = realise(&delayed(&num, self.delay_samples as usize), &den) else {
-            return f64::INFINITY;
-        };
+        let k = realise(&delayed(&num, self.delay_samples as usize), &den).ok()?;
         let nk = k.b.len();
         let h = &self.xaa;
         let mut a = DMatrix::<f64>::zeros(n + nk, n + nk);
@@ -495,10 +514,7 @@ impl Plant {
                 a[(n + i, n + j)] = k.a[(i, j)];
             }
         }
-        a.complex_eigenvalues()
-            .iter()
-            .map(|l| l.norm())
-            .fold(0.0, f64::max)
+        Some(a.complex_eigenvalues().iter().copied().collect())
     }
 
     /// `X_aa^d` and `F_ma^d` at `ω` by a plain complex LU of `(zI - A_d)`
