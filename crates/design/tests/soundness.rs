@@ -11,7 +11,7 @@
 use twoport_control::{AdmittanceGains, Gains, ImpedanceGains};
 use twoport_design::analysis::*;
 use twoport_design::network::HumanBound;
-use twoport_design::verify::{verify, Verdict};
+use twoport_design::verify::{construct, verify, Verdict};
 use twoport_design::{Designer, DeviceModel, Plant};
 
 const T: f64 = 1e-3;
@@ -207,7 +207,8 @@ fn verify_finds_nothing_at_the_excalibur_designs_and_breaks_them_past() {
     let kp = regulator_tf(51_000.0, 90.0, T).unwrap();
     let mass = min_mass(&a, &a.admittance_bound(&kp, HUMAN), 500.0).unwrap();
     let g = |m_kg: f64| Gains::from(AdmittanceGains::new(51_000.0, 90.0, m_kg as f32, 500.0));
-    assert_tight(&m, g(mass), g(mass / 1.01), HUMAN);
+    let over = assert_tight(&m, g(mass), g(mass / 1.01), HUMAN);
+    assert_constructed(&m, &over);
 }
 
 #[test]
@@ -506,4 +507,38 @@ fn a_regulated_loops_narrow_pole_is_on_the_grid() {
     assert!(c.check.absolutely_stable, "{c}");
     let v = verify(&m, T, &g(50.0, 950.0), HUMAN, 0).unwrap();
     assert!(!v.unstable, "{v:?}");
+}
+
+/// Where the admittance display's aliasing term proves nothing: the
+/// two-mass device without the human bound, at the regulator of its best
+/// impedance pair and `b_c = 10,000`. The exact loop has an edge, and
+/// both searches find the same one: past it (3.7 kg) `verify` breaks the
+/// loop and the constructive search puts a pole on the unit circle; above
+/// it (3.8 kg) neither finds anything, from 0.01 Hz to Nyquist.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn the_two_mass_admittance_edge_without_the_human_bound() {
+    let m = device_shipped("two_mass.toml");
+    let d = twoport_design::Designer::new(vec![m.clone()], None, None).unwrap();
+    let design = d
+        .design_admittance(Some((39_739.0, 42.9)), Some(10_000.0), 0.1)
+        .unwrap();
+    assert_eq!(design.coupling, None, "the sound bound proves nothing here");
+    let g = |m_kg: f32| Gains::from(AdmittanceGains::new(39_739.0, 42.9, m_kg, 10_000.0));
+    let freqs: Vec<f64> = (0..50)
+        .map(|i| 0.01 * 50_000f64.powf(i as f64 / 49.0))
+        .collect();
+    let past = verify(&m, T, &g(3.7), None, 0).unwrap();
+    assert!(past.unstable, "{past:?}");
+    let c = construct(&m, T, g(3.7), None, 0, &freqs, &[]).expect("a pole on the circle");
+    assert!((c.spectral_radius - 1.0).abs() < 1e-6, "{c:?}");
+    let above = verify(&m, T, &g(3.8), None, 0).unwrap();
+    assert!(!above.unstable && above.constructed.is_none(), "{above:?}");
+    assert_eq!(construct(&m, T, g(3.8), None, 0, &freqs, &[]), None);
+}
+
+/// A model shipped under `models/`.
+fn device_shipped(file: &str) -> DeviceModel {
+    let path = format!("{}/../../models/{file}", env!("CARGO_MANIFEST_DIR"));
+    DeviceModel::load(std::path::Path::new(&path)).unwrap()
 }

@@ -145,13 +145,15 @@ fn sampled(model: &DeviceModel, hand: &Hand, t: f64) -> Result<Sampled, String> 
 }
 
 /// The device with the hand, from the actuator force to the sampled
-/// actuator position, at `z`: `P(z) = c_xa (zI - A_d)^-1 b_d` (m/N).
+/// actuator position and measured force, at `z`: `(P_x, P_f)` with
+/// `P_x(z) = c_xa (zI - A_d)^-1 b_d` (m/N) and `P_f` the same through
+/// `c_fm` (N/N).
 pub(super) fn actuator_response(
     model: &DeviceModel,
     hand: &Hand,
     t: f64,
     z: num_complex::Complex64,
-) -> Result<num_complex::Complex64, String> {
+) -> Result<(num_complex::Complex64, num_complex::Complex64), String> {
     use num_complex::Complex64;
     let p = sampled(model, hand, t)?;
     let n = p.ad.nrows();
@@ -164,7 +166,8 @@ pub(super) fn actuator_response(
         .lu()
         .solve(&b)
         .ok_or("z is a pole of the sampled device")?;
-    Ok((0..n).map(|i| x[(i, 0)] * p.c_xa[i]).sum())
+    let through = |c: &[f64]| (0..n).map(|i| x[(i, 0)] * c[i]).sum();
+    Ok((through(&p.c_xa), through(&p.c_fm)))
 }
 
 /// The controller as two SISO parts, `f_a = H_x(z) x_a + H_f(z) f_m`.

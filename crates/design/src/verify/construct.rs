@@ -1,12 +1,15 @@
-//! A constructive search on the impedance display: at a frequency where
-//! the design inequality fails for a real hand, build the passive hand and
-//! the passive VE whose loop has a pole on the unit circle there.
+//! A constructive search: at a frequency where the exact loop with a real
+//! hand leaves room for it, build the passive hand and the passive VE
+//! whose loop has a pole on the unit circle there.
 //!
 //! With the hand fixed, the loop has a pole at `z` exactly when the VE's
-//! admittance there is `S(z) = z^-d P(z) (1 - z^-1)/T - 1/Z_cI(z)`, `P`
-//! the sampled device-and-hand from the actuator force to the encoder
-//! (the pole condition of the loop `closed_loop` builds). A passive VE can
-//! take that value iff `Re S >= 0`. Lossless hands (a mass, or a mass on a
+//! immittance there is `S(z)`: on the impedance display its admittance
+//! `S = z^-d P_x (1 - z^-1)/T - 1/Z_cI`; on the admittance display its
+//! impedance `S = -z^-d K_p I P_f / (1 - z^-d K_p P_x) - Z_cA`, with
+//! `I = T/(1 - z^-1)`. `P_x` and `P_f` are the sampled device-and-hand
+//! from the actuator force to the encoder and the load cell (the pole
+//! condition of the loop `closed_loop` builds). A passive VE can take that
+//! value iff `Re S >= 0`. Lossless hands (a mass, or a mass on a
 //! spring, behind the grasp where there is one) are searched for one with
 //! `Re S > 0`; scaled toward zero, a hand lets go, and the free device
 //! gives `Re S < 0`, so a scale between gives the root `Re S = 0`. There
@@ -21,13 +24,13 @@
 
 use super::closed_loop::actuator_response;
 use super::{radius, Hand, Radius, Termination, Ve};
-use crate::analysis::impedance_coupling_tf;
+use crate::analysis::{admittance_coupling_tf, impedance_coupling_tf, regulator_tf};
 use crate::network::HumanBound;
 use crate::DeviceModel;
 use num_complex::Complex64;
 use serde::Serialize;
 use std::f64::consts::PI;
-use twoport_control::ImpedanceGains;
+use twoport_control::Gains;
 
 /// A termination built to put a pole on the unit circle.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -44,7 +47,7 @@ pub struct Constructed {
 struct Setting<'a> {
     model: &'a DeviceModel,
     t: f64,
-    gains: ImpedanceGains,
+    gains: Gains,
     grasp: Option<HumanBound>,
     delay: usize,
 }
@@ -62,15 +65,32 @@ impl Setting<'_> {
         }
     }
 
-    /// `S(e^{jωT})` with `hand`.
+    /// `S(e^{jωT})` with `hand`: the VE's immittance that closes a pole
+    /// there (its admittance on the impedance display, its impedance on
+    /// the admittance display).
     fn s(&self, hand: &Hand, w: f64) -> Option<Complex64> {
         let z = Complex64::from_polar(1.0, w * self.t);
-        let p = actuator_response(self.model, hand, self.t, z).ok()?;
-        let zc = impedance_coupling_tf(self.gains.k_npm.into(), self.gains.b_nspm.into(), self.t)
-            .ok()?
-            .eval(z);
+        let (px, pf) = actuator_response(self.model, hand, self.t, z).ok()?;
         let lag = z.powi(-(self.delay as i32));
-        Some(lag * p * (1.0 - z.inv()) / self.t - zc.inv())
+        let one = Complex64::new(1.0, 0.0);
+        match self.gains {
+            Gains::Impedance(g) => {
+                let zc = impedance_coupling_tf(g.k_npm.into(), g.b_nspm.into(), self.t)
+                    .ok()?
+                    .eval(z);
+                Some(lag * px * (one - z.inv()) / self.t - zc.inv())
+            }
+            Gains::Admittance(g) => {
+                let k = regulator_tf(g.kp_npm.into(), g.bp_nspm.into(), self.t)
+                    .ok()?
+                    .eval(z);
+                let za = admittance_coupling_tf(g.m_kg.into(), g.b_nspm.into(), self.t)
+                    .ok()?
+                    .eval(z);
+                let integrate = self.t / (one - z.inv());
+                Some(-lag * k * integrate * pf / (one - lag * k * px) - za)
+            }
+        }
     }
 
     /// The lossless hand at `w` with the greatest `Re S`, and `Re S`:
@@ -108,15 +128,15 @@ impl Setting<'_> {
     }
 }
 
-/// Build, on the impedance display, a passive hand and VE that put a pole
-/// of the loop on the unit circle, at the frequency (of `frequencies_hz`)
+/// Build a passive hand and VE that put a pole of the loop on the unit
+/// circle, at the frequency (of `frequencies_hz`)
 /// where a lossless hand (of the sweep, or one of the `seeds`' masses and
 /// springs) violates the design inequality most; `None` where none does
 /// at any of them.
 pub fn construct(
     model: &DeviceModel,
     period_s: f64,
-    gains: ImpedanceGains,
+    gains: Gains,
     human: Option<HumanBound>,
     delay_samples: usize,
     frequencies_hz: &[f64],
@@ -157,20 +177,24 @@ pub fn construct(
     let hand = set.hand((m * scale, k * scale));
     let s = set.s(&hand, w)?;
     let half = 0.5 * w * period_s;
-    // A lossless VE of admittance j Im S: a lossless mass below the real
-    // axis, a lossless spring above it.
-    let ve = if s.im < 0.0 {
+    // The lossless VE of immittance j Im S, as an admittance j β: a
+    // lossless mass below the real axis, a lossless spring above it.
+    let beta = match gains {
+        Gains::Impedance(_) => s.im,
+        Gains::Admittance(_) => -1.0 / s.im,
+    };
+    let ve = if beta < 0.0 {
         Ve::LosslessMass {
-            mass_kg: period_s / (2.0 * half.tan() * -s.im),
+            mass_kg: period_s / (2.0 * half.tan() * -beta),
         }
     } else {
         Ve::TrapezoidalSpring {
-            stiffness_npm: 2.0 * half.tan() / (period_s * s.im),
+            stiffness_npm: 2.0 * half.tan() / (period_s * beta),
             damping_nspm: 0.0,
         }
     };
     let termination = Termination { hand, ve };
-    let r: Radius = radius(model, period_s, &gains.into(), &termination, delay_samples).ok()?;
+    let r: Radius = radius(model, period_s, &gains, &termination, delay_samples).ok()?;
     Some(Constructed {
         frequency_hz: w / (2.0 * PI),
         termination,

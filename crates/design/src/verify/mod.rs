@@ -137,8 +137,8 @@ pub struct Verdict {
     pub termination: Termination,
     /// Closed loops evaluated.
     pub evaluations: usize,
-    /// On the impedance display, a lossless hand and VE built to put a
-    /// pole on the unit circle, where one exists (see [`construct`]):
+    /// A lossless hand and VE built to put a pole on the unit circle,
+    /// where the constructive search finds one (see [`construct`]):
     /// proof that the gains are at or past the edge, independent of the
     /// search.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -336,11 +336,15 @@ mod tests {
         let v = verify(&rigid(), 1e-3, &g.into(), None, 0).unwrap();
         let seeds = [v.termination.hand];
         let freqs = [v.frequency_hz, 499.0, 450.0];
-        let c = construct(&rigid(), 1e-3, g, None, 0, &freqs, &seeds).expect("a termination");
+        let c =
+            construct(&rigid(), 1e-3, g.into(), None, 0, &freqs, &seeds).expect("a termination");
         assert!((c.spectral_radius - 1.0).abs() < 1e-6, "{c:?}");
         assert_eq!(c.termination.hand.damping_nspm, 0.0);
         let at = twoport_control::ImpedanceGains::new(19_900.0, 10.0);
-        assert_eq!(construct(&rigid(), 1e-3, at, None, 0, &freqs, &seeds), None);
+        assert_eq!(
+            construct(&rigid(), 1e-3, at.into(), None, 0, &freqs, &seeds),
+            None
+        );
     }
 
     /// The counterexample: at 40,000 N/m and 10 N s/m a passive

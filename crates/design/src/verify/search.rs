@@ -355,22 +355,25 @@ pub fn verify(
     s.two = two;
     // The constructive search, from the worst hands found and a sweep of
     // its own, at the frequencies they bind.
-    let constructed = match gains {
-        Gains::Impedance(g) => {
-            let seeds: Vec<Hand> = finals
-                .iter()
-                .take(5)
-                .map(|(_, kind, p, _)| {
-                    s.two = false;
-                    s.termination(*kind, p).hand
-                })
-                .collect();
-            let mut freqs: Vec<f64> = finals.iter().take(5).map(|f| f.3).collect();
-            freqs.push(r.frequency_hz);
-            construct(model, period_s, *g, human, delay_samples, &freqs, &seeds)
-        }
-        Gains::Admittance(_) => None,
-    };
+    let seeds: Vec<Hand> = finals
+        .iter()
+        .take(5)
+        .map(|(_, kind, p, _)| {
+            s.two = false;
+            s.termination(*kind, p).hand
+        })
+        .collect();
+    let mut freqs: Vec<f64> = finals.iter().take(5).map(|f| f.3).collect();
+    freqs.push(r.frequency_hz);
+    let constructed = construct(
+        model,
+        period_s,
+        *gains,
+        human,
+        delay_samples,
+        &freqs,
+        &seeds,
+    );
     s.two = two;
     Ok(Verdict {
         constructed,
