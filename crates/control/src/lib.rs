@@ -10,6 +10,7 @@ pub mod coupling;
 mod encoder;
 mod estimator;
 pub mod homing;
+pub mod kinematics;
 mod param;
 pub mod passivity;
 mod position;

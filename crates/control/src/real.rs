@@ -55,10 +55,18 @@ pub trait Real:
     fn abs(self) -> Self;
     /// Neither NaN nor infinite.
     fn is_finite(self) -> bool;
+    /// `sin(self)` (self in rad).
+    fn sin(self) -> Self;
+    /// `cos(self)` (self in rad).
+    fn cos(self) -> Self;
+    /// `√self` (NaN below 0).
+    fn sqrt(self) -> Self;
+    /// The angle of `(x, self)` (rad, in `[-π, π]`).
+    fn atan2(self, x: Self) -> Self;
 }
 
 macro_rules! real {
-    ($t:ty) => {
+    ($t:ty, $sin:path, $cos:path, $sqrt:path, $atan2:path) => {
         impl Real for $t {
             const ZERO: Self = 0.0;
             const ONE: Self = 1.0;
@@ -97,9 +105,25 @@ macro_rules! real {
             fn is_finite(self) -> bool {
                 <$t>::is_finite(self)
             }
+            #[inline]
+            fn sin(self) -> Self {
+                $sin(self)
+            }
+            #[inline]
+            fn cos(self) -> Self {
+                $cos(self)
+            }
+            #[inline]
+            fn sqrt(self) -> Self {
+                $sqrt(self)
+            }
+            #[inline]
+            fn atan2(self, x: Self) -> Self {
+                $atan2(self, x)
+            }
         }
     };
 }
 
-real!(f32);
-real!(f64);
+real!(f32, libm::sinf, libm::cosf, libm::sqrtf, libm::atan2f);
+real!(f64, libm::sin, libm::cos, libm::sqrt, libm::atan2);
