@@ -18,10 +18,12 @@
 mod capstan;
 mod cartesian;
 mod pantograph;
+mod serial_arm;
 
 pub use capstan::Capstan;
 pub use cartesian::Cartesian;
 pub use pantograph::Pantograph;
+pub use serial_arm::SerialArm;
 
 use crate::Real;
 

@@ -118,3 +118,48 @@ fn a_cartesian_device_is_the_identity() {
     assert_eq!(j.position_m, [0.1, -0.2, 0.3]);
     assert_eq!(j.torques_nm(&[1.0, 2.0, 3.0]), [1.0, 2.0, 3.0]);
 }
+
+/// The PHANToM Premium 1.5's links: l1 215 mm, l2 170 mm.
+fn phantom() -> SerialArm {
+    SerialArm::new(0.215, 0.17).unwrap()
+}
+
+#[test]
+fn the_serial_arm_is_its_published_forward_map_and_its_derivative() {
+    let k = phantom();
+    let (l1, l2) = (0.215f32 as f64, 0.17f32 as f64);
+    for q in [
+        [0.0, 0.0, 0.0],
+        [0.3, 0.2, 0.5],
+        [-0.8, 0.6, 1.2],
+        [1.2, -0.4, 0.1],
+    ] {
+        let j = Kinematics::<f64, 3>::forward(&k, &q).unwrap();
+        let reach = l1 * q[1].cos() + l2 * q[2].sin();
+        let x = [
+            q[0].cos() * reach,
+            q[0].sin() * reach,
+            l1 * q[1].sin() - l2 * q[2].cos(),
+        ];
+        for (got, want) in j.position_m.iter().zip(x) {
+            assert!((got - want).abs() < 1e-12, "{q:?}");
+        }
+        assert_jacobian(&k, q);
+    }
+}
+
+#[test]
+fn the_serial_arm_faults_on_its_axis_and_with_its_links_folded() {
+    let k = phantom();
+    let f = |q: [f64; 3]| Kinematics::<f64, 3>::forward(&k, &q).map(|_| ());
+    // The handle on the base's axis: l1 cos q2 + l2 sin q3 = 0.
+    let q3 = -(0.215f64 * 1.2f64.cos() / 0.17).asin();
+    assert_eq!(f([0.3, 1.2, q3]), Err(KinematicsFault::Singular));
+    // The forearm along the upper arm: cos(q2 - q3) = 0.
+    let q2 = 0.2;
+    assert_eq!(
+        f([0.3, q2, q2 + core::f64::consts::FRAC_PI_2]),
+        Err(KinematicsFault::Singular)
+    );
+    assert_eq!(f([0.3, q2, q2 + 1.0]), Ok(()));
+}
