@@ -17,11 +17,13 @@
 
 mod capstan;
 mod cartesian;
+mod delta;
 mod pantograph;
 mod serial_arm;
 
 pub use capstan::Capstan;
 pub use cartesian::Cartesian;
+pub use delta::Delta;
 pub use pantograph::Pantograph;
 pub use serial_arm::SerialArm;
 

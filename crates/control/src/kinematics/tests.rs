@@ -163,3 +163,63 @@ fn the_serial_arm_faults_on_its_axis_and_with_its_links_folded() {
     );
     assert_eq!(f([0.3, q2, q2 + 1.0]), Ok(()));
 }
+
+/// A delta of about the Falcon's size: base 40 mm, effector 20 mm, upper
+/// arms 60 mm, parallelograms 102.5 mm.
+fn delta() -> Delta {
+    Delta::new(0.04, 0.02, 0.06, 0.1025).unwrap()
+}
+
+#[test]
+fn the_delta_closes_every_leg_and_its_jacobian_is_the_derivative() {
+    let k = delta();
+    let (r, a, b) = ((0.04f32 - 0.02f32) as f64, 0.06f32 as f64, 0.1025f32 as f64);
+    for q in [
+        [0.5, 0.5, 0.5],
+        [0.2, 0.6, 0.4],
+        [0.9, 0.3, 0.1],
+        [-0.2, 0.4, 0.7],
+    ] {
+        let j = Kinematics::<f64, 3>::forward(&k, &q).unwrap();
+        let p = j.position_m;
+        assert!(p[2] < 0.0, "{q:?}: {p:?}");
+        for (i, phi) in [0.0f64, 120.0, 240.0].iter().enumerate() {
+            let (c, s) = (phi.to_radians().cos(), phi.to_radians().sin());
+            let radial = r + a * q[i].cos();
+            let e = [c * radial, s * radial, -a * q[i].sin()];
+            let len =
+                ((p[0] - e[0]).powi(2) + (p[1] - e[1]).powi(2) + (p[2] - e[2]).powi(2)).sqrt();
+            assert!((len - b).abs() < 1e-9, "{q:?} leg {i}: {len}");
+        }
+        assert_jacobian(&k, q);
+    }
+    // Equal angles: the effector on the axis.
+    let p = Kinematics::<f64, 3>::forward(&k, &[0.4, 0.4, 0.4])
+        .unwrap()
+        .position_m;
+    assert!(p[0].abs() < 1e-6 && p[1].abs() < 1e-6, "{p:?}");
+    // f32, as on the board.
+    let j32 = Kinematics::<f32, 3>::forward(&k, &[0.5, 0.5, 0.5]).unwrap();
+    let j64 = Kinematics::<f64, 3>::forward(&k, &[0.5, 0.5, 0.5]).unwrap();
+    assert!((f64::from(j32.position_m[2]) - j64.position_m[2]).abs() < 1e-5);
+}
+
+#[test]
+fn the_delta_faults_where_its_legs_cannot_meet() {
+    let k = delta();
+    let f = |q: [f64; 3]| Kinematics::<f64, 3>::forward(&k, &q).map(|_| ());
+    // Short parallelograms on level arms: the elbows 139 mm apart, more
+    // than two parallelograms reach.
+    let short = Delta::new(0.04, 0.02, 0.06, 0.03).unwrap();
+    let at = Kinematics::<f64, 3>::forward(&short, &[0.0, 0.0, 0.0]).map(|_| ());
+    assert_eq!(at, Err(KinematicsFault::Unreachable));
+    assert_eq!(f([0.5, 0.5, 0.5]), Ok(()));
+    assert_eq!(
+        f([f64::INFINITY, 0.4, 0.4]),
+        Err(KinematicsFault::NotFinite)
+    );
+    assert_eq!(
+        Delta::new(0.04, 0.02, 0.0, 0.1).unwrap_err().name,
+        "kinematics.upper_m (m)"
+    );
+}
