@@ -10,6 +10,7 @@ mod error;
 pub mod figures;
 pub mod limit_cycle;
 pub mod linalg;
+pub mod linkage;
 pub mod model;
 pub mod network;
 mod par;
