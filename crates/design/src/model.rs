@@ -102,6 +102,26 @@ pub(crate) fn read(path: &Path) -> Result<(String, String), ModelError> {
     }
 }
 
+/// `text` parsed as TOML into `T`; an error names `source` and the line.
+pub(crate) fn parse<T: serde::de::DeserializeOwned>(
+    text: &str,
+    source: &str,
+) -> Result<T, ModelError> {
+    toml::from_str(text).map_err(|e| {
+        let at = e
+            .span()
+            .map(|s| {
+                let line = text[..s.start.min(text.len())].matches('\n').count() + 1;
+                format!("line {line}: ")
+            })
+            .unwrap_or_default();
+        ModelError {
+            source: source.to_string(),
+            message: format!("{at}{}", e.message()),
+        }
+    })
+}
+
 /// The filter pole a model without a force sensor is given (rad/s).
 pub const DEFAULT_LOAD_CELL_POLE_RAD_S: f64 = 235.0;
 
@@ -156,16 +176,7 @@ impl DeviceModel {
             source: source.to_string(),
             message,
         };
-        let raw: RawModel = toml::from_str(text).map_err(|e| {
-            let at = e
-                .span()
-                .map(|s| {
-                    let line = text[..s.start.min(text.len())].matches('\n').count() + 1;
-                    format!("line {line}: ")
-                })
-                .unwrap_or_default();
-            err(format!("{at}{}", e.message()))
-        })?;
+        let raw: RawModel = parse(text, source)?;
         let n = raw.m.len();
         if n == 0 {
             return Err(err(

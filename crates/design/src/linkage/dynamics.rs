@@ -1,7 +1,5 @@
-//! Linkage dynamics for the designer: a linkage's joint-space mass matrix
-//! at a pose, and the mass the hand feels at the handle, `M_x = J^-T M_q
-//! J^-1`, through the control crate's kinematics (the same Jacobian the
-//! board will run).
+//! A linkage's joint-space mass matrix at a pose, and the mass the hand
+//! feels at the handle, `M_x = J^-T M_q J^-1`.
 
 use nalgebra::Matrix3;
 use twoport_control::kinematics::{Kinematics, KinematicsFault, SerialArm};

@@ -1,0 +1,282 @@
+//! Linkage device files: what a device is (its kind and geometry), what
+//! drives it (motors, encoders, transmissions) and its joints, read from
+//! TOML and checked field by field.
+
+use crate::ModelError;
+use serde::Deserialize;
+use twoport_control::kinematics::{Capstan, Delta, Pantograph, SerialArm};
+
+/// A linkage device file.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinkageFile {
+    /// A human-readable name.
+    pub name: String,
+    /// Where its numbers come from (a citation, or "estimate").
+    pub source: String,
+    /// The servo's period (s).
+    pub period_s: f64,
+    /// The linkage's kind and dimensions.
+    pub geometry: Geometry,
+    /// Every motor's drive, the same for each joint.
+    pub motors: Motors,
+    /// Per joint: damping, friction, limits.
+    pub joints: Joints,
+}
+
+/// A linkage's kind and dimensions (m).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Geometry {
+    /// A capstan or sector drive: handle radius, pulley, sector.
+    Capstan {
+        /// Handle radius from the sector's axis (m).
+        r_h_m: f64,
+        /// Motor pulley radius (m).
+        r_p_m: f64,
+        /// Sector radius (m).
+        r_s_m: f64,
+    },
+    /// The five-bar pantograph.
+    Pantograph {
+        /// Proximal links (m).
+        l_m: f64,
+        /// Distal links (m).
+        big_l_m: f64,
+        /// Distance between the motors (m).
+        d_m: f64,
+    },
+    /// The PHANToM-type serial arm.
+    SerialArm {
+        /// Upper arm (m).
+        l1_m: f64,
+        /// Forearm (m).
+        l2_m: f64,
+    },
+    /// The rotary delta.
+    Delta {
+        /// Base radius (m).
+        base_m: f64,
+        /// Effector radius (m).
+        effector_m: f64,
+        /// Upper arms (m).
+        upper_m: f64,
+        /// Parallelograms (m).
+        lower_m: f64,
+    },
+}
+
+/// The motors and their sensing.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Motors {
+    /// Torque constant (N m/A).
+    pub torque_constant_nmpa: f64,
+    /// Peak torque at the motor (N m).
+    pub peak_torque_nm: f64,
+    /// Continuous torque at the motor (N m).
+    pub continuous_torque_nm: f64,
+    /// Encoder counts per motor revolution (after quadrature).
+    pub encoder_counts_per_rev: u32,
+    /// Rotor inertia (kg m²).
+    pub rotor_inertia_kgm2: f64,
+    /// Transmission ratio per joint, motor turns per joint turn (1 for a
+    /// direct drive; a capstan's is folded into its geometry).
+    pub ratios: Vec<f64>,
+}
+
+/// The joints' own losses and limits.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Joints {
+    /// Viscous damping per joint (N m s/rad).
+    pub damping_nmsprad: Vec<f64>,
+    /// Coulomb friction per joint (N m).
+    pub friction_nm: Vec<f64>,
+    /// `[low, high]` per joint (rad).
+    pub limits_rad: Vec<[f64; 2]>,
+}
+
+impl Geometry {
+    /// How many joints (and Cartesian axes) the kind has.
+    pub fn joints(&self) -> usize {
+        match self {
+            Geometry::Capstan { .. } => 1,
+            Geometry::Pantograph { .. } => 2,
+            Geometry::SerialArm { .. } | Geometry::Delta { .. } => 3,
+        }
+    }
+
+    /// Build the kind's kinematics, to check its dimensions as the board
+    /// will.
+    fn check(&self) -> Result<(), String> {
+        let f = |x: f64| x as f32;
+        let r = match *self {
+            Geometry::Capstan {
+                r_h_m,
+                r_p_m,
+                r_s_m,
+            } => Capstan::new(f(r_h_m), f(r_p_m), f(r_s_m)).map(|_| ()),
+            Geometry::Pantograph { l_m, big_l_m, d_m } => {
+                Pantograph::new(f(l_m), f(big_l_m), f(d_m)).map(|_| ())
+            }
+            Geometry::SerialArm { l1_m, l2_m } => SerialArm::new(f(l1_m), f(l2_m)).map(|_| ()),
+            Geometry::Delta {
+                base_m,
+                effector_m,
+                upper_m,
+                lower_m,
+            } => Delta::new(f(base_m), f(effector_m), f(upper_m), f(lower_m)).map(|_| ()),
+        };
+        r.map_err(|e| {
+            let field = e
+                .name
+                .trim_start_matches("kinematics.")
+                .split(' ')
+                .next()
+                .unwrap_or(e.name);
+            format!("geometry.{field} = {}: {}", e.value, e.problem)
+        })
+    }
+}
+
+impl LinkageFile {
+    /// Parse and check a linkage file's text; `source` names it in errors.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use twoport_design::linkage::LinkageFile;
+    /// let text = include_str!("../../../../models/linkages/hapkit.toml");
+    /// let hapkit = LinkageFile::from_toml(text, "hapkit.toml")?;
+    /// assert_eq!(hapkit.geometry.joints(), 1);
+    /// let bad = text.replace("r_p_m = 0.005", "r_p_m = -0.005");
+    /// let e = LinkageFile::from_toml(&bad, "hapkit.toml").unwrap_err();
+    /// assert_eq!(e.to_string(), "hapkit.toml: geometry.r_p_m = -0.005: must be finite and > 0");
+    /// # Ok::<(), twoport_design::ModelError>(())
+    /// ```
+    pub fn from_toml(text: &str, source: &str) -> Result<Self, ModelError> {
+        let file: LinkageFile = crate::model::parse(text, source)?;
+        file.check().map_err(|message| ModelError {
+            source: source.to_string(),
+            message,
+        })?;
+        Ok(file)
+    }
+
+    /// Read and check a linkage file.
+    pub fn load(path: &std::path::Path) -> Result<Self, ModelError> {
+        let (text, source) = crate::model::read(path)?;
+        Self::from_toml(&text, &source)
+    }
+
+    fn check(&self) -> Result<(), String> {
+        let positive = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{name} = {v}: must be finite and > 0"))
+            }
+        };
+        let at_least_zero = |name: &str, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{name} = {v}: must be finite and >= 0"))
+            }
+        };
+        positive("period_s", self.period_s)?;
+        self.geometry.check()?;
+        let m = &self.motors;
+        positive("motors.torque_constant_nmpa", m.torque_constant_nmpa)?;
+        positive("motors.peak_torque_nm", m.peak_torque_nm)?;
+        positive("motors.continuous_torque_nm", m.continuous_torque_nm)?;
+        if m.continuous_torque_nm > m.peak_torque_nm {
+            return Err(format!(
+                "motors.continuous_torque_nm = {} exceeds motors.peak_torque_nm = {}",
+                m.continuous_torque_nm, m.peak_torque_nm
+            ));
+        }
+        if m.encoder_counts_per_rev == 0 {
+            return Err("motors.encoder_counts_per_rev = 0: must be at least 1".into());
+        }
+        at_least_zero("motors.rotor_inertia_kgm2", m.rotor_inertia_kgm2)?;
+        let n = self.geometry.joints();
+        let count = |name: &str, len: usize| {
+            if len == n {
+                Ok(())
+            } else {
+                Err(format!(
+                    "{name} has {len} entries: a {n}-joint linkage needs {n}"
+                ))
+            }
+        };
+        count("motors.ratios", m.ratios.len())?;
+        for (i, r) in m.ratios.iter().enumerate() {
+            positive(&format!("motors.ratios[{i}]"), *r)?;
+        }
+        let j = &self.joints;
+        count("joints.damping_nmsprad", j.damping_nmsprad.len())?;
+        count("joints.friction_nm", j.friction_nm.len())?;
+        count("joints.limits_rad", j.limits_rad.len())?;
+        for (i, d) in j.damping_nmsprad.iter().enumerate() {
+            at_least_zero(&format!("joints.damping_nmsprad[{i}]"), *d)?;
+        }
+        for (i, f) in j.friction_nm.iter().enumerate() {
+            at_least_zero(&format!("joints.friction_nm[{i}]"), *f)?;
+        }
+        for (i, [lo, hi]) in j.limits_rad.iter().enumerate() {
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return Err(format!(
+                    "joints.limits_rad[{i}] = [{lo}, {hi}]: must be finite, low below high"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HAPKIT: &str = include_str!("../../../../models/linkages/hapkit.toml");
+    const HAPLY: &str = include_str!("../../../../models/linkages/haply_2diy.toml");
+
+    fn refused(text: &str, from: &str, to: &str) -> String {
+        assert!(text.contains(from), "{from}");
+        LinkageFile::from_toml(&text.replacen(from, to, 1), "x.toml")
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn the_shipped_linkages_load() {
+        let h = LinkageFile::from_toml(HAPKIT, "hapkit.toml").unwrap();
+        assert!(matches!(h.geometry, Geometry::Capstan { .. }));
+        let p = LinkageFile::from_toml(HAPLY, "haply_2diy.toml").unwrap();
+        assert_eq!(p.geometry.joints(), 2);
+        assert_eq!(p.motors.encoder_counts_per_rev, 13_824);
+    }
+
+    #[test]
+    fn bad_fields_are_named() {
+        assert_eq!(
+            refused(HAPLY, "l_m = 0.07", "l_m = 0.0"),
+            "x.toml: geometry.l_m = 0: must be finite and > 0"
+        );
+        assert_eq!(
+            refused(HAPLY, "ratios = [1.0, 1.0]", "ratios = [1.0]"),
+            "x.toml: motors.ratios has 1 entries: a 2-joint linkage needs 2"
+        );
+        assert!(refused(HAPKIT, "kind = \"capstan\"", "kind = \"gantry\"")
+            .contains("unknown variant `gantry`"));
+        assert!(refused(HAPKIT, "period_s", "perod_s").starts_with("x.toml: line "));
+        assert!(refused(
+            HAPLY,
+            "continuous_torque_nm = 0.1",
+            "continuous_torque_nm = 9.0"
+        )
+        .contains("exceeds motors.peak_torque_nm"));
+    }
+}
