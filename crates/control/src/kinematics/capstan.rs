@@ -2,6 +2,7 @@
 //! the motor's pulley drives a sector that carries the handle.
 
 use super::{finite, Jointed, Kinematics, KinematicsFault};
+use crate::param::positive;
 use crate::{ParamError, Real};
 
 /// A sector of radius `r_s` driven by a motor pulley of radius `r_p`,
@@ -19,19 +20,9 @@ impl Capstan {
     /// The drive with handle radius `r_h_m`, pulley radius `r_p_m` and
     /// sector radius `r_s_m` (m, each finite and > 0).
     pub fn new(r_h_m: f32, r_p_m: f32, r_s_m: f32) -> Result<Self, ParamError> {
-        for (name, v) in [
-            ("kinematics.r_h_m (m)", r_h_m),
-            ("kinematics.r_p_m (m)", r_p_m),
-            ("kinematics.r_s_m (m)", r_s_m),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(ParamError {
-                    name,
-                    value: v,
-                    problem: "must be finite and > 0",
-                });
-            }
-        }
+        let r_h_m = positive("kinematics.r_h_m (m)", r_h_m)?;
+        let r_p_m = positive("kinematics.r_p_m (m)", r_p_m)?;
+        let r_s_m = positive("kinematics.r_s_m (m)", r_s_m)?;
         Ok(Capstan {
             ratio_m_per_rad: r_h_m * r_p_m / r_s_m,
         })

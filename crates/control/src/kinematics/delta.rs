@@ -4,6 +4,7 @@
 //! effector, which stays parallel to the base.
 
 use super::{finite, Jointed, Kinematics, KinematicsFault};
+use crate::param::{non_negative, positive};
 use crate::{ParamError, Real};
 
 /// The motors sit at angles 0°, 120° and 240° about the base's axis (`z`,
@@ -38,24 +39,10 @@ impl Delta {
         upper_m: f32,
         lower_m: f32,
     ) -> Result<Self, ParamError> {
-        for (name, v, positive) in [
-            ("kinematics.base_m (m)", base_m, false),
-            ("kinematics.effector_m (m)", effector_m, false),
-            ("kinematics.upper_m (m)", upper_m, true),
-            ("kinematics.lower_m (m)", lower_m, true),
-        ] {
-            if !(v.is_finite() && (v > 0.0 || (!positive && v == 0.0))) {
-                return Err(ParamError {
-                    name,
-                    value: v,
-                    problem: if positive {
-                        "must be finite and > 0"
-                    } else {
-                        "must be finite and >= 0"
-                    },
-                });
-            }
-        }
+        let base_m = non_negative("kinematics.base_m (m)", base_m)?;
+        let effector_m = non_negative("kinematics.effector_m (m)", effector_m)?;
+        let upper_m = positive("kinematics.upper_m (m)", upper_m)?;
+        let lower_m = positive("kinematics.lower_m (m)", lower_m)?;
         Ok(Delta {
             offset_m: base_m - effector_m,
             upper_m,

@@ -2,6 +2,7 @@
 //! turning a proximal link, whose distal links meet at the handle.
 
 use super::{finite, Jointed, Kinematics, KinematicsFault};
+use crate::param::{non_negative, positive};
 use crate::{ParamError, Real};
 
 /// Motor 1 at the origin and motor 2 at `(d, 0)`, proximal links of
@@ -25,23 +26,9 @@ impl Pantograph {
     /// of lying along one line (the singularity at which the motors lose
     /// hold of the handle), [`Kinematics::forward`] faults.
     pub fn new(l_m: f32, big_l_m: f32, d_m: f32) -> Result<Self, ParamError> {
-        for (name, v, min) in [
-            ("kinematics.l_m (m)", l_m, f32::MIN_POSITIVE),
-            ("kinematics.big_l_m (m)", big_l_m, f32::MIN_POSITIVE),
-            ("kinematics.d_m (m)", d_m, 0.0),
-        ] {
-            if !(v.is_finite() && v >= min) {
-                return Err(ParamError {
-                    name,
-                    value: v,
-                    problem: if min > 0.0 {
-                        "must be finite and > 0"
-                    } else {
-                        "must be finite and >= 0"
-                    },
-                });
-            }
-        }
+        let l_m = positive("kinematics.l_m (m)", l_m)?;
+        let big_l_m = positive("kinematics.big_l_m (m)", big_l_m)?;
+        let d_m = non_negative("kinematics.d_m (m)", d_m)?;
         Ok(Pantograph {
             l_m,
             big_l_m,

@@ -4,6 +4,7 @@
 //! vertical, not from the link before).
 
 use super::{finite, Jointed, Kinematics, KinematicsFault};
+use crate::param::positive;
 use crate::{ParamError, Real};
 
 /// Links `l1` (upper arm) and `l2` (forearm); joint 1 the base's yaw,
@@ -32,15 +33,8 @@ impl SerialArm {
     /// (the handle on the base's axis, or the forearm along the upper
     /// arm), [`Kinematics::forward`] faults.
     pub fn new(l1_m: f32, l2_m: f32) -> Result<Self, ParamError> {
-        for (name, v) in [("kinematics.l1_m (m)", l1_m), ("kinematics.l2_m (m)", l2_m)] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(ParamError {
-                    name,
-                    value: v,
-                    problem: "must be finite and > 0",
-                });
-            }
-        }
+        let l1_m = positive("kinematics.l1_m (m)", l1_m)?;
+        let l2_m = positive("kinematics.l2_m (m)", l2_m)?;
         Ok(SerialArm {
             l1_m,
             l2_m,
