@@ -319,6 +319,12 @@ pub fn verify(
         model: model.name.clone(),
         why: "no termination could be built".into(),
     })?;
+    // The worst one-resonance hands seed the constructive search below.
+    let seeds: Vec<Hand> = finals
+        .iter()
+        .take(5)
+        .map(|(_, kind, p, _)| s.termination(*kind, p).hand)
+        .collect();
     // Then, where nothing was found, hands with two resonances: the best
     // one-resonance terminations with a second mass tuned to the loop's
     // worst frequency or one of its aliases (where the sound bound lets
@@ -355,14 +361,6 @@ pub fn verify(
     s.two = two;
     // The constructive search, from the worst hands found and a sweep of
     // its own, at the frequencies they bind.
-    let seeds: Vec<Hand> = finals
-        .iter()
-        .take(5)
-        .map(|(_, kind, p, _)| {
-            s.two = false;
-            s.termination(*kind, p).hand
-        })
-        .collect();
     let mut freqs: Vec<f64> = finals.iter().take(5).map(|f| f.3).collect();
     freqs.push(r.frequency_hz);
     let constructed = construct(
@@ -374,7 +372,6 @@ pub fn verify(
         &freqs,
         &seeds,
     );
-    s.two = two;
     Ok(Verdict {
         constructed,
         unstable: r.unstable,
