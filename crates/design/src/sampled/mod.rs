@@ -26,12 +26,15 @@
 //! grow no further beyond `N` (true above the device's modes, where the
 //! handle's inertia dominates).
 
-use crate::network::{admittance_display, design_bound, impedance_display, HumanBound};
+mod admittance;
+
+pub use admittance::{admittance_bound, admittance_bound_with};
+
+use crate::network::{design_bound, impedance_display, HumanBound};
 use crate::{Plant, PlantPoint};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 use std::sync::Mutex;
-use twoport_control::ZTransfer;
 
 /// From how many aliases either side of the base band the sums may stop:
 /// past three times the device's highest mode, where the tail bound's
@@ -54,9 +57,10 @@ struct Alias {
     omega: f64,
     re_yhh: f64,
     p: Complex64,
-    /// `|P|` and `|F_mh Y_ha|`.
+    /// `F_mh Y_ha`.
+    fy: Complex64,
+    /// `|P|`.
     p_abs: f64,
-    fy_abs: f64,
 }
 
 /// The device's own terms at one alias frequency, before any human:
@@ -66,8 +70,7 @@ struct Raw {
     omega: f64,
     yhh: Complex64,
     p: Complex64,
-    p_abs: f64,
-    fy_abs: f64,
+    fy: Complex64,
 }
 
 /// The device's terms at each grid point's aliases, evaluated once and
@@ -134,15 +137,8 @@ fn each_alias_pair(
         }
         let [yhh, yha, yah, fmh] = h;
         let p = yah * yha;
-        Raw {
-            omega,
-            yhh,
-            p,
-            // (Moduli without libm's hypot, its slowest part: these are
-            // far from overflow, and a rounding's difference is 1e-16.)
-            p_abs: p.norm_sqr().sqrt(),
-            fy_abs: (fmh * yha).norm_sqr().sqrt(),
-        }
+        let fy = fmh * yha;
+        Raw { omega, yhh, p, fy }
     };
     let with_human = |r: Raw| {
         let h = human.map_or(Complex64::new(0.0, 0.0), |h| {
@@ -152,8 +148,10 @@ fn each_alias_pair(
             omega: r.omega,
             re_yhh: (r.yhh + h).re,
             p: r.p,
-            p_abs: r.p_abs,
-            fy_abs: r.fy_abs,
+            fy: r.fy,
+            // (A modulus without libm's hypot, its slowest part: these are
+            // far from overflow, and a rounding's difference is 1e-16.)
+            p_abs: r.p.norm_sqr().sqrt(),
         }
     };
     let mut own = Vec::new();
@@ -244,111 +242,9 @@ pub fn impedance_bound_with(
     })
 }
 
-/// The admittance-display bound on `Re Z_cA` at each point for the
-/// regulator `kp`, sufficient for the sampled loop (see the module docs).
-/// It is never below the paper's.
-pub fn admittance_bound(
-    plant: &Plant,
-    points: &[PlantPoint],
-    kp: &ZTransfer,
-    human: Option<HumanBound>,
-) -> Vec<f64> {
-    admittance_bound_with(plant, points, kp, human, &AliasCache::default())
-}
-
-/// [`admittance_bound`], the device's alias terms kept in `cache` (made
-/// for `points`).
-pub fn admittance_bound_with(
-    plant: &Plant,
-    points: &[PlantPoint],
-    kp: &ZTransfer,
-    human: Option<HumanBound>,
-    cache: &AliasCache,
-) -> Vec<f64> {
-    crate::par::map(points.len(), |i| {
-        let p = &points[i];
-        match admittance_alias_reach(plant, (i, p), human, cache) {
-            Some(reach) => admittance_point(p, reach, kp, human),
-            None => f64::INFINITY,
-        }
-    })
-}
-
-/// `Σ |α_k| |w_k| / |1 - z^-1|` and `Σ |φ_k| |w_k| / |1 - z^-1|` over the
-/// aliases `k != 0`, with `|w_k| <= 1/R_k`: the aliased hand's reach into
-/// `-x_a*` and `f_m*` per unit held force. `None` where unbounded.
-fn admittance_alias_reach(
-    plant: &Plant,
-    (i, p): (usize, &PlantPoint),
-    human: Option<HumanBound>,
-    cache: &AliasCache,
-) -> Option<(f64, f64)> {
-    let n_min = alias_count(plant);
-    let t = p.period_s;
-    let (mut rx, mut rf, mut tx, mut tf) = (0.0, 0.0, 0.0, 0.0);
-    let bounded = each_alias_pair(plant, (i, p), human, cache, |pair, n| {
-        let (mut ratio_x, mut ratio_f) = (0.0f64, 0.0f64);
-        for a in pair {
-            let w = a.omega.abs();
-            rx += a.p_abs / (t * w * w * a.re_yhh);
-            rf += a.fy_abs / (t * w * a.re_yhh);
-            ratio_x = ratio_x.max(a.p_abs / a.re_yhh);
-            ratio_f = ratio_f.max(a.fy_abs * w / a.re_yhh);
-        }
-        // Σ_{|k|>N} 1/(T ω_k²) = T Σ 1/(θ + 2πk)².
-        (tx, tf) = (ratio_x * t * tail_sum(n), ratio_f * t * tail_sum(n));
-        if n >= n_min && tx <= TAIL_SHARE * rx && tf <= TAIL_SHARE * rf {
-            Flow::Stop
-        } else {
-            Flow::Go
-        }
-    });
-    bounded.then_some((rx + tx, rf + tf))
-}
-
-fn admittance_point(
-    p: &PlantPoint,
-    (rx, rf): (f64, f64),
-    kp: &ZTransfer,
-    human: Option<HumanBound>,
-) -> f64 {
-    let g = admittance_display(p, kp, human);
-    let paper = design_bound(&g);
-    let g_hh = g[0][0].re;
-    if !paper.is_finite() || g_hh <= 0.0 {
-        return f64::INFINITY;
-    }
-    let t = p.period_s;
-    let one = Complex64::new(1.0, 0.0);
-    let diff = (one - p.z.inv()).norm();
-    let k = kp.eval(p.z) * p.delay;
-    let rho_d = k.norm() * diff * rx;
-    // |c| ρ_F with c = K T/(1 - z^-1): the factors |1 - z^-1| cancel.
-    let c_rho_f = k.norm() * t * rf;
-    // The base-band hand's reach into the regulator loop's denominator
-    // D = 1 + K X_aa^d - K α_0 w_0, w_0 in the disk of diameter 1/R_0.
-    let y0 = p.y[0][0] + human.map_or(Complex64::new(0.0, 0.0), |h| h.admittance(p.s));
-    if y0.re <= 0.0 {
-        return f64::INFINITY;
-    }
-    let r0 = 0.5 / y0.re;
-    let p0 = p.y[1][0] * p.y[0][1];
-    let alpha0 = -(one - p.z.inv()) * p0 / (t * p.omega * p.omega);
-    let den = one + k * p.xaa_d;
-    let ka = k * alpha0;
-    let d_min = (den - ka * r0).norm() - ka.norm() * r0;
-    if d_min <= rho_d {
-        return f64::INFINITY;
-    }
-    let q = -(g[0][1] * g[1][0]);
-    let g_max = g[1][1].norm() + q.norm() / g_hh;
-    paper + (c_rho_f + g_max * rho_d) / (d_min - rho_d)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::DeviceModel;
 
     fn rigid(m: f64, b: f64) -> Plant {
         Plant::new(&crate::model::rigid_for_tests(m, b), 1e-3).unwrap()
@@ -430,23 +326,6 @@ mod tests {
                     );
                 }
             }
-        }
-    }
-
-    /// With no alias terms the admittance bound is the paper's.
-    #[test]
-    fn admittance_bound_without_aliases_is_the_papers() {
-        let model = DeviceModel::excalibur().unwrap();
-        let plant = Plant::new(&model, 1e-3).unwrap();
-        let kp = crate::analysis::regulator_tf(51_000.0, 90.0, 1e-3).unwrap();
-        let pts = plant.response(&crate::analysis::log_grid(1.0, plant.nyquist(), 40));
-        for p in &pts {
-            let h = Some(HumanBound::PAPER);
-            let paper = design_bound(&admittance_display(p, &kp, h));
-            let none = admittance_point(p, (0.0, 0.0), &kp, h);
-            assert!((none - paper).abs() <= 1e-12 * paper.abs().max(1.0));
-            let reach = admittance_alias_reach(&plant, (0, p), h, &AliasCache::default()).unwrap();
-            assert!(admittance_point(p, reach, &kp, h) >= paper);
         }
     }
 }
