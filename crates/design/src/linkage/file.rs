@@ -22,6 +22,35 @@ pub struct LinkageFile {
     pub motors: Motors,
     /// Per joint: damping, friction, limits.
     pub joints: Joints,
+    /// The moving masses.
+    pub inertia: Inertia,
+}
+
+/// The linkage's moving masses, besides the rotors (which the motors'
+/// `rotor_inertia_kgm2` and `ratios` give).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Inertia {
+    /// A point mass at the handle and each joint's own link inertia about
+    /// its axis: `M_q = diag(I_j + n_j² I_rotor) + m_h J^T J`.
+    Lumped {
+        /// The handle's mass, with the distal links' share (kg).
+        handle_mass_kg: f64,
+        /// Each joint's link inertia about its axis (kg m²).
+        link_inertia_kgm2: Vec<f64>,
+    },
+    /// The serial arm's links as Cavusoglu, Feygin & Tendick (2002) model
+    /// the PHANToM: links a, c, be, df and the base.
+    SerialArmLinks {
+        /// The forearm's counterweight offset `l3` (m).
+        l3_m: f64,
+        /// Masses of links a, c, be, df (kg).
+        masses_kg: [f64; 4],
+        /// Inertias `[xx, yy, zz]` of links a, c, be, df (kg m²).
+        inertias_kgm2: [[f64; 3]; 4],
+        /// The base's inertia about its axis (kg m²).
+        base_yy_kgm2: f64,
+    },
 }
 
 /// A linkage's kind and dimensions (m).
@@ -85,7 +114,8 @@ pub struct Motors {
     pub ratios: Vec<f64>,
 }
 
-/// The joints' own losses and limits.
+/// The joints' own losses and limits, at the joint (the angle the
+/// kinematics takes; a motor's own are reflected through `ratios`).
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Joints {
@@ -95,6 +125,20 @@ pub struct Joints {
     pub friction_nm: Vec<f64>,
     /// `[low, high]` per joint (rad).
     pub limits_rad: Vec<[f64; 2]>,
+    /// Limits on the difference of two joints, `q[j] - q[i]` (a
+    /// parallelogram's), none by default.
+    #[serde(default)]
+    pub relative: Vec<RelativeLimit>,
+}
+
+/// A limit on `q[j] - q[i]` for `joints = [i, j]`.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RelativeLimit {
+    /// `[i, j]`, counted from 0.
+    pub joints: [usize; 2],
+    /// `[low, high]` (rad).
+    pub rad: [f64; 2],
 }
 
 impl Geometry {
@@ -165,6 +209,16 @@ impl LinkageFile {
     }
 
     /// Read and check a linkage file.
+    /// Whether the file at `path` is a linkage file (it has a
+    /// `[geometry]` table) rather than a device of Cartesian axes.
+    pub fn is_linkage(path: &std::path::Path) -> bool {
+        std::fs::read_to_string(path)
+            .ok()
+            .and_then(|t| t.parse::<toml::Table>().ok())
+            .is_some_and(|t| t.contains_key("geometry"))
+    }
+
+    /// The linkage file at `path`, checked.
     pub fn load(path: &std::path::Path) -> Result<Self, ModelError> {
         let (text, source) = crate::model::read(path)?;
         Self::from_toml(&text, &source)
@@ -232,6 +286,52 @@ impl LinkageFile {
                 ));
             }
         }
+        for (r, lim) in j.relative.iter().enumerate() {
+            let [a, b] = lim.joints;
+            if a >= n || b >= n || a == b {
+                return Err(format!(
+                    "joints.relative[{r}].joints = [{a}, {b}]: two different joints below {n}"
+                ));
+            }
+            let [lo, hi] = lim.rad;
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return Err(format!(
+                    "joints.relative[{r}].rad = [{lo}, {hi}]: must be finite, low below high"
+                ));
+            }
+        }
+        match &self.inertia {
+            Inertia::Lumped {
+                handle_mass_kg,
+                link_inertia_kgm2,
+            } => {
+                at_least_zero("inertia.handle_mass_kg", *handle_mass_kg)?;
+                count("inertia.link_inertia_kgm2", link_inertia_kgm2.len())?;
+                for (i, x) in link_inertia_kgm2.iter().enumerate() {
+                    at_least_zero(&format!("inertia.link_inertia_kgm2[{i}]"), *x)?;
+                }
+            }
+            Inertia::SerialArmLinks {
+                l3_m,
+                masses_kg,
+                inertias_kgm2,
+                base_yy_kgm2,
+            } => {
+                if !matches!(self.geometry, Geometry::SerialArm { .. }) {
+                    return Err("inertia.kind = \"serial_arm_links\": only for geometry.kind = \"serial_arm\"".into());
+                }
+                at_least_zero("inertia.l3_m", *l3_m)?;
+                at_least_zero("inertia.base_yy_kgm2", *base_yy_kgm2)?;
+                for (i, m) in masses_kg.iter().enumerate() {
+                    at_least_zero(&format!("inertia.masses_kg[{i}]"), *m)?;
+                }
+                for (i, row) in inertias_kgm2.iter().enumerate() {
+                    for (k, x) in row.iter().enumerate() {
+                        at_least_zero(&format!("inertia.inertias_kgm2[{i}][{k}]"), *x)?;
+                    }
+                }
+            }
+        }
         Ok(())
     }
 }
@@ -242,6 +342,8 @@ mod tests {
 
     const HAPKIT: &str = include_str!("../../../../models/linkages/hapkit.toml");
     const HAPLY: &str = include_str!("../../../../models/linkages/haply_2diy.toml");
+    const PHANTOM: &str = include_str!("../../../../models/linkages/phantom_premium_1_5.toml");
+    const FALCON: &str = include_str!("../../../../models/linkages/falcon_like.toml");
 
     fn refused(text: &str, from: &str, to: &str) -> String {
         assert!(text.contains(from), "{from}");
@@ -257,6 +359,11 @@ mod tests {
         let p = LinkageFile::from_toml(HAPLY, "haply_2diy.toml").unwrap();
         assert_eq!(p.geometry.joints(), 2);
         assert_eq!(p.motors.encoder_counts_per_rev, 13_824);
+        let a = LinkageFile::from_toml(PHANTOM, "phantom.toml").unwrap();
+        assert!(matches!(a.inertia, Inertia::SerialArmLinks { .. }));
+        assert_eq!(a.joints.relative.len(), 1);
+        let f = LinkageFile::from_toml(FALCON, "falcon.toml").unwrap();
+        assert!(matches!(f.geometry, Geometry::Delta { .. }));
     }
 
     #[test]
@@ -278,5 +385,36 @@ mod tests {
             "continuous_torque_nm = 9.0"
         )
         .contains("exceeds motors.peak_torque_nm"));
+        assert_eq!(
+            refused(PHANTOM, "joints = [1, 2]", "joints = [1, 3]"),
+            "x.toml: joints.relative[0].joints = [1, 3]: two different joints below 3"
+        );
+        assert_eq!(
+            refused(
+                PHANTOM,
+                "rad = [-1.1345, 0.9599]",
+                "rad = [0.9599, -1.1345]"
+            ),
+            "x.toml: joints.relative[0].rad = [0.9599, -1.1345]: must be finite, low below high"
+        );
+        assert_eq!(
+            refused(HAPLY, "handle_mass_kg = 0.02", "handle_mass_kg = -0.02"),
+            "x.toml: inertia.handle_mass_kg = -0.02: must be finite and >= 0"
+        );
+        assert_eq!(
+            refused(
+                HAPLY,
+                "link_inertia_kgm2 = [2.0e-5, 2.0e-5]",
+                "link_inertia_kgm2 = [2.0e-5]"
+            ),
+            "x.toml: inertia.link_inertia_kgm2 has 1 entries: a 2-joint linkage needs 2"
+        );
+        assert!(refused(
+            FALCON,
+            "kind = \"lumped\"\nhandle_mass_kg = 0.06",
+            "kind = \"serial_arm_links\"\nhandle_mass_kg = 0.06"
+        )
+        .contains("inertia"));
+        assert!(refused(HAPKIT, "[inertia]", "[inertial]").contains("inertia"));
     }
 }

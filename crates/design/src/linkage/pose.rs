@@ -1,0 +1,194 @@
+//! A linkage at a pose: its Jacobian (the control crate's, the one the
+//! board runs), its joint-space mass and damping, and the mass and damping
+//! the hand feels at the handle, `M_x = J^-T M_q J^-1`, `D_x = J^-T D_q J^-1`.
+
+use super::file::{Geometry, Inertia, LinkageFile};
+use super::SerialArmDynamics;
+use nalgebra::DMatrix;
+use twoport_control::kinematics::{
+    Capstan, Delta, Kinematics, KinematicsFault, Pantograph, SerialArm,
+};
+
+/// The handle's position, the Jacobian, and the Cartesian mass and damping
+/// at one pose.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PoseDynamics {
+    /// Joint angles (rad).
+    pub q_rad: Vec<f64>,
+    /// The handle's position (m).
+    pub position_m: Vec<f64>,
+    /// `J = ∂x/∂q` (m/rad).
+    pub jacobian: DMatrix<f64>,
+    /// The mass the hand feels, `J^-T M_q J^-1` (kg).
+    pub mass_kg: DMatrix<f64>,
+    /// The damping the hand feels, `J^-T D_q J^-1` (N s/m).
+    pub damping_nspm: DMatrix<f64>,
+}
+
+/// The handle's position and the Jacobian at `q` for the file's geometry.
+pub fn forward(
+    geometry: &Geometry,
+    q: &[f64],
+) -> Result<(Vec<f64>, DMatrix<f64>), KinematicsFault> {
+    fn run<K: Kinematics<f64, N>, const N: usize>(
+        k: K,
+        q: &[f64],
+    ) -> Result<(Vec<f64>, DMatrix<f64>), KinematicsFault> {
+        let q: [f64; N] = q.try_into().map_err(|_| KinematicsFault::NotFinite)?;
+        let j = k.forward(&q)?;
+        Ok((
+            j.position_m.to_vec(),
+            DMatrix::from_fn(N, N, |r, c| j.jacobian[r][c]),
+        ))
+    }
+    let f = |x: f64| x as f32;
+    let bad = |_| KinematicsFault::NotFinite;
+    match *geometry {
+        Geometry::Capstan {
+            r_h_m,
+            r_p_m,
+            r_s_m,
+        } => run::<_, 1>(Capstan::new(f(r_h_m), f(r_p_m), f(r_s_m)).map_err(bad)?, q),
+        Geometry::Pantograph { l_m, big_l_m, d_m } => {
+            run::<_, 2>(Pantograph::new(f(l_m), f(big_l_m), f(d_m)).map_err(bad)?, q)
+        }
+        Geometry::SerialArm { l1_m, l2_m } => {
+            run::<_, 3>(SerialArm::new(f(l1_m), f(l2_m)).map_err(bad)?, q)
+        }
+        Geometry::Delta {
+            base_m,
+            effector_m,
+            upper_m,
+            lower_m,
+        } => run::<_, 3>(
+            Delta::new(f(base_m), f(effector_m), f(upper_m), f(lower_m)).map_err(bad)?,
+            q,
+        ),
+    }
+}
+
+impl LinkageFile {
+    /// The joint-space mass matrix at `q` with the rotors reflected
+    /// (kg m²), given the Jacobian there.
+    pub fn joint_mass(&self, q: &[f64], jacobian: &DMatrix<f64>) -> DMatrix<f64> {
+        let n = q.len();
+        let rotors = DMatrix::from_fn(n, n, |r, c| {
+            if r == c {
+                self.motors.ratios[r].powi(2) * self.motors.rotor_inertia_kgm2
+            } else {
+                0.0
+            }
+        });
+        match (&self.inertia, self.geometry) {
+            (
+                Inertia::Lumped {
+                    handle_mass_kg,
+                    link_inertia_kgm2,
+                },
+                _,
+            ) => {
+                DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(link_inertia_kgm2))
+                    + rotors
+                    + jacobian.transpose() * jacobian * *handle_mass_kg
+            }
+            (
+                Inertia::SerialArmLinks {
+                    l3_m,
+                    masses_kg,
+                    inertias_kgm2,
+                    base_yy_kgm2,
+                },
+                Geometry::SerialArm { l1_m, l2_m },
+            ) => {
+                let arm = SerialArmDynamics {
+                    l1_m,
+                    l2_m,
+                    l3_m: *l3_m,
+                    masses_kg: *masses_kg,
+                    inertias_kgm2: *inertias_kgm2,
+                    base_yy_kgm2: *base_yy_kgm2,
+                    rotor_kgm2: self.motors.rotor_inertia_kgm2,
+                    ratios: [0, 1, 2].map(|i| self.motors.ratios[i]),
+                };
+                let m = arm.joint_mass([q[0], q[1], q[2]]);
+                DMatrix::from_fn(3, 3, |r, c| m[(r, c)])
+            }
+            // (The file's check allows link parameters on a serial arm only.)
+            (Inertia::SerialArmLinks { .. }, _) => rotors,
+        }
+    }
+
+    /// The joint-space damping (N m s/rad).
+    pub fn joint_damping(&self) -> DMatrix<f64> {
+        DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(
+            &self.joints.damping_nmsprad,
+        ))
+    }
+
+    /// Whether `q` is inside the joint limits and the relative ones.
+    pub fn within_limits(&self, q: &[f64]) -> bool {
+        let j = &self.joints;
+        q.iter()
+            .zip(&j.limits_rad)
+            .all(|(x, [lo, hi])| (lo..=hi).contains(&x))
+            && j.relative.iter().all(|r| {
+                let d = q[r.joints[1]] - q[r.joints[0]];
+                (r.rad[0]..=r.rad[1]).contains(&d)
+            })
+    }
+
+    /// The linkage at `q` (rad), or the kinematics' fault there.
+    pub fn pose(&self, q: &[f64]) -> Result<PoseDynamics, KinematicsFault> {
+        let (position_m, jacobian) = forward(&self.geometry, q)?;
+        let inv = jacobian
+            .clone()
+            .try_inverse()
+            .ok_or(KinematicsFault::Singular)?;
+        let cart = |m: DMatrix<f64>| {
+            let x = inv.transpose() * m * &inv;
+            // Symmetric to rounding; make it exactly so.
+            (&x + x.transpose()) * 0.5
+        };
+        Ok(PoseDynamics {
+            q_rad: q.to_vec(),
+            position_m,
+            mass_kg: cart(self.joint_mass(q, &jacobian)),
+            damping_nspm: cart(self.joint_damping()),
+            jacobian,
+        })
+    }
+
+    /// Poses on a grid of `per_joint` angles across each joint's limits,
+    /// inside the relative limits, where the kinematics answer (a pose it
+    /// faults at is one the board refuses too).
+    pub fn workspace(&self, per_joint: usize) -> Vec<PoseDynamics> {
+        let n = self.geometry.joints();
+        let per = per_joint.max(2);
+        let mut poses = Vec::new();
+        let mut idx = vec![0usize; n];
+        loop {
+            let q: Vec<f64> = idx
+                .iter()
+                .zip(&self.joints.limits_rad)
+                .map(|(&i, [lo, hi])| lo + (hi - lo) * i as f64 / (per - 1) as f64)
+                .collect();
+            if self.within_limits(&q) {
+                if let Ok(p) = self.pose(&q) {
+                    poses.push(p);
+                }
+            }
+            let mut d = 0;
+            loop {
+                if d == n {
+                    return poses;
+                }
+                idx[d] += 1;
+                if idx[d] < per {
+                    break;
+                }
+                idx[d] = 0;
+                d += 1;
+            }
+        }
+    }
+}
