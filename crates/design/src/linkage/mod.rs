@@ -4,6 +4,12 @@
 
 mod dynamics;
 mod file;
+mod pose;
+mod proof;
+mod report;
 
 pub use dynamics::SerialArmDynamics;
-pub use file::{Geometry, Joints, LinkageFile, Motors};
+pub use file::{Geometry, Inertia, Joints, LinkageFile, Motors, RelativeLimit};
+pub use pose::{forward, PoseDynamics};
+pub use proof::{hands_off, Binding, HandsOff};
+pub use report::LinkageDesign;

@@ -61,6 +61,14 @@ pub(crate) fn one_axis<A: HasCommon + Clone>(
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let r = match &cli.cmd {
+        Cmd::Design(Display::Impedance(a))
+            if a.common
+                .device
+                .as_deref()
+                .is_some_and(twoport_design::linkage::LinkageFile::is_linkage) =>
+        {
+            synthesis::design_linkage(a)
+        }
         Cmd::Design(Display::Impedance(a)) => each_axis(a, synthesis::design_impedance),
         Cmd::Design(Display::Admittance(a)) => each_axis(a, synthesis::design_admittance),
         Cmd::Check(d) => each_axis(d, check::check),

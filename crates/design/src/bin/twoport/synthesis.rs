@@ -20,3 +20,31 @@ pub(crate) fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     emit(&a.common, &r)
 }
+
+/// Poses per joint on the workspace grid a linkage is proven over.
+const PER_JOINT: usize = 9;
+
+/// `design impedance --device LINKAGE`: the hands-off proof over the
+/// linkage's workspace.
+pub(crate) fn design_linkage(a: &DesignImpedance) -> Result<(), String> {
+    use twoport_design::linkage::{hands_off, LinkageDesign, LinkageFile};
+    let margin = a.margin.fraction()?;
+    let path = a.common.device.as_ref().ok_or("--device: a linkage file")?;
+    let mut file = LinkageFile::load(path).map_err(|e| e.to_string())?;
+    if !a.common.no_human {
+        return Err(format!(
+            "--device {}: a linkage is proven hands off (every passive hand) for now; \
+             give --no-human (a grasp's bound on a linkage is not proven yet)",
+            path.display()
+        ));
+    }
+    if let Some(t) = a.common.period {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(format!("--period {t}: must be finite and > 0"));
+        }
+        file.period_s = t;
+    }
+    let poses = file.workspace(PER_JOINT);
+    let d = hands_off(&file, &poses, a.b.unwrap_or(0.0)).map_err(|e| e.to_string())?;
+    emit(&a.common, &LinkageDesign::new(&file, &d, margin))
+}

@@ -1,0 +1,115 @@
+//! A linkage's workspace design as a report: text for people, JSON for
+//! programs.
+
+use super::file::LinkageFile;
+use super::proof::HandsOff;
+use serde::Serialize;
+use std::fmt;
+
+/// The hands-off design over a linkage's workspace, with the recommended
+/// stiffness `margin` below the boundary.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LinkageDesign {
+    /// The device's name.
+    pub name: String,
+    /// The human assumption: every passive hand.
+    pub human: &'static str,
+    /// The servo's period (s).
+    pub period_s: f64,
+    /// Poses proven.
+    pub poses: usize,
+    /// The boundary stiffness (N/m) at `b_c_nspm`.
+    pub k_c_npm: f64,
+    /// The coupling's damping (N s/m).
+    pub b_c_nspm: f64,
+    /// The recommended stiffness, `margin` below the boundary (N/m).
+    pub recommended_k_c_npm: f64,
+    /// The margin, as a fraction of the boundary.
+    pub margin: f64,
+    /// The binding pose's joint angles (rad) and handle position (m).
+    pub binding_q_rad: Vec<f64>,
+    /// The handle's position there (m).
+    pub binding_position_m: Vec<f64>,
+    /// The least damped direction there (unit vector).
+    pub binding_direction: Vec<f64>,
+    /// The damping along it (N s/m).
+    pub binding_damping_nspm: f64,
+    /// The mass along it (kg).
+    pub binding_mass_kg: f64,
+    /// The lightest and heaviest the handle is over the poses (kg).
+    pub mass_range_kg: (f64, f64),
+    /// The least and most damped (N s/m).
+    pub damping_range_nspm: (f64, f64),
+}
+
+impl LinkageDesign {
+    /// The report of `design` on `file`.
+    pub fn new(file: &LinkageFile, design: &HandsOff, margin: f64) -> Self {
+        let b = &design.binding;
+        LinkageDesign {
+            name: file.name.clone(),
+            human: "none: every passive hand",
+            period_s: file.period_s,
+            poses: design.poses,
+            k_c_npm: design.k_c_npm,
+            b_c_nspm: design.b_c_nspm,
+            recommended_k_c_npm: design.k_c_npm * (1.0 - margin),
+            margin,
+            binding_q_rad: b.pose.q_rad.clone(),
+            binding_position_m: b.pose.position_m.clone(),
+            binding_direction: b.direction.clone(),
+            binding_damping_nspm: b.damping_nspm,
+            binding_mass_kg: b.mass_kg,
+            mass_range_kg: design.mass_range_kg,
+            damping_range_nspm: design.damping_range_nspm,
+        }
+    }
+}
+
+fn list(v: &[f64], scale: f64, digits: usize) -> String {
+    let items: Vec<String> = v
+        .iter()
+        .map(|x| format!("{:.*}", digits, x * scale))
+        .collect();
+    format!("({})", items.join(", "))
+}
+
+impl fmt::Display for LinkageDesign {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "Linkage {}, impedance display at T = {} ms, hands off (every passive hand)",
+            self.name,
+            self.period_s * 1e3
+        )?;
+        writeln!(
+            f,
+            "  workspace: {} poses; the handle weighs {:.1} to {:.1} g, damping {:.4} to {:.4} N s/m",
+            self.poses,
+            self.mass_range_kg.0 * 1e3,
+            self.mass_range_kg.1 * 1e3,
+            self.damping_range_nspm.0,
+            self.damping_range_nspm.1
+        )?;
+        writeln!(
+            f,
+            "  proven coupling: k_c = {:.1} N/m at b_c = {} N s/m (the boundary, every pose)",
+            self.k_c_npm, self.b_c_nspm
+        )?;
+        writeln!(
+            f,
+            "  recommended: k_c = {:.1} N/m, {:.0}% below the boundary",
+            self.recommended_k_c_npm,
+            self.margin * 100.0
+        )?;
+        write!(
+            f,
+            "  binds at q = {} deg, handle at {} mm, direction {}: {:.4} N s/m, {:.1} g",
+            list(&self.binding_q_rad, 180.0 / std::f64::consts::PI, 1),
+            list(&self.binding_position_m, 1e3, 1),
+            list(&self.binding_direction, 1.0, 3),
+            self.binding_damping_nspm,
+            self.binding_mass_kg * 1e3
+        )
+    }
+}
