@@ -11,5 +11,5 @@ mod report;
 pub use dynamics::SerialArmDynamics;
 pub use file::{Geometry, Inertia, Joints, LinkageFile, Motors, RelativeLimit};
 pub use pose::{forward, PoseDynamics};
-pub use proof::{hands_off, Binding, HandsOff};
+pub use proof::{workspace_design, Binding, WorkspaceDesign};
 pub use report::LinkageDesign;

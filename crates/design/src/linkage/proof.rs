@@ -1,7 +1,8 @@
-//! The hands-off proof over a linkage's workspace: the stiffest isotropic
-//! Cartesian coupling `k_c + b_c (1 - z^-1)/T` that keeps the sampled loop
-//! stable for every passive hand (an N-port) and every passive VE, at
-//! every pose.
+//! The proof over a linkage's workspace: the stiffest isotropic Cartesian
+//! coupling `k_c + b_c (1 - z^-1)/T` that keeps the sampled loop stable
+//! for every passive hand (an N-port) and every passive VE, at every pose;
+//! or for every hand that grasps with at least a given damping (a
+//! dead-man switch keeps force off without one).
 //!
 //! At a pose the rigid linkage is `M_x v' + D_x v = f_h + f_a` in
 //! Cartesian coordinates (the motors' torques `J^T f_a` act as a force at
@@ -13,7 +14,10 @@
 //! Colgate's `λ_min(D_x) > k_c T/2 + |b_c|`. It is also necessary: a hand
 //! that holds the handle stiffly in every direction but the least damped
 //! one leaves a one-axis device of that damping, for which Colgate's
-//! condition is exact. `docs/linkages.md` has the argument.
+//! condition is exact. A grasp of at least `b_g` in every direction is a
+//! damper in parallel with the rest of the hand, so it adds to `D_x`:
+//! the same argument with `λ_min(D_x) + b_g`. `docs/linkages.md` has the
+//! argument.
 
 use super::file::LinkageFile;
 use super::pose::PoseDynamics;
@@ -32,13 +36,16 @@ pub struct Binding {
     pub mass_kg: f64,
 }
 
-/// The hands-off design over a workspace.
+/// The design over a workspace.
 #[derive(Clone, Debug, PartialEq)]
-pub struct HandsOff {
+pub struct WorkspaceDesign {
     /// The stiffest proven coupling at `b_c` (N/m): the boundary.
     pub k_c_npm: f64,
     /// The coupling's damping (N s/m).
     pub b_c_nspm: f64,
+    /// The least damping every grasp has, in every direction (N s/m; 0:
+    /// any passive hand, hands off).
+    pub min_grasp_nspm: f64,
     /// Where it binds.
     pub binding: Binding,
     /// Poses proven.
@@ -49,19 +56,20 @@ pub struct HandsOff {
     pub damping_range_nspm: (f64, f64),
 }
 
-/// The hands-off design at coupling damping `b_c` over `poses`: the
-/// boundary `k_c = 2 (λ_min(D_x) - b_c)/T` at the least damped pose, or
-/// why there is none.
-pub fn hands_off(
+/// The design at coupling damping `b_c` over `poses`, for every hand
+/// that grasps with at least `min_grasp` (N s/m; 0 for any passive hand):
+/// the boundary `k_c = 2 (λ_min(D_x) + b_g - b_c)/T` at the least damped
+/// pose, or why there is none.
+pub fn workspace_design(
     file: &LinkageFile,
     poses: &[PoseDynamics],
     b_c_nspm: f64,
-) -> Result<HandsOff, crate::Error> {
-    if !(b_c_nspm.is_finite() && b_c_nspm >= 0.0) {
-        return Err(crate::Error::Gain {
-            name: "b",
-            value: b_c_nspm,
-        });
+    min_grasp_nspm: f64,
+) -> Result<WorkspaceDesign, crate::Error> {
+    for (name, value) in [("b", b_c_nspm), ("min-grasp", min_grasp_nspm)] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(crate::Error::Gain { name, value });
+        }
     }
     let mut binding: Option<Binding> = None;
     let (mut m_lo, mut m_hi) = (f64::INFINITY, 0.0f64);
@@ -90,18 +98,19 @@ pub fn hands_off(
         }
     }
     let binding = binding.ok_or(crate::Error::NoPose)?;
-    let k = 2.0 * (binding.damping_nspm - b_c_nspm) / file.period_s;
+    let k = 2.0 * (binding.damping_nspm + min_grasp_nspm - b_c_nspm) / file.period_s;
     if k.is_nan() || k <= 0.0 {
         return Err(crate::Error::Coupling(format!(
             "{}: b_c = {b_c_nspm} N s/m leaves no stiffness: the handle's least damped \
-             direction has {:.4} N s/m (at q = {:?} rad), and with every passive hand \
-             allowed the coupling's damping must stay below it",
+             direction has {:.4} N s/m (at q = {:?} rad) and the grasp at least \
+             {min_grasp_nspm}; the coupling's damping must stay below their sum",
             file.name, binding.damping_nspm, binding.pose.q_rad
         )));
     }
-    Ok(HandsOff {
+    Ok(WorkspaceDesign {
         k_c_npm: k,
         b_c_nspm,
+        min_grasp_nspm,
         binding,
         poses: poses.len(),
         mass_range_kg: (m_lo, m_hi),
@@ -145,14 +154,14 @@ mod tests {
             let l = shipped(name);
             let poses = l.workspace(7);
             assert!(poses.len() >= 7, "{name}: {} poses", poses.len());
-            let d = hands_off(&l, &poses, 0.0).unwrap();
+            let d = workspace_design(&l, &poses, 0.0, 0.0).unwrap();
             let b = d.binding.damping_nspm;
             let x = DVector::from_column_slice(&d.binding.direction);
             assert!((x.norm() - 1.0).abs() < 1e-12, "{name}");
             let along = x.dot(&(&d.binding.pose.damping_nspm * &x));
             assert!((along - b).abs() <= 1e-9 * b, "{name}: {along} vs {b}");
             assert!((d.k_c_npm - 2.0 * b / l.period_s).abs() <= 1e-9 * d.k_c_npm);
-            let half = hands_off(&l, &poses, 0.5 * b).unwrap();
+            let half = workspace_design(&l, &poses, 0.5 * b, 0.0).unwrap();
             assert!((half.k_c_npm - 0.5 * d.k_c_npm).abs() <= 1e-9 * d.k_c_npm);
             for p in &poses {
                 assert!(l.within_limits(&p.q_rad), "{name}: {:?}", p.q_rad);
@@ -163,31 +172,41 @@ mod tests {
                     assert!(damping >= b * (1.0 - 1e-9), "{name}: {damping} < {b}");
                 }
             }
-            assert!(hands_off(&l, &poses, 1.01 * b).is_err(), "{name}");
-            assert!(hands_off(&l, &poses, f64::NAN).is_err(), "{name}");
+            assert!(
+                workspace_design(&l, &poses, 1.01 * b, 0.0).is_err(),
+                "{name}"
+            );
+            assert!(
+                workspace_design(&l, &poses, f64::NAN, 0.0).is_err(),
+                "{name}"
+            );
         }
-        assert!(hands_off(&shipped(SHIPPED[0]), &[], 0.0).is_err());
+        assert!(workspace_design(&shipped(SHIPPED[0]), &[], 0.0, 0.0).is_err());
     }
 
     /// At the binding pose a hand that holds every other direction leaves
-    /// a one-axis device of the least damping and the mass along it; the
-    /// exact sampled loop of that device (`verify`, independent of the
-    /// proof) finds nothing at the design and breaks it 20 % past.
+    /// a one-axis device of the least damping (the least grasp's added)
+    /// and the mass along it; the exact sampled loop of that device
+    /// (`verify`, independent of the proof) finds nothing at the design
+    /// and breaks it 20 % past, hands off and with a 2 N s/m grasp.
     #[test]
     #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
     fn verify_at_the_binding_pose_of_each_shipped_linkage() {
         use twoport_control::{Gains, ImpedanceGains};
         for name in SHIPPED {
             let l = shipped(name);
-            let d = hands_off(&l, &l.workspace(7), 0.0).unwrap();
-            let axis = crate::model::rigid_for_tests(d.binding.mass_kg, d.binding.damping_nspm);
-            let g = |k: f64| Gains::from(ImpedanceGains::new(k as f32, 0.0));
-            let at =
-                crate::verify::verify(&axis, l.period_s, &g(d.k_c_npm * 0.999), None, 0).unwrap();
-            assert!(!at.unstable, "{name}: {at:?}");
-            let past =
-                crate::verify::verify(&axis, l.period_s, &g(d.k_c_npm * 1.2), None, 0).unwrap();
-            assert!(past.unstable, "{name}: {past:?}");
+            for grasp in [0.0, 2.0] {
+                let d = workspace_design(&l, &l.workspace(7), 0.0, grasp).unwrap();
+                let b = d.binding.damping_nspm + grasp;
+                assert!((d.k_c_npm - 2.0 * b / l.period_s).abs() <= 1e-9 * d.k_c_npm);
+                let axis = crate::model::rigid_for_tests(d.binding.mass_kg, b);
+                let g = |k: f64| Gains::from(ImpedanceGains::new(k as f32, 0.0));
+                let v = |k: f64| crate::verify::verify(&axis, l.period_s, &g(k), None, 0).unwrap();
+                let at = v(d.k_c_npm * 0.999);
+                assert!(!at.unstable, "{name}, grasp {grasp}: {at:?}");
+                let past = v(d.k_c_npm * 1.2);
+                assert!(past.unstable, "{name}, grasp {grasp}: {past:?}");
+            }
         }
     }
 }

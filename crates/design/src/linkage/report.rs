@@ -2,18 +2,20 @@
 //! programs.
 
 use super::file::LinkageFile;
-use super::proof::HandsOff;
+use super::proof::WorkspaceDesign;
 use serde::Serialize;
 use std::fmt;
 
-/// The hands-off design over a linkage's workspace, with the recommended
-/// stiffness `margin` below the boundary.
+/// The design over a linkage's workspace, with the recommended stiffness
+/// `margin` below the boundary.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct LinkageDesign {
     /// The device's name.
     pub name: String,
-    /// The human assumption: every passive hand.
-    pub human: &'static str,
+    /// The human assumption, in words.
+    pub human: String,
+    /// The least damping every grasp has (N s/m; 0: any passive hand).
+    pub min_grasp_nspm: f64,
     /// The servo's period (s).
     pub period_s: f64,
     /// Poses proven.
@@ -44,11 +46,19 @@ pub struct LinkageDesign {
 
 impl LinkageDesign {
     /// The report of `design` on `file`.
-    pub fn new(file: &LinkageFile, design: &HandsOff, margin: f64) -> Self {
+    pub fn new(file: &LinkageFile, design: &WorkspaceDesign, margin: f64) -> Self {
         let b = &design.binding;
         LinkageDesign {
             name: file.name.clone(),
-            human: "none: every passive hand",
+            human: if design.min_grasp_nspm > 0.0 {
+                format!(
+                    "a grasp of at least {} N s/m in every direction (a dead-man switch keeps force off without one)",
+                    design.min_grasp_nspm
+                )
+            } else {
+                "none: every passive hand (hands off)".to_string()
+            },
+            min_grasp_nspm: design.min_grasp_nspm,
             period_s: file.period_s,
             poses: design.poses,
             k_c_npm: design.k_c_npm,
@@ -78,9 +88,10 @@ impl fmt::Display for LinkageDesign {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
-            "Linkage {}, impedance display at T = {} ms, hands off (every passive hand)",
+            "Linkage {}, impedance display at T = {} ms; human: {}",
             self.name,
-            self.period_s * 1e3
+            self.period_s * 1e3,
+            self.human
         )?;
         writeln!(
             f,

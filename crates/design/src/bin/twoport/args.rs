@@ -109,6 +109,11 @@ pub(crate) struct DesignImpedance {
     /// Coupling damping b_cI (N s/m); without it, the best (k, b) pair.
     #[arg(long, allow_negative_numbers = true)]
     pub(crate) b: Option<f64>,
+    /// A linkage device (--device): prove for every hand that grasps with
+    /// at least this damping in every direction (N s/m; a dead-man switch
+    /// keeps force off without a grasp), instead of every passive hand.
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) min_grasp: Option<f64>,
     #[command(flatten)]
     pub(crate) margin: Margin,
     #[command(flatten)]
