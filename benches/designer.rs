@@ -119,6 +119,30 @@ fn verify(c: &mut Criterion) {
     group.finish();
 }
 
+/// A rigid linkage proven at 1,000 poses: each linearised (kinematics,
+/// `J^-T M_q J^-1`, `J^-T D_q J^-1`) and the workspace proven (goal: 2 s).
+fn linkage(c: &mut Criterion) {
+    use twoport_design::linkage::{workspace_design, LinkageFile};
+    let file = LinkageFile::from_toml(
+        include_str!("../models/linkages/phantom_premium_1_5.toml"),
+        "phantom",
+    )
+    .unwrap();
+    let qs: Vec<Vec<f64>> = file
+        .workspace(16)
+        .into_iter()
+        .take(1000)
+        .map(|p| p.q_rad)
+        .collect();
+    assert_eq!(qs.len(), 1000);
+    c.bench_function("PHANToM 1.5: 1,000 poses linearised and proven", |b| {
+        b.iter(|| {
+            let poses: Vec<_> = qs.iter().map(|q| file.pose(q).unwrap()).collect();
+            black_box(workspace_design(&file, &poses, 0.0, 1.0).unwrap().k_c_npm)
+        })
+    });
+}
+
 fn excalibur_model() -> DeviceModel {
     DeviceModel::from_toml(include_str!("../models/excalibur.toml"), "excalibur").unwrap()
 }
@@ -126,6 +150,6 @@ fn excalibur_model() -> DeviceModel {
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = responses, designs, poses, verify
+    targets = responses, designs, poses, verify, linkage
 }
 criterion_main!(benches);

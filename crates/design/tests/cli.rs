@@ -413,3 +413,62 @@ fn design_recommends_a_margin_and_check_reports_it() {
     let e = TWOPORT.failure(&["design", "impedance", "--margin", "2"]);
     assert!(e.contains("--margin 2"), "{e}");
 }
+
+/// A linkage file given as `--device` is proven over its workspace: for
+/// every passive hand, or for every grasp of a least damping (which adds
+/// to the handle's own), and its map is drawn.
+#[test]
+fn linkages_are_proven_over_their_workspace() {
+    let dev = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../models/linkages/phantom_premium_1_5.toml"
+    );
+    let off = TWOPORT.json(&[
+        "design",
+        "impedance",
+        "--device",
+        dev,
+        "--no-human",
+        "--json",
+    ]);
+    let grasp = TWOPORT.json(&[
+        "design",
+        "impedance",
+        "--device",
+        dev,
+        "--min-grasp",
+        "1",
+        "--json",
+    ]);
+    let (k0, k1) = (
+        off["k_c_npm"].as_f64().unwrap(),
+        grasp["k_c_npm"].as_f64().unwrap(),
+    );
+    let b = off["binding_damping_nspm"].as_f64().unwrap();
+    assert!((k0 - 2.0 * b / 1e-3).abs() < 1e-6 * k0, "{off}");
+    assert!((k1 - 2.0 * (b + 1.0) / 1e-3).abs() < 1e-6 * k1, "{grasp}");
+    assert_eq!(off["binding_direction"].as_array().unwrap().len(), 3);
+    let e = TWOPORT.failure(&["design", "impedance", "--device", dev]);
+    assert!(e.contains("--no-human") && e.contains("--min-grasp"), "{e}");
+    let e = TWOPORT.failure(&["design", "impedance", "--min-grasp", "1"]);
+    assert!(e.contains("linkage"), "{e}");
+    let e = TWOPORT.failure(&["design", "impedance", "--device", dev, "--min-grasp", "-1"]);
+    assert!(e.contains("--min-grasp -1"), "{e}");
+    let dir: PathBuf = std::env::temp_dir().join(format!("twoport-map-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("map.svg");
+    let v = TWOPORT.json(&[
+        "plot",
+        "workspace",
+        "--device",
+        dev,
+        "--no-human",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!((v["k_c"].as_f64().unwrap() - k0).abs() < 0.1 * k0, "{v}");
+    assert!(std::fs::read_to_string(&out).unwrap().contains("k_c (N/m)"));
+    let e = TWOPORT.failure(&["plot", "workspace", "--out", out.to_str().unwrap()]);
+    assert!(e.contains("--device LINKAGE"), "{e}");
+}

@@ -11,5 +11,5 @@ mod report;
 pub use dynamics::SerialArmDynamics;
 pub use file::{Geometry, Inertia, Joints, LinkageFile, Motors, RelativeLimit};
 pub use pose::{forward, PoseDynamics};
-pub use proof::{workspace_design, Binding, WorkspaceDesign};
-pub use report::LinkageDesign;
+pub use proof::{workspace_design, workspace_poses, Binding, WorkspaceDesign, DESIGN_GRID};
+pub use report::{stiffness, LinkageDesign};

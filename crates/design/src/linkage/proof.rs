@@ -56,6 +56,61 @@ pub struct WorkspaceDesign {
     pub damping_range_nspm: (f64, f64),
 }
 
+/// Angles per joint on the grid `design` proves a linkage over.
+pub const DESIGN_GRID: usize = 9;
+
+/// Poses that cover the workspace: a grid of `per_joint` angles across
+/// each joint's limits, and the least damped direction's minimum sought
+/// from the grid's five least damped poses (a pattern search inside the
+/// limits, from the grid's spacing down to 1e-6 rad), since the least
+/// damped pose usually lies on a limit or at full reach, between grid
+/// points.
+pub fn workspace_poses(file: &LinkageFile, per_joint: usize) -> Vec<PoseDynamics> {
+    let mut poses = file.workspace(per_joint);
+    let least = |p: &PoseDynamics| p.damping_nspm.clone().symmetric_eigenvalues().min();
+    let damping = |q: &[f64]| {
+        if !file.within_limits(q) {
+            return None;
+        }
+        file.pose(q).ok().map(|p| (least(&p), p))
+    };
+    let mut starts: Vec<(f64, usize)> = poses.iter().map(least).zip(0..).collect();
+    starts.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let spacing: Vec<f64> = file
+        .joints
+        .limits_rad
+        .iter()
+        .map(|[lo, hi]| (hi - lo) / (per_joint.max(2) - 1) as f64)
+        .collect();
+    let mut found = Vec::new();
+    for &(b0, i) in starts.iter().take(5) {
+        let (mut best, mut q) = (b0, poses[i].q_rad.clone());
+        let mut step = 1.0;
+        while step * spacing.iter().fold(0.0f64, |a, &b| a.max(b)) > 1e-6 {
+            let mut moved = false;
+            for j in 0..q.len() {
+                for sign in [-1.0, 1.0] {
+                    let mut t = q.clone();
+                    t[j] += sign * step * spacing[j];
+                    if let Some((b, _)) = damping(&t) {
+                        if b < best {
+                            (best, q, moved) = (b, t, true);
+                        }
+                    }
+                }
+            }
+            if !moved {
+                step *= 0.5;
+            }
+        }
+        if let Some((_, p)) = damping(&q) {
+            found.push(p);
+        }
+    }
+    poses.extend(found);
+    poses
+}
+
 /// The design at coupling damping `b_c` over `poses`, for every hand
 /// that grasps with at least `min_grasp` (N s/m; 0 for any passive hand):
 /// the boundary `k_c = 2 (λ_min(D_x) + b_g - b_c)/T` at the least damped
@@ -182,6 +237,26 @@ mod tests {
             );
         }
         assert!(workspace_design(&shipped(SHIPPED[0]), &[], 0.0, 0.0).is_err());
+    }
+
+    /// The refined coarse grid finds the least damped pose a grid twice as
+    /// fine finds, or a less damped one: the bound does not rest on where
+    /// the grid's points fall.
+    #[test]
+    fn the_refined_grid_finds_the_least_damped_pose() {
+        let least = |poses: &[PoseDynamics]| {
+            poses
+                .iter()
+                .map(|p| p.damping_nspm.clone().symmetric_eigenvalues().min())
+                .fold(f64::INFINITY, f64::min)
+        };
+        for name in SHIPPED {
+            let l = shipped(name);
+            let coarse = least(&workspace_poses(&l, 9));
+            let fine = least(&l.workspace(17));
+            assert!(coarse <= fine * (1.0 + 1e-3), "{name}: {coarse} vs {fine}");
+            assert!(coarse <= least(&l.workspace(9)), "{name}");
+        }
     }
 
     /// At the binding pose a hand that holds every other direction leaves

@@ -76,6 +76,16 @@ impl LinkageDesign {
     }
 }
 
+/// A stiffness to four significant figures, however small.
+pub fn stiffness(k: f64) -> String {
+    if k >= 1000.0 {
+        format!("{k:.0}")
+    } else {
+        let digits = (3 - k.abs().max(1e-12).log10().floor() as i32).clamp(0, 12) as usize;
+        format!("{k:.digits$}")
+    }
+}
+
 fn list(v: &[f64], scale: f64, digits: usize) -> String {
     let items: Vec<String> = v
         .iter()
@@ -104,13 +114,14 @@ impl fmt::Display for LinkageDesign {
         )?;
         writeln!(
             f,
-            "  proven coupling: k_c = {:.1} N/m at b_c = {} N s/m (the boundary, every pose)",
-            self.k_c_npm, self.b_c_nspm
+            "  proven coupling: k_c = {} N/m at b_c = {} N s/m (the boundary, every pose)",
+            stiffness(self.k_c_npm),
+            self.b_c_nspm
         )?;
         writeln!(
             f,
-            "  recommended: k_c = {:.1} N/m, {:.0}% below the boundary",
-            self.recommended_k_c_npm,
+            "  recommended: k_c = {} N/m, {:.0}% below the boundary",
+            stiffness(self.recommended_k_c_npm),
             self.margin * 100.0
         )?;
         write!(

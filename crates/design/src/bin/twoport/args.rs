@@ -193,6 +193,8 @@ pub(crate) enum Fig {
     Fig9,
     /// Impedance range of both displays.
     Fig10,
+    /// A linkage's proven stiffness over its workspace (--device LINKAGE).
+    Workspace,
 }
 
 #[derive(Args, Clone)]
@@ -208,6 +210,10 @@ pub(crate) struct PlotArgs {
     /// Admittance-coupling damping to design at (N s/m).
     #[arg(long, default_value_t = 500.0)]
     pub(crate) b_admittance: f64,
+    /// `workspace`: prove for every grasp of at least this damping (N
+    /// s/m) instead of every passive hand.
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) min_grasp: Option<f64>,
     #[command(flatten)]
     pub(crate) common: Common,
 }

@@ -73,6 +73,7 @@ fn main() -> ExitCode {
         Cmd::Design(Display::Admittance(a)) => each_axis(a, synthesis::design_admittance),
         Cmd::Check(d) => each_axis(d, check::check),
         Cmd::Zrange(d) => one_axis(d, plots::zrange),
+        Cmd::Plot(p) if matches!(p.figure, Fig::Workspace) => plots::plot_workspace(p),
         Cmd::Plot(p) => one_axis(p, plots::plot_fig),
         Cmd::Region(d) => each_axis(d, region::region),
         Cmd::Verify(d) => each_axis(d, verify::verify),

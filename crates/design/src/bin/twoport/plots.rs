@@ -71,6 +71,7 @@ pub(crate) fn plot_fig(p: &PlotArgs) -> Result<(), String> {
         Fig::Fig8 => figures::fig8(a, k, b),
         Fig::Fig9 => figures::fig9(a, (k, b), (m, p.b_admittance)),
         Fig::Fig10 => figures::fig10(a, (k, b), (k, b), (m, p.b_admittance)),
+        Fig::Workspace => return Err("plot workspace takes --device LINKAGE".into()),
     }
     .map_err(|e| e.to_string())?;
     plot::render(&fig, &p.out).map_err(|e| e.to_string())?;
@@ -79,6 +80,72 @@ pub(crate) fn plot_fig(p: &PlotArgs) -> Result<(), String> {
         "wrote {} (k_c = {k:.0} N/m, b_c = {b} N s/m, m_c = {m:.3} kg, b_cA = {} N s/m)",
         p.out.display(),
         p.b_admittance
+    );
+    emit(&p.common, &Printed(v, text))
+}
+
+/// Poses per joint on a workspace map's grid, by joint count.
+const MAP_PER_JOINT: [usize; 3] = [41, 41, 15];
+
+/// `plot workspace --device LINKAGE`: the stiffness each pose proves on
+/// its own, over the workspace (a 3-DOF linkage seen from above), the
+/// pose that binds `design`'s proof marked.
+pub(crate) fn plot_workspace(p: &PlotArgs) -> Result<(), String> {
+    use twoport_design::linkage::{workspace_design, workspace_poses, LinkageFile, DESIGN_GRID};
+    let path = p
+        .common
+        .device
+        .as_ref()
+        .ok_or("plot workspace: give --device LINKAGE")?;
+    let file = LinkageFile::load(path).map_err(|e| e.to_string())?;
+    let grasp = match (p.min_grasp, p.common.no_human) {
+        (Some(g), _) => g,
+        (None, true) => 0.0,
+        (None, false) => {
+            return Err(format!(
+                "--device {}: give --no-human (every passive hand) or --min-grasp B",
+                path.display()
+            ))
+        }
+    };
+    let n = file.geometry.joints();
+    // The design's poses (so that the mark is the design's binding pose)
+    // and a finer grid to draw.
+    let mut poses = workspace_poses(&file, DESIGN_GRID);
+    poses.extend(file.workspace(MAP_PER_JOINT[n - 1]));
+    let whole = workspace_design(&file, &poses, 0.0, grasp).map_err(|e| e.to_string())?;
+    let at = |x: &[f64]| {
+        let mm = |i: usize| x.get(i).copied().unwrap_or(0.0) * 1e3;
+        (mm(0), mm(1))
+    };
+    let points = poses
+        .iter()
+        .filter_map(|pose| {
+            let one = workspace_design(&file, std::slice::from_ref(pose), 0.0, grasp).ok()?;
+            let (x, y) = at(&pose.position_m);
+            Some((x, y, one.k_c_npm))
+        })
+        .collect();
+    let hand = if grasp > 0.0 {
+        format!("every grasp of at least {grasp} N s/m")
+    } else {
+        "every passive hand".to_string()
+    };
+    let map = plot::Map {
+        title: format!("{}: proven k_c, {hand}", file.name),
+        x_label: "x (mm)".into(),
+        y_label: if n == 1 { "".into() } else { "y (mm)".into() },
+        value_label: "k_c (N/m), b_c = 0".into(),
+        points,
+        mark: Some(at(&whole.binding.pose.position_m)),
+    };
+    plot::render_map(&map, &p.out).map_err(|e| e.to_string())?;
+    let v = json!({"out": p.out, "poses": poses.len(), "k_c": whole.k_c_npm, "min_grasp": grasp});
+    let text = format!(
+        "wrote {} ({} poses; the whole workspace is proven at k_c = {} N/m)",
+        p.out.display(),
+        poses.len(),
+        twoport_design::linkage::stiffness(whole.k_c_npm)
     );
     emit(&p.common, &Printed(v, text))
 }

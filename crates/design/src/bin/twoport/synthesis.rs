@@ -26,13 +26,12 @@ pub(crate) fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
     emit(&a.common, &r)
 }
 
-/// Poses per joint on the workspace grid a linkage is proven over.
-const PER_JOINT: usize = 9;
-
 /// `design impedance --device LINKAGE`: the proof over the linkage's
 /// workspace, hands off or for a least grasp.
 pub(crate) fn design_linkage(a: &DesignImpedance) -> Result<(), String> {
-    use twoport_design::linkage::{workspace_design, LinkageDesign, LinkageFile};
+    use twoport_design::linkage::{
+        workspace_design, workspace_poses, LinkageDesign, LinkageFile, DESIGN_GRID,
+    };
     let margin = a.margin.fraction()?;
     let path = a.common.device.as_ref().ok_or("--device: a linkage file")?;
     let mut file = LinkageFile::load(path).map_err(|e| e.to_string())?;
@@ -54,7 +53,7 @@ pub(crate) fn design_linkage(a: &DesignImpedance) -> Result<(), String> {
         }
         file.period_s = t;
     }
-    let poses = file.workspace(PER_JOINT);
+    let poses = workspace_poses(&file, DESIGN_GRID);
     let d =
         workspace_design(&file, &poses, a.b.unwrap_or(0.0), grasp).map_err(|e| e.to_string())?;
     emit(&a.common, &LinkageDesign::new(&file, &d, margin))

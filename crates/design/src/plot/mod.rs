@@ -5,6 +5,10 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
+mod map;
+
+pub use map::{render_map, Map};
+
 /// One curve: a label, a style, and (frequency Hz, value) points. Points
 /// with a value <= 0 are left out (log axis), breaking the line there, as
 /// the paper's Fig. 8 does where the bound turns negative.
