@@ -85,6 +85,18 @@ impl Encoder {
         if first_raw & !mask != 0 {
             return Err(EncoderError::RawOutOfRange(first_raw));
         }
+        Ok(Self::build(bits, mask, pm_per_count, first_raw, origin))
+    }
+
+    /// A 32-bit counter of 1 nm counts reading `at` where it reads
+    /// `at`'s nanometres: a position a computation (a linkage's
+    /// kinematics) drives, unwrapped and read like a sensor's.
+    pub(crate) fn nanometre_counter(at: Position) -> Self {
+        Self::build(32, u32::MAX, 1_000, at.nm() as u32, at)
+    }
+
+    /// The counter, its arguments checked.
+    fn build(bits: u8, mask: u32, pm_per_count: i64, first_raw: u32, origin: Position) -> Self {
         // pm * 1024 / 1000, rounded half up; >= 1 for pm >= 1.
         let q10 = (pm_per_count * 128 + 62) / 125;
         // The position of count c is origin + floor((c q10 + 512) / 1024);
@@ -93,7 +105,7 @@ impl Encoder {
         let room_down = origin.nm() as i64 - i32::MIN as i64;
         let count_max = ((room_up + 1) * 1024 - 513) / q10;
         let count_min = -((room_down * 1024 + 512) / q10);
-        Ok(Encoder {
+        Encoder {
             shift: 32 - bits as u32,
             mask,
             pm_per_count,
@@ -103,7 +115,7 @@ impl Encoder {
             count_min: count_min.max(i32::MIN as i64) as i32,
             count_max: count_max.min(i32::MAX as i64) as i32,
             origin,
-        })
+        }
     }
 
     /// Largest movement between two reads that unwraps unambiguously (counts).

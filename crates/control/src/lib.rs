@@ -11,6 +11,7 @@ mod encoder;
 mod estimator;
 pub mod homing;
 pub mod kinematics;
+pub mod linkage;
 mod param;
 pub mod passivity;
 mod position;
@@ -20,6 +21,7 @@ mod regulator;
 pub mod safety;
 pub mod servo;
 mod tf;
+mod trig;
 pub mod ve;
 pub mod world;
 

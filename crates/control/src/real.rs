@@ -59,6 +59,9 @@ pub trait Real:
     fn sin(self) -> Self;
     /// `cos(self)` (self in rad).
     fn cos(self) -> Self;
+    /// `(sin(self), cos(self))` (self in rad): in f32 arithmetic for
+    /// `f32` (see the kinematics), libm's for `f64`.
+    fn sin_cos(self) -> (Self, Self);
     /// `√self` (NaN below 0).
     fn sqrt(self) -> Self;
     /// The angle of `(x, self)` (rad, in `[-π, π]`).
@@ -66,7 +69,7 @@ pub trait Real:
 }
 
 macro_rules! real {
-    ($t:ty, $sin:path, $cos:path, $sqrt:path, $atan2:path) => {
+    ($t:ty, $sin:path, $cos:path, $sin_cos:path, $sqrt:path, $atan2:path) => {
         impl Real for $t {
             const ZERO: Self = 0.0;
             const ONE: Self = 1.0;
@@ -114,6 +117,10 @@ macro_rules! real {
                 $cos(self)
             }
             #[inline]
+            fn sin_cos(self) -> (Self, Self) {
+                $sin_cos(self)
+            }
+            #[inline]
             fn sqrt(self) -> Self {
                 $sqrt(self)
             }
@@ -125,5 +132,23 @@ macro_rules! real {
     };
 }
 
-real!(f32, libm::sinf, libm::cosf, libm::sqrtf, libm::atan2f);
-real!(f64, libm::sin, libm::cos, libm::sqrt, libm::atan2);
+real!(
+    f32,
+    libm::sinf,
+    libm::cosf,
+    crate::trig::sin_cos_f32,
+    libm::sqrtf,
+    libm::atan2f
+);
+real!(
+    f64,
+    libm::sin,
+    libm::cos,
+    sin_cos_f64,
+    libm::sqrt,
+    libm::atan2
+);
+
+fn sin_cos_f64(x: f64) -> (f64, f64) {
+    (libm::sin(x), libm::cos(x))
+}

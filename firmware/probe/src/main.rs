@@ -251,6 +251,108 @@ fn tick_cost_axes(t: &mut Tally) {
     );
 }
 
+/// A 3-DOF linkage's tick in QEMU: three joint encoders, the kinematics
+/// and Jacobian, the three-axis Cartesian servo with a wall on each axis,
+/// `J^T f` and the motors' limits. The joints sweep back and forth (a
+/// triangle of 300 counts), so the handle passes in and out of the walls.
+fn tick_cost_linkage(t: &mut Tally) {
+    use twoport_control::kinematics::{Delta, Kinematics, SerialArm};
+    use twoport_control::linkage::{JointEncoder, LinkageServo, MotorConfig};
+    use twoport_control::world::{PerAxis, World};
+    /// The walls as their own world type. A board image runs one servo,
+    /// whose tick the compiler inlines into the loop; here the Cartesian
+    /// three-axis probe shares `PerAxis<UnilateralWall, 3>`, and two
+    /// callers of one instantiation would keep it out of line in both.
+    struct Walls(PerAxis<UnilateralWall, 3>);
+    impl World<f32, 3> for Walls {
+        #[inline(always)]
+        fn step_axes(
+            &mut self,
+            ports: &[twoport_control::ve::Port<f32>; 3],
+        ) -> [twoport_control::ve::VeOutput<f32>; 3] {
+            self.0.step_axes(ports)
+        }
+        #[inline(always)]
+        fn offsets_m(&self, x: &[Position; 3]) -> [f32; 3] {
+            self.0.offsets_m(x)
+        }
+        fn reset_axes(&mut self, x: &[Position; 3]) {
+            self.0.reset_axes(x)
+        }
+        fn positions(&self) -> [Position; 3] {
+            self.0.positions()
+        }
+        fn axis_tf(&self, axis: usize) -> VeTransfer {
+            self.0.axis_tf(axis)
+        }
+    }
+    fn run<K: Kinematics<f32, 3> + Copy>(
+        t: &mut Tally,
+        k: K,
+        q0: [f32; 3],
+        counts_per_rev: f32,
+        name: &str,
+        what: &str,
+    ) {
+        let Ok(start) = k.forward(&q0) else {
+            t.check(name, false);
+            return;
+        };
+        let walls = Walls(PerAxis(core::array::from_fn(|i| {
+            let at = Position::from_m(start.position_m[i] + 0.002).unwrap_or(Position::ZERO);
+            let here = Position::from_m(start.position_m[i]).unwrap_or(Position::ZERO);
+            UnilateralWall::new(2_000.0, 2.0, at, Solid::Above, T, here).unwrap()
+        })));
+        let joints = q0.map(|q| JointEncoder::new(16, counts_per_rev, 0, q).unwrap());
+        let gains = ImpedanceGains::new(800.0, 1.0).into();
+        let mut safety = SafetyConfig::new(T, 10.0, 4.0);
+        safety.max_velocity_mps = 10.0;
+        let limits = [[-3.0, 3.0], [-3.0, 3.0], [-3.0, 4.0]];
+        let motors = [MotorConfig::new(1.0, 0.4); 3];
+        let Ok(mut s) =
+            LinkageServo::new(k, joints, limits, [gains; 3], [safety; 3], motors, walls)
+        else {
+            t.check(name, false);
+            return;
+        };
+        let _ = s.enable();
+        let sweep = |k: u32| {
+            let p = k % 600;
+            let c = core::hint::black_box(if p < 300 { p } else { 600 - p });
+            SensorFrame {
+                tick: k,
+                encoder_raw: [c, c, c.wrapping_neg() & 0xFFFF],
+                load_cell_n: [0.0; 3],
+                dead_man_closed: true,
+            }
+        };
+        let (per_tick, _) = counts_per_call(1000, |k| s.tick(&sweep(k)).torque_nm[2]);
+        count(name, per_tick / 1.6, what);
+        t.check(
+            name,
+            per_tick > 0.0 && s.cartesian().safety().faults().is_empty(),
+        );
+    }
+    let arm = SerialArm::new(0.215, 0.17).unwrap();
+    run(
+        t,
+        arm,
+        [0.1, 0.3, 1.0],
+        26_600.0,
+        "serial_arm_tick",
+        "3-DOF serial arm tick (joints, kinematics, Jacobian, walls, safety, J^T f)",
+    );
+    let delta = Delta::new(0.04, 0.02309, 0.06, 0.1025).unwrap();
+    run(
+        t,
+        delta,
+        [0.5, 0.5, 0.5],
+        2_470.0,
+        "delta_tick",
+        "3-DOF delta tick (joints, forward solve, Jacobian, walls, safety, J^T f)",
+    );
+}
+
 /// The same tick with the passivity layer (the series damper) between the
 /// device and the coupling, in two sweeps: pressing into the wall (the
 /// element takes energy in, the layer only books it) and withdrawing from
@@ -453,6 +555,7 @@ fn main() -> ! {
         tick_cost_layered(&mut t);
         tick_cost_ve_port(&mut t);
         tick_cost_axes(&mut t);
+        tick_cost_linkage(&mut t);
         cost_breakdown();
     }
     hprintln!("{} passed, {} failed", t.passed, t.failed);

@@ -7,6 +7,7 @@ pub mod blocks;
 pub mod effects;
 pub mod human;
 pub mod layer;
+pub mod linkage;
 pub mod plant;
 pub mod scene;
 pub mod servo;

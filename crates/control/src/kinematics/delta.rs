@@ -56,7 +56,7 @@ impl Delta {
         let (r, a) = (R::of(self.offset_m), R::of(self.upper_m));
         core::array::from_fn(|i| {
             let (c, s) = (R::of(LEGS[i].0), R::of(LEGS[i].1));
-            let (cq, sq) = (q[i].cos(), q[i].sin());
+            let (sq, cq) = q[i].sin_cos();
             let radial = r + a * cq;
             (
                 [c * radial, s * radial, -a * sq],

@@ -41,6 +41,8 @@ pub enum KinematicsFault {
     Singular,
     /// A joint angle that is not finite.
     NotFinite,
+    /// A joint beyond the limits the proof of the gains covered.
+    OutsideLimits,
 }
 
 /// The handle's position and the Jacobian at one pose.

@@ -42,7 +42,7 @@ impl<R: Real> Kinematics<R, 2> for Pantograph {
     fn forward(&self, q: &[R; 2]) -> Result<Jointed<R, 2>, KinematicsFault> {
         finite(q)?;
         let (l, big_l, d) = (R::of(self.l_m), R::of(self.big_l_m), R::of(self.d_m));
-        let (c1, s1, c2, s2) = (q[0].cos(), q[0].sin(), q[1].cos(), q[1].sin());
+        let ((s1, c1), (s2, c2)) = (q[0].sin_cos(), q[1].sin_cos());
         // The distal joints.
         let (p1x, p1y) = (l * c1, l * s1);
         let (p2x, p2y) = (d + l * c2, l * s2);

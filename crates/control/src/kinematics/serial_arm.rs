@@ -47,9 +47,9 @@ impl<R: Real> Kinematics<R, 3> for SerialArm {
     fn forward(&self, q: &[R; 3]) -> Result<Jointed<R, 3>, KinematicsFault> {
         finite(q)?;
         let (l1, l2) = (R::of(self.l1_m), R::of(self.l2_m));
-        let (c1, s1) = (q[0].cos(), q[0].sin());
-        let (c2, s2) = (q[1].cos(), q[1].sin());
-        let (c3, s3) = (q[2].cos(), q[2].sin());
+        let (s1, c1) = q[0].sin_cos();
+        let (s2, c2) = q[1].sin_cos();
+        let (s3, c3) = q[2].sin_cos();
         // The handle's distance from the base's axis.
         let reach = l1 * c2 + l2 * s3;
         let jacobian = [

@@ -29,8 +29,11 @@ impl Faults {
     pub const HOMING_FAILED: Faults = Faults(1 << 8);
     /// The board restarted from its watchdog: the loop had hung.
     pub const WATCHDOG_RESET: Faults = Faults(1 << 9);
+    /// A linkage's pose is singular, out of reach or outside the joint
+    /// limits its gains were proven for.
+    pub const KINEMATICS: Faults = Faults(1 << 10);
 
-    const NAMES: [(Faults, &'static str); 10] = [
+    const NAMES: [(Faults, &'static str); 11] = [
         (Faults::SENSOR_NOT_FINITE, "sensor reading not finite"),
         (Faults::SENSOR_OUT_OF_RANGE, "sensor reading out of range"),
         (Faults::ENCODER_INVALID, "encoder value invalid"),
@@ -41,6 +44,10 @@ impl Faults {
         (Faults::COMMAND_NOT_FINITE, "force command not finite"),
         (Faults::HOMING_FAILED, "homing found no hard stop"),
         (Faults::WATCHDOG_RESET, "watchdog reset: the loop hung"),
+        (
+            Faults::KINEMATICS,
+            "pose singular, out of reach or outside the proven joints",
+        ),
     ];
 
     /// Whether no fault is set.
