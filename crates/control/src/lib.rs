@@ -18,6 +18,7 @@ mod position;
 mod probe;
 mod real;
 mod regulator;
+mod root;
 pub mod safety;
 pub mod servo;
 mod tf;

@@ -137,7 +137,7 @@ real!(
     libm::sinf,
     libm::cosf,
     crate::trig::sin_cos_f32,
-    libm::sqrtf,
+    crate::root::sqrt_f32,
     libm::atan2f
 );
 real!(

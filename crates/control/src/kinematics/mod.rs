@@ -87,8 +87,13 @@ pub trait Kinematics<R: Real, const N: usize> {
 }
 
 /// `Err(NotFinite)` where any angle is NaN or infinite.
+#[inline(always)]
 fn finite<R: Real, const N: usize>(q: &[R; N]) -> Result<(), KinematicsFault> {
-    if q.iter().all(|x| x.is_finite()) {
+    // `x · 0` is 0 for a finite x and NaN for an infinite or NaN one: one
+    // multiply-add an angle, where testing each angle's bits is four
+    // instructions and a branch on the board.
+    let zero = q.iter().fold(R::ZERO, |acc, x| acc + *x * R::ZERO);
+    if zero == R::ZERO {
         Ok(())
     } else {
         Err(KinematicsFault::NotFinite)

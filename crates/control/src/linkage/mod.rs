@@ -120,11 +120,8 @@ pub struct LinkageServo<K, W, R = f32, const N: usize = 3> {
     motors: MotorLimits<R, N>,
     /// The last pose the kinematics served.
     pose: Jointed<R, N>,
-    /// What the Cartesian servo's handle counters read minus the handle's
-    /// position in nm (wrapping), fixed between calibrations.
-    counter_offset: [u32; N],
-    /// The handle counters' last values.
-    counter: [u32; N],
+    /// The handle's position there.
+    handle: [Position; N],
     fault: Option<KinematicsFault>,
 }
 
@@ -169,8 +166,10 @@ impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<
             position_m: [R::ZERO; N],
             jacobian: [[R::ZERO; N]; N],
         });
-        let counter = pose.position_m.map(|x| nm(x) as u32);
-        let encoders = counter.map(|c| Encoder::nanometre_counter(Position::from_nm(c as i32)));
+        let handle = pose.position_m.map(|x| Position::from_nm(nm(x)));
+        // (The Cartesian servo's encoders are never read: each tick hands
+        // it the handle's position.)
+        let encoders = handle.map(Encoder::nanometre_counter);
         let cartesian =
             Servo::new_in(gains, encoders, safety, world).map_err(LinkageError::Cartesian)?;
         let mut s = LinkageServo {
@@ -180,8 +179,7 @@ impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<
             cartesian,
             motors,
             pose,
-            counter_offset: [0; N],
-            counter,
+            handle,
             fault: None,
         };
         if let Err(f) = served {
@@ -196,7 +194,6 @@ impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<
     }
 
     /// One control tick: joint encoders in, joint torques out.
-    #[inline(always)]
     pub fn tick(&mut self, frame: &SensorFrame<R, N>) -> LinkageOutput<R, N> {
         let mut q = [R::ZERO; N];
         let mut sensors_ok = true;
@@ -212,18 +209,12 @@ impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<
             match serve(&self.kinematics, &self.limits, &q) {
                 Ok(pose) => {
                     self.pose = pose;
-                    for i in 0..N {
-                        self.counter[i] =
-                            (nm(pose.position_m[i]) as u32).wrapping_add(self.counter_offset[i]);
-                    }
+                    self.handle = pose.position_m.map(|x| Position::from_nm(nm(x)));
                 }
                 Err(f) => self.latch(f),
             }
         }
-        let cartesian = self.cartesian.tick(&SensorFrame {
-            encoder_raw: self.counter,
-            ..*frame
-        });
+        let cartesian = self.cartesian.tick_at(frame, &self.handle);
         let limited = self
             .motors
             .step(self.pose.torques_nm(&cartesian.actuator_force_n));
@@ -277,13 +268,8 @@ impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<
         match serve(&self.kinematics, &self.limits, &q_rad.map(R::of)) {
             Ok(pose) => {
                 self.pose = pose;
-                let x = pose.position_m.map(|x| Position::from_nm(nm(x)));
-                // The handle counters keep their values; what they read
-                // maps to the new position from here on.
-                for ((o, c), x) in self.counter_offset.iter_mut().zip(&self.counter).zip(&x) {
-                    *o = c.wrapping_sub(x.nm() as u32);
-                }
-                self.cartesian.calibrate(x);
+                self.handle = pose.position_m.map(|x| Position::from_nm(nm(x)));
+                self.cartesian.calibrate(self.handle);
             }
             Err(f) => self.latch(f),
         }

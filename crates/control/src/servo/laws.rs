@@ -38,6 +38,14 @@ impl<R: Real> Axis<R> {
         }
         (self.estimator.step(self.position), faults)
     }
+
+    /// Take the position `x` found by other means (a linkage's
+    /// kinematics); returns the velocity.
+    #[inline(always)]
+    pub(super) fn sense_at(&mut self, x: Position) -> R {
+        self.position = x;
+        self.estimator.step(x)
+    }
 }
 
 /// The faults of a load-cell reading `f_c` (N) on a cell of range

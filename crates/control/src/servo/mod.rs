@@ -359,10 +359,33 @@ impl<W: World<R, N>, R: Real, const N: usize, L: PortLayer<R>> Servo<W, R, N, L>
 
     /// One control tick of every axis.
     pub fn tick(&mut self, frame: &SensorFrame<R, N>) -> ServoOutput<R, N> {
+        self.run(frame, |front| front.sense(frame))
+    }
+
+    /// One tick at handle positions `x` found by other means (a linkage's
+    /// kinematics), in place of the encoders' reading; `frame`'s raw
+    /// counts are not read. Always inlined into the linkage's tick, where
+    /// passing the output through memory is a tenth of the cost.
+    #[inline(always)]
+    pub(crate) fn tick_at(
+        &mut self,
+        frame: &SensorFrame<R, N>,
+        x: &[Position; N],
+    ) -> ServoOutput<R, N> {
+        self.run(frame, |front| front.sense_at(x))
+    }
+
+    /// The display's tick, its axes sensed by `sense`.
+    #[inline(always)]
+    fn run(
+        &mut self,
+        frame: &SensorFrame<R, N>,
+        sense: impl FnOnce(&mut Frontend<R, N>) -> ([R; N], Faults),
+    ) -> ServoOutput<R, N> {
         let (front, world, layers) = (&mut self.front, &mut self.world, &mut self.layers);
         match &mut self.laws {
-            Laws::Impedance(c) => tick::impedance(front, c, world, layers, frame),
-            Laws::Admittance(a) => tick::admittance(front, a, world, layers, frame),
+            Laws::Impedance(c) => tick::impedance(front, c, world, layers, frame, sense),
+            Laws::Admittance(a) => tick::admittance(front, a, world, layers, frame, sense),
         }
     }
 }

@@ -37,6 +37,17 @@ impl<R: Real, const N: usize> Frontend<R, N> {
         (v, faults)
     }
 
+    /// Every axis at the positions `x` found by other means: the
+    /// velocities, and no sensor faults (the finder reports its own).
+    #[inline(always)]
+    pub(super) fn sense_at(&mut self, x: &[Position; N]) -> ([R; N], Faults) {
+        let mut v = [R::ZERO; N];
+        for ((a, v), x) in self.axes.iter_mut().zip(&mut v).zip(x) {
+            *v = a.sense_at(*x);
+        }
+        (v, Faults::NONE)
+    }
+
     /// Whether the laws may run this tick.
     #[inline(always)]
     pub(super) fn runnable(&self, sensor_faults: Faults) -> bool {
@@ -90,6 +101,9 @@ impl<R: Real, const N: usize> Frontend<R, N> {
     }
 }
 
+// Each display's tick takes what the axes sensed this tick: their encoders'
+// reading, or the positions a linkage's kinematics found.
+//
 // The impedance display's tick is the board's hot path. Each display's
 // tick builds its output at the end, from locals: an output filled in
 // first and then changed is written twice through the caller's pointer
@@ -101,8 +115,9 @@ pub(super) fn impedance<R: Real, W: World<R, N>, L: PortLayer<R>, const N: usize
     world: &mut W,
     layers: &mut [L; N],
     frame: &SensorFrame<R, N>,
+    sense: impl FnOnce(&mut Frontend<R, N>) -> ([R; N], Faults),
 ) -> ServoOutput<R, N> {
-    let (v, faults) = front.sense(frame);
+    let (v, faults) = sense(front);
     let runnable = front.runnable(faults);
     let x = front.position();
     let (answers, command_n) = if runnable {
@@ -149,8 +164,9 @@ pub(super) fn admittance<R: Real, W: World<R, N>, L: PortLayer<R>, const N: usiz
     world: &mut W,
     layers: &mut [L; N],
     frame: &SensorFrame<R, N>,
+    sense: impl FnOnce(&mut Frontend<R, N>) -> ([R; N], Faults),
 ) -> ServoOutput<R, N> {
-    let (v, mut faults) = front.sense(frame);
+    let (v, mut faults) = sense(front);
     let f_c = frame.load_cell_n;
     for (f, c) in f_c.iter().zip(front.safety.configs()) {
         faults = faults.with(load_cell_faults(*f, c.max_sensor_force_n));
