@@ -102,23 +102,30 @@ fn coriolis_terms_do_no_work() {
     assert!((plant.q[0] - 0.1).abs() > 0.1);
 }
 
-/// The peak of `|x|` over `window` ticks from `from`.
-fn peak(x: &[f64], from: usize, window: usize) -> f64 {
-    x[from..(from + window).min(x.len())]
-        .iter()
-        .fold(0.0, |m, v| m.max(v.abs()))
+/// The root mean square of `x` over `window` ticks from `from`.
+fn rms(x: &[f64], from: usize, window: usize) -> f64 {
+    let w = &x[from..(from + window).min(x.len())];
+    (w.iter().map(|v| v * v).sum::<f64>() / w.len().max(1) as f64).sqrt()
+}
+
+/// Whether any joint's torque reached its motor's peak from tick `from` on.
+fn at_peak(file: &LinkageFile, trace: &LinkageTrace, from: usize) -> bool {
+    trace.torque_nm[from..].iter().any(|tau| {
+        tau.iter()
+            .zip(&file.motors.ratios)
+            .any(|(t, n)| t.abs() >= 0.999 * file.motors.peak_torque_nm * n)
+    })
 }
 
 /// The certified coupling at the binding pose, on the nonlinear arm with
 /// the f32 servo and the device's encoders: a grasp of 2 N s/m that holds
 /// every other direction, the handle pushed along the binding direction.
-/// At the certified stiffness the motion does not grow; 20 % past it, it
-/// grows (or the servo trips on speed) along that direction.
+/// At the certified stiffness the motion does not grow and stays inside the
+/// motors' peak; 20 % past it, it grows along that direction (into the
+/// motors' peak, or until the servo trips on speed).
 #[test]
 fn the_binding_pose_holds_at_the_design_and_breaks_past_it() {
-    // (The Haply-like pantograph binds at its singular edge, where the
-    // plant's kinematics stop before the servo's fault does: not yet.)
-    for name in ["phantom_premium_1_5", "falcon_like", "hapkit"] {
+    for name in SHIPPED {
         let file = shipped(name);
         let n = file.geometry.joints();
         let poses = workspace_poses(&file, DESIGN_GRID);
@@ -144,7 +151,7 @@ fn the_binding_pose_holds_at_the_design_and_breaks_past_it() {
         let served = |q: &[f64]| {
             (0..1 << q.len()).all(|corner: usize| {
                 let p: Vec<f64> = (0..q.len())
-                    .map(|i| q[i] + if corner >> i & 1 == 1 { 0.15 } else { -0.15 })
+                    .map(|i| q[i] + if corner >> i & 1 == 1 { 0.03 } else { -0.03 })
                     .collect();
                 file.within_limits(&p) && file.pose(&p).is_ok()
             })
@@ -167,33 +174,30 @@ fn the_binding_pose_holds_at_the_design_and_breaks_past_it() {
         };
         let held = run_linkage(&file, &scene(d.k_c_npm)).unwrap();
         assert!(held.faults.is_empty(), "{name}: {}", held.faults);
+        // At the certified stiffness the grasp's 2 N s/m is the proof's
+        // bound: the linear loop is marginal there, and only the joints'
+        // losses damp it. The motion must not grow.
         let x = held.along(&dir);
-        // (One period of the slowest is under 50 ticks.)
-        let (first, last) = (peak(&x, 0, 50), peak(&x, 2_000, 500));
+        let (first, last) = (rms(&x, 0, 100), rms(&x, 2_000, 500));
         assert!(
             last <= first,
-            "{name} at {} N/m: {first} m then {last} m",
+            "{name} at {} N/m: {first} m then {last} m (rms)",
             d.k_c_npm
         );
         let past = run_linkage(&file, &scene(1.2 * d.k_c_npm)).unwrap();
         let x = past.along(&dir);
-        eprintln!(
-            "{name}: k {:.1}, m {:.4}, at design {:.3e} -> {:.3e}; past {:.3e} -> {:.3e} {}",
-            d.k_c_npm,
-            d.binding.mass_kg,
-            first,
-            last,
-            peak(&x, 0, 50),
-            peak(&x, x.len().saturating_sub(500), 500),
-            past.faults
-        );
-        let grew = peak(&x, x.len().saturating_sub(500), 500) > 1.5 * peak(&x, 0, 50);
+        let n = x.len();
+        let (first, last) = (rms(&x, 0, 100), rms(&x, n.saturating_sub(500), 500));
+        // Growth shows as a 1.5-fold rise, or as a rise into the motors'
+        // peak torque, where saturation holds it in a limit cycle (the
+        // light pantograph gets there within a few periods).
+        let saturated = at_peak(&file, &past, n - 500);
         assert!(
-            grew || past.faults.contains("velocity"),
-            "{name} at 1.2 x {} N/m: {} m, {}",
+            (last > first && (last > 1.5 * first || saturated)) || past.faults.contains("velocity"),
+            "{name} at 1.2 x {} N/m: {first} m then {last} m (rms), {}",
             d.k_c_npm,
-            peak(&x, x.len().saturating_sub(500), 500),
             past.faults
         );
+        assert!(!at_peak(&file, &held, 0), "{name}: the design saturated");
     }
 }
