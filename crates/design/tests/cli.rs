@@ -448,8 +448,13 @@ fn linkages_are_proven_over_their_workspace() {
     assert!((k0 - 2.0 * b / 1e-3).abs() < 1e-6 * k0, "{off}");
     assert!((k1 - 2.0 * (b + 1.0) / 1e-3).abs() < 1e-6 * k1, "{grasp}");
     assert_eq!(off["binding_direction"].as_array().unwrap().len(), 3);
-    let e = TWOPORT.failure(&["design", "impedance", "--device", dev]);
-    assert!(e.contains("--no-human") && e.contains("--min-grasp"), "{e}");
+    // By default, the paper's bound on the grasp: a frequency binds, and
+    // it proves at least what hands off does.
+    let paper = TWOPORT.json(&["design", "impedance", "--device", dev, "--json"]);
+    let kp = paper["k_c_npm"].as_f64().unwrap();
+    assert!(kp >= k0 && kp < 1.01 * k0, "{paper}");
+    assert!(paper["binding_frequency_hz"].as_f64().unwrap() > 0.0, "{paper}");
+    assert!(paper["human"].as_str().unwrap().contains("Z_max"), "{paper}");
     let e = TWOPORT.failure(&["design", "impedance", "--min-grasp", "1"]);
     assert!(e.contains("linkage"), "{e}");
     let e = TWOPORT.failure(&["design", "impedance", "--device", dev, "--min-grasp", "-1"]);

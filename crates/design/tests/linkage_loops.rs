@@ -140,3 +140,121 @@ fn random_n_port_hands_do_not_break_the_workspace_design() {
         }
     }
 }
+
+/// The spectral radius of the loop at `pose` with a hand bounded by the
+/// paper's `Z_max = b_z + k_z/s`: that spring and damper (isotropic) in
+/// series with the passive N-port `inner` (mass, damping and stiffness to
+/// ground at the node between them), and a grasp damper `grasp` at the
+/// handle. State `[x, v, y, w, x_prev]`.
+fn radius_bounded(
+    pose: &PoseDynamics,
+    inner: &Hand,
+    grasp: f64,
+    (kc, bc): (f64, f64),
+    t: f64,
+) -> f64 {
+    let n = pose.q_rad.len();
+    let (bz, kz) = (
+        twoport_design::network::HumanBound::PAPER.damping_nspm,
+        twoport_design::network::HumanBound::PAPER.stiffness_npm,
+    );
+    let i = DMatrix::<f64>::identity(n, n);
+    let minv = pose.mass_kg.clone().try_inverse().unwrap();
+    let mpinv = (&inner.m + &i * 1e-4).try_inverse().unwrap();
+    let d = &pose.damping_nspm + &i * grasp;
+    // [x, v, y, w]' = A [..] + B f.
+    let mut big = DMatrix::zeros(5 * n, 5 * n);
+    let mut put = |r: usize, c: usize, m: &DMatrix<f64>| {
+        big.view_mut((r * n, c * n), (n, n)).copy_from(m);
+    };
+    put(0, 1, &i);
+    put(1, 0, &(-&minv * kz));
+    put(1, 1, &(-&minv * (&d + &i * bz)));
+    put(1, 2, &(&minv * kz));
+    put(1, 3, &(&minv * bz));
+    put(1, 4, &minv);
+    put(2, 3, &i);
+    put(3, 0, &(&mpinv * kz));
+    put(3, 1, &(&mpinv * bz));
+    put(3, 2, &(-&mpinv * (&inner.k + &i * kz)));
+    put(3, 3, &(-&mpinv * (&inner.d + &i * bz)));
+    let e = expm_balanced(&(big * t)).unwrap();
+    let ad = e.view((0, 0), (4 * n, 4 * n)).into_owned();
+    let bd = e.view((0, 4 * n), (4 * n, n)).into_owned();
+    let mut gain = DMatrix::zeros(n, 5 * n);
+    for j in 0..n {
+        gain[(j, j)] = -(kc + bc / t);
+        gain[(j, 4 * n + j)] = bc / t;
+    }
+    let mut cl = DMatrix::zeros(5 * n, 5 * n);
+    let top = &ad * DMatrix::identity(4 * n, 5 * n) + &bd * gain;
+    cl.view_mut((0, 0), (4 * n, 5 * n)).copy_from(&top);
+    for j in 0..n {
+        cl[(4 * n + j, j)] = 1.0;
+    }
+    cl.complex_eigenvalues()
+        .iter()
+        .map(|z| z.norm())
+        .fold(0.0, f64::max)
+}
+
+/// Under the paper's bound on the grasp: 0.1 % inside the bounded design,
+/// no random hand no stiffer than `Z_max` (its spring and damper in series
+/// with a random passive N-port) makes the loop grow, at the binding pose
+/// and at every tenth pose; 20 % past it, the bare handle does (the hand
+/// the bound cannot rule out: none), with or without a 2 N s/m grasp.
+#[test]
+fn hands_under_the_papers_bound_do_not_break_the_bounded_design() {
+    use twoport_design::linkage::bounded_workspace_design;
+    let mut seed = 0x0005_eed0_fa11_u64;
+    for name in [
+        "phantom_premium_1_5.toml",
+        "falcon_like.toml",
+        "haply_2diy.toml",
+        "hapkit.toml",
+    ] {
+        let l = shipped(name);
+        let poses = workspace_poses(&l, 7);
+        for grasp in [0.0, 2.0] {
+            let d = bounded_workspace_design(
+                &l,
+                &poses,
+                0.0,
+                grasp,
+                twoport_design::network::HumanBound::PAPER,
+            )
+            .unwrap();
+            let n = d.binding.direction.len();
+            let t = l.period_s;
+            for pose in std::iter::once(&d.binding.pose).chain(poses.iter().step_by(10)) {
+                for _ in 0..10 {
+                    let inner = Hand {
+                        m: psd(n, (-3.0, 0.0), &mut seed),
+                        d: psd(n, (-3.0, 3.0), &mut seed),
+                        k: psd(n, (0.0, 6.0), &mut seed),
+                    };
+                    let r = radius_bounded(pose, &inner, grasp, (FACTOR * d.k_c_npm, 0.0), t);
+                    assert!(r < 1.0 + 1e-9, "{name}, grasp {grasp}: radius {r}");
+                }
+            }
+            let none = Hand {
+                m: DMatrix::zeros(n, n),
+                d: DMatrix::zeros(n, n),
+                k: DMatrix::zeros(n, n),
+            };
+            let past = radius(
+                &d.binding.pose,
+                &Hand {
+                    d: DMatrix::identity(n, n) * grasp,
+                    ..none
+                },
+                (1.2 * d.k_c_npm, 0.0),
+                t,
+            );
+            assert!(
+                past > 1.0 + 1e-10,
+                "{name}, grasp {grasp}: 20 % past, bare: {past}"
+            );
+        }
+    }
+}

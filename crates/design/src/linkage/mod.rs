@@ -2,14 +2,19 @@
 //! joints), and their dynamics at a pose through the control crate's
 //! kinematics (the same Jacobian the board will run).
 
+mod bounded;
 mod dynamics;
 mod file;
 mod pose;
 mod proof;
 mod report;
 
+pub use bounded::{bound_at, stiffest, stiffest_at, theta_grid, PoseRanges};
 pub use dynamics::SerialArmDynamics;
 pub use file::{Geometry, Inertia, Joints, LinkageFile, Motors, RelativeLimit};
 pub use pose::{forward, PoseDynamics};
-pub use proof::{workspace_design, workspace_poses, Binding, WorkspaceDesign, DESIGN_GRID};
+pub use proof::{
+    bounded_workspace_design, workspace_design, workspace_poses, Binding, WorkspaceDesign,
+    BOUNDED_GRID, DESIGN_GRID,
+};
 pub use report::{stiffness, LinkageDesign};

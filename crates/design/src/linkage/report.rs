@@ -38,6 +38,8 @@ pub struct LinkageDesign {
     pub binding_damping_nspm: f64,
     /// The mass along it (kg).
     pub binding_mass_kg: f64,
+    /// The frequency that binds (Hz), where one does (a bounded grasp).
+    pub binding_frequency_hz: Option<f64>,
     /// The lightest and heaviest the handle is over the poses (kg).
     pub mass_range_kg: (f64, f64),
     /// The least and most damped (N s/m).
@@ -50,7 +52,18 @@ impl LinkageDesign {
         let b = &design.binding;
         LinkageDesign {
             name: file.name.clone(),
-            human: if design.min_grasp_nspm > 0.0 {
+            human: if let Some(h) = design.human {
+                format!(
+                    "no stiffer than Z_max = {} + {}/s in any direction (the paper's bound){}",
+                    h.damping_nspm,
+                    h.stiffness_npm,
+                    if design.min_grasp_nspm > 0.0 {
+                        format!(", with at least {} N s/m", design.min_grasp_nspm)
+                    } else {
+                        String::new()
+                    }
+                )
+            } else if design.min_grasp_nspm > 0.0 {
                 format!(
                     "a grasp of at least {} N s/m in every direction (a dead-man switch keeps force off without one)",
                     design.min_grasp_nspm
@@ -70,6 +83,7 @@ impl LinkageDesign {
             binding_direction: b.direction.clone(),
             binding_damping_nspm: b.damping_nspm,
             binding_mass_kg: b.mass_kg,
+            binding_frequency_hz: b.frequency_hz,
             mass_range_kg: design.mass_range_kg,
             damping_range_nspm: design.damping_range_nspm,
         }
@@ -132,6 +146,10 @@ impl fmt::Display for LinkageDesign {
             list(&self.binding_direction, 1.0, 3),
             self.binding_damping_nspm,
             self.binding_mass_kg * 1e3
-        )
+        )?;
+        match self.binding_frequency_hz {
+            Some(hz) => write!(f, ", at {hz:.2} Hz"),
+            None => Ok(()),
+        }
     }
 }

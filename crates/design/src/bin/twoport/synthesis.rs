@@ -30,23 +30,13 @@ pub(crate) fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
 /// workspace, hands off or for a least grasp.
 pub(crate) fn design_linkage(a: &DesignImpedance) -> Result<(), String> {
     use twoport_design::linkage::{
-        workspace_design, workspace_poses, LinkageDesign, LinkageFile, DESIGN_GRID,
+        bounded_workspace_design, workspace_design, workspace_poses, LinkageDesign, LinkageFile,
+        DESIGN_GRID,
     };
+    use twoport_design::network::HumanBound;
     let margin = a.margin.fraction()?;
     let path = a.common.device.as_ref().ok_or("--device: a linkage file")?;
     let mut file = LinkageFile::load(path).map_err(|e| e.to_string())?;
-    let grasp = match (a.min_grasp, a.common.no_human) {
-        (Some(g), _) => g,
-        (None, true) => 0.0,
-        (None, false) => {
-            return Err(format!(
-                "--device {}: a linkage is proven for every passive hand (--no-human) or for \
-                 every hand that grasps with at least some damping (--min-grasp B); \
-                 the paper's bound on the grasp is not proven for linkages yet",
-                path.display()
-            ))
-        }
-    };
     if let Some(t) = a.common.period {
         if !(t.is_finite() && t > 0.0) {
             return Err(format!("--period {t}: must be finite and > 0"));
@@ -54,7 +44,14 @@ pub(crate) fn design_linkage(a: &DesignImpedance) -> Result<(), String> {
         file.period_s = t;
     }
     let poses = workspace_poses(&file, DESIGN_GRID);
-    let d =
-        workspace_design(&file, &poses, a.b.unwrap_or(0.0), grasp).map_err(|e| e.to_string())?;
+    let b = a.b.unwrap_or(0.0);
+    // A least grasp alone, hands off, or (by default, as for every
+    // device) the paper's bound on how stiff the grasp is.
+    let d = match (a.min_grasp, a.common.no_human) {
+        (Some(g), _) => workspace_design(&file, &poses, b, g),
+        (None, true) => workspace_design(&file, &poses, b, 0.0),
+        (None, false) => bounded_workspace_design(&file, &poses, b, 0.0, HumanBound::PAPER),
+    }
+    .map_err(|e| e.to_string())?;
     emit(&a.common, &LinkageDesign::new(&file, &d, margin))
 }
