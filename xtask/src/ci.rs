@@ -180,11 +180,24 @@ fn design_lib() -> Result<(), String> {
 /// corrupted frames and a link loss, on both boards (for the STM32F405
 /// image, its own loop on QEMU's netduinoplus2, with the log of what it
 /// touches that QEMU does not model): the plain scene, homing onto the
-/// hard stop then armed (the state machine bit for bit too), and the
-/// three-axis image on its building-block world.
+/// hard stop then armed (the state machine bit for bit too), the
+/// three-axis image on its building-block world, and the serial-arm and
+/// delta images against their nonlinear arms.
 fn pil_boards() -> Result<(), String> {
     for board in ["an386", "stm32f405"] {
-        let runs: [&[&str]; 3] = [
+        let linkage = |device| {
+            [
+                "--linkage",
+                device,
+                "--seconds",
+                "2",
+                "--link-loss-at-s",
+                "1.5",
+                "--check",
+            ]
+        };
+        let (arm, delta) = (linkage("serial-arm"), linkage("delta"));
+        let runs: [&[&str]; 5] = [
             &["--seconds", "4", "--link-loss-at-s", "3", "--check"],
             &["scenes/homing.toml", "--seconds", "2", "--check"],
             &[
@@ -195,6 +208,8 @@ fn pil_boards() -> Result<(), String> {
                 "3",
                 "--check",
             ],
+            &arm,
+            &delta,
         ];
         for args in runs {
             let mut all = vec!["--board".to_string(), board.to_string()];

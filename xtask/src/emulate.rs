@@ -1,7 +1,9 @@
 //! The images in QEMU against the host: processor in the loop, the
 //! scope's board mode and the watchdog, each through a pty.
 
-use crate::firmware::{an386_image_with, firmware, passivity_image, stm32f405_qemu_image};
+use crate::firmware::{
+    an386_image_with, firmware, passivity_image, stm32f405_qemu_image, stm32f405_variant,
+};
 use crate::{cargo, cross_target_dir, root, run};
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -63,10 +65,24 @@ pub(crate) fn pil(extra: &[String]) -> Result<(), String> {
         )
     };
     let xyz = args.iter().any(|a| declares_three_axes(a));
+    // (host-sim checks the name; the image is built with it as a feature.)
+    let linkage = match args.iter().position(|a| a == "--linkage") {
+        Some(i) => match args.get(i + 1) {
+            Some(l) if l == "serial-arm" || l == "delta" => Some(l.clone()),
+            other => {
+                return Err(format!(
+                    "pil: --linkage takes serial-arm or delta, not {other:?}"
+                ))
+            }
+        },
+        None => None,
+    };
     match board.as_str() {
         "an386" => {
             let elf = if args.iter().any(|a| a == "--passivity") {
                 passivity_image()?
+            } else if let Some(l) = &linkage {
+                an386_image_with(l)?
             } else if xyz {
                 an386_image_with("xyz")?
             } else {
@@ -80,7 +96,12 @@ pub(crate) fn pil(extra: &[String]) -> Result<(), String> {
             if args.iter().any(|a| a == "--passivity") {
                 return Err("pil: the STM32F405 image has no passivity build".into());
             }
-            let elf = stm32f405_qemu_image(xyz)?;
+            let elf = match &linkage {
+                Some(l) => {
+                    stm32f405_variant(&format!("qemu,{l}"), &format!("twoport-stm32f405-qemu-{l}"))?
+                }
+                None => stm32f405_qemu_image(xyz)?,
+            };
             let log = cross_target_dir("firmware").join("qemu-unmodelled-stm32f405.log");
             let _ = std::fs::remove_file(&log);
             let mut qemu = qemu_netduino(&elf);

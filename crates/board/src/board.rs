@@ -7,6 +7,7 @@ use crate::io::IoScale;
 use crate::region::{check_axes, Region};
 use crate::support::BoardSupport;
 use heapless::{Deque, Vec};
+use twoport_control::drive::Drive;
 use twoport_control::homing::{Homing, HomingConfig};
 use twoport_control::servo::PortLayer;
 use twoport_control::servo::{Direct, Gains, SensorFrame, Servo, ServoOutput};
@@ -25,14 +26,16 @@ pub type Frame = Vec<u8, MAX_FRAME>;
 pub const TX_FRAMES: usize = 8;
 
 /// The portable firmware loop around a [`Servo`] of `N` axes (one by
-/// default) on the world `W`, with the port layer `L` ([`Direct`]: none).
-/// Each axis has its own proven region of `R` grid points, load-cell
-/// scaling and homing; the handshake declares `N`.
+/// default) on the world `W`, with the port layer `L` ([`Direct`]: none),
+/// or around the [`Drive`] `D` that holds such a servo (a linkage's: its
+/// `N` motors turn joints). Each Cartesian axis has its own proven region
+/// of `R` grid points, load-cell scaling and homing; the handshake
+/// declares `N`.
 ///
 /// [`Direct`]: twoport_control::servo::Direct
 #[derive(Clone, Debug)]
-pub struct Board<W, const R: usize, const N: usize = 1, L = Direct> {
-    servo: Servo<W, f32, N, L>,
+pub struct Board<W, const R: usize, const N: usize = 1, L = Direct, D = Servo<W, f32, N, L>> {
+    servo: D,
     regions: [Region<R>; N],
     decoder: Decoder,
     /// Replies and fault reports, sent first.
@@ -47,6 +50,8 @@ pub struct Board<W, const R: usize, const N: usize = 1, L = Direct> {
     tx_dropped: u32,
     io: [IoScale; N],
     last: ServoOutput<f32, N>,
+    /// Each motor's command at the last tick (N, or N m at a joint).
+    motor: [f32; N],
     /// Whether sensor frames from the link drive ticks (processor in the
     /// loop). A board with real sensors must never let the host move it.
     pil: bool,
@@ -82,6 +87,7 @@ pub struct Board<W, const R: usize, const N: usize = 1, L = Direct> {
     /// Loop timing: the last tick's stages, its start, the overruns and
     /// the worst jitter since boot.
     timing: Timing,
+    _cartesian: core::marker::PhantomData<(W, L)>,
 }
 
 /// The loop's timing, in the support's count.
@@ -117,7 +123,12 @@ impl Timing {
     }
 }
 
-impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R, N, L> {
+impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
+where
+    W: World<f32, N>,
+    L: PortLayer,
+    D: Drive<N, World = W, Layer = L>,
+{
     /// A board running `servo`, accepting gain changes on each axis inside
     /// its region of `regions`, and sending telemetry every
     /// `telemetry_every` ticks (0: never). It boots disarmed and
@@ -127,10 +138,10 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
     ///
     /// `N` is between 1 and the link's [`MAX_AXES`] (checked at compile
     /// time).
-    pub fn new(servo: Servo<W, f32, N, L>, regions: [Region<R>; N], telemetry_every: u32) -> Self {
+    pub fn new(servo: D, regions: [Region<R>; N], telemetry_every: u32) -> Self {
         const { assert!(N >= 1 && N <= MAX_AXES, "a board has 1 to MAX_AXES axes") };
-        let period_s = servo.safety().configs()[0].period_s;
-        let position = servo.position();
+        let period_s = servo.servo().safety().configs()[0].period_s;
+        let position = servo.servo().position();
         Board {
             servo,
             regions,
@@ -145,6 +156,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
             tx_dropped: 0,
             io: [IoScale::EXCALIBUR; N],
             last: ServoOutput::at_rest(position, [0.0; N]),
+            motor: [0.0; N],
             pil: false,
             pil_refused: 0,
             pending: None,
@@ -161,6 +173,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
             index: [None; N],
             pending_index: [None; N],
             timing: Timing::default(),
+            _cartesian: core::marker::PhantomData,
         }
     }
 
@@ -203,13 +216,25 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
         &self.last
     }
 
-    /// Each axis's signed PWM duty for its held actuator force.
+    /// Each motor's signed PWM duty for its held command (an axis's force,
+    /// or a joint's torque, against its `IoScale`'s full scale).
     pub fn duty(&self) -> [i16; N] {
-        core::array::from_fn(|i| self.io[i].duty(self.last.actuator_force_n[i]))
+        core::array::from_fn(|i| self.io[i].duty(self.motor[i]))
     }
 
-    /// The servo (gains, safety state).
+    /// Each motor's held command (N, or N m at a joint).
+    pub fn motor_command(&self) -> [f32; N] {
+        self.motor
+    }
+
+    /// The Cartesian servo (gains, safety state).
     pub fn servo(&self) -> &Servo<W, f32, N, L> {
+        self.servo.servo()
+    }
+
+    /// What the board drives: the Cartesian servo, or the linkage's servo
+    /// around it.
+    pub fn drive(&self) -> &D {
         &self.servo
     }
 
@@ -281,9 +306,9 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
             return;
         }
         match msg {
-            Message::Heartbeat => self.servo.heartbeat(),
+            Message::Heartbeat => self.servo.servo_mut().heartbeat(),
             Message::GetGains => {
-                let g = Self::axes(self.servo.gains().map(Into::into));
+                let g = Self::axes(self.servo.servo().gains().map(Into::into));
                 self.queue(Message::Gains(g));
             }
             Message::SetGains(g) => {
@@ -303,7 +328,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
                 self.queue(Message::GainsReply(reply));
             }
             Message::ClearFaults => {
-                self.servo.clear();
+                Drive::clear(&mut self.servo);
                 self.reported = Faults::NONE;
                 self.queue_status();
             }
@@ -349,12 +374,12 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
     /// Whether each axis's gains of `g` lie inside its proven region for
     /// this board's display; the first axis that does not, and why.
     fn check(&self, g: &[Gains; N]) -> Result<(), AxisRefusal> {
-        check_axes(&self.regions, self.servo.display(), g)
+        check_axes(&self.regions, self.servo.servo().display(), g)
     }
 
     fn apply(&mut self, g: [Gains; N]) -> GainsReply {
-        match self.servo.set_gains(g) {
-            Ok(()) => GainsReply::Accepted(Self::axes(self.servo.gains().map(Into::into))),
+        match self.servo.servo_mut().set_gains(g) {
+            Ok(()) => GainsReply::Accepted(Self::axes(self.servo.servo().gains().map(Into::into))),
             Err(e) => GainsReply::Refused(AxisRefusal {
                 axis: e.axis as u8,
                 why: Refusal::OutOfRange,
@@ -470,7 +495,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
     /// telemetry on schedule. Returns the held actuator command.
     pub fn tick(&mut self, frame: &SensorFrame<f32, N>) -> ServoOutput<f32, N> {
         self.dead_man_closed = frame.dead_man_closed;
-        let out = match self.homing.as_mut() {
+        let driven = match self.homing.as_mut() {
             // Each axis's homing law in place of the display's, through the
             // same safety layer; an axis that has homed holds no force.
             Some(h) => self
@@ -478,7 +503,9 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
                 .tick_with(frame, |i, x, v| h[i].as_mut().map_or(0.0, |h| h.step(x, v))),
             None => self.servo.tick(frame),
         };
+        let out = driven.cartesian;
         self.last = out;
+        self.motor = driven.motor;
         self.after_tick(&out);
         if !out.faults.is_empty() && out.faults != self.reported {
             self.reported = out.faults;
@@ -491,7 +518,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
             self.since_telemetry += 1;
             if self.since_telemetry >= self.telemetry_every {
                 self.since_telemetry = 0;
-                let ve = self.servo.world().positions();
+                let ve = self.servo.servo().world().positions();
                 let axes = core::array::from_fn(|i| AxisTelemetry {
                     position_pm: out.position[i].nm() as i64 * 1000,
                     velocity_mps: out.velocity_mps[i],

@@ -6,6 +6,7 @@
 mod board;
 pub mod excalibur;
 mod io;
+pub mod linkage;
 mod region;
 mod support;
 

@@ -7,6 +7,7 @@
 extern crate std;
 
 pub mod coupling;
+pub mod drive;
 mod encoder;
 mod estimator;
 pub mod homing;

@@ -453,8 +453,14 @@ fn linkages_are_proven_over_their_workspace() {
     let paper = TWOPORT.json(&["design", "impedance", "--device", dev, "--json"]);
     let kp = paper["k_c_npm"].as_f64().unwrap();
     assert!(kp >= k0 && kp < 1.01 * k0, "{paper}");
-    assert!(paper["binding_frequency_hz"].as_f64().unwrap() > 0.0, "{paper}");
-    assert!(paper["human"].as_str().unwrap().contains("Z_max"), "{paper}");
+    assert!(
+        paper["binding_frequency_hz"].as_f64().unwrap() > 0.0,
+        "{paper}"
+    );
+    assert!(
+        paper["human"].as_str().unwrap().contains("Z_max"),
+        "{paper}"
+    );
     let e = TWOPORT.failure(&["design", "impedance", "--min-grasp", "1"]);
     assert!(e.contains("linkage"), "{e}");
     let e = TWOPORT.failure(&["design", "impedance", "--device", dev, "--min-grasp", "-1"]);

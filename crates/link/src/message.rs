@@ -8,8 +8,10 @@ use serde::{Deserialize, Serialize};
 
 /// The protocol version both ends must share (checked by the handshake).
 /// Version 4 carries every axis of a board in its frames; version 5 a
-/// session number in every answer, so that a host sees a board reset.
-pub const PROTOCOL_VERSION: u16 = 5;
+/// session number in every answer, so that a host sees a board reset;
+/// version 6 lets a board refuse what its device cannot do
+/// ([`ModeRefusal::Unsupported`]).
+pub const PROTOCOL_VERSION: u16 = 6;
 
 /// The session number of a board no host has shaken hands with since it
 /// booted. A host opens a session with any other number, and a board
@@ -128,6 +130,9 @@ pub enum ModeRefusal {
         /// The board's axes.
         axes: u8,
     },
+    /// This board's device cannot do it: a linkage has no homing run (it
+    /// is calibrated at a known pose instead) (protocol 6).
+    Unsupported,
 }
 
 /// Where the configuration in force came from (protocol 3).

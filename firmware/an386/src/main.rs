@@ -6,7 +6,9 @@
 //! With the `passivity` feature the image runs the series damper at the
 //! actuator's port (`cargo xtask pil --passivity`); with `xyz`, the
 //! three-axis Excalibur image on its building-block world (`cargo xtask
-//! pil scenes/xyz/pil_blocks.toml`).
+//! pil scenes/xyz/pil_blocks.toml`); with `serial-arm` or `delta`, a
+//! linkage image (`twoport_board::linkage`: joint encoders in, joint
+//! torques out; `cargo xtask pil --linkage serial-arm`).
 
 #![no_std]
 #![no_main]
@@ -17,7 +19,7 @@ mod watchdog;
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
-use twoport_board::excalibur;
+
 use twoport_config::{RamFlash, Store};
 use twoport_qemu_exit::exit;
 
@@ -27,14 +29,23 @@ const WATCHDOG_MS: u32 = 50;
 
 #[entry]
 fn main() -> ! {
-    #[cfg(not(any(feature = "passivity", feature = "xyz")))]
-    let board = excalibur::stiff_wall_board();
+    #[cfg(not(any(
+        feature = "passivity",
+        feature = "xyz",
+        feature = "serial-arm",
+        feature = "delta"
+    )))]
+    let board = twoport_board::excalibur::stiff_wall_board().map_err(|_| ());
     #[cfg(feature = "passivity")]
-    let board = excalibur::stiff_wall_board_with_passivity();
+    let board = twoport_board::excalibur::stiff_wall_board_with_passivity().map_err(|_| ());
     #[cfg(feature = "xyz")]
-    let board = excalibur::xyz::board();
+    let board = twoport_board::excalibur::xyz::board().map_err(|_| ());
+    #[cfg(feature = "serial-arm")]
+    let board = twoport_board::linkage::serial_arm_board().map_err(|_| ());
+    #[cfg(feature = "delta")]
+    let board = twoport_board::linkage::delta_board().map_err(|_| ());
     let Ok(mut board) = board.map(|b| b.with_pil(true)) else {
-        hprintln!("the Excalibur board image would not build");
+        hprintln!("the board image would not build");
         exit(false)
     };
     // QEMU's board has no flash for it: the configuration lives in RAM,

@@ -33,6 +33,10 @@
 //! convert, and the three duties go into TIM1's preloaded compare
 //! registers, which take effect together at the next PWM update.
 //!
+//! The `serial-arm` and `delta` features build a linkage image
+//! (`twoport_board::linkage`) on the same three channels: each encoder
+//! counts a joint, each PWM pair drives a joint's motor.
+//!
 //! Flash with `cargo run --release` in this folder (probe-rs, see
 //! `.cargo/config.toml`); add `--features xyz` for the three-axis image.
 //!
@@ -73,8 +77,12 @@ pub const AXES: usize = 3;
 #[cfg(not(feature = "xyz"))]
 type TheBoard =
     twoport_board::Board<twoport_control::ve::UnilateralWall, { excalibur::REGION_POINTS }>;
-#[cfg(feature = "xyz")]
+#[cfg(all(feature = "xyz", not(any(feature = "serial-arm", feature = "delta"))))]
 type TheBoard = excalibur::xyz::XyzBoard;
+#[cfg(feature = "serial-arm")]
+type TheBoard = twoport_board::linkage::SerialArmBoard;
+#[cfg(feature = "delta")]
+type TheBoard = twoport_board::linkage::DeltaBoard;
 
 /// The loop, shared by the control interrupt (ticks) and the main loop
 /// (link bytes).
@@ -142,9 +150,13 @@ fn main() -> ! {
     }
     // A board that cannot build its law never drives the amplifier.
     #[cfg(not(feature = "xyz"))]
-    let board = excalibur::stiff_wall_board();
-    #[cfg(feature = "xyz")]
-    let board = excalibur::xyz::board();
+    let board = excalibur::stiff_wall_board().map_err(|_| ());
+    #[cfg(all(feature = "xyz", not(any(feature = "serial-arm", feature = "delta"))))]
+    let board = excalibur::xyz::board().map_err(|_| ());
+    #[cfg(feature = "serial-arm")]
+    let board = twoport_board::linkage::serial_arm_board().map_err(|_| ());
+    #[cfg(feature = "delta")]
+    let board = twoport_board::linkage::delta_board().map_err(|_| ());
     let Ok(board) = board else { halt() };
     let mut board = board.with_pil(cfg!(feature = "qemu"));
     if init::reset_by_watchdog(&dp.RCC) {

@@ -6,18 +6,28 @@ use super::{BoardPort, LinkError};
 use std::collections::VecDeque;
 use std::time::Duration;
 use twoport_board::excalibur::{self, xyz, REGION_POINTS};
+use twoport_board::linkage::{self as linkage_image, DeltaBoard, SerialArmBoard};
 use twoport_board::{Board, BoardSupport, RawSensors};
 use twoport_config::{RamFlash, Store};
+use twoport_control::drive::Drive;
+use twoport_control::kinematics::{Delta, SerialArm};
 use twoport_control::passivity::SeriesDamper;
-use twoport_control::servo::{Direct, PortLayer};
+use twoport_control::servo::{Direct, PortLayer, Servo};
 use twoport_control::ve::UnilateralWall;
 use twoport_control::world::World;
 
-/// The Excalibur board image's loop, in this process: the plain image's,
-/// the passivity image's (`L`, the series damper), or the three-axis
-/// image's (`N` = 3).
-pub struct LocalBoard<W = UnilateralWall, const N: usize = 1, L = Direct> {
-    board: Board<W, REGION_POINTS, N, L>,
+/// A board image's loop, in this process: the Excalibur's plain image,
+/// its passivity image (`L`, the series damper), its three-axis image
+/// (`N` = 3), or a linkage image (`D`, the linkage's servo, with a region
+/// of `R` points).
+pub struct LocalBoard<
+    W = UnilateralWall,
+    const N: usize = 1,
+    L = Direct,
+    D = Servo<W, f32, N, L>,
+    const R: usize = REGION_POINTS,
+> {
+    board: Board<W, R, N, L, D>,
     link: HostLink,
     /// Its stored configuration, in RAM as on the QEMU images.
     store: Store<RamFlash<512, 256>>,
@@ -56,9 +66,14 @@ impl<const N: usize> BoardSupport<N> for HostLink {
     }
 }
 
-impl<W: World<f32, N>, L: PortLayer, const N: usize> LocalBoard<W, N, L> {
+impl<W, L, D, const N: usize, const R: usize> LocalBoard<W, N, L, D, R>
+where
+    W: World<f32, N>,
+    L: PortLayer,
+    D: Drive<N, World = W, Layer = L>,
+{
     /// `board`, driven by the link's sensor frames.
-    fn driven(board: Board<W, REGION_POINTS, N, L>) -> Self {
+    fn driven(board: Board<W, R, N, L, D>) -> Self {
         let mut board = board.with_pil(true);
         // As the QEMU images boot: the configuration from a RAM flash.
         let mut store = Store::new(RamFlash::<512, 256>::new(), 0, 256);
@@ -71,7 +86,12 @@ impl<W: World<f32, N>, L: PortLayer, const N: usize> LocalBoard<W, N, L> {
     }
 }
 
-impl<W: World<f32, N>, L: PortLayer, const N: usize> LocalBoard<W, N, L> {
+impl<W, L, D, const N: usize, const R: usize> LocalBoard<W, N, L, D, R>
+where
+    W: World<f32, N>,
+    L: PortLayer,
+    D: Drive<N, World = W, Layer = L>,
+{
     /// The same board with each axis homing with its `cfg` (e.g. on an
     /// encoder's index).
     pub fn with_homing(mut self, cfg: [twoport_control::homing::HomingConfig; N]) -> Self {
@@ -107,7 +127,48 @@ impl LocalBoard<xyz::World, 3> {
     }
 }
 
-impl<W: World<f32, N>, L: PortLayer, const N: usize> BoardPort for LocalBoard<W, N, L> {
+/// The serial-arm image's loop.
+pub type LocalSerialArm = LocalBoard<
+    linkage_image::World,
+    3,
+    Direct,
+    linkage_image::Servo<SerialArm>,
+    { linkage_image::REGION_POINTS },
+>;
+
+/// The delta image's loop.
+pub type LocalDelta = LocalBoard<
+    linkage_image::World,
+    3,
+    Direct,
+    linkage_image::Servo<Delta>,
+    { linkage_image::REGION_POINTS },
+>;
+
+impl LocalSerialArm {
+    /// The serial-arm image ([`linkage_image::serial_arm_board`]).
+    pub fn serial_arm() -> Result<Self, LinkError> {
+        linkage_image::serial_arm_board()
+            .map(|b: SerialArmBoard| Self::driven(b))
+            .map_err(|e| LinkError::Image(format!("the serial-arm image: {e:?}")))
+    }
+}
+
+impl LocalDelta {
+    /// The delta image ([`linkage_image::delta_board`]).
+    pub fn delta() -> Result<Self, LinkError> {
+        linkage_image::delta_board()
+            .map(|b: DeltaBoard| Self::driven(b))
+            .map_err(|e| LinkError::Image(format!("the delta image: {e:?}")))
+    }
+}
+
+impl<W, L, D, const N: usize, const R: usize> BoardPort for LocalBoard<W, N, L, D, R>
+where
+    W: World<f32, N>,
+    L: PortLayer,
+    D: Drive<N, World = W, Layer = L>,
+{
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
         // What the images do: the control tick runs each sensor frame as
         // it completes, and the main loop sends what was queued.

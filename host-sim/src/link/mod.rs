@@ -16,6 +16,6 @@ mod port;
 mod session;
 
 pub use error::LinkError;
-pub use local::LocalBoard;
+pub use local::{LocalBoard, LocalDelta, LocalSerialArm};
 pub use port::{BoardPort, SerialBoard};
 pub use session::{LinkFaults, Session, ANSWER_TIMEOUT, HEARTBEAT_EVERY};

@@ -15,14 +15,20 @@
 
 use super::Board;
 use crate::support::BoardSupport;
+use twoport_control::drive::Drive;
 use twoport_control::homing::{Homing, HomingState};
 use twoport_control::servo::PortLayer;
 use twoport_control::servo::ServoOutput;
 use twoport_control::world::World;
-use twoport_control::{Faults, Position};
+use twoport_control::Faults;
 use twoport_link::{Axes, Message, Mode, ModeRefusal, ModeRequest, Status};
 
-impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R, N, L> {
+impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
+where
+    W: World<f32, N>,
+    L: PortLayer,
+    D: Drive<N, World = W, Layer = L>,
+{
     /// Where the state machine is.
     pub fn mode(&self) -> Mode {
         self.mode
@@ -35,7 +41,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
 
     /// The state the link reports.
     pub fn status(&self) -> Status {
-        let safety = self.servo.safety();
+        let safety = self.servo.servo().safety();
         let (faults, first) = (safety.faults(), safety.first_fault());
         Status {
             mode: self.mode,
@@ -50,7 +56,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
     /// watchdog reset at boot, a sensor that did not answer). It disarms
     /// the board at the next tick, like any fault.
     pub fn trip(&mut self, f: Faults) {
-        self.servo.trip(f);
+        self.servo.servo_mut().trip(f);
     }
 
     /// Whether the amplifier's outputs are on: only while homing or armed,
@@ -76,7 +82,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
     }
 
     fn latched(&self) -> Option<ModeRefusal> {
-        let f = self.servo.safety().faults();
+        let f = self.servo.servo().safety().faults();
         (!f.is_empty()).then_some(ModeRefusal::Faulted { faults: f.0 })
     }
 
@@ -91,14 +97,14 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
             })
             .or((!self.calibrated).then_some(ModeRefusal::NotCalibrated))
             .or(self
-                .check(&self.servo.gains())
+                .check(&self.servo.servo().gains())
                 .err()
                 .map(|_| ModeRefusal::GainsNotProven))
             .or((!self.dead_man_closed).then_some(ModeRefusal::DeadManOpen));
         if let Some(why) = why {
             return self.refuse(ModeRequest::Arm, why);
         }
-        match (self.mode, self.servo.enable()) {
+        match (self.mode, self.servo.servo_mut().enable()) {
             // Armed already: the answer is the status.
             (Mode::Armed, Ok(())) => self.queue_status(),
             (_, Ok(())) => self.set_mode(Mode::Armed),
@@ -110,7 +116,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
     /// A homing run in progress is abandoned; the calibration stays what
     /// it was.
     pub(super) fn disarm(&mut self) {
-        self.servo.disable();
+        self.servo.servo_mut().disable();
         self.homing = None;
         self.set_mode(Mode::Disarmed);
     }
@@ -118,19 +124,22 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
     /// `Home`: a disarmed board without faults starts every axis's homing
     /// run from where it stands.
     pub(super) fn home(&mut self) {
-        let why = self.latched().or(match self.mode {
-            Mode::Disarmed => None,
-            m => Some(ModeRefusal::NotDisarmed { mode: m }),
-        });
+        let why = (!D::HOMES)
+            .then_some(ModeRefusal::Unsupported)
+            .or(self.latched())
+            .or(match self.mode {
+                Mode::Disarmed => None,
+                m => Some(ModeRefusal::NotDisarmed { mode: m }),
+            });
         if let Some(why) = why {
             return self.refuse(ModeRequest::Home, why);
         }
-        let x = self.servo.position();
+        let x = self.servo.servo().position();
         let runs: [Option<Homing>; N] =
             core::array::from_fn(|i| Homing::new(self.homing_cfg[i], x[i]).ok());
         if runs.iter().any(Option::is_none) {
             // The image's homing constants are wrong: as unsafe as a fault.
-            self.servo.trip(Faults::HOMING_FAILED);
+            self.servo.servo_mut().trip(Faults::HOMING_FAILED);
             return self.refuse(
                 ModeRequest::Home,
                 ModeRefusal::Faulted {
@@ -138,7 +147,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
                 },
             );
         }
-        match self.servo.enable() {
+        match self.servo.servo_mut().enable() {
             Ok(()) => {
                 self.homing = Some(runs);
                 self.set_mode(Mode::Homing);
@@ -158,14 +167,9 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
             let why = ModeRefusal::WrongAxisCount { axes: N as u8 };
             return self.refuse(ModeRequest::Calibrate, why);
         };
-        let mut x = [Position::ZERO; N];
-        for (x, pm) in x.iter_mut().zip(pm) {
-            let Ok(nm) = i32::try_from(pm / 1000) else {
-                return self.refuse(ModeRequest::Calibrate, ModeRefusal::OutOfRange);
-            };
-            *x = Position::from_nm(nm);
+        if !self.servo.calibrate_pico(pm) {
+            return self.refuse(ModeRequest::Calibrate, ModeRefusal::OutOfRange);
         }
-        self.servo.calibrate(x);
         self.calibrated = true;
         self.queue_status();
     }
@@ -183,20 +187,27 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
                 // Homing on an index: its first pulse calibrates the
                 // encoder from the count it latched.
                 let done = match (cfg.index_position, self.index[axis], h.state()) {
-                    (Some(at), Some(raw), _) => self.servo.calibrate_axis_at(axis, raw, at).is_ok(),
+                    (Some(at), Some(raw), _) => self
+                        .servo
+                        .servo_mut()
+                        .calibrate_axis_at(axis, raw, at)
+                        .is_ok(),
                     (_, _, HomingState::Seeking) => {
                         seeking = true;
                         continue;
                     }
                     (_, _, HomingState::Found) => {
                         // (The loop calibrates only axes it has.)
-                        let _ = self.servo.calibrate_axis(axis, cfg.stop_position);
+                        let _ = self
+                            .servo
+                            .servo_mut()
+                            .calibrate_axis(axis, cfg.stop_position);
                         true
                     }
                     (_, _, HomingState::TimedOut) => false,
                 };
                 if !done {
-                    self.servo.trip(Faults::HOMING_FAILED);
+                    self.servo.servo_mut().trip(Faults::HOMING_FAILED);
                     return self.disarm();
                 }
                 *run = None;

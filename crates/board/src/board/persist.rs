@@ -6,6 +6,7 @@ use super::Board;
 use crate::io::IoScale;
 use embedded_storage::nor_flash::NorFlash;
 use twoport_config::{Config, HomingSetup, Limits, LoadCell, Store};
+use twoport_control::drive::Drive;
 use twoport_control::homing::HomingConfig;
 use twoport_control::servo::Gains;
 use twoport_control::servo::PortLayer;
@@ -13,11 +14,16 @@ use twoport_control::world::World;
 use twoport_control::{Position, SafetyConfig};
 use twoport_link::{ConfigFallback, ConfigSource, Message, Mode, ModeRefusal, ModeRequest};
 
-impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R, N, L> {
+impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
+where
+    W: World<f32, N>,
+    L: PortLayer,
+    D: Drive<N, World = W, Layer = L>,
+{
     /// The configuration in force, each axis's as a record would store it.
     pub fn config(&self) -> [Config; N] {
-        let limits = *self.servo.safety().configs();
-        let gains = self.servo.gains();
+        let limits = *self.servo.servo().safety().configs();
+        let gains = self.servo.servo().gains();
         core::array::from_fn(|i| self.axis_config(i, &limits[i], gains[i]))
     }
 
@@ -62,7 +68,7 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
         if self.check(&gains).is_err() {
             return Err(ConfigFallback::NotProven);
         }
-        let now = *self.servo.safety().configs();
+        let now = *self.servo.servo().safety().configs();
         let limits: [SafetyConfig; N] = core::array::from_fn(|i| SafetyConfig {
             peak_force_n: cfg[i].limits.peak_force_n,
             continuous_force_n: cfg[i].limits.continuous_force_n,
@@ -84,14 +90,15 @@ impl<W: World<f32, N>, L: PortLayer, const R: usize, const N: usize> Board<W, R,
         }
         // Gains first: the only step that can still refuse, and it
         // changes nothing when it does.
-        let old = self.servo.gains();
+        let old = self.servo.servo().gains();
         self.servo
+            .servo_mut()
             .set_gains(gains)
             .map_err(|_| ConfigFallback::Invalid)?;
-        if self.servo.set_limits(limits).is_err() {
+        if self.servo.servo_mut().set_limits(limits).is_err() {
             // Validated above and disarmed: unreachable, but never half
             // applied.
-            let _ = self.servo.set_gains(old);
+            let _ = self.servo.servo_mut().set_gains(old);
             return Err(ConfigFallback::Invalid);
         }
         self.homing_cfg = homing;

@@ -195,6 +195,31 @@ impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<
 
     /// One control tick: joint encoders in, joint torques out.
     pub fn tick(&mut self, frame: &SensorFrame<R, N>) -> LinkageOutput<R, N> {
+        let q = self.read(frame);
+        let cartesian = self.cartesian.tick_at(frame, &self.handle);
+        self.drive(q, cartesian)
+    }
+
+    /// One tick with `law` in place of the Cartesian laws and the world
+    /// (as [`Servo::tick_with`]): `law` gets each Cartesian axis's index,
+    /// the handle's position and velocity (m/s) and answers with the force
+    /// on that axis (N), which goes out through `J^T` and the motors'
+    /// limits like any other. Homing runs through this.
+    pub fn tick_with(
+        &mut self,
+        frame: &SensorFrame<R, N>,
+        law: impl FnMut(usize, Position, R) -> R,
+    ) -> LinkageOutput<R, N> {
+        let q = self.read(frame);
+        let cartesian = self.cartesian.tick_with_at(frame, &self.handle, law);
+        self.drive(q, cartesian)
+    }
+
+    /// The joints read and the handle found: the joint angles (rad). A bad
+    /// counter or a pose the kinematics cannot serve latches its fault
+    /// (the handle stays where it was last served).
+    #[inline(always)]
+    fn read(&mut self, frame: &SensorFrame<R, N>) -> [R; N] {
         let mut q = [R::ZERO; N];
         let mut sensors_ok = true;
         for ((q, j), raw) in q.iter_mut().zip(&mut self.joints).zip(frame.encoder_raw) {
@@ -214,7 +239,12 @@ impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<
                 Err(f) => self.latch(f),
             }
         }
-        let cartesian = self.cartesian.tick_at(frame, &self.handle);
+        q
+    }
+
+    /// The Cartesian tick's force out as the motors' torques.
+    #[inline(always)]
+    fn drive(&mut self, q: [R; N], cartesian: ServoOutput<R, N>) -> LinkageOutput<R, N> {
         let limited = self
             .motors
             .step(self.pose.torques_nm(&cartesian.actuator_force_n));
@@ -278,6 +308,13 @@ impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<
     /// The Cartesian servo: gains, world, safety layer, laws.
     pub fn cartesian(&self) -> &Servo<W, R, N> {
         &self.cartesian
+    }
+
+    /// The Cartesian servo, to change its gains, limits or world between
+    /// ticks (its calibration follows the joints': see
+    /// [`calibrate_joints`](Self::calibrate_joints)).
+    pub fn cartesian_mut(&mut self) -> &mut Servo<W, R, N> {
+        &mut self.cartesian
     }
 
     /// Change every Cartesian axis's gains between ticks (all or none).

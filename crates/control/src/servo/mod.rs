@@ -354,7 +354,22 @@ impl<W: World<R, N>, R: Real, const N: usize, L: PortLayer<R>> Servo<W, R, N, L>
         frame: &SensorFrame<R, N>,
         law: impl FnMut(usize, Position, R) -> R,
     ) -> ServoOutput<R, N> {
-        self.front.tick_with(frame, law)
+        let front = &mut self.front;
+        let sensed = front.sense(frame);
+        front.tick_with(frame, sensed, law)
+    }
+
+    /// [`tick_with`](Self::tick_with) at handle positions `x` found by
+    /// other means (a linkage's kinematics).
+    pub(crate) fn tick_with_at(
+        &mut self,
+        frame: &SensorFrame<R, N>,
+        x: &[Position; N],
+        law: impl FnMut(usize, Position, R) -> R,
+    ) -> ServoOutput<R, N> {
+        let front = &mut self.front;
+        let sensed = front.sense_at(x);
+        front.tick_with(frame, sensed, law)
     }
 
     /// One control tick of every axis.

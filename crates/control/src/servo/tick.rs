@@ -83,9 +83,9 @@ impl<R: Real, const N: usize> Frontend<R, N> {
     pub(super) fn tick_with(
         &mut self,
         frame: &SensorFrame<R, N>,
+        (v, faults): ([R; N], Faults),
         mut law: impl FnMut(usize, Position, R) -> R,
     ) -> ServoOutput<R, N> {
-        let (v, faults) = self.sense(frame);
         let x = self.position();
         let mut out = ServoOutput::at_rest(x, v);
         if self.runnable(faults) {

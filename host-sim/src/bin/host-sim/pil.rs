@@ -31,6 +31,10 @@ pub(crate) struct PilArgs {
     /// actuator's port): compare it with that image's in-process loop.
     #[arg(long)]
     pub(crate) passivity: bool,
+    /// The board runs a linkage image: the device file's nonlinear arm
+    /// against it, pressed into the image's floor (the scene is not read).
+    #[arg(long, value_enum)]
+    pub(crate) linkage: Option<host_sim::pil::linkage::Device>,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub(crate) json: bool,
@@ -66,6 +70,23 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
             "{}: a PIL scene ticks at the board's 1 kHz",
             a.scene.display()
         ));
+    }
+    if let Some(device) = a.linkage {
+        use host_sim::pil::linkage::{self, Device};
+        if a.passivity {
+            return Err("--passivity: the linkage images have no passivity build".into());
+        }
+        let reference = match device {
+            Device::SerialArm => {
+                linkage::run(device, ticks, link::LocalSerialArm::serial_arm()?, faults)?
+            }
+            Device::Delta => linkage::run(device, ticks, link::LocalDelta::delta()?, faults)?,
+        };
+        let local_s = start.elapsed().as_secs_f64();
+        let run = port
+            .map(|p| linkage::run(device, ticks, p, faults))
+            .transpose()?;
+        return pil_report(a, ticks, faults, reference, run, local_s, start);
     }
     if scene.axes == 3 {
         if a.passivity {

@@ -8,6 +8,8 @@
 //! frames and, if asked, corrupted frames and a link loss, so the in-process
 //! run is the reference the firmware must match.
 
+pub mod linkage;
+
 use crate::engine::scene::VeSpec;
 use crate::link::{BoardPort, LinkFaults, Session};
 use crate::Error;
@@ -285,22 +287,7 @@ pub fn run_axes<P: BoardPort, const N: usize>(
         start: Some(start),
         ..Run::default()
     };
-    // The configuration: what it booted with, then saved, which a PIL
-    // board does while it waits for its first tick.
-    let booted = session.config()?;
-    session.send(&Message::SaveConfig)?;
-    let saved = session.wait("SaveConfig", |m| match m {
-        Message::Config(c @ ConfigSource::Stored { .. }) => Some(Ok(*c)),
-        Message::ModeRefused {
-            asked: ModeRequest::SaveConfig,
-            why,
-        } => Some(Err(Error::Link(crate::link::LinkError::Refused {
-            asked: ModeRequest::SaveConfig,
-            why: *why,
-        }))),
-        _ => None,
-    })??;
-    r.config = Some((booted, saved));
+    r.config = Some(boot_and_save(&mut session)?);
     record(&mut session, &mut sim, &mut r)?;
     match start {
         Start::Calibrate => {
@@ -342,16 +329,41 @@ pub fn run_axes<P: BoardPort, const N: usize>(
     r.board_stats = session.board_stats()?;
     r.host_dropped = session.host_dropped();
     r.corrupted_sent = session.corrupted_sent;
-    if let Some(t0) = faults.link_loss_at {
-        // The last tick with a non-zero duty after the loss, plus one.
-        let last_nonzero = r
-            .duties
-            .iter()
-            .skip(t0 as usize)
-            .rposition(|d| d.iter().any(|d| *d != 0));
-        r.zero_after_loss_ticks = Some(last_nonzero.map_or(0, |i| i as u64 + 1));
-    }
+    r.zero_after_loss_ticks = zero_after_loss(&r.duties, faults);
     Ok(r)
+}
+
+/// The configuration a board booted with, then saved, which a PIL board
+/// does while it waits for its first tick.
+fn boot_and_save<P: BoardPort>(
+    session: &mut Session<P>,
+) -> Result<(ConfigSource, ConfigSource), Error> {
+    let booted = session.config()?;
+    session.send(&Message::SaveConfig)?;
+    let saved = session.wait("SaveConfig", |m| match m {
+        Message::Config(c @ ConfigSource::Stored { .. }) => Some(Ok(*c)),
+        Message::ModeRefused {
+            asked: ModeRequest::SaveConfig,
+            why,
+        } => Some(Err(Error::Link(crate::link::LinkError::Refused {
+            asked: ModeRequest::SaveConfig,
+            why: *why,
+        }))),
+        _ => None,
+    })??;
+    Ok((booted, saved))
+}
+
+/// After a link loss (`faults.link_loss_at`), the ticks until the duties
+/// went to zero and stayed there: the last tick with a non-zero duty after
+/// the loss, plus one.
+fn zero_after_loss(duties: &[Axes<i16>], faults: LinkFaults) -> Option<u64> {
+    let t0 = faults.link_loss_at?;
+    let last_nonzero = duties
+        .iter()
+        .skip(t0 as usize)
+        .rposition(|d| d.iter().any(|d| *d != 0));
+    Some(last_nonzero.map_or(0, |i| i as u64 + 1))
 }
 
 /// How far two runs of the same scene drift apart.

@@ -1,0 +1,228 @@
+//! The linkage board images: a PHANToM-type serial arm and a Falcon-like
+//! rotary delta, each a [`LinkageServo`] (joint encoders in, joint torques
+//! out) around the three-axis Cartesian servo, with the coupling the
+//! workspace proof gives for a grasp of at least [`GRASP_NSPM`] and a
+//! floor under the handle. The numbers are the shipped device files'
+//! (`models/linkages/`); a host test holds them to those files and to the
+//! designer's proof.
+//!
+//! A linkage board is calibrated, not homed: the host puts the arm at a
+//! known pose and sends its joint angles (`Calibrate`, in 1e-12 rad).
+
+use crate::io::IoScale;
+use crate::region::{Bound, Region};
+use crate::Board;
+use twoport_control::kinematics::{Delta, Kinematics, SerialArm};
+use twoport_control::linkage::{
+    JointEncoder, JointEncoderError, LinkageError, LinkageServo, MotorConfig,
+};
+use twoport_control::servo::ImpedanceGains;
+use twoport_control::ve::{Solid, UnilateralWall};
+use twoport_control::world::PerAxis;
+use twoport_control::{ParamError, Position, SafetyConfig};
+
+/// Control period (s): both devices' 1 kHz loop.
+pub const PERIOD_S: f32 = 1.0e-3;
+/// The least grasp the images' region assumes (N s/m): a dead-man switch
+/// keeps force off without one.
+pub const GRASP_NSPM: f32 = 2.0;
+/// The coupling both images run: inside their regions at 2 N s/m.
+pub const COUPLING: ImpedanceGains = ImpedanceGains::new(2_000.0, 0.5);
+/// The floor under the rest pose (m below the handle there), its
+/// stiffness (N/m) and damping (N s/m).
+pub const FLOOR: (f32, f32, f32) = (0.005, 1.0e5, 10.0);
+/// Ticks without a host heartbeat before the board forces zero (50 ms).
+pub const HEARTBEAT_TIMEOUT_TICKS: u32 = 50;
+/// Telemetry every this many ticks (100 Hz).
+pub const TELEMETRY_EVERY: u32 = 10;
+/// Grid points of a linkage image's region.
+pub const REGION_POINTS: usize = 5;
+/// The encoder counters' width (bits).
+pub const COUNTER_BITS: u8 = 32;
+
+/// What an image needs of its device file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spec {
+    /// Encoder counts per motor revolution (quadrature).
+    pub counts_per_rev: f32,
+    /// Transmission ratio of each joint (motor turns per joint turn).
+    pub ratios: [f32; 3],
+    /// Each joint's limits (rad), as the proof covered them.
+    pub limits_rad: [[f32; 2]; 3],
+    /// Each motor's peak and continuous torque (N m, at the motor).
+    pub motor_torque_nm: (f32, f32),
+    /// The least damping the handle has anywhere in the workspace, in its
+    /// least damped direction (N s/m): `λ_min(D_x)` at the binding pose.
+    pub least_damping_nspm: f32,
+    /// The calibration pose (rad): where the host puts the arm.
+    pub rest_rad: [f32; 3],
+}
+
+/// The PHANToM Premium 1.5 (`phantom_premium_1_5.toml`).
+// (The base's limits are the file's 1.5708 rad, as published, not π/2.)
+#[allow(clippy::approx_constant)]
+pub const PHANTOM: Spec = Spec {
+    counts_per_rev: 2000.0,
+    ratios: [13.3, 11.2, 11.2],
+    limits_rad: [[-1.5708, 1.5708], [-2.1642, 2.0769], [-0.5061, 3.7350]],
+    motor_torque_nm: (0.129, 0.0286),
+    least_damping_nspm: 0.003_781,
+    rest_rad: [0.0, 0.3, 1.2],
+};
+/// Its arm: `l1`, `l2` (m).
+pub const PHANTOM_ARM: (f32, f32) = (0.215, 0.170);
+
+/// The Falcon-like delta (`falcon_like.toml`).
+pub const FALCON: Spec = Spec {
+    counts_per_rev: 1280.0,
+    ratios: [7.72, 7.72, 7.72],
+    limits_rad: [[-0.3, 1.2], [-0.3, 1.2], [-0.3, 1.2]],
+    motor_torque_nm: (0.1, 0.04),
+    least_damping_nspm: 0.087_78,
+    rest_rad: [0.45, 0.45, 0.45],
+};
+/// Its geometry: base and effector radii, upper and lower arms (m).
+pub const FALCON_DELTA: (f32, f32, f32, f32) = (0.040, 0.02309, 0.060, 0.1025);
+
+/// The images' world: a wall on each Cartesian axis, only the floor (z)
+/// within reach.
+pub type World = PerAxis<UnilateralWall, 3>;
+
+/// A linkage image's servo.
+pub type Servo<K> = LinkageServo<K, World, f32, 3>;
+
+/// A linkage image's board.
+pub type LinkageBoard<K> = Board<World, REGION_POINTS, 3, twoport_control::servo::Direct, Servo<K>>;
+
+/// The serial-arm image's board.
+pub type SerialArmBoard = LinkageBoard<SerialArm>;
+
+/// The delta image's board.
+pub type DeltaBoard = LinkageBoard<Delta>;
+
+/// Why a linkage image could not be built (a constant here is wrong).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BuildError {
+    /// A law's or a kinematics' parameter.
+    Param(ParamError),
+    /// The servo's.
+    Linkage(LinkageError),
+    /// A joint's encoder.
+    Joint(JointEncoderError),
+    /// The region table.
+    Region(crate::RegionError),
+    /// The rest pose is not one the kinematics serve.
+    RestPose,
+}
+
+/// The Cartesian limits every axis runs: 10 N peak, 4 N held, 2 m/s, the
+/// link watchdog and the dead-man switch on.
+pub fn safety() -> SafetyConfig {
+    SafetyConfig {
+        heartbeat_timeout_ticks: HEARTBEAT_TIMEOUT_TICKS,
+        max_velocity_mps: 2.0,
+        require_dead_man: true,
+        ..SafetyConfig::new(PERIOD_S, 10.0, 4.0)
+    }
+}
+
+/// The proven region of `spec`: at each coupling damping `b_c`, the
+/// stiffest `k_c = 2 (λ_min + b_g - b_c)/T` (the workspace proof for
+/// every grasp of at least [`GRASP_NSPM`]).
+pub fn region(spec: &Spec) -> Result<Region<REGION_POINTS>, crate::RegionError> {
+    let total = spec.least_damping_nspm + GRASP_NSPM;
+    let b: [f32; REGION_POINTS] = core::array::from_fn(|i| 0.01 + 0.24 * total * i as f32);
+    let k = b.map(|b| 2.0 * (total - b) / PERIOD_S);
+    Region::new(Bound::MaxStiffness, b, k, None)
+}
+
+/// Each motor's duty scale: full scale at its peak torque at the joint.
+pub fn io(spec: &Spec) -> [IoScale; 3] {
+    spec.ratios.map(|n| IoScale {
+        force_full_scale_n: spec.motor_torque_nm.0 * n,
+        ..IoScale::EXCALIBUR
+    })
+}
+
+/// The board for `spec` on `kinematics`, disarmed and uncalibrated, its
+/// joints reading the rest pose until the host calibrates them.
+pub fn board<K: Kinematics<f32, 3>>(
+    spec: &Spec,
+    kinematics: K,
+) -> Result<LinkageBoard<K>, BuildError> {
+    let at = kinematics
+        .forward(&spec.rest_rad)
+        .map_err(|_| BuildError::RestPose)?
+        .position_m;
+    let (below, k, b) = FLOOR;
+    let p = |x: f32| Position::from_m(x).ok_or(BuildError::RestPose);
+    let far = p(0.5)?;
+    let wall = |surface, solid, probe| {
+        UnilateralWall::new(k, b, surface, solid, PERIOD_S, probe).map_err(BuildError::Param)
+    };
+    let world = PerAxis([
+        wall(far, Solid::Above, p(at[0])?)?,
+        wall(far, Solid::Above, p(at[1])?)?,
+        wall(p(at[2] - below)?, Solid::Below, p(at[2])?)?,
+    ]);
+    let joint = |i: usize| {
+        JointEncoder::new(
+            COUNTER_BITS,
+            spec.counts_per_rev * spec.ratios[i],
+            0,
+            spec.rest_rad[i],
+        )
+        .map_err(BuildError::Joint)
+    };
+    let joints = [joint(0)?, joint(1)?, joint(2)?];
+    let motors = spec.ratios.map(|n| {
+        let (peak, held) = spec.motor_torque_nm;
+        MotorConfig::new(peak * n, held * n)
+    });
+    let servo = LinkageServo::new(
+        kinematics,
+        joints,
+        spec.limits_rad,
+        [COUPLING.into(); 3],
+        [safety(); 3],
+        motors,
+        world,
+    )
+    .map_err(BuildError::Linkage)?;
+    let r = region(spec).map_err(BuildError::Region)?;
+    Ok(Board::new(servo, [r; 3], TELEMETRY_EVERY).with_io(io(spec)))
+}
+
+/// The serial-arm image: the PHANToM Premium 1.5.
+pub fn serial_arm_board() -> Result<SerialArmBoard, BuildError> {
+    let arm = SerialArm::new(PHANTOM_ARM.0, PHANTOM_ARM.1).map_err(BuildError::Param)?;
+    board(&PHANTOM, arm)
+}
+
+/// The delta image: the Falcon-like delta.
+pub fn delta_board() -> Result<DeltaBoard, BuildError> {
+    let (r, e, a, b) = FALCON_DELTA;
+    board(&FALCON, Delta::new(r, e, a, b).map_err(BuildError::Param)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use twoport_control::servo::{Display, Gains};
+
+    /// Both images build; their coupling is inside their region and 20 %
+    /// past its stiffness is not.
+    #[test]
+    fn the_images_build_with_proven_gains() {
+        assert!(serial_arm_board().is_ok());
+        assert!(delta_board().is_ok());
+        for spec in [PHANTOM, FALCON] {
+            let r = region(&spec).unwrap();
+            let g = Gains::from(COUPLING);
+            assert!(r.check(Display::Impedance, &g).is_ok());
+            let kmax = 2.0 * (spec.least_damping_nspm + GRASP_NSPM - COUPLING.b_nspm) / PERIOD_S;
+            let past = Gains::from(ImpedanceGains::new(1.2 * kmax, COUPLING.b_nspm));
+            assert!(r.check(Display::Impedance, &past).is_err());
+        }
+    }
+}

@@ -1,0 +1,188 @@
+//! Processor-in-the-loop on a linkage: the nonlinear arm of the device's
+//! file at this end, a linkage board image (`twoport_board::linkage`) at
+//! the other, joint encoder counts out and joint torque duties back each
+//! tick, in lockstep.
+//!
+//! The run: the board boots and saves its configuration; one tick
+//! disarmed; the host calibrates it at the rest pose (the joint angles,
+//! in 1e-12 rad) and arms it; then a hand that grasps with 2 N s/m (the
+//! images' least grasp) and a 300 N/m spring presses the handle 15 mm
+//! down, through the board's floor 5 mm under the rest pose.
+
+use super::{boot_and_save, zero_after_loss, Run};
+use crate::engine::linkage::{CartesianHand, LinkagePlant};
+use crate::link::{BoardPort, LinkFaults, Session};
+use crate::{Error, Sample};
+use nalgebra::DMatrix;
+use twoport_board::linkage::{self as image, Spec};
+use twoport_board::IoScale;
+use twoport_design::linkage::LinkageFile;
+use twoport_link::{Axes, Message, PilSensors};
+
+/// The linkage images a PIL run drives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+pub enum Device {
+    /// The PHANToM Premium 1.5 serial arm.
+    SerialArm,
+    /// The Falcon-like rotary delta.
+    Delta,
+}
+
+impl Device {
+    /// The device file the plant integrates.
+    pub fn file(self) -> Result<LinkageFile, Error> {
+        let (text, name) = match self {
+            Device::SerialArm => (
+                include_str!("../../../models/linkages/phantom_premium_1_5.toml"),
+                "phantom_premium_1_5.toml",
+            ),
+            Device::Delta => (
+                include_str!("../../../models/linkages/falcon_like.toml"),
+                "falcon_like.toml",
+            ),
+        };
+        LinkageFile::from_toml(text, name).map_err(|e| Error::Pil(e.to_string()))
+    }
+
+    /// The board image's constants.
+    pub fn spec(self) -> &'static Spec {
+        match self {
+            Device::SerialArm => &image::PHANTOM,
+            Device::Delta => &image::FALCON,
+        }
+    }
+}
+
+/// How far down the hand's spring pulls (m below the rest pose), its
+/// stiffness (N/m) and the grasp's damping (N s/m).
+pub const HAND: (f64, f64, f64) = (0.015, 300.0, 2.0);
+
+/// Runge-Kutta sub-steps per tick.
+const SUBSTEPS: u32 = 8;
+
+/// The plant, its encoders and the hand.
+struct Arm {
+    plant: LinkagePlant,
+    hand: CartesianHand,
+    rest: [f64; 3],
+    counts_per_rad: [f64; 3],
+    io: [IoScale; 3],
+    period_s: f64,
+}
+
+impl Arm {
+    fn new(device: Device) -> Result<Arm, Error> {
+        let file = device.file()?;
+        let spec = device.spec();
+        let rest = spec.rest_rad.map(f64::from);
+        let plant = LinkagePlant::at_rest(&file, &rest);
+        let (x, _) = plant.kinematics(&plant.q).map_err(plant_err)?;
+        let (down, k, b) = HAND;
+        let mut anchor = x.clone();
+        anchor[2] -= down;
+        let hand = CartesianHand {
+            anchor_m: anchor,
+            k_npm: DMatrix::identity(3, 3) * k,
+            b_nspm: DMatrix::identity(3, 3) * b,
+        };
+        Ok(Arm {
+            plant,
+            hand,
+            rest,
+            counts_per_rad: core::array::from_fn(|i| {
+                f64::from(spec.counts_per_rev * spec.ratios[i]) / std::f64::consts::TAU
+            }),
+            io: image::io(spec),
+            period_s: f64::from(image::PERIOD_S),
+        })
+    }
+
+    /// Each joint's counter: counts from the rest pose, where it read 0.
+    fn raw(&self) -> [u32; 3] {
+        core::array::from_fn(|i| {
+            let c = ((self.plant.q[i] - self.rest[i]) * self.counts_per_rad[i]).round();
+            c as i64 as i32 as u32
+        })
+    }
+
+    /// One tick: the sensors out, the board's duties back as torques held
+    /// over the period.
+    fn step<P: BoardPort>(
+        &mut self,
+        session: &mut Session<P>,
+    ) -> Result<(Sample<3>, Axes<i16>), Error> {
+        let tick = session.tick_heartbeat()?;
+        let sensors = PilSensors {
+            tick: tick as u32,
+            encoder_raw: Axes::new(self.raw()).unwrap_or_default(),
+            load_cell_raw: Axes::new([0; 3]).unwrap_or_default(),
+            dead_man_closed: true,
+            index_raw: Axes::new([None; 3]).unwrap_or_default(),
+        };
+        let duty = session.exchange(tick, sensors)?;
+        let tau: [f64; 3] = core::array::from_fn(|i| {
+            f64::from(self.io[i].force_n(duty.get(i).copied().unwrap_or(0)))
+        });
+        self.plant
+            .step(&tau, &self.hand, self.period_s, SUBSTEPS)
+            .map_err(plant_err)?;
+        let (x, _) = self.plant.kinematics(&self.plant.q).map_err(plant_err)?;
+        let sample = Sample {
+            t_s: (tick + 1) as f64 * self.period_s,
+            handle_m: [x[0], x[1], x[2]],
+            actuator_n: tau,
+            ..Sample::default()
+        };
+        Ok((sample, duty))
+    }
+}
+
+fn plant_err(e: crate::engine::linkage::PlantError) -> Error {
+    Error::Pil(format!("the linkage plant: {e:?}"))
+}
+
+/// One tick recorded, with the telemetry the board sent.
+fn record<P: BoardPort>(
+    session: &mut Session<P>,
+    arm: &mut Arm,
+    r: &mut Run<3>,
+) -> Result<(), Error> {
+    let (s, duty) = arm.step(session)?;
+    r.samples.push(s);
+    r.duties.push(duty);
+    for m in session.take_messages() {
+        if let Message::Telemetry(t) = m {
+            r.telemetry.push(t);
+        }
+    }
+    Ok(())
+}
+
+/// Run `device`'s image at `port` for `ticks`.
+pub fn run<P: BoardPort>(
+    device: Device,
+    ticks: u64,
+    port: P,
+    faults: LinkFaults,
+) -> Result<Run<3>, Error> {
+    let mut arm = Arm::new(device)?;
+    let mut session = Session::open_axes(port, faults, 3)?;
+    let mut r = Run {
+        start: Some(super::Start::Calibrate),
+        config: Some(boot_and_save(&mut session)?),
+        ..Run::default()
+    };
+    record(&mut session, &mut arm, &mut r)?;
+    let pico = arm.rest.map(|q| (q * 1e12).round() as i64);
+    session.calibrate(Axes::new(pico).unwrap_or_default())?;
+    session.arm()?;
+    r.armed_at_tick = r.samples.len() as u64;
+    while (r.samples.len() as u64) < ticks {
+        record(&mut session, &mut arm, &mut r)?;
+    }
+    r.board_stats = session.board_stats()?;
+    r.host_dropped = session.host_dropped();
+    r.corrupted_sent = session.corrupted_sent;
+    r.zero_after_loss_ticks = zero_after_loss(&r.duties, faults);
+    Ok(r)
+}

@@ -1,0 +1,206 @@
+//! Processor-in-the-loop on a linkage: the nonlinear arm against the
+//! linkage images' loop in-process (CI runs the same check against the
+//! firmware in QEMU on both boards through `cargo xtask pil --linkage
+//! serial-arm|delta --check`).
+
+use host_sim::engine::linkage::LinkagePlant;
+use host_sim::link::{LinkError, LinkFaults, LocalDelta, LocalSerialArm, Session};
+use host_sim::pil::{self, linkage};
+use linkage::Device;
+use nalgebra::DVector;
+use twoport_board::linkage::FLOOR;
+use twoport_link::{Axes, ModeRefusal, ModeRequest};
+
+fn run(device: Device, ticks: u64, faults: LinkFaults) -> pil::Run<3> {
+    match device {
+        Device::SerialArm => {
+            linkage::run(device, ticks, LocalSerialArm::serial_arm().unwrap(), faults).unwrap()
+        }
+        Device::Delta => linkage::run(device, ticks, LocalDelta::delta().unwrap(), faults).unwrap(),
+    }
+}
+
+/// The hand presses the handle through the floor the image holds 5 mm
+/// under the rest pose. After 2 s the handle rests in it, and the motors'
+/// torques balance the hand's force through the arm at each pose:
+/// `τ = J^T f_h` on the device file's nonlinear arm, to 1 % over 0.2 s.
+/// With corrupted frames on the link and the heartbeats stopping at 2.5 s,
+/// every motor is at zero within the watchdog's deadline.
+#[test]
+fn a_linkage_board_holds_the_floor_and_stops_after_a_link_loss() {
+    for device in [Device::SerialArm, Device::Delta] {
+        let faults = LinkFaults {
+            corrupt_every: 50,
+            link_loss_at: Some(2500),
+        };
+        let r = run(device, 3000, faults);
+        let c = pil::compare(&r, &r);
+        let bad = pil::failures(&r, &c, 3000, faults, 50);
+        assert!(bad.is_empty(), "{device:?}: {bad:?}");
+        assert!(
+            r.telemetry[..240].iter().all(|t| t.faults == 0),
+            "{device:?}"
+        );
+        assert!(r.duties[2550..].iter().all(|d| d.iter().all(|d| *d == 0)));
+
+        let file = device.file().unwrap();
+        let rest = device.spec().rest_rad.map(f64::from);
+        let start = LinkagePlant::at_rest(&file, &rest);
+        let (x0, _) = start.kinematics(&start.q).unwrap();
+        let floor = x0[2] - f64::from(FLOOR.0);
+        let s = &r.samples[2400];
+        let into = floor - s.handle_m[2];
+        assert!(
+            into > 0.0 && into < 3e-3,
+            "{device:?}: {into} m into the floor"
+        );
+        for (a, (x, x0)) in s.handle_m.iter().zip(&x0).take(2).enumerate() {
+            assert!((x - x0).abs() < 1e-3, "{device:?}: axis {a}");
+        }
+        // Over 0.2 s at rest (the encoders' quantum dithers the force by
+        // a few percent tick to tick), the mean torques against the mean of
+        // `J^T f_h`, the hand's force through the plant's own Jacobian at
+        // each tick's pose: its spring toward the anchor and its damper on
+        // the handle's velocity (a backward difference).
+        let (down, k, b) = linkage::HAND;
+        let anchor = [x0[0], x0[1], x0[2] - down];
+        let mut plant = LinkagePlant::at_rest(&file, &rest);
+        let (mut got, mut want, mut hand_z) = ([0.0; 3], [0.0; 3], 0.0);
+        let window = 2300..2500;
+        for t in window.clone() {
+            let (s, before) = (&r.samples[t], &r.samples[t - 1]);
+            // The joint angles that put the handle there (Newton).
+            for _ in 0..8 {
+                let (x, j) = plant.kinematics(&plant.q).unwrap();
+                let e = DVector::from_iterator(3, s.handle_m.iter().zip(&x).map(|(a, b)| a - b));
+                plant.q += j.lu().solve(&e).unwrap();
+            }
+            let (_, j) = plant.kinematics(&plant.q).unwrap();
+            let f = DVector::from_fn(3, |a, _| {
+                let v = (s.handle_m[a] - before.handle_m[a]) / 1e-3;
+                -k * (s.handle_m[a] - anchor[a]) - b * v
+            });
+            let tau = j.transpose() * &f;
+            for i in 0..3 {
+                got[i] += s.actuator_n[i] / window.len() as f64;
+                want[i] += tau[i] / window.len() as f64;
+            }
+            hand_z += f[2] / window.len() as f64;
+        }
+        let scale = want.iter().fold(0.0f64, |m, t| m.max(t.abs()));
+        for i in 0..3 {
+            assert!(
+                (got[i] - want[i]).abs() < 0.01 * scale,
+                "{device:?} joint {i}: {} N m, J^T f_h gives {}",
+                got[i],
+                want[i]
+            );
+        }
+        assert!(hand_z < -1.0, "{device:?}: the hand pulls {hand_z} N");
+    }
+}
+
+/// A linkage is calibrated, not homed: the board refuses to home, naming
+/// why. Calibrated at a pose outside the joint limits its proof covered,
+/// it latches the kinematics fault and refuses to arm.
+#[test]
+fn a_linkage_board_refuses_homing_and_a_pose_it_cannot_serve() {
+    let mut s = Session::open_axes(
+        LocalSerialArm::serial_arm().unwrap(),
+        LinkFaults::default(),
+        3,
+    )
+    .unwrap();
+    match s.home() {
+        Err(LinkError::Refused {
+            asked: ModeRequest::Home,
+            why: ModeRefusal::Unsupported,
+        }) => {}
+        other => panic!("{other:?}"),
+    }
+    // The base turned 2 rad: past its 90-degree stop.
+    let pico = [2.0, 0.3, 1.2].map(|q: f64| (q * 1e12) as i64);
+    let status = s.calibrate(Axes::new(pico).unwrap()).unwrap();
+    let kinematics = twoport_control::Faults::KINEMATICS.0;
+    assert_ne!(status.faults & kinematics, 0, "{status:?}");
+    match s.arm() {
+        Err(LinkError::Refused {
+            asked: ModeRequest::Arm,
+            why: ModeRefusal::Faulted { faults },
+        }) => assert_ne!(faults & kinematics, 0),
+        other => panic!("{other:?}"),
+    }
+}
+
+/// Each image's constants are its device file's, and its region is the
+/// designer's workspace proof for a grasp of at least 2 N s/m.
+#[test]
+fn the_images_are_their_device_files_and_their_proof() {
+    use twoport_board::linkage::{region, GRASP_NSPM, PERIOD_S};
+    use twoport_design::linkage::{workspace_design, workspace_poses, Geometry, DESIGN_GRID};
+    for device in [Device::SerialArm, Device::Delta] {
+        let file = device.file().unwrap();
+        let spec = device.spec();
+        let close = |a: f32, b: f64| (f64::from(a) - b).abs() <= 1e-6 * b.abs().max(1e-3);
+        assert!(close(PERIOD_S, file.period_s));
+        assert!(close(
+            spec.counts_per_rev,
+            file.motors.encoder_counts_per_rev as f64
+        ));
+        assert!(close(spec.motor_torque_nm.0, file.motors.peak_torque_nm));
+        assert!(close(
+            spec.motor_torque_nm.1,
+            file.motors.continuous_torque_nm
+        ));
+        for i in 0..3 {
+            assert!(close(spec.ratios[i], file.motors.ratios[i]), "{device:?}");
+            for e in 0..2 {
+                assert!(close(spec.limits_rad[i][e], file.joints.limits_rad[i][e]));
+            }
+        }
+        assert!(
+            file.within_limits(&spec.rest_rad.map(f64::from)),
+            "{device:?}"
+        );
+        match (device, &file.geometry) {
+            (Device::SerialArm, Geometry::SerialArm { l1_m, l2_m }) => {
+                let (a, b) = twoport_board::linkage::PHANTOM_ARM;
+                assert!(close(a, *l1_m) && close(b, *l2_m));
+            }
+            (
+                Device::Delta,
+                Geometry::Delta {
+                    base_m,
+                    effector_m,
+                    upper_m,
+                    lower_m,
+                },
+            ) => {
+                let (r, e, a, b) = twoport_board::linkage::FALCON_DELTA;
+                assert!(close(r, *base_m) && close(e, *effector_m));
+                assert!(close(a, *upper_m) && close(b, *lower_m));
+            }
+            (d, g) => panic!("{d:?} is not {g:?}"),
+        }
+        let poses = workspace_poses(&file, DESIGN_GRID);
+        let r = region(spec).unwrap();
+        // On its grid the region is the proof; between grid points, the
+        // stiffer neighbour's less 1 %, never more than the proof.
+        let total = spec.least_damping_nspm + GRASP_NSPM;
+        let grid = (0..5).map(|i| 0.01 + 0.24 * total * i as f32);
+        for (b_c, on_grid) in grid.map(|b| (b, true)).chain([(0.5, false), (1.3, false)]) {
+            let d = workspace_design(&file, &poses, f64::from(b_c), f64::from(GRASP_NSPM)).unwrap();
+            let kmax = f64::from(r.limit_at(b_c).unwrap());
+            let ok = if on_grid {
+                (kmax - d.k_c_npm).abs() <= 1e-4 * d.k_c_npm
+            } else {
+                kmax <= d.k_c_npm
+            };
+            assert!(
+                ok,
+                "{device:?} at b_c {b_c}: the region allows {kmax}, the proof {}",
+                d.k_c_npm
+            );
+        }
+    }
+}
