@@ -146,7 +146,7 @@ fn hand_radius(human: &HumanBound, omega: f64) -> f64 {
 
 /// `B(θ)`: the least `Re(1/Z_c(e^{jθ}))` that keeps the loop at the pose
 /// stable for every hand the bound allows and every passive VE. The
-/// aliases past [`ALIASES`] are bounded: `|ζ_k| ≤ 1/|s| ≤ 1/(|ω_k| m_min
+/// aliases past the 60th on each side are bounded: `|ζ_k| ≤ 1/|s| ≤ 1/(|ω_k| m_min
 /// - ρ)`, summed as an integral.
 pub fn bound_at(pose: &PoseRanges, human: &HumanBound, period_s: f64, theta: f64) -> f64 {
     let t = period_s;
