@@ -9,6 +9,7 @@ use host_sim::pil::{self, linkage};
 use linkage::Device;
 use nalgebra::DVector;
 use twoport_board::linkage::FLOOR;
+use twoport_control::linkage::Gravity;
 use twoport_link::{Axes, ModeRefusal, ModeRequest};
 
 fn run(device: Device, ticks: u64, faults: LinkFaults) -> pil::Run<3> {
@@ -21,9 +22,10 @@ fn run(device: Device, ticks: u64, faults: LinkFaults) -> pil::Run<3> {
 }
 
 /// The hand presses the handle through the floor the image holds 5 mm
-/// under the rest pose. After 2 s the handle rests in it, and the motors'
-/// torques balance the hand's force through the arm at each pose:
-/// `τ = J^T f_h` on the device file's nonlinear arm, to 1 % over 0.2 s.
+/// under the rest pose, under gravity. After 2 s the handle rests in it,
+/// and the motors' torques balance the hand's force through the arm and
+/// hold the moving masses up: `τ = J^T f_h - G(q)` on the device file's
+/// nonlinear arm, to 1 % over 0.2 s.
 /// With corrupted frames on the link and the heartbeats stopping at 2.5 s,
 /// every motor is at zero within the watchdog's deadline.
 #[test]
@@ -80,7 +82,9 @@ fn a_linkage_board_holds_the_floor_and_stops_after_a_link_loss() {
                 let v = (s.handle_m[a] - before.handle_m[a]) / 1e-3;
                 -k * (s.handle_m[a] - anchor[a]) - b * v
             });
-            let tau = j.transpose() * &f;
+            // The board holds gravity up: the plant's own G(q), from the file.
+            let g = file.gravity_nm(plant.q.as_slice(), &j, linkage::GRAVITY_MPS2);
+            let tau = j.transpose() * &f - DVector::from_vec(g);
             for i in 0..3 {
                 got[i] += s.actuator_n[i] / window.len() as f64;
                 want[i] += tau[i] / window.len() as f64;
@@ -158,10 +162,30 @@ fn the_images_are_their_device_files_and_their_proof() {
                 assert!(close(spec.limits_rad[i][e], file.joints.limits_rad[i][e]));
             }
         }
-        assert!(
-            file.within_limits(&spec.rest_rad.map(f64::from)),
-            "{device:?}"
-        );
+        let rest = spec.rest_rad.map(f64::from);
+        assert!(file.within_limits(&rest), "{device:?}");
+        // The gravity the image holds up is the file's, at the rest pose.
+        let start = LinkagePlant::at_rest(&file, &rest);
+        let (_, j) = start.kinematics(&start.q).unwrap();
+        let g = file.gravity_nm(&rest, &j, linkage::GRAVITY_MPS2);
+        let image: [f64; 3] = match spec.gravity {
+            Gravity::SerialArm { upper_nm, fore_nm } => [
+                0.0,
+                f64::from(upper_nm) * rest[1].cos(),
+                f64::from(fore_nm) * rest[2].sin(),
+            ],
+            Gravity::Handle { weight_n } => {
+                core::array::from_fn(|i| f64::from(weight_n) * j[(2, i)])
+            }
+            Gravity::Off => [0.0; 3],
+        };
+        assert!(g.iter().any(|g| g.abs() > 1e-3), "{device:?}: {g:?}");
+        for i in 0..3 {
+            assert!(
+                (image[i] - g[i]).abs() < 1e-5 * g[i].abs().max(1e-2),
+                "{device:?}: {image:?} vs {g:?}"
+            );
+        }
         match (device, &file.geometry) {
             (Device::SerialArm, Geometry::SerialArm { l1_m, l2_m }) => {
                 let (a, b) = twoport_board::linkage::PHANTOM_ARM;

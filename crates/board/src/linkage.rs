@@ -2,7 +2,8 @@
 //! rotary delta, each a [`LinkageServo`] (joint encoders in, joint torques
 //! out) around the three-axis Cartesian servo, with the coupling the
 //! workspace proof gives for a grasp of at least [`GRASP_NSPM`] and a
-//! floor under the handle. The numbers are the shipped device files'
+//! floor under the handle, holding the moving masses up against gravity.
+//! The numbers are the shipped device files'
 //! (`models/linkages/`); a host test holds them to those files and to the
 //! designer's proof.
 //!
@@ -14,7 +15,7 @@ use crate::region::{Bound, Region};
 use crate::Board;
 use twoport_control::kinematics::{Delta, Kinematics, SerialArm};
 use twoport_control::linkage::{
-    JointEncoder, JointEncoderError, LinkageError, LinkageServo, MotorConfig,
+    Gravity, JointEncoder, JointEncoderError, LinkageError, LinkageServo, MotorConfig,
 };
 use twoport_control::servo::ImpedanceGains;
 use twoport_control::ve::{Solid, UnilateralWall};
@@ -56,6 +57,8 @@ pub struct Spec {
     pub least_damping_nspm: f32,
     /// The calibration pose (rad): where the host puts the arm.
     pub rest_rad: [f32; 3],
+    /// The moving masses the motors hold up (g = 9.81 m/s² along `-z`).
+    pub gravity: Gravity,
 }
 
 /// The PHANToM Premium 1.5 (`phantom_premium_1_5.toml`).
@@ -68,6 +71,12 @@ pub const PHANTOM: Spec = Spec {
     motor_torque_nm: (0.129, 0.0286),
     least_damping_nspm: 0.003_781,
     rest_rad: [0.0, 0.3, 1.2],
+    // g (l1 m_a + l5 m_be + l1 m_c/2), g (l2 m_a/2 + l3 m_c - l6 m_df):
+    // both counterweighted past balance.
+    gravity: Gravity::SerialArm {
+        upper_nm: -0.016_298,
+        fore_nm: -0.073_755,
+    },
 };
 /// Its arm: `l1`, `l2` (m).
 pub const PHANTOM_ARM: (f32, f32) = (0.215, 0.170);
@@ -80,6 +89,8 @@ pub const FALCON: Spec = Spec {
     motor_torque_nm: (0.1, 0.04),
     least_damping_nspm: 0.087_78,
     rest_rad: [0.45, 0.45, 0.45],
+    // The lumped handle's 60 g.
+    gravity: Gravity::Handle { weight_n: 0.5886 },
 };
 /// Its geometry: base and effector radii, upper and lower arms (m).
 pub const FALCON_DELTA: (f32, f32, f32, f32) = (0.040, 0.02309, 0.060, 0.1025);
@@ -188,7 +199,9 @@ pub fn board<K: Kinematics<f32, 3>>(
         motors,
         world,
     )
-    .map_err(BuildError::Linkage)?;
+    .map_err(BuildError::Linkage)?
+    .with_gravity(spec.gravity)
+    .map_err(BuildError::Param)?;
     let r = region(spec).map_err(BuildError::Region)?;
     Ok(Board::new(servo, [r; 3], TELEMETRY_EVERY).with_io(io(spec)))
 }

@@ -63,6 +63,7 @@ use cortex_m::interrupt::Mutex;
 use cortex_m_rt::entry;
 use stm32f4::stm32f405::{self as pac, interrupt};
 use support::Stm32;
+#[cfg(not(any(feature = "serial-arm", feature = "delta")))]
 use twoport_board::excalibur;
 #[cfg(feature = "qemu")]
 use twoport_qemu_exit as _;

@@ -5,7 +5,8 @@
 //!
 //! The run: the board boots and saves its configuration; one tick
 //! disarmed; the host calibrates it at the rest pose (the joint angles,
-//! in 1e-12 rad) and arms it; then a hand that grasps with 2 N s/m (the
+//! in 1e-12 rad) and arms it; then, under gravity the board holds up, a
+//! hand that grasps with 2 N s/m (the
 //! images' least grasp) and a 300 N/m spring presses the handle 15 mm
 //! down, through the board's floor 5 mm under the rest pose.
 
@@ -57,6 +58,9 @@ impl Device {
 /// stiffness (N/m) and the grasp's damping (N s/m).
 pub const HAND: (f64, f64, f64) = (0.015, 300.0, 2.0);
 
+/// Gravity on the arm (m/s², along `-z`).
+pub const GRAVITY_MPS2: f64 = 9.81;
+
 /// Runge-Kutta sub-steps per tick.
 const SUBSTEPS: u32 = 8;
 
@@ -75,7 +79,9 @@ impl Arm {
         let file = device.file()?;
         let spec = device.spec();
         let rest = spec.rest_rad.map(f64::from);
-        let plant = LinkagePlant::at_rest(&file, &rest);
+        let mut plant = LinkagePlant::at_rest(&file, &rest);
+        // (The images hold the moving masses up: gravity acts.)
+        plant.gravity_mps2 = GRAVITY_MPS2;
         let (x, _) = plant.kinematics(&plant.q).map_err(plant_err)?;
         let (down, k, b) = HAND;
         let mut anchor = x.clone();

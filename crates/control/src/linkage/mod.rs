@@ -13,11 +13,13 @@
 //! [`Faults::KINEMATICS`] and the reason, and every motor holds zero
 //! torque.
 
+mod gravity;
 mod joints;
 mod motors;
 #[cfg(test)]
 mod tests;
 
+pub use gravity::Gravity;
 pub use joints::{JointEncoder, JointEncoderError};
 pub use motors::{LimitedTorques, MotorConfig, MotorLimits};
 
@@ -25,7 +27,7 @@ use crate::kinematics::{Jointed, Kinematics, KinematicsFault};
 use crate::safety::AxisError;
 use crate::servo::{Gains, GainsError, SensorFrame, Servo, ServoOutput};
 use crate::world::World;
-use crate::{Encoder, Faults, Position, Real, SafetyConfig};
+use crate::{Encoder, Faults, ParamError, Position, Real, SafetyConfig};
 
 /// The joint angles the proof covered: each joint's `[lo, hi]` (rad).
 pub type JointLimits<const N: usize> = [[f32; 2]; N];
@@ -123,6 +125,7 @@ pub struct LinkageServo<K, W, R = f32, const N: usize = 3> {
     /// The handle's position there.
     handle: [Position; N],
     fault: Option<KinematicsFault>,
+    gravity: Gravity,
 }
 
 impl<K: Kinematics<f32, N>, W: World<f32, N>, const N: usize> LinkageServo<K, W, f32, N> {
@@ -181,6 +184,7 @@ impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<
             pose,
             handle,
             fault: None,
+            gravity: Gravity::Off,
         };
         if let Err(f) = served {
             s.latch(f);
@@ -242,12 +246,21 @@ impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<
         q
     }
 
-    /// The Cartesian tick's force out as the motors' torques.
+    /// The Cartesian tick's force out as the motors' torques, with gravity
+    /// held up while the servo may push.
     #[inline(always)]
     fn drive(&mut self, q: [R; N], cartesian: ServoOutput<R, N>) -> LinkageOutput<R, N> {
-        let limited = self
-            .motors
-            .step(self.pose.torques_nm(&cartesian.actuator_force_n));
+        let mut torque = self.pose.torques_nm(&cartesian.actuator_force_n);
+        if self.gravity != Gravity::Off
+            && cartesian.faults.is_empty()
+            && self.cartesian.safety().is_enabled()
+        {
+            let g = self.gravity.torques_nm(&q, &self.pose);
+            for (t, g) in torque.iter_mut().zip(g) {
+                *t = *t - g;
+            }
+        }
+        let limited = self.motors.step(torque);
         LinkageOutput {
             torque_nm: limited.torque_nm,
             torque_limited: limited.limited,
@@ -303,6 +316,25 @@ impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<
             }
             Err(f) => self.latch(f),
         }
+    }
+
+    /// The same servo holding the moving masses up with `gravity`
+    /// (refused unless finite).
+    pub fn with_gravity(mut self, gravity: Gravity) -> Result<Self, ParamError> {
+        if !gravity.is_finite() {
+            return Err(ParamError {
+                name: "gravity (N or N m)",
+                value: f32::NAN,
+                problem: "must be finite",
+            });
+        }
+        self.gravity = gravity;
+        Ok(self)
+    }
+
+    /// What it holds up.
+    pub fn gravity(&self) -> Gravity {
+        self.gravity
     }
 
     /// The Cartesian servo: gains, world, safety layer, laws.

@@ -285,3 +285,47 @@ fn bad_limits_are_refused() {
         "{e}"
     );
 }
+
+/// Gravity held up: with the handle where the VE holds it (no coupling
+/// force), the motors give `-G(q)`, the serial arm's link moments through
+/// `cos q2` and `sin q3`, and a handle's weight through the Jacobian's
+/// height row; disabled, or with a fault latched, nothing at all.
+#[test]
+fn gravity_is_held_up_only_while_the_servo_may_push() {
+    let (upper, fore) = (0.21, -0.05);
+    let g = Gravity::SerialArm {
+        upper_nm: upper,
+        fore_nm: fore,
+    };
+    let mut s = servo(500.0, [MotorConfig::new(50.0, 20.0); 3])
+        .with_gravity(g)
+        .unwrap();
+    let out = s.tick(&frame(0, [0; 3]));
+    let want = [0.0, -upper * Q0[1].cos(), -fore * Q0[2].sin()];
+    for i in 0..3 {
+        assert!(
+            (out.torque_nm[i] - want[i]).abs() < 1e-6,
+            "{:?}",
+            out.torque_nm
+        );
+    }
+    let w = 0.6;
+    let mut h = servo(500.0, [MotorConfig::new(50.0, 20.0); 3])
+        .with_gravity(Gravity::Handle { weight_n: w })
+        .unwrap();
+    let out = h.tick(&frame(0, [0; 3]));
+    let j = Kinematics::<f32, 3>::forward(&arm(), &Q0).unwrap().jacobian;
+    for i in 0..3 {
+        assert!((out.torque_nm[i] + w * j[2][i]).abs() < 1e-6);
+    }
+    s.disable();
+    assert_eq!(s.tick(&frame(1, [0; 3])).torque_nm, [0.0; 3]);
+    s.clear();
+    s.enable().unwrap();
+    s.trip(Faults::KINEMATICS);
+    assert_eq!(s.tick(&frame(2, [0; 3])).torque_nm, [0.0; 3]);
+    let bad = Gravity::Handle { weight_n: f32::NAN };
+    assert!(servo(500.0, [MotorConfig::new(5.0, 2.0); 3])
+        .with_gravity(bad)
+        .is_err());
+}

@@ -44,6 +44,12 @@ pub enum Inertia {
     SerialArmLinks {
         /// The forearm's counterweight offset `l3` (m).
         l3_m: f64,
+        /// Where link be's centre of mass lies along the upper arm, `l5`
+        /// (m, signed: behind the shoulder when negative).
+        l5_m: f64,
+        /// Where link df's centre of mass lies along the forearm's drive,
+        /// `l6` (m, signed).
+        l6_m: f64,
         /// Masses of links a, c, be, df (kg).
         masses_kg: [f64; 4],
         /// Inertias `[xx, yy, zz]` of links a, c, be, df (kg m²).
@@ -313,6 +319,8 @@ impl LinkageFile {
             }
             Inertia::SerialArmLinks {
                 l3_m,
+                l5_m,
+                l6_m,
                 masses_kg,
                 inertias_kgm2,
                 base_yy_kgm2,
@@ -321,6 +329,11 @@ impl LinkageFile {
                     return Err("inertia.kind = \"serial_arm_links\": only for geometry.kind = \"serial_arm\"".into());
                 }
                 at_least_zero("inertia.l3_m", *l3_m)?;
+                for (name, x) in [("inertia.l5_m", l5_m), ("inertia.l6_m", l6_m)] {
+                    if !x.is_finite() {
+                        return Err(format!("{name} = {x}: must be finite"));
+                    }
+                }
                 at_least_zero("inertia.base_yy_kgm2", *base_yy_kgm2)?;
                 for (i, m) in masses_kg.iter().enumerate() {
                     at_least_zero(&format!("inertia.masses_kg[{i}]"), *m)?;
@@ -385,6 +398,10 @@ mod tests {
             "continuous_torque_nm = 9.0"
         )
         .contains("exceeds motors.peak_torque_nm"));
+        assert_eq!(
+            refused(PHANTOM, "l5_m = -0.0368", "l5_m = nan"),
+            "x.toml: inertia.l5_m = NaN: must be finite"
+        );
         assert_eq!(
             refused(PHANTOM, "joints = [1, 2]", "joints = [1, 3]"),
             "x.toml: joints.relative[0].joints = [1, 3]: two different joints below 3"

@@ -97,6 +97,7 @@ impl LinkageFile {
                     masses_kg,
                     inertias_kgm2,
                     base_yy_kgm2,
+                    ..
                 },
                 Geometry::SerialArm { l1_m, l2_m },
             ) => {
@@ -115,6 +116,59 @@ impl LinkageFile {
             }
             // (The file's check allows link parameters on a serial arm only.)
             (Inertia::SerialArmLinks { .. }, _) => rotors,
+        }
+    }
+
+    /// The moving masses' potential energy at `q` (J), with gravity `g`
+    /// (m/s²) along `-z` and the handle at height `z_m`: a lumped handle
+    /// mass's weight, or the serial arm's links (Cavusoglu, Feygin &
+    /// Tendick 2002: centres of mass at `l1` and `l5` along the upper arm,
+    /// `l2/2`, `l3` and `l6` along the forearm's parts).
+    pub fn potential_j(&self, q: &[f64], z_m: f64, g: f64) -> f64 {
+        match (&self.inertia, self.geometry) {
+            (Inertia::Lumped { handle_mass_kg, .. }, _) => handle_mass_kg * g * z_m,
+            (
+                Inertia::SerialArmLinks {
+                    l3_m,
+                    l5_m,
+                    l6_m,
+                    masses_kg: [ma, mc, mbe, mdf],
+                    ..
+                },
+                Geometry::SerialArm { l1_m, l2_m },
+            ) => {
+                let (up, fore) =
+                    arm_weights(l1_m, l2_m, *l3_m, *l5_m, *l6_m, [*ma, *mc, *mbe, *mdf]);
+                g * (up * q[1].sin() - fore * q[2].cos())
+            }
+            (Inertia::SerialArmLinks { .. }, _) => 0.0,
+        }
+    }
+
+    /// The joint torques gravity asks at `q` (N m), the potential energy's
+    /// gradient, given the Jacobian there and gravity `g` (m/s²) along
+    /// `-z`.
+    pub fn gravity_nm(&self, q: &[f64], jacobian: &DMatrix<f64>, g: f64) -> Vec<f64> {
+        let n = q.len();
+        match (&self.inertia, self.geometry) {
+            (Inertia::Lumped { handle_mass_kg, .. }, _) if jacobian.nrows() == 3 => (0..n)
+                .map(|c| handle_mass_kg * g * jacobian[(2, c)])
+                .collect(),
+            (
+                Inertia::SerialArmLinks {
+                    l3_m,
+                    l5_m,
+                    l6_m,
+                    masses_kg: [ma, mc, mbe, mdf],
+                    ..
+                },
+                Geometry::SerialArm { l1_m, l2_m },
+            ) => {
+                let (up, fore) =
+                    arm_weights(l1_m, l2_m, *l3_m, *l5_m, *l6_m, [*ma, *mc, *mbe, *mdf]);
+                vec![0.0, g * up * q[1].cos(), g * fore * q[2].sin()]
+            }
+            _ => vec![0.0; n],
         }
     }
 
@@ -191,4 +245,22 @@ impl LinkageFile {
             }
         }
     }
+}
+
+/// The serial arm's first moments of mass about the shoulder (kg m): the
+/// upper arm's, `l1 m_a + l5 m_be + l1 m_c/2`, whose height goes as
+/// `sin q2`, and the forearm's, `l2 m_a/2 + l3 m_c - l6 m_df`, whose depth
+/// goes as `cos q3`.
+fn arm_weights(
+    l1: f64,
+    l2: f64,
+    l3: f64,
+    l5: f64,
+    l6: f64,
+    [ma, mc, mbe, mdf]: [f64; 4],
+) -> (f64, f64) {
+    (
+        l1 * ma + l5 * mbe + 0.5 * l1 * mc,
+        0.5 * l2 * ma + l3 * mc - l6 * mdf,
+    )
 }

@@ -163,6 +163,7 @@ pub const OSCILLATING_MARGIN: f64 = 1e-10;
 mod closed_loop;
 mod construct;
 mod search;
+mod simplex;
 
 use closed_loop::{closed_loop, judge};
 pub use construct::{construct, Constructed};

@@ -116,61 +116,17 @@ impl Search<'_> {
 
     /// Nelder-Mead on `-radius` from `start`.
     fn refine(&mut self, kind: VeKind, start: &[f64], iters: usize) -> (Vec<f64>, Radius) {
-        let dim = start.len();
-        let mut simplex: Vec<(Vec<f64>, Radius)> = Vec::with_capacity(dim + 1);
-        let mut s0 = start.to_vec();
-        let r0 = self.eval(kind, &mut s0);
-        simplex.push((s0, r0));
-        for i in 0..dim {
-            let mut p = start.to_vec();
-            // (Small steps in the stiffnesses that tune a resonance.)
-            let tuning = i == 1 || i == self.ve_at() || (self.two && i == 4);
-            p[i] += if tuning { 0.05 } else { 0.3 };
-            let r = self.eval(kind, &mut p);
-            simplex.push((p, r));
-        }
-        let key = |r: &Radius| -r.score;
-        for _ in 0..iters {
-            simplex.sort_by(|a, b| key(&a.1).total_cmp(&key(&b.1)));
-            let worst = simplex[dim].clone();
-            let centroid: Vec<f64> = (0..dim)
-                .map(|j| simplex[..dim].iter().map(|s| s.0[j]).sum::<f64>() / dim as f64)
-                .collect();
-            let at = |c: f64| -> Vec<f64> {
-                (0..dim)
-                    .map(|j| centroid[j] + c * (worst.0[j] - centroid[j]))
-                    .collect()
-            };
-            let mut xr = at(-1.0);
-            let rr = self.eval(kind, &mut xr);
-            if key(&rr) < key(&simplex[0].1) {
-                let mut xe = at(-2.0);
-                let re = self.eval(kind, &mut xe);
-                simplex[dim] = if key(&re) < key(&rr) {
-                    (xe, re)
-                } else {
-                    (xr, rr)
-                };
-            } else if key(&rr) < key(&simplex[dim - 1].1) {
-                simplex[dim] = (xr, rr);
+        let (ve_at, two) = (self.ve_at(), self.two);
+        // (Small steps in the stiffnesses that tune a resonance.)
+        let step = |i: usize| {
+            let tuning = i == 1 || i == ve_at || (two && i == 4);
+            if tuning {
+                0.05
             } else {
-                let mut xc = at(0.5);
-                let rc = self.eval(kind, &mut xc);
-                if key(&rc) < key(&worst.1) {
-                    simplex[dim] = (xc, rc);
-                } else {
-                    let best = simplex[0].0.clone();
-                    for s in simplex.iter_mut().skip(1) {
-                        let mut p: Vec<f64> =
-                            s.0.iter().zip(&best).map(|(x, b)| 0.5 * (x + b)).collect();
-                        let r = self.eval(kind, &mut p);
-                        *s = (p, r);
-                    }
-                }
+                0.3
             }
-        }
-        simplex.sort_by(|a, b| key(&a.1).total_cmp(&key(&b.1)));
-        simplex.swap_remove(0)
+        };
+        super::simplex::maximise(start, step, iters, |p| self.eval(kind, p), |r| r.score)
     }
 }
 

@@ -4,14 +4,15 @@
 //! `M(q)` is the device file's mass matrix (links and reflected rotors),
 //! `c` the Coriolis and centrifugal terms from its derivatives
 //! (`c = M' q' - ½ ∂(q'^T M q')/∂q`, by central differences), `g` the
-//! gravity on a lumped handle mass, `D` the joints' viscous damping and
+//! gravity on the moving masses (a lumped handle mass, or the serial arm's
+//! links), `D` the joints' viscous damping and
 //! `f_c` their Coulomb friction (smoothed over a small speed). `τ_a` is the
 //! motors' torque as the servo gives it (positive resisting positive joint
 //! motion) and `f_h` the hand's force on the handle (N). Integrated by
 //! fourth-order Runge-Kutta at a fixed sub-step.
 
 use nalgebra::{DMatrix, DVector};
-use twoport_design::linkage::{forward, Inertia, LinkageFile};
+use twoport_design::linkage::{forward, LinkageFile};
 
 /// The hand on a linkage's handle, in Cartesian space: a spring to an
 /// anchor and a damper, each a symmetric matrix (a passive N-port hand
@@ -72,7 +73,7 @@ pub struct LinkagePlant {
     pub q: DVector<f64>,
     /// Joint rates (rad/s).
     pub qd: DVector<f64>,
-    /// Gravity along `-z` (m/s²) on a lumped handle mass; 0 leaves it out.
+    /// Gravity along `-z` (m/s²) on the moving masses; 0 leaves it out.
     pub gravity_mps2: f64,
     /// Whether the joints' Coulomb friction acts.
     pub friction: bool,
@@ -105,18 +106,22 @@ impl LinkagePlant {
         Ok(self.file.joint_mass(q.as_slice(), &j))
     }
 
-    /// The potential energy's gradient (N m): a lumped handle mass's
-    /// weight through the Jacobian's `z` row.
-    fn gravity(&self, j: &DMatrix<f64>) -> DVector<f64> {
-        let n = j.ncols();
-        match self.file.inertia {
-            Inertia::Lumped { handle_mass_kg, .. }
-                if self.gravity_mps2 != 0.0 && j.nrows() == 3 =>
-            {
-                DVector::from_fn(n, |c, _| handle_mass_kg * self.gravity_mps2 * j[(2, c)])
-            }
-            _ => DVector::zeros(n),
+    /// The torques gravity asks (N m): the device file's moving masses
+    /// (a lumped handle's, or the serial arm's links).
+    fn gravity(&self, q: &DVector<f64>, j: &DMatrix<f64>) -> DVector<f64> {
+        if self.gravity_mps2 == 0.0 {
+            return DVector::zeros(q.len());
         }
+        DVector::from_vec(self.file.gravity_nm(q.as_slice(), j, self.gravity_mps2))
+    }
+
+    /// The moving masses' potential energy under gravity (J).
+    pub fn potential_j(&self) -> Result<f64, PlantError> {
+        let (x, _) = self.kinematics(&self.q)?;
+        let z = x.get(2).copied().unwrap_or(0.0);
+        Ok(self
+            .file
+            .potential_j(self.q.as_slice(), z, self.gravity_mps2))
     }
 
     /// `q''` at `(q, q')` under motor torques `tau_a` (N m, resisting) and
@@ -154,7 +159,7 @@ impl LinkagePlant {
         };
         let v = &j * qd;
         let hand_torque = j.transpose() * hand.force(&x, &v);
-        let rhs = hand_torque - tau_a - coriolis - self.gravity(&j) - damping - friction;
+        let rhs = hand_torque - tau_a - coriolis - self.gravity(q, &j) - damping - friction;
         m.cholesky()
             .map(|c| c.solve(&rhs))
             .ok_or_else(|| PlantError::Pose(q.as_slice().to_vec()))

@@ -102,6 +102,38 @@ fn coriolis_terms_do_no_work() {
     assert!((plant.q[0] - 0.1).abs() > 0.1);
 }
 
+/// Energy with gravity: with no torque, no hand and no losses, the
+/// kinetic energy and the moving masses' potential energy together are
+/// kept to 1e-6 of the energy that changed hands, on the PHANToM's links
+/// (Cavusoglu's centres of mass) and the delta's lumped handle: the
+/// gravity torques are the potential's gradient. The arm falls far.
+#[test]
+fn gravity_is_the_potentials_gradient() {
+    for (name, q0) in [
+        ("phantom_premium_1_5", vec![0.1, 0.3, 1.0]),
+        ("falcon_like", vec![0.4, 0.5, 0.6]),
+    ] {
+        let mut file = shipped(name);
+        file.joints.damping_nmsprad = vec![0.0; 3];
+        let mut plant = LinkagePlant::at_rest(&file, &q0);
+        plant.gravity_mps2 = 9.81;
+        let total = |p: &LinkagePlant| p.kinetic_j().unwrap() + p.potential_j().unwrap();
+        let (e0, u0) = (total(&plant), plant.potential_j().unwrap());
+        let hand = CartesianHand::off(3);
+        let mut moved = 0.0f64;
+        for _ in 0..150 {
+            plant.step(&[0.0; 3], &hand, 1e-3, 8).unwrap();
+            moved = moved.max((plant.potential_j().unwrap() - u0).abs());
+        }
+        let e1 = total(&plant);
+        assert!(moved > 1e-3, "{name}: {moved} J");
+        assert!(
+            (e1 - e0).abs() < 1e-6 * moved,
+            "{name}: {e0} J then {e1} J ({moved} J moved)"
+        );
+    }
+}
+
 /// The root mean square of `x` over `window` ticks from `from`.
 fn rms(x: &[f64], from: usize, window: usize) -> f64 {
     let w = &x[from..(from + window).min(x.len())];
