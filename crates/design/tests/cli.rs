@@ -463,6 +463,47 @@ fn linkages_are_proven_over_their_workspace() {
     );
     let e = TWOPORT.failure(&["design", "impedance", "--min-grasp", "1"]);
     assert!(e.contains("linkage"), "{e}");
+    // verify searches the linkage's exact loop: nothing 0.1 % inside the
+    // hands-off design, a growing loop 20 % past it.
+    let k = |f: f64| format!("{}", f * k0);
+    let at = TWOPORT.json(&[
+        "verify",
+        "impedance",
+        "--device",
+        dev,
+        "--k",
+        &k(0.999),
+        "--b",
+        "0",
+        "--no-human",
+        "--json",
+    ]);
+    assert_eq!(at["unstable"], false, "{at}");
+    let past = TWOPORT.json(&[
+        "verify",
+        "impedance",
+        "--device",
+        dev,
+        "--k",
+        &k(1.2),
+        "--b",
+        "0",
+        "--no-human",
+        "--json",
+    ]);
+    assert_eq!(past["unstable"], true, "{past}");
+    assert_eq!(past["hand"]["direction"].as_array().unwrap().len(), 3);
+    let e = TWOPORT.failure(&[
+        "verify",
+        "impedance",
+        "--k",
+        "1",
+        "--b",
+        "0",
+        "--min-grasp",
+        "1",
+    ]);
+    assert!(e.contains("linkage"), "{e}");
     let e = TWOPORT.failure(&["design", "impedance", "--device", dev, "--min-grasp", "-1"]);
     assert!(e.contains("--min-grasp -1"), "{e}");
     let dir: PathBuf = std::env::temp_dir().join(format!("twoport-map-{}", std::process::id()));

@@ -8,6 +8,7 @@ mod file;
 mod pose;
 mod proof;
 mod report;
+mod verify;
 
 pub use bounded::{bound_at, stiffest, stiffest_at, theta_grid, PoseRanges};
 pub use dynamics::SerialArmDynamics;
@@ -18,3 +19,4 @@ pub use proof::{
     BOUNDED_GRID, DESIGN_GRID,
 };
 pub use report::{stiffness, LinkageDesign};
+pub use verify::{loop_radius, verify_linkage, HandAssumption, LinkageHand, LinkageVerdict};

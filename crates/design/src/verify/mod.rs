@@ -165,6 +165,8 @@ mod construct;
 mod search;
 mod simplex;
 
+pub(crate) use simplex::maximise as simplex_maximise;
+
 use closed_loop::{closed_loop, judge};
 pub use construct::{construct, Constructed};
 pub use search::verify;

@@ -145,6 +145,10 @@ pub(crate) struct ImpedanceGains {
     /// Coupling damping b_cI (N s/m).
     #[arg(long, allow_negative_numbers = true)]
     pub(crate) b: f64,
+    /// A linkage device (--device, `verify` only): every hand grasps with
+    /// at least this damping in every direction (N s/m).
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) min_grasp: Option<f64>,
     #[command(flatten)]
     pub(crate) common: Common,
 }

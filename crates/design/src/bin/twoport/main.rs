@@ -76,6 +76,14 @@ fn main() -> ExitCode {
         Cmd::Plot(p) if matches!(p.figure, Fig::Workspace) => plots::plot_workspace(p),
         Cmd::Plot(p) => one_axis(p, plots::plot_fig),
         Cmd::Region(d) => each_axis(d, region::region),
+        Cmd::Verify(Display::Impedance(a))
+            if a.common
+                .device
+                .as_deref()
+                .is_some_and(twoport_design::linkage::LinkageFile::is_linkage) =>
+        {
+            verify::verify_linkage(a)
+        }
         Cmd::Verify(d) => each_axis(d, verify::verify),
     };
     match r {

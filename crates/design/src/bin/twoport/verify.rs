@@ -5,6 +5,14 @@ use crate::run::*;
 use twoport_control::{AdmittanceGains as Adm, Gains, ImpedanceGains as Imp};
 
 pub(crate) fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
+    if let Display::Impedance(ImpedanceGains {
+        min_grasp: Some(g), ..
+    }) = d
+    {
+        return Err(format!(
+            "--min-grasp {g}: a grasp's least damping is searched on linkage devices (--device LINKAGE) only"
+        ));
+    }
     // The board's f32 gains: the laws are built from them either way.
     let (common, gains) = match d {
         Display::Impedance(g) => (
@@ -30,4 +38,50 @@ pub(crate) fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(),
         .verify(&gains)
         .map_err(|e| e.to_string())?;
     emit(common, &r)
+}
+
+/// `verify impedance --device LINKAGE`: the search on the exact discrete
+/// loop of the linearised linkage, at the binding pose of the workspace
+/// design under the same hand assumption and at every tenth pose.
+pub(crate) fn verify_linkage(a: &ImpedanceGains) -> Result<(), String> {
+    use twoport_design::linkage::{
+        bounded_workspace_design, verify_linkage, workspace_design, workspace_poses,
+        HandAssumption, LinkageFile, DESIGN_GRID,
+    };
+    use twoport_design::network::HumanBound;
+    let path = a.common.device.as_ref().ok_or("--device: a linkage file")?;
+    let mut file = LinkageFile::load(path).map_err(|e| e.to_string())?;
+    if let Some(t) = a.common.period {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(format!("--period {t}: must be finite and > 0"));
+        }
+        file.period_s = t;
+    }
+    let (k, b) = (gain("k", a.k)?, gain("b", a.b)?);
+    let grasp = match a.min_grasp {
+        Some(g) if !(g.is_finite() && g >= 0.0) => {
+            return Err(format!(
+                "--min-grasp {g}: must be a finite damping >= 0 N s/m"
+            ))
+        }
+        g => g.unwrap_or(0.0),
+    };
+    let human = (!a.common.no_human && a.min_grasp.is_none()).then_some(HumanBound::PAPER);
+    let poses = workspace_poses(&file, DESIGN_GRID);
+    // The pose that binds the design under the same assumption leads.
+    let d = match human {
+        Some(h) => bounded_workspace_design(&file, &poses, 0.0, grasp, h),
+        None => workspace_design(&file, &poses, 0.0, grasp),
+    }
+    .map_err(|e| e.to_string())?;
+    let sample: Vec<_> = std::iter::once(&d.binding.pose)
+        .chain(poses.iter().step_by(10))
+        .collect();
+    let assumption = HandAssumption {
+        min_grasp_nspm: grasp,
+        human,
+    };
+    let v = verify_linkage(&sample, &assumption, (k, b), file.period_s)
+        .ok_or("no pose could be searched")?;
+    emit(&a.common, &v)
 }
