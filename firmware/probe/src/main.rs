@@ -253,11 +253,12 @@ fn tick_cost_axes(t: &mut Tally) {
 
 /// A 3-DOF linkage's tick in QEMU: three joint encoders, the kinematics
 /// and Jacobian, the three-axis Cartesian servo with a wall on each axis,
-/// `J^T f` and the motors' limits. The joints sweep back and forth (a
+/// `J^T f`, gravity held up as the linkage images do, and the motors'
+/// limits. The joints sweep back and forth (a
 /// triangle of 300 counts), so the handle passes in and out of the walls.
 fn tick_cost_linkage(t: &mut Tally) {
     use twoport_control::kinematics::{Delta, Kinematics, SerialArm};
-    use twoport_control::linkage::{JointEncoder, LinkageServo, MotorConfig};
+    use twoport_control::linkage::{Gravity, JointEncoder, LinkageServo, MotorConfig};
     use twoport_control::world::{PerAxis, World};
     /// The walls as their own world type. A board image runs one servo,
     /// whose tick the compiler inlines into the loop; here the Cartesian
@@ -291,6 +292,7 @@ fn tick_cost_linkage(t: &mut Tally) {
         k: K,
         q0: [f32; 3],
         counts_per_rev: f32,
+        gravity: Gravity,
         name: &str,
         what: &str,
     ) {
@@ -311,6 +313,8 @@ fn tick_cost_linkage(t: &mut Tally) {
         let motors = [MotorConfig::new(1.0, 0.4); 3];
         let Ok(mut s) =
             LinkageServo::new(k, joints, limits, [gains; 3], [safety; 3], motors, walls)
+                .map_err(|_| ())
+                .and_then(|s| s.with_gravity(gravity).map_err(|_| ()))
         else {
             t.check(name, false);
             return;
@@ -339,8 +343,12 @@ fn tick_cost_linkage(t: &mut Tally) {
         arm,
         [0.1, 0.3, 1.0],
         26_600.0,
+        Gravity::SerialArm {
+            upper_nm: -0.0163,
+            fore_nm: -0.0738,
+        },
         "serial_arm_tick",
-        "3-DOF serial arm tick (joints, kinematics, Jacobian, walls, safety, J^T f)",
+        "3-DOF serial arm tick (joints, kinematics, Jacobian, walls, safety, J^T f, gravity)",
     );
     let delta = Delta::new(0.04, 0.02309, 0.06, 0.1025).unwrap();
     run(
@@ -348,8 +356,9 @@ fn tick_cost_linkage(t: &mut Tally) {
         delta,
         [0.5, 0.5, 0.5],
         2_470.0,
+        Gravity::Handle { weight_n: 0.5886 },
         "delta_tick",
-        "3-DOF delta tick (joints, forward solve, Jacobian, walls, safety, J^T f)",
+        "3-DOF delta tick (joints, forward solve, Jacobian, walls, safety, J^T f, gravity)",
     );
 }
 
