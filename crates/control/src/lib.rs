@@ -13,6 +13,7 @@ mod estimator;
 pub mod homing;
 pub mod kinematics;
 pub mod linkage;
+pub mod multisine;
 mod param;
 pub mod passivity;
 mod position;

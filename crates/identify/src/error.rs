@@ -1,0 +1,56 @@
+//! Why a record could not be identified.
+
+/// Why a record could not be identified.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum IdentifyError {
+    /// The signals' lengths differ.
+    #[error("{what}: {len} samples, but the force has {force}")]
+    Length {
+        /// The signal.
+        what: &'static str,
+        /// Its length.
+        len: usize,
+        /// The force's.
+        force: usize,
+    },
+    /// Fewer whole periods than an estimate with a variance needs.
+    #[error("{periods} whole periods after the {skipped} skipped: at least 2 are needed (a period is {period} samples)")]
+    TooShort {
+        /// Whole periods left.
+        periods: usize,
+        /// Periods skipped for the transient.
+        skipped: usize,
+        /// Samples a period.
+        period: usize,
+    },
+    /// A sample that is not a number.
+    #[error("{what}[{at}] = {value}: not a finite number")]
+    NotFinite {
+        /// The signal.
+        what: &'static str,
+        /// The sample's index.
+        at: usize,
+        /// Its value.
+        value: f64,
+    },
+    /// An excited harmonic with no force in it.
+    #[error("harmonic {harmonic} ({hz:.3} Hz): the force has no component there (|F| = {force:.3e} N); the excitation does not reach it")]
+    NoExcitation {
+        /// The harmonic.
+        harmonic: usize,
+        /// Its frequency (Hz).
+        hz: f64,
+        /// The force's amplitude there (N).
+        force: f64,
+    },
+    /// A harmonic at or past Nyquist, or a period too short.
+    #[error("harmonic {harmonic} of a {period}-sample period: must be between 1 and {max}")]
+    Harmonic {
+        /// The harmonic.
+        harmonic: usize,
+        /// Samples a period.
+        period: usize,
+        /// The largest allowed.
+        max: usize,
+    },
+}
