@@ -8,6 +8,8 @@ use serde::Deserialize;
 /// Grasp presets. The paper bounds the human by `Z_max = 300 + 1000/s`
 /// (maximum grasp, arm extended); hands-off is `Z = 0`. "Relaxed" is this
 /// project's assumption of a light grip: 30 N s/m and 200 N/m.
+/// "Fingertips" is the least grasp a linkage's design assumes (a dead-man
+/// switch keeps force off without one): 2 N s/m and 50 N/m.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum GraspKind {
@@ -15,6 +17,9 @@ pub enum GraspKind {
     HandsOff,
     /// A light grip.
     Relaxed,
+    /// A pen held in the fingertips: the least grasp linkages are proven
+    /// for.
+    Fingertips,
     /// The paper's maximum grasp.
     Maximum,
 }
@@ -25,6 +30,7 @@ impl GraspKind {
         let (b, k) = match self {
             GraspKind::HandsOff => (0.0, 0.0),
             GraspKind::Relaxed => (30.0, 200.0),
+            GraspKind::Fingertips => (2.0, 50.0),
             GraspKind::Maximum => (300.0, 1000.0),
         };
         Grasp {
@@ -39,6 +45,7 @@ impl GraspKind {
         match self {
             GraspKind::HandsOff => "hands_off",
             GraspKind::Relaxed => "relaxed",
+            GraspKind::Fingertips => "fingertips",
             GraspKind::Maximum => "maximum",
         }
     }

@@ -4,12 +4,15 @@
 
 use crate::engine::blocks::{Block, Blocks};
 use crate::engine::layer::SceneLayer;
+use crate::engine::linkage::{AnyKinematics, Shifted};
 use crate::engine::scene::{
     Discretization, Integration, LayerPort, Precision, Scene, SolidSide, VeSpec,
 };
 use crate::engine::ve::SceneVe;
 use crate::engine::world::SceneWorld;
 use crate::Error;
+use twoport_control::kinematics::Kinematics;
+use twoport_control::linkage::{JointEncoder, LinkageServo, MotorConfig};
 use twoport_control::passivity::{ParallelLimits, PassiveVe};
 use twoport_control::servo::{Gains, PortLayer, SensorFrame, Servo, ServoOutput};
 use twoport_control::ve::{
@@ -19,6 +22,7 @@ use twoport_control::ve::{
 use twoport_control::world::vbb::Block as Block3;
 use twoport_control::world::World;
 use twoport_control::{Encoder, Position, Real, SafetyConfig};
+use twoport_design::linkage::LinkageFile;
 
 /// The board's code for the scene's display on `N` axes, enabled.
 #[derive(Clone, Debug)]
@@ -31,13 +35,19 @@ pub enum SceneServo<const N: usize = 1> {
     F32Layered(Box<LayeredServo<f32, N>>),
     /// The f64 laws with the scene's port layer.
     F64Layered(Box<LayeredServo<f64, N>>),
+    /// A linkage's servo (f32, as its board runs it) around the scene's
+    /// world: joint encoders in, joint torques out.
+    Linkage(Box<LinkageSceneServo<N>>),
 }
+
+/// A linkage scene's servo.
+pub type LinkageSceneServo<const N: usize> = LinkageServo<Shifted, SceneWorld<f32, N>, f32, N>;
 
 /// The board's servo with the scene's port layer on each axis, computing
 /// in `R`.
 pub type LayeredServo<R, const N: usize = 1> = Servo<SceneWorld<R, N>, R, N, SceneLayer<R>>;
 
-/// `$e` on the servo whatever its variant.
+/// `$e` on the (Cartesian) servo whatever its variant.
 macro_rules! each_servo {
     ($self:expr, $s:ident => $e:expr) => {
         match $self {
@@ -45,6 +55,26 @@ macro_rules! each_servo {
             SceneServo::F64($s) => $e,
             SceneServo::F32Layered($s) => $e,
             SceneServo::F64Layered($s) => $e,
+            SceneServo::Linkage(l) => {
+                let $s = l.cartesian();
+                $e
+            }
+        }
+    };
+}
+
+/// The same, to change it.
+macro_rules! each_servo_mut {
+    ($self:expr, $s:ident => $e:expr) => {
+        match $self {
+            SceneServo::F32($s) => $e,
+            SceneServo::F64($s) => $e,
+            SceneServo::F32Layered($s) => $e,
+            SceneServo::F64Layered($s) => $e,
+            SceneServo::Linkage(l) => {
+                let $s = l.cartesian_mut();
+                $e
+            }
         }
     };
 }
@@ -194,7 +224,85 @@ impl<const N: usize> SceneServo<N> {
             SceneServo::F64(s) => s.tick(f),
             SceneServo::F32Layered(s) => output_f64(s.tick(&frame_f32(f))),
             SceneServo::F64Layered(s) => s.tick(f),
+            SceneServo::Linkage(s) => output_f64(s.tick(&frame_f32(f)).cartesian),
         }
+    }
+
+    /// One tick that also answers each motor's command: an axis's force
+    /// (N), or a linkage's joint torque (N m).
+    pub fn tick_driven(&mut self, f: &SensorFrame<f64, N>) -> (ServoOutput<f64, N>, [f64; N]) {
+        match self {
+            SceneServo::Linkage(s) => {
+                let out = s.tick(&frame_f32(f));
+                (output_f64(out.cartesian), out.torque_nm.map(f64::from))
+            }
+            _ => {
+                let out = self.tick(f);
+                (out, out.actuator_force_n)
+            }
+        }
+    }
+
+    /// A linkage scene's servo: the file's joints, limits and motors, the
+    /// scene's gains and world, the Cartesian frame's zero where the world
+    /// starts, the moving masses held up where the scene has gravity.
+    pub fn linkage(scene: &Scene, file: &LinkageFile, safety: SafetyConfig) -> Result<Self, Error> {
+        let t = safety.period_s;
+        let world = SceneWorld::new(scene, t, |_| axis_ve(scene, &safety))?;
+        let start = world.positions();
+        let q0 = &scene.plant.pose_rad;
+        let kinematics = AnyKinematics::new(&file.geometry)?;
+        let at = Shifted {
+            kinematics,
+            origin_m: [0.0; 3],
+        };
+        let q32: [f32; N] = core::array::from_fn(|i| q0[i] as f32);
+        let x0 = Kinematics::<f32, N>::forward(&at, &q32)
+            .map_err(|f| sim_err!("plant.pose_rad: {f:?}"))?
+            .position_m;
+        let mut origin = [0.0f32; 3];
+        for i in 0..N {
+            origin[i] = x0[i] - start[i].m();
+        }
+        let kinematics = Shifted {
+            kinematics,
+            origin_m: origin,
+        };
+        let joint = |i: usize| {
+            let cpr = file.motors.encoder_counts_per_rev as f32 * file.motors.ratios[i] as f32;
+            JointEncoder::new(32, cpr, 0, q32[i]).map_err(|e| sim_err!("joint {i}: {e:?}"))
+        };
+        let mut joints = [joint(0)?; N];
+        for (i, j) in joints.iter_mut().enumerate() {
+            *j = joint(i)?;
+        }
+        let limits = core::array::from_fn(|i| file.joints.limits_rad[i].map(|x| x as f32));
+        let motors = core::array::from_fn(|i| {
+            let n = file.motors.ratios[i];
+            MotorConfig::new(
+                (file.motors.peak_torque_nm * n) as f32,
+                (file.motors.continuous_torque_nm * n) as f32,
+            )
+        });
+        let gains = core::array::from_fn(|a| scene.gains_of(a));
+        let mut s = LinkageServo::new(
+            kinematics,
+            joints,
+            limits,
+            gains,
+            [safety; N],
+            motors,
+            world,
+        )
+        .map_err(|e| sim_err!("plant.linkage: {e}"))?;
+        if scene.plant.gravity_mps2 > 0.0 {
+            s = s
+                .with_gravity(file.gravity_compensation(scene.plant.gravity_mps2))
+                .map_err(|e| sim_err!("plant.gravity_mps2: {e}"))?;
+        }
+        s.enable()
+            .map_err(|f| sim_err!("the linkage's servo would not enable: {f}"))?;
+        Ok(SceneServo::Linkage(Box::new(s)))
     }
 
     /// The point each axis's coupling holds in the world.
@@ -226,12 +334,12 @@ impl<const N: usize> SceneServo<N> {
     /// Grab the block the world's cursor touches (the scope's button);
     /// whether one was there.
     pub fn grab(&mut self) -> bool {
-        each_servo!(self, s => s.world_mut().blocks_mut().is_some_and(|w| w.grab()))
+        each_servo_mut!(self, s => s.world_mut().blocks_mut().is_some_and(|w| w.grab()))
     }
 
     /// Let go of the world's held block.
     pub fn release(&mut self) {
-        each_servo!(self, s => {
+        each_servo_mut!(self, s => {
             if let Some(w) = s.world_mut().blocks_mut() {
                 w.release();
             }
@@ -252,13 +360,14 @@ impl<const N: usize> SceneServo<N> {
                 Some(SceneVe::Passive(p)) => Some(LayerView::Ve64(p)),
                 _ => None,
             },
+            SceneServo::Linkage(_) => None,
         }
     }
 
     /// Change every axis's gains while running (the scope's sliders); they
     /// must be for the scene's display.
     pub fn set_gains(&mut self, g: [Gains; N]) -> Result<(), Error> {
-        each_servo!(self, s => s.set_gains(g)).map_err(|e| Error::Sim(e.error.to_string()))
+        each_servo_mut!(self, s => s.set_gains(g)).map_err(|e| Error::Sim(e.error.to_string()))
     }
 
     /// Move the wall and change its stiffness on every axis while running
@@ -268,7 +377,7 @@ impl<const N: usize> SceneServo<N> {
             "wall position {surface_m} m is out of range (±2.147 m)"
         ))?;
         let k = stiffness_npm as f32;
-        each_servo!(self, s => {
+        each_servo_mut!(self, s => {
             let ves = s.world_mut().axis_ves_mut();
             if ves.is_empty() {
                 return Err("the scene's VE is not a wall".into());

@@ -429,6 +429,7 @@ pub fn hand(ui: &mut Ui, s: &mut ScopeState) {
         ui.selectable_value(&mut g, None, "script");
         ui.selectable_value(&mut g, Some(GraspKind::HandsOff), "hands off");
         ui.selectable_value(&mut g, Some(GraspKind::Relaxed), "relaxed");
+        ui.selectable_value(&mut g, Some(GraspKind::Fingertips), "fingertips");
         ui.selectable_value(&mut g, Some(GraspKind::Maximum), "maximum");
     });
     if g != s.grasp {

@@ -172,6 +172,36 @@ impl LinkageFile {
         }
     }
 
+    /// The board's gravity compensation for these moving masses under
+    /// `g` (m/s²) along `-z`: a lumped handle's weight, or the serial
+    /// arm's two link moments (`G = (0, a cos q2, b sin q3)`).
+    pub fn gravity_compensation(&self, g: f64) -> twoport_control::linkage::Gravity {
+        use twoport_control::linkage::Gravity;
+        match (&self.inertia, self.geometry) {
+            (Inertia::Lumped { handle_mass_kg, .. }, _) => Gravity::Handle {
+                weight_n: (handle_mass_kg * g) as f32,
+            },
+            (
+                Inertia::SerialArmLinks {
+                    l3_m,
+                    l5_m,
+                    l6_m,
+                    masses_kg: [ma, mc, mbe, mdf],
+                    ..
+                },
+                Geometry::SerialArm { l1_m, l2_m },
+            ) => {
+                let (up, fore) =
+                    arm_weights(l1_m, l2_m, *l3_m, *l5_m, *l6_m, [*ma, *mc, *mbe, *mdf]);
+                Gravity::SerialArm {
+                    upper_nm: (g * up) as f32,
+                    fore_nm: (g * fore) as f32,
+                }
+            }
+            (Inertia::SerialArmLinks { .. }, _) => Gravity::Off,
+        }
+    }
+
     /// The joint-space damping (N m s/rad).
     pub fn joint_damping(&self) -> DMatrix<f64> {
         DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(

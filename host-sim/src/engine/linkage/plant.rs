@@ -57,6 +57,10 @@ impl CartesianHand {
     }
 }
 
+/// The hand's force on the handle (N) given the handle's position (m) and
+/// velocity (m/s).
+pub type HandForce<'a> = dyn Fn(&[f64], &[f64]) -> DVector<f64> + 'a;
+
 /// Why the plant cannot go on.
 #[derive(Clone, Debug, PartialEq)]
 pub enum PlantError {
@@ -131,7 +135,7 @@ impl LinkagePlant {
         q: &DVector<f64>,
         qd: &DVector<f64>,
         tau_a: &DVector<f64>,
-        hand: &CartesianHand,
+        hand: &HandForce,
     ) -> Result<DVector<f64>, PlantError> {
         let n = q.len();
         let (x, j) = self.kinematics(q)?;
@@ -158,7 +162,7 @@ impl LinkagePlant {
             DVector::zeros(n)
         };
         let v = &j * qd;
-        let hand_torque = j.transpose() * hand.force(&x, &v);
+        let hand_torque = j.transpose() * hand(&x, v.as_slice());
         let rhs = hand_torque - tau_a - coriolis - self.gravity(q, &j) - damping - friction;
         m.cholesky()
             .map(|c| c.solve(&rhs))
@@ -171,6 +175,19 @@ impl LinkagePlant {
         &mut self,
         tau_a: &[f64],
         hand: &CartesianHand,
+        dt: f64,
+        substeps: u32,
+    ) -> Result<(), PlantError> {
+        let force = |x: &[f64], v: &[f64]| hand.force(x, &DVector::from_column_slice(v));
+        self.step_with(tau_a, &force, dt, substeps)
+    }
+
+    /// [`step`](Self::step) with the hand's force on the handle (N) as a
+    /// function of the handle's position (m) and velocity (m/s).
+    pub fn step_with(
+        &mut self,
+        tau_a: &[f64],
+        hand: &HandForce,
         dt: f64,
         substeps: u32,
     ) -> Result<(), PlantError> {

@@ -47,6 +47,7 @@ impl Scene {
                     .into(),
             );
         }
+        self.check_linkage()?;
         pos("duration_s", self.duration_s)?;
         if let Some(t) = self.period_s {
             if !(t.is_finite() && (1e-6..=0.1).contains(&t)) {
@@ -317,5 +318,85 @@ impl Scene {
             }
         }
         self.humans().map(|_| ())
+    }
+
+    /// A linkage scene: its file loads, has the scene's joints, starts at
+    /// a pose its limits allow and its kinematics serve; and the scene asks
+    /// nothing of it that belongs to an axis's model (the file's encoders,
+    /// losses and motors stand in for the axes' effects).
+    fn check_linkage(&self) -> Result<(), Error> {
+        let p = &self.plant;
+        let Some(path) = &p.linkage else {
+            if !p.pose_rad.is_empty() || p.gravity_mps2 != 0.0 || p.friction.is_some() {
+                return Err(
+                    "plant.pose_rad, plant.gravity_mps2 and plant.friction belong to a linkage \
+                     (plant.linkage)"
+                        .into(),
+                );
+            }
+            return Ok(());
+        };
+        let file = twoport_design::linkage::LinkageFile::load(path)
+            .map_err(|e| sim_err!("plant.linkage: {e}"))?;
+        let joints = file.geometry.joints();
+        if joints != self.axis_count() {
+            return Err(sim_err!(
+                "plant.linkage: {} has {joints} joints; the scene has axes = {}",
+                path.display(),
+                self.axes
+            ));
+        }
+        if p.pose_rad.len() != joints || p.pose_rad.iter().any(|q| !q.is_finite()) {
+            return Err(sim_err!(
+                "plant.pose_rad: give {joints} finite joint angles (rad), not {:?}",
+                p.pose_rad
+            ));
+        }
+        if !file.within_limits(&p.pose_rad) {
+            return Err(sim_err!(
+                "plant.pose_rad = {:?}: outside the joint limits of {}",
+                p.pose_rad,
+                path.display()
+            ));
+        }
+        if let Err(f) = file.pose(&p.pose_rad) {
+            return Err(sim_err!("plant.pose_rad = {:?}: {f:?}", p.pose_rad));
+        }
+        if !(p.gravity_mps2.is_finite() && p.gravity_mps2 >= 0.0) {
+            return Err(sim_err!(
+                "plant.gravity_mps2 = {} must be finite and >= 0",
+                p.gravity_mps2
+            ));
+        }
+        let e = &self.effects;
+        let axis_effects = [
+            ("flexibility", e.flexibility),
+            ("load_cell", e.load_cell),
+            ("encoder", e.encoder.is_some()),
+            ("adc", e.adc.is_some()),
+            ("saturation", e.saturation.is_some()),
+            ("coulomb", e.coulomb.is_some()),
+            ("cogging", e.cogging.is_some()),
+            ("cable_slack", e.cable_slack.is_some()),
+            ("delay", e.delay.is_some()),
+            ("hard_stop", e.hard_stop.is_some()),
+            ("element_delay", e.element_delay.is_some()),
+        ];
+        if let Some((name, _)) = axis_effects.iter().find(|(_, on)| *on) {
+            return Err(sim_err!(
+                "effects.{name}: a linkage's encoders, losses and motors are its file's; \
+                 the axes' effects do not apply"
+            ));
+        }
+        if self.passivity.is_some() {
+            return Err("passivity: not run on a linkage yet".into());
+        }
+        if self.display != Display::Impedance {
+            return Err("display: a linkage runs the impedance display".into());
+        }
+        if self.human.arm.is_some() {
+            return Err("human.arm: a linkage's hand has no arm yet".into());
+        }
+        Ok(())
     }
 }

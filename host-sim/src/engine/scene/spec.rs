@@ -74,6 +74,23 @@ pub struct PlantSpec {
     /// (0, the default: independent axes).
     #[serde(default)]
     pub cross_coupling: f64,
+    /// A linkage's device file (`models/linkages/`): its nonlinear arm in
+    /// place of the axes' models, run through the board's linkage servo.
+    /// The scene's axes are its Cartesian axes, measured from where the
+    /// handle starts.
+    #[serde(default)]
+    pub linkage: Option<PathBuf>,
+    /// The linkage's joint angles at the start (rad).
+    #[serde(default)]
+    pub pose_rad: Vec<f64>,
+    /// Gravity along `-z` on the linkage's moving masses (m/s²), which its
+    /// servo holds up; 0, the default, leaves it out.
+    #[serde(default)]
+    pub gravity_mps2: f64,
+    /// Whether the linkage's joints have their file's Coulomb friction
+    /// (true by default; the proof counts only viscous damping).
+    #[serde(default)]
+    pub friction: Option<bool>,
 }
 
 fn default_model() -> PathBuf {
@@ -93,6 +110,10 @@ impl Default for PlantSpec {
             rigid_mass_kg: default_rigid_mass(),
             rigid_damping_nspm: default_rigid_damping(),
             cross_coupling: 0.0,
+            linkage: None,
+            pose_rad: Vec::new(),
+            gravity_mps2: 0.0,
+            friction: None,
         }
     }
 }

@@ -2,6 +2,7 @@
 //! between the hand and the board's own control code, ticking at the
 //! control period, with only the named effects.
 
+mod linkage;
 mod step;
 
 pub use step::External;
@@ -211,6 +212,8 @@ pub struct Simulation<const N: usize = 1> {
     track_energy: bool,
     /// The scope's grasp, instead of the script's.
     grasp_override: Option<GraspKind>,
+    /// A linkage scene's arm, in place of the axes' models.
+    linkage: Option<Box<linkage::Arm>>,
 }
 
 /// Round half away from zero without a libm call.
@@ -297,7 +300,11 @@ impl<const N: usize> Simulation<N> {
         let period = scene.period();
         let humans = scene.humans()?;
         let nonlinear = scene.nonlinear();
-        let (method, substeps) = if nonlinear || scene.integrator.on_linear {
+        let (method, substeps) = if scene.plant.linkage.is_some() {
+            // A linkage's arm is nonlinear: fourth-order Runge-Kutta, at
+            // least 4 sub-steps a tick.
+            (Method::Rk4, scene.integrator.substeps.max(4))
+        } else if nonlinear || scene.integrator.on_linear {
             (scene.integrator.method, scene.integrator.substeps)
         } else {
             (Method::ExactZoh, 1)
@@ -333,7 +340,17 @@ impl<const N: usize> Simulation<N> {
             period_s: t32,
             ..SafetyConfig::excalibur()
         };
-        let servo = SceneServo::new(&scene, encoder, safety)?;
+        let (servo, linkage) = match &scene.plant.linkage {
+            Some(path) => {
+                let file = twoport_design::linkage::LinkageFile::load(path)
+                    .map_err(|e| sim_err!("plant.linkage: {e}"))?;
+                (
+                    SceneServo::linkage(&scene, &file, safety)?,
+                    Some(Box::new(linkage::Arm::new(&scene, &file)?)),
+                )
+            }
+            None => (SceneServo::new(&scene, encoder, safety)?, None),
+        };
         let total_ticks = (scene.duration_s / period).round() as u64;
         let last_event = humans.iter().map(Human::last_event_end).fold(0.0, f64::max);
         let quiet_tick = ((last_event / period).ceil() as u64).min(total_ticks);
@@ -388,6 +405,7 @@ impl<const N: usize> Simulation<N> {
             device,
             scene,
             grasp_override: None,
+            linkage,
         })
     }
 

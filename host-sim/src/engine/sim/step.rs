@@ -56,6 +56,9 @@ impl<const N: usize> Simulation<N> {
     }
 
     fn step_inner(&mut self, external: Option<External<'_, N>>) -> Sample<N> {
+        if self.linkage.is_some() && external.is_none() {
+            return self.step_linkage();
+        }
         let t = self.time_of(self.tick);
         let n = self.device.n;
         let timing = self.timing();

@@ -1,0 +1,143 @@
+//! A linkage scene's tick: the device file's nonlinear arm in place of
+//! the axes' models, its joint encoders read as the board reads them, the
+//! board's linkage servo (a [`SceneServo::Linkage`]) holding its joint
+//! torques over the tick, and each axis's hand on the handle's Cartesian
+//! coordinate, measured from where the handle starts.
+//!
+//! [`SceneServo::Linkage`]: crate::engine::servo::SceneServo::Linkage
+
+use super::{Sample, Simulation};
+use crate::engine::linkage::LinkagePlant;
+use crate::engine::scene::Scene;
+use crate::Error;
+use nalgebra::DVector;
+use twoport_control::servo::SensorFrame;
+use twoport_design::linkage::LinkageFile;
+
+/// The arm, its encoders and where its handle started.
+#[derive(Clone, Debug)]
+pub(super) struct Arm {
+    pub(super) plant: LinkagePlant,
+    /// Joint angles at the start, where each counter read 0 (rad).
+    q0: Vec<f64>,
+    /// Counts per radian at each joint.
+    counts_per_rad: Vec<f64>,
+    /// The handle's position at the start (m).
+    x0: Vec<f64>,
+}
+
+impl Arm {
+    /// The scene's arm at its start pose, at rest.
+    pub(super) fn new(scene: &Scene, file: &LinkageFile) -> Result<Arm, Error> {
+        let q0 = scene.plant.pose_rad.clone();
+        let mut plant = LinkagePlant::at_rest(file, &q0);
+        plant.gravity_mps2 = scene.plant.gravity_mps2;
+        plant.friction = scene.plant.friction.unwrap_or(true);
+        let (x0, _) = plant
+            .kinematics(&plant.q)
+            .map_err(|e| sim_err!("plant.pose_rad: {e:?}"))?;
+        let counts_per_rad = file
+            .motors
+            .ratios
+            .iter()
+            .map(|n| file.motors.encoder_counts_per_rev as f64 * n / std::f64::consts::TAU)
+            .collect();
+        Ok(Arm {
+            plant,
+            q0,
+            counts_per_rad,
+            x0,
+        })
+    }
+
+    /// The handle's position from its start and velocity (m, m/s).
+    fn handle(&self) -> Option<(Vec<f64>, Vec<f64>)> {
+        let (x, j) = self.plant.kinematics(&self.plant.q).ok()?;
+        let v = &j * &self.plant.qd;
+        Some((
+            x.iter().zip(&self.x0).map(|(x, o)| x - o).collect(),
+            v.iter().copied().collect(),
+        ))
+    }
+}
+
+impl<const N: usize> Simulation<N> {
+    /// One tick of a linkage scene.
+    pub(super) fn step_linkage(&mut self) -> Sample<N> {
+        let t = self.time_of(self.tick);
+        let mut s = Sample::<N>::default();
+        let Some(arm) = self.linkage.as_mut() else {
+            return s;
+        };
+        let raw: [u32; N] = core::array::from_fn(|i| {
+            let c = ((arm.plant.q[i] - arm.q0[i]) * arm.counts_per_rad[i]).round();
+            c as i64 as i32 as u32
+        });
+        let frame = SensorFrame {
+            tick: self.tick as u32,
+            encoder_raw: raw,
+            load_cell_n: [0.0; N],
+            dead_man_closed: true,
+        };
+        let (out, torque) = self.servo.tick_driven(&frame);
+        if !out.faults.is_empty() && self.failure.is_none() {
+            self.failure = Some(format!("the safety layer tripped: {}", out.faults));
+        }
+        // Each axis's hand at this tick, as a force on the handle's
+        // coordinate along that axis.
+        let hands: Vec<_> = self
+            .axes
+            .iter()
+            .map(|a| {
+                let mut h = a.human.at(t);
+                if let Some(g) = self.grasp_override {
+                    h.grasp = g;
+                }
+                h.push_n += a.push_n;
+                h.position_m += a.offset_m;
+                h
+            })
+            .collect();
+        let x0 = arm.x0.clone();
+        let hand = |x: &[f64], v: &[f64]| -> DVector<f64> {
+            DVector::from_fn(N, |i, _| hands[i].force_on(x[i] - x0[i], v[i]))
+        };
+        let stepped = arm
+            .plant
+            .step_with(&torque, &hand, self.period, self.substeps);
+        let handle = arm.handle();
+        match (stepped, handle) {
+            (Ok(()), Some((x, v))) => {
+                for (i, axis) in self.axes.iter_mut().enumerate() {
+                    let f_h = hands[i].force_on(x[i], v[i]);
+                    let p = f_h * v[i];
+                    axis.energy_in += 0.5 * (p + axis.last_power) * self.period;
+                    axis.last_power = p;
+                    axis.detector.push(out.actuator_force_n[i]);
+                    (s.handle_m[i], s.handle_mps[i], s.human_n[i]) = (x[i], v[i], f_h);
+                    s.energy_in_j += axis.energy_in;
+                    self.peak_force = self.peak_force.max(out.actuator_force_n[i].abs());
+                }
+            }
+            (Err(e), _) => {
+                self.failure
+                    .get_or_insert(format!("the arm left what it can reach: {e:?}"));
+            }
+            (_, None) => {
+                self.failure
+                    .get_or_insert("the arm left what it can reach".to_string());
+            }
+        }
+        self.tick += 1;
+        s.t_s = self.time_of(self.tick);
+        s.commanded_n = out.commanded_force_n;
+        s.actuator_n = out.actuator_force_n;
+        s.ve_m = self.servo.ve_position().map(|p| p.m() as f64);
+        s.ve_n = out.ve_force_n;
+        s.coupling_n = out.coupling_force_n;
+        s.energy_stored_j = f64::NAN;
+        s.layer_energy_j = [f64::NAN; N];
+        s.layer_added = [f64::NAN; N];
+        s
+    }
+}
