@@ -101,7 +101,25 @@ fn the_block_world_runs_through_the_phantom() {
     let rel = "scenes/linkages/phantom_blocks.toml";
     let mut sim = Simulation::<3>::with_axes(scene(rel, &[])).unwrap();
     let mut s = Vec::new();
+    // The arm the scope draws ends at the handle, in the world's frame:
+    // the handle's displacement plus where the world started its point,
+    // the same offset all the run.
+    let mut offsets = Vec::new();
     let r = sim.run(|x| s.push(*x));
+    for t in [1_000, 9_000] {
+        let mut again = Simulation::<3>::with_axes(scene(rel, &[])).unwrap();
+        let mut last = None;
+        for _ in 0..t {
+            last = Some(again.step());
+        }
+        let arm = again.linkage_skeleton().unwrap();
+        let end = *arm[0].last().unwrap();
+        let h = last.unwrap().handle_m;
+        offsets.push([end[0] - h[0], end[1] - h[1], end[2] - h[2]]);
+    }
+    for i in 0..3 {
+        assert!((offsets[0][i] - offsets[1][i]).abs() < 1e-9, "{offsets:?}");
+    }
     assert!(r.stable, "{:?}", r.reason);
     assert_eq!(r.sim_seconds, 14.0);
     let block = r.blocks_m[0];

@@ -37,8 +37,14 @@ pub struct WorldState {
     pub board_forces: [Ring; 3],
     /// The last problem to show (a refused connection, a lost link).
     pub message: Option<String>,
+    /// The span each projection shows on each axis (m): the Excalibur's
+    /// workspace, widened to take in a linkage's arm as it starts.
+    pub span_m: [(f64, f64); 3],
     debt_s: f64,
 }
+
+/// The Excalibur's workspace (m), the world view's span by default.
+const WORKSPACE_M: [(f64, f64); 3] = [(-0.15, 0.15), (-0.15, 0.15), (0.0, 0.2)];
 
 impl WorldState {
     /// The scope on a three-axis scene file.
@@ -51,7 +57,15 @@ impl WorldState {
     pub fn new(scene: Scene) -> Result<Self, Error> {
         let n = (HISTORY_S * 1000.0) as usize;
         let sim = Simulation::with_axes(scene)?;
+        let mut span_m = WORKSPACE_M;
+        for p in sim.linkage_skeleton().into_iter().flatten().flatten() {
+            for (a, (lo, hi)) in span_m.iter_mut().enumerate() {
+                *lo = lo.min(p[a] - 0.02);
+                *hi = hi.max(p[a] + 0.02);
+            }
+        }
         Ok(WorldState {
+            span_m,
             world: sim.servo().blocks(),
             sim,
             forces: [Ring::new(n), Ring::new(n), Ring::new(n)],
@@ -158,6 +172,11 @@ impl WorldState {
     /// The world's blocks (none for a constraint).
     pub fn blocks(&self) -> &[Block] {
         self.world.as_ref().map_or(&[], |w| &w.blocks)
+    }
+
+    /// A linkage scene's arm, drawn in the world's frame (m).
+    pub fn arm(&self) -> Option<Vec<Vec<[f64; 3]>>> {
+        self.sim.linkage_skeleton()
     }
 
     /// The block the cursor holds.

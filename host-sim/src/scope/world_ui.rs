@@ -1,5 +1,6 @@
 //! The world view of a three-axis scene: a top (x-y) and a side (x-z)
-//! projection with the blocks, the cursor and the held block, the grab
+//! projection with the blocks, the cursor and the held block, a linkage's
+//! arm, the grab
 //! button, each axis's force on one time axis (and the board's, in board
 //! mode), and the board panel. Dragging in a projection drags the hand
 //! along its two axes.
@@ -10,9 +11,6 @@ use crate::scope::world::WorldState;
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, Ui, Vec2};
 use egui_plot::{Legend, Line, Plot, PlotPoints};
 use twoport_link::Message;
-
-/// The span each projection shows (m): the Excalibur's workspace.
-const SPAN_M: [(f64, f64); 3] = [(-0.15, 0.15), (-0.15, 0.15), (0.0, 0.2)];
 
 /// The whole view.
 pub fn world(ui: &mut Ui, s: &mut WorldState) {
@@ -98,7 +96,7 @@ fn projection(ui: &mut Ui, s: &mut WorldState, axes: [usize; 2], title: &str, wi
         let (resp, painter) = ui.allocate_painter(Vec2::new(width, width * 0.75), Sense::drag());
         let r = resp.rect;
         painter.rect_filled(r, 2.0, Color32::from_gray(24));
-        let [(ax0, ax1), (ay0, ay1)] = axes.map(|a| SPAN_M[a]);
+        let [(ax0, ax1), (ay0, ay1)] = axes.map(|a| s.span_m[a]);
         let to_px = |x: f64, y: f64| {
             Pos2::new(
                 r.left() + ((x - ax0) / (ax1 - ax0)) as f32 * r.width(),
@@ -122,6 +120,21 @@ fn projection(ui: &mut Ui, s: &mut WorldState, axes: [usize; 2], title: &str, wi
                 Stroke::new(1.0, Color32::from_gray(200)),
                 egui::StrokeKind::Inside,
             );
+        }
+        // A linkage's arm, its links in grey and its joints as dots, clipped
+        // to the view (its base may lie outside the workspace drawn).
+        if let Some(arm) = s.arm() {
+            let clipped = painter.with_clip_rect(r);
+            for line in arm {
+                let pts: Vec<Pos2> = line.iter().map(|p| to_px(p[axes[0]], p[axes[1]])).collect();
+                clipped.add(egui::Shape::line(
+                    pts.clone(),
+                    Stroke::new(3.0, Color32::from_gray(170)),
+                ));
+                for p in pts {
+                    clipped.circle_filled(p, 3.0, Color32::from_gray(220));
+                }
+            }
         }
         let c = s.cursor_m();
         painter.circle_filled(

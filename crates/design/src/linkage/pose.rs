@@ -202,6 +202,69 @@ impl LinkageFile {
         }
     }
 
+    /// The arm drawn at `q` (rad): polylines through its joints to the
+    /// handle (m, the kinematics' frame). A serial arm: base, elbow,
+    /// handle. A delta: each leg's motor, elbow and its parallelogram's end
+    /// at the effector, and the effector to the handle. A pantograph: each
+    /// motor, elbow and the handle. A capstan: the handle alone.
+    pub fn skeleton(&self, q: &[f64]) -> Vec<Vec<[f64; 3]>> {
+        let (c, s) = (|a: f64| a.cos(), |a: f64| a.sin());
+        match self.geometry {
+            Geometry::SerialArm { l1_m, l2_m } if q.len() == 3 => {
+                let r1 = l1_m * c(q[1]);
+                let elbow = [c(q[0]) * r1, s(q[0]) * r1, l1_m * s(q[1])];
+                let r2 = l2_m * s(q[2]);
+                let hand = [
+                    elbow[0] + c(q[0]) * r2,
+                    elbow[1] + s(q[0]) * r2,
+                    elbow[2] - l2_m * c(q[2]),
+                ];
+                vec![vec![[0.0; 3], elbow, hand]]
+            }
+            Geometry::Delta {
+                base_m,
+                effector_m,
+                upper_m,
+                ..
+            } if q.len() == 3 => {
+                let Ok((x, _)) = forward(&self.geometry, q) else {
+                    return Vec::new();
+                };
+                (0..3)
+                    .map(|i| {
+                        let a = i as f64 * std::f64::consts::TAU / 3.0;
+                        let (dx, dy) = (c(a), s(a));
+                        let r = base_m + upper_m * c(q[i]);
+                        vec![
+                            [base_m * dx, base_m * dy, 0.0],
+                            [r * dx, r * dy, -upper_m * s(q[i])],
+                            [x[0] + effector_m * dx, x[1] + effector_m * dy, x[2]],
+                            [x[0], x[1], x[2]],
+                        ]
+                    })
+                    .collect()
+            }
+            Geometry::Pantograph { l_m, d_m, .. } if q.len() == 2 => {
+                let Ok((x, _)) = forward(&self.geometry, q) else {
+                    return Vec::new();
+                };
+                let hand = [x[0], x[1], 0.0];
+                vec![
+                    vec![[0.0; 3], [l_m * c(q[0]), l_m * s(q[0]), 0.0], hand],
+                    vec![
+                        [d_m, 0.0, 0.0],
+                        [d_m + l_m * c(q[1]), l_m * s(q[1]), 0.0],
+                        hand,
+                    ],
+                ]
+            }
+            _ => match forward(&self.geometry, q) {
+                Ok((x, _)) => vec![vec![[x[0], 0.0, 0.0]]],
+                Err(_) => Vec::new(),
+            },
+        }
+    }
+
     /// The joint-space damping (N m s/rad).
     pub fn joint_damping(&self) -> DMatrix<f64> {
         DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(
@@ -293,4 +356,59 @@ fn arm_weights(
         l1 * ma + l5 * mbe + 0.5 * l1 * mc,
         0.5 * l2 * ma + l3 * mc - l6 * mdf,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The arm drawn is the arm the kinematics solve: it ends at the
+    /// handle, and each link has its file's length, at every pose of each
+    /// shipped linkage's grid (the delta's parallelograms and the
+    /// pantograph's distal links included, which the drawing does not
+    /// take from the solve), to 1 µm (the kinematics hold their lengths in
+    /// f32, as the board does).
+    #[test]
+    fn the_skeleton_is_the_kinematics() {
+        let dist = |a: &[f64; 3], b: &[f64; 3]| {
+            ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+        };
+        for name in ["phantom_premium_1_5", "falcon_like", "haply_2diy", "hapkit"] {
+            let path = format!(
+                "{}/../../models/linkages/{name}.toml",
+                env!("CARGO_MANIFEST_DIR")
+            );
+            let file = LinkageFile::load(std::path::Path::new(&path)).unwrap();
+            let poses = file.workspace(5);
+            assert!(poses.len() > 3, "{name}");
+            for p in poses {
+                let sk = file.skeleton(&p.q_rad);
+                let end = *sk[0].last().unwrap();
+                for (i, x) in p.position_m.iter().enumerate() {
+                    assert!(
+                        (end[i] - x).abs() < 1e-6,
+                        "{name}: {end:?} vs {:?}",
+                        p.position_m
+                    );
+                }
+                let lengths: Vec<f64> = match file.geometry {
+                    Geometry::SerialArm { l1_m, l2_m } => vec![l1_m, l2_m],
+                    Geometry::Delta {
+                        upper_m, lower_m, ..
+                    } => vec![upper_m, lower_m],
+                    Geometry::Pantograph { l_m, big_l_m, .. } => vec![l_m, big_l_m],
+                    Geometry::Capstan { .. } => vec![],
+                };
+                for line in &sk {
+                    for (k, want) in lengths.iter().enumerate() {
+                        let got = dist(&line[k], &line[k + 1]);
+                        assert!(
+                            (got - want).abs() < 1e-6,
+                            "{name}: link {k} is {got} m, not {want}"
+                        );
+                    }
+                }
+            }
+        }
+    }
 }

@@ -24,11 +24,16 @@ pub(super) struct Arm {
     counts_per_rad: Vec<f64>,
     /// The handle's position at the start (m).
     x0: Vec<f64>,
+    /// Where the scene's frame has its zero, in the kinematics' (m): the
+    /// handle's start less where the world starts its point.
+    origin: [f64; 3],
+    file: LinkageFile,
 }
 
 impl Arm {
-    /// The scene's arm at its start pose, at rest.
-    pub(super) fn new(scene: &Scene, file: &LinkageFile) -> Result<Arm, Error> {
+    /// The scene's arm at its start pose, at rest, the world starting its
+    /// point at `start_m` (m).
+    pub(super) fn new(scene: &Scene, file: &LinkageFile, start_m: &[f64]) -> Result<Arm, Error> {
         let q0 = scene.plant.pose_rad.clone();
         let mut plant = LinkagePlant::at_rest(file, &q0);
         plant.gravity_mps2 = scene.plant.gravity_mps2;
@@ -42,11 +47,16 @@ impl Arm {
             .iter()
             .map(|n| file.motors.encoder_counts_per_rev as f64 * n / std::f64::consts::TAU)
             .collect();
+        let origin = core::array::from_fn(|i| {
+            x0.get(i).copied().unwrap_or(0.0) - start_m.get(i).copied().unwrap_or(0.0)
+        });
         Ok(Arm {
             plant,
             q0,
             counts_per_rad,
             x0,
+            origin,
+            file: file.clone(),
         })
     }
 
@@ -62,6 +72,23 @@ impl Arm {
 }
 
 impl<const N: usize> Simulation<N> {
+    /// A linkage scene's arm as it stands, drawn in the scene's frame (the
+    /// world's): polylines through its joints to the handle (m).
+    pub fn linkage_skeleton(&self) -> Option<Vec<Vec<[f64; 3]>>> {
+        let arm = self.linkage.as_ref()?;
+        let lines = arm.file.skeleton(arm.plant.q.as_slice());
+        Some(
+            lines
+                .into_iter()
+                .map(|l| {
+                    l.into_iter()
+                        .map(|p| core::array::from_fn(|i| p[i] - arm.origin[i]))
+                        .collect()
+                })
+                .collect(),
+        )
+    }
+
     /// One tick of a linkage scene.
     pub(super) fn step_linkage(&mut self) -> Sample<N> {
         let t = self.time_of(self.tick);

@@ -344,10 +344,10 @@ impl<const N: usize> Simulation<N> {
             Some(path) => {
                 let file = twoport_design::linkage::LinkageFile::load(path)
                     .map_err(|e| sim_err!("plant.linkage: {e}"))?;
-                (
-                    SceneServo::linkage(&scene, &file, safety)?,
-                    Some(Box::new(linkage::Arm::new(&scene, &file)?)),
-                )
+                let servo = SceneServo::linkage(&scene, &file, safety)?;
+                let start: Vec<f64> = servo.ve_position().iter().map(|p| p.m() as f64).collect();
+                let arm = linkage::Arm::new(&scene, &file, &start)?;
+                (servo, Some(Box::new(arm)))
             }
             None => (SceneServo::new(&scene, encoder, safety)?, None),
         };
