@@ -45,15 +45,17 @@ fn ringing<const N: usize>(s: &[Sample<N>], axis: usize) -> f64 {
 /// Each linkage at its certified coupling for the least grasp, pressing a
 /// wall along the direction that binds with the fingertips (2 N s/m): the
 /// run is judged stable, and at exactly the bound the loop only rings on
-/// the encoders' quantum (under 0.5 N rms). 20 % past, it rings at least
-/// twice as hard along that direction, a sustained oscillation.
+/// the encoders' quantum (under 0.6 N rms, a few counts' worth of the
+/// coupling's force). 20 % past, it rings at least twice as hard along
+/// that direction, a sustained oscillation. (The Hapkit sweeps 80 mm of
+/// its travel between.)
 #[test]
 fn each_linkage_holds_its_certified_wall_and_rings_past_it() {
     fn check<const N: usize>(rel: &str, k: f64, axis: usize) {
         let (at, s) = run::<N>(rel, &[]);
         assert!(at.stable, "{rel}: {:?}", at.reason);
         let calm = ringing(&s, axis);
-        assert!(calm < 0.5, "{rel}: {calm} N rms at the design");
+        assert!(calm < 0.6, "{rel}: {calm} N rms at the design");
         let (_, s) = run::<N>(rel, &[format!("coupling.k={}", 1.2 * k)]);
         let past = ringing(&s, axis);
         assert!(
@@ -67,6 +69,7 @@ fn each_linkage_holds_its_certified_wall_and_rings_past_it() {
     check::<3>("scenes/linkages/phantom_wall.toml", 4007.0, 0);
     check::<3>("scenes/linkages/falcon_wall.toml", 4175.0, 1);
     check::<2>("scenes/linkages/haply_wall.toml", 4009.0, 0);
+    check::<1>("scenes/linkages/hapkit_wall.toml", 4553.0, 0);
 }
 
 /// A linkage scene asks nothing of an axis's model: its effects are
@@ -129,6 +132,31 @@ fn the_block_world_runs_through_the_phantom() {
         (lo.min(x.handle_m[1]), hi.max(x.handle_m[1]))
     });
     assert!(hi - lo > 0.18, "{lo} to {hi} m");
+    assert!(
+        sweep.iter().all(|x| x.actuator_n[2] < -0.5),
+        "the floor let go"
+    );
+}
+
+/// The block world through the Falcon-like delta, under gravity, at the
+/// coupling certified for the least grasp, with a relaxed hand: stable;
+/// the 20 mm cube is carried 40 mm along +x; the handle then sweeps 55 mm
+/// or more across the workspace in y, the floor pushing back all the way.
+#[test]
+fn the_block_world_runs_through_the_delta() {
+    let rel = "scenes/linkages/falcon_blocks.toml";
+    let mut sim = Simulation::<3>::with_axes(scene(rel, &[])).unwrap();
+    let mut s = Vec::new();
+    let r = sim.run(|x| s.push(*x));
+    assert!(r.stable, "{:?}", r.reason);
+    assert_eq!(r.sim_seconds, 13.0);
+    let block = r.blocks_m[0];
+    assert!((block[0] - 0.005).abs() < 0.005, "{block:?}");
+    let sweep = &s[9_400..11_600];
+    let (lo, hi) = sweep.iter().fold((f64::MAX, f64::MIN), |(lo, hi), x| {
+        (lo.min(x.handle_m[1]), hi.max(x.handle_m[1]))
+    });
+    assert!(hi - lo > 0.055, "{lo} to {hi} m");
     assert!(
         sweep.iter().all(|x| x.actuator_n[2] < -0.5),
         "the floor let go"
