@@ -1,4 +1,4 @@
-//! The three-axis scope as a person uses it (egui_kittest, no window): the
+//! The world view as a person uses it (egui_kittest, no window): the
 //! world view shows the blocks and the cursor, the grab button picks up
 //! the block the cursor rests on and lets it go, and dragging the hand
 //! moves the cursor and the block with it.
@@ -80,7 +80,7 @@ fn board_mode_drives_a_three_axis_board_and_plots_every_axis() {
     use host_sim::link::LocalBoard;
     use twoport_link::{Message, Mode};
     let scene = Scene::load(Path::new("../scenes/xyz/pil_blocks.toml"), &[]).unwrap();
-    let mut s = WorldState::new(scene).unwrap();
+    let mut s = WorldState::<3>::new(scene).unwrap();
     let board = LocalBoard::excalibur_xyz().unwrap();
     s.connect_port(Box::new(board), "in-process", true);
     assert!(s.board.is_some(), "{:?}", s.message);
@@ -116,4 +116,37 @@ fn board_mode_drives_a_three_axis_board_and_plots_every_axis() {
     h.get_by_label("disconnect").click();
     h.run();
     assert!(h.state().board.is_none());
+}
+
+/// A two-axis linkage scene opens in the world view (its x-y plane): the
+/// pantograph's arm is drawn, both its legs ending at the handle, and a
+/// drag moves the handle.
+#[test]
+fn a_two_axis_linkage_scene_shows_its_arm() {
+    let path = Path::new("../scenes/linkages/haply_wall.toml");
+    let file = Path::new("../models/linkages/haply_2diy.toml");
+    let sets = [format!("plant.linkage=\"{}\"", file.display())];
+    let scene = Scene::load(path, &sets).unwrap();
+    let mut state = WorldState::<2>::new(scene).unwrap();
+    for _ in 0..10 {
+        state.advance(0.1);
+    }
+    let arm = state.arm().unwrap();
+    assert_eq!(arm.len(), 2, "two legs");
+    assert_eq!(arm[0].last(), arm[1].last(), "the legs meet at the handle");
+    let before = state.last.unwrap().handle_m;
+    let mut h = Harness::new_ui_state(host_sim::scope::world_ui::world, state);
+    h.set_size(eframe::egui::vec2(1280.0, 860.0));
+    h.run();
+    let _ = h.get_by_label_contains("top: x right, y up");
+    // (The script presses 30 mm past the wall: 45 mm back takes it off.)
+    h.state_mut().drag([0.045, 0.0, 0.0]);
+    for _ in 0..10 {
+        h.state_mut().advance(0.1);
+    }
+    let after = h.state().last.unwrap().handle_m;
+    assert!(
+        (after[0] - before[0]).abs() > 1e-3,
+        "{before:?} -> {after:?}"
+    );
 }

@@ -45,9 +45,9 @@ struct ScopeApp {
     shots: Shots,
 }
 
-/// The scope of a three-axis scene: the world view.
-struct WorldApp {
-    state: crate::scope::world::WorldState,
+/// The scope of a scene of two or three axes: the world view.
+struct WorldApp<const N: usize> {
+    state: crate::scope::world::WorldState<N>,
     shots: Shots,
 }
 
@@ -120,7 +120,7 @@ impl eframe::App for ScopeApp {
     }
 }
 
-impl eframe::App for WorldApp {
+impl<const N: usize> eframe::App for WorldApp<N> {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         self.state.advance(self.shots.frame());
@@ -137,14 +137,20 @@ pub fn display_available() -> bool {
         .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()))
 }
 
-/// Open the scope on `scene` (the world view for a three-axis scene);
+/// Open the scope on `scene` (the world view for a scene of two or three
+/// axes);
 /// returns the screenshots saved.
 pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, Error> {
     let shots = Shots::new(script);
     let saved = shots.saved.clone();
     let parsed = crate::Scene::load(scene, &[])?;
     let app: Box<dyn eframe::App> = if parsed.axes == 3 {
-        Box::new(WorldApp {
+        Box::new(WorldApp::<3> {
+            state: crate::scope::world::WorldState::new(parsed)?,
+            shots,
+        })
+    } else if parsed.axes == 2 {
+        Box::new(WorldApp::<2> {
             state: crate::scope::world::WorldState::new(parsed)?,
             shots,
         })

@@ -1,4 +1,5 @@
-//! The scope of a three-axis scene: its state, kept apart from drawing. The
+//! The scope of a scene of two or three axes: its state, kept apart from
+//! drawing. The
 //! simulation runs in real time; the last seconds of each axis's force are
 //! kept for the plots; the mouse drags the hand and the button grabs. In
 //! board mode a three-axis board drives the plant (lockstep) or runs on its
@@ -16,17 +17,18 @@ use twoport_control::world::vbb::Block;
 /// Seconds of force history per axis.
 const HISTORY_S: f64 = 5.0;
 
-/// What the world view shows and the plots draw.
-pub struct WorldState {
-    sim: Simulation<3>,
+/// What the world view shows and the plots draw, for a scene of `N` axes
+/// (3 by default; a two-axis scene is drawn in its x-y plane).
+pub struct WorldState<const N: usize = 3> {
+    sim: Simulation<N>,
     /// Each axis's actuator force over the last seconds (N).
-    pub forces: [Ring; 3],
+    pub forces: [Ring; N],
     /// The last sample.
-    pub last: Option<Sample<3>>,
+    pub last: Option<Sample<N>>,
     /// The 3-D world after the last tick (none for a VE on each axis).
     world: Option<WorldView>,
     /// Where the mouse has dragged the hand, beyond the script (m).
-    pub hand_offset_m: [f64; 3],
+    pub hand_offset_m: [f64; N],
     /// Why the run stopped, if it has.
     pub stopped: Option<String>,
     /// The board, in board mode.
@@ -34,7 +36,7 @@ pub struct WorldState {
     /// What the board panel's connect controls hold.
     pub link: BoardChoice,
     /// Each axis's force as the board's telemetry reports it (N).
-    pub board_forces: [Ring; 3],
+    pub board_forces: [Ring; N],
     /// The last problem to show (a refused connection, a lost link).
     pub message: Option<String>,
     /// The span each projection shows on each axis (m): the Excalibur's
@@ -46,8 +48,8 @@ pub struct WorldState {
 /// The Excalibur's workspace (m), the world view's span by default.
 const WORKSPACE_M: [(f64, f64); 3] = [(-0.15, 0.15), (-0.15, 0.15), (0.0, 0.2)];
 
-impl WorldState {
-    /// The scope on a three-axis scene file.
+impl<const N: usize> WorldState<N> {
+    /// The scope on a scene file of `N` axes.
     pub fn open(path: &Path) -> Result<Self, Error> {
         let scene = Scene::load(path, &[])?;
         Self::new(scene)
@@ -68,13 +70,13 @@ impl WorldState {
             span_m,
             world: sim.servo().blocks(),
             sim,
-            forces: [Ring::new(n), Ring::new(n), Ring::new(n)],
+            forces: core::array::from_fn(|_| Ring::new(n)),
             last: None,
-            hand_offset_m: [0.0; 3],
+            hand_offset_m: [0.0; N],
             stopped: None,
             board: None,
             link: BoardChoice::default(),
-            board_forces: [Ring::new(n), Ring::new(n), Ring::new(n)],
+            board_forces: core::array::from_fn(|_| Ring::new(n)),
             message: None,
             debt_s: 0.0,
         })
@@ -151,7 +153,8 @@ impl WorldState {
         crate::pil::Setup::for_sim(&self.sim).map(|s| s.at_rest_pm)
     }
 
-    /// Drag the hand by `d_m` (m) along each axis.
+    /// Drag the hand by `d_m` (m) along each axis (x, y, z; those past
+    /// the scene's axes are left out).
     pub fn drag(&mut self, d_m: [f64; 3]) {
         for (o, d) in self.hand_offset_m.iter_mut().zip(d_m) {
             *o = (*o + d).clamp(-0.2, 0.2);
@@ -194,12 +197,14 @@ impl WorldState {
                     .get(a)
                     .map_or(0.0, |x| x.ve_position_pm as f64 * 1e-12)
             }),
-            None => self.last.map_or([0.0; 3], |s| s.ve_m),
+            None => self.last.map_or([0.0; 3], |s| {
+                core::array::from_fn(|a| s.ve_m.get(a).copied().unwrap_or(0.0))
+            }),
         }
     }
 }
 
-impl BoardMode for WorldState {
+impl<const N: usize> BoardMode for WorldState<N> {
     fn board_parts(&mut self) -> (&mut Option<BoardLink>, &mut Option<String>, &Scene) {
         (&mut self.board, &mut self.message, self.sim.scene())
     }

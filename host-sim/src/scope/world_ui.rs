@@ -1,5 +1,5 @@
-//! The world view of a three-axis scene: a top (x-y) and a side (x-z)
-//! projection with the blocks, the cursor and the held block, a linkage's
+//! The world view of a scene of three axes (two: the top alone): a top
+//! (x-y) and a side (x-z) projection with the blocks, the cursor and the held block, a linkage's
 //! arm, the grab
 //! button, each axis's force on one time axis (and the board's, in board
 //! mode), and the board panel. Dragging in a projection drags the hand
@@ -13,19 +13,21 @@ use egui_plot::{Legend, Line, Plot, PlotPoints};
 use twoport_link::Message;
 
 /// The whole view.
-pub fn world(ui: &mut Ui, s: &mut WorldState) {
+pub fn world<const N: usize>(ui: &mut Ui, s: &mut WorldState<N>) {
     ui.heading(s.name().to_string());
     status(ui, s);
     board(ui, s);
     ui.horizontal(|ui| {
         let w = (ui.available_width() / 2.0 - 8.0).max(100.0);
         projection(ui, s, [0, 1], "top: x right, y up", w);
-        projection(ui, s, [0, 2], "side: x right, z up", w);
+        if N == 3 {
+            projection(ui, s, [0, 2], "side: x right, z up", w);
+        }
     });
     forces(ui, s);
 }
 
-fn status(ui: &mut Ui, s: &mut WorldState) {
+fn status<const N: usize>(ui: &mut Ui, s: &mut WorldState<N>) {
     ui.horizontal(|ui| {
         let t = s.last.map_or(0.0, |l| l.t_s);
         ui.label(format!("t = {t:.2} s"));
@@ -51,7 +53,7 @@ fn status(ui: &mut Ui, s: &mut WorldState) {
 
 /// Board mode: connect a three-axis board, its state and buttons
 /// (calibrate where the world's cursor starts, then arm), disconnect.
-fn board(ui: &mut Ui, s: &mut WorldState) {
+fn board<const N: usize>(ui: &mut Ui, s: &mut WorldState<N>) {
     ui.horizontal(|ui| {
         let Some(b) = &s.board else {
             ui.label("board:");
@@ -90,7 +92,13 @@ fn board(ui: &mut Ui, s: &mut WorldState) {
 }
 
 /// One projection onto `axes` (the first drawn right, the second up).
-fn projection(ui: &mut Ui, s: &mut WorldState, axes: [usize; 2], title: &str, width: f32) {
+fn projection<const N: usize>(
+    ui: &mut Ui,
+    s: &mut WorldState<N>,
+    axes: [usize; 2],
+    title: &str,
+    width: f32,
+) {
     ui.vertical(|ui| {
         ui.label(title);
         let (resp, painter) = ui.allocate_painter(Vec2::new(width, width * 0.75), Sense::drag());
@@ -153,7 +161,7 @@ fn projection(ui: &mut Ui, s: &mut WorldState, axes: [usize; 2], title: &str, wi
 }
 
 /// Each axis's actuator force over the last seconds.
-fn forces(ui: &mut Ui, s: &WorldState) {
+fn forces<const N: usize>(ui: &mut Ui, s: &WorldState<N>) {
     const COLORS: [Color32; 3] = [
         Color32::from_rgb(230, 90, 90),
         Color32::from_rgb(90, 200, 110),
