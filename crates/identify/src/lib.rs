@@ -3,6 +3,7 @@
 #![warn(missing_docs)]
 
 mod error;
+pub mod fit;
 pub mod frf;
 
 pub use error::IdentifyError;

@@ -1,0 +1,112 @@
+use super::*;
+use twoport_design::network::HumanBound;
+use twoport_design::Designer;
+
+fn shipped(name: &str) -> DeviceModel {
+    let path = format!("{}/../../models/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    DeviceModel::load(path.as_ref()).unwrap()
+}
+
+fn base(m: &DeviceModel) -> ModelBase {
+    ModelBase {
+        name: format!("identified {}", m.name),
+        period_s: m.period_s,
+        peak_force_n: m.peak_force_n,
+        continuous_force_n: m.continuous_force_n,
+        load_cell_pole_rad_s: m.force_sensor.then_some(m.load_cell_pole_rad_s),
+    }
+}
+
+fn rng(seed: &mut u64) -> f64 {
+    *seed ^= *seed << 13;
+    *seed ^= *seed >> 7;
+    *seed ^= *seed << 17;
+    (*seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+}
+
+/// What an experiment on `truth` would measure at harmonics of 0.5 Hz up
+/// to `top_hz`: its exact sampled responses with complex noise of
+/// `rel` of each (standard deviation), and that variance reported.
+fn measure(truth: &DeviceModel, top_hz: f64, rel: f64) -> Measured {
+    let freq: Vec<f64> = (1..)
+        .map(|h| 0.5 * h as f64)
+        .take_while(|f| *f <= top_hz)
+        .collect();
+    let h = sampled_response(truth, &freq).unwrap();
+    let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut noisy = |v: Complex64| {
+        // Uniform noise of the same variance as the Gaussian's.
+        let s = rel * v.norm() * 12f64.sqrt() / 2f64.sqrt();
+        v + Complex64::new(s * rng(&mut seed), s * rng(&mut seed))
+    };
+    let var: Vec<f64> = h.iter().map(|(x, _)| (rel * x.norm()).powi(2)).collect();
+    let position = Frf {
+        freq_hz: freq.clone(),
+        response: h.iter().map(|(x, _)| noisy(*x)).collect(),
+        variance: var,
+        periods: 10,
+    };
+    let load_cell = truth.force_sensor.then(|| Frf {
+        freq_hz: freq.clone(),
+        response: h.iter().map(|(_, f)| noisy(*f)).collect(),
+        variance: h.iter().map(|(_, f)| (rel * f.norm()).powi(2)).collect(),
+        periods: 10,
+    });
+    Measured {
+        position,
+        load_cell,
+    }
+}
+
+fn impedance_k(m: &DeviceModel, b: f64) -> f64 {
+    let d = Designer::new(vec![m.clone()], None, Some(HumanBound::PAPER)).unwrap();
+    d.design_impedance(Some(b), 0.0)
+        .unwrap()
+        .coupling
+        .unwrap()
+        .0
+}
+
+/// The capstan handle is one mass: the criterion keeps no mode, and the
+/// fit finds its mass and damping.
+#[test]
+fn a_rigid_device_is_fit_as_one_mass() {
+    let truth = shipped("capstan");
+    let (fits, best) = fit_orders(&measure(&truth, 100.0, 0.005), &base(&truth));
+    let f = &fits[best.unwrap()];
+    assert_eq!(f.chain.modes(), 0, "{:?}", f.chain);
+    assert!(
+        (f.chain.masses_kg[0] / 0.25 - 1.0).abs() < 0.005,
+        "{:?}",
+        f.chain
+    );
+    assert!(
+        (f.chain.actuator_nspm / 2.0 - 1.0).abs() < 0.02,
+        "{:?}",
+        f.chain
+    );
+    assert!(f.reduced_chi2() < 1.5, "{}", f.reduced_chi2());
+}
+
+/// The two-mass device: one mode, its masses and flexure back, and the
+/// design on the identified model where the true model's is.
+#[test]
+fn the_two_mass_device_comes_back_with_its_mode() {
+    let truth = shipped("two_mass");
+    let (fits, best) = fit_orders(&measure(&truth, 450.0, 0.005), &base(&truth));
+    let f = &fits[best.unwrap()];
+    assert_eq!(f.chain.modes(), 1, "{:?}", f.chain);
+    for (got, want) in f.chain.masses_kg.iter().zip([0.6, 0.15]) {
+        assert!((got / want - 1.0).abs() < 0.01, "{:?}", f.chain);
+    }
+    assert!(
+        (f.chain.springs_npm[0] / 3e5 - 1.0).abs() < 0.01,
+        "{:?}",
+        f.chain
+    );
+    let (k_true, k_fit) = (impedance_k(&truth, 10.0), impedance_k(&f.model, 10.0));
+    assert!(
+        (k_fit / k_true - 1.0).abs() < 0.03,
+        "{k_fit} against {k_true}"
+    );
+}
