@@ -128,15 +128,21 @@ fn the_block_world_runs_through_the_phantom() {
     assert_eq!(r.sim_seconds, 14.0);
     let block = r.blocks_m[0];
     assert!((block[0] - 0.01).abs() < 0.005, "{block:?}");
-    let sweep = &s[9_500..12_200];
+    let span = floor_sweep_span(&s[9_500..12_200]);
+    assert!(span > 0.18, "{span} m");
+}
+
+/// How far the handle ranges in y over `sweep` (m), the floor pushing
+/// back (the actuator's z force below -0.5 N) all the way.
+fn floor_sweep_span(sweep: &[Sample<3>]) -> f64 {
     let (lo, hi) = sweep.iter().fold((f64::MAX, f64::MIN), |(lo, hi), x| {
         (lo.min(x.handle_m[1]), hi.max(x.handle_m[1]))
     });
-    assert!(hi - lo > 0.18, "{lo} to {hi} m");
     assert!(
         sweep.iter().all(|x| x.actuator_n[2] < -0.5),
         "the floor let go"
     );
+    hi - lo
 }
 
 /// The block world through the Falcon-like delta, under gravity, at the
@@ -153,15 +159,8 @@ fn the_block_world_runs_through_the_delta() {
     assert_eq!(r.sim_seconds, 13.0);
     let block = r.blocks_m[0];
     assert!((block[0] - 0.005).abs() < 0.005, "{block:?}");
-    let sweep = &s[9_400..11_600];
-    let (lo, hi) = sweep.iter().fold((f64::MAX, f64::MIN), |(lo, hi), x| {
-        (lo.min(x.handle_m[1]), hi.max(x.handle_m[1]))
-    });
-    assert!(hi - lo > 0.055, "{lo} to {hi} m");
-    assert!(
-        sweep.iter().all(|x| x.actuator_n[2] < -0.5),
-        "the floor let go"
-    );
+    let span = floor_sweep_span(&s[9_400..11_600]);
+    assert!(span > 0.055, "{span} m");
 }
 
 /// The certified walls hold under every grasp of the assumption, not

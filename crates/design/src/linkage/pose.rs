@@ -125,24 +125,11 @@ impl LinkageFile {
     /// Tendick 2002: centres of mass at `l1` and `l5` along the upper arm,
     /// `l2/2`, `l3` and `l6` along the forearm's parts).
     pub fn potential_j(&self, q: &[f64], z_m: f64, g: f64) -> f64 {
-        match (&self.inertia, self.geometry) {
-            (Inertia::Lumped { handle_mass_kg, .. }, _) => handle_mass_kg * g * z_m,
-            (
-                Inertia::SerialArmLinks {
-                    l3_m,
-                    l5_m,
-                    l6_m,
-                    masses_kg: [ma, mc, mbe, mdf],
-                    ..
-                },
-                Geometry::SerialArm { l1_m, l2_m },
-            ) => {
-                let (up, fore) =
-                    arm_weights(l1_m, l2_m, *l3_m, *l5_m, *l6_m, [*ma, *mc, *mbe, *mdf]);
-                g * (up * q[1].sin() - fore * q[2].cos())
-            }
-            (Inertia::SerialArmLinks { .. }, _) => 0.0,
+        if let Inertia::Lumped { handle_mass_kg, .. } = &self.inertia {
+            return handle_mass_kg * g * z_m;
         }
+        self.arm_moments()
+            .map_or(0.0, |(up, fore)| g * (up * q[1].sin() - fore * q[2].cos()))
     }
 
     /// The joint torques gravity asks at `q` (N m), the potential energy's
@@ -150,24 +137,11 @@ impl LinkageFile {
     /// `-z`.
     pub fn gravity_nm(&self, q: &[f64], jacobian: &DMatrix<f64>, g: f64) -> Vec<f64> {
         let n = q.len();
-        match (&self.inertia, self.geometry) {
+        match (&self.inertia, self.arm_moments()) {
             (Inertia::Lumped { handle_mass_kg, .. }, _) if jacobian.nrows() == 3 => (0..n)
                 .map(|c| handle_mass_kg * g * jacobian[(2, c)])
                 .collect(),
-            (
-                Inertia::SerialArmLinks {
-                    l3_m,
-                    l5_m,
-                    l6_m,
-                    masses_kg: [ma, mc, mbe, mdf],
-                    ..
-                },
-                Geometry::SerialArm { l1_m, l2_m },
-            ) => {
-                let (up, fore) =
-                    arm_weights(l1_m, l2_m, *l3_m, *l5_m, *l6_m, [*ma, *mc, *mbe, *mdf]);
-                vec![0.0, g * up * q[1].cos(), g * fore * q[2].sin()]
-            }
+            (_, Some((up, fore))) => vec![0.0, g * up * q[1].cos(), g * fore * q[2].sin()],
             _ => vec![0.0; n],
         }
     }
@@ -177,10 +151,24 @@ impl LinkageFile {
     /// arm's two link moments (`G = (0, a cos q2, b sin q3)`).
     pub fn gravity_compensation(&self, g: f64) -> twoport_control::linkage::Gravity {
         use twoport_control::linkage::Gravity;
-        match (&self.inertia, self.geometry) {
+        match (&self.inertia, self.arm_moments()) {
             (Inertia::Lumped { handle_mass_kg, .. }, _) => Gravity::Handle {
                 weight_n: (handle_mass_kg * g) as f32,
             },
+            (_, Some((up, fore))) => Gravity::SerialArm {
+                upper_nm: (g * up) as f32,
+                fore_nm: (g * fore) as f32,
+            },
+            (_, None) => Gravity::Off,
+        }
+    }
+
+    /// The serial arm's first moments of mass about the shoulder (kg m):
+    /// the upper arm's, `l1 m_a + l5 m_be + l1 m_c/2`, whose height goes as
+    /// `sin q2`, and the forearm's, `l2 m_a/2 + l3 m_c - l6 m_df`, whose
+    /// depth goes as `cos q3`. `None` but for a serial arm's links.
+    fn arm_moments(&self) -> Option<(f64, f64)> {
+        match (&self.inertia, self.geometry) {
             (
                 Inertia::SerialArmLinks {
                     l3_m,
@@ -190,15 +178,11 @@ impl LinkageFile {
                     ..
                 },
                 Geometry::SerialArm { l1_m, l2_m },
-            ) => {
-                let (up, fore) =
-                    arm_weights(l1_m, l2_m, *l3_m, *l5_m, *l6_m, [*ma, *mc, *mbe, *mdf]);
-                Gravity::SerialArm {
-                    upper_nm: (g * up) as f32,
-                    fore_nm: (g * fore) as f32,
-                }
-            }
-            (Inertia::SerialArmLinks { .. }, _) => Gravity::Off,
+            ) => Some((
+                l1_m * ma + l5_m * mbe + 0.5 * l1_m * mc,
+                0.5 * l2_m * ma + l3_m * mc - l6_m * mdf,
+            )),
+            _ => None,
         }
     }
 
@@ -338,24 +322,6 @@ impl LinkageFile {
             }
         }
     }
-}
-
-/// The serial arm's first moments of mass about the shoulder (kg m): the
-/// upper arm's, `l1 m_a + l5 m_be + l1 m_c/2`, whose height goes as
-/// `sin q2`, and the forearm's, `l2 m_a/2 + l3 m_c - l6 m_df`, whose depth
-/// goes as `cos q3`.
-fn arm_weights(
-    l1: f64,
-    l2: f64,
-    l3: f64,
-    l5: f64,
-    l6: f64,
-    [ma, mc, mbe, mdf]: [f64; 4],
-) -> (f64, f64) {
-    (
-        l1 * ma + l5 * mbe + 0.5 * l1 * mc,
-        0.5 * l2 * ma + l3 * mc - l6 * mdf,
-    )
 }
 
 #[cfg(test)]

@@ -107,13 +107,14 @@ impl Chain {
             c_f[(0, n - 1)] = s;
             c_f[(0, n - 2)] = -s;
         }
-        let all = self
+        let finite = self
             .masses_kg
             .iter()
             .chain(&self.springs_npm)
             .chain(&self.links_nspm)
-            .chain([&self.actuator_nspm, &self.handle_nspm]);
-        if all.clone().any(|v| !v.is_finite()) {
+            .chain([&self.actuator_nspm, &self.handle_nspm])
+            .all(|v| v.is_finite());
+        if !finite {
             return None;
         }
         Some(DeviceModel {
