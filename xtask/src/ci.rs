@@ -229,10 +229,11 @@ fn pil_passivity() -> Result<(), String> {
 /// The tests, closing on the total so that CI reads the whole count rather
 /// than the last crate's doc-test line. The long hard cases (24 h of
 /// ticks, 2 x 10^4 random terminations) are ignored in debug builds and run
-/// here in release, as are the designer's verify searches and the scope in
+/// here in release, as are the designer's verify searches, the model fits
+/// (minutes in debug, seconds in release) and the scope in
 /// a real window under Xvfb (screenshots) with an hour of scope buffers.
 fn tests() -> Result<(), String> {
-    let runs: [&[&str]; 4] = [
+    let runs: [&[&str]; 5] = [
         &[
             "test",
             "--release",
@@ -257,6 +258,7 @@ fn tests() -> Result<(), String> {
             "--test",
             "soundness",
         ],
+        &["test", "--release", "-p", "twoport-identify", "--lib"],
         &[
             "test",
             "--release",
