@@ -1,8 +1,22 @@
 //! Small allocation-free complex solvers for the per-frequency work: each
 //! frequency point solves one small system, so the solvers reuse buffers.
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, Schur};
 use num_complex::Complex64;
+
+/// The eigenvalues of a real square matrix, or `None` where it has a
+/// number that is not finite or the QR iteration does not settle. Every
+/// eigenvalue in the crate goes through here: nalgebra's own
+/// `complex_eigenvalues` iterates without a bound, and a degenerate
+/// model (a spring of 10^14 N/m on a gram) would hang a design.
+pub fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex64>> {
+    if !a.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let n = a.nrows().max(1);
+    let schur = Schur::try_new(a.clone(), f64::EPSILON, 1000 * n)?;
+    Some(schur.complex_eigenvalues().iter().copied().collect())
+}
 
 /// Solve `a x = b` in place by LU with partial pivoting: `a` is n x n
 /// row-major, `b` is n x m row-major; on return `b` holds `x`. Returns
@@ -184,6 +198,22 @@ mod tests {
 
     fn c(re: f64, im: f64) -> Complex64 {
         Complex64::new(re, im)
+    }
+
+    /// A damped oscillator's poles come back; a matrix with a number that
+    /// is not finite gives none, rather than an iteration that never ends.
+    #[test]
+    fn eigenvalues_are_found_or_refused() {
+        // x'' + 2 x' + 5 x = 0: poles -1 ± 2j.
+        let a = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -5.0, -2.0]);
+        let mut l = eigenvalues(&a).unwrap();
+        l.sort_by(|x, y| x.im.total_cmp(&y.im));
+        assert!((l[0] - c(-1.0, -2.0)).norm() < 1e-12, "{l:?}");
+        assert!((l[1] - c(-1.0, 2.0)).norm() < 1e-12, "{l:?}");
+        for bad in [f64::NAN, f64::INFINITY] {
+            let a = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, bad, -2.0]);
+            assert!(eigenvalues(&a).is_none());
+        }
     }
 
     #[test]

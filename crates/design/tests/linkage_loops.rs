@@ -60,7 +60,8 @@ fn radius(pose: &PoseDynamics, hand: &Hand, (kc, bc): (f64, f64), t: f64) -> f64
     for i in 0..n {
         cl[(2 * n + i, i)] = 1.0;
     }
-    cl.complex_eigenvalues()
+    twoport_design::linalg::eigenvalues(&cl)
+        .unwrap()
         .iter()
         .map(|z| z.norm())
         .fold(0.0, f64::max)
@@ -192,7 +193,8 @@ fn radius_bounded(
     for j in 0..n {
         cl[(4 * n + j, j)] = 1.0;
     }
-    cl.complex_eigenvalues()
+    twoport_design::linalg::eigenvalues(&cl)
+        .unwrap()
         .iter()
         .map(|z| z.norm())
         .fold(0.0, f64::max)

@@ -244,9 +244,9 @@ impl System {
         self.a.nrows()
     }
 
-    /// Eigenvalues of `A` (rad/s).
-    pub fn poles(&self) -> Vec<nalgebra::Complex<f64>> {
-        self.a.complex_eigenvalues().iter().copied().collect()
+    /// Eigenvalues of `A` (rad/s), or `None` where they cannot be found.
+    pub fn poles(&self) -> Option<Vec<nalgebra::Complex<f64>>> {
+        twoport_design::linalg::eigenvalues(&self.a)
     }
 }
 

@@ -166,8 +166,7 @@ pub fn loop_radius(
     for j in 0..n {
         cl[(s + j, j)] = 1.0;
     }
-    let r = cl
-        .complex_eigenvalues()
+    let r = crate::linalg::eigenvalues(&cl)?
         .iter()
         .map(|z| z.norm())
         .fold(0.0, f64::max);

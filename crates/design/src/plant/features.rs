@@ -37,10 +37,9 @@ fn oscillating_poles(m: &DMatrix<f64>, d: &DMatrix<f64>, k: &DMatrix<f64>) -> Ve
     // then sits at s = 0, which no oscillating pole is.
     let none = (DMatrix::zeros(n, 0), DMatrix::zeros(1, n));
     let (a, _) = augmented(&(&minv * k), &(&minv * d), &none.0, &none.1, 0.0);
-    if !a.iter().all(|x| x.is_finite()) {
-        return Vec::new();
-    }
-    oscillating(a.complex_eigenvalues().as_slice())
+    crate::linalg::eigenvalues(&a)
+        .map(|poles| oscillating(&poles))
+        .unwrap_or_default()
 }
 
 /// `(Im λ, -Re λ)` of the poles with `Im λ > 0`.

@@ -245,7 +245,8 @@ impl Plant {
         let fma = Siso::new(ad.clone(), bd_act, c_fm);
 
         let a_q = a.view((0, 0), (2 * n, 2 * n)).into_owned();
-        let free_poles = a_q.complex_eigenvalues();
+        let unsettled = "the device's poles could not be found (a number is not finite, or the eigenvalue iteration did not settle)";
+        let free_poles = crate::linalg::eigenvalues(&a_q).ok_or(unsettled)?;
         let mut modes: Vec<Mode> = free_poles
             .iter()
             .filter(|l| l.im > 0.0)
@@ -255,7 +256,7 @@ impl Plant {
             })
             .collect();
         modes.sort_by(|x, y| x.omega_n.total_cmp(&y.omega_n));
-        let discrete_poles = ad.complex_eigenvalues();
+        let discrete_poles = crate::linalg::eigenvalues(&ad).ok_or(unsettled)?;
         let discrete_angles = discrete_poles
             .iter()
             .map(|l| l.im.atan2(l.re).abs())
@@ -514,7 +515,7 @@ impl Plant {
                 a[(n + i, n + j)] = k.a[(i, j)];
             }
         }
-        Some(a.complex_eigenvalues().iter().copied().collect())
+        crate::linalg::eigenvalues(&a)
     }
 
     /// `X_aa^d` and `F_ma^d` at `ω` by a plain complex LU of `(zI - A_d)`

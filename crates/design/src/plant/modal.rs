@@ -32,7 +32,7 @@ impl Modal {
         let act = ac.transpose();
         let mut poles = Vec::with_capacity(na);
         let mut residues = Vec::with_capacity(na);
-        for l in a.complex_eigenvalues().iter().copied() {
+        for l in crate::linalg::eigenvalues(&a)? {
             let shift = l + Complex64::new(1e-9, 1e-9) * l.norm().max(1.0);
             let v = inverse_iteration(&ac, shift)?;
             let w = inverse_iteration(&act, shift)?;

@@ -264,7 +264,16 @@ pub(super) fn judge(a: &DMatrix<f64>, period_s: f64) -> Radius {
     let (mut rho, mut arg, mut score) = (0.0, 0.0, 0.0f64);
     let mut unstable = false;
     let slow = 2.0 * PI * 0.1 * period_s;
-    for l in a.complex_eigenvalues().iter() {
+    let Some(poles) = crate::linalg::eigenvalues(a) else {
+        // No poles found is no proof of stability.
+        return Radius {
+            spectral_radius: f64::INFINITY,
+            frequency_hz: 0.0,
+            score: f64::INFINITY,
+            unstable: true,
+        };
+    };
+    for l in &poles {
         let th = l.im.atan2(l.re).abs();
         if l.norm() > rho {
             (rho, arg) = (l.norm(), th);

@@ -269,7 +269,8 @@ mod tests {
                 let g = imp(k, 20.0);
                 let a = closed_loop(&model, 1e-3, &g, &term, 0).unwrap();
                 let osc = |m: &DMatrix<f64>| {
-                    m.complex_eigenvalues()
+                    crate::linalg::eigenvalues(m)
+                        .unwrap()
                         .iter()
                         .filter(|l| l.im.abs() > 1e-3)
                         .map(|l| l.norm())

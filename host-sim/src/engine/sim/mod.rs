@@ -243,7 +243,12 @@ fn max_stable_step(method: Method, poles: &[nalgebra::Complex<f64>]) -> f64 {
 
 /// The warning for a sub-step `h` that `method` cannot take on `sys`.
 pub fn integrator_warning(sys: &System, method: Method, h: f64) -> Option<String> {
-    let poles = sys.poles();
+    let Some(poles) = sys.poles() else {
+        return Some(format!(
+            "{} at h = {h:.3e} s: the plant's poles could not be found, so its stability is unknown",
+            method.name()
+        ));
+    };
     let bad = poles
         .iter()
         .filter(|l| !method.stable_for(**l, h))
