@@ -1,29 +1,42 @@
-//! From a measured frequency response to a physical model: a chain of
-//! masses (a rigid mass-damper, or one to four lightly damped modes) whose
-//! exact sampled response, the one `twoport design` analyses, matches the
-//! measurement at every excited harmonic.
+//! From a measured frequency response to a physical model whose exact
+//! sampled response, the one `twoport design` analyses, matches the
+//! measurement at every excited harmonic: a rigid mass-damper, or one to
+//! four lightly damped modes.
 //!
-//! 1. **Start** from the measurement itself: the total mass and damping
-//!    from the lowest harmonics; the resonances and antiresonances from
-//!    the peaks and dips of `|X/F| ω²`; and from them, by Cauer's ladder
-//!    ([`ladder`]), the one chain with those frequencies.
-//! 2. **Fit** every mass, spring and damper (their logarithms) by
-//!    Levenberg-Marquardt ([`lm`]) to the encoder's response, and the load
-//!    cell's where there is one, each harmonic weighted by its measured
-//!    variance (with a floor of 0.2% of the response, for what no model
-//!    of a few modes captures).
-//! 3. **Choose the order** by the Bayesian information criterion,
+//! The model's form follows what was measured:
+//!
+//! - **the encoder alone** ([`chain`]): a chain of masses from the
+//!   actuator to the handle. The handle's motion is not observed, so the
+//!   chain's end is where it is taken to be; Cauer's ladder ([`ladder`])
+//!   gives the one chain with the resonances and antiresonances seen at
+//!   the encoder, and the fit starts there.
+//! - **the encoder and a load cell** ([`modal`]): the device's modes as
+//!   the actuator and the load cell see them, the handle hung on the load
+//!   cell. Nothing is assumed of where the handle sits along the
+//!   structure. The fit starts from each mode's pole, searched, and its
+//!   residues by linear least squares ([`start`]).
+//!
+//! Then:
+//!
+//! 1. **Fit** every parameter by Levenberg-Marquardt ([`lm`]) to both
+//!    channels, each harmonic weighted by its measured variance (with a
+//!    floor of 0.2% of the response, for what no model of a few modes
+//!    captures).
+//! 2. **Choose the order** by the Bayesian information criterion,
 //!    `χ² + p ln(N)` over the orders that could be started: a mode is kept
 //!    only if it explains more than noise would.
-//! 4. **Bound** the fit: the parameters' covariance from the Jacobian,
+//! 3. **Bound** the fit: the parameters' covariance from the Jacobian,
 //!    inflated by the misfit (`χ²/ν` where above one).
 
 pub mod chain;
 pub mod ladder;
 pub mod lm;
+pub mod modal;
+pub mod start;
 
 use crate::frf::Frf;
 use chain::{Chain, ModelBase};
+use modal::Modal;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use std::f64::consts::TAU;
@@ -40,11 +53,38 @@ pub struct Measured {
     pub load_cell: Option<Frf>,
 }
 
+/// The physical form of a fitted model.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Form {
+    /// A chain of masses (the encoder alone measured).
+    Chain(Chain),
+    /// Modes with the handle on a load cell.
+    Modal(Modal),
+}
+
+impl Form {
+    /// Flexible modes in the band.
+    pub fn modes(&self) -> usize {
+        match self {
+            Form::Chain(c) => c.modes(),
+            Form::Modal(m) => m.modes.len(),
+        }
+    }
+
+    /// The model-file form.
+    pub fn model(&self, base: &ModelBase) -> Option<DeviceModel> {
+        match self {
+            Form::Chain(c) => c.model(base),
+            Form::Modal(m) => m.model(base),
+        }
+    }
+}
+
 /// One order's fit.
 #[derive(Clone, Debug)]
-pub struct ChainFit {
-    /// The chain found.
-    pub chain: Chain,
+pub struct Fit {
+    /// The model found, in its physical form.
+    pub form: Form,
     /// Its model file.
     pub model: DeviceModel,
     /// The weighted sum of squared residuals.
@@ -60,7 +100,7 @@ pub struct ChainFit {
     pub bic: f64,
 }
 
-impl ChainFit {
+impl Fit {
     /// `χ²` per degree of freedom.
     pub fn reduced_chi2(&self) -> f64 {
         self.chi2 / (self.residuals - self.parameters).max(1) as f64
@@ -105,10 +145,9 @@ fn residual(model: Complex64, measured: Complex64, var: f64) -> Complex64 {
     l / rel
 }
 
-/// The weighted residuals of `chain` against `data`.
-fn residuals(chain: &Chain, base: &ModelBase, data: &Measured) -> Option<DVector<f64>> {
-    let model = chain.model(base)?;
-    let h = sampled_response(&model, &data.position.freq_hz)?;
+/// The weighted residuals of `model` against `data`.
+fn residuals(model: &DeviceModel, data: &Measured) -> Option<DVector<f64>> {
+    let h = sampled_response(model, &data.position.freq_hz)?;
     let mut r = Vec::with_capacity(4 * h.len());
     for (i, (x, f)) in h.iter().enumerate() {
         let e = residual(*x, data.position.response[i], data.position.variance[i]);
@@ -183,20 +222,19 @@ fn features(data: &Frf, modes: usize) -> Option<(Vec<usize>, Vec<usize>)> {
     Some((anti, res))
 }
 
-/// Fit a chain of `modes` modes to `data`, or `None` where the
-/// measurement shows fewer resonances or the search finds no model.
-/// With `stiff_load_cell`, the load cell is a flexure of its own past the
-/// band, between the chain and a handle mass (the handle's share of the
-/// mass read from the load cell at low frequency); without, it is the
-/// chain's last spring.
-pub fn fit_chain(
-    data: &Measured,
-    base: &ModelBase,
-    modes: usize,
-    stiff_load_cell: bool,
-) -> Option<ChainFit> {
+/// Fit a chain of `modes` modes, or `None` where the measurement shows
+/// fewer resonances or the search finds no model. A load cell, if
+/// measured, is the chain's last spring: a flexure in the band.
+pub fn fit_chain(data: &Measured, base: &ModelBase, modes: usize) -> Option<Fit> {
     let x = &data.position;
     let (m_t, d_t) = rigid_estimate(x, base.period_s)?;
+    // At low frequency the load cell reads the force that accelerates the
+    // handle's mass, `-sign m_h/m_t` of the push (the acceleration per
+    // push has a positive real part, whatever the damping).
+    let sign = match &data.load_cell {
+        Some(lc) if lc.response.iter().take(5).map(|h| h.re).sum::<f64>() > 0.0 => -1.0,
+        _ => 1.0,
+    };
     let start = if modes == 0 {
         Chain {
             masses_kg: vec![m_t],
@@ -211,22 +249,7 @@ pub fn fit_chain(
         let w = |i: &usize| TAU * x.freq_hz[*i];
         let anti: Vec<f64> = anti.iter().map(w).collect();
         let res: Vec<f64> = res.iter().map(w).collect();
-        let mut l = ladder::synthesise(m_t, &anti, &res)?;
-        if stiff_load_cell {
-            let lc = data.load_cell.as_ref()?;
-            let share = lc.response[..lc.response.len().min(5)]
-                .iter()
-                .map(|h| h.norm())
-                .sum::<f64>()
-                / lc.response.len().clamp(1, 5) as f64;
-            let last = l.masses_kg.last_mut()?;
-            let handle = (share * m_t).clamp(1e-3 * *last, 0.9 * *last);
-            *last -= handle;
-            l.masses_kg.push(handle);
-            // Well past the band: five times Nyquist.
-            let w = TAU * 5.0 / (2.0 * base.period_s);
-            l.springs_npm.push(handle * w * w);
-        }
+        let l = ladder::synthesise(m_t, &anti, &res)?;
         let links = (0..l.springs_npm.len())
             .map(|i| {
                 let (a, b) = (l.masses_kg[i], l.masses_kg[i + 1]);
@@ -237,23 +260,16 @@ pub fn fit_chain(
             masses_kg: l.masses_kg,
             springs_npm: l.springs_npm,
             links_nspm: links,
-            actuator_nspm: 0.8 * d_t,
-            handle_nspm: 0.2 * d_t,
-            load_cell_sign: 1.0,
+            // The damping to ground starts at the actuator: at the handle
+            // it would show in a load cell at low frequency, where the
+            // handle's mass alone does.
+            actuator_nspm: d_t,
+            handle_nspm: 1e-3 * d_t,
+            load_cell_sign: sign,
         }
     };
-    // The load cell's sign is whichever fits the start better.
-    let start = [1.0, -1.0]
-        .into_iter()
-        .map(|s| Chain {
-            load_cell_sign: s,
-            ..start.clone()
-        })
-        .filter_map(|c| residuals(&c, base, data).map(|r| (r.norm_squared(), c)))
-        .min_by(|a, b| a.0.total_cmp(&b.0))?
-        .1;
     let masses = start.masses_kg.len();
-    let sign = start.load_cell_sign;
+    let model = |p: &DVector<f64>| Chain::from_log(masses, p, sign).model(base);
     // First the dampers alone, the frequencies held where the ladder put
     // them (a guessed damping is what a start gets most wrong), then all.
     let p0 = start.to_log();
@@ -262,20 +278,76 @@ pub fn fit_chain(
         |d| {
             let mut p = p0.clone();
             p.rows_mut(fixed, d.len()).copy_from(d);
-            residuals(&Chain::from_log(masses, &p, sign), base, data)
+            model(&p).and_then(|m| residuals(&m, data))
         },
         p0.rows(fixed, p0.len() - fixed).into_owned(),
         50,
     )?;
     let mut p1 = p0.clone();
     p1.rows_mut(fixed, damped.p.len()).copy_from(&damped.p);
-    let sol = lm::minimise(
-        |p| residuals(&Chain::from_log(masses, p, sign), base, data),
-        p1,
+    finish(data, p1, model, |p| {
+        Form::Chain(Chain::from_log(masses, p, sign))
+    })
+}
+
+/// Fit `modes` modes, with the handle on its load cell, to what the
+/// encoder and the load cell measured; `None` where the measurement
+/// shows fewer resonances or the search finds no model.
+pub fn fit_modal(data: &Measured, base: &ModelBase, modes: usize) -> Option<Fit> {
+    let x = &data.position;
+    let pole = base.load_cell_pole_rad_s?;
+    let rigid = rigid_estimate(x, base.period_s)?;
+    let omegas: Vec<f64> = if modes == 0 {
+        Vec::new()
+    } else {
+        features(x, modes)?
+            .1
+            .iter()
+            .map(|i| TAU * x.freq_hz[*i])
+            .collect()
+    };
+    let start = start::modal_start(data, base.period_s, pole, rigid, &omegas)?;
+    let sign = start.load_cell_sign;
+    let from = |p: &DVector<f64>| Modal::from_params(p, sign, base.period_s);
+    // First with proportional damping, then with the modes' coupling: the
+    // coupling is small, and fitting it from a start far off only slows
+    // the search.
+    let full = start.to_params();
+    let coupled = start.coupling.len();
+    let plain = full.rows(0, full.len() - coupled).into_owned();
+    let widen = |p: &DVector<f64>| {
+        DVector::from_iterator(
+            full.len(),
+            p.iter().copied().chain(std::iter::repeat_n(0.0, coupled)),
+        )
+    };
+    let first = lm::minimise(
+        |p| {
+            from(&widen(p))
+                .model(base)
+                .and_then(|m| residuals(&m, data))
+        },
+        plain,
         200,
     )?;
-    let chain = Chain::from_log(masses, &sol.p, sign);
-    let model = chain.model(base)?;
+    finish(
+        data,
+        widen(&first.p),
+        |p| from(p).model(base),
+        |p| Form::Modal(from(p)),
+    )
+}
+
+/// Levenberg-Marquardt from `p0` on every parameter, and the fit's
+/// statistics where it ends.
+fn finish(
+    data: &Measured,
+    p0: DVector<f64>,
+    model: impl Fn(&DVector<f64>) -> Option<DeviceModel> + Sync,
+    form: impl Fn(&DVector<f64>) -> Form,
+) -> Option<Fit> {
+    let sol = lm::minimise(|p| model(p).and_then(|m| residuals(&m, data)), p0, 200)?;
+    let found = model(&sol.p)?;
     let residuals = sol.jacobian.nrows();
     let parameters = sol.p.len();
     let nu = (residuals - parameters).max(1) as f64;
@@ -283,9 +355,9 @@ pub fn fit_chain(
     let jtj = sol.jacobian.transpose() * &sol.jacobian;
     let eps = 1e-12 * jtj.norm();
     let covariance = jtj.pseudo_inverse(eps).ok()? * inflate;
-    Some(ChainFit {
-        chain,
-        model,
+    Some(Fit {
+        form: form(&sol.p),
+        model: found,
         chi2: sol.cost,
         residuals,
         parameters,
@@ -295,16 +367,38 @@ pub fn fit_chain(
 }
 
 /// Every order from a rigid body to [`MAX_MODES`] that could be fitted,
-/// and the index of the one the criterion chooses.
-pub fn fit_orders(data: &Measured, base: &ModelBase) -> (Vec<ChainFit>, Option<usize>) {
+/// in the form the measurement calls for, and the index of the one the
+/// criterion chooses.
+pub fn fit_orders(data: &Measured, base: &ModelBase) -> (Vec<Fit>, Option<usize>) {
     let sensor = data.load_cell.is_some() && base.load_cell_pole_rad_s.is_some();
-    let fits: Vec<ChainFit> = (0..=MAX_MODES)
-        .flat_map(|m| {
-            let stiff = sensor.then(|| fit_chain(data, base, m, true)).flatten();
-            let inband = (m > 0 || !sensor)
-                .then(|| fit_chain(data, base, m, false))
-                .flatten();
-            stiff.into_iter().chain(inband)
+    // With a load cell, the modes are the device's own and the handle
+    // hangs on a stiff flexure; where the handle cannot be taken out of
+    // the modes that way, its flexure is itself one of them, and the
+    // chain with the load cell as its last spring is fitted instead.
+    let encoder_only;
+    let (data, base) = if sensor {
+        (data, base)
+    } else {
+        encoder_only = (
+            Measured {
+                position: data.position.clone(),
+                load_cell: None,
+            },
+            ModelBase {
+                load_cell_pole_rad_s: None,
+                ..base.clone()
+            },
+        );
+        (&encoder_only.0, &encoder_only.1)
+    };
+    let fits: Vec<Fit> = (0..=MAX_MODES)
+        .filter_map(|m| {
+            if sensor {
+                fit_modal(data, base, m)
+                    .or_else(|| (m > 0).then(|| fit_chain(data, base, m)).flatten())
+            } else {
+                fit_chain(data, base, m)
+            }
         })
         .collect();
     let best = fits
