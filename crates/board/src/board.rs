@@ -1,6 +1,7 @@
 //! The loop: servo tick, link in, frames out.
 
 mod arming;
+mod identify;
 mod persist;
 
 use crate::io::IoScale;
@@ -8,6 +9,7 @@ use crate::region::{check_axes, Region};
 use crate::support::BoardSupport;
 use heapless::{Deque, Vec};
 use twoport_control::drive::Drive;
+use twoport_control::experiment::Experiment;
 use twoport_control::homing::{Homing, HomingConfig};
 use twoport_control::servo::PortLayer;
 use twoport_control::servo::{Direct, Gains, SensorFrame, Servo, ServoOutput};
@@ -72,6 +74,9 @@ pub struct Board<W, const R: usize, const N: usize = 1, L = Direct, D = Servo<W,
     /// others go on.
     homing_cfg: [HomingConfig; N],
     homing: Option<[Option<Homing>; N]>,
+    /// The identification experiment in progress (in
+    /// [`Mode::Identifying`]).
+    experiment: Option<Experiment<N>>,
     /// The dead-man switch at the last tick (open before the first).
     dead_man_closed: bool,
     /// Whether the amplifier's outputs are on (as last commanded).
@@ -166,6 +171,7 @@ where
             calibrated: false,
             homing_cfg: [HomingConfig::gentle(Position::ZERO, period_s); N],
             homing: None,
+            experiment: None,
             dead_man_closed: false,
             outputs_on: false,
             config_source: None,
@@ -335,6 +341,7 @@ where
             Message::Arm => self.arm(),
             Message::Disarm => self.disarm(),
             Message::Home => self.home(),
+            Message::Identify(req) => self.identify(req),
             Message::Calibrate { position_pm } => self.calibrate(position_pm),
             Message::GetStatus => self.queue_status(),
             Message::SaveConfig => self.request_save(),
@@ -495,17 +502,23 @@ where
     /// telemetry on schedule. Returns the held actuator command.
     pub fn tick(&mut self, frame: &SensorFrame<f32, N>) -> ServoOutput<f32, N> {
         self.dead_man_closed = frame.dead_man_closed;
-        let driven = match self.homing.as_mut() {
+        let driven = match (self.homing.as_mut(), self.experiment.as_ref()) {
             // Each axis's homing law in place of the display's, through the
             // same safety layer; an axis that has homed holds no force.
-            Some(h) => self
+            (Some(h), _) => self
                 .servo
                 .tick_with(frame, |i, x, v| h[i].as_mut().map_or(0.0, |h| h.step(x, v))),
-            None => self.servo.tick(frame),
+            // The experiment's law, through the same safety layer.
+            (None, Some(e)) => self.servo.tick_with(frame, |i, x, v| e.force(i, x, v)),
+            (None, None) => self.servo.tick(frame),
         };
         let out = driven.cartesian;
         self.last = out;
         self.motor = driven.motor;
+        // (Telemetry of this tick goes out in the experiment's mode, even
+        // on the tick that ends it.)
+        let identifying = self.mode == Mode::Identifying;
+        self.after_experiment_tick();
         self.after_tick(&out);
         if !out.faults.is_empty() && out.faults != self.reported {
             self.reported = out.faults;
@@ -514,9 +527,10 @@ where
                 first: out.faults.lowest().0,
             });
         }
-        if self.telemetry_every > 0 {
+        if self.telemetry_every > 0 || identifying {
             self.since_telemetry += 1;
-            if self.since_telemetry >= self.telemetry_every {
+            // Every tick of an experiment: its record is the point of it.
+            if self.since_telemetry >= self.telemetry_every || identifying {
                 self.since_telemetry = 0;
                 let ve = self.servo.servo().world().positions();
                 let axes = core::array::from_fn(|i| AxisTelemetry {
@@ -532,7 +546,11 @@ where
                     axes: Self::axes(axes),
                     faults: out.faults.0,
                     loop_cycles: self.loop_cycles,
-                    mode: self.mode,
+                    mode: if identifying {
+                        Mode::Identifying
+                    } else {
+                        self.mode
+                    },
                     stage_cycles: self.timing.stages,
                     deadline_misses: self.timing.deadline_misses,
                     worst_jitter_cycles: self.timing.worst_jitter,

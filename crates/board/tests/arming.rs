@@ -459,3 +459,158 @@ fn homing_on_an_index_that_never_pulses_fails_at_the_stop() {
     assert_eq!(b.servo().safety().faults(), Faults::HOMING_FAILED);
     assert_eq!(b.mode(), Mode::Disarmed);
 }
+
+/// An experiment the test boards can play: 5 N of harmonics 1 to 20 of
+/// 200 ticks, three periods, held by 2,000 N/m and 30 N s/m.
+fn experiment() -> twoport_link::Experiment {
+    twoport_link::Experiment {
+        axis: 0,
+        period_ticks: 200,
+        first: 1,
+        last: 20,
+        peak_n: 5.0,
+        periods: 3,
+        hold_k_npm: 2_000.0,
+        hold_b_nspm: 30.0,
+    }
+}
+
+fn telemetry(msgs: &[Message]) -> Vec<twoport_link::Telemetry> {
+    msgs.iter()
+        .filter_map(|m| match m {
+            Message::Telemetry(t) => Some(*t),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Armed, the board plays the experiment: telemetry every tick (the
+/// board sends none otherwise), the actuator's force the hold minus the
+/// multisine, the same multisine each period, and at the end of the last
+/// period it disarms, outputs off.
+#[test]
+fn an_armed_board_plays_an_experiment_and_disarms_at_its_end() {
+    let mut b = board();
+    let mut io = Bench::new(None);
+    io.say(Message::Calibrate {
+        position_pm: Axes::one(0),
+    });
+    tick(&mut b, &mut io);
+    assert_eq!(refused(&ask_to_arm(&mut b, &mut io)), []);
+    // Past the arming ramp, so that every tick's force is the law's.
+    for _ in 0..SafetyConfig::excalibur().ramp_ticks {
+        tick(&mut b, &mut io);
+    }
+    io.heard();
+    io.say(Message::Identify(experiment()));
+    let mut heard = Vec::new();
+    for _ in 0..700 {
+        tick(&mut b, &mut io);
+        heard.extend(io.heard());
+    }
+    let modes: Vec<Mode> = statuses(&heard).iter().map(|s| s.mode).collect();
+    assert_eq!(modes, [Mode::Identifying, Mode::Disarmed]);
+    let t = telemetry(&heard);
+    assert_eq!(t.len(), 600, "one frame per tick of the experiment");
+    assert!(t.windows(2).all(|w| w[1].tick == w[0].tick + 1));
+    assert!(t.iter().all(|t| t.mode == Mode::Identifying));
+    let m = twoport_control::multisine::Multisine::new(200, 1, 20, 5.0).unwrap();
+    for (n, t) in t.iter().enumerate() {
+        let a = t.axes[0];
+        let hold = 2_000.0 * (a.position_pm as f32 * 1e-12) + 30.0 * a.velocity_mps;
+        let want = hold - m.at(n as u32);
+        assert!(
+            (a.actuator_n - want).abs() < 1e-3,
+            "tick {n}: {} against {want}",
+            a.actuator_n
+        );
+    }
+    assert_eq!((b.mode(), io.duty, io.outputs), (Mode::Disarmed, 0, false));
+    assert!(b.experiment().is_none());
+}
+
+/// Every condition is named: a disarmed board, a band past Nyquist, a
+/// peak past the continuous force, a hold outside the proven region, an
+/// axis the board lacks. None of them changes the mode.
+#[test]
+fn an_experiment_is_refused_with_the_reason() {
+    let mut b = board();
+    let mut io = Bench::new(None);
+    io.say(Message::Calibrate {
+        position_pm: Axes::one(0),
+    });
+    tick(&mut b, &mut io);
+    io.say(Message::Identify(experiment()));
+    tick(&mut b, &mut io);
+    assert_eq!(
+        refused(&io.heard()),
+        [(
+            ModeRequest::Identify,
+            ModeRefusal::NotArmed {
+                mode: Mode::Disarmed
+            }
+        )]
+    );
+    assert_eq!(refused(&ask_to_arm(&mut b, &mut io)), []);
+    let bad = [
+        twoport_link::Experiment {
+            last: 100,
+            ..experiment()
+        },
+        twoport_link::Experiment {
+            peak_n: 1e4,
+            ..experiment()
+        },
+        twoport_link::Experiment {
+            hold_k_npm: 60_000.0,
+            ..experiment()
+        },
+        twoport_link::Experiment {
+            hold_b_nspm: f32::NAN,
+            ..experiment()
+        },
+        twoport_link::Experiment {
+            axis: 1,
+            ..experiment()
+        },
+        twoport_link::Experiment {
+            periods: 0,
+            ..experiment()
+        },
+    ];
+    for x in bad {
+        io.say(Message::Identify(x));
+        tick(&mut b, &mut io);
+        assert_eq!(
+            refused(&io.heard()),
+            [(ModeRequest::Identify, ModeRefusal::BadExperiment)],
+            "{x:?}"
+        );
+        assert_eq!(b.mode(), Mode::Armed);
+    }
+}
+
+/// The dead-man opens halfway: zero force at once, disarmed, the fault
+/// named, and the experiment over.
+#[test]
+fn releasing_the_handle_ends_an_experiment_at_zero_force() {
+    let mut b = board();
+    let mut io = Bench::new(None);
+    io.say(Message::Calibrate {
+        position_pm: Axes::one(0),
+    });
+    tick(&mut b, &mut io);
+    assert_eq!(refused(&ask_to_arm(&mut b, &mut io)), []);
+    io.say(Message::Identify(experiment()));
+    for _ in 0..300 {
+        tick(&mut b, &mut io);
+    }
+    assert_eq!(b.mode(), Mode::Identifying);
+    assert!(io.force_n().abs() > 0.5, "{} N", io.force_n());
+    io.dead_man_closed = false;
+    tick(&mut b, &mut io);
+    assert_eq!((b.mode(), io.force_n()), (Mode::Disarmed, 0.0));
+    assert!(b.experiment().is_none());
+    let s = statuses(&io.heard());
+    assert_eq!(Faults(s.last().unwrap().faults), Faults::DEAD_MAN);
+}

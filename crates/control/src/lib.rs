@@ -10,6 +10,7 @@ pub mod coupling;
 pub mod drive;
 mod encoder;
 mod estimator;
+pub mod experiment;
 pub mod homing;
 pub mod kinematics;
 pub mod linkage;

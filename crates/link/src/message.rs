@@ -10,8 +10,9 @@ use serde::{Deserialize, Serialize};
 /// Version 4 carries every axis of a board in its frames; version 5 a
 /// session number in every answer, so that a host sees a board reset;
 /// version 6 lets a board refuse what its device cannot do
-/// ([`ModeRefusal::Unsupported`]).
-pub const PROTOCOL_VERSION: u16 = 6;
+/// ([`ModeRefusal::Unsupported`]); version 7 runs identification
+/// experiments ([`Message::Identify`]).
+pub const PROTOCOL_VERSION: u16 = 7;
 
 /// The session number of a board no host has shaken hands with since it
 /// booted. A host opens a session with any other number, and a board
@@ -87,6 +88,9 @@ pub enum Mode {
     Homing,
     /// Running the law: force output on.
     Armed,
+    /// Playing an identification experiment, telemetry every tick; back
+    /// to disarmed when it ends (protocol 7).
+    Identifying,
 }
 
 /// What the host asked the state machine for.
@@ -100,6 +104,8 @@ pub enum ModeRequest {
     Calibrate,
     /// [`Message::SaveConfig`].
     SaveConfig,
+    /// [`Message::Identify`] (protocol 7).
+    Identify,
 }
 
 /// Why the board would not change mode.
@@ -133,6 +139,15 @@ pub enum ModeRefusal {
     /// This board's device cannot do it: a linkage has no homing run (it
     /// is calibrated at a known pose instead) (protocol 6).
     Unsupported,
+    /// Only an armed board may do this (protocol 7).
+    NotArmed {
+        /// The mode it is in.
+        mode: Mode,
+    },
+    /// The experiment asked for cannot be played: an axis the board does
+    /// not have, a band past Nyquist, a peak past the axis's force limit,
+    /// no period, or a hold outside the axis's proven region (protocol 7).
+    BadExperiment,
 }
 
 /// Where the configuration in force came from (protocol 3).
@@ -289,6 +304,31 @@ pub struct ActuatorFrame {
     pub session: u16,
 }
 
+/// An identification experiment (protocol 7): a periodic multisine force
+/// of harmonics `first..=last` of `period_ticks`, peaking at `peak_n`, on
+/// one axis for `periods` periods, every axis held where it stood by a
+/// spring-damper of `hold_k_npm` (N/m) and `hold_b_nspm` (N s/m), which
+/// must lie in the axis's proven region.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Experiment {
+    /// The axis excited.
+    pub axis: u8,
+    /// The multisine's period (ticks).
+    pub period_ticks: u32,
+    /// Its lowest harmonic.
+    pub first: u32,
+    /// Its highest harmonic (below half the period).
+    pub last: u32,
+    /// Its peak (N).
+    pub peak_n: f32,
+    /// Periods played.
+    pub periods: u32,
+    /// The hold's stiffness (N/m).
+    pub hold_k_npm: f32,
+    /// The hold's damping (N s/m).
+    pub hold_b_nspm: f32,
+}
+
 /// Every message.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Message {
@@ -378,6 +418,11 @@ pub enum Message {
     GetStats,
     /// The board's link counters (protocol 2).
     Stats(LinkStats),
+    /// Play an identification experiment: an armed board, calibrated, its
+    /// dead-man switch closed and no fault latched, switches to
+    /// [`Mode::Identifying`] and sends telemetry every tick until it ends
+    /// (protocol 7).
+    Identify(Experiment),
 }
 
 /// The board's view of the link.

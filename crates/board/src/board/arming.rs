@@ -74,14 +74,14 @@ where
         self.queue(Message::ModeRefused { asked, why });
     }
 
-    fn set_mode(&mut self, mode: Mode) {
+    pub(super) fn set_mode(&mut self, mode: Mode) {
         if self.mode != mode {
             self.mode = mode;
             self.queue_status();
         }
     }
 
-    fn latched(&self) -> Option<ModeRefusal> {
+    pub(super) fn latched(&self) -> Option<ModeRefusal> {
         let f = self.servo.servo().safety().faults();
         (!f.is_empty()).then_some(ModeRefusal::Faulted { faults: f.0 })
     }
@@ -92,7 +92,9 @@ where
         let why = self
             .latched()
             .or(match self.mode {
-                Mode::Homing => Some(ModeRefusal::NotDisarmed { mode: self.mode }),
+                Mode::Homing | Mode::Identifying => {
+                    Some(ModeRefusal::NotDisarmed { mode: self.mode })
+                }
                 _ => None,
             })
             .or((!self.calibrated).then_some(ModeRefusal::NotCalibrated))
@@ -118,6 +120,7 @@ where
     pub(super) fn disarm(&mut self) {
         self.servo.servo_mut().disable();
         self.homing = None;
+        self.experiment = None;
         self.set_mode(Mode::Disarmed);
     }
 
