@@ -327,3 +327,41 @@ fn a_board_homes_on_the_index_pulse_before_the_stop() {
     assert!(lowest > -0.008, "went down to {lowest} m");
     assert!(r.armed_at_tick > n);
 }
+
+/// The identification scene: the board plays its experiment 0.3 s after
+/// arming and streams every tick; the record is whole and its force is
+/// the hold minus the multisine (the board's law, bit for bit), and the
+/// board disarms when the last period ends.
+#[test]
+fn the_board_plays_the_scenes_experiment_and_streams_every_tick() {
+    let scene = Scene::load(Path::new("../scenes/identify/excalibur.toml"), &[]).unwrap();
+    let spec = scene.identify.unwrap();
+    let x = spec.experiment(1e-3).unwrap();
+    let scene = Scene {
+        identify: Some(host_sim::engine::scene::IdentifySpec { periods: 3, ..spec }),
+        ..scene
+    };
+    let r = pil::run(
+        scene,
+        4000,
+        LocalBoard::excalibur().unwrap(),
+        LinkFaults::default(),
+    )
+    .unwrap();
+    let (played, at) = r.experiment.unwrap();
+    assert_eq!(played, twoport_link::Experiment { periods: 3, ..x });
+    assert_eq!(at, r.armed_at_tick + 300);
+    let log = r.experiment_log(true).unwrap().unwrap();
+    assert_eq!(log.force_n.len(), 3000);
+    let m = twoport_control::multisine::Multisine::new(1000, 1, 450, 20.0).unwrap();
+    for (n, (f, x)) in log.force_n.iter().zip(&log.position_m).enumerate().skip(1) {
+        let v = (x - log.position_m[n - 1]) / 1e-3;
+        let hold = 2000.0 * x + 20.0 * v;
+        let want = m.at(n as u32) as f64 - hold;
+        assert!((f - want).abs() < 2e-3, "tick {n}: {f} against {want}");
+    }
+    let last = r.telemetry.last().unwrap();
+    assert_eq!(last.mode, twoport_link::Mode::Disarmed);
+    let c = pil::compare(&r, &r);
+    assert!(pil::failures(&r, &c, 4000, LinkFaults::default(), 0).is_empty());
+}

@@ -180,7 +180,8 @@ fn design_lib() -> Result<(), String> {
 /// corrupted frames and a link loss, on both boards (for the STM32F405
 /// image, its own loop on QEMU's netduinoplus2, with the log of what it
 /// touches that QEMU does not model): the plain scene, homing onto the
-/// hard stop then armed (the state machine bit for bit too), the
+/// hard stop then armed (the state machine bit for bit too), an
+/// identification experiment streaming every tick, the
 /// three-axis image on its building-block world, and the serial-arm and
 /// delta images against their nonlinear arms.
 fn pil_boards() -> Result<(), String> {
@@ -197,9 +198,16 @@ fn pil_boards() -> Result<(), String> {
             ]
         };
         let (arm, delta) = (linkage("serial-arm"), linkage("delta"));
-        let runs: [&[&str]; 5] = [
+        let runs: [&[&str]; 6] = [
             &["--seconds", "4", "--link-loss-at-s", "3", "--check"],
             &["scenes/homing.toml", "--seconds", "2", "--check"],
+            // Two whole periods of the identification experiment.
+            &[
+                "scenes/identify/excalibur.toml",
+                "--seconds",
+                "2.3",
+                "--check",
+            ],
             &[
                 "scenes/xyz/pil_blocks.toml",
                 "--seconds",

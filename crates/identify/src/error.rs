@@ -43,6 +43,14 @@ pub enum IdentifyError {
         /// The force's amplitude there (N).
         force: f64,
     },
+    /// A record file that cannot be read: where, and why.
+    #[error("{place}: {why}")]
+    Log {
+        /// The file, and the line where there is one.
+        place: String,
+        /// What is wrong there.
+        why: String,
+    },
     /// A harmonic at or past Nyquist, or a period too short.
     #[error("harmonic {harmonic} of a {period}-sample period: must be between 1 and {max}")]
     Harmonic {

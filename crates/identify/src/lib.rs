@@ -5,5 +5,6 @@
 mod error;
 pub mod fit;
 pub mod frf;
+pub mod log;
 
 pub use error::IdentifyError;

@@ -125,6 +125,14 @@ impl<P: BoardPort> Session<P> {
         self.ask(Message::Arm, ModeRequest::Arm, |s| s.mode == Mode::Armed)
     }
 
+    /// Start an identification experiment on an armed board; the caller
+    /// runs its ticks, the board streaming each.
+    pub fn identify(&mut self, x: twoport_link::Experiment) -> Result<Status, LinkError> {
+        self.ask(Message::Identify(x), ModeRequest::Identify, |s| {
+            s.mode == Mode::Identifying
+        })
+    }
+
     /// Start homing; the caller runs ticks until
     /// [`homed`](crate::pil::homed).
     pub fn home(&mut self) -> Result<Status, LinkError> {

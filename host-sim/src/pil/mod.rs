@@ -53,6 +53,9 @@ pub struct Run<const N: usize = 1> {
     /// Homing: the ticks it took, and how far the board's calibrated
     /// position was from the plant's then (m).
     pub homing: Option<(u64, f64)>,
+    /// The identification experiment the scene asked for, and the tick
+    /// the board started it at.
+    pub experiment: Option<(twoport_link::Experiment, u64)>,
 }
 
 impl<const N: usize> Default for Run<N> {
@@ -69,7 +72,55 @@ impl<const N: usize> Default for Run<N> {
             config: None,
             armed_at_tick: 0,
             homing: None,
+            experiment: None,
         }
+    }
+}
+
+impl<const N: usize> Run<N> {
+    /// The identification experiment's record, from the board's
+    /// telemetry of every tick it played: the excited axis's push (N,
+    /// toward +x), encoder and, `with_load_cell`, load cell. `None` where
+    /// the run played none; an error where a tick's telemetry is missing.
+    pub fn experiment_log(
+        &self,
+        with_load_cell: bool,
+    ) -> Option<Result<twoport_identify::log::Log, Error>> {
+        let (x, _) = self.experiment?;
+        let axis = usize::from(x.axis);
+        let frames: Vec<&Telemetry> = self
+            .telemetry
+            .iter()
+            .filter(|t| t.mode == Mode::Identifying)
+            .collect();
+        if let Some(w) = frames
+            .windows(2)
+            .find(|w| w[1].tick != w[0].tick.wrapping_add(1))
+        {
+            return Some(Err(pil_err!(
+                "the experiment's telemetry jumps from tick {} to {}: its record has a gap",
+                w[0].tick,
+                w[1].tick
+            )));
+        }
+        let get = |f: &dyn Fn(&twoport_link::AxisTelemetry) -> f64| -> Vec<f64> {
+            frames
+                .iter()
+                .map(|t| t.axes.get(axis).map_or(f64::NAN, f))
+                .collect()
+        };
+        Some(Ok(twoport_identify::log::Log {
+            // (A PIL scene ticks at the board's 1 kHz.)
+            period_s: 1e-3,
+            force_n: get(&|a| -f64::from(a.actuator_n)),
+            position_m: get(&|a| a.position_pm as f64 * 1e-12),
+            load_cell_n: with_load_cell.then(|| get(&|a| f64::from(a.load_cell_n))),
+            excitation: Some(twoport_identify::log::Excitation {
+                period_ticks: x.period_ticks as usize,
+                first: x.first as usize,
+                last: x.last as usize,
+            }),
+        }))
     }
 }
 
@@ -313,6 +364,16 @@ pub fn run_axes<P: BoardPort, const N: usize>(
     // transport.
     session.arm()?;
     r.armed_at_tick = r.samples.len() as u64;
+    if let Some(spec) = sim.scene().identify {
+        let period = sim.scene().period();
+        let x = spec.experiment(period)?;
+        let at = r.armed_at_tick + (spec.start_s / period).round() as u64;
+        while (r.samples.len() as u64) < at.min(ticks) {
+            record(&mut session, &mut sim, &mut r)?;
+        }
+        session.identify(x)?;
+        r.experiment = Some((x, r.samples.len() as u64));
+    }
     while (r.samples.len() as u64) < ticks {
         record(&mut session, &mut sim, &mut r)?;
     }
@@ -395,8 +456,8 @@ pub fn compare<const N: usize>(a: &Run<N>, b: &Run<N>) -> Comparison {
             c.max_force_error_n = c.max_force_error_n.max(df);
         }
     }
-    c.start_differs =
-        (a.armed_at_tick, a.homing.map(|h| h.0)) != (b.armed_at_tick, b.homing.map(|h| h.0));
+    c.start_differs = (a.armed_at_tick, a.homing.map(|h| h.0), a.experiment)
+        != (b.armed_at_tick, b.homing.map(|h| h.0), b.experiment);
     c.duty_mismatches = a
         .duties
         .iter()
@@ -442,6 +503,18 @@ pub fn failures<const N: usize>(
     }
     if c.ticks != ticks {
         bad.push(format!("{} of {ticks} ticks ran", c.ticks));
+    }
+    if let Some((x, at)) = run.experiment {
+        let want = u64::from(x.period_ticks * x.periods).min(ticks.saturating_sub(at));
+        match run.experiment_log(false) {
+            Some(Ok(log)) if log.force_n.len() as u64 == want => {}
+            Some(Ok(log)) => bad.push(format!(
+                "the experiment streamed {} of its {want} ticks",
+                log.force_n.len()
+            )),
+            Some(Err(e)) => bad.push(e.to_string()),
+            None => {}
+        }
     }
     if u64::from(run.board_stats.rx.dropped()) < run.corrupted_sent {
         bad.push(format!(

@@ -592,6 +592,7 @@ pub fn board_state(ui: &mut Ui, b: &BoardLink) -> Option<twoport_link::Message> 
     let colour = match mode {
         Mode::Armed => Color32::GREEN,
         Mode::Homing => Color32::YELLOW,
+        Mode::Identifying => Color32::LIGHT_BLUE,
         Mode::Disarmed => Color32::GRAY,
     };
     ui.colored_label(

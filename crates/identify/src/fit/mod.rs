@@ -80,6 +80,35 @@ impl Form {
     }
 }
 
+impl Measured {
+    /// The responses an experiment's record shows at the harmonics it
+    /// played, averaged over its whole periods after the first `skip` (the
+    /// transient). Refused, with the reason: a record that does not name
+    /// its excitation, or one [`frf::periodic`](crate::frf::periodic)
+    /// refuses.
+    pub fn from_log(log: &crate::log::Log, skip: usize) -> Result<Measured, crate::IdentifyError> {
+        let e = log.excitation.ok_or(crate::IdentifyError::Log {
+            place: "the record".into(),
+            why: "it does not name its excitation (the `# twoport experiment:` line)".into(),
+        })?;
+        let harmonics: Vec<usize> = (e.first..=e.last).collect();
+        let at = |signal: &[f64]| {
+            crate::frf::periodic(
+                &log.force_n,
+                signal,
+                log.period_s,
+                e.period_ticks,
+                &harmonics,
+                skip,
+            )
+        };
+        Ok(Measured {
+            position: at(&log.position_m)?,
+            load_cell: log.load_cell_n.as_deref().map(at).transpose()?,
+        })
+    }
+}
+
 /// One order's fit.
 #[derive(Clone, Debug)]
 pub struct Fit {

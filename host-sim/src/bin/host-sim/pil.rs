@@ -35,6 +35,11 @@ pub(crate) struct PilArgs {
     /// against it, pressed into the image's floor (the scene is not read).
     #[arg(long, value_enum)]
     pub(crate) linkage: Option<host_sim::pil::linkage::Device>,
+    /// Write the identification experiment's record (the scene's
+    /// `[identify]`) to this CSV file: the board's over the port where
+    /// there is one, else the in-process loop's.
+    #[arg(long)]
+    pub(crate) log: Option<PathBuf>,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub(crate) json: bool,
@@ -115,9 +120,20 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
         pil::run(scene.clone(), ticks, link::LocalBoard::excalibur()?, faults)?
     };
     let local_s = start.elapsed().as_secs_f64();
+    let load_cell = scene.effects.load_cell;
     let run = port
         .map(|p| pil::run(scene, ticks, p, faults))
         .transpose()?;
+    if let Some(path) = &a.log {
+        let log = run
+            .as_ref()
+            .unwrap_or(&reference)
+            .experiment_log(load_cell)
+            .ok_or_else(|| {
+                err!("--log: the scene plays no experiment (add an [identify] section)")
+            })??;
+        std::fs::write(path, log.to_csv()).map_err(|e| err!("--log {}: {e}", path.display()))?;
+    }
     pil_report(a, ticks, faults, reference, run, local_s, start)
 }
 

@@ -48,6 +48,7 @@ impl Scene {
             );
         }
         self.check_linkage()?;
+        self.check_identify()?;
         pos("duration_s", self.duration_s)?;
         if let Some(t) = self.period_s {
             if !(t.is_finite() && (1e-6..=0.1).contains(&t)) {

@@ -2,10 +2,12 @@
 
 mod check;
 mod effects;
+mod identify;
 mod parse;
 mod spec;
 
 pub use effects::*;
+pub use identify::IdentifySpec;
 pub use parse::{apply_set, checked, parse_toml, read, SceneError};
 pub use spec::*;
 
@@ -56,6 +58,9 @@ pub struct Scene {
     pub effects: Effects,
     /// The time-domain passivity layer; absent means none.
     pub passivity: Option<PassivitySpec>,
+    /// An identification experiment the board plays once armed
+    /// (processor in the loop); absent means none.
+    pub identify: Option<IdentifySpec>,
 }
 
 impl Scene {
