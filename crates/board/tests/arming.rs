@@ -468,6 +468,9 @@ fn experiment() -> twoport_link::Experiment {
         period_ticks: 200,
         first: 1,
         last: 20,
+        amplitude_n: twoport_control::multisine::Multisine::new(200, 1, 20, 5.0)
+            .unwrap()
+            .amplitude(),
         peak_n: 5.0,
         periods: 3,
         hold_k_npm: 2_000.0,
@@ -559,6 +562,11 @@ fn an_experiment_is_refused_with_the_reason() {
         },
         twoport_link::Experiment {
             peak_n: 1e4,
+            ..experiment()
+        },
+        // An amplitude whose rms is past the peak the host claims.
+        twoport_link::Experiment {
+            amplitude_n: 5.0,
             ..experiment()
         },
         twoport_link::Experiment {

@@ -28,6 +28,36 @@ impl Multisine {
     /// Refused: a period under 4 ticks, a band empty or past Nyquist
     /// (`last < P/2`), a peak not finite and positive.
     pub fn new(period_ticks: u32, first: u32, last: u32, peak: f32) -> Result<Self, ParamError> {
+        if !(peak.is_finite() && peak > 0.0) {
+            return Err(ParamError {
+                name: "multisine peak",
+                value: peak,
+                problem: "must be finite and > 0",
+            });
+        }
+        let unit = Multisine::with_amplitude(period_ticks, first, last, 1.0)?;
+        // (A scan of the whole period: `period × harmonics` terms, which a
+        // host does, not a board's link handler.)
+        let mut most = 0.0f32;
+        for n in 0..period_ticks {
+            most = most.max(unit.at(n).abs());
+        }
+        Ok(Multisine {
+            amplitude: peak / most,
+            ..unit
+        })
+    }
+
+    /// Harmonics `first..=last` of a period of `period_ticks` ticks, each
+    /// of amplitude `amplitude` (its peak then follows from the phases:
+    /// [`new`](Self::new) finds the amplitude for a peak). Refused as in
+    /// `new`, and an amplitude not finite and positive.
+    pub fn with_amplitude(
+        period_ticks: u32,
+        first: u32,
+        last: u32,
+        amplitude: f32,
+    ) -> Result<Self, ParamError> {
         if period_ticks < 4 {
             return Err(ParamError {
                 name: "multisine period (ticks)",
@@ -42,27 +72,26 @@ impl Multisine {
                 problem: "must satisfy 1 <= first <= last < period/2",
             });
         }
-        if !(peak.is_finite() && peak > 0.0) {
+        if !(amplitude.is_finite() && amplitude > 0.0) {
             return Err(ParamError {
-                name: "multisine peak",
-                value: peak,
+                name: "multisine amplitude",
+                value: amplitude,
                 problem: "must be finite and > 0",
             });
         }
-        let unit = Multisine {
+        Ok(Multisine {
             period_ticks,
             first,
             last,
-            amplitude: 1.0,
-        };
-        let mut most = 0.0f32;
-        for n in 0..period_ticks {
-            most = most.max(unit.at(n).abs());
-        }
-        Ok(Multisine {
-            amplitude: peak / most,
-            ..unit
+            amplitude,
         })
+    }
+
+    /// Its root mean square over a period: `A √(K/2)` for `K` harmonics.
+    /// No peak is below it.
+    pub fn rms(&self) -> f32 {
+        let k = (self.last - self.first + 1) as f32;
+        self.amplitude * Real::sqrt(k / 2.0)
     }
 
     /// The period (ticks).
@@ -150,5 +179,20 @@ mod tests {
         assert!(Multisine::new(100, 10, 50, 1.0).is_err());
         let e = Multisine::new(100, 1, 10, f32::NAN).unwrap_err();
         assert_eq!(e.name, "multisine peak");
+    }
+
+    /// A multisine made from its amplitude is the one made from its peak,
+    /// bit for bit; its rms is the period's, and below its peak.
+    #[test]
+    fn the_amplitude_makes_the_same_multisine_and_its_rms_is_the_periods() {
+        let m = Multisine::new(400, 2, 90, 7.0).unwrap();
+        let a = Multisine::with_amplitude(400, 2, 90, m.amplitude()).unwrap();
+        assert_eq!(a, m);
+        let ms = (0..400).map(|n| (m.at(n) as f64).powi(2)).sum::<f64>() / 400.0;
+        assert!((ms.sqrt() - m.rms() as f64).abs() < 1e-4 * ms.sqrt(), "{ms}");
+        assert!(m.rms() < 7.0);
+        for bad in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+            assert!(Multisine::with_amplitude(400, 2, 90, bad).is_err());
+        }
     }
 }

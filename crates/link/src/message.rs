@@ -305,10 +305,11 @@ pub struct ActuatorFrame {
 }
 
 /// An identification experiment (protocol 7): a periodic multisine force
-/// of harmonics `first..=last` of `period_ticks`, peaking at `peak_n`, on
-/// one axis for `periods` periods, every axis held where it stood by a
-/// spring-damper of `hold_k_npm` (N/m) and `hold_b_nspm` (N s/m), which
-/// must lie in the axis's proven region.
+/// of harmonics `first..=last` of `period_ticks`, each of `amplitude_n`
+/// (the host finds it for the peak it wants: a board does not scan a
+/// period), on one axis for `periods` periods, every axis held where it
+/// stood by a spring-damper of `hold_k_npm` (N/m) and `hold_b_nspm`
+/// (N s/m), which must lie in the axis's proven region.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Experiment {
     /// The axis excited.
@@ -319,7 +320,10 @@ pub struct Experiment {
     pub first: u32,
     /// Its highest harmonic (below half the period).
     pub last: u32,
-    /// Its peak (N).
+    /// Each harmonic's amplitude (N).
+    pub amplitude_n: f32,
+    /// The peak the host found for it (N): the board refuses one past the
+    /// axis's continuous force, or below the multisine's rms.
     pub peak_n: f32,
     /// Periods played.
     pub periods: u32,

@@ -505,7 +505,9 @@ pub fn failures<const N: usize>(
         bad.push(format!("{} of {ticks} ticks ran", c.ticks));
     }
     if let Some((x, at)) = run.experiment {
-        let want = u64::from(x.period_ticks * x.periods).min(ticks.saturating_sub(at));
+        // (A tick's telemetry follows its actuator frame, so the run's
+        // last tick's is never read.)
+        let want = u64::from(x.period_ticks * x.periods).min(ticks.saturating_sub(at + 1));
         match run.experiment_log(false) {
             Some(Ok(log)) if log.force_n.len() as u64 == want => {}
             Some(Ok(log)) => bad.push(format!(

@@ -59,13 +59,15 @@ where
 
     /// `req` as this board would play it from where the device stands, if
     /// it can: an axis it has, a band below Nyquist, a peak within the
-    /// axis's continuous force, and a hold inside every axis's proven
-    /// region (the hold is a coupling to a fixed point).
+    /// axis's continuous force and no lower than the multisine's rms (a
+    /// host's peak that cannot be), and a hold inside every axis's proven
+    /// region (the hold is a coupling to a fixed point). Whatever the
+    /// host says, the safety layer bounds every tick's force.
     fn experiment_for(&self, req: &Request) -> Option<Experiment<N>> {
         let servo = self.servo.servo();
         let axis = usize::from(req.axis);
         let cfg = servo.safety().configs().get(axis)?;
-        // (A peak that is not a number fails the multisine's own check.)
+        // (A peak that is not a number fails the rms check below.)
         if req.peak_n > cfg.continuous_force_n {
             return None;
         }
@@ -77,7 +79,16 @@ where
         {
             return None;
         }
-        let excitation = Multisine::new(req.period_ticks, req.first, req.last, req.peak_n).ok()?;
+        let excitation =
+            Multisine::with_amplitude(req.period_ticks, req.first, req.last, req.amplitude_n)
+                .ok()?;
+        if excitation
+            .rms()
+            .partial_cmp(&req.peak_n)
+            .is_none_or(|o| o.is_gt())
+        {
+            return None;
+        }
         let coupling =
             ImpedanceCoupling::new(req.hold_k_npm, req.hold_b_nspm, cfg.period_s).ok()?;
         Experiment::new(axis, excitation, coupling, req.periods, servo.position()).ok()

@@ -73,11 +73,19 @@ impl IdentifySpec {
                 self.periods
             ));
         }
+        let m = twoport_control::multisine::Multisine::new(
+            period_ticks,
+            lo as u32,
+            hi as u32,
+            self.peak_n as f32,
+        )
+        .map_err(|e| sim_err!("identify: {e}"))?;
         Ok(twoport_link::Experiment {
             axis: self.axis,
             period_ticks,
             first: lo as u32,
             last: hi as u32,
+            amplitude_n: m.amplitude(),
             peak_n: self.peak_n as f32,
             periods: self.periods,
             hold_k_npm: self.hold_k_npm as f32,
