@@ -353,7 +353,7 @@ fn the_board_plays_the_scenes_experiment_and_streams_every_tick() {
     assert_eq!(at, r.armed_at_tick + 300);
     let log = r.experiment_log(true).unwrap().unwrap();
     assert_eq!(log.force_n.len(), 3000);
-    let m = twoport_control::multisine::Multisine::new(1000, 1, 450, 20.0).unwrap();
+    let m = twoport_control::multisine::Multisine::new(1000, 1, 450, spec.peak_n as f32).unwrap();
     for (n, (f, x)) in log.force_n.iter().zip(&log.position_m).enumerate().skip(1) {
         let v = (x - log.position_m[n - 1]) / 1e-3;
         let hold = 2000.0 * x + 20.0 * v;

@@ -241,7 +241,7 @@ fn pil_passivity() -> Result<(), String> {
 /// (minutes in debug, seconds in release) and the scope in
 /// a real window under Xvfb (screenshots) with an hour of scope buffers.
 fn tests() -> Result<(), String> {
-    let runs: [&[&str]; 5] = [
+    let runs: [&[&str]; 6] = [
         &[
             "test",
             "--release",
@@ -267,6 +267,9 @@ fn tests() -> Result<(), String> {
             "soundness",
         ],
         &["test", "--release", "-p", "twoport-identify", "--lib"],
+        // The experiment on the flexible Excalibur, identified and
+        // designed for: release only, as the fits are.
+        &["test", "--release", "-p", "host-sim", "--test", "identify"],
         &[
             "test",
             "--release",

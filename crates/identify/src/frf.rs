@@ -38,6 +38,33 @@ fn dft(x: &[f64], h: usize) -> Complex64 {
         .sum()
 }
 
+/// The average over the whole periods after the first `skip` of
+/// `signal`'s DFT at each of `harmonics` of a period of `period` samples
+/// (the caller has checked that there are such periods).
+pub fn mean_spectrum(
+    signal: &[f64],
+    period: usize,
+    harmonics: &[usize],
+    skip: usize,
+) -> Vec<Complex64> {
+    let periods = (signal.len() / period.max(1)).saturating_sub(skip).max(1);
+    harmonics
+        .iter()
+        .map(|&h| {
+            (skip..skip + periods)
+                .map(|k| {
+                    dft(
+                        &signal
+                            [(k * period).min(signal.len())..((k + 1) * period).min(signal.len())],
+                        h,
+                    )
+                })
+                .sum::<Complex64>()
+                / periods as f64
+        })
+        .collect()
+}
+
 /// The response from `force_n` to `position_m`, sampled every `period_s`,
 /// at `harmonics` of a period of `period` samples, over the whole periods
 /// after the first `skip`.

@@ -29,6 +29,7 @@
 //!    inflated by the misfit (`χ²/ν` where above one).
 
 pub mod chain;
+pub mod friction;
 pub mod ladder;
 pub mod lm;
 pub mod modal;
@@ -51,6 +52,16 @@ pub struct Measured {
     pub position: Frf,
     /// Actuator force to load cell.
     pub load_cell: Option<Frf>,
+    /// The velocity's sign per unit force, `S/F`, at the same harmonics,
+    /// where the record gave it: what Coulomb friction adds to the force
+    /// ([`friction`]).
+    pub friction: Option<Vec<Complex64>>,
+    /// The encoder's quantum (m), where the record shows it: the least
+    /// step between the positions it read.
+    pub encoder_quantum_m: Option<f64>,
+    /// Coulomb friction already taken out of the responses (N), if any
+    /// has been ([`friction::without`]).
+    pub coulomb_n: Option<f64>,
 }
 
 /// The physical form of a fitted model.
@@ -102,11 +113,55 @@ impl Measured {
                 skip,
             )
         };
+        let spectrum = |x: &[f64]| crate::frf::mean_spectrum(x, e.period_ticks, &harmonics, skip);
+        let force = spectrum(&log.force_n);
+        // A quantised reading's error repeats with the motion, period after
+        // period, so no averaging removes it: its share of each harmonic,
+        // `N q²/12` (`q` the least step the record shows), is a floor on
+        // that harmonic's variance. Where the response is far below a
+        // count, the harmonic then counts for what it is worth.
+        let floored = |mut f: Frf, signal: &[f64]| {
+            let q = quantum(signal);
+            if let Some(q) = q {
+                let floor = e.period_ticks as f64 * q * q / 12.0;
+                for (v, fm) in f.variance.iter_mut().zip(&force) {
+                    *v += floor / fm.norm_sqr().max(f64::MIN_POSITIVE);
+                }
+            }
+            (f, q)
+        };
+        let (position, encoder) = floored(at(&log.position_m)?, &log.position_m);
+        let load_cell = match log.load_cell_n.as_deref() {
+            Some(lc) => Some(floored(at(lc)?, lc).0),
+            None => None,
+        };
+        let sign = friction::velocity_sign(&log.position_m);
+        let friction = spectrum(&sign)
+            .iter()
+            .zip(&force)
+            .map(|(s, f)| s / f)
+            .collect();
         Ok(Measured {
-            position: at(&log.position_m)?,
-            load_cell: log.load_cell_n.as_deref().map(at).transpose()?,
+            position,
+            load_cell,
+            friction: Some(friction),
+            encoder_quantum_m: encoder,
+            coulomb_n: None,
         })
     }
+}
+
+/// The least step between the values a quantised signal took, if it
+/// took two.
+fn quantum(signal: &[f64]) -> Option<f64> {
+    let mut levels = signal.to_vec();
+    levels.sort_by(f64::total_cmp);
+    levels.dedup();
+    let q = levels
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .fold(f64::INFINITY, f64::min);
+    q.is_finite().then_some(q)
 }
 
 /// One order's fit.
@@ -174,16 +229,26 @@ fn residual(model: Complex64, measured: Complex64, var: f64) -> Complex64 {
     l / rel
 }
 
-/// The weighted residuals of `model` against `data`.
-fn residuals(model: &DeviceModel, data: &Measured) -> Option<DVector<f64>> {
+/// The weighted residuals of `model` against `data`, with `coulomb_n` more
+/// friction than `data` has had taken out (see [`friction`]).
+fn residuals(model: &DeviceModel, data: &Measured, coulomb_n: f64) -> Option<DVector<f64>> {
     let h = sampled_response(model, &data.position.freq_hz)?;
     let mut r = Vec::with_capacity(4 * h.len());
     for (i, (x, f)) in h.iter().enumerate() {
-        let e = residual(*x, data.position.response[i], data.position.variance[i]);
+        // The device felt the push less friction: X = H (F - F_c S).
+        let felt = match &data.friction {
+            Some(s) if coulomb_n != 0.0 => 1.0 - coulomb_n * s[i],
+            _ => Complex64::new(1.0, 0.0),
+        };
+        let e = residual(
+            *x * felt,
+            data.position.response[i],
+            data.position.variance[i],
+        );
         r.push(e.re);
         r.push(e.im);
         if let (Some(lc), true) = (&data.load_cell, model.force_sensor) {
-            let e = residual(*f, lc.response[i], lc.variance[i]);
+            let e = residual(*f * felt, lc.response[i], lc.variance[i]);
             r.push(e.re);
             r.push(e.im);
         }
@@ -307,7 +372,7 @@ pub fn fit_chain(data: &Measured, base: &ModelBase, modes: usize) -> Option<Fit>
         |d| {
             let mut p = p0.clone();
             p.rows_mut(fixed, d.len()).copy_from(d);
-            model(&p).and_then(|m| residuals(&m, data))
+            model(&p).and_then(|m| residuals(&m, data, 0.0))
         },
         p0.rows(fixed, p0.len() - fixed).into_owned(),
         50,
@@ -354,7 +419,7 @@ pub fn fit_modal(data: &Measured, base: &ModelBase, modes: usize) -> Option<Fit>
         |p| {
             from(&widen(p))
                 .model(base)
-                .and_then(|m| residuals(&m, data))
+                .and_then(|m| residuals(&m, data, 0.0))
         },
         plain,
         200,
@@ -375,8 +440,27 @@ fn finish(
     model: impl Fn(&DVector<f64>) -> Option<DeviceModel> + Sync,
     form: impl Fn(&DVector<f64>) -> Form,
 ) -> Option<Fit> {
-    let sol = lm::minimise(|p| model(p).and_then(|m| residuals(&m, data)), p0, 200)?;
-    let found = model(&sol.p)?;
+    // Where the record shows friction, its amount is a parameter too, the
+    // last: what is left of it once the start's estimate was taken out.
+    let extra = usize::from(data.friction.is_some());
+    let k = p0.len();
+    let p0 = DVector::from_iterator(
+        k + extra,
+        p0.iter().copied().chain(std::iter::repeat_n(0.0, extra)),
+    );
+    let split = |p: &DVector<f64>| (p.rows(0, k).into_owned(), p.get(k).copied().unwrap_or(0.0));
+    let sol = lm::minimise(
+        |p| {
+            let (q, f_c) = split(p);
+            model(&q).and_then(|m| residuals(&m, data, f_c))
+        },
+        p0,
+        200,
+    )?;
+    let (q, more) = split(&sol.p);
+    let mut found = model(&q)?;
+    found.coulomb_friction_n = data.coulomb_n.map(|f| (f + more).max(0.0));
+    found.encoder_quantum_m = data.encoder_quantum_m;
     let residuals = sol.jacobian.nrows();
     let parameters = sol.p.len();
     let nu = (residuals - parameters).max(1) as f64;
@@ -385,7 +469,7 @@ fn finish(
     let eps = 1e-12 * jtj.norm();
     let covariance = jtj.pseudo_inverse(eps).ok()? * inflate;
     Some(Fit {
-        form: form(&sol.p),
+        form: form(&q),
         model: found,
         chi2: sol.cost,
         residuals,
@@ -399,6 +483,37 @@ fn finish(
 /// in the form the measurement calls for, and the index of the one the
 /// criterion chooses.
 pub fn fit_orders(data: &Measured, base: &ModelBase) -> (Vec<Fit>, Option<usize>) {
+    // Friction out first, where the record shows the velocity's sign:
+    // estimated where the device moves as one body, a quarter of the way
+    // to its lowest resonance.
+    // The start's estimate is refined by each fit's last step.
+    let linear;
+    let data = match &data.friction {
+        Some(_) => {
+            let below = lowest_resonance_hz(&data.position)
+                .or(data.position.freq_hz.last().copied())
+                .unwrap_or(0.0)
+                / 4.0;
+            let f_c =
+                friction::rigid_with_friction(data, base.period_s, below).map_or(0.0, |r| r.2);
+            linear = friction::without(data, f_c);
+            &linear
+        }
+        None => data,
+    };
+    fit_orders_linear(data, base)
+}
+
+/// The lowest of the most prominent resonances seen at the encoder (Hz).
+fn lowest_resonance_hz(x: &Frf) -> Option<f64> {
+    (1..=3)
+        .rev()
+        .find_map(|m| features(x, m))
+        .and_then(|(_, res)| res.first().map(|i| x.freq_hz[*i]))
+}
+
+/// [`fit_orders`] on a record with no friction in it.
+fn fit_orders_linear(data: &Measured, base: &ModelBase) -> (Vec<Fit>, Option<usize>) {
     let sensor = data.load_cell.is_some() && base.load_cell_pole_rad_s.is_some();
     // With a load cell, the modes are the device's own and the handle
     // hangs on a stiff flexure; where the handle cannot be taken out of
@@ -410,8 +525,8 @@ pub fn fit_orders(data: &Measured, base: &ModelBase) -> (Vec<Fit>, Option<usize>
     } else {
         encoder_only = (
             Measured {
-                position: data.position.clone(),
                 load_cell: None,
+                ..data.clone()
             },
             ModelBase {
                 load_cell_pole_rad_s: None,
