@@ -189,7 +189,10 @@ mod tests {
         let a = Multisine::with_amplitude(400, 2, 90, m.amplitude()).unwrap();
         assert_eq!(a, m);
         let ms = (0..400).map(|n| (m.at(n) as f64).powi(2)).sum::<f64>() / 400.0;
-        assert!((ms.sqrt() - m.rms() as f64).abs() < 1e-4 * ms.sqrt(), "{ms}");
+        assert!(
+            (ms.sqrt() - m.rms() as f64).abs() < 1e-4 * ms.sqrt(),
+            "{ms}"
+        );
         assert!(m.rms() < 7.0);
         for bad in [0.0, -1.0, f32::NAN, f32::INFINITY] {
             assert!(Multisine::with_amplitude(400, 2, 90, bad).is_err());

@@ -8,6 +8,31 @@ macro_rules! err {
     };
 }
 
+/// `println!` for a report a reader may stop reading (`| head`): a closed
+/// pipe ends the program quietly, as it does any Unix filter, where
+/// `println!` would panic.
+macro_rules! say {
+    () => {
+        crate::say(format_args!(""))
+    };
+    ($($t:tt)*) => {
+        crate::say(format_args!($($t)*))
+    };
+}
+
+/// One line on standard output; see [`say!`].
+fn say(args: std::fmt::Arguments) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_fmt(args).and_then(|()| out.write_all(b"\n")) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("host-sim: standard output: {e}");
+        std::process::exit(2);
+    }
+}
+
 mod pil;
 mod run;
 mod scope;

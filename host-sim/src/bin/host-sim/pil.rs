@@ -192,24 +192,24 @@ pub(crate) fn pil_report<const N: usize>(
         "wall_s": remote_s,
     });
     if a.json {
-        println!("{v}");
+        say!("{v}");
     } else {
-        println!(
+        say!(
             "PIL ({board}): {} ticks in {remote_s:.2} s; position error {:.3e} m, force error {:.3e} N, \
              {} duty mismatches; {} corrupted frames sent, {frames_dropped} dropped",
             c.ticks, c.max_position_error_m, c.max_force_error_n, c.duty_mismatches,
             run.corrupted_sent
         );
         match run.homing {
-            Some((n, err)) => println!(
+            Some((n, err)) => say!(
                 "  homed onto the hard stop in {n} ticks (calibration {:+.1} um off the plant), armed at tick {}",
                 err * 1e6,
                 run.armed_at_tick
             ),
-            None => println!("  calibrated at rest, armed at tick {}", run.armed_at_tick),
+            None => say!("  calibrated at rest, armed at tick {}", run.armed_at_tick),
         }
         if let Some(z) = run.zero_after_loss_ticks {
-            println!(
+            say!(
                 "  link loss: zero force after {z} ticks (watchdog deadline {})",
                 twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS
             );

@@ -132,7 +132,7 @@ fn run_axes<const N: usize>(a: &RunArgs, scene: Scene) -> Result<(), Error> {
         host_sim::study::plot::png(&kept, &name, p)?;
     }
     if a.scene.json {
-        println!(
+        say!(
             "{}",
             serde_json::to_string(&report).map_err(|e| e.to_string())?
         );
@@ -171,26 +171,26 @@ pub(crate) fn finish_csv(
 /// A run's first lines: the scene, stable or not, and why not.
 pub(crate) fn print_verdict(scene: &str, reason: &Option<String>) {
     match reason {
-        None => println!("{scene}: stable"),
-        Some(why) => println!("{scene}: UNSTABLE\n  {why}"),
+        None => say!("{scene}: stable"),
+        Some(why) => say!("{scene}: UNSTABLE\n  {why}"),
     }
 }
 
 pub(crate) fn print_report(r: &Report) {
     print_verdict(&r.scene, &r.reason);
-    println!(
+    say!(
         "  peak force {:.1} N, human energy in {:.3} J, {:.1} s simulated in {:.3} s ({:.0}x real time)",
         r.peak_force_n, r.energy_in_j, r.sim_seconds, r.wall_seconds, r.realtime_factor
     );
-    println!("  plant: {} x {} per tick", r.integrator, r.substeps);
+    say!("  plant: {} x {} per tick", r.integrator, r.substeps);
     if let Some(w) = &r.integrator_warning {
-        println!("  warning: {w}");
+        say!("  warning: {w}");
     }
     for e in &r.effects {
-        println!("  effect {:<12} {:>8.1} ns/tick", e.name, e.ns_per_tick);
+        say!("  effect {:<12} {:>8.1} ns/tick", e.name, e.ns_per_tick);
     }
     for (i, b) in r.blocks_m.iter().enumerate() {
-        println!(
+        say!(
             "  block {i} at ({:.1}, {:.1}, {:.1}) mm",
             b[0] * 1e3,
             b[1] * 1e3,

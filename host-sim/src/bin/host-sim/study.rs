@@ -95,9 +95,9 @@ pub(crate) fn sweep(a: &SweepArgs) -> Result<(), Error> {
     )?;
     b.finish_and_clear();
     if a.scene.json {
-        println!("{}", json!({"param": a.param, "marginal": m}));
+        say!("{}", json!({"param": a.param, "marginal": m}));
     } else {
-        println!(
+        say!(
             "{}: marginal value {m:.6} (the last stable value, within {}%)",
             a.param,
             a.tol * 100.0
@@ -111,7 +111,7 @@ pub(crate) fn sweep(a: &SweepArgs) -> Result<(), Error> {
 pub(crate) fn passivity(a: &PassivityArgs) -> Result<(), Error> {
     let rows = over_cases(&a.scenes, "passivity scenes", passivity::table)?;
     if a.json {
-        println!("{}", json!({ "rows": rows }));
+        say!("{}", json!({ "rows": rows }));
     } else {
         print!("{}", passivity::markdown(&rows));
     }
@@ -136,7 +136,7 @@ pub(crate) fn table1(a: &Table1Args) -> Result<(), Error> {
         t.admittance_boundary_m,
     );
     if a.json {
-        println!(
+        say!(
             "{}",
             json!({"cases": rows, "all_stable_at_theoretical_gains": all_stable,
             "impedance_boundary_k": k_bound,
@@ -144,35 +144,53 @@ pub(crate) fn table1(a: &Table1Args) -> Result<(), Error> {
         );
         return Ok(());
     }
-    println!("Table I  Theoretical versus experimental (paper) and simulated (linear model) stability boundary gains");
-    println!(
+    say!("Table I  Theoretical versus experimental (paper) and simulated (linear model) stability boundary gains");
+    say!(
         "{:<26} {:>10} {:>6}   {:>8} {:>6}",
-        "", "k_cI N/m", "b_cI", "m_cA kg", "b_cA"
+        "",
+        "k_cI N/m",
+        "b_cI",
+        "m_cA kg",
+        "b_cA"
     );
-    println!(
+    say!(
         "{:<26} {:>10} {:>6}   {:>8} {:>6}",
-        "theoretical", "51,000", "90", "5.0", "500"
+        "theoretical",
+        "51,000",
+        "90",
+        "5.0",
+        "500"
     );
-    println!(
+    say!(
         "{:<26} {:>10} {:>6}   {:>8} {:>6}",
-        "experimental (paper)", "75,000", "90", "4.3", "500"
+        "experimental (paper)",
+        "75,000",
+        "90",
+        "4.3",
+        "500"
     );
     let fmt_k = k_bound.map_or("> 2e6".into(), |k| format!("{k:.0}"));
     let fmt_m = m_bound.map_or("< 0.01".into(), |m| format!("{m:.2}"));
-    println!(
+    say!(
         "{:<26} {:>10} {:>6}   {:>8} {:>6}",
-        "simulated (this model)", fmt_k, "90", fmt_m, "500"
+        "simulated (this model)",
+        fmt_k,
+        "90",
+        fmt_m,
+        "500"
     );
-    println!();
-    println!(
+    say!();
+    say!(
         "{:<36} {:>22} {:>14}",
-        "case", "stable at theoretical", "boundary"
+        "case",
+        "stable at theoretical",
+        "boundary"
     );
     for r in &rows {
         let m = r["marginal"]
             .as_f64()
             .map_or("none found".into(), |v| format!("{v:.4}"));
-        println!(
+        say!(
             "{:<36} {:>22} {:>14}",
             r["case"].as_str().unwrap_or(""),
             r["stable_at_theoretical_gains"],
@@ -214,7 +232,7 @@ pub(crate) fn accuracy(a: &AccuracyArgs) -> Result<(), Error> {
         serde_json::to_string_pretty(&cells).map_err(|e| e.to_string())?,
     )?;
     host_sim::study::plot::accuracy_png(&cells, &a.out.join("accuracy.png"))?;
-    println!(
+    say!(
         "wrote {}/accuracy.md, accuracy.json, accuracy.png ({} runs)",
         a.out.display(),
         cells.len()
