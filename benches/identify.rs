@@ -1,0 +1,51 @@
+//! Identification from a 30 s experiment: the board's multisine on the
+//! flexible Excalibur (simulated once, outside the timing), then what
+//! `identify` does with the record: the frequency responses over its
+//! periods, and the fit of every order with the choice among them. The
+//! goal is the fit of a 5-DOF model in at most 1 s.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use host_sim::link::{LinkFaults, LocalBoard};
+use host_sim::{pil, Scene};
+use std::hint::black_box;
+use std::path::Path;
+use twoport_identify::fit::{self, chain::ModelBase, Measured};
+
+fn identify(c: &mut Criterion) {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenes/identify/excalibur.toml"
+    );
+    let scene = Scene::load(Path::new(path), &[]).unwrap();
+    let ticks = (scene.duration_s / 1e-3).round() as u64;
+    let run = pil::run(
+        scene,
+        ticks,
+        LocalBoard::excalibur().unwrap(),
+        LinkFaults::default(),
+    )
+    .unwrap();
+    let log = run.experiment_log(true).unwrap().unwrap();
+    let base = ModelBase {
+        name: "identified".into(),
+        period_s: 1e-3,
+        peak_force_n: 200.0,
+        continuous_force_n: 100.0,
+        load_cell_pole_rad_s: Some(235.0),
+    };
+    c.bench_function(
+        "identify: responses of a 30 s record (450 harmonics)",
+        |b| b.iter(|| Measured::from_log(black_box(&log), 2).unwrap()),
+    );
+    let data = Measured::from_log(&log, 2).unwrap();
+    c.bench_function("identify: fit every order, Excalibur (5 DOF chosen)", |b| {
+        b.iter(|| fit::fit_orders(black_box(&data), &base))
+    });
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(10);
+    targets = identify
+}
+criterion_main!(benches);
