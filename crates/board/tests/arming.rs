@@ -164,6 +164,15 @@ fn start_homing(b: &mut TestBoard, io: &mut Bench) {
     io.say(Message::Home);
 }
 
+/// Tell the board it stands at 0, and tick once (so it has read its
+/// dead-man switch).
+fn calibrate_at_rest(b: &mut TestBoard, io: &mut Bench) {
+    io.say(Message::Calibrate {
+        position_pm: Axes::one(0),
+    });
+    tick(b, io);
+}
+
 /// Ask the board to arm and tick once; what it answered.
 fn ask_to_arm(b: &mut TestBoard, io: &mut Bench) -> Vec<Message> {
     io.say(Message::Arm);
@@ -240,10 +249,7 @@ fn gains_outside_the_proven_region_never_arm() {
     // An image built with gains its region does not hold.
     let mut b = board_with(60_000.0);
     let mut io = Bench::new(None);
-    io.say(Message::Calibrate {
-        position_pm: Axes::one(0),
-    });
-    tick(&mut b, &mut io);
+    calibrate_at_rest(&mut b, &mut io);
     assert_eq!(
         refused(&ask_to_arm(&mut b, &mut io)),
         [(ModeRequest::Arm, ModeRefusal::GainsNotProven)]
@@ -258,10 +264,7 @@ fn gains_outside_the_proven_region_never_arm() {
 fn any_fault_disarms_and_latches_until_cleared_and_re_armed() {
     let mut b = board();
     let mut io = Bench::new(None);
-    io.say(Message::Calibrate {
-        position_pm: Axes::one(0),
-    });
-    tick(&mut b, &mut io);
+    calibrate_at_rest(&mut b, &mut io);
     io.say(Message::Arm);
     for k in 0..400 {
         tick(&mut b, &mut io);
@@ -495,10 +498,7 @@ fn telemetry(msgs: &[Message]) -> Vec<twoport_link::Telemetry> {
 fn an_armed_board_plays_an_experiment_and_disarms_at_its_end() {
     let mut b = board();
     let mut io = Bench::new(None);
-    io.say(Message::Calibrate {
-        position_pm: Axes::one(0),
-    });
-    tick(&mut b, &mut io);
+    calibrate_at_rest(&mut b, &mut io);
     assert_eq!(refused(&ask_to_arm(&mut b, &mut io)), []);
     // Past the arming ramp, so that every tick's force is the law's.
     for _ in 0..SafetyConfig::excalibur().ramp_ticks {
@@ -539,10 +539,7 @@ fn an_armed_board_plays_an_experiment_and_disarms_at_its_end() {
 fn an_experiment_is_refused_with_the_reason() {
     let mut b = board();
     let mut io = Bench::new(None);
-    io.say(Message::Calibrate {
-        position_pm: Axes::one(0),
-    });
-    tick(&mut b, &mut io);
+    calibrate_at_rest(&mut b, &mut io);
     io.say(Message::Identify(experiment()));
     tick(&mut b, &mut io);
     assert_eq!(
@@ -604,10 +601,7 @@ fn an_experiment_is_refused_with_the_reason() {
 fn releasing_the_handle_ends_an_experiment_at_zero_force() {
     let mut b = board();
     let mut io = Bench::new(None);
-    io.say(Message::Calibrate {
-        position_pm: Axes::one(0),
-    });
-    tick(&mut b, &mut io);
+    calibrate_at_rest(&mut b, &mut io);
     assert_eq!(refused(&ask_to_arm(&mut b, &mut io)), []);
     io.say(Message::Identify(experiment()));
     for _ in 0..300 {
