@@ -164,7 +164,7 @@ fn doc() -> Result<(), String> {
 
 fn design_lib() -> Result<(), String> {
     run(
-        "twoport-design without its cli and plot features",
+        "twoport-design without its plot feature",
         cargo().args([
             "check",
             "-p",
