@@ -24,7 +24,9 @@
 //!    captures).
 //! 2. **Choose the order** by the Bayesian information criterion,
 //!    `χ² + p ln(N)` over the orders that could be started: a mode is kept
-//!    only if it explains more than noise would.
+//!    only if it explains more than noise would. The orders are climbed
+//!    from a rigid body, and the climb stops at the first that explains
+//!    the data to their noise ([`Fit::at_noise`]).
 //! 3. **Bound** the fit: the parameters' covariance from the Jacobian,
 //!    inflated by the misfit (`χ²/ν` where above one).
 
@@ -34,6 +36,7 @@ pub mod ladder;
 pub mod lm;
 pub mod modal;
 pub mod start;
+pub mod uncertainty;
 
 use crate::frf::Frf;
 use chain::{Chain, ModelBase};
@@ -182,9 +185,41 @@ pub struct Fit {
     pub covariance: DMatrix<f64>,
     /// The information criterion the order is chosen by.
     pub bic: f64,
+    /// The parameters found, in the form's own order
+    /// ([`Chain::to_log`], [`Modal::to_params`]); the covariance's first
+    /// rows and columns are theirs, and its last, where the record showed
+    /// friction, the friction's.
+    pub params: DVector<f64>,
+    /// What the model was built on.
+    pub base: ModelBase,
 }
 
 impl Fit {
+    /// The model at other parameters of the same form (the order of
+    /// [`params`](Self::params)), with the fit's friction and encoder
+    /// quantum; `None` where they make no valid model.
+    pub fn model_at(&self, p: &DVector<f64>) -> Option<DeviceModel> {
+        let mut m = match &self.form {
+            Form::Chain(c) => {
+                Chain::from_log(c.masses_kg.len(), p, c.load_cell_sign).model(&self.base)
+            }
+            Form::Modal(m) => {
+                Modal::from_params(p, m.load_cell_sign, self.base.period_s).model(&self.base)
+            }
+        }?;
+        m.coulomb_friction_n = self.model.coulomb_friction_n;
+        m.encoder_quantum_m = self.model.encoder_quantum_m;
+        Some(m)
+    }
+
+    /// Whether the misfit is what the noise alone would leave: `χ²/ν`
+    /// within three of its standard deviations (`√(2/ν)`) of one, or
+    /// below.
+    pub fn at_noise(&self) -> bool {
+        let nu = (self.residuals - self.parameters).max(1) as f64;
+        self.reduced_chi2() <= 1.0 + 3.0 * (2.0 / nu).sqrt()
+    }
+
     /// `χ²` per degree of freedom.
     pub fn reduced_chi2(&self) -> f64 {
         self.chi2 / (self.residuals - self.parameters).max(1) as f64
@@ -379,7 +414,7 @@ pub fn fit_chain(data: &Measured, base: &ModelBase, modes: usize) -> Option<Fit>
     )?;
     let mut p1 = p0.clone();
     p1.rows_mut(fixed, damped.p.len()).copy_from(&damped.p);
-    finish(data, p1, model, |p| {
+    finish(data, base, p1, model, |p| {
         Form::Chain(Chain::from_log(masses, p, sign))
     })
 }
@@ -426,6 +461,7 @@ pub fn fit_modal(data: &Measured, base: &ModelBase, modes: usize) -> Option<Fit>
     )?;
     finish(
         data,
+        base,
         widen(&first.p),
         |p| from(p).model(base),
         |p| Form::Modal(from(p)),
@@ -436,6 +472,7 @@ pub fn fit_modal(data: &Measured, base: &ModelBase, modes: usize) -> Option<Fit>
 /// statistics where it ends.
 fn finish(
     data: &Measured,
+    base: &ModelBase,
     p0: DVector<f64>,
     model: impl Fn(&DVector<f64>) -> Option<DeviceModel> + Sync,
     form: impl Fn(&DVector<f64>) -> Form,
@@ -476,6 +513,8 @@ fn finish(
         parameters,
         covariance,
         bic: sol.cost + parameters as f64 * (residuals as f64).ln(),
+        params: q,
+        base: base.clone(),
     })
 }
 
@@ -535,16 +574,23 @@ fn fit_orders_linear(data: &Measured, base: &ModelBase) -> (Vec<Fit>, Option<usi
         );
         (&encoder_only.0, &encoder_only.1)
     };
-    let fits: Vec<Fit> = (0..=MAX_MODES)
-        .filter_map(|m| {
-            if sensor {
-                fit_modal(data, base, m)
-                    .or_else(|| (m > 0).then(|| fit_chain(data, base, m)).flatten())
-            } else {
-                fit_chain(data, base, m)
-            }
-        })
-        .collect();
+    let mut fits: Vec<Fit> = Vec::new();
+    for m in 0..=MAX_MODES {
+        let fit = if sensor {
+            fit_modal(data, base, m).or_else(|| (m > 0).then(|| fit_chain(data, base, m)).flatten())
+        } else {
+            fit_chain(data, base, m)
+        };
+        let Some(fit) = fit else { continue };
+        let done = fit.at_noise();
+        fits.push(fit);
+        // A model that explains the data to their noise leaves a further
+        // mode only the noise to fit: p more parameters lower χ² by about
+        // p, and the criterion charges p ln(N). The climb stops there.
+        if done {
+            break;
+        }
+    }
     let best = fits
         .iter()
         .enumerate()

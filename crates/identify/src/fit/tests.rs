@@ -155,3 +155,73 @@ fn the_excalibur_comes_back_as_three_modes() {
         "{k_fit} against {k_true}"
     );
 }
+
+/// The set that spans the two-mass device's fit: the truth's masses lie
+/// inside the range the set covers, every member carries the damping
+/// doubt, and the design proven for the whole set is no stiffer than the
+/// true model's, and not needlessly softer.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn the_set_spans_the_truth_and_its_design_holds_for_it() {
+    use uncertainty::{span, Doubt};
+    let truth = shipped("two_mass");
+    let f = &chosen(&truth, 450.0);
+    let doubt = Doubt::default();
+    let set = span(f, doubt).unwrap();
+    // The fit itself, lowered by the doubt, then pairs either side of it.
+    assert_eq!(set[0].direction, None);
+    assert!(set.len() >= 3 && set.len() % 2 == 1, "{}", set.len());
+    let lowered = set[0].model.d.clone() / (1.0 - doubt.damping);
+    assert!((lowered - &f.model.d).norm() <= 1e-12 * f.model.d.norm());
+    let range = |i: usize| {
+        set.iter()
+            .map(|m| m.model.m[(i, i)])
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            })
+    };
+    for (i, want) in [(0, 0.6), (1, 0.15)] {
+        let (lo, hi) = range(i);
+        assert!(
+            lo <= want && want <= hi,
+            "mass {i}: {want} not in [{lo}, {hi}]"
+        );
+        assert!(
+            hi / lo < 1.1,
+            "mass {i}: [{lo}, {hi}] spans more than the noise"
+        );
+    }
+    let (k_true, k_fit) = (impedance_k(&truth, 10.0), impedance_k(&f.model, 10.0));
+    let robust = Designer::new(
+        set.iter().map(|m| m.model.clone()).collect(),
+        None,
+        Some(HumanBound::PAPER),
+    )
+    .unwrap()
+    .design_impedance(Some(10.0), 0.0)
+    .unwrap()
+    .coupling
+    .unwrap()
+    .0;
+    assert!(robust <= k_true, "{robust} against {k_true} (fit {k_fit})");
+    assert!(
+        robust >= 0.8 * k_true,
+        "{robust} against {k_true} (fit {k_fit})"
+    );
+    assert!(span(
+        f,
+        Doubt {
+            damping: 1.0,
+            ..doubt
+        }
+    )
+    .is_none());
+    assert!(span(
+        f,
+        Doubt {
+            sigmas: f64::NAN,
+            ..doubt
+        }
+    )
+    .is_none());
+}
