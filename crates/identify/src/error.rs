@@ -61,4 +61,16 @@ pub enum IdentifyError {
         /// The largest allowed.
         max: usize,
     },
+    /// The force was held at its largest value for consecutive samples:
+    /// the amplifier or the board's limit cut the excitation, and the
+    /// response is not the device's alone.
+    #[error("the force is clipped: {samples} samples sit at its largest value, {force_n:.4} N, the first run at t = {at_s:.4} s; lower the excitation's peak")]
+    Clipped {
+        /// Samples at the extreme.
+        samples: usize,
+        /// The extreme (N, signed).
+        force_n: f64,
+        /// Where the first run of them starts (s).
+        at_s: f64,
+    },
 }

@@ -24,6 +24,28 @@ pub struct Frf {
     pub periods: usize,
 }
 
+impl Frf {
+    /// The coherence each harmonic's estimate implies: the share of one
+    /// period's response the excitation explains, `γ² = 1/(1 + P σ²/|H|²)`
+    /// (1 where the periods agree exactly; 1/2 where a period's noise is
+    /// as large as its response). Computed from the spread of the periods,
+    /// so in closed loop it is the excitation's, not the feedback's.
+    pub fn coherence(&self) -> Vec<f64> {
+        self.response
+            .iter()
+            .zip(&self.variance)
+            .map(|(h, v)| {
+                let snr = h.norm_sqr() / (self.periods as f64 * v);
+                if snr.is_finite() {
+                    snr / (1.0 + snr)
+                } else {
+                    1.0
+                }
+            })
+            .collect()
+    }
+}
+
 /// Each whole period's DFT, `Σ x_n e^{-j 2π h n/N}`, at each of
 /// `harmonics`: `[period][harmonic]`, for the `periods` periods after the
 /// first `skip`. One FFT a period (rustfft, any length): a 30 s record at
@@ -224,6 +246,33 @@ mod tests {
             );
             assert!(sd < 0.02 * g.norm(), "h {h}: σ {sd:e}, |G| {:e}", g.norm());
         }
+    }
+
+    /// Where each period's noise at a harmonic is as large as the
+    /// response there, the coherence is a half; with no noise, one.
+    #[test]
+    fn coherence_is_the_share_the_excitation_explains() {
+        let (n, periods, harmonics) = (200, 60, 40);
+        let force: Vec<f64> = (0..n * periods)
+            .map(|i| {
+                (1..=harmonics)
+                    .map(|h| (TAU * h as f64 * (i % n) as f64 / n as f64 + h as f64).cos())
+                    .sum()
+            })
+            .collect();
+        // A harmonic of amplitude 1 has a DFT of n/2; white noise of
+        // variance s² has n s² there: equal when s² = n/4.
+        let s = (n as f64 / 4.0).sqrt() * 12f64.sqrt();
+        let mut seed = 0x5eed_u64;
+        let noisy: Vec<f64> = force.iter().map(|f| f + s * rng(&mut seed)).collect();
+        let hs: Vec<usize> = (1..=harmonics).collect();
+        let clean = periodic(&force, &force, 1e-3, n, &hs, 0).unwrap();
+        assert!(clean.coherence().iter().all(|c| *c > 1.0 - 1e-9));
+        let c = periodic(&force, &noisy, 1e-3, n, &hs, 0)
+            .unwrap()
+            .coherence();
+        let mean = c.iter().sum::<f64>() / c.len() as f64;
+        assert!((mean - 0.5).abs() < 0.06, "{mean}: {c:?}");
     }
 
     #[test]

@@ -105,6 +105,7 @@ impl Measured {
             place: "the record".into(),
             why: "it does not name its excitation (the `# twoport experiment:` line)".into(),
         })?;
+        clipped(&log.force_n, log.period_s)?;
         let harmonics: Vec<usize> = (e.first..=e.last).collect();
         let at = |signal: &[f64]| {
             crate::frf::periodic(
@@ -151,6 +152,28 @@ impl Measured {
             encoder_quantum_m: encoder,
             coulomb_n: None,
         })
+    }
+}
+
+/// Refuse a force that sits at its largest magnitude for two samples
+/// running or more: a multisine touches its peak once a period at most,
+/// so a run there is a limit cutting it.
+fn clipped(force_n: &[f64], period_s: f64) -> Result<(), crate::IdentifyError> {
+    let peak = force_n.iter().fold(0.0_f64, |a, f| a.max(f.abs()));
+    if peak == 0.0 {
+        return Ok(());
+    }
+    let at_peak = |f: &f64| f.abs() >= peak * (1.0 - 1e-12);
+    let first = force_n
+        .windows(2)
+        .position(|w| at_peak(&w[0]) && at_peak(&w[1]));
+    match first {
+        None => Ok(()),
+        Some(i) => Err(crate::IdentifyError::Clipped {
+            samples: force_n.iter().filter(|f| at_peak(f)).count(),
+            force_n: force_n[i],
+            at_s: i as f64 * period_s,
+        }),
     }
 }
 

@@ -225,3 +225,54 @@ fn the_set_spans_the_truth_and_its_design_holds_for_it() {
     )
     .is_none());
 }
+
+/// A record of a 1 kg mass pushed by three harmonics of a 100-sample
+/// period, `scale` times the force and clipped at `limit_n`.
+fn pushed_mass(scale: f64, limit_n: f64) -> crate::log::Log {
+    let (n, periods, dt) = (100, 6, 1e-3);
+    let force: Vec<f64> = (0..n * periods)
+        .map(|i| {
+            let t = (i % n) as f64 / n as f64;
+            let f: f64 = (1..=3).map(|h| (TAU * h as f64 * t + h as f64).cos()).sum();
+            (scale * f).clamp(-limit_n, limit_n)
+        })
+        .collect();
+    let (mut x, mut v) = (0.0, 0.0);
+    let position = force
+        .iter()
+        .map(|f| {
+            v += f * dt;
+            x += v * dt;
+            x
+        })
+        .collect();
+    crate::log::Log {
+        period_s: dt,
+        force_n: force,
+        position_m: position,
+        load_cell_n: None,
+        excitation: Some(crate::log::Excitation {
+            period_ticks: n,
+            first: 1,
+            last: 3,
+        }),
+    }
+}
+
+/// A clipped force is refused with where it starts; the same record
+/// below the limit is not; a harmonic the excitation does not reach is
+/// named.
+#[test]
+fn clipped_or_unexcited_records_are_refused() {
+    assert!(Measured::from_log(&pushed_mass(1.0, 10.0), 1).is_ok());
+    let e = Measured::from_log(&pushed_mass(1.0, 1.5), 1).unwrap_err();
+    assert!(
+        matches!(e, crate::IdentifyError::Clipped { force_n, .. } if force_n.abs() == 1.5),
+        "{e}"
+    );
+    assert!(e.to_string().contains("lower the excitation's peak"), "{e}");
+    let mut log = pushed_mass(1.0, 10.0);
+    log.excitation.as_mut().unwrap().last = 5;
+    let e = Measured::from_log(&log, 1).unwrap_err().to_string();
+    assert!(e.contains("harmonic 4"), "{e}");
+}
