@@ -347,3 +347,57 @@ pub(crate) fn gain(name: &str, v: f64) -> Result<f64, String> {
         .then_some(v)
         .ok_or_else(|| format!("--{name} {v}: must be a finite number >= 0"))
 }
+
+/// A figure's file format.
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum PlotFormat {
+    Png,
+    Svg,
+}
+
+#[derive(Args, Clone)]
+pub(crate) struct IdentifyArgs {
+    /// The experiment's record: CSV with columns t_s, force_n, position_m
+    /// and optionally load_cell_n, after a `# twoport experiment:` line
+    /// naming the excitation (what `host-sim pil --log` and a board's
+    /// capture write).
+    pub(crate) record: PathBuf,
+    /// Folder to write into: model.toml (the fit), set/NN.toml (the set
+    /// that spans its uncertainty) and set.toml (a device file whose one
+    /// axis has each model of the set as a pose).
+    #[arg(long)]
+    pub(crate) out: PathBuf,
+    /// The amplifier's peak force (N): the model needs it, and no
+    /// experiment measures it.
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) peak_force: f64,
+    /// The amplifier's continuous force (N).
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) continuous_force: f64,
+    /// The load cell's filter pole (rad/s); needed where the record has a
+    /// load cell.
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) load_cell_pole: Option<f64>,
+    /// Whole periods skipped at the start, while the transient settles.
+    #[arg(long, default_value_t = 2)]
+    pub(crate) skip: usize,
+    /// The model's name; by default, from the record's file name.
+    #[arg(long)]
+    pub(crate) name: Option<String>,
+    /// Standard deviations the set reaches either side of the fit along
+    /// each principal direction of its covariance.
+    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
+    pub(crate) sigmas: f64,
+    /// The fraction by which every model of the set has its damping
+    /// lowered: what amplitude-dependent damping (friction before it
+    /// slides) may have added during the experiment.
+    #[arg(long, default_value_t = 0.05, allow_negative_numbers = true)]
+    pub(crate) damping_doubt: f64,
+    /// Draw the measured responses with the fit's, and their coherence,
+    /// into the output folder in this format.
+    #[arg(long, value_enum)]
+    pub(crate) plot: Option<PlotFormat>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub(crate) json: bool,
+}

@@ -2,6 +2,7 @@
 
 mod args;
 mod check;
+mod identify;
 mod plots;
 mod region;
 mod run;
@@ -42,6 +43,10 @@ pub(crate) enum Cmd {
     /// unstable at these gains (independent of the two-port proof).
     #[command(subcommand)]
     Verify(Display<ImpedanceGains, AdmittanceGains>),
+    /// Identify a device from a bench experiment's record: a model file,
+    /// a set of models that spans what the fit does not know, and the
+    /// figures of the fit.
+    Identify(IdentifyArgs),
 }
 
 /// `run` on `args`, refusing a device file: the command draws one axis.
@@ -85,6 +90,7 @@ fn main() -> ExitCode {
             verify::verify_linkage(a)
         }
         Cmd::Verify(d) => each_axis(d, verify::verify),
+        Cmd::Identify(a) => identify::identify(a),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,13 +5,8 @@ use crate::analysis::{
     impedance_range_impedance, regulator_tf, Analysis,
 };
 use crate::network::HumanBound;
-use crate::plot::{Curve, Figure};
-use plotters::style::RGBColor;
+use crate::plot::{Curve, Figure, RGBColor, BLUE, GREY, RED};
 use std::f64::consts::PI;
-
-const GREY: RGBColor = RGBColor(110, 110, 110);
-const BLUE: RGBColor = RGBColor(31, 90, 180);
-const RED: RGBColor = RGBColor(190, 40, 40);
 
 fn hz(a: &Analysis) -> impl Iterator<Item = f64> + '_ {
     a.points.iter().map(|p| p.omega / (2.0 * PI))

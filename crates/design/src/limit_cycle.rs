@@ -119,8 +119,10 @@ impl fmt::Display for LimitCycle {
         write!(
             f,
             "  quantisation ({} µm encoder, {} N friction): the force moves by {:.3} N",
-            self.encoder_quantum_m * 1e6,
-            self.coulomb_friction_n,
+            // Four decimals, without trailing zeros: a quantum read off a
+            // record is 1 µm, not 0.9999999999992654.
+            (self.encoder_quantum_m * 1e10).round() / 1e4,
+            (self.coulomb_friction_n * 1e4).round() / 1e4,
             self.quantum_force_n
         )?;
         if self.held {

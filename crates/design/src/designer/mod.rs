@@ -127,14 +127,21 @@ impl Designer {
     pub fn name(&self) -> String {
         match self.poses.as_slice() {
             [p] => p.model.name.clone(),
-            ps => format!(
-                "{} poses ({})",
-                ps.len(),
-                ps.iter()
-                    .map(|p| p.model.name.as_str())
-                    .collect::<Vec<_>>()
-                    .join("; ")
-            ),
+            ps => {
+                // A set from identification has dozens: name a few.
+                const NAMED: usize = 4;
+                let names: Vec<&str> = ps.iter().map(|p| p.model.name.as_str()).collect();
+                let listed = if names.len() > NAMED + 1 {
+                    format!(
+                        "{}; and {} more",
+                        names[..NAMED].join("; "),
+                        names.len() - NAMED
+                    )
+                } else {
+                    names.join("; ")
+                };
+                format!("{} poses ({listed})", ps.len())
+            }
         }
     }
 

@@ -8,6 +8,16 @@ use std::path::Path;
 mod map;
 
 pub use map::{render_map, Map};
+pub use plotters::style::RGBColor;
+
+/// The figures' palette: bounds and references.
+pub const GREY: RGBColor = RGBColor(110, 110, 110);
+/// Measured or designed.
+pub const BLUE: RGBColor = RGBColor(31, 90, 180);
+/// The other side of a pair.
+pub const RED: RGBColor = RGBColor(190, 40, 40);
+/// A fit or a model.
+pub const INK: RGBColor = RGBColor(20, 20, 20);
 
 /// One curve: a label, a style, and (frequency Hz, value) points. Points
 /// with a value <= 0 are left out (log axis), breaking the line there, as

@@ -1,0 +1,362 @@
+//! `twoport identify`: an experiment's record to a model file, the set of
+//! models that spans what the fit does not know (a device file whose one
+//! axis has each as a pose), and the figures of the fit.
+
+use crate::args::{IdentifyArgs, PlotFormat};
+use serde_json::json;
+use std::f64::consts::TAU;
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+use twoport_design::plot::{self, Curve, Figure};
+use twoport_design::{DeviceModel, Plant};
+use twoport_identify::fit::{self, chain::ModelBase, uncertainty, Fit, Form, Measured};
+use twoport_identify::frf::Frf;
+use twoport_identify::log::Log;
+
+pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
+    let positive = |name: &str, v: f64| {
+        (v.is_finite() && v > 0.0)
+            .then_some(v)
+            .ok_or_else(|| format!("--{name} {v}: must be a finite number > 0"))
+    };
+    let peak = positive("peak-force", a.peak_force)?;
+    let continuous = positive("continuous-force", a.continuous_force)?;
+    let text =
+        std::fs::read_to_string(&a.record).map_err(|e| format!("{}: {e}", a.record.display()))?;
+    let source = a.record.display().to_string();
+    let log = Log::from_csv(&text, &source).map_err(|e| e.to_string())?;
+    let pole = match (&log.load_cell_n, a.load_cell_pole) {
+        (Some(_), None) => {
+            return Err(format!(
+                "{source}: the record has a load cell (load_cell_n); give its filter pole with --load-cell-pole (rad/s)"
+            ))
+        }
+        (None, Some(_)) => {
+            return Err(format!(
+                "--load-cell-pole: {source} has no load_cell_n column"
+            ))
+        }
+        (_, p) => p.map(|p| positive("load-cell-pole", p)).transpose()?,
+    };
+    let most = log.force_n.iter().fold(0.0_f64, |m, f| m.max(f.abs()));
+    if most > peak {
+        return Err(format!(
+            "{source}: the force reaches {most:.4} N, past --peak-force {peak} N; give the amplifier's peak"
+        ));
+    }
+    let data = Measured::from_log(&log, a.skip).map_err(|e| format!("{source}: {e}"))?;
+    let doubt = uncertainty::Doubt {
+        sigmas: a.sigmas,
+        damping: a.damping_doubt,
+    };
+    if !(a.sigmas.is_finite() && a.sigmas >= 0.0) {
+        return Err(format!(
+            "--sigmas {}: must be a finite number >= 0",
+            a.sigmas
+        ));
+    }
+    if !(0.0..1.0).contains(&a.damping_doubt) {
+        return Err(format!(
+            "--damping-doubt {}: must be a fraction from 0 to below 1",
+            a.damping_doubt
+        ));
+    }
+    let base = ModelBase {
+        name: a.name.clone().unwrap_or_else(|| {
+            let stem = a
+                .record
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned());
+            format!("identified from {}", stem.unwrap_or(source.clone()))
+        }),
+        period_s: log.period_s,
+        peak_force_n: peak,
+        continuous_force_n: continuous,
+        load_cell_pole_rad_s: pole,
+    };
+    let (fits, best) = fit::fit_orders(&data, &base);
+    let chosen = best
+        .map(|i| &fits[i])
+        .ok_or_else(|| format!("{source}: no model of 0 to {} modes fits", fit::MAX_MODES))?;
+    let set = uncertainty::span(chosen, doubt)
+        .ok_or_else(|| format!("{source}: the fit's covariance is not finite"))?;
+
+    std::fs::create_dir_all(a.out.join("set")).map_err(|e| format!("{}: {e}", a.out.display()))?;
+    let write = |path: PathBuf, text: String| {
+        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+        Ok::<PathBuf, String>(path)
+    };
+    let header = provenance(&source, chosen);
+    let model_path = write(a.out.join("model.toml"), chosen.model.to_toml(&header))?;
+    let mut members = Vec::new();
+    for (i, m) in set.iter().enumerate() {
+        let what = match m.direction {
+            None => "the fit".to_string(),
+            Some(d) => format!("direction {d}, {:+} sigma (step {:.2e})", m.sigmas, m.step),
+        };
+        let note = format!(
+            "{header}\nMember {i} of the set: {what}; damping lowered by {}%.",
+            100.0 * doubt.damping
+        );
+        let name = format!("{i:02}.toml");
+        let mut model = m.model.clone();
+        model.name = format!("{} [set {i:02}]", base.name);
+        write(a.out.join("set").join(&name), model.to_toml(&note))?;
+        members.push(format!("set/{name}"));
+    }
+    let device = format!(
+        "# The set of models that spans what the fit of {source} does not know:\n\
+         # a design for this device file is proven for every one of them.\n\
+         name = {:?}\n\n[[axis]]\nname = \"identified\"\nmodels = [\n{}\n]\n",
+        base.name,
+        members
+            .iter()
+            .map(|m| format!("  {m:?},"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
+    let set_path = write(a.out.join("set.toml"), device)?;
+    // The files written read back as the models they are.
+    DeviceModel::load(&model_path).map_err(|e| e.to_string())?;
+    twoport_design::Device::load(&set_path).map_err(|e| e.to_string())?;
+
+    let figures = match a.plot {
+        Some(format) => draw(&a.out, format, &data, chosen)?,
+        None => Vec::new(),
+    };
+    report(
+        a,
+        &log,
+        &data,
+        &fits,
+        best,
+        &set,
+        &model_path,
+        &set_path,
+        &figures,
+    )
+}
+
+/// The header of every model file written: where it came from.
+fn provenance(source: &str, f: &Fit) -> String {
+    let form = match &f.form {
+        Form::Chain(_) => "a chain of masses",
+        Form::Modal(_) => "modes, the handle on its load cell",
+    };
+    format!(
+        "Identified by `twoport identify` from {source}:\n{} modes, {form}; chi2/nu {:.3}.",
+        f.form.modes(),
+        f.reduced_chi2()
+    )
+}
+
+/// The lightly damped modes below Nyquist: (Hz, damping ratio).
+fn resonances(m: &DeviceModel) -> Vec<(f64, f64)> {
+    Plant::new(m, m.period_s)
+        .map(|p| {
+            p.modes()
+                .iter()
+                .filter(|x| x.omega_n < std::f64::consts::PI / m.period_s)
+                .map(|x| (x.omega_n / TAU, x.zeta))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+#[allow(clippy::too_many_arguments)]
+fn report(
+    a: &IdentifyArgs,
+    log: &Log,
+    data: &Measured,
+    fits: &[Fit],
+    best: Option<usize>,
+    set: &[uncertainty::Member],
+    model_path: &Path,
+    set_path: &Path,
+    figures: &[PathBuf],
+) -> Result<(), String> {
+    let f = &fits[best.unwrap_or(0)];
+    let x = &data.position;
+    let coherence = x.coherence();
+    let (worst_at, worst) = coherence
+        .iter()
+        .enumerate()
+        .fold((0, 1.0_f64), |b, (i, c)| if *c < b.1 { (i, *c) } else { b });
+    let res = resonances(&f.model);
+    let directions = set
+        .iter()
+        .filter_map(|m| m.direction)
+        .max()
+        .map_or(0, |d| d + 1);
+    let form = match f.form {
+        Form::Chain(_) => "chain",
+        Form::Modal(_) => "modal",
+    };
+    if a.json {
+        let v = json!({
+            "record": a.record,
+            "samples": log.force_n.len(),
+            "period_s": log.period_s,
+            "harmonics_hz": [x.freq_hz.first(), x.freq_hz.last()],
+            "periods_averaged": x.periods,
+            "coherence_min": worst,
+            "coherence_min_hz": x.freq_hz.get(worst_at),
+            "orders": fits.iter().map(|g| json!({
+                "modes": g.form.modes(),
+                "chi2_per_dof": g.reduced_chi2(),
+                "bic": g.bic,
+            })).collect::<Vec<_>>(),
+            "chosen": {
+                "form": form,
+                "modes": f.form.modes(),
+                "resonances_hz": res.iter().map(|r| r.0).collect::<Vec<_>>(),
+                "damping_ratios": res.iter().map(|r| r.1).collect::<Vec<_>>(),
+                "chi2_per_dof": f.reduced_chi2(),
+            },
+            "coulomb_friction_n": f.model.coulomb_friction_n,
+            "encoder_quantum_m": f.model.encoder_quantum_m,
+            "model": model_path,
+            "set": set_path,
+            "set_models": set.len(),
+            "sigmas": a.sigmas,
+            "damping_doubt": a.damping_doubt,
+            "figures": figures,
+        });
+        println!("{v}");
+        return Ok(());
+    }
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "record {}: {} samples at {:.0} Hz, harmonics {:.3} to {:.3} Hz, {} periods averaged",
+        a.record.display(),
+        log.force_n.len(),
+        1.0 / log.period_s,
+        x.freq_hz.first().copied().unwrap_or(0.0),
+        x.freq_hz.last().copied().unwrap_or(0.0),
+        x.periods
+    );
+    let _ = writeln!(
+        t,
+        "coherence (encoder): lowest {worst:.3} at {:.3} Hz",
+        x.freq_hz.get(worst_at).copied().unwrap_or(0.0)
+    );
+    let _ = writeln!(t, "orders fitted (modes: chi2/nu, BIC):");
+    for (i, g) in fits.iter().enumerate() {
+        let mark = if Some(i) == best { "  <- chosen" } else { "" };
+        let _ = writeln!(
+            t,
+            "  {}: {:.3}, {:.1}{mark}",
+            g.form.modes(),
+            g.reduced_chi2(),
+            g.bic
+        );
+    }
+    let _ = writeln!(t, "model ({form}), resonances below Nyquist:");
+    for (hz, zeta) in &res {
+        let _ = writeln!(t, "  {hz:9.3} Hz  damping ratio {zeta:.4}");
+    }
+    if let Some(c) = f.model.coulomb_friction_n {
+        let _ = writeln!(t, "Coulomb friction {c:.4} N");
+    }
+    if let Some(q) = f.model.encoder_quantum_m {
+        let _ = writeln!(t, "encoder quantum {:.4} um", q * 1e6);
+    }
+    let _ = writeln!(t, "wrote {}", model_path.display());
+    let _ = writeln!(
+        t,
+        "wrote {}: {} models, +-{} sigma along {directions} directions, damping lowered by {}%",
+        set_path.display(),
+        set.len(),
+        a.sigmas,
+        100.0 * a.damping_doubt
+    );
+    for p in figures {
+        let _ = writeln!(t, "wrote {}", p.display());
+    }
+    let _ = write!(
+        t,
+        "prove a coupling for all of them: twoport design impedance --device {}",
+        set_path.display()
+    );
+    println!("{t}");
+    Ok(())
+}
+
+/// The measured responses beside the fit's, and the coherence.
+fn draw(out: &Path, format: PlotFormat, data: &Measured, f: &Fit) -> Result<Vec<PathBuf>, String> {
+    let ext = match format {
+        PlotFormat::Png => "png",
+        PlotFormat::Svg => "svg",
+    };
+    let model = fit::sampled_response(&f.model, &data.position.freq_hz)
+        .ok_or("the fitted model has no finite response")?;
+    let curve =
+        |label: &str, color, width, dashed, frf: &Frf, value: &dyn Fn(usize) -> f64| Curve {
+            label: label.into(),
+            width,
+            dashed,
+            color,
+            points: frf
+                .freq_hz
+                .iter()
+                .enumerate()
+                .map(|(i, hz)| (*hz, value(i)))
+                .collect(),
+        };
+    let x = &data.position;
+    let mut written = Vec::new();
+    let mut figure = |name: &str, fig: Figure| {
+        let path = out.join(format!("{name}.{ext}"));
+        plot::render(&fig, &path).map_err(|e| e.to_string())?;
+        written.push(path);
+        Ok::<(), String>(())
+    };
+    figure(
+        "encoder",
+        Figure {
+            title: "Actuator force to encoder: measured and fitted".into(),
+            y_label: "|X/F| (m/N)".into(),
+            curves: vec![
+                curve("measured", plot::BLUE, 2, false, x, &|i| {
+                    x.response[i].norm()
+                }),
+                curve("fit", plot::INK, 2, true, x, &|i| model[i].0.norm()),
+                curve("measured, 1 sigma", plot::RED, 1, false, x, &|i| {
+                    x.variance[i].sqrt()
+                }),
+            ],
+        },
+    )?;
+    let cx = x.coherence();
+    let mut coherence = vec![curve("encoder", plot::BLUE, 2, false, x, &|i| cx[i])];
+    if let Some(lc) = &data.load_cell {
+        figure(
+            "load_cell",
+            Figure {
+                title: "Actuator force to load cell: measured and fitted".into(),
+                y_label: "|F_lc/F| (N/N)".into(),
+                curves: vec![
+                    curve("measured", plot::BLUE, 2, false, lc, &|i| {
+                        lc.response[i].norm()
+                    }),
+                    curve("fit", plot::INK, 2, true, lc, &|i| model[i].1.norm()),
+                    curve("measured, 1 sigma", plot::RED, 1, false, lc, &|i| {
+                        lc.variance[i].sqrt()
+                    }),
+                ],
+            },
+        )?;
+        let c = lc.coherence();
+        coherence.push(curve("load cell", plot::RED, 2, false, lc, &|i| c[i]));
+    }
+    figure(
+        "coherence",
+        Figure {
+            title: "Coherence of each harmonic (from the spread of the periods)".into(),
+            y_label: "coherence".into(),
+            curves: coherence,
+        },
+    )?;
+    Ok(written)
+}
