@@ -139,16 +139,18 @@ impl Measured {
             Some(lc) => Some(floored(at(lc)?, lc).0),
             None => None,
         };
-        let sign = friction::velocity_sign(&log.position_m);
-        let friction = spectrum(&sign)
-            .iter()
-            .zip(&force)
-            .map(|(s, f)| s / f)
-            .collect();
+        let sign = friction::tick_sign(&log.position_m, e.period_ticks, e.last, skip);
+        let friction = sign.map(|sign| {
+            crate::frf::mean_spectrum(&sign, e.period_ticks, &harmonics, 0)
+                .iter()
+                .zip(&force)
+                .map(|(s, f)| s / f)
+                .collect()
+        });
         Ok(Measured {
             position,
             load_cell,
-            friction: Some(friction),
+            friction,
             encoder_quantum_m: encoder,
             coulomb_n: None,
         })
