@@ -465,6 +465,14 @@ impl Plant {
         }
     }
 
+    /// `X_aa^d` and `F_ma^d` alone at `omega` (rad/s), as [`at`](Self::at)
+    /// gives them, without the continuous terms: what a fit evaluates
+    /// thousands of times.
+    pub fn sampled_at(&self, omega: f64, work: &mut Scratch) -> (Complex64, Complex64) {
+        let z = Complex64::from_polar(1.0, omega * self.period_s);
+        (self.xaa.eval(z, work), self.fma.eval(z, work))
+    }
+
     /// The largest pole radius of the device under the position regulator
     /// `K_p` (the admittance display with the VE port held): the loop is
     /// stable iff it is < 1.
@@ -560,6 +568,18 @@ mod tests {
         let m =
             DeviceModel::from_toml(include_str!("../../../../models/excalibur.toml"), "x").unwrap();
         Plant::new(&m, 1e-3).unwrap()
+    }
+
+    /// `sampled_at` gives `at`'s sampled terms exactly, across the band.
+    #[test]
+    fn sampled_at_is_ats_sampled_terms() {
+        let p = excalibur();
+        let mut w = p.scratch();
+        for i in 1..200 {
+            let omega = p.nyquist() * i as f64 / 200.0;
+            let full = p.at(omega, &mut w);
+            assert_eq!(p.sampled_at(omega, &mut w), (full.xaa_d, full.fma_d));
+        }
     }
 
     /// The paper's lightly damped modes: about 45, 79, 277 Hz and 3.5 kHz.

@@ -268,10 +268,10 @@ pub fn sampled_response(
     freq_hz
         .iter()
         .map(|f| {
-            let p = plant.at(TAU * f, &mut work);
+            let (xaa_d, fma_d) = plant.sampled_at(TAU * f, &mut work);
             // X_aa^d is -x_a per f_a, and f_a pushes the actuator toward
             // -x: so it is x per push. F_ma^d is per f_a: negate.
-            let v = (p.xaa_d, -p.fma_d);
+            let v = (xaa_d, -fma_d);
             (v.0.is_finite() && v.1.is_finite()).then_some(v)
         })
         .collect()
