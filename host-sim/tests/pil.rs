@@ -2,7 +2,7 @@
 //! check against the firmware in QEMU through `cargo xtask pil --check`).
 
 use host_sim::link::{self, LinkFaults, LocalBoard};
-use host_sim::pil;
+use host_sim::pil::{self, Lockstep};
 use host_sim::{Scene, Simulation};
 use std::path::Path;
 use twoport_link::Axes;

@@ -156,10 +156,19 @@ impl Setup {
     }
 }
 
-impl<P: BoardPort> Session<P> {
+/// A session as a simulation's controller: the board plays its servo,
+/// this process its plant.
+pub trait Lockstep {
     /// One tick of `sim` with the board as its controller; returns the
     /// sample and the duties the board answered.
-    pub fn step<const N: usize>(
+    fn step<const N: usize>(
+        &mut self,
+        sim: &mut Simulation<N>,
+    ) -> Result<(Sample<N>, Axes<i16>), Error>;
+}
+
+impl<P: BoardPort> Lockstep for Session<P> {
+    fn step<const N: usize>(
         &mut self,
         sim: &mut Simulation<N>,
     ) -> Result<(Sample<N>, Axes<i16>), Error> {

@@ -4,6 +4,7 @@
 
 use crate::engine::scene::Scene;
 use crate::link::{BoardPort, LinkFaults, SerialBoard, Session};
+use crate::pil::Lockstep;
 use crate::Error;
 use crate::{Sample, Simulation};
 use twoport_link::{GainsReply, Message, Status, Telemetry};

@@ -1,7 +1,7 @@
 //! The transport to a board: a serial port (the firmware in QEMU through a
 //! pty, or a real board), or anything else that moves the link's bytes.
 
-use super::LinkError;
+use crate::LinkError;
 use std::time::Duration;
 
 /// The board end of the link.

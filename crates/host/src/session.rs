@@ -2,7 +2,7 @@
 //! ask and wait for answers, the lockstep exchange of a processor-in-the-
 //! loop run, and the link faults a test injects.
 
-use super::{BoardPort, LinkError};
+use crate::{BoardPort, LinkError};
 use std::sync::atomic::{AtomicU16, Ordering};
 use std::time::{Duration, Instant};
 use twoport_board::excalibur;
@@ -44,7 +44,9 @@ pub struct Session<P: BoardPort> {
     seq: u16,
     decoder: Decoder,
     inbox: Vec<Message>,
-    pub(crate) io: twoport_board::IoScale,
+    /// The board's sensor and actuator scaling (counts to SI), for a host
+    /// that plays its plant.
+    pub io: twoport_board::IoScale,
     faults: LinkFaults,
     tick: u64,
     /// The encoder's index mark as a count, and the unwrapped count of
@@ -133,8 +135,8 @@ impl<P: BoardPort> Session<P> {
         })
     }
 
-    /// Start homing; the caller runs ticks until
-    /// [`homed`](crate::pil::homed).
+    /// Start homing; the caller runs ticks until the board's status says
+    /// it has homed.
     pub fn home(&mut self) -> Result<Status, LinkError> {
         self.ask(Message::Home, ModeRequest::Home, |s| s.mode == Mode::Homing)
     }
@@ -158,7 +160,7 @@ impl<P: BoardPort> Session<P> {
 
     /// The count the index latched this tick, if the axis passed it
     /// between the last frame's `raw` and this one.
-    pub(crate) fn index_crossing(&mut self, raw: u32) -> Option<u32> {
+    pub fn index_crossing(&mut self, raw: u32) -> Option<u32> {
         let (bits, _) = excalibur::ENCODER;
         let (mark, last) = self.index.as_mut()?;
         let shift = 32 - u32::from(bits);
@@ -322,7 +324,7 @@ impl<P: BoardPort> Session<P> {
 
     /// The next tick's number, with its heartbeat sent where one is due
     /// and the link is not lost.
-    pub(crate) fn tick_heartbeat(&mut self) -> Result<u64, LinkError> {
+    pub fn tick_heartbeat(&mut self) -> Result<u64, LinkError> {
         let tick = self.tick;
         self.tick += 1;
         let lost = self.faults.link_loss_at.is_some_and(|t| tick >= t);
@@ -334,11 +336,7 @@ impl<P: BoardPort> Session<P> {
 
     /// Send tick `tick`'s sensors (and, on schedule, a corrupted copy
     /// first) and wait for the board's duties.
-    pub(crate) fn exchange(
-        &mut self,
-        tick: u64,
-        sensors: PilSensors,
-    ) -> Result<Axes<i16>, LinkError> {
+    pub fn exchange(&mut self, tick: u64, sensors: PilSensors) -> Result<Axes<i16>, LinkError> {
         let want = sensors.tick;
         let good = self.frame(&Message::Sensors(sensors))?;
         let every = self.faults.corrupt_every;
