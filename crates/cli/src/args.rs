@@ -357,14 +357,17 @@ pub(crate) enum PlotFormat {
 
 #[derive(Args, Clone)]
 pub(crate) struct IdentifyArgs {
-    /// The experiment's record: CSV with columns t_s, force_n, position_m
-    /// and optionally load_cell_n, after a `# twoport experiment:` line
-    /// naming the excitation (what `host-sim pil --log` and a board's
-    /// capture write).
-    pub(crate) record: PathBuf,
-    /// Folder to write into: model.toml (the fit), set/NN.toml (the set
-    /// that spans its uncertainty) and set.toml (a device file whose one
-    /// axis has each model of the set as a pose).
+    /// The experiments' records, one an axis, each named by its file's
+    /// stem (x.csv is the axis x): CSV with columns t_s, force_n,
+    /// position_m and optionally load_cell_n, after a `# twoport
+    /// experiment:` line naming the excitation (what `host-sim pil --log`
+    /// and a board's capture write).
+    #[arg(required = true)]
+    pub(crate) records: Vec<PathBuf>,
+    /// Folder to write into: for each axis, AXIS/model.toml (its fit),
+    /// AXIS/set/NN.toml (the set that spans its uncertainty) and its
+    /// figures; device.toml (every axis's fit) and set.toml (every axis's
+    /// set, each model a pose), for `design --device`.
     #[arg(long)]
     pub(crate) out: PathBuf,
     /// The amplifier's peak force (N): the model needs it, and no
@@ -374,14 +377,14 @@ pub(crate) struct IdentifyArgs {
     /// The amplifier's continuous force (N).
     #[arg(long, allow_negative_numbers = true)]
     pub(crate) continuous_force: f64,
-    /// The load cell's filter pole (rad/s); needed where the record has a
+    /// The load cell's filter pole (rad/s); needed where a record has a
     /// load cell.
     #[arg(long, allow_negative_numbers = true)]
     pub(crate) load_cell_pole: Option<f64>,
     /// Whole periods skipped at the start, while the transient settles.
     #[arg(long, default_value_t = 2)]
     pub(crate) skip: usize,
-    /// The model's name; by default, from the record's file name.
+    /// The device's name; by default, from the records' file names.
     #[arg(long)]
     pub(crate) name: Option<String>,
     /// Standard deviations the set reaches either side of the fit along

@@ -1,6 +1,8 @@
-//! `twoport identify`: an experiment's record to a model file, the set of
-//! models that spans what the fit does not know (a device file whose one
-//! axis has each as a pose), and the figures of the fit.
+//! `twoport identify`: experiment records, one an axis, to each axis's
+//! model file, the set of models that spans what its fit does not know,
+//! and the figures of the fit; and two device files over the axes: the
+//! fits (`device.toml`) and the sets, each model of an axis's set a pose
+//! (`set.toml`).
 
 use crate::args::{IdentifyArgs, PlotFormat};
 use serde_json::json;
@@ -19,35 +21,13 @@ pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
             .then_some(v)
             .ok_or_else(|| format!("--{name} {v}: must be a finite number > 0"))
     };
-    let peak = positive("peak-force", a.peak_force)?;
-    let continuous = positive("continuous-force", a.continuous_force)?;
-    let text =
-        std::fs::read_to_string(&a.record).map_err(|e| format!("{}: {e}", a.record.display()))?;
-    let source = a.record.display().to_string();
-    let log = Log::from_csv(&text, &source).map_err(|e| e.to_string())?;
-    let pole = match (&log.load_cell_n, a.load_cell_pole) {
-        (Some(_), None) => {
-            return Err(format!(
-                "{source}: the record has a load cell (load_cell_n); give its filter pole with --load-cell-pole (rad/s)"
-            ))
-        }
-        (None, Some(_)) => {
-            return Err(format!(
-                "--load-cell-pole: {source} has no load_cell_n column"
-            ))
-        }
-        (_, p) => p.map(|p| positive("load-cell-pole", p)).transpose()?,
-    };
-    let most = log.force_n.iter().fold(0.0_f64, |m, f| m.max(f.abs()));
-    if most > peak {
-        return Err(format!(
-            "{source}: the force reaches {most:.4} N, past --peak-force {peak} N; give the amplifier's peak"
-        ));
-    }
-    let data = Measured::from_log(&log, a.skip).map_err(|e| format!("{source}: {e}"))?;
-    let doubt = uncertainty::Doubt {
-        sigmas: a.sigmas,
-        damping: a.damping_doubt,
+    let amp = Amplifier {
+        peak: positive("peak-force", a.peak_force)?,
+        continuous: positive("continuous-force", a.continuous_force)?,
+        pole: a
+            .load_cell_pole
+            .map(|p| positive("load-cell-pole", p))
+            .transpose()?,
     };
     if !(a.sigmas.is_finite() && a.sigmas >= 0.0) {
         return Err(format!(
@@ -61,33 +41,168 @@ pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
             a.damping_doubt
         ));
     }
+    // Each record is one axis, named by its file's stem.
+    let mut names: Vec<String> = Vec::new();
+    for r in &a.records {
+        let name = r
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .filter(|s| !s.is_empty())
+            .ok_or_else(|| format!("{}: a record needs a file name", r.display()))?;
+        if names.contains(&name) {
+            return Err(format!(
+                "{}: two records name the axis {name:?}; each record's file name names its axis",
+                r.display()
+            ));
+        }
+        names.push(name);
+    }
+    let device = a
+        .name
+        .clone()
+        .unwrap_or_else(|| format!("identified from {}", names.join(", ")));
+    let axes = a
+        .records
+        .iter()
+        .zip(&names)
+        .map(|(r, name)| axis(a, &amp, r, name, &device))
+        .collect::<Result<Vec<_>, _>>()?;
+
+    let write = |path: PathBuf, text: String| {
+        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+        Ok::<PathBuf, String>(path)
+    };
+    let file = |what: &str, models: &dyn Fn(&Axis) -> Vec<String>| {
+        let mut t = format!("# {what}\nname = {device:?}\n");
+        for x in &axes {
+            let list: Vec<String> = models(x).iter().map(|m| format!("  {m:?},")).collect();
+            t += &format!(
+                "\n[[axis]]\nname = {:?}\nmodels = [\n{}\n]\n",
+                x.name,
+                list.join("\n")
+            );
+        }
+        t
+    };
+    let device_path = write(
+        a.out.join("device.toml"),
+        file(
+            "The fitted model of each axis, as `twoport identify` found it.",
+            &|x| vec![format!("{}/model.toml", x.name)],
+        ),
+    )?;
+    let set_path = write(
+        a.out.join("set.toml"),
+        file(
+            "Each axis's set of models, spanning what its fit does not know:\n# a design for this device file is proven for every one of them.",
+            &|x| x.members.clone(),
+        ),
+    )?;
+    // The files written read back as the device they describe.
+    for p in [&device_path, &set_path] {
+        twoport_design::Device::load(p).map_err(|e| e.to_string())?;
+    }
+    if a.json {
+        let v = json!({
+            "device": device_path,
+            "set": set_path,
+            "sigmas": a.sigmas,
+            "damping_doubt": a.damping_doubt,
+            "axes": axes.iter().map(|x| x.json.clone()).collect::<Vec<_>>(),
+        });
+        println!("{v}");
+        return Ok(());
+    }
+    for x in &axes {
+        println!("axis {}:\n{}", x.name, x.text);
+    }
+    println!(
+        "wrote {} (each axis's fit) and {} (each axis's set: +-{} sigma, damping lowered by {}%)\n\
+         prove a coupling for all of them: twoport design impedance --device {}",
+        device_path.display(),
+        set_path.display(),
+        a.sigmas,
+        100.0 * a.damping_doubt,
+        set_path.display()
+    );
+    Ok(())
+}
+
+/// What no experiment measures, the same for every axis.
+struct Amplifier {
+    peak: f64,
+    continuous: f64,
+    pole: Option<f64>,
+}
+
+/// One axis identified: its report, and its set's files (relative to the
+/// output folder).
+struct Axis {
+    name: String,
+    json: serde_json::Value,
+    text: String,
+    members: Vec<String>,
+}
+
+/// Identify the axis `name` from `record`, writing its model, its set and
+/// its figures under the output folder's `name/`.
+fn axis(
+    a: &IdentifyArgs,
+    amp: &Amplifier,
+    record: &Path,
+    name: &str,
+    device: &str,
+) -> Result<Axis, String> {
+    let text = std::fs::read_to_string(record).map_err(|e| format!("{}: {e}", record.display()))?;
+    let source = record.display().to_string();
+    let log = Log::from_csv(&text, &source).map_err(|e| e.to_string())?;
+    let pole = match (&log.load_cell_n, amp.pole) {
+        (Some(_), None) => {
+            return Err(format!(
+                "{source}: the record has a load cell (load_cell_n); give its filter pole with --load-cell-pole (rad/s)"
+            ))
+        }
+        (None, Some(_)) if a.records.len() == 1 => {
+            return Err(format!(
+                "--load-cell-pole: {source} has no load_cell_n column"
+            ))
+        }
+        (lc, p) => p.filter(|_| lc.is_some()),
+    };
+    let most = log.force_n.iter().fold(0.0_f64, |m, f| m.max(f.abs()));
+    if most > amp.peak {
+        return Err(format!(
+            "{source}: the force reaches {most:.4} N, past --peak-force {} N; give the amplifier's peak",
+            amp.peak
+        ));
+    }
+    let data = Measured::from_log(&log, a.skip).map_err(|e| format!("{source}: {e}"))?;
     let base = ModelBase {
-        name: a.name.clone().unwrap_or_else(|| {
-            let stem = a
-                .record
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned());
-            format!("identified from {}", stem.unwrap_or(source.clone()))
-        }),
+        name: format!("{device}, axis {name}"),
         period_s: log.period_s,
-        peak_force_n: peak,
-        continuous_force_n: continuous,
+        peak_force_n: amp.peak,
+        continuous_force_n: amp.continuous,
         load_cell_pole_rad_s: pole,
     };
     let (fits, best) = fit::fit_orders(&data, &base);
     let chosen = best
         .map(|i| &fits[i])
         .ok_or_else(|| format!("{source}: no model of 0 to {} modes fits", fit::MAX_MODES))?;
+    let doubt = uncertainty::Doubt {
+        sigmas: a.sigmas,
+        damping: a.damping_doubt,
+    };
     let set = uncertainty::span(chosen, doubt)
         .ok_or_else(|| format!("{source}: the fit's covariance is not finite"))?;
 
-    std::fs::create_dir_all(a.out.join("set")).map_err(|e| format!("{}: {e}", a.out.display()))?;
+    let dir = a.out.join(name);
+    std::fs::create_dir_all(dir.join("set")).map_err(|e| format!("{}: {e}", dir.display()))?;
     let write = |path: PathBuf, text: String| {
         std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
         Ok::<PathBuf, String>(path)
     };
     let header = provenance(&source, chosen);
-    let model_path = write(a.out.join("model.toml"), chosen.model.to_toml(&header))?;
+    let model_path = write(dir.join("model.toml"), chosen.model.to_toml(&header))?;
     let mut members = Vec::new();
     for (i, m) in set.iter().enumerate() {
         let what = match m.direction {
@@ -98,43 +213,32 @@ pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
             "{header}\nMember {i} of the set: {what}; damping lowered by {}%.",
             100.0 * doubt.damping
         );
-        let name = format!("{i:02}.toml");
+        let file = format!("{i:02}.toml");
         let mut model = m.model.clone();
         model.name = format!("{} [set {i:02}]", base.name);
-        write(a.out.join("set").join(&name), model.to_toml(&note))?;
-        members.push(format!("set/{name}"));
+        write(dir.join("set").join(&file), model.to_toml(&note))?;
+        members.push(format!("{name}/set/{file}"));
     }
-    let device = format!(
-        "# The set of models that spans what the fit of {source} does not know:\n\
-         # a design for this device file is proven for every one of them.\n\
-         name = {:?}\n\n[[axis]]\nname = \"identified\"\nmodels = [\n{}\n]\n",
-        base.name,
-        members
-            .iter()
-            .map(|m| format!("  {m:?},"))
-            .collect::<Vec<_>>()
-            .join("\n")
-    );
-    let set_path = write(a.out.join("set.toml"), device)?;
-    // The files written read back as the models they are.
-    DeviceModel::load(&model_path).map_err(|e| e.to_string())?;
-    twoport_design::Device::load(&set_path).map_err(|e| e.to_string())?;
-
     let figures = match a.plot {
-        Some(format) => draw(&a.out, format, &data, chosen)?,
+        Some(format) => draw(&dir, format, &data, chosen)?,
         None => Vec::new(),
     };
-    report(
-        a,
+    let (json, text) = report(
+        &source,
         &log,
         &data,
         &fits,
         best,
         &set,
         &model_path,
-        &set_path,
         &figures,
-    )
+    );
+    Ok(Axis {
+        name: name.to_string(),
+        json,
+        text,
+        members,
+    })
 }
 
 /// The header of every model file written: where it came from.
@@ -163,18 +267,18 @@ fn resonances(m: &DeviceModel) -> Vec<(f64, f64)> {
         .unwrap_or_default()
 }
 
+/// One axis's report: its JSON and its text.
 #[allow(clippy::too_many_arguments)]
 fn report(
-    a: &IdentifyArgs,
+    source: &str,
     log: &Log,
     data: &Measured,
     fits: &[Fit],
     best: Option<usize>,
     set: &[uncertainty::Member],
     model_path: &Path,
-    set_path: &Path,
     figures: &[PathBuf],
-) -> Result<(), String> {
+) -> (serde_json::Value, String) {
     let f = &fits[best.unwrap_or(0)];
     let x = &data.position;
     let coherence = x.coherence();
@@ -192,44 +296,37 @@ fn report(
         Form::Chain(_) => "chain",
         Form::Modal(_) => "modal",
     };
-    if a.json {
-        let v = json!({
-            "record": a.record,
-            "samples": log.force_n.len(),
-            "period_s": log.period_s,
-            "harmonics_hz": [x.freq_hz.first(), x.freq_hz.last()],
-            "periods_averaged": x.periods,
-            "coherence_min": worst,
-            "coherence_min_hz": x.freq_hz.get(worst_at),
-            "orders": fits.iter().map(|g| json!({
-                "modes": g.form.modes(),
-                "chi2_per_dof": g.reduced_chi2(),
-                "bic": g.bic,
-            })).collect::<Vec<_>>(),
-            "chosen": {
-                "form": form,
-                "modes": f.form.modes(),
-                "resonances_hz": res.iter().map(|r| r.0).collect::<Vec<_>>(),
-                "damping_ratios": res.iter().map(|r| r.1).collect::<Vec<_>>(),
-                "chi2_per_dof": f.reduced_chi2(),
-            },
-            "coulomb_friction_n": f.model.coulomb_friction_n,
-            "encoder_quantum_m": f.model.encoder_quantum_m,
-            "model": model_path,
-            "set": set_path,
-            "set_models": set.len(),
-            "sigmas": a.sigmas,
-            "damping_doubt": a.damping_doubt,
-            "figures": figures,
-        });
-        println!("{v}");
-        return Ok(());
-    }
+    let v = json!({
+        "record": source,
+        "samples": log.force_n.len(),
+        "period_s": log.period_s,
+        "harmonics_hz": [x.freq_hz.first(), x.freq_hz.last()],
+        "periods_averaged": x.periods,
+        "coherence_min": worst,
+        "coherence_min_hz": x.freq_hz.get(worst_at),
+        "orders": fits.iter().map(|g| json!({
+            "modes": g.form.modes(),
+            "chi2_per_dof": g.reduced_chi2(),
+            "bic": g.bic,
+        })).collect::<Vec<_>>(),
+        "chosen": {
+            "form": form,
+            "modes": f.form.modes(),
+            "resonances_hz": res.iter().map(|r| r.0).collect::<Vec<_>>(),
+            "damping_ratios": res.iter().map(|r| r.1).collect::<Vec<_>>(),
+            "chi2_per_dof": f.reduced_chi2(),
+        },
+        "coulomb_friction_n": f.model.coulomb_friction_n,
+        "encoder_quantum_m": f.model.encoder_quantum_m,
+        "model": model_path,
+        "set_models": set.len(),
+        "set_directions": directions,
+        "figures": figures,
+    });
     let mut t = String::new();
     let _ = writeln!(
         t,
-        "record {}: {} samples at {:.0} Hz, harmonics {:.3} to {:.3} Hz, {} periods averaged",
-        a.record.display(),
+        "  record {source}: {} samples at {:.0} Hz, harmonics {:.3} to {:.3} Hz, {} periods averaged",
         log.force_n.len(),
         1.0 / log.period_s,
         x.freq_hz.first().copied().unwrap_or(0.0),
@@ -238,49 +335,40 @@ fn report(
     );
     let _ = writeln!(
         t,
-        "coherence (encoder): lowest {worst:.3} at {:.3} Hz",
+        "  coherence (encoder): lowest {worst:.3} at {:.3} Hz",
         x.freq_hz.get(worst_at).copied().unwrap_or(0.0)
     );
-    let _ = writeln!(t, "orders fitted (modes: chi2/nu, BIC):");
+    let _ = writeln!(t, "  orders fitted (modes: chi2/nu, BIC):");
     for (i, g) in fits.iter().enumerate() {
         let mark = if Some(i) == best { "  <- chosen" } else { "" };
         let _ = writeln!(
             t,
-            "  {}: {:.3}, {:.1}{mark}",
+            "    {}: {:.3}, {:.1}{mark}",
             g.form.modes(),
             g.reduced_chi2(),
             g.bic
         );
     }
-    let _ = writeln!(t, "model ({form}), resonances below Nyquist:");
+    let _ = writeln!(t, "  model ({form}), resonances below Nyquist:");
     for (hz, zeta) in &res {
-        let _ = writeln!(t, "  {hz:9.3} Hz  damping ratio {zeta:.4}");
+        let _ = writeln!(t, "    {hz:9.3} Hz  damping ratio {zeta:.4}");
     }
     if let Some(c) = f.model.coulomb_friction_n {
-        let _ = writeln!(t, "Coulomb friction {c:.4} N");
+        let _ = writeln!(t, "  Coulomb friction {c:.4} N");
     }
     if let Some(q) = f.model.encoder_quantum_m {
-        let _ = writeln!(t, "encoder quantum {:.4} um", q * 1e6);
+        let _ = writeln!(t, "  encoder quantum {:.4} um", q * 1e6);
     }
-    let _ = writeln!(t, "wrote {}", model_path.display());
-    let _ = writeln!(
-        t,
-        "wrote {}: {} models, +-{} sigma along {directions} directions, damping lowered by {}%",
-        set_path.display(),
-        set.len(),
-        a.sigmas,
-        100.0 * a.damping_doubt
-    );
-    for p in figures {
-        let _ = writeln!(t, "wrote {}", p.display());
-    }
+    let _ = writeln!(t, "  wrote {}", model_path.display());
     let _ = write!(
         t,
-        "prove a coupling for all of them: twoport design impedance --device {}",
-        set_path.display()
+        "  its set: {} models, along {directions} principal directions",
+        set.len()
     );
-    println!("{t}");
-    Ok(())
+    for p in figures {
+        let _ = write!(t, "\n  wrote {}", p.display());
+    }
+    (v, t)
 }
 
 /// The measured responses beside the fit's, and the coherence.

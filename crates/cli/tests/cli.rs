@@ -530,6 +530,7 @@ fn linkages_are_proven_over_their_workspace() {
 /// on the encoder. `tweak` edits the samples before they are written.
 fn capstan_record(
     dir: &std::path::Path,
+    name: &str,
     tweak: impl Fn(&mut twoport_identify::log::Log),
 ) -> PathBuf {
     use twoport_control::multisine::Multisine;
@@ -563,7 +564,7 @@ fn capstan_record(
         }),
     };
     tweak(&mut log);
-    let path = dir.join("capstan.csv");
+    let path = dir.join(format!("{name}.csv"));
     std::fs::write(&path, log.to_csv()).unwrap();
     path
 }
@@ -574,19 +575,24 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// `identify` on a rigid handle's record: one mass, its mass and damping
-/// back, and the model, the set and the figures written. (That a design
-/// for the set holds for the true device is the release tests' part:
-/// `host-sim/tests/identify.rs`.)
+/// `identify` on two records of a rigid handle, the axes x and y: one
+/// mass each, its mass and damping back, each axis's model, set and
+/// figures written, and the two device files over both axes. (That a
+/// design for the set holds for the true device is the release tests'
+/// part: `host-sim/tests/identify.rs`.)
 #[test]
-fn identify_writes_a_model_and_a_set_a_design_can_use() {
+fn identify_writes_each_axis_and_the_device_files() {
     let dir = scratch("identify");
-    let record = capstan_record(&dir, |_| {});
+    let (x, y) = (
+        capstan_record(&dir, "x", |_| {}),
+        capstan_record(&dir, "y", |_| {}),
+    );
     let out = dir.join("out");
-    let (r, o) = (record.to_str().unwrap(), out.to_str().unwrap());
+    let o = out.to_str().unwrap();
     let v = TWOPORT.json(&[
         "identify",
-        r,
+        x.to_str().unwrap(),
+        y.to_str().unwrap(),
         "--out",
         o,
         "--peak-force",
@@ -597,23 +603,42 @@ fn identify_writes_a_model_and_a_set_a_design_can_use() {
         "svg",
         "--json",
     ]);
-    assert_eq!(v["chosen"]["modes"], 0, "{v}");
-    assert_eq!(v["chosen"]["form"], "chain");
-    assert!(v["coherence_min"].as_f64().unwrap() > 0.99, "{v}");
-    for f in ["model.toml", "set.toml", "encoder.svg", "coherence.svg"] {
+    let axes = v["axes"].as_array().unwrap();
+    assert_eq!(axes.len(), 2, "{v}");
+    for a in axes {
+        assert_eq!(a["chosen"]["modes"], 0, "{v}");
+        assert_eq!(a["chosen"]["form"], "chain");
+        assert!(a["coherence_min"].as_f64().unwrap() > 0.99, "{v}");
+    }
+    for f in [
+        "device.toml",
+        "set.toml",
+        "x/model.toml",
+        "y/model.toml",
+        "x/encoder.svg",
+        "y/coherence.svg",
+    ] {
         assert!(out.join(f).is_file(), "{f} not written");
     }
-    let model = std::fs::read_to_string(out.join("model.toml")).unwrap();
+    let model = std::fs::read_to_string(out.join("x/model.toml")).unwrap();
     let fitted = twoport_design::DeviceModel::from_toml(&model, "model.toml").unwrap();
     assert!((fitted.m[(0, 0)] / 0.25 - 1.0).abs() < 0.01, "{model}");
     assert!((fitted.d[(0, 0)] / 2.0 - 1.0).abs() < 0.05, "{model}");
-    // The set: a device file whose one axis has every model as a pose,
-    // each the fit's form with the damping lowered by the doubt (5%).
+    // device.toml: each axis its fit; set.toml: each axis its set, every
+    // model the fit's form with the damping lowered by the doubt (5%).
+    let device = twoport_design::Device::load(&out.join("device.toml")).unwrap();
+    let names: Vec<&str> = device.axes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["x", "y"]);
+    assert_eq!(device.axes[0].models, [fitted.clone()]);
     let set = twoport_design::Device::load(&out.join("set.toml")).unwrap();
-    let poses = &set.axes[0].models;
-    assert_eq!(poses.len(), v["set_models"].as_u64().unwrap() as usize);
-    assert!((poses[0].d[(0, 0)] / fitted.d[(0, 0)] - 0.95).abs() < 1e-9);
-    assert!(poses.iter().all(|p| p.dof() == 1));
+    for (axis, a) in set.axes.iter().zip(axes) {
+        assert_eq!(
+            axis.models.len(),
+            a["set_models"].as_u64().unwrap() as usize
+        );
+        assert!(axis.models.iter().all(|p| p.dof() == 1));
+    }
+    assert!((set.axes[0].models[0].d[(0, 0)] / fitted.d[(0, 0)] - 0.95).abs() < 1e-9);
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -637,7 +662,7 @@ fn identify_refuses_bad_records_and_arguments() {
         args.extend(extra);
         TWOPORT.failure(&args)
     };
-    let good = capstan_record(&dir, |_| {});
+    let good = capstan_record(&dir, "capstan", |_| {});
     for (extra, want) in [
         (
             &["--load-cell-pole", "235"][..],
@@ -663,10 +688,16 @@ fn identify_refuses_bad_records_and_arguments() {
         (&|l| l.force_n[10] *= 100.0, "past --peak-force"),
     ];
     for (tweak, want) in cases {
-        let e = fail(&capstan_record(&dir, tweak), &[]);
+        let e = fail(&capstan_record(&dir, "capstan", tweak), &[]);
         assert!(e.contains(want) && e.contains("capstan.csv"), "{want}: {e}");
     }
     let e = fail(&dir.join("missing.csv"), &[]);
     assert!(e.contains("missing.csv"), "{e}");
+    // Two records of one name would be one axis twice.
+    let other = dir.join("again");
+    std::fs::create_dir_all(&other).unwrap();
+    let twin = capstan_record(&other, "capstan", |_| {});
+    let e = fail(&good, &[twin.to_str().unwrap()]);
+    assert!(e.contains("two records name the axis \"capstan\""), "{e}");
     std::fs::remove_dir_all(dir).unwrap();
 }
