@@ -5,6 +5,7 @@
 //! (`set.toml`).
 
 use crate::args::{IdentifyArgs, PlotFormat};
+use num_complex::Complex64;
 use serde_json::json;
 use std::f64::consts::TAU;
 use std::fmt::Write;
@@ -400,49 +401,47 @@ fn draw(out: &Path, format: PlotFormat, data: &Measured, f: &Fit) -> Result<Vec<
         written.push(path);
         Ok::<(), String>(())
     };
+    // The measured response, the fit's, and the measurement's deviation.
+    let fitted = |frf: &Frf, pick: fn(&(Complex64, Complex64)) -> Complex64| {
+        vec![
+            curve("measured", plot::BLUE, 2, false, frf, &|i| {
+                frf.response[i].norm()
+            }),
+            curve("fit", plot::INK, 2, true, frf, &|i| pick(&model[i]).norm()),
+            curve("measured, 1 sigma", plot::RED, 1, false, frf, &|i| {
+                frf.variance[i].sqrt()
+            }),
+        ]
+    };
     figure(
         "encoder",
         Figure {
             title: "Actuator force to encoder: measured and fitted".into(),
             y_label: "|X/F| (m/N)".into(),
-            curves: vec![
-                curve("measured", plot::BLUE, 2, false, x, &|i| {
-                    x.response[i].norm()
-                }),
-                curve("fit", plot::INK, 2, true, x, &|i| model[i].0.norm()),
-                curve("measured, 1 sigma", plot::RED, 1, false, x, &|i| {
-                    x.variance[i].sqrt()
-                }),
-            ],
+            curves: fitted(x, |m| m.0),
         },
     )?;
+    // On a log axis as what the coherence leaves, 1 - γ²: the noise's
+    // share of one period's response, from 1e-6 to one half at a glance.
     let cx = x.coherence();
-    let mut coherence = vec![curve("encoder", plot::BLUE, 2, false, x, &|i| cx[i])];
+    let mut coherence = vec![curve("encoder", plot::BLUE, 2, false, x, &|i| 1.0 - cx[i])];
     if let Some(lc) = &data.load_cell {
         figure(
             "load_cell",
             Figure {
                 title: "Actuator force to load cell: measured and fitted".into(),
                 y_label: "|F_lc/F| (N/N)".into(),
-                curves: vec![
-                    curve("measured", plot::BLUE, 2, false, lc, &|i| {
-                        lc.response[i].norm()
-                    }),
-                    curve("fit", plot::INK, 2, true, lc, &|i| model[i].1.norm()),
-                    curve("measured, 1 sigma", plot::RED, 1, false, lc, &|i| {
-                        lc.variance[i].sqrt()
-                    }),
-                ],
+                curves: fitted(lc, |m| m.1),
             },
         )?;
         let c = lc.coherence();
-        coherence.push(curve("load cell", plot::RED, 2, false, lc, &|i| c[i]));
+        coherence.push(curve("load cell", plot::RED, 2, false, lc, &|i| 1.0 - c[i]));
     }
     figure(
         "coherence",
         Figure {
-            title: "Coherence of each harmonic (from the spread of the periods)".into(),
-            y_label: "coherence".into(),
+            title: "What the excitation does not explain: 1 - coherence".into(),
+            y_label: "1 - coherence (noise share)".into(),
             curves: coherence,
         },
     )?;

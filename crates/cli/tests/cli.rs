@@ -629,7 +629,7 @@ fn identify_writes_each_axis_and_the_device_files() {
     let device = twoport_design::Device::load(&out.join("device.toml")).unwrap();
     let names: Vec<&str> = device.axes.iter().map(|a| a.name.as_str()).collect();
     assert_eq!(names, ["x", "y"]);
-    assert_eq!(device.axes[0].models, [fitted.clone()]);
+    assert_eq!(device.axes[0].models, std::slice::from_ref(&fitted));
     let set = twoport_design::Device::load(&out.join("set.toml")).unwrap();
     for (axis, a) in set.axes.iter().zip(axes) {
         assert_eq!(
