@@ -116,8 +116,7 @@ fn bad_inputs_are_named() {
         e.contains("no/such.toml") && e.contains("cannot read"),
         "{e}"
     );
-    let dir = std::env::temp_dir().join(format!("twoport-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("errors");
     let bad = dir.join("bad.toml");
     let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -144,6 +143,7 @@ fn bad_inputs_are_named() {
     assert!(e.contains("--period 0"), "{e}");
     let e = TWOPORT.failure(&["plot", "fig8", "--out", dir.join("x.jpg").to_str().unwrap()]);
     assert!(e.contains(".png or .svg"), "{e}");
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
