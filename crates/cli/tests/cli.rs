@@ -174,6 +174,9 @@ fn every_subcommand_has_help() {
         vec!["zrange", "impedance", "--help"],
         vec!["zrange", "admittance", "--help"],
         vec!["plot", "--help"],
+        vec!["region", "impedance", "--help"],
+        vec!["verify", "impedance", "--help"],
+        vec!["identify", "--help"],
     ] {
         let out = TWOPORT.run(&args);
         assert!(out.status.success(), "{args:?}");
