@@ -24,6 +24,19 @@ pub(crate) fn designer(c: &Common) -> Result<Designer, String> {
     Designer::new(models, c.period, human).map_err(|e| e.to_string())
 }
 
+/// The linkage file of `--device`, at `--period` where one is given.
+pub(crate) fn linkage_file(c: &Common) -> Result<twoport_design::linkage::LinkageFile, String> {
+    let path = c.device.as_ref().ok_or("--device: a linkage file")?;
+    let mut file = twoport_design::linkage::LinkageFile::load(path).map_err(|e| e.to_string())?;
+    if let Some(t) = c.period {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(format!("--period {t}: must be finite and > 0"));
+        }
+        file.period_s = t;
+    }
+    Ok(file)
+}
+
 /// The one pose of a command that takes one.
 pub(crate) fn single<'a>(d: &'a Designer, command: &str) -> Result<&'a Pose, String> {
     match d.poses() {

@@ -30,19 +30,11 @@ pub(crate) fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
 /// workspace, hands off or for a least grasp.
 pub(crate) fn design_linkage(a: &DesignImpedance) -> Result<(), String> {
     use twoport_design::linkage::{
-        bounded_workspace_design, workspace_design, workspace_poses, LinkageDesign, LinkageFile,
-        DESIGN_GRID,
+        bounded_workspace_design, workspace_design, workspace_poses, LinkageDesign, DESIGN_GRID,
     };
     use twoport_design::network::HumanBound;
     let margin = a.margin.fraction()?;
-    let path = a.common.device.as_ref().ok_or("--device: a linkage file")?;
-    let mut file = LinkageFile::load(path).map_err(|e| e.to_string())?;
-    if let Some(t) = a.common.period {
-        if !(t.is_finite() && t > 0.0) {
-            return Err(format!("--period {t}: must be finite and > 0"));
-        }
-        file.period_s = t;
-    }
+    let file = linkage_file(&a.common)?;
     let poses = workspace_poses(&file, DESIGN_GRID);
     let b = a.b.unwrap_or(0.0);
     // A least grasp alone, hands off, or (by default, as for every

@@ -46,17 +46,10 @@ pub(crate) fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(),
 pub(crate) fn verify_linkage(a: &ImpedanceGains) -> Result<(), String> {
     use twoport_design::linkage::{
         bounded_workspace_design, verify_linkage, workspace_design, workspace_poses,
-        HandAssumption, LinkageFile, DESIGN_GRID,
+        HandAssumption, DESIGN_GRID,
     };
     use twoport_design::network::HumanBound;
-    let path = a.common.device.as_ref().ok_or("--device: a linkage file")?;
-    let mut file = LinkageFile::load(path).map_err(|e| e.to_string())?;
-    if let Some(t) = a.common.period {
-        if !(t.is_finite() && t > 0.0) {
-            return Err(format!("--period {t}: must be finite and > 0"));
-        }
-        file.period_s = t;
-    }
+    let file = linkage_file(&a.common)?;
     let (k, b) = (gain("k", a.k)?, gain("b", a.b)?);
     let grasp = match a.min_grasp {
         Some(g) if !(g.is_finite() && g >= 0.0) => {
