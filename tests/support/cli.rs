@@ -47,3 +47,12 @@ impl Tool {
         String::from_utf8(out.stderr).unwrap()
     }
 }
+
+/// A fresh folder under the system's temporary one for a test named
+/// `name`, unique to this process; the test removes it when it ends.
+#[allow(dead_code)]
+pub fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("twoport-cli-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}

@@ -69,10 +69,6 @@ pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
         .map(|(r, name)| axis(a, &amp, r, name, &device))
         .collect::<Result<Vec<_>, _>>()?;
 
-    let write = |path: PathBuf, text: String| {
-        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
-        Ok::<PathBuf, String>(path)
-    };
     let file = |what: &str, models: &dyn Fn(&Axis) -> Vec<String>| {
         let mut t = format!("# {what}\nname = {device:?}\n");
         for x in &axes {
@@ -85,14 +81,14 @@ pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
         }
         t
     };
-    let device_path = write(
+    let device_path = write_file(
         a.out.join("device.toml"),
         file(
             "The fitted model of each axis, as `twoport identify` found it.",
             &|x| vec![format!("{}/model.toml", x.name)],
         ),
     )?;
-    let set_path = write(
+    let set_path = write_file(
         a.out.join("set.toml"),
         file(
             "Each axis's set of models, spanning what its fit does not know:\n# a design for this device file is proven for every one of them.",
@@ -127,6 +123,12 @@ pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
         set_path.display()
     );
     Ok(())
+}
+
+/// Write `text` to `path`, an error naming the file.
+fn write_file(path: PathBuf, text: String) -> Result<PathBuf, String> {
+    std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(path)
 }
 
 /// What no experiment measures, the same for every axis.
@@ -198,12 +200,8 @@ fn axis(
 
     let dir = a.out.join(name);
     std::fs::create_dir_all(dir.join("set")).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let write = |path: PathBuf, text: String| {
-        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
-        Ok::<PathBuf, String>(path)
-    };
     let header = provenance(&source, chosen);
-    let model_path = write(dir.join("model.toml"), chosen.model.to_toml(&header))?;
+    let model_path = write_file(dir.join("model.toml"), chosen.model.to_toml(&header))?;
     let mut members = Vec::new();
     for (i, m) in set.iter().enumerate() {
         let what = match m.direction {
@@ -217,7 +215,7 @@ fn axis(
         let file = format!("{i:02}.toml");
         let mut model = m.model.clone();
         model.name = format!("{} [set {i:02}]", base.name);
-        write(dir.join("set").join(&file), model.to_toml(&note))?;
+        write_file(dir.join("set").join(&file), model.to_toml(&note))?;
         members.push(format!("{name}/set/{file}"));
     }
     let figures = match a.plot {

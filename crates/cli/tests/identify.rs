@@ -1,0 +1,186 @@
+//! `twoport identify` as a user runs it: bench records of a rigid handle
+//! in, each axis's model, set and figures out, and bad records and
+//! arguments refused with what is wrong.
+
+#[path = "../../../tests/support/cli.rs"]
+mod support;
+
+use std::path::PathBuf;
+use support::scratch;
+
+/// `twoport`, run from the repository root.
+const TWOPORT: support::Tool = support::Tool {
+    bin: env!("CARGO_BIN_EXE_twoport"),
+    root: concat!(env!("CARGO_MANIFEST_DIR"), "/../.."),
+};
+
+/// A bench record of the capstan handle (0.25 kg, 2 N s/m): a multisine
+/// of 1 to 100 Hz at 1 kHz, the exact sampled motion, and 1 nm of noise
+/// on the encoder. `tweak` edits the samples before they are written.
+fn capstan_record(
+    dir: &std::path::Path,
+    name: &str,
+    tweak: impl Fn(&mut twoport_identify::log::Log),
+) -> PathBuf {
+    use twoport_control::multisine::Multisine;
+    let (m, b, t, period, periods) = (0.25_f64, 2.0_f64, 1e-3_f64, 1000u32, 8u32);
+    let ms = Multisine::new(period, 1, 100, 2.0).unwrap();
+    let a = (-b * t / m).exp();
+    let (mut x, mut v) = (0.0_f64, 0.0_f64);
+    let mut seed = 0x2545_f491_u64;
+    let (mut force, mut position) = (Vec::new(), Vec::new());
+    for n in 0..period * periods {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        let noise = ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2e-9;
+        let f = ms.at(n) as f64;
+        force.push(f);
+        position.push(x + noise);
+        // The exact motion under a force held over the tick.
+        x += m / b * (1.0 - a) * v + (t / b - m * (1.0 - a) / (b * b)) * f;
+        v = a * v + (1.0 - a) / b * f;
+    }
+    let mut log = twoport_identify::log::Log {
+        period_s: t,
+        force_n: force,
+        position_m: position,
+        load_cell_n: None,
+        excitation: Some(twoport_identify::log::Excitation {
+            period_ticks: period as usize,
+            first: 1,
+            last: 100,
+        }),
+    };
+    tweak(&mut log);
+    let path = dir.join(format!("{name}.csv"));
+    std::fs::write(&path, log.to_csv()).unwrap();
+    path
+}
+
+/// `identify` on two records of a rigid handle, the axes x and y: one
+/// mass each, its mass and damping back, each axis's model, set and
+/// figures written, and the two device files over both axes. (That a
+/// design for the set holds for the true device is the release tests'
+/// part: `host-sim/tests/identify.rs`.)
+#[test]
+fn identify_writes_each_axis_and_the_device_files() {
+    let dir = scratch("identify");
+    let (x, y) = (
+        capstan_record(&dir, "x", |_| {}),
+        capstan_record(&dir, "y", |_| {}),
+    );
+    let out = dir.join("out");
+    let o = out.to_str().unwrap();
+    let v = TWOPORT.json(&[
+        "identify",
+        x.to_str().unwrap(),
+        y.to_str().unwrap(),
+        "--out",
+        o,
+        "--peak-force",
+        "10",
+        "--continuous-force",
+        "4",
+        "--plot",
+        "svg",
+        "--json",
+    ]);
+    let axes = v["axes"].as_array().unwrap();
+    assert_eq!(axes.len(), 2, "{v}");
+    for a in axes {
+        assert_eq!(a["chosen"]["modes"], 0, "{v}");
+        assert_eq!(a["chosen"]["form"], "chain");
+        assert!(a["coherence_min"].as_f64().unwrap() > 0.99, "{v}");
+    }
+    for f in [
+        "device.toml",
+        "set.toml",
+        "x/model.toml",
+        "y/model.toml",
+        "x/encoder.svg",
+        "y/coherence.svg",
+    ] {
+        assert!(out.join(f).is_file(), "{f} not written");
+    }
+    let model = std::fs::read_to_string(out.join("x/model.toml")).unwrap();
+    let fitted = twoport_design::DeviceModel::from_toml(&model, "model.toml").unwrap();
+    assert!((fitted.m[(0, 0)] / 0.25 - 1.0).abs() < 0.01, "{model}");
+    assert!((fitted.d[(0, 0)] / 2.0 - 1.0).abs() < 0.05, "{model}");
+    // device.toml: each axis its fit; set.toml: each axis its set, every
+    // model the fit's form with the damping lowered by the doubt (5%).
+    let device = twoport_design::Device::load(&out.join("device.toml")).unwrap();
+    let names: Vec<&str> = device.axes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["x", "y"]);
+    assert_eq!(device.axes[0].models, std::slice::from_ref(&fitted));
+    let set = twoport_design::Device::load(&out.join("set.toml")).unwrap();
+    for (axis, a) in set.axes.iter().zip(axes) {
+        assert_eq!(
+            axis.models.len(),
+            a["set_models"].as_u64().unwrap() as usize
+        );
+        assert!(axis.models.iter().all(|p| p.dof() == 1));
+    }
+    assert!((set.axes[0].models[0].d[(0, 0)] / fitted.d[(0, 0)] - 0.95).abs() < 1e-9);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Bad records and arguments are refused with what is wrong.
+#[test]
+fn identify_refuses_bad_records_and_arguments() {
+    let dir = scratch("identify-bad");
+    let out = dir.join("out");
+    let o = out.to_str().unwrap().to_string();
+    let fail = |record: &PathBuf, extra: &[&str]| {
+        let mut args = vec![
+            "identify",
+            record.to_str().unwrap(),
+            "--out",
+            &o,
+            "--peak-force",
+            "10",
+            "--continuous-force",
+            "4",
+        ];
+        args.extend(extra);
+        TWOPORT.failure(&args)
+    };
+    let good = capstan_record(&dir, "capstan", |_| {});
+    for (extra, want) in [
+        (
+            &["--load-cell-pole", "235"][..],
+            "has no load_cell_n column",
+        ),
+        (&["--sigmas", "-1"][..], "--sigmas -1"),
+        (&["--damping-doubt", "1"][..], "--damping-doubt 1"),
+        (&["--skip", "7"][..], "whole periods"),
+    ] {
+        let e = fail(&good, extra);
+        assert!(e.contains(want), "{extra:?}: {e}");
+    }
+    type Tweak = dyn Fn(&mut twoport_identify::log::Log);
+    let cases: [(&Tweak, &str); 3] = [
+        (
+            &|l| l.force_n.iter_mut().for_each(|f| *f = f.clamp(-1.0, 1.0)),
+            "the force is clipped",
+        ),
+        (
+            &|l| l.load_cell_n = Some(vec![0.0; l.force_n.len()]),
+            "give its filter pole with --load-cell-pole",
+        ),
+        (&|l| l.force_n[10] *= 100.0, "past --peak-force"),
+    ];
+    for (tweak, want) in cases {
+        let e = fail(&capstan_record(&dir, "capstan", tweak), &[]);
+        assert!(e.contains(want) && e.contains("capstan.csv"), "{want}: {e}");
+    }
+    let e = fail(&dir.join("missing.csv"), &[]);
+    assert!(e.contains("missing.csv"), "{e}");
+    // Two records of one name would be one axis twice.
+    let other = dir.join("again");
+    std::fs::create_dir_all(&other).unwrap();
+    let twin = capstan_record(&other, "capstan", |_| {});
+    let e = fail(&good, &[twin.to_str().unwrap()]);
+    assert!(e.contains("two records name the axis \"capstan\""), "{e}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
