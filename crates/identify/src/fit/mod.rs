@@ -241,13 +241,17 @@ impl Fit {
     /// within three of its standard deviations (`√(2/ν)`) of one, or
     /// below.
     pub fn at_noise(&self) -> bool {
-        let nu = (self.residuals - self.parameters).max(1) as f64;
-        self.reduced_chi2() <= 1.0 + 3.0 * (2.0 / nu).sqrt()
+        self.reduced_chi2() <= 1.0 + 3.0 * (2.0 / self.dof()).sqrt()
+    }
+
+    /// Degrees of freedom `ν`: residuals less parameters (at least one).
+    fn dof(&self) -> f64 {
+        (self.residuals - self.parameters).max(1) as f64
     }
 
     /// `χ²` per degree of freedom.
     pub fn reduced_chi2(&self) -> f64 {
-        self.chi2 / (self.residuals - self.parameters).max(1) as f64
+        self.chi2 / self.dof()
     }
 }
 
