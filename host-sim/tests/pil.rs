@@ -365,3 +365,45 @@ fn the_board_plays_the_scenes_experiment_and_streams_every_tick() {
     let c = pil::compare(&r, &r);
     assert!(pil::failures(&r, &c, 4000, LinkFaults::default(), 0).is_empty());
 }
+
+/// Before its first tick the board says what it can do: the image's
+/// period, the Excalibur's limits and its shipped region's envelope,
+/// telemetry every 10 ticks. A scene at another period is refused, naming
+/// both periods.
+#[test]
+fn the_board_states_its_spec_and_a_scene_at_another_period_is_refused() {
+    use twoport_board::excalibur;
+    let r = run(5, LinkFaults::default());
+    let spec = r.spec.unwrap();
+    assert_eq!(spec.period_ns, 1_000_000);
+    assert_eq!(spec.stream_every, excalibur::TELEMETRY_EVERY);
+    assert!(!spec.linkage);
+    let axis = spec.axes[0];
+    let s = excalibur::safety();
+    assert_eq!(
+        (axis.peak_force_n, axis.continuous_force_n),
+        (s.peak_force_n, s.continuous_force_n)
+    );
+    assert_eq!(axis.region, excalibur::proven_region().unwrap().envelope());
+    let twoport_link::ProvenRegion::MaxStiffness { k_max_npm, .. } = axis.region else {
+        panic!("{:?}", axis.region)
+    };
+    // The paper's coupling is inside it.
+    assert!(k_max_npm >= 51_000.0, "{k_max_npm}");
+
+    let s = Scene::load(
+        Path::new("../scenes/stiff_wall.toml"),
+        &["period_s=0.0005".to_string()],
+    )
+    .unwrap();
+    let e = pil::run(
+        s,
+        10,
+        LocalBoard::excalibur().unwrap(),
+        LinkFaults::default(),
+    )
+    .err()
+    .unwrap();
+    assert!(e.to_string().contains("period_s"), "{e}");
+    assert!(e.to_string().contains("0.001"), "{e}");
+}

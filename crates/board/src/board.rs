@@ -3,6 +3,7 @@
 mod arming;
 mod identify;
 mod persist;
+mod spec;
 
 use crate::io::IoScale;
 use crate::region::{check_axes, Region};
@@ -342,6 +343,8 @@ where
             Message::Disarm => self.disarm(),
             Message::Home => self.home(),
             Message::Identify(req) => self.identify(req),
+            Message::GetSpec => self.answer_spec(),
+            Message::SetStream { every_ticks } => self.answer_stream(every_ticks),
             Message::Calibrate { position_pm } => self.calibrate(position_pm),
             Message::GetStatus => self.queue_status(),
             Message::SaveConfig => self.request_save(),

@@ -3,7 +3,7 @@
 //! per axis of a board of several ([`check_axes`]).
 
 use twoport_control::servo::{Display, Gains};
-use twoport_link::{AxisRefusal, Refusal};
+use twoport_link::{AxisRefusal, ProvenRegion, Refusal};
 
 /// What a region bounds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -117,6 +117,52 @@ impl<const N: usize> Region<N> {
         }
     }
 
+    /// The region's envelope as the link's specification gives it: its
+    /// damping range and its extreme limit (the stiffest spring, or the
+    /// lightest mass) with the damping it is proven at.
+    pub fn envelope(&self) -> ProvenRegion {
+        let g = &self.damping_nspm;
+        let (b_min_nspm, b_max_nspm) = (g[0], g[N - 1]);
+        let better = |a: f32, c: f32| match self.bound {
+            Bound::MaxStiffness => c > a,
+            Bound::MinMass => c < a,
+        };
+        let best = (1..N).fold(0, |i, j| {
+            if better(self.limit[i], self.limit[j]) {
+                j
+            } else {
+                i
+            }
+        });
+        let (limit, at) = (self.limit[best], g[best]);
+        match (self.bound, self.regulator) {
+            (Bound::MinMass, Some((kp_npm, bp_nspm))) => ProvenRegion::MinMass {
+                kp_npm,
+                bp_nspm,
+                b_min_nspm,
+                b_max_nspm,
+                m_min_kg: limit,
+                b_at_m_min_nspm: at,
+            },
+            // A mass region built without its regulator accepts no gains
+            // (`check` refuses every one); a zero regulator says so.
+            (Bound::MinMass, None) => ProvenRegion::MinMass {
+                kp_npm: 0.0,
+                bp_nspm: 0.0,
+                b_min_nspm,
+                b_max_nspm,
+                m_min_kg: limit,
+                b_at_m_min_nspm: at,
+            },
+            (Bound::MaxStiffness, _) => ProvenRegion::MaxStiffness {
+                b_min_nspm,
+                b_max_nspm,
+                k_max_npm: limit,
+                b_at_k_max_nspm: at,
+            },
+        }
+    }
+
     /// The proven limit at damping `b`, or `None` off the grid.
     pub fn limit_at(&self, b_nspm: f32) -> Option<f32> {
         let g = &self.damping_nspm;
@@ -192,6 +238,26 @@ mod tests {
         )
         .unwrap();
         assert_eq!(m.limit_at(400.0), Some(6.0 * 1.01));
+        assert_eq!(
+            r.envelope(),
+            ProvenRegion::MaxStiffness {
+                b_min_nspm: 30.0,
+                b_max_nspm: 90.0,
+                k_max_npm: 51_400.0,
+                b_at_k_max_nspm: 60.0,
+            }
+        );
+        assert_eq!(
+            m.envelope(),
+            ProvenRegion::MinMass {
+                kp_npm: 51_000.0,
+                bp_nspm: 90.0,
+                b_min_nspm: 300.0,
+                b_max_nspm: 500.0,
+                m_min_kg: 5.0,
+                b_at_m_min_nspm: 500.0,
+            }
+        );
         assert_eq!(
             Region::new(Bound::MinMass, [1.0, 1.0], [1.0, 1.0], None),
             Err(RegionError::Grid)

@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use twoport_board::excalibur;
 use twoport_link::{
     encode, Axes, ConfigSource, Decoder, LinkStats, Message, Mode, ModeRequest, PilSensors, Role,
-    Status, MAX_FRAME, NO_SESSION,
+    Spec, Status, MAX_FRAME, NO_SESSION,
 };
 
 /// How long the host waits for the board's answer to one frame.
@@ -147,6 +147,28 @@ impl<P: BoardPort> Session<P> {
         self.send(&Message::GetConfig)?;
         self.wait("GetConfig", |m| match m {
             Message::Config(c) => Some(*c),
+            _ => None,
+        })
+    }
+
+    /// What the board can do: its period, each axis's limits and proven
+    /// region, and the telemetry rate in force (protocol 8).
+    pub fn spec(&mut self) -> Result<Spec, LinkError> {
+        self.inbox.retain(|m| !matches!(m, Message::Spec(_)));
+        self.send(&Message::GetSpec)?;
+        self.wait("GetSpec", |m| match m {
+            Message::Spec(s) => Some(*s),
+            _ => None,
+        })
+    }
+
+    /// Have the board send telemetry every `every_ticks` ticks (0: none
+    /// outside an experiment), and wait until it says so (protocol 8).
+    pub fn set_stream(&mut self, every_ticks: u32) -> Result<(), LinkError> {
+        self.inbox.retain(|m| !matches!(m, Message::Stream { .. }));
+        self.send(&Message::SetStream { every_ticks })?;
+        self.wait("SetStream", |m| match m {
+            Message::Stream { every_ticks: e } if *e == every_ticks => Some(()),
             _ => None,
         })
     }

@@ -7,6 +7,7 @@ mod axes;
 mod crc;
 mod frame;
 mod message;
+mod spec;
 
 pub use axes::{Axes, MAX_AXES};
 pub use crc::crc16;
@@ -16,3 +17,4 @@ pub use message::{
     GainsReply, HandshakeError, LinkStats, Message, Mode, ModeRefusal, ModeRequest, PilSensors,
     Refusal, Role, Status, Telemetry, NO_SESSION, PROTOCOL_VERSION,
 };
+pub use spec::{AxisSpec, ProvenRegion, Spec};

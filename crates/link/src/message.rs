@@ -3,7 +3,7 @@
 //! so today's boards send multiples of 1000; the wire has room for finer).
 
 use crate::frame::Stats;
-use crate::Axes;
+use crate::{Axes, Spec};
 use serde::{Deserialize, Serialize};
 
 /// The protocol version both ends must share (checked by the handshake).
@@ -11,8 +11,10 @@ use serde::{Deserialize, Serialize};
 /// session number in every answer, so that a host sees a board reset;
 /// version 6 lets a board refuse what its device cannot do
 /// ([`ModeRefusal::Unsupported`]); version 7 runs identification
-/// experiments ([`Message::Identify`]).
-pub const PROTOCOL_VERSION: u16 = 7;
+/// experiments ([`Message::Identify`]); version 8 tells a host what the
+/// board can do ([`Message::GetSpec`]) and lets it set the telemetry rate
+/// ([`Message::SetStream`]).
+pub const PROTOCOL_VERSION: u16 = 8;
 
 /// The session number of a board no host has shaken hands with since it
 /// booted. A host opens a session with any other number, and a board
@@ -427,6 +429,22 @@ pub enum Message {
     /// [`Mode::Identifying`] and sends telemetry every tick until it ends
     /// (protocol 7).
     Identify(Experiment),
+    /// Ask for the board's [`Spec`] (protocol 8).
+    GetSpec,
+    /// What the board can do and what it will accept (protocol 8).
+    Spec(Spec),
+    /// Send telemetry every `every_ticks` ticks from now on (0: none
+    /// outside an experiment), in any mode (protocol 8).
+    SetStream {
+        /// Ticks between telemetry frames.
+        every_ticks: u32,
+    },
+    /// The telemetry rate in force, in answer to
+    /// [`SetStream`](Message::SetStream) (protocol 8).
+    Stream {
+        /// Ticks between telemetry frames (0: none).
+        every_ticks: u32,
+    },
 }
 
 /// The board's view of the link.

@@ -107,6 +107,47 @@ fn all_messages() -> Vec<Message> {
             duty: Axes::new([-32_767, 32_767, 0]).unwrap(),
             session: 0x5A5A,
         }),
+        Message::GetSpec,
+        // The widest spec: every axis admittance, every number full width.
+        Message::Spec(Spec {
+            period_ns: u32::MAX,
+            stream_every: u32::MAX,
+            linkage: true,
+            axes: Axes::new([f32::MAX, 1.0, -0.0].map(|x| AxisSpec {
+                peak_force_n: x,
+                continuous_force_n: x,
+                max_velocity_mps: x,
+                region: ProvenRegion::MinMass {
+                    kp_npm: x,
+                    bp_nspm: x,
+                    b_min_nspm: x,
+                    b_max_nspm: x,
+                    m_min_kg: x,
+                    b_at_m_min_nspm: x,
+                },
+            }))
+            .unwrap(),
+        }),
+        Message::Spec(Spec {
+            period_ns: 1_000_000,
+            stream_every: 0,
+            linkage: false,
+            axes: Axes::one(AxisSpec {
+                peak_force_n: 200.0,
+                continuous_force_n: 100.0,
+                max_velocity_mps: 1.0,
+                region: ProvenRegion::MaxStiffness {
+                    b_min_nspm: 10.0,
+                    b_max_nspm: 90.0,
+                    k_max_npm: 51_074.0,
+                    b_at_k_max_nspm: 90.0,
+                },
+            }),
+        }),
+        Message::SetStream {
+            every_ticks: u32::MAX,
+        },
+        Message::Stream { every_ticks: 0 },
     ]
 }
 

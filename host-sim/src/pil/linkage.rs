@@ -173,8 +173,15 @@ pub fn run<P: BoardPort>(
 ) -> Result<Run<3>, Error> {
     let mut arm = Arm::new(device)?;
     let mut session = Session::open_axes(port, faults, 3)?;
+    let spec = session.spec()?;
+    if !spec.linkage {
+        return Err(pil_err!(
+            "the board at the port drives no linkage: flash a linkage image"
+        ));
+    }
     let mut r = Run {
         start: Some(super::Start::Calibrate),
+        spec: Some(spec),
         config: Some(boot_and_save(&mut session)?),
         ..Run::default()
     };

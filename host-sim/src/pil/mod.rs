@@ -56,6 +56,8 @@ pub struct Run<const N: usize = 1> {
     /// The identification experiment the scene asked for, and the tick
     /// the board started it at.
     pub experiment: Option<(twoport_link::Experiment, u64)>,
+    /// What the board said it can do, asked before its first tick.
+    pub spec: Option<twoport_link::Spec>,
 }
 
 impl<const N: usize> Default for Run<N> {
@@ -68,6 +70,7 @@ impl<const N: usize> Default for Run<N> {
             board_stats: LinkStats::default(),
             host_dropped: 0,
             zero_after_loss_ticks: None,
+            spec: None,
             start: None,
             config: None,
             armed_at_tick: 0,
@@ -343,8 +346,18 @@ pub fn run_axes<P: BoardPort, const N: usize>(
     let start = setup.start;
     let mut session = Session::open_axes(port, faults, N as u8)?;
     session.set_index(setup.index_m);
+    let spec = session.spec()?;
+    let period = sim.scene().period();
+    if (spec.period_s() - period).abs() > 1e-9 {
+        return Err(pil_err!(
+            "the board's servo runs every {} s and the scene's every {period} s: \
+             set the scene's period_s to the board's",
+            spec.period_s()
+        ));
+    }
     let mut r = Run {
         start: Some(start),
+        spec: Some(spec),
         ..Run::default()
     };
     r.config = Some(boot_and_save(&mut session)?);
@@ -449,6 +462,8 @@ pub struct Comparison {
     pub duty_mismatches: u64,
     /// Whether the two boards armed (or homed) at different ticks.
     pub start_differs: bool,
+    /// Whether the two boards' specifications differ.
+    pub spec_differs: bool,
 }
 
 /// Compare a run with its reference, tick by tick, every axis.
@@ -467,6 +482,7 @@ pub fn compare<const N: usize>(a: &Run<N>, b: &Run<N>) -> Comparison {
     }
     c.start_differs = (a.armed_at_tick, a.homing.map(|h| h.0), a.experiment)
         != (b.armed_at_tick, b.homing.map(|h| h.0), b.experiment);
+    c.spec_differs = a.spec != b.spec;
     c.duty_mismatches = a
         .duties
         .iter()
@@ -512,6 +528,12 @@ pub fn failures<const N: usize>(
     }
     if c.ticks != ticks {
         bad.push(format!("{} of {ticks} ticks ran", c.ticks));
+    }
+    if c.spec_differs {
+        bad.push(format!(
+            "the board's specification differs from the in-process image's: {:?}",
+            run.spec
+        ));
     }
     if let Some((x, at)) = run.experiment {
         // Every tick's telemetry, up to the run's end. A tick's telemetry

@@ -1,0 +1,79 @@
+//! What a board says it can do (protocol 8): its servo's period, each
+//! axis's force and speed limits, and the region of couplings its designer
+//! proved absolutely stable, so that a host application picks its gains
+//! from a proof instead of a hand-set "max stiffness".
+
+use crate::Axes;
+use serde::{Deserialize, Serialize};
+
+/// The board's specification, sent in answer to [`GetSpec`].
+///
+/// [`GetSpec`]: crate::Message::GetSpec
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Spec {
+    /// The servo's period (ns).
+    pub period_ns: u32,
+    /// Telemetry goes out every this many ticks (0: none outside an
+    /// experiment); [`SetStream`](crate::Message::SetStream) changes it.
+    pub stream_every: u32,
+    /// Whether the motors turn a linkage's joints: such a board is
+    /// calibrated at a known pose and has no homing run.
+    pub linkage: bool,
+    /// Each Cartesian axis's.
+    pub axes: Axes<AxisSpec>,
+}
+
+/// One Cartesian axis's limits and proven region.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AxisSpec {
+    /// The force the safety layer allows for a short time (N).
+    pub peak_force_n: f32,
+    /// The force it allows indefinitely (N).
+    pub continuous_force_n: f32,
+    /// The speed past which it faults to zero force (m/s).
+    pub max_velocity_mps: f32,
+    /// The couplings the board accepts on this axis.
+    pub region: ProvenRegion,
+}
+
+/// The envelope of a proven region: the range of coupling damping it
+/// covers and its extreme coupling. Inside the range the board accepts a
+/// coupling up to its proven limit at that damping, which
+/// [`Refusal::NotProvenStable`](crate::Refusal::NotProvenStable) names
+/// when a request goes past it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum ProvenRegion {
+    /// Impedance display: a spring-damper coupling.
+    MaxStiffness {
+        /// Least coupling damping proven (N s/m).
+        b_min_nspm: f32,
+        /// Greatest (N s/m).
+        b_max_nspm: f32,
+        /// The stiffest coupling proven (N/m) ...
+        k_max_npm: f32,
+        /// ... at this damping (N s/m).
+        b_at_k_max_nspm: f32,
+    },
+    /// Admittance display: a mass-damper coupling, for one regulator.
+    MinMass {
+        /// The regulator's stiffness (N/m) ...
+        kp_npm: f32,
+        /// ... and damping (N s/m) the region was proven for.
+        bp_nspm: f32,
+        /// Least coupling damping proven (N s/m).
+        b_min_nspm: f32,
+        /// Greatest (N s/m).
+        b_max_nspm: f32,
+        /// The lightest coupling mass proven (kg) ...
+        m_min_kg: f32,
+        /// ... at this damping (N s/m).
+        b_at_m_min_nspm: f32,
+    },
+}
+
+impl Spec {
+    /// The servo's period (s).
+    pub fn period_s(&self) -> f64 {
+        f64::from(self.period_ns) * 1e-9
+    }
+}
