@@ -1,6 +1,7 @@
 //! The loop: servo tick, link in, frames out.
 
 mod arming;
+mod host_ve;
 mod identify;
 mod persist;
 mod spec;
@@ -78,6 +79,9 @@ pub struct Board<W, const R: usize, const N: usize = 1, L = Direct, D = Servo<W,
     /// The identification experiment in progress (in
     /// [`Mode::Identifying`]).
     experiment: Option<Experiment<N>>,
+    /// The host's VE, when the coupling holds it instead of the image's
+    /// (protocol 8).
+    host: Option<host_ve::HostVe<N>>,
     /// The dead-man switch at the last tick (open before the first).
     dead_man_closed: bool,
     /// Whether the amplifier's outputs are on (as last commanded).
@@ -173,6 +177,7 @@ where
             homing_cfg: [HomingConfig::gentle(Position::ZERO, period_s); N],
             homing: None,
             experiment: None,
+            host: None,
             dead_man_closed: false,
             outputs_on: false,
             config_source: None,
@@ -345,6 +350,8 @@ where
             Message::Identify(req) => self.identify(req),
             Message::GetSpec => self.answer_spec(),
             Message::SetStream { every_ticks } => self.answer_stream(every_ticks),
+            Message::SetVe(source) => self.set_ve(source),
+            Message::VeUpdate(u) => self.ve_update(u),
             Message::Calibrate { position_pm } => self.calibrate(position_pm),
             Message::GetStatus => self.queue_status(),
             Message::SaveConfig => self.request_save(),
@@ -505,6 +512,7 @@ where
     /// telemetry on schedule. Returns the held actuator command.
     pub fn tick(&mut self, frame: &SensorFrame<f32, N>) -> ServoOutput<f32, N> {
         self.dead_man_closed = frame.dead_man_closed;
+        self.host_ve_tick();
         let driven = match (self.homing.as_mut(), self.experiment.as_ref()) {
             // Each axis's homing law in place of the display's, through the
             // same safety layer; an axis that has homed holds no force.
@@ -513,7 +521,10 @@ where
                 .tick_with(frame, |i, x, v| h[i].as_mut().map_or(0.0, |h| h.step(x, v))),
             // The experiment's law, through the same safety layer.
             (None, Some(e)) => self.servo.tick_with(frame, |i, x, v| e.force(i, x, v)),
-            (None, None) => self.servo.tick(frame),
+            (None, None) => match self.host.as_mut() {
+                Some(h) => self.servo.tick_on(frame, &mut h.world),
+                None => self.servo.tick(frame),
+            },
         };
         let out = driven.cartesian;
         self.last = out;
@@ -535,7 +546,10 @@ where
             // Every tick of an experiment: its record is the point of it.
             if self.since_telemetry >= self.telemetry_every || identifying {
                 self.since_telemetry = 0;
-                let ve = self.servo.servo().world().positions();
+                let (ve, ve_seq) = match &self.host {
+                    Some(h) => (World::<f32, N>::positions(&h.world), h.seq()),
+                    None => (self.servo.servo().world().positions(), 0),
+                };
                 let axes = core::array::from_fn(|i| AxisTelemetry {
                     position_pm: out.position[i].nm() as i64 * 1000,
                     velocity_mps: out.velocity_mps[i],
@@ -558,6 +572,7 @@ where
                     deadline_misses: self.timing.deadline_misses,
                     worst_jitter_cycles: self.timing.worst_jitter,
                     session: self.session,
+                    ve_seq,
                 }));
             }
         }

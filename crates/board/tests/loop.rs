@@ -1,7 +1,6 @@
 //! The portable firmware loop driven over the wire, as a host drives it.
 
 use twoport_board::{Board, BoardSupport, Bound, RawSensors, Region};
-use twoport_control::servo::SensorFrame;
 use twoport_control::ve::BilateralConstraint;
 use twoport_control::{AdmittanceGains, Encoder, Faults, Position, SafetyConfig, Servo};
 use twoport_link::{
@@ -10,6 +9,8 @@ use twoport_link::{
 };
 
 mod common;
+mod wire;
+use wire::{frame, replies, send};
 
 fn safety() -> SafetyConfig {
     SafetyConfig {
@@ -21,21 +22,6 @@ fn safety() -> SafetyConfig {
 
 fn board() -> Board<BilateralConstraint, 3> {
     common::board(51_000.0, safety(), 10)
-}
-
-fn send(b: &mut Board<BilateralConstraint, 3>, seq: u16, m: Message) {
-    let mut buf = [0u8; MAX_FRAME];
-    let n = encode(seq, &m, &mut buf).unwrap();
-    b.on_bytes(&buf[..n]);
-}
-
-fn replies(b: &mut Board<BilateralConstraint, 3>) -> Vec<Message> {
-    let mut d = Decoder::new();
-    let mut out = Vec::new();
-    while let Some(f) = b.pop_tx() {
-        d.feed(&f, |e| out.push(e.msg));
-    }
-    out
 }
 
 /// Tick 0 (the board then knows the dead-man is closed), calibrate where
@@ -52,10 +38,6 @@ fn arm(b: &mut Board<BilateralConstraint, 3>, raw: u32) {
     send(b, 101, Message::Arm);
     assert_eq!(b.mode(), Mode::Armed, "{:?}", replies(b));
     replies(b);
-}
-
-fn frame(tick: u32, raw: u32) -> SensorFrame {
-    SensorFrame::held(tick, [raw], [0.0])
 }
 
 /// A one-axis board's acceptance of `g`.
@@ -603,65 +585,4 @@ fn deadline_misses_and_the_worst_jitter_are_counted_and_reported() {
     tick(&mut b, &mut io);
     let t = tick(&mut b, &mut io);
     assert_eq!((t.deadline_misses, t.worst_jitter_cycles), (2, 48));
-}
-
-/// The board says what it can do: its period, each axis's limits and its
-/// proven region's envelope, and the telemetry rate, which the host sets
-/// and which takes effect from the next tick, in any mode.
-#[test]
-fn the_spec_names_the_limits_and_the_region_and_the_stream_follows_the_host() {
-    use twoport_link::{AxisSpec, ProvenRegion, Spec};
-    let mut b = board();
-    send(&mut b, 0, Message::GetSpec);
-    let s = safety();
-    let want = Spec {
-        period_ns: 1_000_000,
-        stream_every: 10,
-        linkage: false,
-        axes: Axes::one(AxisSpec {
-            peak_force_n: s.peak_force_n,
-            continuous_force_n: s.continuous_force_n,
-            max_velocity_mps: s.max_velocity_mps,
-            region: ProvenRegion::MaxStiffness {
-                b_min_nspm: 30.0,
-                b_max_nspm: 90.0,
-                k_max_npm: 51_400.0,
-                b_at_k_max_nspm: 60.0,
-            },
-        }),
-    };
-    assert_eq!(replies(&mut b), vec![Message::Spec(want)]);
-    let ticks = |b: &mut Board<BilateralConstraint, 3>, from: u32, n: u32| -> Vec<u32> {
-        for t in from..from + n {
-            b.tick(&frame(t, 0));
-        }
-        replies(b)
-            .into_iter()
-            .filter_map(|m| match m {
-                Message::Telemetry(t) => Some(t.tick),
-                _ => None,
-            })
-            .collect()
-    };
-    assert_eq!(ticks(&mut b, 0, 20), vec![9, 19]);
-    // Every tick, disarmed.
-    send(&mut b, 1, Message::SetStream { every_ticks: 1 });
-    assert_eq!(replies(&mut b), vec![Message::Stream { every_ticks: 1 }]);
-    assert_eq!(ticks(&mut b, 20, 3), vec![20, 21, 22]);
-    // Every third, counted from the request.
-    send(&mut b, 2, Message::SetStream { every_ticks: 3 });
-    replies(&mut b);
-    assert_eq!(ticks(&mut b, 23, 7), vec![25, 28]);
-    // None.
-    send(&mut b, 3, Message::SetStream { every_ticks: 0 });
-    replies(&mut b);
-    assert_eq!(ticks(&mut b, 30, 50), Vec::<u32>::new());
-    send(&mut b, 4, Message::GetSpec);
-    assert!(matches!(
-        replies(&mut b).as_slice(),
-        [Message::Spec(Spec {
-            stream_every: 0,
-            ..
-        })]
-    ));
 }

@@ -35,6 +35,13 @@ pub trait Drive<const N: usize> {
     fn servo_mut(&mut self) -> &mut Servo<Self::World, f32, N, Self::Layer>;
     /// One control tick.
     fn tick(&mut self, frame: &SensorFrame<f32, N>) -> Driven<N>;
+    /// One control tick against `world` in place of the servo's own (the
+    /// host's VE): see [`Servo::tick_on`].
+    fn tick_on<V: World<f32, N>>(
+        &mut self,
+        frame: &SensorFrame<f32, N>,
+        world: &mut V,
+    ) -> Driven<N>;
     /// One tick with `law` in place of the laws and the world (homing):
     /// see [`Servo::tick_with`].
     fn tick_with(
@@ -63,6 +70,17 @@ impl<W: World<f32, N>, L: PortLayer, const N: usize> Drive<N> for Servo<W, f32, 
     }
     fn tick(&mut self, frame: &SensorFrame<f32, N>) -> Driven<N> {
         let cartesian = Servo::tick(self, frame);
+        Driven {
+            cartesian,
+            motor: cartesian.actuator_force_n,
+        }
+    }
+    fn tick_on<V: World<f32, N>>(
+        &mut self,
+        frame: &SensorFrame<f32, N>,
+        world: &mut V,
+    ) -> Driven<N> {
+        let cartesian = Servo::tick_on(self, frame, world);
         Driven {
             cartesian,
             motor: cartesian.actuator_force_n,
@@ -109,6 +127,17 @@ impl<K: Kinematics<f32, N>, W: World<f32, N>, const N: usize> Drive<N>
     }
     fn tick(&mut self, frame: &SensorFrame<f32, N>) -> Driven<N> {
         let out = LinkageServo::tick(self, frame);
+        Driven {
+            cartesian: out.cartesian,
+            motor: out.torque_nm,
+        }
+    }
+    fn tick_on<V: World<f32, N>>(
+        &mut self,
+        frame: &SensorFrame<f32, N>,
+        world: &mut V,
+    ) -> Driven<N> {
+        let out = LinkageServo::tick_on(self, frame, world);
         Driven {
             cartesian: out.cartesian,
             motor: out.torque_nm,

@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use twoport_board::excalibur;
 use twoport_link::{
     encode, Axes, ConfigSource, Decoder, LinkStats, Message, Mode, ModeRequest, PilSensors, Role,
-    Spec, Status, MAX_FRAME, NO_SESSION,
+    Spec, Status, VeSource, VeUpdate, MAX_FRAME, NO_SESSION,
 };
 
 /// How long the host waits for the board's answer to one frame.
@@ -171,6 +171,40 @@ impl<P: BoardPort> Session<P> {
             Message::Stream { every_ticks: e } if *e == every_ticks => Some(()),
             _ => None,
         })
+    }
+
+    /// Run the VE on the board or on the host (disarmed only), and wait
+    /// for the board to say which it runs (protocol 8).
+    pub fn set_ve(&mut self, source: VeSource) -> Result<VeSource, LinkError> {
+        self.inbox.retain(|m| {
+            !matches!(
+                m,
+                Message::Ve(_)
+                    | Message::ModeRefused {
+                        asked: ModeRequest::SetVe,
+                        ..
+                    }
+            )
+        });
+        self.send(&Message::SetVe(source))?;
+        let r = self.wait("SetVe", |m| match m {
+            Message::Ve(s) => Some(Ok(*s)),
+            Message::ModeRefused {
+                asked: ModeRequest::SetVe,
+                why,
+            } => Some(Err(*why)),
+            _ => None,
+        })?;
+        r.map_err(|why| LinkError::Refused {
+            asked: ModeRequest::SetVe,
+            why,
+        })
+    }
+
+    /// Send the host VE's points, update `seq` (no answer: the telemetry's
+    /// `ve_seq` says which update the board holds).
+    pub fn ve_update(&mut self, seq: u32, position_pm: Axes<i64>) -> Result<(), LinkError> {
+        self.send(&Message::VeUpdate(VeUpdate { seq, position_pm }))
     }
 
     /// The scene's encoder has an index mark at `index_m` (m): send the

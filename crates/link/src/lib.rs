@@ -8,6 +8,7 @@ mod crc;
 mod frame;
 mod message;
 mod spec;
+mod ve;
 
 pub use axes::{Axes, MAX_AXES};
 pub use crc::crc16;
@@ -18,3 +19,4 @@ pub use message::{
     Refusal, Role, Status, Telemetry, NO_SESSION, PROTOCOL_VERSION,
 };
 pub use spec::{AxisSpec, ProvenRegion, Spec};
+pub use ve::{VeSource, VeUpdate};

@@ -3,7 +3,7 @@
 //! so today's boards send multiples of 1000; the wire has room for finer).
 
 use crate::frame::Stats;
-use crate::{Axes, Spec};
+use crate::{Axes, Spec, VeSource, VeUpdate};
 use serde::{Deserialize, Serialize};
 
 /// The protocol version both ends must share (checked by the handshake).
@@ -77,6 +77,9 @@ pub struct Telemetry {
     /// The session the board is in ([`NO_SESSION`] after a reset;
     /// protocol 5).
     pub session: u16,
+    /// The last host VE update the board took ([`VeUpdate::seq`]; 0
+    /// before any; protocol 8).
+    pub ve_seq: u32,
 }
 
 /// The board's state machine (protocol 3). A board boots disarmed with its
@@ -108,6 +111,8 @@ pub enum ModeRequest {
     SaveConfig,
     /// [`Message::Identify`] (protocol 7).
     Identify,
+    /// [`Message::SetVe`] (protocol 8).
+    SetVe,
 }
 
 /// Why the board would not change mode.
@@ -150,6 +155,8 @@ pub enum ModeRefusal {
     /// not have, a band past Nyquist, a peak past the axis's force limit,
     /// no period, or a hold outside the axis's proven region (protocol 7).
     BadExperiment,
+    /// A host VE's deadline must be at least one tick (protocol 8).
+    BadDeadline,
 }
 
 /// Where the configuration in force came from (protocol 3).
@@ -445,6 +452,14 @@ pub enum Message {
         /// Ticks between telemetry frames (0: none).
         every_ticks: u32,
     },
+    /// Run the VE on the board or on the host: disarmed only (protocol 8).
+    SetVe(VeSource),
+    /// The VE source in force, in answer to [`SetVe`](Message::SetVe)
+    /// (protocol 8).
+    Ve(VeSource),
+    /// The host VE's points (protocol 8); no answer: the telemetry's
+    /// `ve_seq` says which update the board holds.
+    VeUpdate(VeUpdate),
 }
 
 /// The board's view of the link.

@@ -3,7 +3,7 @@
 //! proved absolutely stable, so that a host application picks its gains
 //! from a proof instead of a hand-set "max stiffness".
 
-use crate::Axes;
+use crate::{Axes, VeSource};
 use serde::{Deserialize, Serialize};
 
 /// The board's specification, sent in answer to [`GetSpec`].
@@ -19,6 +19,8 @@ pub struct Spec {
     /// Whether the motors turn a linkage's joints: such a board is
     /// calibrated at a known pose and has no homing run.
     pub linkage: bool,
+    /// Where the VE the coupling holds runs now.
+    pub ve: VeSource,
     /// Each Cartesian axis's.
     pub axes: Axes<AxisSpec>,
 }

@@ -42,6 +42,7 @@ fn all_messages() -> Vec<Message> {
             deadline_misses: u32::MAX,
             worst_jitter_cycles: u32::MAX,
             session: u16::MAX,
+            ve_seq: u32::MAX,
         }),
         Message::GetGains,
         Message::Gains(Axes::new([gi, gi, gi]).unwrap()),
@@ -113,6 +114,10 @@ fn all_messages() -> Vec<Message> {
             period_ns: u32::MAX,
             stream_every: u32::MAX,
             linkage: true,
+            ve: VeSource::Host {
+                ramp_ticks: u32::MAX,
+                deadline_ticks: u32::MAX,
+            },
             axes: Axes::new([f32::MAX, 1.0, -0.0].map(|x| AxisSpec {
                 peak_force_n: x,
                 continuous_force_n: x,
@@ -132,6 +137,7 @@ fn all_messages() -> Vec<Message> {
             period_ns: 1_000_000,
             stream_every: 0,
             linkage: false,
+            ve: VeSource::Board,
             axes: Axes::one(AxisSpec {
                 peak_force_n: 200.0,
                 continuous_force_n: 100.0,
@@ -148,6 +154,15 @@ fn all_messages() -> Vec<Message> {
             every_ticks: u32::MAX,
         },
         Message::Stream { every_ticks: 0 },
+        Message::SetVe(VeSource::Host {
+            ramp_ticks: 10,
+            deadline_ticks: 30,
+        }),
+        Message::Ve(VeSource::Board),
+        Message::VeUpdate(VeUpdate {
+            seq: u32::MAX,
+            position_pm: Axes::new([i64::MIN, i64::MAX, 0]).unwrap(),
+        }),
     ]
 }
 

@@ -109,7 +109,10 @@ where
         match (self.mode, self.servo.servo_mut().enable()) {
             // Armed already: the answer is the status.
             (Mode::Armed, Ok(())) => self.queue_status(),
-            (_, Ok(())) => self.set_mode(Mode::Armed),
+            (_, Ok(())) => {
+                self.host_ve_armed();
+                self.set_mode(Mode::Armed);
+            }
             (_, Err(f)) => self.refuse(ModeRequest::Arm, ModeRefusal::Faulted { faults: f.0 }),
         }
     }

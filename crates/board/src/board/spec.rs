@@ -24,12 +24,11 @@ where
             region: self.regions[i].envelope(),
         });
         Spec {
-            // (A period past 4.29 s is no servo's; it saturates.)
-            period_ns: (f64::from(limits[0].period_s) * 1e9)
-                .round()
-                .min(f64::from(u32::MAX)) as u32,
+            // (A period past 4.29 s is no servo's: the cast saturates.)
+            period_ns: (f64::from(limits[0].period_s) * 1e9 + 0.5) as u32,
             stream_every: self.telemetry_every,
             linkage: !D::HOMES,
+            ve: self.ve_source(),
             axes: Self::axes(axes),
         }
     }

@@ -204,6 +204,18 @@ impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<
         self.drive(q, cartesian)
     }
 
+    /// [`tick`](Self::tick) against `world` in place of the Cartesian
+    /// servo's own (see [`Servo::tick_on`]).
+    pub fn tick_on<V: World<R, N>>(
+        &mut self,
+        frame: &SensorFrame<R, N>,
+        world: &mut V,
+    ) -> LinkageOutput<R, N> {
+        let q = self.read(frame);
+        let cartesian = self.cartesian.tick_at_on(frame, &self.handle, world);
+        self.drive(q, cartesian)
+    }
+
     /// One tick with `law` in place of the Cartesian laws and the world
     /// (as [`Servo::tick_with`]): `law` gets each Cartesian axis's index,
     /// the handle's position and velocity (m/s) and answers with the force

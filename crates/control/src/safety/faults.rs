@@ -32,8 +32,10 @@ impl Faults {
     /// A linkage's pose is singular, out of reach or outside the joint
     /// limits its gains were proven for.
     pub const KINEMATICS: Faults = Faults(1 << 10);
+    /// The host's VE sent no update within its deadline.
+    pub const VE_STALE: Faults = Faults(1 << 11);
 
-    const NAMES: [(Faults, &'static str); 11] = [
+    const NAMES: [(Faults, &'static str); 12] = [
         (Faults::SENSOR_NOT_FINITE, "sensor reading not finite"),
         (Faults::SENSOR_OUT_OF_RANGE, "sensor reading out of range"),
         (Faults::ENCODER_INVALID, "encoder value invalid"),
@@ -47,6 +49,10 @@ impl Faults {
         (
             Faults::KINEMATICS,
             "pose singular, out of reach or outside the proven joints",
+        ),
+        (
+            Faults::VE_STALE,
+            "host VE late: no update within its deadline",
         ),
     ];
 

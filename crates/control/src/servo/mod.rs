@@ -390,6 +390,35 @@ impl<W: World<R, N>, R: Real, const N: usize, L: PortLayer<R>> Servo<W, R, N, L>
         self.run(frame, |front| front.sense_at(x))
     }
 
+    /// One control tick of every axis against `world` in place of the
+    /// servo's own, which does not step: the host's VE, held between its
+    /// updates ([`Held`](crate::world::Held)). The laws, the port layers
+    /// and the safety layer are the servo's.
+    pub fn tick_on<V: World<R, N>>(
+        &mut self,
+        frame: &SensorFrame<R, N>,
+        world: &mut V,
+    ) -> ServoOutput<R, N> {
+        let (front, layers) = (&mut self.front, &mut self.layers);
+        display(&mut self.laws, front, world, layers, frame, |f| {
+            f.sense(frame)
+        })
+    }
+
+    /// [`tick_on`](Self::tick_on) at handle positions `x` found by other
+    /// means (a linkage's kinematics).
+    pub(crate) fn tick_at_on<V: World<R, N>>(
+        &mut self,
+        frame: &SensorFrame<R, N>,
+        x: &[Position; N],
+        world: &mut V,
+    ) -> ServoOutput<R, N> {
+        let (front, layers) = (&mut self.front, &mut self.layers);
+        display(&mut self.laws, front, world, layers, frame, |f| {
+            f.sense_at(x)
+        })
+    }
+
     /// The display's tick, its axes sensed by `sense`.
     #[inline(always)]
     fn run(
@@ -398,9 +427,22 @@ impl<W: World<R, N>, R: Real, const N: usize, L: PortLayer<R>> Servo<W, R, N, L>
         sense: impl FnOnce(&mut Frontend<R, N>) -> ([R; N], Faults),
     ) -> ServoOutput<R, N> {
         let (front, world, layers) = (&mut self.front, &mut self.world, &mut self.layers);
-        match &mut self.laws {
-            Laws::Impedance(c) => tick::impedance(front, c, world, layers, frame, sense),
-            Laws::Admittance(a) => tick::admittance(front, a, world, layers, frame, sense),
-        }
+        display(&mut self.laws, front, world, layers, frame, sense)
+    }
+}
+
+/// The display's tick on `world`, its axes sensed by `sense`.
+#[inline(always)]
+fn display<R: Real, V: World<R, N>, L: PortLayer<R>, const N: usize>(
+    laws: &mut Laws<R, N>,
+    front: &mut Frontend<R, N>,
+    world: &mut V,
+    layers: &mut [L; N],
+    frame: &SensorFrame<R, N>,
+    sense: impl FnOnce(&mut Frontend<R, N>) -> ([R; N], Faults),
+) -> ServoOutput<R, N> {
+    match laws {
+        Laws::Impedance(c) => tick::impedance(front, c, world, layers, frame, sense),
+        Laws::Admittance(a) => tick::admittance(front, a, world, layers, frame, sense),
     }
 }

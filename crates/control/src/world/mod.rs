@@ -13,7 +13,10 @@
 //! force applied *to* the world along the axis (N), `v` its velocity along
 //! the axis (m/s). Axis 0 is x, 1 is y, 2 is z.
 
+mod held;
 pub mod vbb;
+
+pub use held::Held;
 
 use crate::ve::{Port, VeOutput, VeTransfer, VirtualEnvironment};
 use crate::{Position, Real};
