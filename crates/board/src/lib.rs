@@ -8,9 +8,11 @@ pub mod excalibur;
 mod io;
 pub mod linkage;
 mod region;
+mod simulated;
 mod support;
 
 pub use board::{Board, Frame, TX_FRAMES};
 pub use io::{IoScale, DUTY_FULL_SCALE};
 pub use region::{check_axes, Bound, Region, RegionError};
+pub use simulated::{SimAxis, Simulated};
 pub use support::{BoardSupport, RawSensors};

@@ -1,10 +1,10 @@
 //! What can go wrong on the host's side of a link.
 
 use thiserror::Error;
-use twoport_link::{ModeRefusal, ModeRequest};
+use twoport_link::{AxisRefusal, ModeRefusal, ModeRequest};
 
 /// Why a call to a board failed.
-#[derive(Clone, Debug, PartialEq, Eq, Error)]
+#[derive(Clone, Debug, PartialEq, Error)]
 pub enum LinkError {
     /// The serial port would not open.
     #[error("serial port {path}: {why}")]
@@ -39,7 +39,7 @@ pub enum LinkError {
         seconds: u64,
     },
     /// The board refused a mode change or a request, and why.
-    #[error("the board refused {asked:?}: {why:?}")]
+    #[error("the board refused {asked:?}: {}", refusal(why))]
     Refused {
         /// What was asked.
         asked: ModeRequest,
@@ -60,4 +60,40 @@ pub enum LinkError {
         /// This host's.
         ours: u16,
     },
+    /// The board refused gains, naming the first axis it refused and why.
+    #[error("the board refused the gains of axis {}: {:?}", .0.axis, .0.why)]
+    GainsRefused(AxisRefusal),
+    /// A call gave another number of values than the board has axes.
+    #[error("{what}: {given} values for a board of {board} axes")]
+    Axes {
+        /// The call.
+        what: String,
+        /// Values given.
+        given: usize,
+        /// The board's axes.
+        board: usize,
+    },
+    /// A position outside the board's range (±2.147 m), or not a number.
+    #[error("{what}: axis {axis} at {value_m} m is outside the board's range (±2.147 m)")]
+    OutOfRange {
+        /// The call.
+        what: String,
+        /// The axis.
+        axis: usize,
+        /// The value given (m).
+        value_m: f64,
+    },
+    /// The board latched faults (their bits) while the host waited.
+    #[error("the board faulted: {}", twoport_control::Faults(*.0))]
+    Faulted(u16),
+}
+
+/// A refusal in words, with latched faults named.
+fn refusal(why: &ModeRefusal) -> String {
+    match why {
+        ModeRefusal::Faulted { faults } => {
+            format!("faults latched: {}", twoport_control::Faults(*faults))
+        }
+        other => format!("{other:?}"),
+    }
 }

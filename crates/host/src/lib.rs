@@ -2,10 +2,14 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+mod device;
 mod error;
 mod port;
 mod session;
+mod simulated;
 
+pub use device::{AxisState, Board, State, HEARTBEAT_PERIOD, HEARTBEAT_POLLS, STATE_BUFFER};
 pub use error::LinkError;
 pub use port::{BoardPort, SerialBoard};
 pub use session::{LinkFaults, Session, ANSWER_TIMEOUT, HEARTBEAT_EVERY};
+pub use simulated::{Pace, SimulatedBoard};

@@ -1,0 +1,139 @@
+//! The Excalibur board image on a simulated device, in this process and
+//! running free, behind the same [`BoardPort`] as a serial board: what a
+//! host application is tried on without hardware or an emulator, and
+//! what the device object's tests drive.
+
+use crate::{BoardPort, LinkError};
+use std::collections::VecDeque;
+use std::time::{Duration, Instant};
+use twoport_board::excalibur::{self, REGION_POINTS};
+use twoport_board::{Board, BoardSupport, IoScale, RawSensors, SimAxis, Simulated};
+use twoport_control::ve::UnilateralWall;
+
+/// How a simulated board's ticks keep time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pace {
+    /// This many ticks each time the host reads: the same run for the same
+    /// calls, whatever the machine (tests).
+    PerRead(u32),
+    /// As many ticks as the wall clock has run periods since the last
+    /// read, at most a second's worth (trying an application).
+    RealTime,
+}
+
+/// The simulated board's link: two byte queues.
+#[derive(Default)]
+struct Wire {
+    rx: VecDeque<u8>,
+    out: Vec<u8>,
+}
+
+impl BoardSupport<1> for Wire {
+    // (The simulated device in front of it reads the sensors.)
+    fn sample(&mut self) -> RawSensors<1> {
+        RawSensors::default()
+    }
+    fn set_duty(&mut self, _: [i16; 1]) {}
+    fn set_outputs(&mut self, _: bool) {}
+    fn feed_watchdog(&mut self) {}
+    fn read_byte(&mut self) -> Option<u8> {
+        self.rx.pop_front()
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        self.out.extend_from_slice(bytes);
+    }
+    fn cycles(&mut self) -> u32 {
+        0
+    }
+    fn cycles_per_tick(&self) -> u32 {
+        0
+    }
+}
+
+/// The shipped Excalibur image (its wall, its proven region, its safety
+/// layer) running on one simulated axis: the actuator's 0.93 kg with
+/// 4 N s/m, a hand pushing with a constant force, a 1 µm encoder.
+pub struct SimulatedBoard {
+    board: Board<UnilateralWall, REGION_POINTS>,
+    io: Simulated<Wire, 1>,
+    pace: Pace,
+    last: Option<Instant>,
+    ticks: u64,
+}
+
+impl SimulatedBoard {
+    /// The image on a device the hand pushes along +x with `hand_n` (N),
+    /// ticking at `pace`.
+    pub fn excalibur(hand_n: f32, pace: Pace) -> Result<Self, LinkError> {
+        let board = excalibur::stiff_wall_board()
+            .map_err(|e| LinkError::Image(format!("the Excalibur board image: {e:?}")))?;
+        let io = Simulated::new(
+            Wire::default(),
+            [SimAxis::excalibur(hand_n)],
+            [IoScale::EXCALIBUR],
+            excalibur::ENCODER,
+            excalibur::PERIOD_S,
+        );
+        Ok(SimulatedBoard {
+            board,
+            io,
+            pace,
+            last: None,
+            ticks: 0,
+        })
+    }
+
+    /// Where the simulated handle is (m).
+    pub fn position_m(&self) -> f32 {
+        self.io.position_m()[0]
+    }
+
+    /// Ticks run since boot.
+    pub fn ticks(&self) -> u64 {
+        self.ticks
+    }
+
+    /// Run `n` control ticks, serving the link between them as a board's
+    /// main loop does.
+    pub fn run(&mut self, n: u32) {
+        for _ in 0..n {
+            self.board.poll_link(&mut self.io);
+            self.board.control_tick(&mut self.io);
+            self.board.flush(&mut self.io);
+            self.ticks += 1;
+        }
+    }
+}
+
+impl BoardPort for SimulatedBoard {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        self.io.inner().rx.extend(bytes);
+        Ok(())
+    }
+
+    fn recv(&mut self, buf: &mut [u8], _timeout: Duration) -> Result<usize, LinkError> {
+        let n = match self.pace {
+            Pace::PerRead(n) => n,
+            Pace::RealTime => {
+                let now = Instant::now();
+                let period = Duration::from_secs_f32(excalibur::PERIOD_S);
+                let since = *self.last.get_or_insert(now);
+                let due = (now.duration_since(since).as_secs_f64() / period.as_secs_f64()) as u64;
+                // (Behind by more than a second, the board starts afresh
+                // from now rather than race.)
+                let n = due.min(1000) as u32;
+                self.last = Some(if due > 1000 { now } else { since + period * n });
+                n
+            }
+        };
+        self.run(n);
+        // (The board answers what it has already read even with no tick.)
+        self.board.poll_link(&mut self.io);
+        self.board.flush(&mut self.io);
+        let out = &mut self.io.inner().out;
+        let k = buf.len().min(out.len());
+        buf[..k].copy_from_slice(&out[..k]);
+        out.drain(..k);
+        Ok(k)
+    }
+}

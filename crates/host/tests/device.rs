@@ -1,0 +1,130 @@
+//! The device object on the shipped Excalibur image, run in-process on a
+//! simulated device, one tick per read: the same run on every machine.
+
+use std::time::Duration;
+use twoport_control::Faults;
+use twoport_host::{Board, LinkError, Pace, SimulatedBoard};
+use twoport_link::{Gains, Mode, ProvenRegion, Refusal, VeSource};
+
+/// The wall the host's VE renders (m): solid above.
+const WALL_M: f64 = 0.005;
+
+fn open(hand_n: f32) -> Board<SimulatedBoard> {
+    Board::open(SimulatedBoard::excalibur(hand_n, Pace::PerRead(1)).unwrap(), 1).unwrap()
+}
+
+/// The VE a host application runs: a wall at 5 mm whose point (the god
+/// object) follows the handle in free space and stays on the surface
+/// past it.
+fn wall(x_m: f64) -> f64 {
+    x_m.min(WALL_M)
+}
+
+/// An application opens the board, reads what it can prove, calibrates,
+/// hands the VE to the host, arms, and renders a wall at 1 kHz against a
+/// hand pushing 2 N: the handle stops at the wall, pressed in by the
+/// coupling's spring (2 N / 51,000 N/m = 39 um), and the board holds every
+/// update it was sent.
+#[test]
+fn an_application_renders_a_wall_from_the_host_and_lets_go() {
+    let mut b = open(2.0);
+    let spec = *b.spec();
+    assert_eq!((b.axes(), spec.period_ns, spec.ve), (1, 1_000_000, VeSource::Board));
+    let ProvenRegion::MaxStiffness { k_max_npm, .. } = spec.axes[0].region else {
+        panic!("{spec:?}")
+    };
+    assert!(k_max_npm > 51_000.0);
+    b.calibrate(&[0.0]).unwrap();
+    b.stream(1).unwrap();
+    b.host_ve(1, 20).unwrap();
+    assert_eq!(b.arm().unwrap().mode, Mode::Armed);
+    b.take_states();
+    let mut sent = 0;
+    for _ in 0..3000 {
+        b.poll().unwrap();
+        if let Some(s) = b.latest() {
+            sent = b.send_ve(&[wall(s.axes[0].position_m)]).unwrap();
+        }
+    }
+    let states = b.take_states();
+    let deepest = states
+        .iter()
+        .map(|s| s.axes[0].position_m)
+        .fold(f64::MIN, f64::max);
+    // It meets the wall at some speed; the wall stops it within the
+    // spring's share of that energy, ½ m v² = ½ k d², past the press.
+    let hit = states
+        .iter()
+        .find(|s| s.axes[0].position_m > WALL_M)
+        .unwrap();
+    let reach = hit.axes[0].velocity_mps * (0.93f64 / 51_000.0).sqrt();
+    let last = states.last().unwrap();
+    assert_eq!((last.mode, last.faults), (Mode::Armed, 0));
+    let x = last.axes[0].position_m;
+    let press = 2.0 / 51_000.0;
+    assert!((x - WALL_M - press).abs() < 10e-6, "at {x} m");
+    assert!(
+        deepest < WALL_M + press + reach,
+        "{deepest} m deep, {reach} m of reach"
+    );
+    // The board holds the update sent one or two reads before.
+    assert!(sent - last.ve_seq <= 2, "{sent} sent, {} held", last.ve_seq);
+    assert!((last.axes[0].ve_position_m - WALL_M).abs() < 1e-9);
+    b.close().unwrap();
+}
+
+/// A host that stops sending its VE: the board holds the last update for
+/// its deadline, then gives zero force and disarms, and the object's next
+/// call that waits on the board says which fault latched.
+#[test]
+fn a_host_that_falls_silent_gets_zero_force_not_a_stale_wall() {
+    let mut b = open(0.0);
+    b.calibrate(&[0.0]).unwrap();
+    b.stream(1).unwrap();
+    b.host_ve(1, 20).unwrap();
+    b.arm().unwrap();
+    b.send_ve(&[0.001]).unwrap();
+    for _ in 0..60 {
+        b.poll().unwrap();
+    }
+    let states = b.take_states();
+    let faulted = states
+        .iter()
+        .position(|s| s.faults & Faults::VE_STALE.0 != 0)
+        .unwrap();
+    // Pulled toward the point until the deadline, then nothing.
+    assert!(states[..faulted].iter().any(|s| s.axes[0].actuator_n.abs() > 1.0));
+    assert!(states[faulted..].iter().all(|s| s.axes[0].actuator_n == 0.0));
+    assert_eq!(states.last().unwrap().mode, Mode::Disarmed);
+    let e = b.home(Duration::from_secs(1)).unwrap_err();
+    assert!(e.to_string().contains("host VE late"), "{e}");
+}
+
+/// Calls that cannot be right are refused by name before anything is
+/// sent, and the board's refusals come back with its reason.
+#[test]
+fn wrong_calls_are_named_and_refusals_carry_the_boards_reason() {
+    let mut b = open(0.0);
+    let e = b.calibrate(&[0.0, 0.0]).unwrap_err();
+    assert!(matches!(e, LinkError::Axes { given: 2, board: 1, .. }), "{e}");
+    let e = b.send_ve(&[f64::NAN]).unwrap_err();
+    assert!(e.to_string().contains("outside the board's range"), "{e}");
+    let e = b
+        .set_gains(&[Gains::Impedance {
+            k_npm: 80_000.0,
+            b_nspm: 90.0,
+        }])
+        .unwrap_err();
+    assert!(
+        matches!(e, LinkError::GainsRefused(r) if matches!(r.why, Refusal::NotProvenStable { .. })),
+        "{e}"
+    );
+    // Arming uncalibrated.
+    let e = b.arm().unwrap_err();
+    assert!(e.to_string().contains("NotCalibrated"), "{e}");
+    // The VE moves only while disarmed.
+    b.calibrate(&[0.0]).unwrap();
+    b.arm().unwrap();
+    let e = b.host_ve(1, 20).unwrap_err();
+    assert!(e.to_string().contains("NotDisarmed"), "{e}");
+}
