@@ -3,7 +3,7 @@
 //! each step's time is printed at the end (CI must stay under 45 minutes on
 //! a busy machine).
 
-use crate::emulate::{pil, scope_board, watchdog};
+use crate::emulate::{device, pil, scope_board, watchdog};
 use crate::firmware::thumb;
 use crate::fuzz::fuzz;
 use crate::probe::qemu;
@@ -20,7 +20,7 @@ struct Step {
 
 /// The steps, in the order CI runs them: the quick checks first, the
 /// tests' total last, so that a log's last line is the whole count.
-const STEPS: [Step; 12] = [
+const STEPS: [Step; 13] = [
     Step {
         name: "fmt",
         what: "rustfmt on the workspace, the firmware's two and fuzz's",
@@ -65,6 +65,11 @@ const STEPS: [Step; 12] = [
         name: "scope-board",
         what: "the scope's board mode against the firmware in QEMU",
         run: scope_board,
+    },
+    Step {
+        name: "device",
+        what: "a host application on the free-running board in QEMU",
+        run: || device(&["--check".to_string()]),
     },
     Step {
         name: "watchdog",

@@ -270,3 +270,44 @@ pub(crate) fn host_test_against_an386(
         )
     })
 }
+
+/// The an386 image that runs free against a device simulated on the chip,
+/// in QEMU with virtual time held to the wall clock (`align=on`: QEMU
+/// sleeps when the board runs ahead), its link's pty printed. With
+/// `--check`, the host's device-object test runs against it and the board
+/// stops after; without, it runs until interrupted, for trying an
+/// application on it.
+pub(crate) fn device(args: &[String]) -> Result<(), String> {
+    let check = match args {
+        [] => false,
+        [a] if a == "--check" => true,
+        other => {
+            return Err(format!(
+                "device: unknown arguments {other:?} (only --check)"
+            ))
+        }
+    };
+    let elf = an386_image_with("sim-device")?;
+    let mut qemu = Command::new("qemu-system-arm");
+    qemu.args(["-machine", "mps2-an386", "-cpu", "cortex-m4"])
+        .args(["-icount", "shift=6,align=on"])
+        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
+        .arg(&elf)
+        .args(["-serial", "pty"])
+        .stdin(Stdio::null());
+    with_board_in_qemu(qemu, |pty| {
+        if check {
+            return run(
+                "the device object against the free-running board",
+                cargo()
+                    .env("TWOPORT_PTY", pty)
+                    .args(["test", "--release", "-p", "twoport-host", "--test", "qemu"])
+                    .args(["--", "--ignored"]),
+            );
+        }
+        eprintln!("xtask: open {pty} with twoport_host::Board::open_serial; Ctrl-C stops it");
+        loop {
+            std::thread::sleep(std::time::Duration::from_secs(3600));
+        }
+    })
+}

@@ -38,6 +38,7 @@ fn main() -> ExitCode {
         Some("pil") => emulate::pil(&args[1..]),
         Some("watchdog") => emulate::watchdog(),
         Some("scope-board") => emulate::scope_board(),
+        Some("device") => emulate::device(&args[1..]),
         Some("fuzz") => {
             let secs = args.get(1).map_or(Ok(60), |s| {
                 s.parse::<u32>().map_err(|e| format!("seconds: {e}"))
@@ -58,7 +59,7 @@ fn main() -> ExitCode {
             ]),
         ),
         _ => Err(format!(
-            "usage: cargo xtask <ci [step...]|thumb|firmware|qemu|pil [--board an386|stm32f405] [options]|scope-board|watchdog|fuzz [seconds]|accuracy>\n  got: {}",
+            "usage: cargo xtask <ci [step...]|thumb|firmware|qemu|pil [--board an386|stm32f405] [options]|scope-board|device [--check]|watchdog|fuzz [seconds]|accuracy>\n  got: {}",
             args.join(" ")
         )),
     };

@@ -345,7 +345,15 @@ where
                 self.queue_status();
             }
             Message::Arm => self.arm(),
-            Message::Disarm => self.disarm(),
+            Message::Disarm => {
+                // (A board disarmed already answers with its status too:
+                // the host's call waits for one.)
+                let was = self.mode;
+                self.disarm();
+                if was == Mode::Disarmed {
+                    self.queue_status();
+                }
+            }
             Message::Home => self.home(),
             Message::Identify(req) => self.identify(req),
             Message::GetSpec => self.answer_spec(),

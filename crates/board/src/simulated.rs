@@ -9,16 +9,17 @@ use crate::io::IoScale;
 use crate::support::{BoardSupport, RawSensors};
 
 /// One axis of the simulated device: a rigid mass with viscous damping,
-/// pushed by its motor and by a hand with a constant force, read by an
-/// encoder of `pm_per_count` (pm) on a counter of `bits` bits. The load
-/// cell reads the hand's force.
+/// pushed by its motor and by a hand with a constant force. The hand
+/// leans on the handle only while the amplifier's outputs are on (it lets
+/// go of a handle that does not push back, which would otherwise drift off
+/// before the host arms the board). The load cell reads the hand's force.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SimAxis {
     /// The moving mass (kg).
     pub mass_kg: f32,
     /// Its viscous damping to ground (N s/m).
     pub damping_nspm: f32,
-    /// The hand's force along +x (N), constant.
+    /// The hand's force along +x (N) while the outputs are on.
     pub hand_n: f32,
     /// Where the mass starts (m).
     pub start_m: f32,
@@ -118,19 +119,23 @@ impl<S: BoardSupport<N>, const N: usize> BoardSupport<N> for Simulated<S, N> {
         for i in 0..N {
             let a = &self.axes[i];
             // f_a resists positive motion: the motor pushes with -f_a.
-            let motor = if self.outputs_on {
-                self.io[i].force_n(self.duty[i])
-            } else {
-                0.0
+            let (motor, hand) = match self.outputs_on {
+                true => (self.io[i].force_n(self.duty[i]), a.hand_n),
+                false => (0.0, 0.0),
             };
-            let f = a.hand_n - motor - a.damping_nspm * self.v_mps[i];
+            let f = hand - motor - a.damping_nspm * self.v_mps[i];
             self.v_mps[i] += t * f / a.mass_kg;
             self.x_m[i] += t * self.v_mps[i];
         }
         RawSensors {
             encoder_raw: core::array::from_fn(|i| self.count(self.x_m[i])),
             load_cell_counts: core::array::from_fn(|i| {
-                self.io[i].load_cell_counts(self.axes[i].hand_n)
+                let hand = if self.outputs_on {
+                    self.axes[i].hand_n
+                } else {
+                    0.0
+                };
+                self.io[i].load_cell_counts(hand)
             }),
             dead_man_closed: true,
             index_raw: [None; N],
@@ -204,12 +209,14 @@ mod tests {
         )
     }
 
-    /// The hand alone accelerates the mass against its damping: the
-    /// velocity follows `F/b (1 - e^(-b t/m))` to 1%, the encoder reads
-    /// the position to its count, and the load cell the hand.
+    /// The hand alone (the motor at zero duty) accelerates the mass
+    /// against its damping: the velocity follows `F/b (1 - e^(-b t/m))`
+    /// to 1%, the encoder reads the position to its count, and the load
+    /// cell the hand.
     #[test]
     fn the_hand_moves_the_mass_as_its_equation_says() {
         let mut d = device(2.0);
+        d.set_outputs(true);
         let mut s = RawSensors::default();
         for _ in 0..500 {
             s = d.sample();
@@ -224,15 +231,16 @@ mod tests {
         assert!(s.dead_man_closed);
     }
 
-    /// The motor pushes with `-f_a` only while the outputs are on: a duty
-    /// for 2 N balances the hand's 2 N to its step (6 mN), and in 0.1 s the
-    /// mass moves a five-hundredth of the 11 mm the hand alone moves it.
+    /// With the outputs off nothing pushes (the hand lets go). With them
+    /// on, a duty for 2 N balances the hand's 2 N to its step (6 mN), and
+    /// in 0.1 s the mass moves a five-hundredth of the 11 mm the hand alone
+    /// moves it.
     #[test]
-    fn the_motor_pushes_only_with_its_outputs_on() {
+    fn the_motor_and_the_hand_push_only_with_the_outputs_on() {
         let mut d = device(2.0);
-        d.set_duty([IoScale::EXCALIBUR.duty(2.0)]);
-        d.sample();
-        assert!(d.velocity_mps()[0] > 0.0);
+        d.set_duty([IoScale::EXCALIBUR.duty(-5.0)]);
+        let s = d.sample();
+        assert_eq!((d.velocity_mps()[0], s.load_cell_counts[0]), (0.0, 0));
         let mut d = device(2.0);
         d.set_duty([IoScale::EXCALIBUR.duty(2.0)]);
         d.set_outputs(true);

@@ -4,8 +4,8 @@
 
 use twoport_control::{Faults, SafetyConfig};
 use twoport_link::{
-    Axes, AxisSpec, Message, Mode, ModeRefusal, ModeRequest, ProvenRegion, Spec, Telemetry,
-    VeSource, VeUpdate,
+    Axes, AxisSpec, Contact, Message, Mode, ModeRefusal, ModeRequest, ProvenRegion, Spec,
+    Telemetry, VeSource, VeUpdate,
 };
 
 mod common;
@@ -54,6 +54,7 @@ fn update(seq: u32, pm: i64) -> Message {
     Message::VeUpdate(VeUpdate {
         seq,
         position_pm: Axes::one(pm),
+        contact: Axes::one(Contact::Held),
     })
 }
 
@@ -210,6 +211,7 @@ fn updates_move_the_point_and_a_late_host_faults_to_zero_force() {
         Message::VeUpdate(VeUpdate {
             seq: 8,
             position_pm: Axes::new([0, 0]).unwrap(),
+            contact: Axes::new([Contact::Held; 2]).unwrap(),
         }),
     );
     send(&mut b, 5, update(9, i64::MAX));
@@ -246,4 +248,25 @@ fn updates_move_the_point_and_a_late_host_faults_to_zero_force() {
     let out = b.tick(&frame(5, 0));
     assert_eq!(b.mode(), Mode::Armed);
     assert_eq!(out.commanded_force_n, [0.0]);
+}
+
+/// A host's call waits for an answer, so a board answers `Disarm` with
+/// its status even when it is disarmed already (a fault, or a lost host,
+/// may have disarmed it first).
+#[test]
+fn disarm_is_answered_even_when_the_board_is_disarmed_already() {
+    let mut b = board();
+    send(&mut b, 0, Message::Disarm);
+    let r = replies(&mut b);
+    assert!(
+        matches!(r.as_slice(), [Message::Status(s)] if s.mode == Mode::Disarmed),
+        "{r:?}"
+    );
+    let mut b = armed(b, 0);
+    send(&mut b, 1, Message::Disarm);
+    let r = replies(&mut b);
+    assert!(
+        matches!(r.as_slice(), [Message::Status(s)] if s.mode == Mode::Disarmed),
+        "{r:?}"
+    );
 }

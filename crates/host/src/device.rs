@@ -7,8 +7,8 @@ use crate::{BoardPort, LinkError, LinkFaults, SerialBoard, Session};
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 use twoport_link::{
-    Axes, ConfigSource, Gains, GainsReply, Message, Mode, ModeRefusal, ModeRequest, Spec, Status,
-    Telemetry, VeSource,
+    Axes, ConfigSource, Contact, Gains, GainsReply, Message, Mode, ModeRefusal, ModeRequest, Spec,
+    Status, Telemetry, VeSource,
 };
 
 /// States kept for the application before the oldest are dropped (about
@@ -287,13 +287,21 @@ impl<P: BoardPort> Board<P> {
         self.session.set_ve(VeSource::Board)
     }
 
-    /// Send the host VE's point for each axis (m); returns the update's
-    /// number, which the streamed states' `ve_seq` echo once the board
-    /// holds it.
-    pub fn send_ve(&mut self, position_m: &[f64]) -> Result<u32, LinkError> {
+    /// Send the host VE's surface for each axis (m) and what each is (a
+    /// point the coupling holds, a surface solid above or below, or none);
+    /// returns the update's number, which the streamed states' `ve_seq`
+    /// echo once the board holds it.
+    pub fn send_ve(&mut self, position_m: &[f64], contact: &[Contact]) -> Result<u32, LinkError> {
         let pm = self.per_axis(position_m, "send_ve")?;
+        let contact = Axes::from_slice(contact)
+            .filter(|c| c.len() == self.axes())
+            .ok_or(LinkError::Axes {
+                what: "send_ve (contact)".into(),
+                given: contact.len(),
+                board: self.axes(),
+            })?;
         self.ve_seq = self.ve_seq.wrapping_add(1);
-        self.session.ve_update(self.ve_seq, pm)?;
+        self.session.ve_update(self.ve_seq, pm, contact)?;
         Ok(self.ve_seq)
     }
 

@@ -13,3 +13,8 @@ pub use error::LinkError;
 pub use port::{BoardPort, SerialBoard};
 pub use session::{LinkFaults, Session, ANSWER_TIMEOUT, HEARTBEAT_EVERY};
 pub use simulated::{Pace, SimulatedBoard};
+
+/// The link's types an application meets in this crate's calls.
+pub use twoport_link::{
+    Axes, AxisSpec, Contact, Gains, Mode, ProvenRegion, Spec, Status, VeSource,
+};

@@ -7,8 +7,8 @@ use std::sync::atomic::{AtomicU16, Ordering};
 use std::time::{Duration, Instant};
 use twoport_board::excalibur;
 use twoport_link::{
-    encode, Axes, ConfigSource, Decoder, LinkStats, Message, Mode, ModeRequest, PilSensors, Role,
-    Spec, Status, VeSource, VeUpdate, MAX_FRAME, NO_SESSION,
+    encode, Axes, ConfigSource, Contact, Decoder, LinkStats, Message, Mode, ModeRequest,
+    PilSensors, Role, Spec, Status, VeSource, VeUpdate, MAX_FRAME, NO_SESSION,
 };
 
 /// How long the host waits for the board's answer to one frame.
@@ -201,10 +201,19 @@ impl<P: BoardPort> Session<P> {
         })
     }
 
-    /// Send the host VE's points, update `seq` (no answer: the telemetry's
-    /// `ve_seq` says which update the board holds).
-    pub fn ve_update(&mut self, seq: u32, position_pm: Axes<i64>) -> Result<(), LinkError> {
-        self.send(&Message::VeUpdate(VeUpdate { seq, position_pm }))
+    /// Send the host VE's surfaces and what each is, update `seq` (no
+    /// answer: the telemetry's `ve_seq` says which update the board holds).
+    pub fn ve_update(
+        &mut self,
+        seq: u32,
+        position_pm: Axes<i64>,
+        contact: Axes<Contact>,
+    ) -> Result<(), LinkError> {
+        self.send(&Message::VeUpdate(VeUpdate {
+            seq,
+            position_pm,
+            contact,
+        }))
     }
 
     /// The scene's encoder has an index mark at `index_m` (m): send the

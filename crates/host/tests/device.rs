@@ -4,32 +4,32 @@
 use std::time::Duration;
 use twoport_control::Faults;
 use twoport_host::{Board, LinkError, Pace, SimulatedBoard};
-use twoport_link::{Gains, Mode, ProvenRegion, Refusal, VeSource};
+use twoport_link::{Contact, Gains, Mode, ProvenRegion, Refusal, VeSource};
 
 /// The wall the host's VE renders (m): solid above.
 const WALL_M: f64 = 0.005;
 
 fn open(hand_n: f32) -> Board<SimulatedBoard> {
-    Board::open(SimulatedBoard::excalibur(hand_n, Pace::PerRead(1)).unwrap(), 1).unwrap()
-}
-
-/// The VE a host application runs: a wall at 5 mm whose point (the god
-/// object) follows the handle in free space and stays on the surface
-/// past it.
-fn wall(x_m: f64) -> f64 {
-    x_m.min(WALL_M)
+    Board::open(
+        SimulatedBoard::excalibur(hand_n, Pace::PerRead(1)).unwrap(),
+        1,
+    )
+    .unwrap()
 }
 
 /// An application opens the board, reads what it can prove, calibrates,
-/// hands the VE to the host, arms, and renders a wall at 1 kHz against a
-/// hand pushing 2 N: the handle stops at the wall, pressed in by the
-/// coupling's spring (2 N / 51,000 N/m = 39 um), and the board holds every
-/// update it was sent.
+/// hands the VE to the host, arms, and sends a wall at 5 mm (solid above)
+/// at 1 kHz against a hand pushing 2 N: the handle stops at the wall,
+/// pressed in by the coupling's spring (2 N / 51,000 N/m = 39 um), and
+/// the board holds every update it was sent.
 #[test]
 fn an_application_renders_a_wall_from_the_host_and_lets_go() {
     let mut b = open(2.0);
     let spec = *b.spec();
-    assert_eq!((b.axes(), spec.period_ns, spec.ve), (1, 1_000_000, VeSource::Board));
+    assert_eq!(
+        (b.axes(), spec.period_ns, spec.ve),
+        (1, 1_000_000, VeSource::Board)
+    );
     let ProvenRegion::MaxStiffness { k_max_npm, .. } = spec.axes[0].region else {
         panic!("{spec:?}")
     };
@@ -42,9 +42,7 @@ fn an_application_renders_a_wall_from_the_host_and_lets_go() {
     let mut sent = 0;
     for _ in 0..3000 {
         b.poll().unwrap();
-        if let Some(s) = b.latest() {
-            sent = b.send_ve(&[wall(s.axes[0].position_m)]).unwrap();
-        }
+        sent = b.send_ve(&[WALL_M], &[Contact::Above]).unwrap();
     }
     let states = b.take_states();
     let deepest = states
@@ -83,7 +81,7 @@ fn a_host_that_falls_silent_gets_zero_force_not_a_stale_wall() {
     b.stream(1).unwrap();
     b.host_ve(1, 20).unwrap();
     b.arm().unwrap();
-    b.send_ve(&[0.001]).unwrap();
+    b.send_ve(&[0.001], &[Contact::Held]).unwrap();
     for _ in 0..60 {
         b.poll().unwrap();
     }
@@ -93,8 +91,12 @@ fn a_host_that_falls_silent_gets_zero_force_not_a_stale_wall() {
         .position(|s| s.faults & Faults::VE_STALE.0 != 0)
         .unwrap();
     // Pulled toward the point until the deadline, then nothing.
-    assert!(states[..faulted].iter().any(|s| s.axes[0].actuator_n.abs() > 1.0));
-    assert!(states[faulted..].iter().all(|s| s.axes[0].actuator_n == 0.0));
+    assert!(states[..faulted]
+        .iter()
+        .any(|s| s.axes[0].actuator_n.abs() > 1.0));
+    assert!(states[faulted..]
+        .iter()
+        .all(|s| s.axes[0].actuator_n == 0.0));
     assert_eq!(states.last().unwrap().mode, Mode::Disarmed);
     let e = b.home(Duration::from_secs(1)).unwrap_err();
     assert!(e.to_string().contains("host VE late"), "{e}");
@@ -106,8 +108,22 @@ fn a_host_that_falls_silent_gets_zero_force_not_a_stale_wall() {
 fn wrong_calls_are_named_and_refusals_carry_the_boards_reason() {
     let mut b = open(0.0);
     let e = b.calibrate(&[0.0, 0.0]).unwrap_err();
-    assert!(matches!(e, LinkError::Axes { given: 2, board: 1, .. }), "{e}");
-    let e = b.send_ve(&[f64::NAN]).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            LinkError::Axes {
+                given: 2,
+                board: 1,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let e = b.send_ve(&[f64::NAN], &[Contact::Held]).unwrap_err();
+    assert!(e.to_string().contains("outside the board's range"), "{e}");
+    let e = b.send_ve(&[0.0], &[]).unwrap_err();
+    assert!(e.to_string().contains("contact"), "{e}");
+    let e = b.send_ve(&[3.0], &[Contact::Held]).unwrap_err();
     assert!(e.to_string().contains("outside the board's range"), "{e}");
     let e = b
         .set_gains(&[Gains::Impedance {

@@ -11,9 +11,9 @@ pub enum VeSource {
     /// The board's own VE, in its image (the default at boot).
     #[default]
     Board,
-    /// The host's: each [`VeUpdate`] moves the coupling's VE point per
-    /// axis, in a straight line over `ramp_ticks` ticks, and it is held
-    /// there until the next. An armed board that runs more than
+    /// The host's: each [`VeUpdate`] moves each axis's surface in a
+    /// straight line over `ramp_ticks` ticks, and it is held there until
+    /// the next. An armed board that runs more than
     /// `deadline_ticks` ticks on one update faults to zero force.
     Host {
         /// Ticks a move takes: the host's period, in the board's ticks,
@@ -24,13 +24,33 @@ pub enum VeSource {
     },
 }
 
-/// One update of the host's VE: where each axis's VE point is now. The
-/// board takes an update whose `seq` is newer (by wrapping order) than the
-/// last it took, and ignores any other.
+/// What an axis's surface in a [`VeUpdate`] is to the VE point the
+/// coupling holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Contact {
+    /// The point is the surface, rigid: the host moves it.
+    #[default]
+    Held,
+    /// The VE is solid above the surface: below it the point follows the
+    /// handle with no force, and it stops at the surface.
+    Above,
+    /// Solid below the surface: free above it, stopped at it.
+    Below,
+    /// No surface: the point follows the handle with no force.
+    Free,
+}
+
+/// One update of the host's VE: each axis's surface and what it is. The
+/// board solves the VE point against it at its servo's rate, so a surface
+/// under the handle, sent at the host's rate, renders a wall with no lag
+/// in free space. The board takes an update whose `seq` is newer (by
+/// wrapping order) than the last it took, and ignores any other.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct VeUpdate {
     /// The host's count of its updates.
     pub seq: u32,
-    /// Each axis's VE point (pm).
+    /// Each axis's surface (pm).
     pub position_pm: Axes<i64>,
+    /// What each axis's surface is.
+    pub contact: Axes<Contact>,
 }

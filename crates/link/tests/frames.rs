@@ -162,6 +162,7 @@ fn all_messages() -> Vec<Message> {
         Message::VeUpdate(VeUpdate {
             seq: u32::MAX,
             position_pm: Axes::new([i64::MIN, i64::MAX, 0]).unwrap(),
+            contact: Axes::new([Contact::Held, Contact::Above, Contact::Free]).unwrap(),
         }),
     ]
 }

@@ -8,7 +8,12 @@
 //! three-axis Excalibur image on its building-block world (`cargo xtask
 //! pil scenes/xyz/pil_blocks.toml`); with `serial-arm` or `delta`, a
 //! linkage image (`twoport_board::linkage`: joint encoders in, joint
-//! torques out; `cargo xtask pil --linkage serial-arm`).
+//! torques out; `cargo xtask pil --linkage serial-arm`). With `sim-device`
+//! the Excalibur image runs free on its own clock (SysTick, 1 ms) against
+//! a device simulated on the chip (`twoport_board::Simulated`: the
+//! actuator's mass, a hand pushing 2 N along +x, a 1 µm encoder), so that
+//! a host application drives it as it would a real board (`cargo xtask
+//! device`).
 
 #![no_std]
 #![no_main]
@@ -33,7 +38,8 @@ fn main() -> ! {
         feature = "passivity",
         feature = "xyz",
         feature = "serial-arm",
-        feature = "delta"
+        feature = "delta",
+        feature = "sim-device"
     )))]
     let board = twoport_board::excalibur::stiff_wall_board().map_err(|_| ());
     #[cfg(feature = "passivity")]
@@ -44,7 +50,9 @@ fn main() -> ! {
     let board = twoport_board::linkage::serial_arm_board().map_err(|_| ());
     #[cfg(feature = "delta")]
     let board = twoport_board::linkage::delta_board().map_err(|_| ());
-    let Ok(mut board) = board.map(|b| b.with_pil(true)) else {
+    #[cfg(feature = "sim-device")]
+    let board = twoport_board::excalibur::stiff_wall_board().map_err(|_| ());
+    let Ok(mut board) = board.map(|b| b.with_pil(!cfg!(feature = "sim-device"))) else {
         hprintln!("the board image would not build");
         exit(false)
     };
@@ -68,8 +76,25 @@ fn main() -> ! {
         p.SYST.clear_current();
         p.SYST.enable_counter();
     }
+    #[cfg(feature = "sim-device")]
+    run_free(board, io, store);
+    #[cfg(not(feature = "sim-device"))]
+    run_lockstep(board, io, store);
+}
+
+/// Lockstep: each control tick waits for the host's sensor frame.
+#[cfg(not(feature = "sim-device"))]
+fn run_lockstep<W, L, D, const R: usize, const N: usize>(
+    mut board: twoport_board::Board<W, R, N, L, D>,
+    mut io: uart::Uart,
+    mut store: Store<RamFlash<512, 256>>,
+) -> !
+where
+    W: twoport_control::world::World<f32, N>,
+    L: twoport_control::servo::PortLayer,
+    D: twoport_control::drive::Drive<N, World = W, Layer = L>,
+{
     hprintln!("twoport-an386: board loop up, waiting on UART0");
-    // Lockstep: each control tick waits for the host's sensor frame.
     #[cfg(feature = "watchdog-test")]
     let mut armed_ticks = 0u32;
     loop {
@@ -88,6 +113,50 @@ fn main() -> ! {
                 #[allow(clippy::empty_loop)]
                 loop {}
             }
+        }
+    }
+}
+
+/// SysTick counts per control tick: the board's 25 MHz core clock over
+/// the Excalibur's 1 kHz.
+#[cfg(feature = "sim-device")]
+const CYCLES_PER_TICK: u32 = 25_000;
+
+/// The hand's push on the simulated handle (N, along +x).
+#[cfg(feature = "sim-device")]
+const HAND_N: f32 = 2.0;
+
+/// The free-running board: a control tick each period of its own clock,
+/// its sensors from the simulated device, and the link served between
+/// ticks, as a board with real hardware runs.
+#[cfg(feature = "sim-device")]
+fn run_free(
+    mut board: twoport_board::Board<
+        twoport_control::ve::UnilateralWall,
+        { twoport_board::excalibur::REGION_POINTS },
+    >,
+    mut io: uart::Uart,
+    mut store: Store<RamFlash<512, 256>>,
+) -> ! {
+    use twoport_board::{excalibur, BoardSupport, IoScale, SimAxis, Simulated};
+    io.cycles_per_tick = CYCLES_PER_TICK;
+    let mut dev = Simulated::new(
+        io,
+        [SimAxis::excalibur(HAND_N)],
+        [IoScale::EXCALIBUR],
+        excalibur::ENCODER,
+        excalibur::PERIOD_S,
+    );
+    hprintln!("twoport-an386: simulated device, running free, link on UART0");
+    let mut next = dev.cycles();
+    loop {
+        board.poll_link(&mut dev);
+        board.service_config(&mut store);
+        board.flush(&mut dev);
+        if dev.cycles().wrapping_sub(next) as i32 >= 0 {
+            next = next.wrapping_add(CYCLES_PER_TICK);
+            board.control_tick(&mut dev);
+            board.flush(&mut dev);
         }
     }
 }

@@ -25,6 +25,9 @@ pub struct Uart {
     cycles: u32,
     /// The watchdog the loop feeds.
     pub watchdog: Option<crate::watchdog::Watchdog>,
+    /// The control period in SysTick counts where the image keeps its own
+    /// time (the simulated device's); 0 where the host paces the ticks.
+    pub cycles_per_tick: u32,
 }
 
 impl Uart {
@@ -41,6 +44,7 @@ impl Uart {
             last: 0,
             cycles: 0,
             watchdog: None,
+            cycles_per_tick: 0,
         }
     }
 
@@ -67,7 +71,8 @@ impl Uart {
 }
 
 impl<const N: usize> BoardSupport<N> for Uart {
-    // Never called: this image is processor-in-the-loop only.
+    // Never called: the sensors are the host's (processor in the loop)
+    // or the simulated device's in front of this support.
     fn sample(&mut self) -> RawSensors<N> {
         RawSensors::default()
     }
@@ -81,9 +86,8 @@ impl<const N: usize> BoardSupport<N> for Uart {
             w.feed();
         }
     }
-    // Processor in the loop: the host paces the ticks.
     fn cycles_per_tick(&self) -> u32 {
-        0
+        self.cycles_per_tick
     }
     fn read_byte(&mut self) -> Option<u8> {
         self.read()

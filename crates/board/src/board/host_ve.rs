@@ -6,9 +6,19 @@
 use super::Board;
 use twoport_control::drive::Drive;
 use twoport_control::servo::PortLayer;
-use twoport_control::world::{Held, World};
+use twoport_control::world::{Contact, Held, World};
 use twoport_control::{Faults, Position};
 use twoport_link::{Message, Mode, ModeRefusal, ModeRequest, VeSource, VeUpdate};
+
+/// The wire's contact as the held world's.
+fn contact_law(c: twoport_link::Contact) -> Contact {
+    match c {
+        twoport_link::Contact::Held => Contact::Held,
+        twoport_link::Contact::Above => Contact::Above,
+        twoport_link::Contact::Below => Contact::Below,
+        twoport_link::Contact::Free => Contact::Free,
+    }
+}
 
 /// The host's VE as the board holds it.
 #[derive(Clone, Copy, Debug)]
@@ -79,16 +89,18 @@ where
         self.queue(Message::Ve(now));
     }
 
-    /// `VeUpdate`: the points move at the next tick, if the board runs the
-    /// host's VE, the update is newer than the last taken, it is for this
-    /// board's axes and every point is in range (±2.147 m). Any other is
-    /// ignored, and a host that sends nothing else runs into its deadline.
+    /// `VeUpdate`: the surfaces move at the next tick, if the board runs
+    /// the host's VE, the update is newer than the last taken, it is for
+    /// this board's axes and every surface is in range (±2.147 m). Any
+    /// other is ignored, and a host that sends nothing else runs into its
+    /// deadline.
     pub(super) fn ve_update(&mut self, u: VeUpdate) {
         let Some(h) = self.host.as_mut() else {
             return;
         };
         let newer = h.seq.is_none_or(|s| (u.seq.wrapping_sub(s) as i32) > 0);
-        let Some(pm) = u.position_pm.to_array::<N>() else {
+        let (Some(pm), Some(contact)) = (u.position_pm.to_array::<N>(), u.contact.to_array::<N>())
+        else {
             return;
         };
         let mut points = [Position::ZERO; N];
@@ -99,7 +111,7 @@ where
             }
         }
         if newer {
-            h.world.set(points);
+            h.world.set(points, contact.map(contact_law));
             h.age_ticks = 0;
             h.seq = Some(u.seq);
         }

@@ -1,59 +1,95 @@
-//! The host's VE as the board runs it (protocol 8): one point per axis,
-//! which the host moves at its own rate and the board holds between its
-//! updates, so that the coupling runs at the servo's rate against a VE
-//! that runs on the PC.
+//! The host's VE as the board runs it (protocol 8): per axis, a surface
+//! the host moves at its own rate and the board holds between updates,
+//! and the VE point the coupling holds against it, solved at the servo's
+//! rate, so that a delay on the link never lags the point behind the
+//! handle in free space.
 
 use super::World;
 use crate::ve::{Port, VeOutput, VeTransfer};
 use crate::{Position, Real, ZTransfer};
 
-/// Points the host moves, held between its updates.
+/// What an axis's held surface is to its VE point.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Contact {
+    /// The point is the surface: rigid ground that does not yield to the
+    /// coupling (admittance zero), moved only by the host.
+    #[default]
+    Held,
+    /// The VE is solid above the surface: the point follows the coupling
+    /// freely (no force) below it and stops at it.
+    Above,
+    /// Solid below the surface: free above it, stopped at it.
+    Below,
+    /// No surface: the point follows the coupling freely (no force).
+    Free,
+}
+
+/// Surfaces the host moves, held between its updates, and the VE points
+/// the coupling holds against them.
 ///
-/// Between updates each point is rigid ground: it does not yield to the
-/// coupling's force (admittance zero). An update moves it there in a
-/// straight line over the next `ramp` ticks, at the velocity that takes it
-/// there, so that the VE's positions stay the sum of its velocities and a
-/// passivity layer at the VE's port counts the energy the move puts in.
-/// A ramp as long as the host's period spreads each move over the period
-/// (a first-order hold, one period late) instead of one tick's jump, which
-/// the coupling's damper would feel as a spike `b Δx / T` once a period.
-/// An update that comes before a ramp ends starts a new one from where the
-/// point is.
+/// Each tick, an axis's point moves as a massless body would under the
+/// coupling's law: where it is free, to where the coupling pulls no more
+/// (`f = 0`); where its surface stops it, to the surface, rigidly. The law
+/// is piecewise: free (impedance zero) or in contact (admittance zero),
+/// both passive. The host's side then needs no fast answer: a surface
+/// under a moving handle, sent at 1 kHz, is rendered at the servo's rate.
+///
+/// An update moves a surface there in a straight line over the next
+/// `ramp` ticks, at the velocity that takes it there, so that a point
+/// pushed by it moves as the sum of its velocities and a passivity layer at
+/// the VE's port counts the energy the move puts in. A ramp as long as the
+/// host's period spreads each move over the period (a first-order hold, one
+/// period late) instead of one tick's jump, which the coupling's damper
+/// would feel as a spike `b Δx / T` once a period. An update that comes
+/// before a ramp ends starts a new one from where the surface is.
 #[derive(Clone, Copy, Debug)]
 pub struct Held<const N: usize> {
     points: [Position; N],
+    surfaces: [Position; N],
     target: [Position; N],
+    contact: [Contact; N],
     /// Ticks left to reach the target (0: there).
     left: u32,
     /// Ticks a move takes (at least 1).
     ramp: u32,
-    /// 1 / T (1/s).
+    /// T (s) and 1 / T (1/s).
+    period_s: f32,
     rate_hz: f32,
 }
 
 impl<const N: usize> Held<N> {
-    /// Points at `at`, for a servo of period `period_s` (s, > 0), each
-    /// update reached over `ramp_ticks` ticks (0 counts as 1: the next
-    /// tick).
+    /// Points held at `at` (each axis [`Contact::Held`]), for a servo of
+    /// period `period_s` (s, > 0), each update reached over `ramp_ticks`
+    /// ticks (0 counts as 1: the next tick).
     pub fn new(at: [Position; N], period_s: f32, ramp_ticks: u32) -> Self {
         Held {
             points: at,
+            surfaces: at,
             target: at,
+            contact: [Contact::Held; N],
             left: 0,
             ramp: ramp_ticks.max(1),
+            period_s,
             rate_hz: 1.0 / period_s,
         }
     }
 
-    /// Move each axis's point to `to`, starting at the next tick.
-    pub fn set(&mut self, to: [Position; N]) {
+    /// Move each axis's surface to `to`, starting at the next tick, and
+    /// make it what `contact` says from then on.
+    pub fn set(&mut self, to: [Position; N], contact: [Contact; N]) {
         self.target = to;
+        self.contact = contact;
         self.left = self.ramp;
     }
 
-    /// Where the points are going, while they move.
+    /// Where the surfaces are going, while they move.
     pub fn pending(&self) -> Option<[Position; N]> {
         (self.left > 0).then_some(self.target)
+    }
+
+    /// Each axis's surface now.
+    pub fn surfaces(&self) -> [Position; N] {
+        self.surfaces
     }
 
     /// This tick's answer to every axis's port, committed (the world's
@@ -63,22 +99,37 @@ impl<const N: usize> Held<N> {
         let finite = ports
             .iter()
             .all(|p| p.f0_n.is_finite() && p.z_nspm.is_finite());
-        let moving = finite && self.left > 0;
-        let next: [Position; N] = core::array::from_fn(|i| {
+        if !finite {
+            return core::array::from_fn(|i| ports[i].at(R::ZERO));
+        }
+        let moving = self.left > 0;
+        let rate = R::of(self.rate_hz) * R::M_PER_NM;
+        let t_nm = R::of(self.period_s) / R::M_PER_NM;
+        let mut out = [VeOutput::default(); N];
+        for i in 0..N {
             if moving {
                 // The rest of the way in equal steps (the last lands on
                 // the target exactly).
-                let step = (self.target[i] - self.points[i]) / self.left as i32;
-                self.points[i].offset_nm(step)
-            } else {
-                self.points[i]
+                let step = (self.target[i] - self.surfaces[i]) / self.left as i32;
+                self.surfaces[i] = self.surfaces[i].offset_nm(step);
             }
-        });
-        let rate = R::of(self.rate_hz) * R::M_PER_NM;
-        let out =
-            core::array::from_fn(|i| ports[i].at(next[i].nm_from::<R>(self.points[i]) * rate));
+            let (p, s) = (self.points[i], self.surfaces[i]);
+            // Where the coupling would leave a free point: f = 0.
+            let free = || {
+                let d = ports[i].f0_n / ports[i].z_nspm * t_nm;
+                let half = if d < R::ZERO { -R::HALF } else { R::HALF };
+                p.offset_nm((d + half).trunc_i32())
+            };
+            let next = match self.contact[i] {
+                Contact::Held => s,
+                Contact::Free => free(),
+                Contact::Above => free().min(s),
+                Contact::Below => free().max(s),
+            };
+            out[i] = ports[i].at(next.nm_from::<R>(p) * rate);
+            self.points[i] = next;
+        }
         if moving {
-            self.points = next;
             self.left -= 1;
         }
         out
@@ -86,8 +137,19 @@ impl<const N: usize> Held<N> {
 
     fn reset_points(&mut self, x: &[Position; N]) {
         self.points = *x;
+        self.surfaces = *x;
         self.target = *x;
+        self.contact = [Contact::Held; N];
         self.left = 0;
+    }
+
+    /// Axis `axis`'s law: free, impedance zero; held or in contact (the
+    /// piece a proof of a wall needs), admittance zero.
+    fn tf_of(&self, axis: usize) -> VeTransfer {
+        match self.contact.get(axis) {
+            Some(Contact::Free) => VeTransfer::Impedance(ZTransfer::gain(0.0)),
+            _ => VeTransfer::Admittance(ZTransfer::gain(0.0)),
+        }
     }
 }
 
@@ -111,9 +173,8 @@ macro_rules! held_world {
                 self.points
             }
 
-            /// `V/F = 0`: between updates a point does not yield.
-            fn axis_tf(&self, _axis: usize) -> VeTransfer {
-                VeTransfer::Admittance(ZTransfer::gain(0.0))
+            fn axis_tf(&self, axis: usize) -> VeTransfer {
+                self.tf_of(axis)
             }
         }
     )*};
@@ -144,7 +205,10 @@ mod tests {
             out.map(|o| (o.velocity_mps, o.force_n)),
             [(0.0, 2.0), (0.0, -1.0)]
         );
-        w.set([Position::from_nm(10_000), Position::from_nm(5_000)]);
+        w.set(
+            [Position::from_nm(10_000), Position::from_nm(5_000)],
+            [Contact::Held; 2],
+        );
         let bad = World::<f32, 2>::step_axes(&mut w, &[port(f32::NAN), port(0.0)]);
         assert_eq!(bad.map(|o| o.velocity_mps), [0.0, 0.0]);
         assert_eq!(World::<f32, 2>::positions(&w)[0], Position::ZERO);
@@ -161,7 +225,10 @@ mod tests {
         assert_eq!(out[0].velocity_mps, 0.0);
         // The positions are the sum of the velocities (times T, to the
         // f32 period's precision).
-        w.set([Position::from_nm(-3_000), Position::from_nm(5_000)]);
+        w.set(
+            [Position::from_nm(-3_000), Position::from_nm(5_000)],
+            [Contact::Held; 2],
+        );
         let v = World::<f64, 2>::step_axes(
             &mut w,
             &[Port {
@@ -185,7 +252,7 @@ mod tests {
     #[test]
     fn a_ramp_spreads_the_move_over_its_ticks_and_lands_exactly() {
         let mut w = Held::new([Position::ZERO], 1e-3, 4);
-        w.set([Position::from_nm(10_001)]);
+        w.set([Position::from_nm(10_001)], [Contact::Held]);
         let mut path = std::vec::Vec::new();
         for _ in 0..5 {
             let [o] = World::<f64, 1>::step_axes(&mut w, &[port_f64()]);
@@ -197,9 +264,9 @@ mod tests {
         for p in &path[..3] {
             assert!((p.1 - 2.5e-3).abs() < 1e-9, "{path:?}");
         }
-        w.set([Position::ZERO]);
+        w.set([Position::ZERO], [Contact::Held]);
         World::<f64, 1>::step_axes(&mut w, &[port_f64()]);
-        w.set([Position::from_nm(-4_000)]);
+        w.set([Position::from_nm(-4_000)], [Contact::Held]);
         let x: std::vec::Vec<i32> = (0..4)
             .map(|_| {
                 World::<f64, 1>::step_axes(&mut w, &[port_f64()]);
@@ -215,5 +282,61 @@ mod tests {
             f0_n: 0.0,
             z_nspm: 1.0,
         }
+    }
+
+    /// A spring-damper coupling to a handle at `x_h` (m, at rest) seen as
+    /// a port by a point at `p` (backward Euler, T = 1 ms).
+    fn coupling(x_h: f64, p: Position) -> Port<f64> {
+        let (k, b, t) = (51_000.0, 90.0, 1e-3);
+        Port {
+            f0_n: k * (x_h - p.nm() as f64 * 1e-9),
+            z_nspm: b + k * t,
+        }
+    }
+
+    /// Solid above a surface at 1 mm, a handle at 0.4 mm: the point
+    /// joins the handle (as fast as the damper lets it: 36% of the way a
+    /// tick) with no force left (to the nanometre's), and the
+    /// handle at 1.5 mm presses it onto the surface, where it stops and
+    /// the coupling's spring pushes back. Free, it follows the handle
+    /// anywhere; below, it stops from underneath.
+    #[test]
+    fn a_surface_stops_the_point_only_on_its_solid_side() {
+        let mut w = Held::new([Position::ZERO], 1e-3, 1);
+        w.set([Position::from_nm(1_000_000)], [Contact::Above]);
+        let step = |w: &mut Held<1>, x_h: f64| {
+            let p = World::<f64, 1>::positions(w)[0];
+            World::<f64, 1>::step_axes(w, &[coupling(x_h, p)])[0]
+        };
+        let mut last = VeOutput::default();
+        for _ in 0..40 {
+            last = step(&mut w, 0.4e-3);
+        }
+        let p = World::<f64, 1>::positions(&w)[0].nm();
+        assert!((p - 400_000).abs() <= 1, "{p}");
+        assert!(last.force_n.abs() < 0.1, "{last:?}");
+        for _ in 0..40 {
+            last = step(&mut w, 1.5e-3);
+        }
+        assert_eq!(World::<f64, 1>::positions(&w)[0].nm(), 1_000_000);
+        assert!((last.force_n - 51_000.0 * 0.5e-3).abs() < 1e-6, "{last:?}");
+        assert!(matches!(
+            World::<f64, 1>::axis_tf(&w, 0),
+            VeTransfer::Admittance(_)
+        ));
+        w.set([Position::from_nm(1_000_000)], [Contact::Free]);
+        for _ in 0..40 {
+            step(&mut w, 1.5e-3);
+        }
+        assert!((World::<f64, 1>::positions(&w)[0].nm() - 1_500_000).abs() <= 1);
+        assert!(matches!(
+            World::<f64, 1>::axis_tf(&w, 0),
+            VeTransfer::Impedance(_)
+        ));
+        w.set([Position::from_nm(1_200_000)], [Contact::Below]);
+        for _ in 0..40 {
+            step(&mut w, 0.0);
+        }
+        assert_eq!(World::<f64, 1>::positions(&w)[0].nm(), 1_200_000);
     }
 }

@@ -16,7 +16,7 @@
 mod held;
 pub mod vbb;
 
-pub use held::Held;
+pub use held::{Contact, Held};
 
 use crate::ve::{Port, VeOutput, VeTransfer, VirtualEnvironment};
 use crate::{Position, Real};
