@@ -274,9 +274,10 @@ pub(crate) fn host_test_against_an386(
 /// The an386 image that runs free against a device simulated on the chip,
 /// in QEMU with virtual time held to the wall clock (`align=on`: QEMU
 /// sleeps when the board runs ahead), its link's pty printed. With
-/// `--check`, the host's device-object test runs against it and the board
-/// stops after; without, it runs until interrupted, for trying an
-/// application on it.
+/// `--check`, two applications drive it in turn: the host's device-object
+/// test, and the C example built with the system C compiler against the
+/// library and its committed header (itself checked against the crate).
+/// Without, it runs until interrupted, for trying an application on it.
 pub(crate) fn device(args: &[String]) -> Result<(), String> {
     let check = match args {
         [] => false,
@@ -288,6 +289,12 @@ pub(crate) fn device(args: &[String]) -> Result<(), String> {
         }
     };
     let elf = an386_image_with("sim-device")?;
+    let example = if check {
+        crate::header::header(true)?;
+        Some(c_example()?)
+    } else {
+        None
+    };
     let mut qemu = Command::new("qemu-system-arm");
     qemu.args(["-machine", "mps2-an386", "-cpu", "cortex-m4"])
         .args(["-icount", "shift=6,align=on"])
@@ -296,18 +303,54 @@ pub(crate) fn device(args: &[String]) -> Result<(), String> {
         .args(["-serial", "pty"])
         .stdin(Stdio::null());
     with_board_in_qemu(qemu, |pty| {
-        if check {
-            return run(
-                "the device object against the free-running board",
-                cargo()
-                    .env("TWOPORT_PTY", pty)
-                    .args(["test", "--release", "-p", "twoport-host", "--test", "qemu"])
-                    .args(["--", "--ignored"]),
-            );
-        }
-        eprintln!("xtask: open {pty} with twoport_host::Board::open_serial; Ctrl-C stops it");
-        loop {
-            std::thread::sleep(std::time::Duration::from_secs(3600));
-        }
+        let Some((exe, lib)) = &example else {
+            eprintln!("xtask: open {pty} with twoport_host::Board::open_serial; Ctrl-C stops it");
+            loop {
+                std::thread::sleep(std::time::Duration::from_secs(3600));
+            }
+        };
+        run(
+            "the device object against the free-running board",
+            cargo()
+                .env("TWOPORT_PTY", pty)
+                .args(["test", "--release", "-p", "twoport-host", "--test", "qemu"])
+                .args(["--", "--ignored"]),
+        )?;
+        run(
+            "the C example against the free-running board",
+            Command::new(exe).arg(pty).env("LD_LIBRARY_PATH", lib),
+        )
     })
+}
+
+/// The C example, `crates/capi/examples/wall.c`, built with the system C
+/// compiler (warnings are errors) against the release library; returns
+/// the program and the library's folder.
+fn c_example() -> Result<(std::path::PathBuf, std::path::PathBuf), String> {
+    run(
+        "build the C ABI's library",
+        cargo().args(["build", "--release", "-q", "-p", "twoport-capi"]),
+    )?;
+    let lib = crate::target_dir().join("release");
+    let capi = root().join("crates/capi");
+    let exe = lib.join("twoport-wall");
+    run(
+        "build the C example (cc)",
+        Command::new("cc")
+            .args([
+                "-std=c11",
+                "-Wall",
+                "-Wextra",
+                "-Werror",
+                "-D_POSIX_C_SOURCE=199309L",
+            ])
+            .arg("-I")
+            .arg(capi.join("include"))
+            .arg(capi.join("examples/wall.c"))
+            .arg("-L")
+            .arg(&lib)
+            .args(["-ltwoport", "-lm", "-o"])
+            .arg(&exe),
+    )?;
+    Ok((exe, lib))
 }

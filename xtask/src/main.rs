@@ -22,6 +22,7 @@ mod counts;
 mod emulate;
 mod firmware;
 mod fuzz;
+mod header;
 mod probe;
 mod toolchain;
 
@@ -39,6 +40,7 @@ fn main() -> ExitCode {
         Some("watchdog") => emulate::watchdog(),
         Some("scope-board") => emulate::scope_board(),
         Some("device") => emulate::device(&args[1..]),
+        Some("header") => header::header(args.get(1).is_some_and(|a| a == "--check")),
         Some("fuzz") => {
             let secs = args.get(1).map_or(Ok(60), |s| {
                 s.parse::<u32>().map_err(|e| format!("seconds: {e}"))
@@ -59,7 +61,7 @@ fn main() -> ExitCode {
             ]),
         ),
         _ => Err(format!(
-            "usage: cargo xtask <ci [step...]|thumb|firmware|qemu|pil [--board an386|stm32f405] [options]|scope-board|device [--check]|watchdog|fuzz [seconds]|accuracy>\n  got: {}",
+            "usage: cargo xtask <ci [step...]|thumb|firmware|qemu|pil [--board an386|stm32f405] [options]|scope-board|device [--check]|header [--check]|watchdog|fuzz [seconds]|accuracy>\n  got: {}",
             args.join(" ")
         )),
     };
@@ -85,13 +87,18 @@ pub(crate) fn root() -> PathBuf {
         .to_path_buf()
 }
 
+/// Where the host's builds go (`CARGO_TARGET_DIR`, or the checkout's
+/// `target`).
+pub(crate) fn target_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target"))
+}
+
 /// Where cross builds go: beside the host build, in their own folders, so
 /// that two compilers never share a directory.
 pub(crate) fn cross_target_dir(name: &str) -> PathBuf {
-    let base = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root().join("target"));
-    base.join(name)
+    target_dir().join(name)
 }
 
 pub(crate) fn run(what: &str, cmd: &mut Command) -> Result<(), String> {

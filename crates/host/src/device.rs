@@ -261,6 +261,13 @@ impl<P: BoardPort> Board<P> {
         self.states.drain(..).collect()
     }
 
+    /// The oldest `n` states streamed (or all, if fewer), oldest first;
+    /// the rest stay.
+    pub fn take_states_up_to(&mut self, n: usize) -> Vec<State> {
+        let n = n.min(self.states.len());
+        self.states.drain(..n).collect()
+    }
+
     /// The newest state streamed.
     pub fn latest(&self) -> Option<&State> {
         self.latest.as_ref()

@@ -23,6 +23,17 @@ impl BoardPort for Box<dyn BoardPort> {
     }
 }
 
+/// Any port that may move to another thread, chosen at run time (the C
+/// ABI's and the Python package's).
+impl BoardPort for Box<dyn BoardPort + Send> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        (**self).send(bytes)
+    }
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError> {
+        (**self).recv(buf, timeout)
+    }
+}
+
 /// A serial port: the firmware in QEMU (`-serial pty`) or a real board.
 pub struct SerialBoard(Box<dyn serialport::SerialPort>);
 
@@ -40,8 +51,15 @@ impl SerialBoard {
     }
 }
 
+/// How long a write may wait for the port to take its bytes: a board that
+/// has not drained its link in this time is not reading it.
+pub const WRITE_TIMEOUT: Duration = Duration::from_millis(500);
+
 impl BoardPort for SerialBoard {
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        // (A read leaves its own, shorter, timeout on the port: a full
+        // buffer must not fail a write that waits a millisecond more.)
+        let _ = self.0.set_timeout(WRITE_TIMEOUT);
         std::io::Write::write_all(&mut self.0, bytes)
             .map_err(|e| LinkError::Transport(format!("write: {e}")))
     }

@@ -74,13 +74,17 @@ impl SimulatedBoard {
             excalibur::ENCODER,
             excalibur::PERIOD_S,
         );
-        Ok(SimulatedBoard {
+        let mut b = SimulatedBoard {
             board,
             io,
             pace,
             last: None,
             ticks: 0,
-        })
+        };
+        // A board ticks from boot: its first tick has read the dead-man
+        // switch before any host can ask it to arm.
+        b.run(1);
+        Ok(b)
     }
 
     /// Where the simulated handle is (m).

@@ -122,6 +122,14 @@ where
 #[cfg(feature = "sim-device")]
 const CYCLES_PER_TICK: u32 = 25_000;
 
+/// Ticks the simulated board waits for its host's heartbeat.
+#[cfg(feature = "sim-device")]
+const HOST_PATIENCE_TICKS: u32 = 500;
+
+/// Link bytes read between looks at the clock.
+#[cfg(feature = "sim-device")]
+const BYTES_PER_LOOK: usize = 32;
+
 /// The hand's push on the simulated handle (N, along +x).
 #[cfg(feature = "sim-device")]
 const HAND_N: f32 = 2.0;
@@ -140,6 +148,18 @@ fn run_free(
 ) -> ! {
     use twoport_board::{excalibur, BoardSupport, IoScale, SimAxis, Simulated};
     io.cycles_per_tick = CYCLES_PER_TICK;
+    // QEMU shares the machine's cores with the host application it serves,
+    // so a busy machine stalls the host for longer than a board's own would:
+    // this board waits half a second for its heartbeat (the shipped image,
+    // 50 ms).
+    let mut cfg = board.config();
+    for c in &mut cfg {
+        c.limits.heartbeat_timeout_ticks = HOST_PATIENCE_TICKS;
+    }
+    if board.apply_config(&cfg).is_err() {
+        hprintln!("twoport-an386: the simulated device's limits would not apply");
+        exit(false)
+    }
     let mut dev = Simulated::new(
         io,
         [SimAxis::excalibur(HAND_N)],
@@ -149,14 +169,34 @@ fn run_free(
     );
     hprintln!("twoport-an386: simulated device, running free, link on UART0");
     let mut next = dev.cycles();
+    // The frame going out, and how much of it has.
+    let mut out: Option<(twoport_board::Frame, usize)> = None;
     loop {
-        board.poll_link(&mut dev);
+        // The link never holds off a tick, as a real board's timer
+        // interrupt would not let it: a few bytes in at a time, and out
+        // only what the UART takes now (a host that reads slowly loses
+        // the oldest telemetry in the board's queue, not ticks).
+        for _ in 0..BYTES_PER_LOOK {
+            let Some(byte) = dev.read_byte() else { break };
+            board.on_bytes(&[byte]);
+        }
         board.service_config(&mut store);
-        board.flush(&mut dev);
+        loop {
+            if out.is_none() {
+                out = board.pop_tx().map(|f| (f, 0));
+            }
+            let Some((frame, sent)) = &mut out else { break };
+            if !dev.inner().try_send(frame[*sent]) {
+                break;
+            }
+            *sent += 1;
+            if *sent == frame.len() {
+                out = None;
+            }
+        }
         if dev.cycles().wrapping_sub(next) as i32 >= 0 {
             next = next.wrapping_add(CYCLES_PER_TICK);
             board.control_tick(&mut dev);
-            board.flush(&mut dev);
         }
     }
 }

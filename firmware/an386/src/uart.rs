@@ -61,6 +61,16 @@ impl Uart {
         Some(unsafe { read_volatile(DATA as *const u32) } as u8)
     }
 
+    /// Send `b` if the transmitter has room now; `false` if it is full.
+    pub fn try_send(&mut self, b: u8) -> bool {
+        if self.state() & STATE_TX_FULL != 0 {
+            return false;
+        }
+        // SAFETY: UART0's DATA register; writing it sends the byte.
+        unsafe { write_volatile(DATA as *mut u32, b as u32) };
+        true
+    }
+
     fn send(&mut self, bytes: &[u8]) {
         for &b in bytes {
             while self.state() & STATE_TX_FULL != 0 {}

@@ -1,0 +1,252 @@
+//! The C ABI's plain data: what a board can do, its state at one tick, and
+//! the codes every call returns. Units are SI.
+
+use twoport_host::{Contact, Mode, ProvenRegion, Spec, State};
+
+/// The most axes a board has (a three-axis device).
+pub const TP_MAX_AXES: usize = 3;
+
+/// A VE surface that is the point the coupling holds, moved by the host.
+pub const TP_CONTACT_HELD: u8 = 0;
+/// A VE surface solid above: free below it, the point stopped at it.
+pub const TP_CONTACT_ABOVE: u8 = 1;
+/// A VE surface solid below: free above it.
+pub const TP_CONTACT_BELOW: u8 = 2;
+/// No surface: the point follows the handle with no force.
+pub const TP_CONTACT_FREE: u8 = 3;
+
+/// The contact a C caller's code names, if it names one.
+pub(crate) fn contact(c: u8) -> Option<Contact> {
+    match c {
+        TP_CONTACT_HELD => Some(Contact::Held),
+        TP_CONTACT_ABOVE => Some(Contact::Above),
+        TP_CONTACT_BELOW => Some(Contact::Below),
+        TP_CONTACT_FREE => Some(Contact::Free),
+        _ => None,
+    }
+}
+
+/// What a call did. On anything but `TP_RESULT_OK`, `tp_last_error` says
+/// why.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TpResult {
+    /// Done.
+    Ok = 0,
+    /// The link failed: the port, the transport, the handshake.
+    Link = 1,
+    /// The board refused (a mode change, gains past the proven region).
+    Refused = 2,
+    /// An argument is wrong: NULL, another count than the board's axes,
+    /// a value out of range, nothing streamed yet.
+    Argument = 3,
+    /// The board did not answer in time.
+    Timeout = 4,
+    /// The board has reset since it was opened (or another host opened
+    /// it): open it again.
+    Reset = 5,
+    /// The board latched a fault while the call waited.
+    Faulted = 6,
+    /// twoport failed inside (a bug), caught at the boundary.
+    Panic = 7,
+}
+
+/// What a board was doing.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TpMode {
+    /// Outputs off, zero force.
+    Disarmed = 0,
+    /// Homing onto its stops.
+    Homing = 1,
+    /// The coupling running, force on.
+    Armed = 2,
+    /// Playing an identification experiment.
+    Identifying = 3,
+}
+
+/// Which display a proven region bounds.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TpDisplay {
+    /// A spring-damper coupling: `limit` is the stiffest (N/m).
+    Impedance = 0,
+    /// A mass-damper coupling for one regulator: `limit` is the lightest
+    /// mass (kg).
+    Admittance = 1,
+}
+
+/// One axis's limits and proven region.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TpAxisSpec {
+    /// The force the safety layer allows for a short time (N).
+    pub peak_force_n: f64,
+    /// The force it allows indefinitely (N).
+    pub continuous_force_n: f64,
+    /// The speed past which the axis faults to zero force (m/s).
+    pub max_velocity_mps: f64,
+    /// The display the region bounds.
+    pub display: TpDisplay,
+    /// The least coupling damping proven (N s/m).
+    pub b_min_nspm: f64,
+    /// The greatest (N s/m).
+    pub b_max_nspm: f64,
+    /// The extreme coupling proven: the stiffest spring (N/m) or the
+    /// lightest mass (kg) ...
+    pub limit: f64,
+    /// ... at this damping (N s/m).
+    pub b_at_limit_nspm: f64,
+    /// The admittance region's regulator stiffness (N/m; 0 for impedance).
+    pub kp_npm: f64,
+    /// Its damping (N s/m; 0 for impedance).
+    pub bp_nspm: f64,
+}
+
+/// What a board can do.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TpSpec {
+    /// The servo's period (s).
+    pub period_s: f64,
+    /// Telemetry every this many ticks (0: none).
+    pub stream_every: u32,
+    /// Whether the motors turn a linkage's joints.
+    pub linkage: bool,
+    /// The board's axes (1 to `TP_MAX_AXES`).
+    pub axes: u8,
+    /// Each axis's, the first `axes` of them.
+    pub axis: [TpAxisSpec; TP_MAX_AXES],
+}
+
+/// One axis at one tick.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TpAxisState {
+    /// Handle position (m).
+    pub position_m: f64,
+    /// Handle velocity (m/s).
+    pub velocity_mps: f64,
+    /// Load-cell force (N).
+    pub load_cell_n: f64,
+    /// Force the law commanded (N; positive resists positive motion).
+    pub commanded_n: f64,
+    /// Force sent to the amplifier, after the safety layer (N).
+    pub actuator_n: f64,
+    /// The VE point the coupling holds (m).
+    pub ve_position_m: f64,
+}
+
+/// The board at one tick.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TpState {
+    /// The board's tick.
+    pub tick: u32,
+    /// Latched fault bits (0: none; `tp_last_error` names them when a
+    /// call fails on one).
+    pub faults: u16,
+    /// What the board was doing.
+    pub mode: TpMode,
+    /// The host VE update the board held.
+    pub ve_seq: u32,
+    /// The board's axes.
+    pub axes: u8,
+    /// Each axis's, the first `axes` of them.
+    pub axis: [TpAxisState; TP_MAX_AXES],
+}
+
+impl From<&Spec> for TpSpec {
+    fn from(s: &Spec) -> Self {
+        let zero = TpAxisSpec {
+            peak_force_n: 0.0,
+            continuous_force_n: 0.0,
+            max_velocity_mps: 0.0,
+            display: TpDisplay::Impedance,
+            b_min_nspm: 0.0,
+            b_max_nspm: 0.0,
+            limit: 0.0,
+            b_at_limit_nspm: 0.0,
+            kp_npm: 0.0,
+            bp_nspm: 0.0,
+        };
+        let mut axis = [zero; TP_MAX_AXES];
+        for (out, a) in axis.iter_mut().zip(s.axes.iter()) {
+            let f = f64::from;
+            let base = TpAxisSpec {
+                peak_force_n: f(a.peak_force_n),
+                continuous_force_n: f(a.continuous_force_n),
+                max_velocity_mps: f(a.max_velocity_mps),
+                ..zero
+            };
+            *out = match a.region {
+                ProvenRegion::MaxStiffness {
+                    b_min_nspm,
+                    b_max_nspm,
+                    k_max_npm,
+                    b_at_k_max_nspm,
+                } => TpAxisSpec {
+                    display: TpDisplay::Impedance,
+                    b_min_nspm: f(b_min_nspm),
+                    b_max_nspm: f(b_max_nspm),
+                    limit: f(k_max_npm),
+                    b_at_limit_nspm: f(b_at_k_max_nspm),
+                    ..base
+                },
+                ProvenRegion::MinMass {
+                    kp_npm,
+                    bp_nspm,
+                    b_min_nspm,
+                    b_max_nspm,
+                    m_min_kg,
+                    b_at_m_min_nspm,
+                } => TpAxisSpec {
+                    display: TpDisplay::Admittance,
+                    b_min_nspm: f(b_min_nspm),
+                    b_max_nspm: f(b_max_nspm),
+                    limit: f(m_min_kg),
+                    b_at_limit_nspm: f(b_at_m_min_nspm),
+                    kp_npm: f(kp_npm),
+                    bp_nspm: f(bp_nspm),
+                    ..base
+                },
+            };
+        }
+        TpSpec {
+            period_s: s.period_s(),
+            stream_every: s.stream_every,
+            linkage: s.linkage,
+            axes: s.axes.len() as u8,
+            axis,
+        }
+    }
+}
+
+impl From<&State> for TpState {
+    fn from(s: &State) -> Self {
+        let mut axis = [TpAxisState::default(); TP_MAX_AXES];
+        for (out, a) in axis.iter_mut().zip(s.axes.iter()) {
+            *out = TpAxisState {
+                position_m: a.position_m,
+                velocity_mps: a.velocity_mps,
+                load_cell_n: a.load_cell_n,
+                commanded_n: a.commanded_n,
+                actuator_n: a.actuator_n,
+                ve_position_m: a.ve_position_m,
+            };
+        }
+        TpState {
+            tick: s.tick,
+            faults: s.faults,
+            mode: match s.mode {
+                Mode::Disarmed => TpMode::Disarmed,
+                Mode::Homing => TpMode::Homing,
+                Mode::Armed => TpMode::Armed,
+                Mode::Identifying => TpMode::Identifying,
+            },
+            ve_seq: s.ve_seq,
+            axes: s.axes.len() as u8,
+            axis,
+        }
+    }
+}
