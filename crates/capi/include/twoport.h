@@ -245,6 +245,14 @@ typedef struct TpState {
    */
   uint32_t ve_seq;
   /**
+   * Ticks since boot that overran their period, or came late.
+   */
+  uint32_t deadline_misses;
+  /**
+   * The loop's last tick, in the board's cycle count.
+   */
+  uint32_t loop_cycles;
+  /**
    * The board's axes.
    */
   uint8_t axes;

@@ -150,6 +150,10 @@ pub struct TpState {
     pub mode: TpMode,
     /// The host VE update the board held.
     pub ve_seq: u32,
+    /// Ticks since boot that overran their period, or came late.
+    pub deadline_misses: u32,
+    /// The loop's last tick, in the board's cycle count.
+    pub loop_cycles: u32,
     /// The board's axes.
     pub axes: u8,
     /// Each axis's, the first `axes` of them.
@@ -245,6 +249,8 @@ impl From<&State> for TpState {
                 Mode::Identifying => TpMode::Identifying,
             },
             ve_seq: s.ve_seq,
+            deadline_misses: s.deadline_misses,
+            loop_cycles: s.loop_cycles,
             axes: s.axes.len() as u8,
             axis,
         }

@@ -52,8 +52,15 @@ pub struct State {
     pub mode: Mode,
     /// The host VE update the board held.
     pub ve_seq: u32,
-    /// Ticks since boot that overran their period.
+    /// Ticks since boot that overran their period, or came more than
+    /// half a period late.
     pub deadline_misses: u32,
+    /// The loop's last tick, in the board's count (cycles, or
+    /// instructions in an emulator).
+    pub loop_cycles: u32,
+    /// The largest difference since boot between a tick's start-to-start
+    /// time and the period, in the same count.
+    pub worst_jitter_cycles: u32,
 }
 
 impl From<&Telemetry> for State {
@@ -72,6 +79,8 @@ impl From<&Telemetry> for State {
             mode: t.mode,
             ve_seq: t.ve_seq,
             deadline_misses: t.deadline_misses,
+            loop_cycles: t.loop_cycles,
+            worst_jitter_cycles: t.worst_jitter_cycles,
         }
     }
 }
