@@ -77,21 +77,22 @@ fn the_board_loop_matches_the_scenes_own_servo_within_pwm_resolution() {
     assert!(worst < 2e-5, "{worst} m apart");
 }
 
-#[test]
-fn a_scene_with_another_encoder_is_refused_by_name() {
-    let s = Scene::load(
-        Path::new("../scenes/stiff_wall.toml"),
-        &["effects.encoder.bits=32".to_string()],
-    )
-    .unwrap();
-    let e = pil::run(
+/// Why a PIL run of the stiff-wall scene with `set` refuses to start.
+fn refusal(set: &str) -> host_sim::Error {
+    let s = Scene::load(Path::new("../scenes/stiff_wall.toml"), &[set.to_string()]).unwrap();
+    pil::run(
         s,
         10,
         LocalBoard::excalibur().unwrap(),
         LinkFaults::default(),
     )
     .err()
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn a_scene_with_another_encoder_is_refused_by_name() {
+    let e = refusal("effects.encoder.bits=32");
     assert!(matches!(e, host_sim::Error::Pil(_)), "{e:?}");
     assert!(e.to_string().contains("effects.encoder"), "{e}");
 }
@@ -391,19 +392,7 @@ fn the_board_states_its_spec_and_a_scene_at_another_period_is_refused() {
     // The paper's coupling is inside it.
     assert!(k_max_npm >= 51_000.0, "{k_max_npm}");
 
-    let s = Scene::load(
-        Path::new("../scenes/stiff_wall.toml"),
-        &["period_s=0.0005".to_string()],
-    )
-    .unwrap();
-    let e = pil::run(
-        s,
-        10,
-        LocalBoard::excalibur().unwrap(),
-        LinkFaults::default(),
-    )
-    .err()
-    .unwrap();
+    let e = refusal("period_s=0.0005");
     assert!(e.to_string().contains("period_s"), "{e}");
     assert!(e.to_string().contains("0.001"), "{e}");
 }
