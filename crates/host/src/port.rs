@@ -40,14 +40,17 @@ pub struct SerialBoard(Box<dyn serialport::SerialPort>);
 impl SerialBoard {
     /// Open `path` (115200 8N1; a pty ignores the rate).
     pub fn open(path: &str) -> Result<Self, LinkError> {
-        serialport::new(path, 115_200)
+        let port = serialport::new(path, 115_200)
             .timeout(Duration::from_millis(20))
             .open()
-            .map(SerialBoard)
             .map_err(|e| LinkError::Open {
                 path: path.to_string(),
                 why: e.to_string(),
-            })
+            })?;
+        // What the board sent before this host opened the port was for
+        // another host.
+        let _ = port.clear(serialport::ClearBuffer::All);
+        Ok(SerialBoard(port))
     }
 }
 

@@ -311,7 +311,15 @@ impl<P: BoardPort> Session<P> {
     fn handshake(&mut self) -> Result<(), LinkError> {
         let deadline = Instant::now() + ANSWER_TIMEOUT;
         loop {
-            self.send(&Message::hello(Role::Host, self.axes, self.session))?;
+            // A board's link may not take bytes at first (QEMU looks for a
+            // pty's new reader once a second): a write that cannot go out
+            // yet is tried again until the deadline, like one unanswered.
+            let sent = self.send(&Message::hello(Role::Host, self.axes, self.session));
+            if let Err(e) = sent {
+                if Instant::now() > deadline {
+                    return Err(e);
+                }
+            }
             self.pump(Duration::from_millis(100))?;
             if let Some(i) = self
                 .inbox
