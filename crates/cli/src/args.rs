@@ -404,3 +404,51 @@ pub(crate) struct IdentifyArgs {
     #[arg(long)]
     pub(crate) json: bool,
 }
+
+/// `rates`: the devices, the servo rates and the linkages' grasp.
+#[derive(Args, Clone)]
+pub(crate) struct RatesArgs {
+    /// Device model files (one axis each); the shipped Excalibur, capstan
+    /// and two-mass device by default.
+    #[arg(long, num_args = 1.., default_values = [
+        "models/excalibur.toml", "models/capstan.toml", "models/two_mass.toml",
+    ])]
+    pub(crate) model: Vec<PathBuf>,
+    /// Linkage files, proven over their workspace at b = 0 for a grasp of
+    /// at least --min-grasp; the shipped four by default.
+    #[arg(long, num_args = 0.., default_values = [
+        "models/linkages/phantom_premium_1_5.toml", "models/linkages/falcon_like.toml",
+        "models/linkages/haply_2diy.toml", "models/linkages/hapkit.toml",
+    ])]
+    pub(crate) linkage: Vec<PathBuf>,
+    /// Servo rates (Hz), comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [1000.0, 2000.0, 4000.0, 10000.0], allow_negative_numbers = true)]
+    rates: Vec<f64>,
+    /// The linkages' least grasp damping (N s/m).
+    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
+    min_grasp: f64,
+    /// Draw the table as a log-log figure (.png or .svg).
+    #[arg(long)]
+    pub(crate) plot: Option<PathBuf>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub(crate) json: bool,
+}
+
+impl RatesArgs {
+    /// The rates, each finite and positive, or the one that is not.
+    pub(crate) fn rates(&self) -> Result<Vec<f64>, String> {
+        match self.rates.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
+            Some(r) => Err(format!("--rates: {r} Hz is not a rate")),
+            None => Ok(self.rates.clone()),
+        }
+    }
+
+    /// The grasp, finite and not negative.
+    pub(crate) fn grasp(&self) -> Result<f64, String> {
+        let g = self.min_grasp;
+        (g.is_finite() && g >= 0.0)
+            .then_some(g)
+            .ok_or_else(|| format!("--min-grasp {g}: a damping (N s/m), 0 or more"))
+    }
+}

@@ -414,6 +414,8 @@ fn draw(out: &Path, format: PlotFormat, data: &Measured, f: &Fit) -> Result<Vec<
     figure(
         "encoder",
         Figure {
+            x_label: "frequency (Hz)".into(),
+            legend: plot::LegendAt::LowerRight,
             title: "Actuator force to encoder: measured and fitted".into(),
             y_label: "|X/F| (m/N)".into(),
             curves: fitted(x, |m| m.0),
@@ -427,6 +429,8 @@ fn draw(out: &Path, format: PlotFormat, data: &Measured, f: &Fit) -> Result<Vec<
         figure(
             "load_cell",
             Figure {
+                x_label: "frequency (Hz)".into(),
+                legend: plot::LegendAt::LowerRight,
                 title: "Actuator force to load cell: measured and fitted".into(),
                 y_label: "|F_lc/F| (N/N)".into(),
                 curves: fitted(lc, |m| m.1),
@@ -438,6 +442,8 @@ fn draw(out: &Path, format: PlotFormat, data: &Measured, f: &Fit) -> Result<Vec<
     figure(
         "coherence",
         Figure {
+            x_label: "frequency (Hz)".into(),
+            legend: plot::LegendAt::LowerRight,
             title: "What the excitation does not explain: 1 - coherence".into(),
             y_label: "1 - coherence (noise share)".into(),
             curves: coherence,

@@ -4,6 +4,7 @@ mod args;
 mod check;
 mod identify;
 mod plots;
+mod rates;
 mod region;
 mod run;
 mod synthesis;
@@ -47,6 +48,9 @@ pub(crate) enum Cmd {
     /// a set of models that spans what the fit does not know, and the
     /// figures of the fit.
     Identify(IdentifyArgs),
+    /// What the servo rate buys: each device's proven coupling at each
+    /// servo rate, as a table and a figure.
+    Rates(RatesArgs),
 }
 
 /// `run` on `args`, refusing a device file: the command draws one axis.
@@ -91,6 +95,7 @@ fn main() -> ExitCode {
         }
         Cmd::Verify(d) => each_axis(d, verify::verify),
         Cmd::Identify(a) => identify::identify(a),
+        Cmd::Rates(a) => rates::rates(a),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,

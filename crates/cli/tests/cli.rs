@@ -177,6 +177,7 @@ fn every_subcommand_has_help() {
         vec!["region", "impedance", "--help"],
         vec!["verify", "impedance", "--help"],
         vec!["identify", "--help"],
+        vec!["rates", "--help"],
     ] {
         let out = TWOPORT.run(&args);
         assert!(out.status.success(), "{args:?}");

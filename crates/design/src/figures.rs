@@ -5,7 +5,7 @@ use crate::analysis::{
     impedance_range_impedance, regulator_tf, Analysis,
 };
 use crate::network::HumanBound;
-use crate::plot::{Curve, Figure, RGBColor, BLUE, GREY, RED};
+use crate::plot::{Curve, Figure, LegendAt, RGBColor, BLUE, GREY, RED};
 use std::f64::consts::PI;
 
 fn hz(a: &Analysis) -> impl Iterator<Item = f64> + '_ {
@@ -35,6 +35,8 @@ pub fn fig8(a: &Analysis, k: f64, b: f64) -> Result<Figure, crate::Error> {
     let tf = impedance_coupling_tf(k, b, a.period_s)?;
     let coupling = a.points.iter().map(|p| tf.eval(p.z).inv().re).collect();
     Ok(Figure {
+        x_label: "frequency (Hz)".into(),
+        legend: LegendAt::LowerRight,
         title: "Fig. 8  Impedance display virtual coupling design".into(),
         y_label: "Re(1/Z_cI)  (m/(N s))".into(),
         curves: vec![
@@ -78,6 +80,8 @@ pub fn fig9(
     let tf = admittance_coupling_tf(m, b, a.period_s)?;
     let coupling = a.points.iter().map(|p| tf.eval(p.z).re).collect();
     Ok(Figure {
+        x_label: "frequency (Hz)".into(),
+        legend: LegendAt::LowerRight,
         title: format!("Fig. 9  Admittance display virtual coupling design (K_p = {kp:.0} + {bp:.0}(1 - 1/z)/T)"),
         y_label: "Re Z_cA  (N s/m)".into(),
         curves: vec![
@@ -113,6 +117,8 @@ pub fn fig10(
             .collect()
     };
     Ok(Figure {
+        x_label: "frequency (Hz)".into(),
+        legend: LegendAt::LowerRight,
         title: "Fig. 10  Impedance range (thin: impedance display, bold: admittance display; the Z_max coincide, eq 29)".into(),
         y_label: "|Z|  (N s/m)".into(),
         curves: vec![

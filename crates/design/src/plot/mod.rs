@@ -35,12 +35,25 @@ pub struct Curve {
     pub points: Vec<(f64, f64)>,
 }
 
+/// A corner of the plot, for the legend.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LegendAt {
+    /// Lower right.
+    LowerRight,
+    /// Upper left.
+    UpperLeft,
+}
+
 /// A log-log figure.
 pub struct Figure {
     /// Title.
     pub title: String,
+    /// X axis label with unit (the curves' first coordinate).
+    pub x_label: String,
     /// Y axis label with unit.
     pub y_label: String,
+    /// Where the legend goes: the corner the curves leave empty.
+    pub legend: LegendAt,
     /// The curves.
     pub curves: Vec<Curve>,
 }
@@ -123,13 +136,14 @@ fn draw<DB: DrawingBackend>(fig: &Figure, root: DrawingArea<DB, Shift>) -> Resul
     let mut chart = ChartBuilder::on(&root)
         .caption(&fig.title, ("sans-serif", 22))
         .margin(12)
+        .margin_right(40)
         .x_label_area_size(48)
         .y_label_area_size(80)
         .build_cartesian_2d((x0..x1).log_scale(), (y0 / 2.0..y1 * 2.0).log_scale())
         .map_err(e)?;
     chart
         .configure_mesh()
-        .x_desc("frequency (Hz)")
+        .x_desc(fig.x_label.as_str())
         .y_desc(&fig.y_label)
         .label_style(("sans-serif", 15))
         .axis_desc_style(("sans-serif", 17))
@@ -165,7 +179,10 @@ fn draw<DB: DrawingBackend>(fig: &Figure, root: DrawingArea<DB, Shift>) -> Resul
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font(("sans-serif", 15))
-        .position(SeriesLabelPosition::LowerRight)
+        .position(match fig.legend {
+            LegendAt::LowerRight => SeriesLabelPosition::LowerRight,
+            LegendAt::UpperLeft => SeriesLabelPosition::UpperLeft,
+        })
         .draw()
         .map_err(e)?;
     root.present().map_err(e)?;

@@ -265,12 +265,15 @@ pub(super) fn judge(a: &DMatrix<f64>, period_s: f64) -> Radius {
     let mut unstable = false;
     let slow = 2.0 * PI * 0.1 * period_s;
     let Some(poles) = crate::linalg::eigenvalues(a) else {
-        // No poles found is no proof of stability.
+        // Where the QR iteration does not settle, the radius still follows
+        // from the powers of the matrix (its frequency does not: 0 says
+        // unknown); where a number is not finite, nothing is proven.
+        let rho = crate::linalg::spectral_radius_gelfand(a).unwrap_or(f64::INFINITY);
         return Radius {
-            spectral_radius: f64::INFINITY,
+            spectral_radius: rho,
             frequency_hz: 0.0,
-            score: f64::INFINITY,
-            unstable: true,
+            score: rho,
+            unstable: rho > 1.0 + UNSTABLE_MARGIN,
         };
     };
     for l in &poles {
