@@ -20,7 +20,7 @@ struct Step {
 
 /// The steps, in the order CI runs them: the quick checks first, the
 /// tests' total last, so that a log's last line is the whole count.
-const STEPS: [Step; 13] = [
+const STEPS: [Step; 14] = [
     Step {
         name: "fmt",
         what: "rustfmt on the workspace, the firmware's two and fuzz's",
@@ -70,6 +70,11 @@ const STEPS: [Step; 13] = [
         name: "device",
         what: "a host application on the free-running board in QEMU",
         run: || device(&["--check".to_string()]),
+    },
+    Step {
+        name: "python",
+        what: "the Python wheel built (maturin, abi3), installed and tested (pytest)",
+        run: crate::python::python,
     },
     Step {
         name: "watchdog",

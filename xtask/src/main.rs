@@ -24,6 +24,7 @@ mod firmware;
 mod fuzz;
 mod header;
 mod probe;
+mod python;
 mod toolchain;
 
 use std::path::PathBuf;
@@ -40,6 +41,7 @@ fn main() -> ExitCode {
         Some("watchdog") => emulate::watchdog(),
         Some("scope-board") => emulate::scope_board(),
         Some("device") => emulate::device(&args[1..]),
+        Some("python") => python::python(),
         Some("header") => header::header(args.get(1).is_some_and(|a| a == "--check")),
         Some("fuzz") => {
             let secs = args.get(1).map_or(Ok(60), |s| {
@@ -61,7 +63,7 @@ fn main() -> ExitCode {
             ]),
         ),
         _ => Err(format!(
-            "usage: cargo xtask <ci [step...]|thumb|firmware|qemu|pil [--board an386|stm32f405] [options]|scope-board|device [--check]|header [--check]|watchdog|fuzz [seconds]|accuracy>\n  got: {}",
+            "usage: cargo xtask <ci [step...]|thumb|firmware|qemu|pil [--board an386|stm32f405] [options]|scope-board|device [--check]|header [--check]|python|watchdog|fuzz [seconds]|accuracy>\n  got: {}",
             args.join(" ")
         )),
     };

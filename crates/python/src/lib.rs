@@ -1,0 +1,318 @@
+#![doc = include_str!("../README.md")]
+#![forbid(unsafe_code)]
+
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+use std::time::Duration;
+use twoport_design::network::HumanBound;
+use twoport_design::{Designer, DeviceModel};
+use twoport_host::{
+    Board as HostBoard, BoardPort, Contact, LinkError, Pace, ProvenRegion, SerialBoard,
+    SimulatedBoard, State,
+};
+
+/// A proven virtual coupling: the boundary the designer proved, and the
+/// gain it recommends inside it.
+#[pyclass(frozen, get_all, module = "twoport")]
+#[derive(Clone)]
+struct Design {
+    /// "impedance" or "admittance".
+    display: String,
+    /// The boundary's stiffness (N/m; impedance) or mass (kg; admittance).
+    limit: f64,
+    /// The coupling damping it is proven at (N s/m).
+    b_nspm: f64,
+    /// The recommended gain, `margin` inside the boundary.
+    recommended: f64,
+    /// The sample period it is proven for (s).
+    period_s: f64,
+    /// Where the design binds (Hz), if it does.
+    binding_frequency_hz: Option<f64>,
+}
+
+#[pymethods]
+impl Design {
+    fn __repr__(&self) -> String {
+        let unit = if self.display == "impedance" {
+            "N/m"
+        } else {
+            "kg"
+        };
+        format!(
+            "Design({}: {:.6} {unit} at {} N s/m, T = {} s)",
+            self.display, self.limit, self.b_nspm, self.period_s
+        )
+    }
+}
+
+fn model(path: Option<PathBuf>) -> PyResult<DeviceModel> {
+    let path = path.unwrap_or_else(|| twoport_design::model::EXCALIBUR_PATH.into());
+    DeviceModel::load_or_excalibur(&path)
+        .map_err(|e| PyValueError::new_err(format!("{}: {e}", path.display())))
+}
+
+/// Design the impedance display's coupling for the device `model` (a
+/// model file; the paper's Excalibur by default): at damping `b` (N s/m),
+/// or the best `(k, b)` pair; for every passive human within the paper's
+/// bound (`human=False`: any passive human at all), at `period` (s; the
+/// model's by default), `margin` inside the boundary. The design runs with
+/// the GIL released.
+#[pyfunction]
+#[pyo3(signature = (model=None, b=None, period=None, human=true, margin=0.1))]
+fn design_impedance(
+    py: Python<'_>,
+    model: Option<PathBuf>,
+    b: Option<f64>,
+    period: Option<f64>,
+    human: bool,
+    margin: f64,
+) -> PyResult<Design> {
+    let m = self::model(model)?;
+    let human = human.then_some(HumanBound::PAPER);
+    py.detach(move || {
+        let d = Designer::new(vec![m], period, human).map_err(|e| e.to_string())?;
+        let period_s = d.period_s();
+        let r = d.design_impedance(b, margin).map_err(|e| e.to_string())?;
+        let (limit, b_nspm) = r
+            .coupling
+            .ok_or_else(|| r.message.clone().unwrap_or("no coupling is proven".into()))?;
+        Ok(Design {
+            display: "impedance".into(),
+            limit,
+            b_nspm,
+            recommended: limit * (1.0 - margin),
+            period_s,
+            binding_frequency_hz: r.binds_at.map(|x| x.frequency_hz),
+        })
+    })
+    .map_err(|e: String| PyValueError::new_err(e))
+}
+
+/// A board: a real one over a serial port, the firmware in QEMU through
+/// its pty, or the shipped Excalibur image on a simulated device in this
+/// process. Its servo loop runs on the board (or in Rust), never in
+/// Python; Python reads its streamed states as numpy arrays and sends its
+/// VE's surfaces. Closing it (or letting it go) disarms it.
+#[pyclass(unsendable, module = "twoport")]
+struct Board {
+    inner: Option<HostBoard<Box<dyn BoardPort + Send>>>,
+}
+
+fn link(e: LinkError) -> PyErr {
+    PyRuntimeError::new_err(e.to_string())
+}
+
+impl Board {
+    fn open(&mut self) -> PyResult<&mut HostBoard<Box<dyn BoardPort + Send>>> {
+        self.inner
+            .as_mut()
+            .ok_or_else(|| PyRuntimeError::new_err("the board is closed"))
+    }
+}
+
+/// The states as numpy arrays: one entry per field, axis-indexed fields
+/// as (states, axes).
+fn arrays<'py>(py: Python<'py>, states: &[State], axes: usize) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let col = |f: fn(&State) -> f64| PyArray1::from_iter(py, states.iter().map(f));
+    d.set_item("tick", col(|s| f64::from(s.tick)))?;
+    d.set_item("faults", col(|s| f64::from(s.faults)))?;
+    d.set_item("ve_seq", col(|s| f64::from(s.ve_seq)))?;
+    let per_axis = |f: fn(&twoport_host::AxisState) -> f64| -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let v: Vec<f64> = states
+            .iter()
+            .flat_map(|s| (0..axes).map(move |i| f(&s.axes[i])))
+            .collect();
+        PyArray1::from_vec(py, v).reshape([states.len(), axes])
+    };
+    d.set_item("position_m", per_axis(|a| a.position_m)?)?;
+    d.set_item("velocity_mps", per_axis(|a| a.velocity_mps)?)?;
+    d.set_item("load_cell_n", per_axis(|a| a.load_cell_n)?)?;
+    d.set_item("commanded_n", per_axis(|a| a.commanded_n)?)?;
+    d.set_item("actuator_n", per_axis(|a| a.actuator_n)?)?;
+    d.set_item("ve_position_m", per_axis(|a| a.ve_position_m)?)?;
+    Ok(d)
+}
+
+fn contact(name: &str) -> PyResult<Contact> {
+    match name {
+        "held" => Ok(Contact::Held),
+        "above" => Ok(Contact::Above),
+        "below" => Ok(Contact::Below),
+        "free" => Ok(Contact::Free),
+        other => Err(PyValueError::new_err(format!(
+            "contact {other:?}: one of \"held\", \"above\", \"below\", \"free\""
+        ))),
+    }
+}
+
+#[pymethods]
+impl Board {
+    /// Open the board of `axes` axes at the serial port `path`.
+    #[staticmethod]
+    #[pyo3(signature = (path, axes=1))]
+    fn serial(py: Python<'_>, path: String, axes: u8) -> PyResult<Board> {
+        let b = py.detach(move || {
+            let port: Box<dyn BoardPort + Send> = Box::new(SerialBoard::open(&path)?);
+            HostBoard::open(port, axes)
+        });
+        Ok(Board {
+            inner: Some(b.map_err(link)?),
+        })
+    }
+
+    /// The shipped Excalibur image on a simulated device in this process,
+    /// ticking with the wall clock, a hand pushing `hand_n` (N) along +x
+    /// while the board's outputs are on.
+    #[staticmethod]
+    #[pyo3(signature = (hand_n=2.0))]
+    fn simulated(hand_n: f32) -> PyResult<Board> {
+        let port: Box<dyn BoardPort + Send> =
+            Box::new(SimulatedBoard::excalibur(hand_n, Pace::RealTime).map_err(link)?);
+        Ok(Board {
+            inner: Some(HostBoard::open(port, 1).map_err(link)?),
+        })
+    }
+
+    /// What the board can do: its period (s), and per axis its force
+    /// limits and its proven region's envelope.
+    fn spec<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = *self.open()?.spec();
+        let d = PyDict::new(py);
+        d.set_item("period_s", s.period_s())?;
+        d.set_item("linkage", s.linkage)?;
+        let axes = pyo3::types::PyList::empty(py);
+        for a in s.axes.iter() {
+            let x = PyDict::new(py);
+            x.set_item("peak_force_n", a.peak_force_n)?;
+            x.set_item("continuous_force_n", a.continuous_force_n)?;
+            x.set_item("max_velocity_mps", a.max_velocity_mps)?;
+            match a.region {
+                ProvenRegion::MaxStiffness {
+                    b_min_nspm,
+                    b_max_nspm,
+                    k_max_npm,
+                    b_at_k_max_nspm,
+                } => {
+                    x.set_item("display", "impedance")?;
+                    x.set_item("b_range_nspm", (b_min_nspm, b_max_nspm))?;
+                    x.set_item("k_max_npm", k_max_npm)?;
+                    x.set_item("b_at_k_max_nspm", b_at_k_max_nspm)?;
+                }
+                ProvenRegion::MinMass {
+                    kp_npm,
+                    bp_nspm,
+                    b_min_nspm,
+                    b_max_nspm,
+                    m_min_kg,
+                    b_at_m_min_nspm,
+                } => {
+                    x.set_item("display", "admittance")?;
+                    x.set_item("regulator", (kp_npm, bp_nspm))?;
+                    x.set_item("b_range_nspm", (b_min_nspm, b_max_nspm))?;
+                    x.set_item("m_min_kg", m_min_kg)?;
+                    x.set_item("b_at_m_min_nspm", b_at_m_min_nspm)?;
+                }
+            }
+            axes.append(x)?;
+        }
+        d.set_item("axes", axes)?;
+        Ok(d)
+    }
+
+    /// Tell a disarmed board where each axis stands (m).
+    fn calibrate(&mut self, position_m: Vec<f64>) -> PyResult<()> {
+        self.open()?
+            .calibrate(&position_m)
+            .map(|_| ())
+            .map_err(link)
+    }
+
+    /// Arm: the coupling runs and the force comes on.
+    fn arm(&mut self) -> PyResult<()> {
+        self.open()?.arm().map(|_| ()).map_err(link)
+    }
+
+    /// Disarm: zero force at once.
+    fn disarm(&mut self) -> PyResult<()> {
+        self.open()?.disarm().map(|_| ()).map_err(link)
+    }
+
+    /// Stream the state every `every_ticks` ticks (0: none).
+    fn stream(&mut self, every_ticks: u32) -> PyResult<()> {
+        self.open()?.stream(every_ticks).map_err(link)
+    }
+
+    /// Run the VE on the host (disarmed only).
+    #[pyo3(signature = (ramp_ticks=1, deadline_ticks=50))]
+    fn host_ve(&mut self, ramp_ticks: u32, deadline_ticks: u32) -> PyResult<()> {
+        self.open()?
+            .host_ve(ramp_ticks, deadline_ticks)
+            .map(|_| ())
+            .map_err(link)
+    }
+
+    /// Send each axis's VE surface (m) and what it is ("held", "above",
+    /// "below", "free"); returns the update's number.
+    fn send_ve(&mut self, position_m: Vec<f64>, contact: Vec<String>) -> PyResult<u32> {
+        let c = contact
+            .iter()
+            .map(|c| self::contact(c))
+            .collect::<PyResult<Vec<_>>>()?;
+        self.open()?.send_ve(&position_m, &c).map_err(link)
+    }
+
+    /// Read what the board sent and feed its watchdog (call at least
+    /// every 20 ms while armed); returns the states read.
+    fn poll(&mut self) -> PyResult<usize> {
+        self.open()?.poll().map_err(link)
+    }
+
+    /// Run the link for `seconds` (s), reading the stream and feeding the
+    /// watchdog, with the GIL released: the loop a script waits in.
+    fn run_for(&mut self, py: Python<'_>, seconds: f64) -> PyResult<()> {
+        if !(seconds.is_finite() && seconds >= 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "seconds {seconds}: not a time"
+            )));
+        }
+        let b = self.open()?;
+        py.detach(|| {
+            let end = std::time::Instant::now() + Duration::from_secs_f64(seconds);
+            while std::time::Instant::now() < end {
+                b.poll()?;
+            }
+            Ok(())
+        })
+        .map_err(link)
+    }
+
+    /// The states streamed since the last call, as numpy arrays.
+    fn take_states<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let b = self.open()?;
+        let axes = b.axes();
+        let states = b.take_states();
+        arrays(py, &states, axes)
+    }
+
+    /// Disarm and let the board go.
+    fn close(&mut self) -> PyResult<()> {
+        match self.inner.take() {
+            Some(b) => b.close().map_err(link),
+            None => Ok(()),
+        }
+    }
+}
+
+/// twoport: haptic interfaces that are stable by design.
+#[pymodule]
+#[pyo3(name = "twoport")]
+fn twoport_py(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(design_impedance, m)?)?;
+    m.add_class::<Design>()?;
+    m.add_class::<Board>()?;
+    Ok(())
+}

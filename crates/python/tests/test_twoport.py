@@ -1,0 +1,83 @@
+"""twoport from Python: the designer, and a board whose servo loop stays in
+Rust while Python reads its stream as numpy arrays."""
+
+import pathlib
+import threading
+
+import numpy as np
+import pytest
+
+import twoport
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+EXCALIBUR = str(ROOT / "models" / "excalibur.toml")
+
+
+def test_the_paper_design_comes_back_from_python():
+    d = twoport.design_impedance(EXCALIBUR, b=90.0, margin=0.0)
+    assert d.display == "impedance"
+    assert d.b_nspm == 90.0
+    assert abs(d.limit - 51_073.0) < 0.001 * 51_073.0
+    assert d.period_s == 0.001
+    # The best pair at twice the rate is the rate table's.
+    fast = twoport.design_impedance(EXCALIBUR, period=0.0005, margin=0.0)
+    assert abs(fast.limit - 181_606.0) < 0.001 * 181_606.0
+    assert "N/m" in repr(d)
+
+
+def test_bad_inputs_are_named():
+    with pytest.raises(ValueError, match="no/such.toml"):
+        twoport.design_impedance("no/such.toml")
+    with pytest.raises(ValueError, match="b"):
+        twoport.design_impedance(EXCALIBUR, b=-1.0)
+    b = twoport.Board.simulated()
+    with pytest.raises(ValueError, match="contact"):
+        b.send_ve([0.0], ["sideways"])
+    with pytest.raises(RuntimeError, match="values for a board of 1 axes"):
+        b.calibrate([0.0, 0.0])
+    b.close()
+    with pytest.raises(RuntimeError, match="closed"):
+        b.arm()
+
+
+def test_a_host_wall_from_python_holds_the_simulated_hand():
+    b = twoport.Board.simulated(hand_n=2.0)
+    axis = b.spec()["axes"][0]
+    assert axis["display"] == "impedance" and axis["k_max_npm"] > 51_000.0
+    b.calibrate([0.0])
+    b.stream(1)
+    b.host_ve(1, 500)
+    b.arm()
+    # The VE at 200 Hz from Python: the wall sent, the link run between.
+    for _ in range(200):
+        b.send_ve([0.005], ["above"])
+        b.run_for(0.005)
+    s = b.take_states()
+    x = s["position_m"]
+    assert x.shape == (len(s["tick"]), 1) and x.dtype == np.float64
+    assert len(s["tick"]) > 100
+    assert np.all(s["faults"] == 0)
+    # At rest on the wall, 2 N into the 51,000 N/m coupling.
+    assert abs(x[-1, 0] - (0.005 + 2.0 / 51_000.0)) < 10e-6
+    b.close()
+
+
+def test_the_link_runs_with_the_gil_released():
+    b = twoport.Board.simulated()
+    ticks = []
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            ticks.append(1)
+
+    t = threading.Thread(target=count)
+    t.start()
+    before = len(ticks)
+    b.run_for(0.3)
+    during = len(ticks) - before
+    stop.set()
+    t.join()
+    b.close()
+    # A Python thread ran while the board's link did.
+    assert during > 1000
