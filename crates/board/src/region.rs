@@ -247,6 +247,12 @@ mod tests {
                 b_at_k_max_nspm: 60.0,
             }
         );
+        let e = r.envelope();
+        assert_eq!((e.is_impedance(), e.b_range_nspm()), (true, (30.0, 90.0)));
+        assert_eq!((e.limit(), e.regulator()), ((51_400.0, 60.0), None));
+        let e = m.envelope();
+        assert_eq!((e.is_impedance(), e.limit()), (false, (5.0, 500.0)));
+        assert_eq!(e.regulator(), Some((51_000.0, 90.0)));
         assert_eq!(
             m.envelope(),
             ProvenRegion::MinMass {

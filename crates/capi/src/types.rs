@@ -1,7 +1,7 @@
 //! The C ABI's plain data: what a board can do, its state at one tick, and
 //! the codes every call returns. Units are SI.
 
-use twoport_host::{Contact, Mode, ProvenRegion, Spec, State};
+use twoport_host::{Contact, Mode, Spec, State};
 
 /// The most axes a board has (a three-axis device).
 pub const TP_MAX_AXES: usize = 3;
@@ -183,37 +183,25 @@ impl From<&Spec> for TpSpec {
                 max_velocity_mps: f(a.max_velocity_mps),
                 ..zero
             };
-            *out = match a.region {
-                ProvenRegion::MaxStiffness {
-                    b_min_nspm,
-                    b_max_nspm,
-                    k_max_npm,
-                    b_at_k_max_nspm,
-                } => TpAxisSpec {
-                    display: TpDisplay::Impedance,
-                    b_min_nspm: f(b_min_nspm),
-                    b_max_nspm: f(b_max_nspm),
-                    limit: f(k_max_npm),
-                    b_at_limit_nspm: f(b_at_k_max_nspm),
-                    ..base
+            let r = &a.region;
+            let ((b_min, b_max), (limit, b_at), (kp, bp)) = (
+                r.b_range_nspm(),
+                r.limit(),
+                r.regulator().unwrap_or((0.0, 0.0)),
+            );
+            *out = TpAxisSpec {
+                display: if r.is_impedance() {
+                    TpDisplay::Impedance
+                } else {
+                    TpDisplay::Admittance
                 },
-                ProvenRegion::MinMass {
-                    kp_npm,
-                    bp_nspm,
-                    b_min_nspm,
-                    b_max_nspm,
-                    m_min_kg,
-                    b_at_m_min_nspm,
-                } => TpAxisSpec {
-                    display: TpDisplay::Admittance,
-                    b_min_nspm: f(b_min_nspm),
-                    b_max_nspm: f(b_max_nspm),
-                    limit: f(m_min_kg),
-                    b_at_limit_nspm: f(b_at_m_min_nspm),
-                    kp_npm: f(kp_npm),
-                    bp_nspm: f(bp_nspm),
-                    ..base
-                },
+                b_min_nspm: f(b_min),
+                b_max_nspm: f(b_max),
+                limit: f(limit),
+                b_at_limit_nspm: f(b_at),
+                kp_npm: f(kp),
+                bp_nspm: f(bp),
+                ..base
             };
         }
         TpSpec {

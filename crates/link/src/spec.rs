@@ -73,6 +73,58 @@ pub enum ProvenRegion {
     },
 }
 
+impl ProvenRegion {
+    /// Whether it bounds the impedance display's spring-damper (else the
+    /// admittance display's mass-damper).
+    pub fn is_impedance(&self) -> bool {
+        matches!(self, ProvenRegion::MaxStiffness { .. })
+    }
+
+    /// The coupling damping it covers, least and greatest (N s/m).
+    pub fn b_range_nspm(&self) -> (f32, f32) {
+        match *self {
+            ProvenRegion::MaxStiffness {
+                b_min_nspm,
+                b_max_nspm,
+                ..
+            }
+            | ProvenRegion::MinMass {
+                b_min_nspm,
+                b_max_nspm,
+                ..
+            } => (b_min_nspm, b_max_nspm),
+        }
+    }
+
+    /// Its extreme coupling, the stiffest spring (N/m) or the lightest
+    /// mass (kg), and the damping it is proven at (N s/m).
+    pub fn limit(&self) -> (f32, f32) {
+        match *self {
+            ProvenRegion::MaxStiffness {
+                k_max_npm,
+                b_at_k_max_nspm,
+                ..
+            } => (k_max_npm, b_at_k_max_nspm),
+            ProvenRegion::MinMass {
+                m_min_kg,
+                b_at_m_min_nspm,
+                ..
+            } => (m_min_kg, b_at_m_min_nspm),
+        }
+    }
+
+    /// The regulator `(k_p N/m, b_p N s/m)` an admittance region holds
+    /// for.
+    pub fn regulator(&self) -> Option<(f32, f32)> {
+        match *self {
+            ProvenRegion::MinMass {
+                kp_npm, bp_nspm, ..
+            } => Some((kp_npm, bp_nspm)),
+            ProvenRegion::MaxStiffness { .. } => None,
+        }
+    }
+}
+
 impl Spec {
     /// The servo's period (s).
     pub fn period_s(&self) -> f64 {

@@ -10,8 +10,7 @@ use std::time::Duration;
 use twoport_design::network::HumanBound;
 use twoport_design::{Designer, DeviceModel};
 use twoport_host::{
-    Board as HostBoard, BoardPort, Contact, LinkError, Pace, ProvenRegion, SerialBoard,
-    SimulatedBoard, State,
+    Board as HostBoard, BoardPort, Contact, LinkError, Pace, SerialBoard, SimulatedBoard, State,
 };
 
 /// A proven virtual coupling: the boundary the designer proved, and the
@@ -190,32 +189,28 @@ impl Board {
             x.set_item("peak_force_n", a.peak_force_n)?;
             x.set_item("continuous_force_n", a.continuous_force_n)?;
             x.set_item("max_velocity_mps", a.max_velocity_mps)?;
-            match a.region {
-                ProvenRegion::MaxStiffness {
-                    b_min_nspm,
-                    b_max_nspm,
-                    k_max_npm,
-                    b_at_k_max_nspm,
-                } => {
-                    x.set_item("display", "impedance")?;
-                    x.set_item("b_range_nspm", (b_min_nspm, b_max_nspm))?;
-                    x.set_item("k_max_npm", k_max_npm)?;
-                    x.set_item("b_at_k_max_nspm", b_at_k_max_nspm)?;
-                }
-                ProvenRegion::MinMass {
-                    kp_npm,
-                    bp_nspm,
-                    b_min_nspm,
-                    b_max_nspm,
-                    m_min_kg,
-                    b_at_m_min_nspm,
-                } => {
-                    x.set_item("display", "admittance")?;
-                    x.set_item("regulator", (kp_npm, bp_nspm))?;
-                    x.set_item("b_range_nspm", (b_min_nspm, b_max_nspm))?;
-                    x.set_item("m_min_kg", m_min_kg)?;
-                    x.set_item("b_at_m_min_nspm", b_at_m_min_nspm)?;
-                }
+            let r = &a.region;
+            let (limit, b_at) = r.limit();
+            x.set_item(
+                "display",
+                if r.is_impedance() {
+                    "impedance"
+                } else {
+                    "admittance"
+                },
+            )?;
+            x.set_item("b_range_nspm", r.b_range_nspm())?;
+            x.set_item(
+                if r.is_impedance() {
+                    "k_max_npm"
+                } else {
+                    "m_min_kg"
+                },
+                limit,
+            )?;
+            x.set_item("b_at_limit_nspm", b_at)?;
+            if let Some(reg) = r.regulator() {
+                x.set_item("regulator", reg)?;
             }
             axes.append(x)?;
         }

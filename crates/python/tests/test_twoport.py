@@ -44,6 +44,8 @@ def test_a_host_wall_from_python_holds_the_simulated_hand():
     b = twoport.Board.simulated(hand_n=2.0)
     axis = b.spec()["axes"][0]
     assert axis["display"] == "impedance" and axis["k_max_npm"] > 51_000.0
+    lo, hi = axis["b_range_nspm"]
+    assert lo == 10.0 and abs(hi - 155.885) < 1e-3
     b.calibrate([0.0])
     b.stream(1)
     b.host_ve(1, 500)
