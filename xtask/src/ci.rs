@@ -83,8 +83,8 @@ const STEPS: [Step; 14] = [
     },
     Step {
         name: "fuzz",
-        what: "each fuzz target for 40 s",
-        run: || fuzz(40),
+        what: "each fuzz target for 25 s",
+        run: || fuzz(25),
     },
     Step {
         name: "tests",
