@@ -7,8 +7,8 @@ use crate::{BoardPort, LinkError, LinkFaults, SerialBoard, Session};
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 use twoport_link::{
-    Axes, ConfigSource, Contact, Gains, GainsReply, Message, Mode, ModeRefusal, ModeRequest, Spec,
-    Status, Telemetry, VeSource,
+    Axes, ConfigSource, Contact, Gains, GainsReply, Message, Mode, Spec, Status, Telemetry,
+    VeSource,
 };
 
 /// States kept for the application before the oldest are dropped (about
@@ -188,8 +188,7 @@ impl<P: BoardPort> Board<P> {
 
     /// Disarm: zero force at once.
     pub fn disarm(&mut self) -> Result<Status, LinkError> {
-        self.session.send(&Message::Disarm)?;
-        self.session.wait("Disarm", |m| match m {
+        self.session.call(&Message::Disarm, "Disarm", |m| match m {
             Message::Status(s) if s.mode == Mode::Disarmed => Some(*s),
             _ => None,
         })
@@ -197,20 +196,20 @@ impl<P: BoardPort> Board<P> {
 
     /// Clear latched faults (the board stays disarmed).
     pub fn clear_faults(&mut self) -> Result<Status, LinkError> {
-        self.session.send(&Message::ClearFaults)?;
-        self.session.wait("ClearFaults", |m| match m {
-            Message::Status(s) => Some(*s),
-            _ => None,
-        })
+        self.session
+            .call(&Message::ClearFaults, "ClearFaults", |m| match m {
+                Message::Status(s) => Some(*s),
+                _ => None,
+            })
     }
 
     /// The gains in force, one per axis.
     pub fn gains(&mut self) -> Result<Axes<Gains>, LinkError> {
-        self.session.send(&Message::GetGains)?;
-        self.session.wait("GetGains", |m| match m {
-            Message::Gains(g) => Some(*g),
-            _ => None,
-        })
+        self.session
+            .call(&Message::GetGains, "GetGains", |m| match m {
+                Message::Gains(g) => Some(*g),
+                _ => None,
+            })
     }
 
     /// New gains, one per axis: all in force from the next tick, or none,
@@ -222,11 +221,12 @@ impl<P: BoardPort> Board<P> {
             given: gains.len(),
             board: self.axes(),
         })?;
-        self.session.send(&Message::SetGains(g))?;
-        let r = self.session.wait("SetGains", |m| match m {
-            Message::GainsReply(r) => Some(*r),
-            _ => None,
-        })?;
+        let r = self
+            .session
+            .call(&Message::SetGains(g), "SetGains", |m| match m {
+                Message::GainsReply(r) => Some(*r),
+                _ => None,
+            })?;
         match r {
             GainsReply::Accepted(g) => Ok(g),
             GainsReply::Refused(why) => Err(LinkError::GainsRefused(why)),
@@ -267,7 +267,7 @@ impl<P: BoardPort> Board<P> {
 
     /// The states streamed since the last call, oldest first.
     pub fn take_states(&mut self) -> Vec<State> {
-        self.states.drain(..).collect()
+        self.take_states_up_to(usize::MAX)
     }
 
     /// The oldest `n` states streamed (or all, if fewer), oldest first;
@@ -324,19 +324,7 @@ impl<P: BoardPort> Board<P> {
     /// Store the configuration in force in the board's flash (disarmed
     /// only).
     pub fn save(&mut self) -> Result<ConfigSource, LinkError> {
-        self.session.send(&Message::SaveConfig)?;
-        let r = self.session.wait("SaveConfig", |m| match m {
-            Message::Config(c @ ConfigSource::Stored { .. }) => Some(Ok(*c)),
-            Message::ModeRefused {
-                asked: ModeRequest::SaveConfig,
-                why,
-            } => Some(Err(*why)),
-            _ => None,
-        })?;
-        r.map_err(|why: ModeRefusal| LinkError::Refused {
-            asked: ModeRequest::SaveConfig,
-            why,
-        })
+        self.session.save()
     }
 
     /// Disarm and let the board go.

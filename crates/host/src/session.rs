@@ -143,20 +143,29 @@ impl<P: BoardPort> Session<P> {
 
     /// Where the board's configuration came from.
     pub fn config(&mut self) -> Result<ConfigSource, LinkError> {
-        self.inbox.retain(|m| !matches!(m, Message::Config(_)));
-        self.send(&Message::GetConfig)?;
-        self.wait("GetConfig", |m| match m {
+        self.call(&Message::GetConfig, "GetConfig", |m| match m {
             Message::Config(c) => Some(*c),
             _ => None,
         })
     }
 
+    /// Send `msg` and wait for the answer `pick` takes. Any such answer
+    /// already received answered an earlier question, and goes first.
+    pub fn call<T>(
+        &mut self,
+        msg: &Message,
+        what: &str,
+        mut pick: impl FnMut(&Message) -> Option<T>,
+    ) -> Result<T, LinkError> {
+        self.inbox.retain(|m| pick(m).is_none());
+        self.send(msg)?;
+        self.wait(what, pick)
+    }
+
     /// What the board can do: its period, each axis's limits and proven
     /// region, and the telemetry rate in force (protocol 8).
     pub fn spec(&mut self) -> Result<Spec, LinkError> {
-        self.inbox.retain(|m| !matches!(m, Message::Spec(_)));
-        self.send(&Message::GetSpec)?;
-        self.wait("GetSpec", |m| match m {
+        self.call(&Message::GetSpec, "GetSpec", |m| match m {
             Message::Spec(s) => Some(*s),
             _ => None,
         })
@@ -165,9 +174,8 @@ impl<P: BoardPort> Session<P> {
     /// Have the board send telemetry every `every_ticks` ticks (0: none
     /// outside an experiment), and wait until it says so (protocol 8).
     pub fn set_stream(&mut self, every_ticks: u32) -> Result<(), LinkError> {
-        self.inbox.retain(|m| !matches!(m, Message::Stream { .. }));
-        self.send(&Message::SetStream { every_ticks })?;
-        self.wait("SetStream", |m| match m {
+        let msg = Message::SetStream { every_ticks };
+        self.call(&msg, "SetStream", |m| match m {
             Message::Stream { every_ticks: e } if *e == every_ticks => Some(()),
             _ => None,
         })
@@ -176,29 +184,34 @@ impl<P: BoardPort> Session<P> {
     /// Run the VE on the board or on the host (disarmed only), and wait
     /// for the board to say which it runs (protocol 8).
     pub fn set_ve(&mut self, source: VeSource) -> Result<VeSource, LinkError> {
-        self.inbox.retain(|m| {
-            !matches!(
-                m,
-                Message::Ve(_)
-                    | Message::ModeRefused {
-                        asked: ModeRequest::SetVe,
-                        ..
-                    }
-            )
-        });
-        self.send(&Message::SetVe(source))?;
-        let r = self.wait("SetVe", |m| match m {
-            Message::Ve(s) => Some(Ok(*s)),
-            Message::ModeRefused {
-                asked: ModeRequest::SetVe,
-                why,
-            } => Some(Err(*why)),
+        self.request(&Message::SetVe(source), ModeRequest::SetVe, |m| match m {
+            Message::Ve(s) => Some(*s),
             _ => None,
-        })?;
-        r.map_err(|why| LinkError::Refused {
-            asked: ModeRequest::SetVe,
-            why,
         })
+    }
+
+    /// Store the configuration in force in the board's flash (disarmed
+    /// only), and where it is now.
+    pub fn save(&mut self) -> Result<ConfigSource, LinkError> {
+        self.request(&Message::SaveConfig, ModeRequest::SaveConfig, |m| match m {
+            Message::Config(c @ ConfigSource::Stored { .. }) => Some(*c),
+            _ => None,
+        })
+    }
+
+    /// [`call`](Self::call) for a request the board may refuse: the answer
+    /// `pick` takes, or the board's refusal of `asked` as an error.
+    fn request<T>(
+        &mut self,
+        msg: &Message,
+        asked: ModeRequest,
+        mut pick: impl FnMut(&Message) -> Option<T>,
+    ) -> Result<T, LinkError> {
+        let r = self.call(msg, &format!("{asked:?}"), |m| match m {
+            Message::ModeRefused { asked: a, why } if *a == asked => Some(Err(*why)),
+            m => pick(m).map(Ok),
+        })?;
+        r.map_err(|why| LinkError::Refused { asked, why })
     }
 
     /// Send the host VE's surfaces and what each is, update `seq` (no
@@ -383,8 +396,7 @@ impl<P: BoardPort> Session<P> {
 
     /// The board's link counters.
     pub fn board_stats(&mut self) -> Result<LinkStats, LinkError> {
-        self.send(&Message::GetStats)?;
-        self.wait("GetStats", |m| match m {
+        self.call(&Message::GetStats, "GetStats", |m| match m {
             Message::Stats(s) => Some(*s),
             _ => None,
         })

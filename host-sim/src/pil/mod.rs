@@ -17,9 +17,7 @@ use crate::{Sample, Scene, Simulation};
 use twoport_board::excalibur::{self, xyz};
 use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::Faults as BoardFaults;
-use twoport_link::{
-    Axes, ConfigSource, LinkStats, Message, Mode, ModeRequest, PilSensors, Status, Telemetry,
-};
+use twoport_link::{Axes, ConfigSource, LinkStats, Message, Mode, PilSensors, Status, Telemetry};
 
 /// How far a homed board's position may be from the plant's: the stop's
 /// give under the homing force (25 µm on the scenes' 2e5 N/m stop) and a
@@ -422,18 +420,7 @@ fn boot_and_save<P: BoardPort>(
     session: &mut Session<P>,
 ) -> Result<(ConfigSource, ConfigSource), Error> {
     let booted = session.config()?;
-    session.send(&Message::SaveConfig)?;
-    let saved = session.wait("SaveConfig", |m| match m {
-        Message::Config(c @ ConfigSource::Stored { .. }) => Some(Ok(*c)),
-        Message::ModeRefused {
-            asked: ModeRequest::SaveConfig,
-            why,
-        } => Some(Err(Error::Link(crate::link::LinkError::Refused {
-            asked: ModeRequest::SaveConfig,
-            why: *why,
-        }))),
-        _ => None,
-    })??;
+    let saved = session.save()?;
     Ok((booted, saved))
 }
 
