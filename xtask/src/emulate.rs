@@ -12,9 +12,14 @@ use std::process::{Command, Stdio};
 /// exit codes) and virtual time from the instruction count, so that the
 /// images' SysTick measurements are deterministic.
 pub(crate) fn qemu_an386(elf: &Path) -> Command {
+    qemu_an386_timed(elf, "shift=6")
+}
+
+/// [`qemu_an386`] with `icount` as QEMU's `-icount` option.
+fn qemu_an386_timed(elf: &Path, icount: &str) -> Command {
     let mut c = Command::new("qemu-system-arm");
     c.args(["-machine", "mps2-an386", "-cpu", "cortex-m4"])
-        .args(["-icount", "shift=6"])
+        .args(["-icount", icount])
         .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
         .arg(elf)
         .stdin(Stdio::null());
@@ -295,13 +300,8 @@ pub(crate) fn device(args: &[String]) -> Result<(), String> {
     } else {
         None
     };
-    let mut qemu = Command::new("qemu-system-arm");
-    qemu.args(["-machine", "mps2-an386", "-cpu", "cortex-m4"])
-        .args(["-icount", "shift=6,align=on"])
-        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
-        .arg(&elf)
-        .args(["-serial", "pty"])
-        .stdin(Stdio::null());
+    let mut qemu = qemu_an386_timed(&elf, "shift=6,align=on");
+    qemu.args(["-serial", "pty"]);
     with_board_in_qemu(qemu, |pty| {
         let Some((exe, lib)) = &example else {
             eprintln!("xtask: open {pty} with twoport_host::Board::open_serial; Ctrl-C stops it");
