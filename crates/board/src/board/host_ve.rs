@@ -25,8 +25,6 @@ fn contact_law(c: twoport_link::Contact) -> Contact {
 pub(super) struct HostVe<const N: usize> {
     /// The points, held between updates.
     pub(super) world: Held<N>,
-    /// Ticks a move takes.
-    ramp_ticks: u32,
     /// Ticks one update may serve.
     deadline_ticks: u32,
     /// Ticks run since the last update taken (or since arming).
@@ -53,7 +51,7 @@ where
         match &self.host {
             None => VeSource::Board,
             Some(h) => VeSource::Host {
-                ramp_ticks: h.ramp_ticks,
+                ramp_ticks: h.world.ramp_ticks(),
                 deadline_ticks: h.deadline_ticks,
             },
         }
@@ -78,7 +76,6 @@ where
                 let x = self.servo.servo().position();
                 Some(HostVe {
                     world: Held::new(x, period_s, ramp_ticks),
-                    ramp_ticks: ramp_ticks.max(1),
                     deadline_ticks,
                     age_ticks: 0,
                     seq: None,

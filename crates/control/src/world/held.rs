@@ -87,6 +87,11 @@ impl<const N: usize> Held<N> {
         (self.left > 0).then_some(self.target)
     }
 
+    /// Ticks a move takes.
+    pub fn ramp_ticks(&self) -> u32 {
+        self.ramp
+    }
+
     /// Each axis's surface now.
     pub fn surfaces(&self) -> [Position; N] {
         self.surfaces
