@@ -106,28 +106,6 @@ fn poses(c: &mut Criterion) {
     );
 }
 
-/// The work `twoport.design_impedance(path, b=90.0)` does in Python, in
-/// Rust: the model file read, the designer built, the design at b 90 (the
-/// Python overhead is the Python call's time over this; see
-/// `crates/python/examples/overhead.py`).
-fn python_call(c: &mut Criterion) {
-    use twoport_design::Designer;
-    let path = std::path::Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../models/excalibur.toml"
-    ));
-    c.bench_function(
-        "design_impedance as the Python call: file, designer, b 90",
-        |b| {
-            b.iter(|| {
-                let m = DeviceModel::load(black_box(path)).unwrap();
-                let d = Designer::new(vec![m], None, Some(HumanBound::PAPER)).unwrap();
-                black_box(d.design_impedance(Some(90.0), 0.1).unwrap())
-            })
-        },
-    );
-}
-
 fn verify(c: &mut Criterion) {
     use twoport_control::{Gains, ImpedanceGains};
     use twoport_design::verify::verify;
@@ -188,6 +166,6 @@ fn excalibur_model() -> DeviceModel {
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = responses, designs, poses, python_call, verify, linkage
+    targets = responses, designs, poses, verify, linkage
 }
 criterion_main!(benches);

@@ -14,6 +14,9 @@
 //! - `scope-board`: the scope's board mode against the firmware in QEMU.
 //! - `watchdog`: hang the an386 image's loop on purpose; the watchdog
 //!   resets it and it comes back disarmed with the reset as a fault.
+//! - `python`: build the wheel into a venv of its own and run pytest.
+//! - `overhead [rounds]`: a design call from Python against the same work
+//!   from Rust, in turns (default 7 rounds); the ratio.
 //! - `fuzz [seconds]`: run each cargo-fuzz target (default 60 s each).
 //! - `accuracy`: regenerate docs/accuracy.md and docs/accuracy.png.
 
@@ -42,6 +45,13 @@ fn main() -> ExitCode {
         Some("scope-board") => emulate::scope_board(),
         Some("device") => emulate::device(&args[1..]),
         Some("python") => python::python(),
+        Some("overhead") => args.get(1).map_or(Ok(7), |s| {
+            s.parse::<u32>()
+                .ok()
+                .filter(|&n| n > 0)
+                .ok_or(format!("rounds: {s:?} is not a positive whole number"))
+        })
+        .and_then(python::overhead),
         Some("header") => header::header(args.get(1).is_some_and(|a| a == "--check")),
         Some("fuzz") => {
             let secs = args.get(1).map_or(Ok(60), |s| {
@@ -63,7 +73,7 @@ fn main() -> ExitCode {
             ]),
         ),
         _ => Err(format!(
-            "usage: cargo xtask <ci [step...]|thumb|firmware|qemu|pil [--board an386|stm32f405] [options]|scope-board|device [--check]|header [--check]|python|watchdog|fuzz [seconds]|accuracy>\n  got: {}",
+            "usage: cargo xtask <ci [step...]|thumb|firmware|qemu|pil [--board an386|stm32f405] [options]|scope-board|device [--check]|header [--check]|python|overhead [rounds]|watchdog|fuzz [seconds]|accuracy>\n  got: {}",
             args.join(" ")
         )),
     };

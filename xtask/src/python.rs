@@ -1,9 +1,10 @@
 //! The Python package: built by maturin as one abi3 wheel, installed into
 //! a virtual environment of its own with its test dependencies (from
-//! PyPI), and tested there with pytest.
+//! PyPI), and tested there with pytest. `overhead` times a design call
+//! from Python against the same work from Rust.
 
-use crate::{root, run, target_dir};
-use std::path::PathBuf;
+use crate::{cargo, root, run, target_dir};
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The tools the step installs into its environment.
@@ -11,6 +12,21 @@ const TOOLS: [&str; 3] = ["maturin>=1.5,<2", "pytest", "numpy"];
 
 /// Build the wheel, install it, run `crates/python/tests`.
 pub(crate) fn python() -> Result<(), String> {
+    let bin = wheel()?;
+    run(
+        "pytest crates/python/tests",
+        Command::new(bin.join("python")).current_dir(root()).args([
+            "-m",
+            "pytest",
+            "-q",
+            "crates/python/tests",
+        ]),
+    )
+}
+
+/// The environment with the package's wheel built and installed; its
+/// `bin` folder.
+fn wheel() -> Result<PathBuf, String> {
     let venv = target_dir().join("python-venv");
     let bin = venv.join("bin");
     if !bin.join("python").exists() {
@@ -59,13 +75,78 @@ pub(crate) fn python() -> Result<(), String> {
             ])
             .arg(&wheel),
     )?;
+    Ok(bin)
+}
+
+/// `twoport.design_impedance` on the Excalibur's model from Python against
+/// the same work from Rust (`crates/design/examples/design_call.rs`), each
+/// timed the same way in its own process, in turns for `rounds` rounds so
+/// both see the same machine; the ratio of their medians.
+pub(crate) fn overhead(rounds: u32) -> Result<(), String> {
+    let bin = wheel()?;
     run(
-        "pytest crates/python/tests",
-        Command::new(bin.join("python")).current_dir(root()).args([
-            "-m",
-            "pytest",
+        "the Rust side (design_call, release)",
+        cargo().args([
+            "build",
+            "--release",
             "-q",
-            "crates/python/tests",
+            "-p",
+            "twoport-design",
+            "--example",
+            "design_call",
         ]),
-    )
+    )?;
+    let model = root().join("models").join("excalibur.toml");
+    let rust = target_dir()
+        .join("release")
+        .join("examples")
+        .join("design_call");
+    let script = root().join("crates/python/examples/overhead.py");
+    let (mut from_rust, mut from_python) = (Vec::new(), Vec::new());
+    for round in 1..=rounds {
+        let r = median_of(Command::new(&rust).arg(&model))?;
+        let p = median_of(Command::new(bin.join("python")).arg(&script).arg(&model))?;
+        eprintln!(
+            "xtask: round {round}: Rust {:.3} ms, Python {:.3} ms",
+            r * 1e3,
+            p * 1e3
+        );
+        from_rust.push(r);
+        from_python.push(p);
+    }
+    let (r, p) = (median(&mut from_rust), median(&mut from_python));
+    println!(
+        "design_impedance(excalibur, b 90): Rust {:.3} ms, Python {:.3} ms, Python/Rust {:.3} (median of {rounds} rounds)",
+        r * 1e3,
+        p * 1e3,
+        p / r
+    );
+    Ok(())
+}
+
+/// The `median_s` a timing program prints.
+fn median_of(cmd: &mut Command) -> Result<f64, String> {
+    let what = Path::new(cmd.get_program()).display().to_string();
+    let out = cmd
+        .output()
+        .map_err(|e| format!("{what}: could not start: {e}"))?;
+    if !out.status.success() {
+        return Err(format!(
+            "{what}: failed ({}): {}",
+            out.status,
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    text.lines()
+        .find_map(|l| l.strip_prefix("median_s "))
+        .ok_or_else(|| format!("{what}: printed no median_s line: {text}"))?
+        .trim()
+        .parse::<f64>()
+        .map_err(|e| format!("{what}: median_s: {e}"))
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
 }
