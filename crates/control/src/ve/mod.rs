@@ -14,12 +14,14 @@
 
 mod constraint;
 mod cursor;
+mod host_body;
 mod spring;
 #[cfg(test)]
 mod tests;
 
 pub use constraint::BilateralConstraint;
 pub use cursor::{CursorMass, ExplicitCursor, LosslessCursor, PAPER_MIN_CURSOR_MASS_KG};
+pub use host_body::HostBody;
 pub use spring::{Solid, Spring, TrapezoidalSpring, UnilateralWall};
 
 use crate::{Position, Real, ZTransfer};

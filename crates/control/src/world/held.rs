@@ -92,6 +92,24 @@ impl<const N: usize> Held<N> {
         self.ramp
     }
 
+    /// The ramp's law in the z-domain, for a host that updates once every
+    /// `ramp` ticks: each surface is the mean of the targets over the last
+    /// `ramp` ticks, each target held from the tick it takes its first step
+    /// (a zero-order hold), `S(z)/U(z) = (1/N) Σ_{i<N} z^-i` with `N` the
+    /// ramp (to the steps' whole nanometres: within `N` nm).
+    pub fn ramp_response(&self, z: num_complex::Complex64) -> num_complex::Complex64 {
+        let zi = z.inv();
+        let (mut sum, mut p) = (
+            num_complex::Complex64::new(0.0, 0.0),
+            num_complex::Complex64::new(1.0, 0.0),
+        );
+        for _ in 0..self.ramp {
+            sum += p;
+            p *= zi;
+        }
+        sum / f64::from(self.ramp)
+    }
+
     /// Each axis's surface now.
     pub fn surfaces(&self) -> [Position; N] {
         self.surfaces
@@ -190,6 +208,55 @@ held_world!(f32 f64);
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The ramp the designer analyses is the ramp the board runs: targets
+    /// sent every `N` ticks along a sinusoid, each held surface against the
+    /// mean of the targets over the last `N` ticks, and that mean's steady
+    /// response to a sinusoid against `ramp_response`.
+    #[test]
+    fn a_host_updating_every_ramp_moves_the_surface_as_analysed() {
+        use num_complex::Complex64;
+        for n in [1u32, 4, 10] {
+            let mut w = Held::<1>::new([Position::ZERO], 1e-4, n);
+            let ports = [port(0.0)];
+            // 16 whole periods over the 2,000 ticks fitted, so the hold's images
+            // fall on other bins.
+            let th = 2.0 * core::f64::consts::PI * 16.0 / 2000.0;
+            let target = |k: u32| (2.0e5 * (th * f64::from(k)).sin()) as i32;
+            let mut held = [0i32; 4000];
+            let mut fit = (Complex64::new(0.0, 0.0), Complex64::new(0.0, 0.0));
+            for k in 0..4000u32 {
+                if k % n == 0 {
+                    w.set([Position::from_nm(target(k))], [Contact::Held]);
+                }
+                held[k as usize] = target(k - k % n);
+                World::<f32, 1>::step_axes(&mut w, &ports);
+                let s = w.surfaces()[0].nm();
+                let mean: f64 = (0..n as usize)
+                    .map(|i| f64::from(held[(k as usize).saturating_sub(i)]))
+                    .sum::<f64>()
+                    / f64::from(n);
+                assert!(
+                    (f64::from(s) - mean).abs() <= f64::from(n),
+                    "N {n} tick {k}: {s} against {mean}"
+                );
+                // The steady response of surface to the held target at θ
+                // (one period of a host's update: the hold's phase is
+                // the same at every update).
+                if k >= 2000 {
+                    let e = Complex64::from_polar(1.0, -th * f64::from(k));
+                    fit.0 += f64::from(s) * e;
+                    fit.1 += f64::from(held[k as usize]) * e;
+                }
+            }
+            let h = w.ramp_response(Complex64::from_polar(1.0, th));
+            assert!(
+                (fit.0 / fit.1 - h).norm() < 1e-3 * h.norm(),
+                "N {n}: {} against {h}",
+                fit.0 / fit.1
+            );
+        }
+    }
 
     fn port(f0_n: f32) -> Port<f32> {
         Port {
