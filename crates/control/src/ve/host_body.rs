@@ -32,9 +32,10 @@ pub struct HostBody {
 }
 
 impl HostBody {
-    /// A body of mass `mass_kg` (kg, > 0), damping `damping_nspm` (N s/m,
-    /// >= 0) and stiffness `stiffness_npm` (N/m, >= 0) to the anchor at 0,
-    /// stepped every `period_s` (s, > 0), at rest at `position_m` (m).
+    /// A body of mass `mass_kg` (kg, positive), damping `damping_nspm`
+    /// (N s/m, not negative) and stiffness `stiffness_npm` (N/m, not
+    /// negative) to the anchor at 0, stepped every `period_s` (s,
+    /// positive), at rest at `position_m` (m).
     pub fn new(
         mass_kg: f32,
         damping_nspm: f32,
