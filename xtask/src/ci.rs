@@ -275,6 +275,8 @@ fn tests() -> Result<(), String> {
             "twoport-design",
             "--test",
             "soundness",
+            "--test",
+            "host_ve",
         ],
         &["test", "--release", "-p", "twoport-identify", "--lib"],
         // The experiment on the flexible Excalibur, identified and

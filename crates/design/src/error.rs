@@ -11,6 +11,9 @@ pub enum Error {
     /// A law's parameter is out of its range.
     #[error("{0}")]
     Param(#[from] twoport_control::ParamError),
+    /// A host loop that cannot be: a zero VE period or delay.
+    #[error("host VE: {0}")]
+    HostLoop(String),
     /// No pose was given.
     #[error("no device model was given")]
     NoPose,

@@ -8,6 +8,7 @@ pub mod device;
 mod error;
 #[cfg(feature = "plot")]
 pub mod figures;
+pub mod host_ve;
 pub mod limit_cycle;
 pub mod linalg;
 pub mod linkage;

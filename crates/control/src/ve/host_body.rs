@@ -92,6 +92,21 @@ impl HostBody {
         )
     }
 
+    /// Its mass (kg).
+    pub fn mass_kg(&self) -> f32 {
+        self.mass_kg
+    }
+
+    /// Its damping (N s/m).
+    pub fn damping_nspm(&self) -> f32 {
+        self.damping_nspm
+    }
+
+    /// Its spring to the anchor (N/m).
+    pub fn stiffness_npm(&self) -> f32 {
+        self.stiffness_npm
+    }
+
     /// The host period `T_h` (s).
     pub fn period_s(&self) -> f32 {
         self.period_s

@@ -54,14 +54,14 @@ impl Ve {
 /// The device with the hand, discretised under the ZOH from the actuator
 /// force: `(A_d, b_d, c_xa, c_fm)` with outputs the actuator position `x_a`
 /// (m) and the measured force `f_m` (N).
-struct Sampled {
-    ad: DMatrix<f64>,
-    bd: Vec<f64>,
-    c_xa: Vec<f64>,
+pub(super) struct Sampled {
+    pub(super) ad: DMatrix<f64>,
+    pub(super) bd: Vec<f64>,
+    pub(super) c_xa: Vec<f64>,
     c_fm: Vec<f64>,
 }
 
-fn sampled(model: &DeviceModel, hand: &Hand, t: f64) -> Result<Sampled, String> {
+pub(super) fn sampled(model: &DeviceModel, hand: &Hand, t: f64) -> Result<Sampled, String> {
     let n = model.dof();
     let grasp = hand.grasp;
     let ny = n + usize::from(grasp.is_some());

@@ -162,6 +162,7 @@ pub const OSCILLATING_MARGIN: f64 = 1e-10;
 
 mod closed_loop;
 mod construct;
+mod host;
 mod search;
 mod simplex;
 
@@ -169,6 +170,7 @@ pub(crate) use simplex::maximise as simplex_maximise;
 
 use closed_loop::{closed_loop, judge};
 pub use construct::{construct, Constructed};
+pub use host::{host_radius, monodromy, verify_host, HostVerdict};
 pub use search::verify;
 
 /// The closed loop's spectral radius for one termination.

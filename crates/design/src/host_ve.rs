@@ -1,0 +1,325 @@
+//! The VE on the host, the coupling on the board: a proof of the two-rate
+//! loop for a host VE that moves with the handle.
+//!
+//! The board runs the impedance coupling at its servo period `T` against a
+//! VE point held at the host's surface ([`Held`]). A host that simulates a
+//! body ([`HostBody`]) reads the coupling's force every `N` ticks, steps
+//! its body once per its own period `N T`, and sends the body's position;
+//! the board takes the update's first step `d` ticks after the tick whose
+//! force the host read, and ramps it over `N` ticks. The VE then closes a
+//! loop through the host's rate and the link's delay: from the coupling's
+//! force to the VE point's velocity it is linear but periodic in `N`
+//! ticks, and no longer passive (a delayed mass gives energy back).
+//!
+//! The proof closes the host's loop around the proven one. With the
+//! surface still, the board's loop is the single-rate one the designer
+//! proved for every passive VE. The host then sees, from its body's
+//! velocity to the force it reads, one system at its own rate: the body's
+//! position held, delayed `d` ticks and ramped (the mean over `N` ticks of
+//! the held positions, [`Held::ramp_response`]), pushing the coupling and
+//! the device with the hand, and the force read every `N`th tick. Its
+//! impedance at the host's frequency `θ_h = Nθ` sums the `N` servo
+//! frequencies `θ_m = θ + 2πm/N` that fold onto it:
+//!
+//! ```text
+//! Z_env(θ) = Σ_m c_m Z_in(θ_m),
+//! c_m = T_h/(1 - e^{-jNθ}) · (1 - e^{-jθ_m})/T · e^{-jdθ_m} · R(θ_m)²,
+//! ```
+//!
+//! where `Z_in` is the impedance the VE point meets: the coupling in series
+//! with the device and the hand, `1/Z_in = 1/Z_cI + z^-d Y_h*`. For every
+//! passive hand, `Re(1/Z_in) >= e(θ_m) = Re(1/Z_cI) - S(θ_m)` (`S` the
+//! designer's sound bound, `e > 0` where the coupling is proven), so
+//! `Z_in(θ_m)` lies in the disk through 0 of diameter `1/e`, and
+//! `Re(c_m Z_in) >= -(|c_m| - Re c_m) / (2 e)`. The host's body (its
+//! impedance `Z_b`, [`HostBody::tf`]) closes the loop `1 + Z_env/Z_b`, so
+//! the two-rate loop is stable for every passive hand when
+//!
+//! ```text
+//! Re Z_b(θ_h) > W(θ) = Σ_m (|c_m| - Re c_m) / (2 e(θ_m))   for all θ in (0, π/N].
+//! ```
+//!
+//! (Scaling the body's admittance from 0, a still surface and the proven
+//! loop, to its own keeps `Re(Z_b/τ + Z_env) > 0` on the way, so no pole
+//! crosses the circle.) `Z_b`'s real part is its damping plus what its
+//! integration dissipates, `B + M (1 - cos θ_h)/T_h` for a free body; near
+//! DC, `W → (k τ)² / (4 b)` with `τ = (d + N - 1) T`: a body the host moves
+//! needs damping against the coupling's spring delayed by the host's
+//! period and the link, whatever its mass.
+//!
+//! The frequencies evaluated: 256 uniform in `(0, π/N]` and every point of
+//! the designer's grid folded into it, so every frequency the designer
+//! checks is among some `θ_m`. `verify::host` is the independent check:
+//! the exact periodic loop's growth over one host period against a search
+//! of hands.
+
+use crate::analysis::{grid, impedance_coupling_tf, Analysis, GridSpec};
+use crate::network::HumanBound;
+use crate::{Error, Plant};
+use num_complex::Complex64;
+use serde::Serialize;
+use std::f64::consts::PI;
+use twoport_control::ve::{HostBody, VeTransfer};
+use twoport_control::world::Held;
+use twoport_control::Position;
+
+/// A host VE and the link to it, in servo ticks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HostLoop {
+    /// The host's period in servo ticks, `N` (>= 1): it reads every `N`th
+    /// tick's force and the board ramps each update over `N` ticks.
+    pub ve_period_ticks: u32,
+    /// Ticks from the tick whose force the host read to the tick that
+    /// takes the update's first step, `d` (>= 1): the host's read, its
+    /// step and the link both ways.
+    pub delay_ticks: u32,
+    /// The host's body, at the host's period.
+    pub body: HostBody,
+}
+
+impl HostLoop {
+    /// A host at `ve_period_ticks` servo ticks of `servo_period_s`, with
+    /// `delay_ticks` of delay, stepping a body of `mass_kg`,
+    /// `damping_nspm` and `stiffness_npm`. Refuses a zero period or delay
+    /// and a body parameter out of its range, naming it.
+    pub fn new(
+        servo_period_s: f64,
+        ve_period_ticks: u32,
+        delay_ticks: u32,
+        (mass_kg, damping_nspm, stiffness_npm): (f64, f64, f64),
+    ) -> Result<Self, Error> {
+        if ve_period_ticks == 0 {
+            return Err(Error::HostLoop(
+                "the VE period must be at least one servo tick".into(),
+            ));
+        }
+        if delay_ticks == 0 {
+            return Err(Error::HostLoop(
+                "the delay must be at least one servo tick: a host answers a force it has read"
+                    .into(),
+            ));
+        }
+        let t_h = servo_period_s * f64::from(ve_period_ticks);
+        let body = HostBody::new(
+            mass_kg as f32,
+            damping_nspm as f32,
+            stiffness_npm as f32,
+            t_h as f32,
+            0.0,
+        )?;
+        Ok(HostLoop {
+            ve_period_ticks,
+            delay_ticks,
+            body,
+        })
+    }
+
+    /// `c_m` at base frequency `theta` (rad per tick), `m = 0..N`.
+    fn weights(&self, theta: f64, period_s: f64) -> Vec<Complex64> {
+        let n = self.ve_period_ticks;
+        let ramp = Held::<1>::new([Position::ZERO], period_s as f32, n);
+        let t_h = period_s * f64::from(n);
+        let hold = t_h / (1.0 - Complex64::from_polar(1.0, -f64::from(n) * theta));
+        (0..n)
+            .map(|m| {
+                let th = theta + 2.0 * PI * f64::from(m) / f64::from(n);
+                let z = Complex64::from_polar(1.0, th);
+                let r = ramp.ramp_response(z);
+                hold * (1.0 - z.inv()) / period_s
+                    * Complex64::from_polar(1.0, -f64::from(self.delay_ticks) * th)
+                    * r
+                    * r
+            })
+            .collect()
+    }
+
+    /// The body's impedance `F/V` at the host's frequency `theta_h` (rad
+    /// per host period), from its own law.
+    fn body_impedance(&self, theta_h: f64) -> Complex64 {
+        let z = Complex64::from_polar(1.0, theta_h);
+        match self.body.tf() {
+            VeTransfer::Admittance(y) => y.eval(z).inv(),
+            VeTransfer::Impedance(zb) => zb.eval(z),
+        }
+    }
+}
+
+/// What [`check_host_ve`] found.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct HostCheck {
+    /// Whether `Re Z_b > W` at every frequency evaluated (and the coupling
+    /// is proven for every passive VE there).
+    pub proven: bool,
+    /// The least of `Re Z_b - W` over them (N s/m).
+    pub min_margin_nspm: f64,
+    /// The base frequency where it is least (Hz, in `(0, 1/(2 N T)]`).
+    pub worst_frequency_hz: f64,
+    /// The least body damping that proves the loop with this body's mass
+    /// and spring (N s/m): the largest `W - Re Z_b` with the damping taken
+    /// out (`Re Z_b` is linear in it). Infinite where the coupling is not
+    /// proven for every passive VE at some frequency.
+    pub least_damping_nspm: f64,
+    /// How many base frequencies were evaluated.
+    pub frequencies: usize,
+}
+
+/// Base frequencies in `(0, π/N]` (rad per tick): 256 uniform, and the
+/// designer's grid folded in.
+fn base_grid(plant: &Plant, n: u32) -> Vec<f64> {
+    let t = plant.period_s();
+    let top = PI / f64::from(n);
+    let period = 2.0 * top;
+    let mut th: Vec<f64> = (1..=256).map(|i| top * f64::from(i) / 256.0).collect();
+    for w in grid(plant, GridSpec::DEFAULT) {
+        let f = (w * t).rem_euclid(period);
+        let f = if f > top { period - f } else { f };
+        if f > 1e-9 * top {
+            th.push(f);
+        }
+    }
+    th.sort_by(f64::total_cmp);
+    th.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * top);
+    th
+}
+
+/// Prove the impedance coupling `(k, b)` (N/m, N s/m) on `plant` against
+/// the host's loop, for every passive hand (within `human` where given).
+pub fn check_host_ve(
+    plant: &Plant,
+    k: f64,
+    b: f64,
+    human: Option<HumanBound>,
+    host: &HostLoop,
+) -> Result<HostCheck, Error> {
+    let t = plant.period_s();
+    let n = host.ve_period_ticks as usize;
+    let zc = impedance_coupling_tf(k, b, t)?;
+    let bases = base_grid(plant, host.ve_period_ticks);
+    // Every folded frequency in [0, π] (the real parts are even in θ).
+    let fold = |th: f64| ((th + PI).rem_euclid(2.0 * PI) - PI).abs();
+    let omegas: Vec<f64> = bases
+        .iter()
+        .flat_map(|&th| (0..n).map(move |m| th + 2.0 * PI * m as f64 / n as f64))
+        .map(|th| fold(th).max(1e-12) / t)
+        .collect();
+    let a = Analysis::on(plant, &omegas);
+    let bound = a.impedance_bound(human);
+    let excess: Vec<f64> = a
+        .points
+        .iter()
+        .zip(&bound)
+        .map(|(p, s)| zc.eval(p.z).inv().re - s)
+        .collect();
+    let damping = f64::from(host.body.damping_nspm());
+    let (mut worst, mut least_damping) = ((f64::INFINITY, 0.0), f64::NEG_INFINITY);
+    for (i, &th) in bases.iter().enumerate() {
+        let mut w = 0.0;
+        for (m, c) in host.weights(th, t).iter().enumerate() {
+            let e = excess[i * n + m];
+            // |c| - Re c without the cancellation near DC.
+            let short = if c.re > 0.0 {
+                c.im * c.im / (c.norm() + c.re)
+            } else {
+                c.norm() - c.re
+            };
+            w += if e > 0.0 {
+                short / (2.0 * e)
+            } else if short == 0.0 {
+                0.0
+            } else {
+                f64::INFINITY
+            };
+        }
+        let re_zb = host.body_impedance(f64::from(host.ve_period_ticks) * th).re;
+        let margin = re_zb - w;
+        let margin = if margin.is_nan() {
+            f64::NEG_INFINITY
+        } else {
+            margin
+        };
+        if margin < worst.0 {
+            worst = (margin, th / (2.0 * PI * t));
+        }
+        least_damping = least_damping.max(w - (re_zb - damping));
+    }
+    Ok(HostCheck {
+        proven: worst.0 > 0.0,
+        min_margin_nspm: worst.0,
+        worst_frequency_hz: worst.1,
+        least_damping_nspm: least_damping.max(0.0),
+        frequencies: bases.len(),
+    })
+}
+
+/// The stiffest impedance coupling at damping `b` (N s/m) proven both for
+/// every passive VE and against `host` (N/m, to 1e-4 of it): the
+/// single-rate limit, lowered by bisection until the host's loop is
+/// proven; `None` where no stiffness above 1e-6 of the limit is.
+pub fn host_max_stiffness(
+    plant: &Plant,
+    b: f64,
+    human: Option<HumanBound>,
+    host: &HostLoop,
+) -> Result<Option<f64>, Error> {
+    let a = Analysis::new(plant, GridSpec::DEFAULT);
+    let Some(limit) = crate::analysis::max_stiffness(&a, &a.impedance_bound(human), b) else {
+        return Ok(None);
+    };
+    let proven = |k: f64| check_host_ve(plant, k, b, human, host).map(|c| c.proven);
+    // Just inside the single-rate boundary, where the excess is positive.
+    let top = limit * (1.0 - 1e-6);
+    if proven(top)? {
+        return Ok(Some(top));
+    }
+    let (mut lo, mut hi) = (top * 1e-6, top);
+    if !proven(lo)? {
+        return Ok(None);
+    }
+    while (hi - lo) > 1e-4 * lo {
+        let mid = (lo * hi).sqrt();
+        if proven(mid)? {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Ok(Some(lo))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::max_stiffness;
+    use crate::DeviceModel;
+
+    fn excalibur(t: f64) -> (DeviceModel, Plant) {
+        let m = DeviceModel::excalibur().unwrap();
+        let p = Plant::new(&m, t).unwrap();
+        (m, p)
+    }
+
+    /// A host that never moves its body (all damping) adds nothing: the
+    /// loop is proven exactly where the coupling is proven for every
+    /// passive VE, and not past it.
+    #[test]
+    fn a_still_body_leaves_the_single_rate_proof() {
+        let (_, p) = excalibur(1e-3);
+        let a = Analysis::new(&p, GridSpec::DEFAULT);
+        let limit = max_stiffness(&a, &a.impedance_bound(Some(HumanBound::PAPER)), 90.0).unwrap();
+        let still = HostLoop::new(1e-3, 1, 1, (1.0, 1e12, 0.0)).unwrap();
+        let at = |k: f64| check_host_ve(&p, k, 90.0, Some(HumanBound::PAPER), &still).unwrap();
+        assert!(at(0.99 * limit).proven);
+        assert!(!at(1.01 * limit).proven);
+        assert!(at(1.01 * limit).least_damping_nspm.is_infinite());
+    }
+
+    #[test]
+    fn a_host_loop_that_cannot_be_is_named() {
+        let e = HostLoop::new(1e-3, 0, 1, (1.0, 1.0, 0.0)).unwrap_err();
+        assert!(e.to_string().contains("VE period"), "{e}");
+        let e = HostLoop::new(1e-3, 1, 0, (1.0, 1.0, 0.0)).unwrap_err();
+        assert!(e.to_string().contains("delay"), "{e}");
+        let e = HostLoop::new(1e-3, 1, 1, (0.0, 1.0, 0.0)).unwrap_err();
+        assert!(e.to_string().contains("host body mass"), "{e}");
+    }
+}

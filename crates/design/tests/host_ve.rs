@@ -1,0 +1,136 @@
+//! The proof of a host VE's two-rate loop (`host_ve`) against what does
+//! not share its method: the exact periodic loop's growth over one host
+//! period (`verify::host`), a search of hands, and the clamped handle's
+//! own boundary found by bisection. The Excalibur at 1, 4 and 10 kHz, and
+//! a rigid device with and without a delay.
+//!
+//! Each case runs designs and searches that take a second or more in a
+//! debug build, so they are ignored there; CI runs the file in release.
+
+use twoport_design::host_ve::{check_host_ve, host_max_stiffness, HostLoop};
+use twoport_design::network::HumanBound;
+use twoport_design::verify::{host_radius, verify_host, Hand};
+use twoport_design::{DeviceModel, Plant};
+
+fn excalibur(t: f64) -> (DeviceModel, Plant) {
+    let m = DeviceModel::excalibur().unwrap();
+    let p = Plant::new(&m, t).unwrap();
+    (m, p)
+}
+
+/// A rigid 1-DOF device, handle and actuator at one point.
+fn rigid(mass_kg: f64, damping_nspm: f64, delay: u32) -> DeviceModel {
+    DeviceModel::from_toml(
+        &format!(
+            "period_s = 0.001\npeak_force_n = 50.0\ncontinuous_force_n = 20.0\n\
+             delay_samples = {delay}\nM = [[{mass_kg}]]\nD = [[{damping_nspm}]]\n\
+             K = [[0.0]]\nG = [[1.0, -1.0]]\nC_v = [[1.0], [-1.0]]\n"
+        ),
+        "rigid",
+    )
+    .unwrap()
+}
+
+/// The host's loop costs stiffness, more the longer the delay, and
+/// damping on the host's body buys it back.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn delay_costs_stiffness_and_host_damping_buys_it_back() {
+    let (_, p) = excalibur(1e-3);
+    let h = Some(HumanBound::PAPER);
+    let k = |d: u32, damping: f64| {
+        let host = HostLoop::new(1e-3, 1, d, (5.0, damping, 0.0)).unwrap();
+        host_max_stiffness(&p, 90.0, h, &host).unwrap().unwrap()
+    };
+    let (k1, k3, k3_damped) = (k(1, 1.0), k(3, 1.0), k(3, 100.0));
+    assert!(k3 < k1, "{k3} against {k1}");
+    assert!(k3_damped > k3, "{k3_damped} against {k3}");
+}
+
+/// One case against the exact periodic loop: at the least damping the
+/// proof asks for, the search of hands finds nothing; with no damping on
+/// the body, a hand free to clamp the handle makes the loop grow; and the
+/// clamped handle's own boundary (by bisection on the damping) lies below
+/// what the proof asks for.
+fn cross_check(m: &DeviceModel, p: &Plant, (k, b): (f64, f64), (n, d): (u32, u32), mass: f64) {
+    let t = p.period_s();
+    let clamp = Hand {
+        mass_kg: 1e-3,
+        stiffness_npm: 1e8,
+        damping_nspm: 1e-3,
+        grasp: None,
+        second: None,
+    };
+    {
+        let (m, p) = (m, p);
+        let host = |damping: f64| HostLoop::new(t, n, d, (mass, damping, 0.0)).unwrap();
+        for human in [None, Some(HumanBound::PAPER)] {
+            let need = check_host_ve(p, k, b, human, &host(0.0))
+                .unwrap()
+                .least_damping_nspm;
+            assert!(need.is_finite() && need > 0.0, "T {t} N {n} d {d}: {need}");
+            let at = host(1.01 * need);
+            assert!(check_host_ve(p, k, b, human, &at).unwrap().proven);
+            let v = verify_host(m, t, (k, b), human, &at).unwrap();
+            assert!(
+                !v.unstable && v.spectral_radius < 1.0,
+                "T {t} N {n} d {d} human {}: B {need} proven, yet {v:?}",
+                human.is_some()
+            );
+        }
+        // With no damping on the body, a hand that is free to clamp
+        // the handle makes the loop grow.
+        let grows = verify_host(m, t, (k, b), None, &host(0.0)).unwrap();
+        assert!(grows.unstable, "T {t} N {n} d {d}: {grows:?}");
+        // The clamped handle's own boundary, by bisection on the
+        // damping, lies below what the proof asks for.
+        let rho = |damping: f64| {
+            host_radius(m, t, (k, b), &clamp, &host(damping))
+                .unwrap()
+                .spectral_radius
+        };
+        let need = check_host_ve(p, k, b, None, &host(0.0))
+            .unwrap()
+            .least_damping_nspm;
+        assert!(
+            rho(0.0) > 1.0 && rho(need) < 1.0,
+            "T {t}: {} {}",
+            rho(0.0),
+            rho(need)
+        );
+    }
+}
+
+/// The Excalibur at 1, 4 and 10 kHz, the host at 1 kHz or the servo's
+/// rate, light and heavy bodies.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn the_proof_holds_in_the_exact_periodic_loop_of_the_excalibur() {
+    for (t, k, b, n, d, mass) in [
+        (1e-3, 46_700.0, 72.2, 1u32, 2u32, 0.1),
+        (1e-3, 46_700.0, 72.2, 1, 3, 10.0),
+        (2.5e-4, 100_000.0, 300.0, 4, 4, 0.1),
+        (1e-4, 300_000.0, 1000.0, 10, 10, 0.3),
+    ] {
+        let (m, p) = excalibur(t);
+        cross_check(&m, &p, (k, b), (n, d), mass);
+    }
+}
+
+/// A rigid, lightly damped device (1 kg, 20 N s/m), without and with a
+/// tick of delay, the host at the servo's rate and at a quarter of it.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn the_proof_holds_in_the_exact_periodic_loop_of_a_rigid_device() {
+    use twoport_design::analysis::{max_stiffness, Analysis, GridSpec};
+    for delay in [0, 1] {
+        let m = rigid(1.0, 20.0, delay);
+        let p = Plant::new(&m, 1e-3).unwrap();
+        let a = Analysis::new(&p, GridSpec::DEFAULT);
+        let b = 5.0;
+        let k = 0.9 * max_stiffness(&a, &a.impedance_bound(None), b).unwrap();
+        for (n, d, mass) in [(1u32, 2u32, 0.2), (4, 4, 0.5)] {
+            cross_check(&m, &p, (k, b), (n, d), mass);
+        }
+    }
+}
