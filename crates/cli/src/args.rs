@@ -427,6 +427,20 @@ pub(crate) struct RatesArgs {
     /// The linkages' least grasp damping (N s/m).
     #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
     min_grasp: f64,
+    /// Also prove each lumped device's coupling against a body the host
+    /// simulates and moves with the handle: its mass (kg) and damping
+    /// (N s/m), e.g. `1,10`. Each rate then gives the stiffest coupling at
+    /// the best pair's damping proven against it too.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    host_body: Option<Vec<f64>>,
+    /// The host's VE rate (Hz): every servo rate must be a whole multiple.
+    #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
+    ve_rate: f64,
+    /// From the tick whose force the host reads to the tick that takes its
+    /// answer (s): the host's step and the link both ways. Rounded up to
+    /// whole ticks.
+    #[arg(long, default_value_t = 0.002, allow_negative_numbers = true)]
+    host_delay: f64,
     /// Draw the table as a log-log figure (.png or .svg).
     #[arg(long)]
     pub(crate) plot: Option<PathBuf>,
@@ -435,7 +449,68 @@ pub(crate) struct RatesArgs {
     pub(crate) json: bool,
 }
 
+/// A host body and its link, as `twoport rates --host-body` gives them.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HostArgs {
+    /// The body's mass (kg) and damping (N s/m).
+    pub(crate) body: (f64, f64),
+    /// The VE rate (Hz).
+    pub(crate) ve_rate_hz: f64,
+    /// The delay (s).
+    pub(crate) delay_s: f64,
+}
+
+impl HostArgs {
+    /// `(N, d)` at `servo_hz`: the VE period and the delay in ticks, or
+    /// why the rate is not a whole multiple of the VE rate.
+    pub(crate) fn ticks(&self, servo_hz: f64) -> Result<(u32, u32), String> {
+        let n = servo_hz / self.ve_rate_hz;
+        if (n - n.round()).abs() > 1e-9 * n || n.round() < 1.0 {
+            return Err(format!(
+                "--rates {servo_hz} Hz: not a whole multiple of --ve-rate {} Hz",
+                self.ve_rate_hz
+            ));
+        }
+        let d = (self.delay_s * servo_hz - 1e-9).ceil().max(1.0);
+        Ok((n.round() as u32, d as u32))
+    }
+}
+
 impl RatesArgs {
+    /// The host body and link, checked, where `--host-body` is given.
+    pub(crate) fn host(&self) -> Result<Option<HostArgs>, String> {
+        let Some(b) = &self.host_body else {
+            return Ok(None);
+        };
+        let &[m, d] = b.as_slice() else {
+            return Err(format!(
+                "--host-body {b:?}: give the mass (kg) and the damping (N s/m), e.g. 1,10"
+            ));
+        };
+        if !(m.is_finite() && m > 0.0) {
+            return Err(format!("--host-body {m},{d}: the mass must be > 0 kg"));
+        }
+        if !(d.is_finite() && d >= 0.0) {
+            return Err(format!(
+                "--host-body {m},{d}: the damping must be 0 N s/m or more"
+            ));
+        }
+        if !(self.ve_rate.is_finite() && self.ve_rate > 0.0) {
+            return Err(format!("--ve-rate {}: not a rate (Hz)", self.ve_rate));
+        }
+        if !(self.host_delay.is_finite() && self.host_delay > 0.0) {
+            return Err(format!(
+                "--host-delay {}: must be a time > 0 s",
+                self.host_delay
+            ));
+        }
+        Ok(Some(HostArgs {
+            body: (m, d),
+            ve_rate_hz: self.ve_rate,
+            delay_s: self.host_delay,
+        }))
+    }
+
     /// The rates, each finite and positive, or the one that is not.
     pub(crate) fn rates(&self) -> Result<Vec<f64>, String> {
         match self.rates.iter().find(|r| !(r.is_finite() && **r > 0.0)) {

@@ -61,6 +61,17 @@ fn bad_rates_and_grasps_are_named() {
     assert!(e.contains("--rates: 0 Hz"), "{e}");
     let e = TWOPORT.failure(&["rates", "--min-grasp", "-1"]);
     assert!(e.contains("--min-grasp -1"), "{e}");
+    let e = TWOPORT.failure(&["rates", "--host-body", "1"]);
+    assert!(e.contains("--host-body [1.0]"), "{e}");
+    let e = TWOPORT.failure(&["rates", "--host-body", "0,10"]);
+    assert!(e.contains("the mass must be > 0 kg"), "{e}");
+    let e = TWOPORT.failure(&["rates", "--host-body", "1,10", "--rates", "1500"]);
+    assert!(
+        e.contains("1500 Hz: not a whole multiple of --ve-rate 1000 Hz"),
+        "{e}"
+    );
+    let e = TWOPORT.failure(&["rates", "--host-body", "1,10", "--host-delay", "0"]);
+    assert!(e.contains("--host-delay 0"), "{e}");
     let e = TWOPORT.failure(&["rates", "--model", "no/such.toml"]);
     assert!(e.contains("no/such.toml"), "{e}");
 }

@@ -252,7 +252,7 @@ pub fn check_host_ve(
 }
 
 /// The stiffest impedance coupling at damping `b` (N s/m) proven both for
-/// every passive VE and against `host` (N/m, to 1e-4 of it): the
+/// every passive VE and against `host` (N/m, to 1e-3 of it): the
 /// single-rate limit, lowered by bisection until the host's loop is
 /// proven; `None` where no stiffness above 1e-6 of the limit is.
 pub fn host_max_stiffness(
@@ -275,7 +275,7 @@ pub fn host_max_stiffness(
     if !proven(lo)? {
         return Ok(None);
     }
-    while (hi - lo) > 1e-4 * lo {
+    while (hi - lo) > 1e-3 * lo {
         let mid = (lo * hi).sqrt();
         if proven(mid)? {
             lo = mid;
@@ -284,6 +284,52 @@ pub fn host_max_stiffness(
         }
     }
     Ok(Some(lo))
+}
+
+/// The best pair against `host`: the damping in `(0, b_max]` (N s/m) whose
+/// stiffest coupling proven against it is stiffest, and that stiffness,
+/// `(k N/m, b N s/m)`. A damping helps the single-rate proof and, delayed
+/// by the host, works against the host's loop, so the pair lies below the
+/// single-rate one: searched over seven dampings spaced by ratios of 2.6
+/// down to `b_max / 300`, then by golden sections around the best.
+pub fn host_best_pair(
+    plant: &Plant,
+    human: Option<HumanBound>,
+    host: &HostLoop,
+    b_max: f64,
+) -> Result<Option<(f64, f64)>, Error> {
+    let k_at = |b: f64| host_max_stiffness(plant, b, human, host).map(|k| k.unwrap_or(0.0));
+    let ln = |i: f64| b_max.ln() - i * (300f64.ln() / 6.0);
+    let k_at = |b: f64| k_at(b.min(b_max));
+    let mut best = (0.0, b_max, 0.0);
+    for i in 0..7 {
+        let b = ln(f64::from(i)).exp().min(b_max);
+        let k = k_at(b)?;
+        if k > best.0 {
+            best = (k, b, f64::from(i));
+        }
+    }
+    if best.0 == 0.0 {
+        return Ok(None);
+    }
+    // Golden sections in log b over the best's neighbours.
+    let (mut lo, mut hi) = (ln((best.2 + 1.0).min(6.0)), ln((best.2 - 1.0).max(0.0)));
+    let g = 0.618_033_988_749_895;
+    for _ in 0..6 {
+        let (x1, x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+        let (k1, k2) = (k_at(x1.exp())?, k_at(x2.exp())?);
+        for (k, x) in [(k1, x1), (k2, x2)] {
+            if k > best.0 {
+                best = (k, x.exp().min(b_max), best.2);
+            }
+        }
+        if k1 > k2 {
+            hi = x2;
+        } else {
+            lo = x1;
+        }
+    }
+    Ok(Some((best.0, best.1)))
 }
 
 #[cfg(test)]

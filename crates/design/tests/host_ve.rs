@@ -134,3 +134,21 @@ fn the_proof_holds_in_the_exact_periodic_loop_of_a_rigid_device() {
         }
     }
 }
+
+/// The best pair against a host body is on the proof's boundary (proven,
+/// and not at 1% more stiffness), below the single-rate best pair, and a
+/// longer delay lowers it.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn the_best_pair_against_a_host_body_is_on_its_boundary() {
+    use twoport_design::host_ve::host_best_pair;
+    let (_, p) = excalibur(1e-3);
+    let h = Some(HumanBound::PAPER);
+    let host = |d: u32| HostLoop::new(1e-3, 1, d, (1.0, 10.0, 0.0)).unwrap();
+    let (k, b) = host_best_pair(&p, h, &host(2), 72.2).unwrap().unwrap();
+    assert!(check_host_ve(&p, k, b, h, &host(2)).unwrap().proven);
+    assert!(!check_host_ve(&p, 1.01 * k, b, h, &host(2)).unwrap().proven);
+    assert!(k < 51_889.0 && b <= 72.2, "{k} at {b}");
+    let (k4, _) = host_best_pair(&p, h, &host(4), 72.2).unwrap().unwrap();
+    assert!(k4 < k, "{k4} against {k}");
+}
