@@ -257,7 +257,8 @@ has_common!(
     DesignImpedance,
     DesignAdmittance,
     ImpedanceGains,
-    AdmittanceGains
+    AdmittanceGains,
+    HostVeArgs
 );
 
 impl HasCommon for RegionImpedance {
@@ -427,20 +428,10 @@ pub(crate) struct RatesArgs {
     /// The linkages' least grasp damping (N s/m).
     #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
     min_grasp: f64,
-    /// Also prove each lumped device's coupling against a body the host
-    /// simulates and moves with the handle: its mass (kg) and damping
-    /// (N s/m), e.g. `1,10`. Each rate then gives the stiffest coupling at
-    /// the best pair's damping proven against it too.
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
-    host_body: Option<Vec<f64>>,
-    /// The host's VE rate (Hz): every servo rate must be a whole multiple.
-    #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
-    ve_rate: f64,
-    /// From the tick whose force the host reads to the tick that takes its
-    /// answer (s): the host's step and the link both ways. Rounded up to
-    /// whole ticks.
-    #[arg(long, default_value_t = 0.002, allow_negative_numbers = true)]
-    host_delay: f64,
+    /// With --host-body, each lumped device's row also gives the best
+    /// coupling proven against that body.
+    #[command(flatten)]
+    pub(crate) host: HostOpts,
     /// Draw the table as a log-log figure (.png or .svg).
     #[arg(long)]
     pub(crate) plot: Option<PathBuf>,
@@ -449,7 +440,25 @@ pub(crate) struct RatesArgs {
     pub(crate) json: bool,
 }
 
-/// A host body and its link, as `twoport rates --host-body` gives them.
+/// A body the host simulates and moves with the handle, and its link.
+#[derive(Args, Clone)]
+pub(crate) struct HostOpts {
+    /// The host body's mass (kg) and damping (N s/m), e.g. `1,10`: a body
+    /// the host steps at its VE rate from the force the board reports and
+    /// sends back as a held surface.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    host_body: Option<Vec<f64>>,
+    /// The host's VE rate (Hz): the servo rate must be a whole multiple.
+    #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
+    ve_rate: f64,
+    /// From the tick whose force the host reads to the tick that takes its
+    /// answer (s): the host's step and the link both ways. Rounded up to
+    /// whole ticks.
+    #[arg(long, default_value_t = 0.002, allow_negative_numbers = true)]
+    host_delay: f64,
+}
+
+/// A host body and its link, checked.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct HostArgs {
     /// The body's mass (kg) and damping (N s/m).
@@ -476,9 +485,9 @@ impl HostArgs {
     }
 }
 
-impl RatesArgs {
+impl HostOpts {
     /// The host body and link, checked, where `--host-body` is given.
-    pub(crate) fn host(&self) -> Result<Option<HostArgs>, String> {
+    pub(crate) fn get(&self) -> Result<Option<HostArgs>, String> {
         let Some(b) = &self.host_body else {
             return Ok(None);
         };
@@ -510,7 +519,30 @@ impl RatesArgs {
             delay_s: self.host_delay,
         }))
     }
+}
 
+/// `twoport host-ve`'s arguments.
+#[derive(Args, Clone)]
+pub(crate) struct HostVeArgs {
+    /// Coupling stiffness k_cI (N/m); without it, the stiffest proven
+    /// (at --b, or the best pair).
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) k: Option<f64>,
+    /// Coupling damping b_cI (N s/m); without it (and without --k), the
+    /// best pair.
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) b: Option<f64>,
+    #[command(flatten)]
+    pub(crate) host: HostOpts,
+    /// Also search hands on the exact two-rate loop (independent of the
+    /// proof).
+    #[arg(long)]
+    pub(crate) verify: bool,
+    #[command(flatten)]
+    pub(crate) common: Common,
+}
+
+impl RatesArgs {
     /// The rates, each finite and positive, or the one that is not.
     pub(crate) fn rates(&self) -> Result<Vec<f64>, String> {
         match self.rates.iter().find(|r| !(r.is_finite() && **r > 0.0)) {

@@ -2,6 +2,7 @@
 
 mod args;
 mod check;
+mod host;
 mod identify;
 mod plots;
 mod rates;
@@ -51,6 +52,10 @@ pub(crate) enum Cmd {
     /// What the servo rate buys: each device's proven coupling at each
     /// servo rate, as a table and a figure.
     Rates(RatesArgs),
+    /// Prove an impedance coupling against a body the host simulates and
+    /// moves with the handle, at its VE rate and the link's delay (or find
+    /// the stiffest such coupling).
+    HostVe(HostVeArgs),
 }
 
 /// `run` on `args`, refusing a device file: the command draws one axis.
@@ -96,6 +101,7 @@ fn main() -> ExitCode {
         Cmd::Verify(d) => each_axis(d, verify::verify),
         Cmd::Identify(a) => identify::identify(a),
         Cmd::Rates(a) => rates::rates(a),
+        Cmd::HostVe(a) => one_axis(a, host::host_ve),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,

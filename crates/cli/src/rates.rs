@@ -95,7 +95,7 @@ fn linkage_row(path: &Path, rates: &[f64], grasp: f64) -> Result<Row, String> {
 pub(crate) fn rates(a: &RatesArgs) -> Result<(), String> {
     let rates = a.rates()?;
     let grasp = a.grasp()?;
-    let host = a.host()?;
+    let host = a.host.get()?;
     if let Some(h) = &host {
         for r in &rates {
             h.ticks(*r)?;
