@@ -300,9 +300,7 @@ pub(crate) fn device(args: &[String]) -> Result<(), String> {
     } else {
         None
     };
-    let mut qemu = qemu_an386_timed(&elf, "shift=6,align=on");
-    qemu.args(["-serial", "pty"]);
-    with_board_in_qemu(qemu, |pty| {
+    with_device(&elf, |pty| {
         let Some((exe, lib)) = &example else {
             eprintln!("xtask: open {pty} with twoport_host::Board::open_serial; Ctrl-C stops it");
             loop {
@@ -321,6 +319,17 @@ pub(crate) fn device(args: &[String]) -> Result<(), String> {
             Command::new(exe).arg(pty).env("LD_LIBRARY_PATH", lib),
         )
     })
+}
+
+/// The `sim-device` image `elf` free-running
+/// in QEMU, virtual time held to the wall clock; `f` gets its pty.
+pub(crate) fn with_device(
+    elf: &Path,
+    f: impl FnOnce(&str) -> Result<(), String>,
+) -> Result<(), String> {
+    let mut qemu = qemu_an386_timed(elf, "shift=6,align=on");
+    qemu.args(["-serial", "pty"]);
+    with_board_in_qemu(qemu, f)
 }
 
 /// The C example, `crates/capi/examples/wall.c`, built with the system C

@@ -10,7 +10,9 @@ use std::process::Command;
 /// The tools the step installs into its environment.
 const TOOLS: [&str; 3] = ["maturin>=1.5,<2", "pytest", "numpy"];
 
-/// Build the wheel, install it, run `crates/python/tests`.
+/// Build the wheel, install it, run `crates/python/tests`, then the wall
+/// example (`crates/python/examples/wall.py`) against the free-running
+/// board in QEMU: home, arm, a wall from Python at 1 kHz, disarm.
 pub(crate) fn python() -> Result<(), String> {
     let bin = wheel()?;
     run(
@@ -21,7 +23,16 @@ pub(crate) fn python() -> Result<(), String> {
             "-q",
             "crates/python/tests",
         ]),
-    )
+    )?;
+    let elf = crate::firmware::an386_image_with("sim-device")?;
+    crate::emulate::with_device(&elf, |pty| {
+        run(
+            "the Python example against the free-running board",
+            Command::new(bin.join("python"))
+                .arg(root().join("crates/python/examples/wall.py"))
+                .arg(pty),
+        )
+    })
 }
 
 /// The environment with the package's wheel built and installed; its

@@ -9,10 +9,11 @@ use crate::io::IoScale;
 use crate::support::{BoardSupport, RawSensors};
 
 /// One axis of the simulated device: a rigid mass with viscous damping,
-/// pushed by its motor and by a hand with a constant force. The hand
-/// leans on the handle only while the amplifier's outputs are on (it lets
-/// go of a handle that does not push back, which would otherwise drift off
-/// before the host arms the board). The load cell reads the hand's force.
+/// pushed by its motor and by a hand with a constant force, above a hard
+/// stop where it has one (what homing drives into). The hand leans on the
+/// handle only while the amplifier's outputs are on (it lets go of a
+/// handle that does not push back, which would otherwise drift off before
+/// the host arms the board). The load cell reads the hand's force.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SimAxis {
     /// The moving mass (kg).
@@ -23,17 +24,22 @@ pub struct SimAxis {
     pub hand_n: f32,
     /// Where the mass starts (m).
     pub start_m: f32,
+    /// A rigid stop below which the mass cannot go (m), or none: the mass
+    /// stops dead on it.
+    pub stop_m: Option<f32>,
 }
 
 impl SimAxis {
     /// The Excalibur's actuator mass (0.93 kg) with 4 N s/m of damping,
-    /// at rest at the origin, the hand pushing with `hand_n`.
+    /// at rest at the origin, the hand pushing with `hand_n`, a stop 30 mm
+    /// below (the Excalibur image homes toward negative positions).
     pub const fn excalibur(hand_n: f32) -> Self {
         SimAxis {
             mass_kg: 0.93,
             damping_nspm: 4.0,
             hand_n,
             start_m: 0.0,
+            stop_m: Some(-0.03),
         }
     }
 }
@@ -126,6 +132,12 @@ impl<S: BoardSupport<N>, const N: usize> BoardSupport<N> for Simulated<S, N> {
             let f = hand - motor - a.damping_nspm * self.v_mps[i];
             self.v_mps[i] += t * f / a.mass_kg;
             self.x_m[i] += t * self.v_mps[i];
+            if let Some(stop) = a.stop_m {
+                if self.x_m[i] < stop {
+                    self.x_m[i] = stop;
+                    self.v_mps[i] = self.v_mps[i].max(0.0);
+                }
+            }
         }
         RawSensors {
             encoder_raw: core::array::from_fn(|i| self.count(self.x_m[i])),
@@ -248,6 +260,24 @@ mod tests {
             d.sample();
         }
         assert!(d.position_m()[0].abs() < 2e-5, "{:?}", d.position_m());
+    }
+
+    /// A motor pushing toward the stop stops dead on it and stays, and the
+    /// hand lifts the mass off it again.
+    #[test]
+    fn the_stop_holds_the_mass_and_lets_it_go() {
+        let mut d = device(2.0);
+        d.set_outputs(true);
+        d.set_duty([IoScale::EXCALIBUR.duty(5.0)]);
+        for _ in 0..2000 {
+            d.sample();
+        }
+        assert_eq!((d.position_m()[0], d.velocity_mps()[0]), (-0.03, 0.0));
+        d.set_duty([0]);
+        for _ in 0..100 {
+            d.sample();
+        }
+        assert!(d.position_m()[0] > -0.03 && d.velocity_mps()[0] > 0.0);
     }
 
     /// Counts round to the nearest, on either side of zero, and wrap to

@@ -1,4 +1,4 @@
-/* A wall from the host: open a board, arm it, render a wall at 5 mm
+/* A wall from the host: open a board, home it, arm it, render a wall at 5 mm
  * (solid above) from this program for two seconds against whatever pushes
  * the handle, and disarm.
  *
@@ -44,8 +44,8 @@ int main(int argc, char **argv) {
            (unsigned)spec.axes, spec.period_s, spec.axis[0].limit,
            spec.axis[0].b_at_limit_nspm);
 
-    const double zero = 0.0;
-    if (tp_board_calibrate(b, &zero, 1) != TP_RESULT_OK) return fail(b, "calibrate");
+    /* Into the stop and back out calibrated: at most 30 s. */
+    if (tp_board_home(b, 30.0) != TP_RESULT_OK) return fail(b, "home");
     if (tp_board_stream(b, 1) != TP_RESULT_OK) return fail(b, "stream");
     /* Surfaces reached in one tick; up to half a second on one update (a
      * board in QEMU shares the machine with this program). */

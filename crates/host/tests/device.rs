@@ -144,3 +144,19 @@ fn wrong_calls_are_named_and_refusals_carry_the_boards_reason() {
     let e = b.host_ve(1, 20).unwrap_err();
     assert!(e.to_string().contains("NotDisarmed"), "{e}");
 }
+
+/// Homing drives the simulated handle into its stop (30 mm below where it
+/// started) and calls the stall the Excalibur image's stop position,
+/// -20 mm: the board is calibrated, disarmed, and reads the handle there.
+#[test]
+fn homing_finds_the_stop_and_calibrates() {
+    let mut b = open(2.0);
+    let s = b.home(Duration::from_secs(60)).unwrap();
+    assert!(s.calibrated && s.mode == Mode::Disarmed, "{s:?}");
+    b.stream(1).unwrap();
+    for _ in 0..20 {
+        b.poll().unwrap();
+    }
+    let x = b.latest().unwrap().axes[0].position_m;
+    assert!((x + 0.020).abs() < 1e-5, "at {x} m");
+}

@@ -218,6 +218,44 @@ impl Board {
         Ok(d)
     }
 
+    /// Home every axis into its stop and wait until the board is
+    /// calibrated (at most `timeout_s` s), the link served with the GIL
+    /// released; a fault on the way raises naming it.
+    #[pyo3(signature = (timeout_s=30.0))]
+    fn home(&mut self, py: Python<'_>, timeout_s: f64) -> PyResult<()> {
+        if !(timeout_s.is_finite() && timeout_s >= 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "timeout_s {timeout_s}: not a time"
+            )));
+        }
+        let b = self.open()?;
+        py.detach(|| b.home(Duration::from_secs_f64(timeout_s.min(3600.0))))
+            .map(|_| ())
+            .map_err(link)
+    }
+
+    /// The newest state read, as a dict (`mode` by name, per-axis fields
+    /// as lists), or None before any.
+    fn latest<'py>(&mut self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(s) = self.open()?.latest().copied() else {
+            return Ok(None);
+        };
+        let d = PyDict::new(py);
+        d.set_item("tick", s.tick)?;
+        d.set_item("mode", format!("{:?}", s.mode).to_lowercase())?;
+        d.set_item("faults", s.faults)?;
+        d.set_item("ve_seq", s.ve_seq)?;
+        let n = self.open()?.axes();
+        let axis = |f: fn(&twoport_host::AxisState) -> f64| -> Vec<f64> {
+            s.axes.iter().take(n).map(f).collect()
+        };
+        d.set_item("position_m", axis(|a| a.position_m))?;
+        d.set_item("velocity_mps", axis(|a| a.velocity_mps))?;
+        d.set_item("actuator_n", axis(|a| a.actuator_n))?;
+        d.set_item("ve_position_m", axis(|a| a.ve_position_m))?;
+        Ok(Some(d))
+    }
+
     /// Tell a disarmed board where each axis stands (m).
     fn calibrate(&mut self, position_m: Vec<f64>) -> PyResult<()> {
         self.open()?

@@ -83,3 +83,18 @@ def test_the_link_runs_with_the_gil_released():
     b.close()
     # A Python thread ran while the board's link did.
     assert during > 1000
+
+
+def test_homing_finds_the_stop_and_latest_says_where():
+    # The simulated handle's stop is where the Excalibur image calls -20 mm.
+    b = twoport.Board.simulated(2.0)
+    assert b.latest() is None or b.latest()["mode"] != "armed"
+    b.home(30.0)
+    b.stream(1)
+    b.run_for(0.05)
+    s = b.latest()
+    assert s["mode"] == "disarmed" and s["faults"] == 0
+    assert abs(s["position_m"][0] + 0.020) < 1e-5
+    with pytest.raises(ValueError, match="timeout_s"):
+        b.home(-1.0)
+    b.close()
