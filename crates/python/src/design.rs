@@ -339,7 +339,8 @@ pub(crate) fn zrange<'py>(
 
 /// The proven region of the impedance display: the stiffest proven
 /// coupling at each of `points` dampings log-spaced from `b_from` to
-/// `b_to` (N s/m); a dict of numpy arrays `b_nspm`, `k_max_npm`.
+/// `b_to` (N s/m); a dict of numpy arrays `b_nspm`, `k_max_npm` (a damping
+/// with no proven stiffness has no row).
 #[pyfunction]
 #[pyo3(signature = (model=None, b_from=10.0, b_to=1000.0, points=32, period=None, human=true))]
 pub(crate) fn region<'py>(
