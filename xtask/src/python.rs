@@ -7,8 +7,9 @@ use crate::{cargo, root, run, target_dir};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The tools the step installs into its environment.
-const TOOLS: [&str; 3] = ["maturin>=1.5,<2", "pytest", "numpy"];
+/// The tools the step installs into its environment (dask: the campaign
+/// example, across processes).
+const TOOLS: [&str; 4] = ["maturin>=1.5,<2", "pytest", "numpy", "dask"];
 
 /// Build the wheel, install it, run `crates/python/tests`, then the wall
 /// example (`crates/python/examples/wall.py`) against the free-running
