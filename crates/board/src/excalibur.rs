@@ -49,6 +49,7 @@ impl From<RegionError> for BuildError {
     }
 }
 
+pub mod fast;
 pub mod xyz;
 
 /// The proven region (impedance display, paper human bound, T = 1 ms).
@@ -81,9 +82,15 @@ pub const REGION_POINTS: usize = region::DAMPING_NSPM.len();
 /// The axis limits: Excalibur's, with the link watchdog and the dead-man
 /// switch on.
 pub const fn safety() -> SafetyConfig {
+    safety_at(PERIOD_S, HEARTBEAT_TIMEOUT_TICKS)
+}
+
+/// [`safety`] for a servo of period `period_s` (s) whose watchdog waits
+/// `heartbeat_ticks`.
+pub(crate) const fn safety_at(period_s: f32, heartbeat_ticks: u32) -> SafetyConfig {
     SafetyConfig {
-        period_s: PERIOD_S,
-        heartbeat_timeout_ticks: HEARTBEAT_TIMEOUT_TICKS,
+        period_s,
+        heartbeat_timeout_ticks: heartbeat_ticks,
         require_dead_man: true,
         ..SafetyConfig::excalibur()
     }
@@ -102,6 +109,15 @@ pub fn proven_region() -> Result<Region<REGION_POINTS>, RegionError> {
 /// The board's servo: the impedance display on the wall, disabled until the
 /// host enables it.
 pub fn stiff_wall_servo() -> Result<Servo<UnilateralWall>, BuildError> {
+    wall_servo(COUPLING, safety())
+}
+
+/// The impedance display with `coupling` on the wall, under `safety` (its
+/// period the servo's).
+pub(crate) fn wall_servo(
+    coupling: ImpedanceGains,
+    safety: SafetyConfig,
+) -> Result<Servo<UnilateralWall>, BuildError> {
     let (bits, pm) = ENCODER;
     let enc = Encoder::new(bits, pm, 0, Position::ZERO)?;
     let (x, k, b) = WALL;
@@ -110,10 +126,10 @@ pub fn stiff_wall_servo() -> Result<Servo<UnilateralWall>, BuildError> {
         b,
         Position::from_nm(x),
         Solid::Above,
-        PERIOD_S,
+        safety.period_s,
         Position::ZERO,
     )?;
-    Ok(Servo::new([COUPLING.into()], [enc], [safety()], ve)?)
+    Ok(Servo::new([coupling.into()], [enc], [safety], ve)?)
 }
 
 /// The actuator's port as the passivity layer sees it: the moving mass at
