@@ -396,3 +396,80 @@ fn the_board_states_its_spec_and_a_scene_at_another_period_is_refused() {
     assert!(e.to_string().contains("period_s"), "{e}");
     assert!(e.to_string().contains("0.001"), "{e}");
 }
+
+/// The 4 kHz image with the VE on the host at 1 kHz: the board states its
+/// 0.25 ms period, takes an update every 4 ticks (the last telemetry holds
+/// one sent within a telemetry period), and holds the host's wall at
+/// 10 mm, stiffer than the 1 kHz image holds its own.
+#[test]
+fn the_fast_image_holds_a_wall_sent_from_the_host_at_1_khz() {
+    use twoport_board::excalibur::fast;
+    let s = Scene::load(Path::new("../scenes/pil/fast_host_ve.toml"), &[]).unwrap();
+    let host = pil::HostVe {
+        every_ticks: 4,
+        deadline_ticks: 40,
+    };
+    let ticks = 12_000; // 3 s: the hand moves in and shakes against the wall
+    let r = pil::run_with::<_, 1>(
+        s,
+        ticks,
+        link::LocalFast::excalibur_fast().unwrap(),
+        LinkFaults::default(),
+        Some(host),
+    )
+    .unwrap();
+    assert_eq!(r.spec.unwrap().period_ns, 250_000);
+    assert_eq!(
+        u64::from(r.ve_updates_sent),
+        (ticks - r.armed_at_tick).div_ceil(4)
+    );
+    let held = r.telemetry.last().unwrap().ve_seq;
+    let every = fast::TELEMETRY_EVERY / 4;
+    assert!(
+        held > 0 && r.ve_updates_sent - held <= every,
+        "{held} of {}",
+        r.ve_updates_sent
+    );
+    assert!(r.telemetry.iter().all(|t| t.faults == 0));
+    // The VE point reaches the host's surface and never passes it.
+    let ve_max = r
+        .telemetry
+        .iter()
+        .filter(|t| t.mode == twoport_link::Mode::Armed)
+        .map(|t| t.axes[0].ve_position_pm)
+        .max();
+    assert_eq!(ve_max, Some(10_000_000_000));
+    // The same hand pushes the handle less deep into it than into the
+    // 1 kHz image's own wall (0.86 mm against 1.28 mm, the rest the
+    // flexible handle's give).
+    let deepest = |s: &[host_sim::Sample]| s.iter().map(|s| s.handle_m[0]).fold(f64::MIN, f64::max);
+    let slow = run(ticks / 4, LinkFaults::default());
+    let (fast_in, slow_in) = (deepest(&r.samples) - 0.010, deepest(&slow.samples) - 0.010);
+    assert!(
+        0.0 < fast_in && fast_in < 0.8 * slow_in,
+        "{fast_in} m in, against {slow_in} m"
+    );
+}
+
+/// A host VE needs the scene's wall to send.
+#[test]
+fn a_host_ve_run_without_a_wall_is_refused_by_name() {
+    let s = Scene::load(
+        Path::new("../scenes/table1/impedance_bilateral_maximum.toml"),
+        &[],
+    )
+    .unwrap();
+    let e = pil::run_with::<_, 1>(
+        s,
+        10,
+        LocalBoard::excalibur().unwrap(),
+        LinkFaults::default(),
+        Some(pil::HostVe {
+            every_ticks: 1,
+            deadline_ticks: 10,
+        }),
+    )
+    .err()
+    .unwrap();
+    assert!(e.to_string().contains("ve.kind = \"wall\""), "{e}");
+}

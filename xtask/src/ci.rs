@@ -208,8 +208,20 @@ fn pil_boards() -> Result<(), String> {
             ]
         };
         let (arm, delta) = (linkage("serial-arm"), linkage("delta"));
-        let runs: [&[&str]; 6] = [
+        let runs: [&[&str]; 7] = [
             &["--seconds", "4", "--link-loss-at-s", "3", "--check"],
+            // The 4 kHz image with the VE on the host at 1 kHz.
+            &[
+                "--fast",
+                "scenes/pil/fast_host_ve.toml",
+                "--host-ve-hz",
+                "1000",
+                "--seconds",
+                "4",
+                "--link-loss-at-s",
+                "3",
+                "--check",
+            ],
             &["scenes/homing.toml", "--seconds", "2", "--check"],
             // Two whole periods of the identification experiment.
             &[

@@ -70,6 +70,8 @@ pub(crate) fn pil(extra: &[String]) -> Result<(), String> {
         )
     };
     let xyz = args.iter().any(|a| declares_three_axes(a));
+    // (host-sim reads it too: the 4 kHz image's reference and period.)
+    let fast = args.iter().any(|a| a == "--fast");
     // (host-sim checks the name; the image is built with it as a feature.)
     let linkage = match args.iter().position(|a| a == "--linkage") {
         Some(i) => match args.get(i + 1) {
@@ -90,6 +92,8 @@ pub(crate) fn pil(extra: &[String]) -> Result<(), String> {
                 an386_image_with(l)?
             } else if xyz {
                 an386_image_with("xyz")?
+            } else if fast {
+                an386_image_with("fast")?
             } else {
                 firmware()?.join("twoport-an386")
             };
@@ -105,6 +109,7 @@ pub(crate) fn pil(extra: &[String]) -> Result<(), String> {
                 Some(l) => {
                     stm32f405_variant(&format!("qemu,{l}"), &format!("twoport-stm32f405-qemu-{l}"))?
                 }
+                None if fast => stm32f405_variant("qemu,fast", "twoport-stm32f405-qemu-fast")?,
                 None => stm32f405_qemu_image(xyz)?,
             };
             let log = cross_target_dir("firmware").join("qemu-unmodelled-stm32f405.log");

@@ -10,6 +10,7 @@
 //! - `pil [--board an386|stm32f405] [host-sim pil options]`:
 //!   processor-in-the-loop, a board image in QEMU against host-sim's plant
 //!   over `-serial pty` (e.g. `--json`, `--seconds 4`, `--link-loss-at-s 3`,
+//!   `--fast` for the 4 kHz image, `--host-ve-hz 1000` for a VE on the host,
 //!   `--check`, `--passivity`).
 //! - `scope-board`: the scope's board mode against the firmware in QEMU.
 //! - `watchdog`: hang the an386 image's loop on purpose; the watchdog

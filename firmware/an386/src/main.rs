@@ -39,9 +39,12 @@ fn main() -> ! {
         feature = "xyz",
         feature = "serial-arm",
         feature = "delta",
-        feature = "sim-device"
+        feature = "sim-device",
+        feature = "fast"
     )))]
     let board = twoport_board::excalibur::stiff_wall_board().map_err(|_| ());
+    #[cfg(feature = "fast")]
+    let board = twoport_board::excalibur::fast::board().map_err(|_| ());
     #[cfg(feature = "passivity")]
     let board = twoport_board::excalibur::stiff_wall_board_with_passivity().map_err(|_| ());
     #[cfg(feature = "xyz")]

@@ -61,7 +61,9 @@ impl Uart {
         Some(unsafe { read_volatile(DATA as *const u32) } as u8)
     }
 
-    /// Send `b` if the transmitter has room now; `false` if it is full.
+    /// Send `b` if the transmitter has room now; `false` if it is full
+    /// (the free-running image's link, which never waits on the UART).
+    #[cfg(feature = "sim-device")]
     pub fn try_send(&mut self, b: u8) -> bool {
         if self.state() & STATE_TX_FULL != 0 {
             return false;

@@ -75,9 +75,12 @@ pub const AXES: usize = 1;
 #[cfg(feature = "xyz")]
 pub const AXES: usize = 3;
 
-#[cfg(not(feature = "xyz"))]
+#[cfg(not(any(feature = "xyz", feature = "fast")))]
 type TheBoard =
     twoport_board::Board<twoport_control::ve::UnilateralWall, { excalibur::REGION_POINTS }>;
+#[cfg(feature = "fast")]
+type TheBoard =
+    twoport_board::Board<twoport_control::ve::UnilateralWall, { excalibur::fast::REGION_POINTS }>;
 #[cfg(all(feature = "xyz", not(any(feature = "serial-arm", feature = "delta"))))]
 type TheBoard = excalibur::xyz::XyzBoard;
 #[cfg(feature = "serial-arm")]
@@ -150,8 +153,10 @@ fn main() -> ! {
         init::instruction_counter(&dp.TIM5);
     }
     // A board that cannot build its law never drives the amplifier.
-    #[cfg(not(feature = "xyz"))]
+    #[cfg(not(any(feature = "xyz", feature = "fast")))]
     let board = excalibur::stiff_wall_board().map_err(|_| ());
+    #[cfg(feature = "fast")]
+    let board = excalibur::fast::board().map_err(|_| ());
     #[cfg(all(feature = "xyz", not(any(feature = "serial-arm", feature = "delta"))))]
     let board = excalibur::xyz::board().map_err(|_| ());
     #[cfg(feature = "serial-arm")]

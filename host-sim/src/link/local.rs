@@ -5,7 +5,7 @@
 use super::{BoardPort, LinkError};
 use std::collections::VecDeque;
 use std::time::Duration;
-use twoport_board::excalibur::{self, xyz, REGION_POINTS};
+use twoport_board::excalibur::{self, fast, xyz, REGION_POINTS};
 use twoport_board::linkage::{self as linkage_image, DeltaBoard, SerialArmBoard};
 use twoport_board::{Board, BoardSupport, RawSensors};
 use twoport_config::{RamFlash, Store};
@@ -115,6 +115,19 @@ impl LocalBoard<UnilateralWall, 1, SeriesDamper> {
         excalibur::stiff_wall_board_with_passivity()
             .map(Self::driven)
             .map_err(|e| LinkError::Image(format!("the Excalibur passivity image: {e:?}")))
+    }
+}
+
+/// The 4 kHz image's loop.
+pub type LocalFast =
+    LocalBoard<UnilateralWall, 1, Direct, Servo<UnilateralWall>, { fast::REGION_POINTS }>;
+
+impl LocalFast {
+    /// The 4 kHz image ([`fast::board`]).
+    pub fn excalibur_fast() -> Result<Self, LinkError> {
+        fast::board()
+            .map(Self::driven)
+            .map_err(|e| LinkError::Image(format!("the 4 kHz Excalibur image: {e:?}")))
     }
 }
 

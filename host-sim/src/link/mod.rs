@@ -5,7 +5,7 @@
 
 mod local;
 
-pub use local::{LocalBoard, LocalDelta, LocalSerialArm};
+pub use local::{LocalBoard, LocalDelta, LocalFast, LocalSerialArm};
 pub use twoport_host::{
     BoardPort, LinkError, LinkFaults, SerialBoard, Session, ANSWER_TIMEOUT, HEARTBEAT_EVERY,
 };

@@ -56,6 +56,8 @@ pub struct Run<const N: usize = 1> {
     pub experiment: Option<(twoport_link::Experiment, u64)>,
     /// What the board said it can do, asked before its first tick.
     pub spec: Option<twoport_link::Spec>,
+    /// Host VE updates sent (0: the board's own VE ran).
+    pub ve_updates_sent: u32,
 }
 
 impl<const N: usize> Default for Run<N> {
@@ -74,6 +76,7 @@ impl<const N: usize> Default for Run<N> {
             armed_at_tick: 0,
             homing: None,
             experiment: None,
+            ve_updates_sent: 0,
         }
     }
 }
@@ -122,6 +125,40 @@ impl<const N: usize> Run<N> {
                 last: x.last as usize,
             }),
         }))
+    }
+}
+
+/// A VE on the host beside the board's servo: the scene's wall sent as a
+/// surface every `every_ticks` ticks (a 1 kHz host on a 4 kHz board: 4),
+/// each ramped over that many, the board faulting past `deadline_ticks`
+/// on one update.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HostVe {
+    /// Ticks between the host's updates (>= 1).
+    pub every_ticks: u32,
+    /// The board's deadline on one update (ticks).
+    pub deadline_ticks: u32,
+}
+
+impl HostVe {
+    /// The scene's wall as the host's surface: where it is (pm) and which
+    /// side is solid; other VEs have no surface to send.
+    fn surface(scene: &Scene) -> Result<(i64, twoport_link::Contact), Error> {
+        use crate::engine::scene::SolidSide;
+        match scene.ve {
+            VeSpec::Wall {
+                position_m, solid, ..
+            } => Ok((
+                (position_m * 1e12).round() as i64,
+                match solid {
+                    SolidSide::Above => twoport_link::Contact::Above,
+                    SolidSide::Below => twoport_link::Contact::Below,
+                },
+            )),
+            _ => Err(Error::Pil(
+                "a host VE run sends the scene's wall: set ve.kind = \"wall\"".into(),
+            )),
+        }
     }
 }
 
@@ -339,6 +376,20 @@ pub fn run_axes<P: BoardPort, const N: usize>(
     port: P,
     faults: LinkFaults,
 ) -> Result<Run<N>, Error> {
+    run_with(scene, ticks, port, faults, None)
+}
+
+/// [`run_axes`], with the VE on the host where `host_ve` says: the board
+/// handed the VE before it arms, then sent the scene's wall from the tick
+/// it arms and every `every_ticks` after, before that tick's sensors.
+pub fn run_with<P: BoardPort, const N: usize>(
+    scene: Scene,
+    ticks: u64,
+    port: P,
+    faults: LinkFaults,
+    host_ve: Option<HostVe>,
+) -> Result<Run<N>, Error> {
+    let surface = host_ve.map(|_| HostVe::surface(&scene)).transpose()?;
     let mut sim = Simulation::<N>::with_axes(scene)?;
     let setup = Setup::for_sim(&sim)?;
     let start = setup.start;
@@ -379,24 +430,49 @@ pub fn run_axes<P: BoardPort, const N: usize>(
             r.homing = Some((r.samples.len() as u64 - 1, f64::NAN));
         }
     }
+    if let Some(h) = host_ve {
+        session.set_ve(twoport_link::VeSource::Host {
+            ramp_ticks: h.every_ticks,
+            deadline_ticks: h.deadline_ticks,
+        })?;
+    }
     // Armed straight after the status that allowed it, which the board
     // sends before that tick's actuator frame: the same tick on every
     // transport.
     session.arm()?;
     r.armed_at_tick = r.samples.len() as u64;
+    // The host's VE: the wall sent from the armed tick on, every
+    // `every_ticks`, always before a tick's sensors (so on the same tick
+    // whatever the transport).
+    let armed = r.armed_at_tick;
+    let mut seq = 0u32;
+    let mut host = |session: &mut Session<P>, at: u64| -> Result<(), Error> {
+        if let (Some(h), Some((pm, contact))) = (host_ve, surface) {
+            if (at - armed).is_multiple_of(u64::from(h.every_ticks.max(1))) {
+                seq += 1;
+                let pm = Axes::new([pm; N]).unwrap_or_default();
+                let contact = Axes::new([contact; N]).unwrap_or_default();
+                session.ve_update(seq, pm, contact)?;
+            }
+        }
+        Ok(())
+    };
     if let Some(spec) = sim.scene().identify {
         let period = sim.scene().period();
         let x = spec.experiment(period)?;
         let at = r.armed_at_tick + (spec.start_s / period).round() as u64;
         while (r.samples.len() as u64) < at.min(ticks) {
+            host(&mut session, r.samples.len() as u64)?;
             record(&mut session, &mut sim, &mut r)?;
         }
         session.identify(x)?;
         r.experiment = Some((x, r.samples.len() as u64));
     }
     while (r.samples.len() as u64) < ticks {
+        host(&mut session, r.samples.len() as u64)?;
         record(&mut session, &mut sim, &mut r)?;
     }
+    r.ve_updates_sent = seq;
     if let Some((n, err)) = &mut r.homing {
         // The board's position in its first telemetry after homing
         // against the plant's where that tick read its sensors: the end of
@@ -539,6 +615,17 @@ pub fn failures<const N: usize>(
             )),
             Some(Err(e)) => bad.push(e.to_string()),
             None => {}
+        }
+    }
+    // A host VE's updates reached the board: the last telemetry holds one
+    // sent at most a telemetry period before the end.
+    if run.ve_updates_sent > 0 {
+        let held = run.telemetry.last().map_or(0, |t| t.ve_seq);
+        if held == 0 || held > run.ve_updates_sent {
+            bad.push(format!(
+                "the host sent {} VE updates and the board's last telemetry holds update {held}",
+                run.ve_updates_sent
+            ));
         }
     }
     if u64::from(run.board_stats.rx.dropped()) < run.corrupted_sent {

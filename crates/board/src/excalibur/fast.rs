@@ -22,7 +22,7 @@ pub mod region {
 pub const PERIOD_S: f32 = 2.5e-4;
 /// The coupling: 90% of the stiffest proven at 1,066 N s/m, the region's
 /// point nearest the best pair (627,082 N/m at 1,009 N s/m).
-pub const COUPLING: ImpedanceGains = ImpedanceGains::new(563_000.0, 1_066.0199);
+pub const COUPLING: ImpedanceGains = ImpedanceGains::new(563_000.0, 1_066.019_9);
 /// Ticks without a host heartbeat before the board forces zero (50 ms, as
 /// the 1 kHz image).
 pub const HEARTBEAT_TIMEOUT_TICKS: u32 = 200;

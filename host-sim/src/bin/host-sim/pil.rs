@@ -35,6 +35,16 @@ pub(crate) struct PilArgs {
     /// against it, pressed into the image's floor (the scene is not read).
     #[arg(long, value_enum)]
     pub(crate) linkage: Option<host_sim::pil::linkage::Device>,
+    /// The board runs the 4 kHz image (`twoport_board::excalibur::fast`):
+    /// the scene's period must be its 0.25 ms.
+    #[arg(long)]
+    pub(crate) fast: bool,
+    /// Run the VE on the host at this rate (Hz): the scene's wall sent as
+    /// a surface every board-rate / this ticks, ramped over as many, the
+    /// board's own wall set aside. The board's rate must be a whole
+    /// multiple.
+    #[arg(long)]
+    pub(crate) host_ve_hz: Option<f64>,
     /// Write the identification experiment's record (the scene's
     /// `[identify]`) to this CSV file: the board's over the port where
     /// there is one, else the in-process loop's.
@@ -56,8 +66,37 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
         return Err(err!("--seconds {}: must be in (0, 3600]", a.seconds));
     }
     let scene = load(&a.scene, &[])?;
-    // (Every scene ticks at the board's 1 kHz.)
-    let period = 1e-3;
+    // The board's period: the scene must tick at it.
+    let (period, deadline) = if a.fast {
+        let f = twoport_board::excalibur::fast::PERIOD_S;
+        (
+            f64::from(f),
+            twoport_board::excalibur::fast::HEARTBEAT_TIMEOUT_TICKS,
+        )
+    } else {
+        (1e-3, twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS)
+    };
+    let host_ve = match a.host_ve_hz {
+        None => None,
+        Some(hz) => {
+            let every = 1.0 / (period * hz);
+            if !(every.is_finite()
+                && every >= 1.0 - 1e-6
+                && (every - every.round()).abs() < 1e-6 * every)
+            {
+                return Err(err!(
+                    "--host-ve-hz {hz}: the board's {} Hz is not a whole multiple of it",
+                    1.0 / period
+                ));
+            }
+            let every = every.round() as u32;
+            // Ten of the host's periods on one update.
+            Some(pil::HostVe {
+                every_ticks: every,
+                deadline_ticks: 10 * every,
+            })
+        }
+    };
     let ticks = (a.seconds / period).round() as u64;
     let link_loss_at = match a.link_loss_at_s {
         Some(t) if t.is_finite() && t >= 0.0 && t < a.seconds => Some((t / period).round() as u64),
@@ -70,11 +109,42 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
     };
     let port = a.port.as_deref().map(link::SerialBoard::open).transpose()?;
     let start = std::time::Instant::now();
-    if (scene.period() - period).abs() > 1e-12 {
+    // (The board's f32 period, to its rounding.)
+    if (scene.period() - period).abs() > 1e-6 * period {
         return Err(err!(
-            "{}: a PIL scene ticks at the board's 1 kHz",
-            a.scene.display()
+            "{}: a PIL scene ticks at the board's {} Hz (period_s = {period})",
+            a.scene.display(),
+            1.0 / period
         ));
+    }
+    if a.fast || host_ve.is_some() {
+        if a.passivity || a.linkage.is_some() || scene.axes != 1 {
+            return Err(
+                "--fast and --host-ve-hz run the one-axis wall images (no --passivity, --linkage or three axes)".into(),
+            );
+        }
+        let reference = if a.fast {
+            pil::run_with::<_, 1>(
+                scene.clone(),
+                ticks,
+                link::LocalFast::excalibur_fast()?,
+                faults,
+                host_ve,
+            )?
+        } else {
+            pil::run_with::<_, 1>(
+                scene.clone(),
+                ticks,
+                link::LocalBoard::excalibur()?,
+                faults,
+                host_ve,
+            )?
+        };
+        let local_s = start.elapsed().as_secs_f64();
+        let run = port
+            .map(|p| pil::run_with::<_, 1>(scene, ticks, p, faults, host_ve))
+            .transpose()?;
+        return pil_report(a, ticks, faults, reference, run, local_s, start, deadline);
     }
     if let Some(device) = a.linkage {
         use host_sim::pil::linkage::{self, Device};
@@ -91,7 +161,7 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
         let run = port
             .map(|p| linkage::run(device, ticks, p, faults))
             .transpose()?;
-        return pil_report(a, ticks, faults, reference, run, local_s, start);
+        return pil_report(a, ticks, faults, reference, run, local_s, start, deadline);
     }
     if scene.axes == 3 {
         if a.passivity {
@@ -107,7 +177,7 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
         let run = port
             .map(|p| pil::run_axes::<_, 3>(scene, ticks, p, faults))
             .transpose()?;
-        return pil_report(a, ticks, faults, reference, run, local_s, start);
+        return pil_report(a, ticks, faults, reference, run, local_s, start, deadline);
     }
     let reference = if a.passivity {
         pil::run(
@@ -134,11 +204,13 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
             })??;
         std::fs::write(path, log.to_csv()).map_err(|e| err!("--log {}: {e}", path.display()))?;
     }
-    pil_report(a, ticks, faults, reference, run, local_s, start)
+    pil_report(a, ticks, faults, reference, run, local_s, start, deadline)
 }
 
 /// A PIL run's report, compared with the in-process `reference`: the
-/// board's `run` over the serial port where there was one.
+/// board's `run` over the serial port where there was one; the board's
+/// watchdog waits `deadline` ticks.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn pil_report<const N: usize>(
     a: &PilArgs,
     ticks: u64,
@@ -147,6 +219,7 @@ pub(crate) fn pil_report<const N: usize>(
     run: Option<host_sim::pil::Run<N>>,
     local_s: f64,
     start: std::time::Instant,
+    deadline: u32,
 ) -> Result<(), Error> {
     use host_sim::pil;
     let board = if run.is_some() {
@@ -176,7 +249,9 @@ pub(crate) fn pil_report<const N: usize>(
         "corrupted_sent": run.corrupted_sent,
         "board_frames_received": run.board_stats.rx.frames,
         "zero_force_after_link_loss_ticks": run.zero_after_loss_ticks,
-        "watchdog_deadline_ticks": twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS,
+        "watchdog_deadline_ticks": deadline,
+        "ve_updates_sent": run.ve_updates_sent,
+        "ve_seq_held": run.telemetry.last().map(|t| t.ve_seq),
         "telemetry_frames": run.telemetry.len(),
         "axes": axes,
         "peak_force_n": peak,
@@ -208,16 +283,19 @@ pub(crate) fn pil_report<const N: usize>(
             ),
             None => say!("  calibrated at rest, armed at tick {}", run.armed_at_tick),
         }
-        if let Some(z) = run.zero_after_loss_ticks {
+        if run.ve_updates_sent > 0 {
             say!(
-                "  link loss: zero force after {z} ticks (watchdog deadline {})",
-                twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS
+                "  host VE: {} updates sent, the board's last telemetry holds update {}",
+                run.ve_updates_sent,
+                run.telemetry.last().map_or(0, |t| t.ve_seq)
             );
+        }
+        if let Some(z) = run.zero_after_loss_ticks {
+            say!("  link loss: zero force after {z} ticks (watchdog deadline {deadline})");
         }
     }
     if a.check {
-        let deadline = u64::from(twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS);
-        let bad = pil::failures(&run, &c, ticks, faults, deadline);
+        let bad = pil::failures(&run, &c, ticks, faults, u64::from(deadline));
         if !bad.is_empty() {
             return Err(err!("PIL check failed: {}", bad.join("; ")));
         }
