@@ -24,7 +24,7 @@ pub use cursor::{CursorMass, ExplicitCursor, LosslessCursor, PAPER_MIN_CURSOR_MA
 pub use host_body::HostBody;
 pub use spring::{Solid, Spring, TrapezoidalSpring, UnilateralWall};
 
-use crate::{Position, Real, ZTransfer};
+use crate::{ParamError, Position, Real, ZTransfer};
 
 /// The paper's Fig. 7 causality of a VE's own law.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -91,6 +91,37 @@ impl<R: Real> Port<R> {
     }
 }
 
+/// One parameter of a VE a host may set on a disarmed board. Any value in
+/// range keeps the VE passive (its laws are passive for every stiffness
+/// and damping not negative), so the proven coupling holds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum VeParam {
+    /// Where its surface or anchor is.
+    Surface(Position),
+    /// Its stiffness (N/m, not negative).
+    Stiffness(f32),
+    /// Its damping (N s/m, not negative).
+    Damping(f32),
+}
+
+impl VeParam {
+    /// The refusal of a VE that has no such parameter.
+    pub fn unsupported(self) -> ParamError {
+        ParamError {
+            name: match self {
+                VeParam::Surface(_) => "VE surface",
+                VeParam::Stiffness(_) => "VE stiffness (N/m)",
+                VeParam::Damping(_) => "VE damping (N s/m)",
+            },
+            value: match self {
+                VeParam::Surface(p) => p.m(),
+                VeParam::Stiffness(v) | VeParam::Damping(v) => v,
+            },
+            problem: "is not a parameter of this VE",
+        }
+    }
+}
+
 /// The linear(ised) law of a VE as a z-domain transfer function.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum VeTransfer {
@@ -129,4 +160,9 @@ pub trait VirtualEnvironment<R: Real = f32> {
     /// The VE's law in the z-domain (for a piecewise law: the piece named in
     /// its documentation, e.g. a wall in contact).
     fn tf(&self) -> VeTransfer;
+    /// Set one of its parameters; a VE without it refuses, naming it, and
+    /// a value out of range is refused by name, the VE unchanged.
+    fn set_param(&mut self, p: VeParam) -> Result<(), ParamError> {
+        Err(p.unsupported())
+    }
 }

@@ -1,7 +1,7 @@
 //! Springs: the spring-damper to an anchor, its lossless trapezoidal
 //! form, and the one-sided wall that is a spring that only pushes.
 
-use super::{Causality, Port, VeOutput, VeTransfer, VirtualEnvironment};
+use super::{Causality, Port, VeOutput, VeParam, VeTransfer, VirtualEnvironment};
 use crate::{param, Integrator, ParamError, Position, Real, ZTransfer};
 
 /// Which side of the wall surface is solid.
@@ -83,6 +83,19 @@ impl<R: Real> Spring<R> {
         self.anchor = anchor;
     }
 
+    /// The anchor, stiffness or damping; [`VirtualEnvironment::set_param`].
+    fn set(&mut self, p: VeParam) -> Result<(), ParamError> {
+        let (k, b) = self.gains();
+        match p {
+            VeParam::Surface(x) => {
+                self.set_anchor(x);
+                Ok(())
+            }
+            VeParam::Stiffness(k) => self.set_gains(k, b),
+            VeParam::Damping(b) => self.set_gains(k, b),
+        }
+    }
+
     /// The probe's offset from the anchor now (m).
     fn stretch_m(&self) -> R {
         self.probe.offset_m(self.anchor)
@@ -131,6 +144,10 @@ impl<R: Real> VirtualEnvironment<R> for Spring<R> {
     fn tf(&self) -> VeTransfer {
         let (b, kt) = (self.b.to_f64(), self.kt.to_f64());
         VeTransfer::Impedance(ZTransfer::first_order([b + kt, -b], -1.0))
+    }
+
+    fn set_param(&mut self, p: VeParam) -> Result<(), ParamError> {
+        self.set(p)
     }
 }
 
@@ -368,5 +385,9 @@ impl<R: Real> VirtualEnvironment<R> for UnilateralWall<R> {
     /// In contact: the spring's `F/V = b + kT/(1 - z^-1)`.
     fn tf(&self) -> VeTransfer {
         self.spring.tf()
+    }
+
+    fn set_param(&mut self, p: VeParam) -> Result<(), ParamError> {
+        self.spring.set(p)
     }
 }

@@ -136,3 +136,43 @@ fn constructors_refuse_bad_parameters() {
         UnilateralWall::new(-1.0, 0.0, Position::ZERO, Solid::Above, T, Position::ZERO).is_err()
     );
 }
+
+/// A wall's surface, stiffness and damping set through the VE trait and
+/// through a world: the law is the one built with them; a bad value and a
+/// parameter the VE does not have are refused by name, the VE unchanged.
+#[test]
+fn a_walls_parameters_are_set_by_name_and_checked() {
+    use crate::world::{PerAxis, World};
+    let t = 1e-3;
+    let mut w = UnilateralWall::new(1000.0, 10.0, Position::ZERO, Solid::Above, t, Position::ZERO)
+        .unwrap();
+    w.set_param(VeParam::Surface(Position::from_nm(-1_000_000))).unwrap();
+    w.set_param(VeParam::Stiffness(5000.0)).unwrap();
+    World::<f32, 1>::set_axis_param(&mut w, 0, VeParam::Damping(20.0)).unwrap();
+    let built = UnilateralWall::new(
+        5000.0,
+        20.0,
+        Position::from_nm(-1_000_000),
+        Solid::Above,
+        t,
+        Position::ZERO,
+    )
+    .unwrap();
+    let port = Port {
+        f0_n: 3.0,
+        z_nspm: 100.0,
+    };
+    assert_eq!(w.clone().step(port), built.clone().step(port));
+    assert_eq!(w.gains(), (5000.0, 20.0));
+    let e = w.set_param(VeParam::Stiffness(-1.0)).unwrap_err();
+    assert_eq!(e.name, "stiffness (N/m)");
+    assert_eq!(w.gains(), (5000.0, 20.0));
+    let e = World::<f32, 1>::set_axis_param(&mut w, 1, VeParam::Damping(1.0)).unwrap_err();
+    assert_eq!(e.problem, "is not a parameter of this VE");
+    let mut axes = PerAxis([w; 3]);
+    axes.set_axis_param(2, VeParam::Stiffness(7000.0)).unwrap();
+    assert_eq!((axes.0[2].gains().0, axes.0[0].gains().0), (7000.0, 5000.0));
+    let mut cursor = CursorMass::new(1.0, t, Position::ZERO).unwrap();
+    let e = cursor.set_param(VeParam::Stiffness(1.0)).unwrap_err();
+    assert_eq!(e.name, "VE stiffness (N/m)");
+}

@@ -18,8 +18,8 @@ pub mod vbb;
 
 pub use held::{Contact, Held};
 
-use crate::ve::{Port, VeOutput, VeTransfer, VirtualEnvironment};
-use crate::{Position, Real};
+use crate::ve::{Port, VeOutput, VeParam, VeTransfer, VirtualEnvironment};
+use crate::{ParamError, Position, Real};
 
 /// A virtual environment of `N` Cartesian axes stepped once per tick
 /// against one coupling [`Port`] per axis. `step` must not allocate, panic
@@ -43,6 +43,12 @@ pub trait World<R: Real, const N: usize> {
     /// Axis `axis`'s law in the z-domain, the others held still (for a
     /// piecewise law, the piece its documentation names).
     fn axis_tf(&self, axis: usize) -> VeTransfer;
+    /// Set a parameter of axis `axis`'s VE; a world without it refuses,
+    /// naming it (see [`VirtualEnvironment::set_param`]).
+    fn set_axis_param(&mut self, axis: usize, p: VeParam) -> Result<(), ParamError> {
+        let _ = axis;
+        Err(p.unsupported())
+    }
 }
 
 /// One axis's world is a one-axis VE.
@@ -71,6 +77,13 @@ impl<R: Real, V: VirtualEnvironment<R>> World<R, 1> for V {
         match axis {
             0 => self.tf(),
             _ => VeTransfer::Impedance(crate::ZTransfer::gain(0.0)),
+        }
+    }
+
+    fn set_axis_param(&mut self, axis: usize, p: VeParam) -> Result<(), ParamError> {
+        match axis {
+            0 => self.set_param(p),
+            _ => Err(p.unsupported()),
         }
     }
 }
@@ -135,6 +148,13 @@ macro_rules! per_axis {
                 match self.0.get(axis) {
                     Some(ve) => ve.tf(),
                     None => VeTransfer::Impedance(crate::ZTransfer::gain(0.0)),
+                }
+            }
+
+            fn set_axis_param(&mut self, axis: usize, p: VeParam) -> Result<(), ParamError> {
+                match self.0.get_mut(axis) {
+                    Some(ve) => ve.set_param(p),
+                    None => Err(p.unsupported()),
                 }
             }
         }
