@@ -5,6 +5,7 @@ mod host_ve;
 mod identify;
 mod persist;
 mod spec;
+mod ve_param;
 
 use crate::io::IoScale;
 use crate::region::{check_axes, Region};
@@ -82,6 +83,10 @@ pub struct Board<W, const R: usize, const N: usize = 1, L = Direct, D = Servo<W,
     /// The host's VE, when the coupling holds it instead of the image's
     /// (protocol 8).
     host: Option<host_ve::HostVe<N>>,
+    /// Each axis's travel (lowest, highest), where the image knows it,
+    /// and what the link carries (bytes/s): stated in the spec.
+    workspace: [Option<(Position, Position)>; N],
+    link_bytes_per_s: Option<u32>,
     /// The dead-man switch at the last tick (open before the first).
     dead_man_closed: bool,
     /// Whether the amplifier's outputs are on (as last commanded).
@@ -178,6 +183,8 @@ where
             homing: None,
             experiment: None,
             host: None,
+            workspace: [None; N],
+            link_bytes_per_s: None,
             dead_man_closed: false,
             outputs_on: false,
             config_source: None,
@@ -194,6 +201,20 @@ where
     /// configuration that does not validate).
     pub fn with_homing(mut self, cfg: [HomingConfig; N]) -> Self {
         self.homing_cfg = cfg;
+        self
+    }
+
+    /// The same board stating each axis's travel (lowest, highest
+    /// position) in its spec.
+    pub fn with_workspace(mut self, travel: [(Position, Position); N]) -> Self {
+        self.workspace = travel.map(Some);
+        self
+    }
+
+    /// The same board stating what its link carries (bytes/s: a UART's
+    /// baud over ten) in its spec.
+    pub fn with_link_rate(mut self, bytes_per_s: u32) -> Self {
+        self.link_bytes_per_s = Some(bytes_per_s);
         self
     }
 
@@ -360,6 +381,7 @@ where
             Message::SetStream { every_ticks } => self.answer_stream(every_ticks),
             Message::SetVe(source) => self.set_ve(source),
             Message::VeUpdate(u) => self.ve_update(u),
+            Message::SetVeParam { axis, param } => self.set_ve_param(axis, param),
             Message::Calibrate { position_pm } => self.calibrate(position_pm),
             Message::GetStatus => self.queue_status(),
             Message::SaveConfig => self.request_save(),

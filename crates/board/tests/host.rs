@@ -76,6 +76,7 @@ fn the_spec_names_the_limits_and_the_region_and_the_stream_follows_the_host() {
         stream_every: 10,
         linkage: false,
         ve: VeSource::Board,
+        link_bytes_per_s: None,
         axes: Axes::one(AxisSpec {
             peak_force_n: s.peak_force_n,
             continuous_force_n: s.continuous_force_n,
@@ -86,6 +87,7 @@ fn the_spec_names_the_limits_and_the_region_and_the_stream_follows_the_host() {
                 k_max_npm: 51_400.0,
                 b_at_k_max_nspm: 60.0,
             },
+            workspace_nm: None,
         }),
     };
     assert_eq!(replies(&mut b), vec![Message::Spec(want)]);

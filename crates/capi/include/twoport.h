@@ -36,6 +36,21 @@
 #define TP_CONTACT_FREE 3
 
 /**
+ * `tp_board_set_ve_param`: the VE's surface or anchor (m).
+ */
+#define TP_VE_SURFACE 0
+
+/**
+ * Its stiffness (N/m).
+ */
+#define TP_VE_STIFFNESS 1
+
+/**
+ * Its damping (N s/m).
+ */
+#define TP_VE_DAMPING 2
+
+/**
  * What a call did. On anything but `TP_RESULT_OK`, `tp_last_error` says
  * why.
  */
@@ -165,6 +180,18 @@ typedef struct TpAxisSpec {
    * Its damping (N s/m; 0 for impedance).
    */
   double bp_nspm;
+  /**
+   * Whether the board states the axis's travel (protocol 9) ...
+   */
+  bool has_workspace;
+  /**
+   * ... its lowest position (m) ...
+   */
+  double workspace_lo_m;
+  /**
+   * ... and its highest (m).
+   */
+  double workspace_hi_m;
 } TpAxisSpec;
 
 /**
@@ -183,6 +210,11 @@ typedef struct TpSpec {
    * Whether the motors turn a linkage's joints.
    */
   bool linkage;
+  /**
+   * What the link carries (bytes/s; 0 where the board does not say):
+   * a stream faster than that loses frames.
+   */
+  uint32_t link_bytes_per_s;
   /**
    * The board's axes (1 to `TP_MAX_AXES`).
    */
@@ -417,6 +449,17 @@ enum TpResult tp_board_host_ve(struct TpBoard *b, uint32_t ramp_ticks, uint32_t 
  * `b` is an open board.
  */
 enum TpResult tp_board_board_ve(struct TpBoard *b);
+
+/**
+ * Set one parameter of the board's own VE on `axis` (disarmed only):
+ * `TP_VE_SURFACE` (m), `TP_VE_STIFFNESS` (N/m) or `TP_VE_DAMPING` (N s/m)
+ * to `value`. A value out of range, an axis the board has not or a
+ * parameter its VE has not is refused (`tp_last_error` says which).
+ *
+ * # Safety
+ * `b` is an open board.
+ */
+enum TpResult tp_board_set_ve_param(struct TpBoard *b, size_t axis, uint8_t param, double value);
 
 /**
  * Send the host VE's surface for each of `n` axes (m) and what each is

@@ -15,7 +15,8 @@ use twoport_host::{
 };
 pub use types::{
     TpAxisSpec, TpAxisState, TpDisplay, TpMode, TpResult, TpSpec, TpState, TP_CONTACT_ABOVE,
-    TP_CONTACT_BELOW, TP_CONTACT_FREE, TP_CONTACT_HELD, TP_MAX_AXES,
+    TP_CONTACT_BELOW, TP_CONTACT_FREE, TP_CONTACT_HELD, TP_MAX_AXES, TP_VE_DAMPING,
+    TP_VE_STIFFNESS, TP_VE_SURFACE,
 };
 
 /// A board, opened by `tp_board_open_serial` or `tp_board_open_simulated`
@@ -33,7 +34,9 @@ fn fail(e: &LinkError) -> TpResult {
     LAST_ERROR.with(|l| *l.borrow_mut() = msg);
     match e {
         LinkError::Refused { .. } | LinkError::GainsRefused(_) => TpResult::Refused,
-        LinkError::Axes { .. } | LinkError::OutOfRange { .. } => TpResult::Argument,
+        LinkError::Axes { .. } | LinkError::OutOfRange { .. } | LinkError::BadValue { .. } => {
+            TpResult::Argument
+        }
         LinkError::Timeout { .. } => TpResult::Timeout,
         LinkError::Reset(_) | LinkError::Foreign { .. } => TpResult::Reset,
         LinkError::Faulted(_) => TpResult::Faulted,
@@ -396,6 +399,33 @@ pub unsafe extern "C" fn tp_board_host_ve(
 pub unsafe extern "C" fn tp_board_board_ve(b: *mut TpBoard) -> TpResult {
     with_board(b, |b| {
         b.0.board_ve().map_or_else(|e| fail(&e), |_| TpResult::Ok)
+    })
+}
+
+/// Set one parameter of the board's own VE on `axis` (disarmed only):
+/// `TP_VE_SURFACE` (m), `TP_VE_STIFFNESS` (N/m) or `TP_VE_DAMPING` (N s/m)
+/// to `value`. A value out of range, an axis the board has not or a
+/// parameter its VE has not is refused (`tp_last_error` says which).
+///
+/// # Safety
+/// `b` is an open board.
+#[no_mangle]
+pub unsafe extern "C" fn tp_board_set_ve_param(
+    b: *mut TpBoard,
+    axis: usize,
+    param: u8,
+    value: f64,
+) -> TpResult {
+    use twoport_host::VeSetting;
+    with_board(b, |b| {
+        let setting = match param {
+            TP_VE_SURFACE => VeSetting::Surface(value),
+            TP_VE_STIFFNESS => VeSetting::Stiffness(value),
+            TP_VE_DAMPING => VeSetting::Damping(value),
+            _ => return bad("param is not TP_VE_SURFACE, TP_VE_STIFFNESS or TP_VE_DAMPING"),
+        };
+        b.0.set_ve_param(axis, setting)
+            .map_or_else(|e| fail(&e), |_| TpResult::Ok)
     })
 }
 

@@ -14,6 +14,12 @@ pub const TP_CONTACT_ABOVE: u8 = 1;
 pub const TP_CONTACT_BELOW: u8 = 2;
 /// No surface: the point follows the handle with no force.
 pub const TP_CONTACT_FREE: u8 = 3;
+/// `tp_board_set_ve_param`: the VE's surface or anchor (m).
+pub const TP_VE_SURFACE: u8 = 0;
+/// Its stiffness (N/m).
+pub const TP_VE_STIFFNESS: u8 = 1;
+/// Its damping (N s/m).
+pub const TP_VE_DAMPING: u8 = 2;
 
 /// The contact a C caller's code names, if it names one.
 pub(crate) fn contact(c: u8) -> Option<Contact> {
@@ -101,6 +107,12 @@ pub struct TpAxisSpec {
     pub kp_npm: f64,
     /// Its damping (N s/m; 0 for impedance).
     pub bp_nspm: f64,
+    /// Whether the board states the axis's travel (protocol 9) ...
+    pub has_workspace: bool,
+    /// ... its lowest position (m) ...
+    pub workspace_lo_m: f64,
+    /// ... and its highest (m).
+    pub workspace_hi_m: f64,
 }
 
 /// What a board can do.
@@ -113,6 +125,9 @@ pub struct TpSpec {
     pub stream_every: u32,
     /// Whether the motors turn a linkage's joints.
     pub linkage: bool,
+    /// What the link carries (bytes/s; 0 where the board does not say):
+    /// a stream faster than that loses frames.
+    pub link_bytes_per_s: u32,
     /// The board's axes (1 to `TP_MAX_AXES`).
     pub axes: u8,
     /// Each axis's, the first `axes` of them.
@@ -173,14 +188,21 @@ impl From<&Spec> for TpSpec {
             b_at_limit_nspm: 0.0,
             kp_npm: 0.0,
             bp_nspm: 0.0,
+            has_workspace: false,
+            workspace_lo_m: 0.0,
+            workspace_hi_m: 0.0,
         };
         let mut axis = [zero; TP_MAX_AXES];
         for (out, a) in axis.iter_mut().zip(s.axes.iter()) {
             let f = f64::from;
+            let (lo, hi) = a.workspace_nm.unwrap_or((0, 0));
             let base = TpAxisSpec {
                 peak_force_n: f(a.peak_force_n),
                 continuous_force_n: f(a.continuous_force_n),
                 max_velocity_mps: f(a.max_velocity_mps),
+                has_workspace: a.workspace_nm.is_some(),
+                workspace_lo_m: f64::from(lo) * 1e-9,
+                workspace_hi_m: f64::from(hi) * 1e-9,
                 ..zero
             };
             let r = &a.region;
@@ -208,6 +230,7 @@ impl From<&Spec> for TpSpec {
             period_s: s.period_s(),
             stream_every: s.stream_every,
             linkage: s.linkage,
+            link_bytes_per_s: s.link_bytes_per_s.unwrap_or(0),
             axes: s.axes.len() as u8,
             axis,
         }

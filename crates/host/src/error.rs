@@ -83,6 +83,14 @@ pub enum LinkError {
         /// The value given (m).
         value_m: f64,
     },
+    /// A value the board would not take, named before it is sent.
+    #[error("{what} {why}")]
+    BadValue {
+        /// The call and the value.
+        what: String,
+        /// What is wrong with it.
+        why: String,
+    },
     /// The board latched faults (their bits) while the host waited.
     #[error("the board faulted: {}", twoport_control::Faults(*.0))]
     Faulted(u16),

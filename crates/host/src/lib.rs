@@ -8,7 +8,9 @@ mod port;
 mod session;
 mod simulated;
 
-pub use device::{AxisState, Board, State, HEARTBEAT_PERIOD, HEARTBEAT_POLLS, STATE_BUFFER};
+pub use device::{
+    AxisState, Board, State, VeSetting, HEARTBEAT_PERIOD, HEARTBEAT_POLLS, STATE_BUFFER,
+};
 pub use error::LinkError;
 pub use port::{BoardPort, SerialBoard};
 pub use session::{LinkFaults, Session, ANSWER_TIMEOUT, HEARTBEAT_EVERY};
@@ -16,5 +18,5 @@ pub use simulated::{Pace, SimulatedBoard};
 
 /// The link's types an application meets in this crate's calls.
 pub use twoport_link::{
-    Axes, AxisSpec, Contact, Gains, Mode, ProvenRegion, Spec, Status, VeSource,
+    Axes, AxisSpec, Contact, Gains, Mode, ProvenRegion, Spec, Status, VeParam, VeSource,
 };

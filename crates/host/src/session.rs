@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use twoport_board::excalibur;
 use twoport_link::{
     encode, Axes, ConfigSource, Contact, Decoder, LinkStats, Message, Mode, ModeRequest,
-    PilSensors, Role, Spec, Status, VeSource, VeUpdate, MAX_FRAME, NO_SESSION,
+    PilSensors, Role, Spec, Status, VeParam, VeSource, VeUpdate, MAX_FRAME, NO_SESSION,
 };
 
 /// How long the host waits for the board's answer to one frame.
@@ -186,6 +186,16 @@ impl<P: BoardPort> Session<P> {
     pub fn set_ve(&mut self, source: VeSource) -> Result<VeSource, LinkError> {
         self.request(&Message::SetVe(source), ModeRequest::SetVe, |m| match m {
             Message::Ve(s) => Some(*s),
+            _ => None,
+        })
+    }
+
+    /// Set one parameter of the board's own VE on `axis` (disarmed only),
+    /// and wait for the board to say what it set (protocol 9).
+    pub fn set_ve_param(&mut self, axis: u8, param: VeParam) -> Result<VeParam, LinkError> {
+        let msg = Message::SetVeParam { axis, param };
+        self.request(&msg, ModeRequest::SetVeParam, |m| match m {
+            Message::VeParamSet { axis: a, param } if *a == axis => Some(*param),
             _ => None,
         })
     }

@@ -160,3 +160,34 @@ fn homing_finds_the_stop_and_calibrates() {
     let x = b.latest().unwrap().axes[0].position_m;
     assert!((x + 0.020).abs() < 1e-5, "at {x} m");
 }
+
+/// The board's own wall set from the application: moved to 5 mm, it
+/// holds the simulated hand's 2 N there (39 um in, as the host's wall
+/// did); a value out of range is named before it is sent, an axis the
+/// board has not too, and an armed board refuses.
+#[test]
+fn the_boards_own_wall_is_set_from_the_host() {
+    use twoport_host::VeSetting;
+    let mut b = open(2.0);
+    b.calibrate(&[0.0]).unwrap();
+    let e = b.set_ve_param(0, VeSetting::Stiffness(-1.0)).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("stiffness -1 N/m must be a finite number"),
+        "{e}"
+    );
+    let e = b.set_ve_param(1, VeSetting::Damping(1.0)).unwrap_err();
+    assert!(matches!(e, LinkError::Axes { .. }), "{e}");
+    let e = b.set_ve_param(0, VeSetting::Surface(3.0)).unwrap_err();
+    assert!(matches!(e, LinkError::OutOfRange { .. }), "{e}");
+    b.set_ve_param(0, VeSetting::Surface(WALL_M)).unwrap();
+    b.stream(1).unwrap();
+    b.arm().unwrap();
+    for _ in 0..3000 {
+        b.poll().unwrap();
+    }
+    let x = b.latest().unwrap().axes[0].position_m;
+    assert!((x - WALL_M - 2.0 / 51_000.0).abs() < 10e-6, "at {x} m");
+    let e = b.set_ve_param(0, VeSetting::Damping(1.0)).unwrap_err();
+    assert!(e.to_string().contains("NotDisarmed"), "{e}");
+}

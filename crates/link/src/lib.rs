@@ -19,4 +19,4 @@ pub use message::{
     Refusal, Role, Status, Telemetry, NO_SESSION, PROTOCOL_VERSION,
 };
 pub use spec::{AxisSpec, ProvenRegion, Spec};
-pub use ve::{Contact, VeSource, VeUpdate};
+pub use ve::{Contact, VeParam, VeSource, VeUpdate};

@@ -3,7 +3,7 @@
 //! so today's boards send multiples of 1000; the wire has room for finer).
 
 use crate::frame::Stats;
-use crate::{Axes, Spec, VeSource, VeUpdate};
+use crate::{Axes, Spec, VeParam, VeSource, VeUpdate};
 use serde::{Deserialize, Serialize};
 
 /// The protocol version both ends must share (checked by the handshake).
@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 /// experiments ([`Message::Identify`]); version 8 tells a host what the
 /// board can do ([`Message::GetSpec`]) and lets it set the telemetry rate
 /// ([`Message::SetStream`]).
-pub const PROTOCOL_VERSION: u16 = 8;
+pub const PROTOCOL_VERSION: u16 = 9;
 
 /// The session number of a board no host has shaken hands with since it
 /// booted. A host opens a session with any other number, and a board
@@ -113,6 +113,8 @@ pub enum ModeRequest {
     Identify,
     /// [`Message::SetVe`] (protocol 8).
     SetVe,
+    /// [`Message::SetVeParam`] (protocol 9).
+    SetVeParam,
 }
 
 /// Why the board would not change mode.
@@ -157,6 +159,9 @@ pub enum ModeRefusal {
     BadExperiment,
     /// A host VE's deadline must be at least one tick (protocol 8).
     BadDeadline,
+    /// The board's VE has no such parameter on that axis, or the value is
+    /// out of its range (protocol 9).
+    BadVeParam,
 }
 
 /// Where the configuration in force came from (protocol 3).
@@ -460,6 +465,22 @@ pub enum Message {
     /// The host VE's points (protocol 8); no answer: the telemetry's
     /// `ve_seq` says which update the board holds.
     VeUpdate(VeUpdate),
+    /// Set one parameter of the board's own VE on `axis`: disarmed only
+    /// (protocol 9).
+    SetVeParam {
+        /// The axis (0 is x).
+        axis: u8,
+        /// What to set, and to what.
+        param: VeParam,
+    },
+    /// The parameter in force, in answer to
+    /// [`SetVeParam`](Message::SetVeParam) (protocol 9).
+    VeParamSet {
+        /// The axis.
+        axis: u8,
+        /// What was set.
+        param: VeParam,
+    },
 }
 
 /// The board's view of the link.

@@ -21,6 +21,10 @@ pub struct Spec {
     pub linkage: bool,
     /// Where the VE the coupling holds runs now.
     pub ve: VeSource,
+    /// What the link carries (bytes/s), where the board knows it (a UART's
+    /// baud rate over ten): a stream faster than that loses frames
+    /// (protocol 9).
+    pub link_bytes_per_s: Option<u32>,
     /// Each Cartesian axis's.
     pub axes: Axes<AxisSpec>,
 }
@@ -36,6 +40,9 @@ pub struct AxisSpec {
     pub max_velocity_mps: f32,
     /// The couplings the board accepts on this axis.
     pub region: ProvenRegion,
+    /// The axis's travel, lowest and highest position (nm, the board's
+    /// positions: within ±2.147 m), where the board knows it (protocol 9).
+    pub workspace_nm: Option<(i32, i32)>,
 }
 
 /// The envelope of a proven region: the range of coupling damping it

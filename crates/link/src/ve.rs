@@ -24,6 +24,20 @@ pub enum VeSource {
     },
 }
 
+/// One parameter of the board's own VE on one axis (protocol 9): its
+/// surface (or anchor), stiffness or damping. A disarmed board takes it
+/// ([`Message::SetVeParam`](crate::Message::SetVeParam)); any value in
+/// range keeps the VE passive, so the proven coupling holds.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum VeParam {
+    /// Where the surface or anchor is (pm, within ±2.147 m).
+    SurfacePm(i64),
+    /// The stiffness (N/m, not negative).
+    StiffnessNpm(f32),
+    /// The damping (N s/m, not negative).
+    DampingNspm(f32),
+}
+
 /// What an axis's surface in a [`VeUpdate`] is to the VE point the
 /// coupling holds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]

@@ -118,6 +118,7 @@ fn all_messages() -> Vec<Message> {
                 ramp_ticks: u32::MAX,
                 deadline_ticks: u32::MAX,
             },
+            link_bytes_per_s: Some(u32::MAX),
             axes: Axes::new([f32::MAX, 1.0, -0.0].map(|x| AxisSpec {
                 peak_force_n: x,
                 continuous_force_n: x,
@@ -130,6 +131,7 @@ fn all_messages() -> Vec<Message> {
                     m_min_kg: x,
                     b_at_m_min_nspm: x,
                 },
+                workspace_nm: Some((i32::MIN, i32::MAX)),
             }))
             .unwrap(),
         }),
@@ -138,6 +140,7 @@ fn all_messages() -> Vec<Message> {
             stream_every: 0,
             linkage: false,
             ve: VeSource::Board,
+            link_bytes_per_s: None,
             axes: Axes::one(AxisSpec {
                 peak_force_n: 200.0,
                 continuous_force_n: 100.0,
@@ -148,6 +151,7 @@ fn all_messages() -> Vec<Message> {
                     k_max_npm: 51_074.0,
                     b_at_k_max_nspm: 90.0,
                 },
+                workspace_nm: None,
             }),
         }),
         Message::SetStream {
@@ -164,6 +168,18 @@ fn all_messages() -> Vec<Message> {
             position_pm: Axes::new([i64::MIN, i64::MAX, 0]).unwrap(),
             contact: Axes::new([Contact::Held, Contact::Above, Contact::Free]).unwrap(),
         }),
+        Message::SetVeParam {
+            axis: u8::MAX,
+            param: VeParam::SurfacePm(i64::MIN),
+        },
+        Message::SetVeParam {
+            axis: 0,
+            param: VeParam::StiffnessNpm(f32::MAX),
+        },
+        Message::VeParamSet {
+            axis: 2,
+            param: VeParam::DampingNspm(-0.0),
+        },
     ]
 }
 

@@ -103,12 +103,18 @@ impl Board {
         let d = PyDict::new(py);
         d.set_item("period_s", s.period_s())?;
         d.set_item("linkage", s.linkage)?;
+        d.set_item("link_bytes_per_s", s.link_bytes_per_s)?;
         let axes = pyo3::types::PyList::empty(py);
         for a in s.axes.iter() {
             let x = PyDict::new(py);
             x.set_item("peak_force_n", a.peak_force_n)?;
             x.set_item("continuous_force_n", a.continuous_force_n)?;
             x.set_item("max_velocity_mps", a.max_velocity_mps)?;
+            x.set_item(
+                "workspace_m",
+                a.workspace_nm
+                    .map(|(lo, hi)| (f64::from(lo) * 1e-9, f64::from(hi) * 1e-9)),
+            )?;
             let r = &a.region;
             let (limit, b_at) = r.limit();
             x.set_item(
@@ -174,6 +180,31 @@ impl Board {
         d.set_item("actuator_n", axis(|a| a.actuator_n))?;
         d.set_item("ve_position_m", axis(|a| a.ve_position_m))?;
         Ok(Some(d))
+    }
+
+    /// Set one parameter of the board's own VE on `axis` (disarmed only):
+    /// "surface" (m), "stiffness" (N/m) or "damping" (N s/m).
+    fn set_ve_param(&mut self, axis: usize, name: &str, value: f64) -> PyResult<()> {
+        use twoport_host::VeSetting;
+        let setting = match name {
+            "surface" => VeSetting::Surface(value),
+            "stiffness" => VeSetting::Stiffness(value),
+            "damping" => VeSetting::Damping(value),
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "{other:?}: one of \"surface\", \"stiffness\", \"damping\""
+                )))
+            }
+        };
+        match self.open()?.set_ve_param(axis, setting) {
+            Ok(_) => Ok(()),
+            Err(
+                e @ (LinkError::BadValue { .. }
+                | LinkError::Axes { .. }
+                | LinkError::OutOfRange { .. }),
+            ) => Err(PyValueError::new_err(e.to_string())),
+            Err(e) => Err(link(e)),
+        }
     }
 
     /// Tell a disarmed board where each axis stands (m).

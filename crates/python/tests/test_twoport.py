@@ -98,3 +98,23 @@ def test_homing_finds_the_stop_and_latest_says_where():
     with pytest.raises(ValueError, match="timeout_s"):
         b.home(-1.0)
     b.close()
+
+
+def test_the_boards_own_wall_is_set_from_python():
+    b = twoport.Board.simulated(2.0)
+    spec = b.spec()
+    assert spec["link_bytes_per_s"] is None and spec["axes"][0]["workspace_m"] is None
+    b.calibrate([0.0])
+    b.set_ve_param(0, "surface", 0.005)
+    with pytest.raises(ValueError, match="stiffness"):
+        b.set_ve_param(0, "stiffness", -1.0)
+    with pytest.raises(ValueError, match="one of"):
+        b.set_ve_param(0, "mass", 1.0)
+    b.stream(1)
+    b.arm()
+    b.run_for(1.0)
+    x = b.latest()["position_m"][0]
+    assert abs(x - 0.005 - 2.0 / 51000.0) < 10e-6, x
+    with pytest.raises(RuntimeError, match="NotDisarmed"):
+        b.set_ve_param(0, "damping", 1.0)
+    b.close()

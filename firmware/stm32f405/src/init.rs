@@ -235,6 +235,10 @@ pub fn usart(u: &pac::USART2) {
         .write(|w| w.ue().set_bit().te().set_bit().re().set_bit());
 }
 
+/// The link's rate: 115,200 baud, 8N1 (ten bits a byte), in bytes/s, as
+/// the board states it in its spec.
+pub const LINK_BYTES_PER_S: u32 = 115_200 / 10;
+
 /// Control-loop timer counts (1 us each) per tick: the image's period, so
 /// the interrupt rate and the laws' `T` cannot disagree. 1 kHz as shipped;
 /// 100 to 1000 counts give the 1-10 kHz range (a new `T` needs its own

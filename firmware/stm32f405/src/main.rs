@@ -164,7 +164,9 @@ fn main() -> ! {
     #[cfg(feature = "delta")]
     let board = twoport_board::linkage::delta_board().map_err(|_| ());
     let Ok(board) = board else { halt() };
-    let mut board = board.with_pil(cfg!(feature = "qemu"));
+    let mut board = board
+        .with_pil(cfg!(feature = "qemu"))
+        .with_link_rate(init::LINK_BYTES_PER_S);
     if init::reset_by_watchdog(&dp.RCC) {
         board.trip(twoport_control::Faults::WATCHDOG_RESET);
         log::watchdog_reset();

@@ -1,5 +1,5 @@
-//! What the board tells a host it can do (protocol 8), and the telemetry
-//! rate the host asks for.
+//! What the board tells a host it can do (protocol 8; its travel and its
+//! link's rate, protocol 9), and the telemetry rate the host asks for.
 
 use super::Board;
 use twoport_control::drive::Drive;
@@ -22,6 +22,7 @@ where
             continuous_force_n: limits[i].continuous_force_n,
             max_velocity_mps: limits[i].max_velocity_mps,
             region: self.regions[i].envelope(),
+            workspace_nm: self.workspace[i].map(|(lo, hi)| (lo.nm(), hi.nm())),
         });
         Spec {
             // (A period past 4.29 s is no servo's: the cast saturates.)
@@ -29,6 +30,7 @@ where
             stream_every: self.telemetry_every,
             linkage: !D::HOMES,
             ve: self.ve_source(),
+            link_bytes_per_s: self.link_bytes_per_s,
             axes: Self::axes(axes),
         }
     }

@@ -81,7 +81,10 @@ pub fn servo() -> Result<XyzServo, BuildError> {
 /// processor-in-the-loop images add `.with_pil(true)`.
 pub fn board() -> Result<XyzBoard, BuildError> {
     let region = proven_region()?;
+    // The world's walls are the travel it states.
+    let [lo, hi] = VbbConfig::excalibur(PERIOD_S).workspace;
     Ok(Board::new(servo()?, [region; 3], TELEMETRY_EVERY)
         .with_io([IoScale::EXCALIBUR; 3])
-        .with_homing(HOMING))
+        .with_homing(HOMING)
+        .with_workspace(core::array::from_fn(|i| (lo[i], hi[i]))))
 }

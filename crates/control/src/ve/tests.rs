@@ -144,9 +144,17 @@ fn constructors_refuse_bad_parameters() {
 fn a_walls_parameters_are_set_by_name_and_checked() {
     use crate::world::{PerAxis, World};
     let t = 1e-3;
-    let mut w = UnilateralWall::new(1000.0, 10.0, Position::ZERO, Solid::Above, t, Position::ZERO)
+    let mut w = UnilateralWall::new(
+        1000.0,
+        10.0,
+        Position::ZERO,
+        Solid::Above,
+        t,
+        Position::ZERO,
+    )
+    .unwrap();
+    w.set_param(VeParam::Surface(Position::from_nm(-1_000_000)))
         .unwrap();
-    w.set_param(VeParam::Surface(Position::from_nm(-1_000_000))).unwrap();
     w.set_param(VeParam::Stiffness(5000.0)).unwrap();
     World::<f32, 1>::set_axis_param(&mut w, 0, VeParam::Damping(20.0)).unwrap();
     let built = UnilateralWall::new(

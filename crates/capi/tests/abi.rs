@@ -1,0 +1,59 @@
+//! The C ABI called as C calls it, against the simulated board in this
+//! process: the spec's protocol-9 fields and the board's own VE's
+//! parameters, with bad arguments refused and named.
+
+use std::ffi::CStr;
+use std::ptr::null_mut;
+use twoport::*;
+
+fn last_error() -> String {
+    // SAFETY: tp_last_error always returns a valid, NUL-terminated string
+    // owned by this thread.
+    unsafe { CStr::from_ptr(tp_last_error()) }
+        .to_string_lossy()
+        .into_owned()
+}
+
+#[test]
+fn the_spec_and_the_boards_own_ve_through_the_c_abi() {
+    let mut b: *mut TpBoard = null_mut();
+    // SAFETY: `b` is a valid place for the board's pointer.
+    assert_eq!(
+        unsafe { tp_board_open_simulated(2.0, &mut b) },
+        TpResult::Ok
+    );
+    let mut spec = std::mem::MaybeUninit::<TpSpec>::uninit();
+    // SAFETY: `b` is open and `spec` is a writable TpSpec.
+    assert_eq!(unsafe { tp_board_spec(b, spec.as_mut_ptr()) }, TpResult::Ok);
+    // SAFETY: tp_board_spec wrote it.
+    let spec = unsafe { spec.assume_init() };
+    // The shipped image states neither its travel nor its link's rate.
+    assert_eq!(
+        (spec.link_bytes_per_s, spec.axis[0].has_workspace),
+        (0, false)
+    );
+    // SAFETY (each call below): `b` is open.
+    let set = |p, v| unsafe { tp_board_set_ve_param(b, 0, p, v) };
+    assert_eq!(set(9, 1.0), TpResult::Argument);
+    assert!(last_error().contains("TP_VE_SURFACE"), "{}", last_error());
+    assert_eq!(set(TP_VE_STIFFNESS, -1.0), TpResult::Argument);
+    assert!(
+        last_error().contains("must be a finite number"),
+        "{}",
+        last_error()
+    );
+    assert_eq!(set(TP_VE_SURFACE, 0.005), TpResult::Ok);
+    assert_eq!(set(TP_VE_DAMPING, 100.0), TpResult::Ok);
+    // SAFETY: `b` is open.
+    assert_eq!(
+        unsafe { tp_board_set_ve_param(b, 1, TP_VE_DAMPING, 1.0) },
+        TpResult::Argument
+    );
+    // SAFETY: `b` is open; closing frees it.
+    assert_eq!(unsafe { tp_board_close(b) }, TpResult::Ok);
+    // SAFETY: a NULL board is refused, not read.
+    assert_eq!(
+        unsafe { tp_board_set_ve_param(null_mut(), 0, TP_VE_DAMPING, 1.0) },
+        TpResult::Argument
+    );
+}
