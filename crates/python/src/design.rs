@@ -140,8 +140,8 @@ fn value(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
-fn designer(m: DeviceModel, period: Option<f64>, human: bool) -> Result<Designer, String> {
-    Designer::new(vec![m], period, human.then_some(HumanBound::PAPER)).map_err(|e| e.to_string())
+fn designer(poses: Vec<DeviceModel>, period: Option<f64>, human: bool) -> Result<Designer, String> {
+    Designer::new(poses, period, human.then_some(HumanBound::PAPER)).map_err(|e| e.to_string())
 }
 
 fn to_design(
@@ -169,7 +169,8 @@ fn to_design(
 }
 
 /// Design the impedance display's coupling for `model` (a `Model`, a
-/// model file, or the paper's Excalibur): at damping `b` (N s/m), or the
+/// model file, a list of them: the poses of one axis, proven together,
+/// as `load_device` gives them; or the paper's Excalibur): at damping `b` (N s/m), or the
 /// best `(k, b)` pair; for every passive human within the paper's bound
 /// (`human=False`: any passive human at all), at `period` (s; the
 /// model's by default), `margin` inside the boundary.
@@ -183,7 +184,7 @@ pub(crate) fn design_impedance(
     human: bool,
     margin: f64,
 ) -> PyResult<Design> {
-    let m = ModelArg::load(model)?;
+    let m = ModelArg::poses(model)?;
     py.detach(move || {
         let d = designer(m, period, human)?;
         let r = d.design_impedance(b, margin).map_err(|e| e.to_string())?;
@@ -209,7 +210,7 @@ pub(crate) fn design_admittance(
     human: bool,
     margin: f64,
 ) -> PyResult<Design> {
-    let m = ModelArg::load(model)?;
+    let m = ModelArg::poses(model)?;
     let regulator = match (kp, bp) {
         (Some(kp), Some(bp)) => Some((kp, bp)),
         (None, None) => None,
@@ -237,7 +238,7 @@ pub(crate) fn check_impedance(
     period: Option<f64>,
     human: bool,
 ) -> PyResult<Check> {
-    let m = ModelArg::load(model)?;
+    let m = ModelArg::poses(model)?;
     py.detach(move || {
         let r = designer(m, period, human)?
             .check_impedance(k, b)
@@ -283,7 +284,7 @@ pub(crate) fn verify(
             ))
         }
     };
-    let model = ModelArg::load(model)?;
+    let model = ModelArg::poses(model)?;
     py.detach(move || {
         let r = designer(model, period, human)?
             .verify(&gains)
@@ -317,9 +318,12 @@ pub(crate) fn zrange<'py>(
     if points < 2 {
         return Err(value(format!("points {points}: need at least 2")));
     }
-    let m = ModelArg::load(model)?;
+    let m = ModelArg::poses(model)?;
     let (freq, range) = py
         .detach(move || {
+            if m.len() > 1 {
+                return Err("zrange draws one pose: give one model".to_string());
+            }
             let d = designer(m, period, true)?;
             let pose = &d.poses()[0];
             let omegas = analysis::log_grid(2.0 * PI * 0.1, pose.plant.nyquist(), points);
@@ -352,7 +356,7 @@ pub(crate) fn region<'py>(
     period: Option<f64>,
     human: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let m = ModelArg::load(model)?;
+    let m = ModelArg::poses(model)?;
     let rows = py
         .detach(move || {
             designer(m, period, human)?
@@ -389,7 +393,7 @@ pub(crate) fn host_ve(
     human: bool,
     verify: bool,
 ) -> PyResult<HostCheck> {
-    let m = ModelArg::load(model)?;
+    let m = ModelArg::poses(model)?;
     let (c, v, n, d) = py
         .detach(move || {
             let des = designer(m, period, human)?;
@@ -407,14 +411,25 @@ pub(crate) fn host_ve(
             let d = ((host_delay / t) - 1e-9).ceil().max(1.0) as u32;
             let host = HostLoop::new(t, n.round() as u32, d, (body.0, body.1, 0.0))
                 .map_err(|e| e.to_string())?;
-            let pose = &des.poses()[0];
             let human = human.then_some(HumanBound::PAPER);
-            let c = check_host_ve(&pose.plant, k, b, human, &host).map_err(|e| e.to_string())?;
-            let v = if verify {
-                Some(verify_host(&pose.model, t, (k, b), human, &host).map_err(|e| e.to_string())?)
-            } else {
-                None
-            };
+            // The worst pose's proof, and the worst pose's search.
+            let mut c: Option<twoport_design::host_ve::HostCheck> = None;
+            let mut v: Option<twoport_design::verify::HostVerdict> = None;
+            for pose in des.poses() {
+                let p =
+                    check_host_ve(&pose.plant, k, b, human, &host).map_err(|e| e.to_string())?;
+                if c.is_none_or(|c| p.min_margin_nspm < c.min_margin_nspm) {
+                    c = Some(p);
+                }
+                if verify {
+                    let r = verify_host(&pose.model, t, (k, b), human, &host)
+                        .map_err(|e| e.to_string())?;
+                    if v.is_none_or(|v| r.spectral_radius > v.spectral_radius) {
+                        v = Some(r);
+                    }
+                }
+            }
+            let c = c.ok_or("no pose")?;
             Ok((c, v, host.ve_period_ticks, host.delay_ticks))
         })
         .map_err(value)?;

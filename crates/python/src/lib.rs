@@ -20,6 +20,7 @@ fn twoport_py(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(design::region, m)?)?;
     m.add_function(wrap_pyfunction!(design::host_ve, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(model::load_device, m)?)?;
     m.add_class::<design::Design>()?;
     m.add_class::<design::Check>()?;
     m.add_class::<design::Verdict>()?;

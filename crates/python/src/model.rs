@@ -16,24 +16,72 @@ pub(crate) struct Model {
     pub(crate) inner: DeviceModel,
 }
 
-/// A model argument: a `Model`, a model file's path, or None (the
-/// paper's Excalibur).
+/// A model argument: a `Model`, a model file's path, a list of them (the
+/// poses of one axis: a design is proven for all), or None (the paper's
+/// Excalibur).
 #[derive(FromPyObject)]
 pub(crate) enum ModelArg {
     Model(Py<Model>),
     Path(PathBuf),
+    Poses(Vec<Pose>),
+}
+
+/// One pose in a list of them.
+#[derive(FromPyObject)]
+pub(crate) enum Pose {
+    Model(Py<Model>),
+    Path(PathBuf),
+}
+
+impl Pose {
+    fn load(self) -> PyResult<DeviceModel> {
+        match self {
+            Pose::Model(m) => Ok(m.get().inner.clone()),
+            Pose::Path(p) => load(&p),
+        }
+    }
 }
 
 impl ModelArg {
-    /// The device model, the Excalibur for None; a file that is not a
-    /// model raises naming it.
-    pub(crate) fn load(arg: Option<ModelArg>) -> PyResult<DeviceModel> {
+    /// The poses, the Excalibur for None; a file that is not a model
+    /// raises naming it, and so does an empty list.
+    pub(crate) fn poses(arg: Option<ModelArg>) -> PyResult<Vec<DeviceModel>> {
         match arg {
-            Some(ModelArg::Model(m)) => Ok(m.get().inner.clone()),
-            Some(ModelArg::Path(p)) => load(&p),
-            None => load(&PathBuf::from(twoport_design::model::EXCALIBUR_PATH)),
+            Some(ModelArg::Model(m)) => Ok(vec![m.get().inner.clone()]),
+            Some(ModelArg::Path(p)) => Ok(vec![load(&p)?]),
+            Some(ModelArg::Poses(v)) if v.is_empty() => Err(PyValueError::new_err(
+                "an empty list of poses: give at least one model",
+            )),
+            Some(ModelArg::Poses(v)) => v.into_iter().map(Pose::load).collect(),
+            None => Ok(vec![load(&PathBuf::from(
+                twoport_design::model::EXCALIBUR_PATH,
+            ))?]),
         }
     }
+}
+
+/// A device file's axes, each the list of its poses' models (a design for
+/// an axis passes its list): `{"name": ..., "axes": {"x": [Model, ...]}}`.
+#[pyfunction]
+pub(crate) fn load_device<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let d = twoport_design::Device::load(&path)
+        .map_err(|e| PyValueError::new_err(format!("{}: {e}", path.display())))?;
+    let axes = pyo3::types::PyDict::new(py);
+    for a in d.axes {
+        let poses = a
+            .models
+            .into_iter()
+            .map(|m| Py::new(py, Model { inner: m }))
+            .collect::<PyResult<Vec<_>>>()?;
+        axes.set_item(a.name, poses)?;
+    }
+    let out = pyo3::types::PyDict::new(py);
+    out.set_item("name", d.name)?;
+    out.set_item("axes", axes)?;
+    Ok(out)
 }
 
 fn load(path: &std::path::Path) -> PyResult<DeviceModel> {

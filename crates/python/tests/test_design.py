@@ -89,3 +89,21 @@ def test_a_scene_runs_with_overrides_and_comes_back_as_arrays():
     assert 0.005 < s["handle_m"][:, 0].max() < 0.012
     with pytest.raises(ValueError, match="no_such_field"):
         twoport.simulate(scene, ["no_such_field=1"])
+
+
+def test_a_device_files_axes_and_a_list_of_poses_are_designed_for_together():
+    dev = twoport.load_device(str(ROOT / "models" / "devices" / "excalibur_xyz.toml"))
+    assert list(dev["axes"]) == ["x", "y", "z"] and len(dev["axes"]["x"]) == 1
+    x = twoport.design_impedance(dev["axes"]["x"], b=90.0)
+    assert abs(x.limit - 51_073.0) < 1.0, x
+    # Two poses: proven for both, so no stiffer than the softer alone.
+    two = str(ROOT / "models" / "two_mass.toml")
+    both = twoport.design_impedance([EXCALIBUR, two], b=90.0)
+    alone = [twoport.design_impedance(m, b=90.0).limit for m in (EXCALIBUR, two)]
+    assert abs(both.limit - min(alone)) <= 1e-6 * min(alone), (both, alone)
+    with pytest.raises(ValueError, match="empty list"):
+        twoport.design_impedance([])
+    with pytest.raises(ValueError, match="one pose"):
+        twoport.zrange(1000.0, 10.0, model=[EXCALIBUR, two])
+    with pytest.raises(ValueError, match="no/such.toml"):
+        twoport.load_device("no/such.toml")
