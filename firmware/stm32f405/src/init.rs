@@ -244,10 +244,10 @@ pub const LINK_BYTES_PER_S: u32 = 115_200 / 10;
 /// 100 to 1000 counts give the 1-10 kHz range (a new `T` needs its own
 /// proven region: `twoport region impedance --period T --rust`).
 const LOOP_COUNTS: u32 = (PERIOD_S * 1.0e6 + 0.5) as u32;
-#[cfg(not(feature = "fast"))]
-use excalibur::PERIOD_S;
 #[cfg(feature = "fast")]
 use excalibur::fast::PERIOD_S;
+#[cfg(not(feature = "fast"))]
+use excalibur::PERIOD_S;
 const _: () = assert!(LOOP_COUNTS >= 100 && LOOP_COUNTS <= 1000);
 
 /// TIM2's update interrupt calls the control tick every `PERIOD_S`.
