@@ -255,6 +255,39 @@ pub(crate) fn check_impedance(
     .map_err(|e: String| value(e))
 }
 
+/// Check the admittance display's coupling of mass `m` (kg) and damping
+/// `b` (N s/m) with the regulator `(kp, bp)` for absolute stability on
+/// `model` (which needs a force sensor).
+#[pyfunction]
+#[pyo3(signature = (kp, bp, m, b, model=None, period=None, human=true))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn check_admittance(
+    py: Python<'_>,
+    kp: f64,
+    bp: f64,
+    m: f64,
+    b: f64,
+    model: Option<ModelArg>,
+    period: Option<f64>,
+    human: bool,
+) -> PyResult<Check> {
+    let poses = ModelArg::poses(model)?;
+    py.detach(move || {
+        let r = designer(poses, period, human)?
+            .check_admittance((kp, bp), m, b)
+            .map_err(|e| e.to_string())?;
+        Ok(Check {
+            absolutely_stable: r.check.absolutely_stable,
+            min_margin: r.check.min_margin,
+            worst_frequency_hz: r.check.worst_frequency_hz,
+            boundary: r.boundary,
+            gain_margin: r.gain_margin,
+            worst_pose: r.worst_pose,
+        })
+    })
+    .map_err(|e: String| value(e))
+}
+
 /// Search the exact sampled loop for a passive hand and VE that make the
 /// impedance coupling `(k, b)` (or, with `m`, the admittance coupling of
 /// mass `m` kg and damping `b` with the regulator `(kp, bp)`) unstable:
@@ -303,18 +336,34 @@ pub(crate) fn verify(
 }
 
 /// The impedance range the hand feels with the impedance coupling `(k,
-/// b)`, from 0.1 Hz to Nyquist at `points` frequencies: a dict of numpy
-/// arrays `frequency_hz`, `z_min`, `z_max` (complex, N s/m).
+/// b)` (or, with `m`, `kp` and `bp`, the admittance coupling of mass `m`
+/// and damping `b` with that regulator), from 0.1 Hz to Nyquist at
+/// `points` frequencies: a dict of numpy arrays `frequency_hz`, `z_min`,
+/// `z_max` (complex, N s/m).
 #[pyfunction]
-#[pyo3(signature = (k, b, model=None, period=None, points=200))]
+#[pyo3(signature = (k=None, b=0.0, model=None, period=None, points=200, m=None, kp=None, bp=None))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn zrange<'py>(
     py: Python<'py>,
-    k: f64,
+    k: Option<f64>,
     b: f64,
     model: Option<ModelArg>,
     period: Option<f64>,
     points: usize,
+    m: Option<f64>,
+    kp: Option<f64>,
+    bp: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let admittance = match (k, m, kp, bp) {
+        (Some(_), None, None, None) => None,
+        (None, Some(m), Some(kp), Some(bp)) => Some((m, kp, bp)),
+        _ => {
+            return Err(value(
+                "give k (impedance display) or m, kp and bp (admittance display)",
+            ))
+        }
+    };
+    let k = k.unwrap_or(0.0);
     if points < 2 {
         return Err(value(format!("points {points}: need at least 2")));
     }
@@ -328,8 +377,11 @@ pub(crate) fn zrange<'py>(
             let pose = &d.poses()[0];
             let omegas = analysis::log_grid(2.0 * PI * 0.1, pose.plant.nyquist(), points);
             let a = Analysis::on(&pose.plant, &omegas);
-            let r = analysis::impedance_range_impedance(&a, k, b)
-                .ok_or_else(|| format!("k {k}, b {b}: not a valid coupling"))?;
+            let r = match admittance {
+                None => analysis::impedance_range_impedance(&a, k, b),
+                Some((m, kp, bp)) => analysis::impedance_range_admittance(&a, (kp, bp), (m, b)),
+            }
+            .ok_or_else(|| format!("b {b}: not a valid coupling with these gains"))?;
             let f: Vec<f64> = omegas.iter().map(|w| w / (2.0 * PI)).collect();
             Ok::<_, String>((f, r))
         })
@@ -341,12 +393,14 @@ pub(crate) fn zrange<'py>(
     Ok(out)
 }
 
-/// The proven region of the impedance display: the stiffest proven
-/// coupling at each of `points` dampings log-spaced from `b_from` to
-/// `b_to` (N s/m); a dict of numpy arrays `b_nspm`, `k_max_npm` (a damping
-/// with no proven stiffness has no row).
+/// The proven region: at each of `points` dampings log-spaced from
+/// `b_from` to `b_to` (N s/m), the stiffest proven impedance coupling, or
+/// with the regulator `(kp, bp)` the lightest proven admittance coupling
+/// mass; a dict of numpy arrays `b_nspm` and `k_max_npm` (or `m_min_kg`)
+/// (a damping with no proven coupling has no row).
 #[pyfunction]
-#[pyo3(signature = (model=None, b_from=10.0, b_to=1000.0, points=32, period=None, human=true))]
+#[pyo3(signature = (model=None, b_from=10.0, b_to=1000.0, points=32, period=None, human=true, kp=None, bp=None))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn region<'py>(
     py: Python<'py>,
     model: Option<ModelArg>,
@@ -355,22 +409,38 @@ pub(crate) fn region<'py>(
     points: usize,
     period: Option<f64>,
     human: bool,
+    kp: Option<f64>,
+    bp: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let regulator = match (kp, bp) {
+        (Some(kp), Some(bp)) => Some((kp, bp)),
+        (None, None) => None,
+        _ => {
+            return Err(value(
+                "kp and bp: give both (the admittance display) or neither",
+            ))
+        }
+    };
     let m = ModelArg::poses(model)?;
     let rows = py
         .detach(move || {
-            designer(m, period, human)?
-                .region_impedance((b_from, b_to), points)
-                .map(|r| r.rows)
-                .map_err(|e| e.to_string())
+            let d = designer(m, period, human)?;
+            match regulator {
+                Some(r) => d.region_admittance(r, (b_from, b_to), points),
+                None => d.region_impedance((b_from, b_to), points),
+            }
+            .map(|r| r.rows)
+            .map_err(|e| e.to_string())
         })
         .map_err(value)?;
     let out = PyDict::new(py);
     out.set_item("b_nspm", PyArray1::from_iter(py, rows.iter().map(|r| r.0)))?;
-    out.set_item(
-        "k_max_npm",
-        PyArray1::from_iter(py, rows.iter().map(|r| r.1)),
-    )?;
+    let limit = if regulator.is_some() {
+        "m_min_kg"
+    } else {
+        "k_max_npm"
+    };
+    out.set_item(limit, PyArray1::from_iter(py, rows.iter().map(|r| r.1)))?;
     Ok(out)
 }
 

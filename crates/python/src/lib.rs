@@ -15,6 +15,7 @@ fn twoport_py(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(design::design_impedance, m)?)?;
     m.add_function(wrap_pyfunction!(design::design_admittance, m)?)?;
     m.add_function(wrap_pyfunction!(design::check_impedance, m)?)?;
+    m.add_function(wrap_pyfunction!(design::check_admittance, m)?)?;
     m.add_function(wrap_pyfunction!(design::verify, m)?)?;
     m.add_function(wrap_pyfunction!(design::zrange, m)?)?;
     m.add_function(wrap_pyfunction!(design::region, m)?)?;

@@ -60,6 +60,14 @@ def test_bad_arrays_and_arguments_are_named():
 def test_admittance_zrange_and_region_come_back_as_arrays():
     a = twoport.design_admittance(EXCALIBUR)
     assert a.display == "admittance" and a.limit > 0 and a.regulator is not None
+    kp, bp = a.regulator
+    assert twoport.check_admittance(kp, bp, a.recommended, a.b_nspm, model=EXCALIBUR).absolutely_stable
+    assert not twoport.check_admittance(kp, bp, 0.8 * a.limit, a.b_nspm,
+                                        model=EXCALIBUR).absolutely_stable
+    ra = twoport.region(EXCALIBUR, b_from=1.0, b_to=50.0, points=6, kp=kp, bp=bp)
+    assert ra["m_min_kg"].shape == ra["b_nspm"].shape and np.all(ra["m_min_kg"] > 0)
+    za = twoport.zrange(m=a.recommended, b=a.b_nspm, kp=kp, bp=bp, model=EXCALIBUR, points=20)
+    assert za["z_max"].shape == (20,)
     z = twoport.zrange(51_000.0, 90.0, model=EXCALIBUR, points=50)
     assert z["frequency_hz"].shape == (50,) and z["z_min"].dtype == np.complex128
     assert np.all(np.isfinite(z["z_min"])) and np.all(np.isfinite(z["z_max"]))
