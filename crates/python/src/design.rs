@@ -14,7 +14,7 @@ use twoport_control::{AdmittanceGains, Gains, ImpedanceGains};
 use twoport_design::analysis::{self, Analysis};
 use twoport_design::host_ve::{check_host_ve, HostLoop};
 use twoport_design::network::HumanBound;
-use twoport_design::verify::verify_host;
+use twoport_design::verify::{verify_host, Hand};
 use twoport_design::{Designer, DeviceModel};
 
 /// A proven virtual coupling: the boundary the designer proved, and the
@@ -70,6 +70,19 @@ pub(crate) struct Check {
     worst_pose: Option<String>,
 }
 
+impl From<twoport_design::designer::CheckReport> for Check {
+    fn from(r: twoport_design::designer::CheckReport) -> Self {
+        Check {
+            absolutely_stable: r.check.absolutely_stable,
+            min_margin: r.check.min_margin,
+            worst_frequency_hz: r.check.worst_frequency_hz,
+            boundary: r.boundary,
+            gain_margin: r.gain_margin,
+            worst_pose: r.worst_pose,
+        }
+    }
+}
+
 #[pymethods]
 impl Check {
     fn __repr__(&self) -> String {
@@ -95,6 +108,19 @@ pub(crate) struct Verdict {
     hand: (f64, f64, f64),
     /// Closed loops evaluated.
     evaluations: usize,
+}
+
+impl Verdict {
+    /// A search's worst: whether it grows, its radius and rate, the hand.
+    fn of(unstable: bool, radius: f64, growth: f64, h: &Hand, evaluations: usize) -> Self {
+        Verdict {
+            unstable,
+            spectral_radius: radius,
+            growth_per_s: growth,
+            hand: (h.mass_kg, h.stiffness_npm, h.damping_nspm),
+            evaluations,
+        }
+    }
 }
 
 #[pymethods]
@@ -243,14 +269,7 @@ pub(crate) fn check_impedance(
         let r = designer(m, period, human)?
             .check_impedance(k, b)
             .map_err(|e| e.to_string())?;
-        Ok(Check {
-            absolutely_stable: r.check.absolutely_stable,
-            min_margin: r.check.min_margin,
-            worst_frequency_hz: r.check.worst_frequency_hz,
-            boundary: r.boundary,
-            gain_margin: r.gain_margin,
-            worst_pose: r.worst_pose,
-        })
+        Ok(Check::from(r))
     })
     .map_err(|e: String| value(e))
 }
@@ -276,14 +295,7 @@ pub(crate) fn check_admittance(
         let r = designer(poses, period, human)?
             .check_admittance((kp, bp), m, b)
             .map_err(|e| e.to_string())?;
-        Ok(Check {
-            absolutely_stable: r.check.absolutely_stable,
-            min_margin: r.check.min_margin,
-            worst_frequency_hz: r.check.worst_frequency_hz,
-            boundary: r.boundary,
-            gain_margin: r.gain_margin,
-            worst_pose: r.worst_pose,
-        })
+        Ok(Check::from(r))
     })
     .map_err(|e: String| value(e))
 }
@@ -323,14 +335,13 @@ pub(crate) fn verify(
             .verify(&gains)
             .map_err(|e| e.to_string())?;
         let v = r.verdict;
-        let h = v.termination.hand;
-        Ok(Verdict {
-            unstable: v.unstable,
-            spectral_radius: v.spectral_radius,
-            growth_per_s: v.growth_per_s,
-            hand: (h.mass_kg, h.stiffness_npm, h.damping_nspm),
-            evaluations: v.evaluations,
-        })
+        Ok(Verdict::of(
+            v.unstable,
+            v.spectral_radius,
+            v.growth_per_s,
+            &v.termination.hand,
+            v.evaluations,
+        ))
     })
     .map_err(|e: String| value(e))
 }
@@ -506,13 +517,13 @@ pub(crate) fn host_ve(
     let verify = match v {
         Some(v) => Some(Py::new(
             py,
-            Verdict {
-                unstable: v.unstable,
-                spectral_radius: v.spectral_radius,
-                growth_per_s: v.growth_per_s,
-                hand: (v.hand.mass_kg, v.hand.stiffness_npm, v.hand.damping_nspm),
-                evaluations: v.evaluations,
-            },
+            Verdict::of(
+                v.unstable,
+                v.spectral_radius,
+                v.growth_per_s,
+                &v.hand,
+                v.evaluations,
+            ),
         )?),
         None => None,
     };
