@@ -127,6 +127,9 @@ impl<P: BoardPort> Board<P> {
     /// named.
     pub fn open(port: P, axes: u8) -> Result<Self, LinkError> {
         let mut session = Session::open_axes(port, LinkFaults::default(), axes)?;
+        // The board runs on its own clock: its watchdog runs while a call
+        // waits for an answer.
+        session.heartbeat_while_waiting(HEARTBEAT_PERIOD);
         let spec = session.spec()?;
         Ok(Board {
             session,
@@ -139,6 +142,11 @@ impl<P: BoardPort> Board<P> {
             ve_seq: 0,
             closed: false,
         })
+    }
+
+    /// The port the board is on (a simulated board's, to look at it).
+    pub fn port(&self) -> &P {
+        self.session.port()
     }
 
     /// What the board said it can do when it was opened (its period, each

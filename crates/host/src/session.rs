@@ -54,6 +54,10 @@ pub struct Session<P: BoardPort> {
     index: Option<(i64, Option<i64>)>,
     /// Frames the host injected corrupted.
     pub corrupted_sent: u64,
+    /// Heartbeats sent this often while a call waits for its answer (a
+    /// board that runs on its own clock), or none (lockstep: the host's
+    /// ticks carry them, and the board's watchdog counts its ticks).
+    heartbeat_while_waiting: Option<Duration>,
 }
 
 impl<P: BoardPort> Session<P> {
@@ -80,9 +84,22 @@ impl<P: BoardPort> Session<P> {
             tick: 0,
             index: None,
             corrupted_sent: 0,
+            heartbeat_while_waiting: None,
         };
         s.handshake()?;
         Ok(s)
+    }
+
+    /// The port the board is on.
+    pub fn port(&self) -> &P {
+        &self.port
+    }
+
+    /// Send a heartbeat every `period` while a call waits for its answer:
+    /// for a board on its own clock, whose watchdog runs while the host
+    /// waits (the device object sets it; lockstep sessions do not).
+    pub fn heartbeat_while_waiting(&mut self, period: Duration) {
+        self.heartbeat_while_waiting = Some(period);
     }
 
     /// Ask for a mode change and wait for the board's status that shows it
@@ -307,8 +324,15 @@ impl<P: BoardPort> Session<P> {
         mut want: impl FnMut(&Message) -> Option<T>,
     ) -> Result<T, LinkError> {
         let deadline = Instant::now() + ANSWER_TIMEOUT;
+        let mut beat = Instant::now();
         loop {
             self.check_session()?;
+            if let Some(period) = self.heartbeat_while_waiting {
+                if beat.elapsed() >= period {
+                    self.send(&Message::Heartbeat)?;
+                    beat = Instant::now();
+                }
+            }
             if let Some((i, v)) = self
                 .inbox
                 .iter()
@@ -325,7 +349,11 @@ impl<P: BoardPort> Session<P> {
                     seconds: ANSWER_TIMEOUT.as_secs(),
                 });
             }
-            self.pump((deadline - now).min(Duration::from_millis(50)))?;
+            let slice = self
+                .heartbeat_while_waiting
+                .unwrap_or(Duration::from_millis(50))
+                .min(Duration::from_millis(50));
+            self.pump((deadline - now).min(slice))?;
         }
     }
 

@@ -191,3 +191,61 @@ fn the_boards_own_wall_is_set_from_the_host() {
     let e = b.set_ve_param(0, VeSetting::Damping(1.0)).unwrap_err();
     assert!(e.to_string().contains("NotDisarmed"), "{e}");
 }
+
+/// A port whose board answers a `GetGains` only 40 ms after it was asked
+/// (a busy link), counting the heartbeats sent meanwhile.
+struct Slow {
+    inner: SimulatedBoard,
+    decoder: twoport_link::Decoder,
+    hold_until: Option<std::time::Instant>,
+    heartbeats_while_held: usize,
+}
+
+impl twoport_host::BoardPort for Slow {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        let now = std::time::Instant::now();
+        let held = self.hold_until.is_some_and(|t| now < t);
+        let (mut asked, mut beats) = (false, 0);
+        self.decoder.feed(bytes, |e| match e.msg {
+            twoport_link::Message::GetGains => asked = true,
+            twoport_link::Message::Heartbeat => beats += 1,
+            _ => {}
+        });
+        if held {
+            self.heartbeats_while_held += beats;
+        }
+        if asked {
+            self.hold_until = Some(now + Duration::from_millis(40));
+        }
+        self.inner.send(bytes)
+    }
+
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError> {
+        if let Some(t) = self.hold_until {
+            let now = std::time::Instant::now();
+            if now < t {
+                std::thread::sleep(timeout.min(t - now));
+                return Ok(0);
+            }
+        }
+        self.inner.recv(buf, timeout)
+    }
+}
+
+/// While a call waits for a slow answer, the device object keeps the
+/// board's watchdog fed: a heartbeat goes out before the answer is taken,
+/// whatever the machine's speed (the answer comes 40 ms late, the
+/// heartbeats every 10 ms).
+#[test]
+fn a_call_that_waits_keeps_sending_heartbeats() {
+    let port = Slow {
+        inner: SimulatedBoard::excalibur(2.0, Pace::PerRead(1)).unwrap(),
+        decoder: twoport_link::Decoder::new(),
+        hold_until: None,
+        heartbeats_while_held: 0,
+    };
+    let mut b = Board::open(port, 1).unwrap();
+    b.gains().unwrap();
+    let sent = b.port().heartbeats_while_held;
+    assert!(sent >= 1, "{sent} heartbeats while the answer was held");
+}
