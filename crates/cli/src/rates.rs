@@ -190,6 +190,19 @@ fn figure(rows: &[Row], rates: &[f64]) -> Figure {
                 points: rates.iter().zip(&r.at).map(|(f, a)| (*f, a.1)).collect(),
             });
         }
+        if let Some(h) = &r.host {
+            curves.push(Curve {
+                label: format!("{}, a body the host moves", r.name),
+                width: 1,
+                dashed: false,
+                color,
+                points: rates
+                    .iter()
+                    .zip(h)
+                    .filter_map(|(f, p)| p.map(|(k, _)| (*f, k)))
+                    .collect(),
+            });
+        }
     }
     Figure {
         title: "What the servo rate buys: the proven coupling stiffness".into(),
