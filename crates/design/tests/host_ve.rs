@@ -142,3 +142,65 @@ fn the_best_pair_against_a_host_body_is_on_its_boundary() {
     let (k4, _) = host_best_pair(&p, h, &host(4), 72.2).unwrap().unwrap();
     assert!(k4 < k, "{k4} against {k}");
 }
+
+/// Many rigid, lightly damped devices (a fixed pseudo-random sweep: mass,
+/// damping, the coupling at 90% of its limit, the host's period and
+/// delay, the body's mass): with the least damping the proof asks for on
+/// the body, the exact periodic loop decays with a clamped, a free, a
+/// middling and a heavy hand.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn random_rigid_devices_hold_where_the_proof_says() {
+    use twoport_design::analysis::{max_stiffness, Analysis, GridSpec};
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let hand = |m: f64, k: f64| Hand {
+        mass_kg: m,
+        stiffness_npm: k,
+        damping_nspm: 1e-3,
+        grasp: None,
+        second: None,
+    };
+    let mut checked = 0;
+    for _ in 0..12 {
+        let (mass, damping) = (0.2 + 1.8 * next(), 2.0 + 38.0 * next());
+        let m = rigid(mass, damping, 0);
+        let p = Plant::new(&m, 1e-3).unwrap();
+        let a = Analysis::new(&p, GridSpec::DEFAULT);
+        let b = damping * (0.05 + 0.45 * next());
+        let Some(limit) = max_stiffness(&a, &a.impedance_bound(None), b) else {
+            continue;
+        };
+        let k = 0.9 * limit;
+        let n = [1u32, 2, 4][(3.0 * next()) as usize % 3];
+        let d = 1 + (2.0 * f64::from(n) * next()) as u32;
+        let body = 0.05 * 100f64.powf(next());
+        let host = |bh: f64| HostLoop::new(1e-3, n, d, (body, bh, 0.0)).unwrap();
+        let need = check_host_ve(&p, k, b, None, &host(0.0))
+            .unwrap()
+            .least_damping_nspm;
+        assert!(need.is_finite(), "m {mass} d {damping} b {b}: {need}");
+        let at = host(1.01 * need + 1e-6);
+        assert!(check_host_ve(&p, k, b, None, &at).unwrap().proven);
+        let w = (k / body).sqrt();
+        for h in [
+            hand(1e-3, 1e8),
+            hand(1e-4, 0.1),
+            hand(0.1, 1e4),
+            hand(10.0, 10.0 * w * w),
+        ] {
+            let r = host_radius(&m, 1e-3, (k, b), &h, &at).unwrap();
+            assert!(
+                !r.unstable,
+                "m {mass} d {damping} k {k} b {b} N {n} d {d} body {body} B {need}: {h:?} gives {r:?}"
+            );
+        }
+        checked += 1;
+    }
+    assert!(checked >= 10, "{checked} devices checked");
+}
