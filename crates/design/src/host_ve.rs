@@ -182,8 +182,187 @@ fn base_grid(plant: &Plant, n: u32) -> Vec<f64> {
     th
 }
 
-/// Prove the impedance coupling `(k, b)` (N/m, N s/m) on `plant` against
-/// the host's loop, for every passive hand (within `human` where given).
+/// The device's side of the host's loop, evaluated once for any coupling:
+/// at each base frequency, the designer's sound bound at the `N`
+/// frequencies that fold onto it, the host's weights `c_m` there, and the
+/// body's real impedance. A coupling's check then costs its own
+/// response at those frequencies, so the searches for the stiffest
+/// coupling and the best pair evaluate the device once.
+pub struct HostAnalysis<'a> {
+    plant: &'a Plant,
+    human: Option<HumanBound>,
+    host: HostLoop,
+    bases: Vec<f64>,
+    /// `z` at each folded frequency, base by base, `N` a base.
+    z: Vec<Complex64>,
+    /// The sound bound there.
+    bound: Vec<f64>,
+    /// `c_m`, laid out as `z`.
+    weights: Vec<Complex64>,
+    /// `Re Z_b` at each base frequency's host frequency.
+    re_zb: Vec<f64>,
+    /// The single-rate analysis and its bound, for the searches.
+    single: std::cell::OnceCell<(Analysis, Vec<f64>)>,
+}
+
+impl<'a> HostAnalysis<'a> {
+    /// Evaluate `plant` (with the hand within `human` where given) and
+    /// `host` on the base frequencies.
+    pub fn new(plant: &'a Plant, human: Option<HumanBound>, host: &HostLoop) -> Self {
+        let t = plant.period_s();
+        let n = host.ve_period_ticks as usize;
+        let bases = base_grid(plant, host.ve_period_ticks);
+        // Every folded frequency in [0, π] (the real parts are even in θ).
+        let fold = |th: f64| ((th + PI).rem_euclid(2.0 * PI) - PI).abs();
+        let omegas: Vec<f64> = bases
+            .iter()
+            .flat_map(|&th| (0..n).map(move |m| th + 2.0 * PI * m as f64 / n as f64))
+            .map(|th| fold(th).max(1e-12) / t)
+            .collect();
+        let a = Analysis::on(plant, &omegas);
+        let bound = a.impedance_bound(human);
+        let weights = bases.iter().flat_map(|&th| host.weights(th, t)).collect();
+        let re_zb = bases
+            .iter()
+            .map(|&th| host.body_impedance(f64::from(host.ve_period_ticks) * th).re)
+            .collect();
+        HostAnalysis {
+            plant,
+            human,
+            host: *host,
+            bases,
+            z: a.points.iter().map(|p| p.z).collect(),
+            bound,
+            weights,
+            re_zb,
+            single: std::cell::OnceCell::new(),
+        }
+    }
+
+    /// Prove the impedance coupling `(k, b)` (N/m, N s/m) against the
+    /// host's loop, for every passive hand (within `human` where given).
+    pub fn check(&self, k: f64, b: f64) -> Result<HostCheck, Error> {
+        let t = self.plant.period_s();
+        let n = self.host.ve_period_ticks as usize;
+        let zc = impedance_coupling_tf(k, b, t)?;
+        let damping = f64::from(self.host.body.damping_nspm());
+        let (mut worst, mut least_damping) = ((f64::INFINITY, 0.0), f64::NEG_INFINITY);
+        for (i, &th) in self.bases.iter().enumerate() {
+            let mut w = 0.0;
+            for m in i * n..(i + 1) * n {
+                let (c, e) = (self.weights[m], zc.eval(self.z[m]).inv().re - self.bound[m]);
+                // |c| - Re c without the cancellation near DC.
+                let short = if c.re > 0.0 {
+                    c.im * c.im / (c.norm() + c.re)
+                } else {
+                    c.norm() - c.re
+                };
+                w += if e > 0.0 {
+                    short / (2.0 * e)
+                } else if short == 0.0 {
+                    0.0
+                } else {
+                    f64::INFINITY
+                };
+            }
+            let re_zb = self.re_zb[i];
+            let margin = re_zb - w;
+            let margin = if margin.is_nan() {
+                f64::NEG_INFINITY
+            } else {
+                margin
+            };
+            if margin < worst.0 {
+                worst = (margin, th / (2.0 * PI * t));
+            }
+            least_damping = least_damping.max(w - (re_zb - damping));
+        }
+        Ok(HostCheck {
+            proven: worst.0 > 0.0,
+            min_margin_nspm: worst.0,
+            worst_frequency_hz: worst.1,
+            least_damping_nspm: least_damping.max(0.0),
+            frequencies: self.bases.len(),
+        })
+    }
+
+    /// The stiffest coupling at damping `b` (N s/m) proven both for every
+    /// passive VE and against the host (N/m, to 1e-3 of it): the
+    /// single-rate limit, lowered by bisection until the host's loop is
+    /// proven; `None` where no stiffness above 1e-6 of the limit is.
+    pub fn max_stiffness(&self, b: f64) -> Result<Option<f64>, Error> {
+        let (a, bound) = self.single.get_or_init(|| {
+            let a = Analysis::new(self.plant, GridSpec::DEFAULT);
+            let bound = a.impedance_bound(self.human);
+            (a, bound)
+        });
+        let Some(limit) = crate::analysis::max_stiffness(a, bound, b) else {
+            return Ok(None);
+        };
+        let proven = |k: f64| self.check(k, b).map(|c| c.proven);
+        // Just inside the single-rate boundary, where the excess is positive.
+        let top = limit * (1.0 - 1e-6);
+        if proven(top)? {
+            return Ok(Some(top));
+        }
+        let (mut lo, mut hi) = (top * 1e-6, top);
+        if !proven(lo)? {
+            return Ok(None);
+        }
+        while (hi - lo) > 1e-3 * lo {
+            let mid = (lo * hi).sqrt();
+            if proven(mid)? {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        Ok(Some(lo))
+    }
+
+    /// The best pair against the host: the damping in `(0, b_max]` (N s/m)
+    /// whose stiffest coupling proven against it is stiffest, and that
+    /// stiffness, `(k N/m, b N s/m)`. A damping helps the single-rate
+    /// proof and, delayed by the host, works against the host's loop, so
+    /// the pair lies below the single-rate one: searched over seven
+    /// dampings spaced by ratios of 2.6 down to `b_max / 300`, then by
+    /// golden sections around the best.
+    pub fn best_pair(&self, b_max: f64) -> Result<Option<(f64, f64)>, Error> {
+        let k_at = |b: f64| self.max_stiffness(b.min(b_max)).map(|k| k.unwrap_or(0.0));
+        let ln = |i: f64| b_max.ln() - i * (300f64.ln() / 6.0);
+        let mut best = (0.0, b_max, 0.0);
+        for i in 0..7 {
+            let b = ln(f64::from(i)).exp().min(b_max);
+            let k = k_at(b)?;
+            if k > best.0 {
+                best = (k, b, f64::from(i));
+            }
+        }
+        if best.0 == 0.0 {
+            return Ok(None);
+        }
+        // Golden sections in log b over the best's neighbours.
+        let (mut lo, mut hi) = (ln((best.2 + 1.0).min(6.0)), ln((best.2 - 1.0).max(0.0)));
+        let g = 0.618_033_988_749_895;
+        for _ in 0..6 {
+            let (x1, x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+            let (k1, k2) = (k_at(x1.exp())?, k_at(x2.exp())?);
+            for (k, x) in [(k1, x1), (k2, x2)] {
+                if k > best.0 {
+                    best = (k, x.exp().min(b_max), best.2);
+                }
+            }
+            if k1 > k2 {
+                hi = x2;
+            } else {
+                lo = x1;
+            }
+        }
+        Ok(Some((best.0, best.1)))
+    }
+}
+
+/// [`HostAnalysis::check`] for one coupling.
 pub fn check_host_ve(
     plant: &Plant,
     k: f64,
@@ -191,145 +370,27 @@ pub fn check_host_ve(
     human: Option<HumanBound>,
     host: &HostLoop,
 ) -> Result<HostCheck, Error> {
-    let t = plant.period_s();
-    let n = host.ve_period_ticks as usize;
-    let zc = impedance_coupling_tf(k, b, t)?;
-    let bases = base_grid(plant, host.ve_period_ticks);
-    // Every folded frequency in [0, π] (the real parts are even in θ).
-    let fold = |th: f64| ((th + PI).rem_euclid(2.0 * PI) - PI).abs();
-    let omegas: Vec<f64> = bases
-        .iter()
-        .flat_map(|&th| (0..n).map(move |m| th + 2.0 * PI * m as f64 / n as f64))
-        .map(|th| fold(th).max(1e-12) / t)
-        .collect();
-    let a = Analysis::on(plant, &omegas);
-    let bound = a.impedance_bound(human);
-    let excess: Vec<f64> = a
-        .points
-        .iter()
-        .zip(&bound)
-        .map(|(p, s)| zc.eval(p.z).inv().re - s)
-        .collect();
-    let damping = f64::from(host.body.damping_nspm());
-    let (mut worst, mut least_damping) = ((f64::INFINITY, 0.0), f64::NEG_INFINITY);
-    for (i, &th) in bases.iter().enumerate() {
-        let mut w = 0.0;
-        for (m, c) in host.weights(th, t).iter().enumerate() {
-            let e = excess[i * n + m];
-            // |c| - Re c without the cancellation near DC.
-            let short = if c.re > 0.0 {
-                c.im * c.im / (c.norm() + c.re)
-            } else {
-                c.norm() - c.re
-            };
-            w += if e > 0.0 {
-                short / (2.0 * e)
-            } else if short == 0.0 {
-                0.0
-            } else {
-                f64::INFINITY
-            };
-        }
-        let re_zb = host.body_impedance(f64::from(host.ve_period_ticks) * th).re;
-        let margin = re_zb - w;
-        let margin = if margin.is_nan() {
-            f64::NEG_INFINITY
-        } else {
-            margin
-        };
-        if margin < worst.0 {
-            worst = (margin, th / (2.0 * PI * t));
-        }
-        least_damping = least_damping.max(w - (re_zb - damping));
-    }
-    Ok(HostCheck {
-        proven: worst.0 > 0.0,
-        min_margin_nspm: worst.0,
-        worst_frequency_hz: worst.1,
-        least_damping_nspm: least_damping.max(0.0),
-        frequencies: bases.len(),
-    })
+    HostAnalysis::new(plant, human, host).check(k, b)
 }
 
-/// The stiffest impedance coupling at damping `b` (N s/m) proven both for
-/// every passive VE and against `host` (N/m, to 1e-3 of it): the
-/// single-rate limit, lowered by bisection until the host's loop is
-/// proven; `None` where no stiffness above 1e-6 of the limit is.
+/// [`HostAnalysis::max_stiffness`] for one damping.
 pub fn host_max_stiffness(
     plant: &Plant,
     b: f64,
     human: Option<HumanBound>,
     host: &HostLoop,
 ) -> Result<Option<f64>, Error> {
-    let a = Analysis::new(plant, GridSpec::DEFAULT);
-    let Some(limit) = crate::analysis::max_stiffness(&a, &a.impedance_bound(human), b) else {
-        return Ok(None);
-    };
-    let proven = |k: f64| check_host_ve(plant, k, b, human, host).map(|c| c.proven);
-    // Just inside the single-rate boundary, where the excess is positive.
-    let top = limit * (1.0 - 1e-6);
-    if proven(top)? {
-        return Ok(Some(top));
-    }
-    let (mut lo, mut hi) = (top * 1e-6, top);
-    if !proven(lo)? {
-        return Ok(None);
-    }
-    while (hi - lo) > 1e-3 * lo {
-        let mid = (lo * hi).sqrt();
-        if proven(mid)? {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    Ok(Some(lo))
+    HostAnalysis::new(plant, human, host).max_stiffness(b)
 }
 
-/// The best pair against `host`: the damping in `(0, b_max]` (N s/m) whose
-/// stiffest coupling proven against it is stiffest, and that stiffness,
-/// `(k N/m, b N s/m)`. A damping helps the single-rate proof and, delayed
-/// by the host, works against the host's loop, so the pair lies below the
-/// single-rate one: searched over seven dampings spaced by ratios of 2.6
-/// down to `b_max / 300`, then by golden sections around the best.
+/// [`HostAnalysis::best_pair`].
 pub fn host_best_pair(
     plant: &Plant,
     human: Option<HumanBound>,
     host: &HostLoop,
     b_max: f64,
 ) -> Result<Option<(f64, f64)>, Error> {
-    let k_at = |b: f64| host_max_stiffness(plant, b, human, host).map(|k| k.unwrap_or(0.0));
-    let ln = |i: f64| b_max.ln() - i * (300f64.ln() / 6.0);
-    let k_at = |b: f64| k_at(b.min(b_max));
-    let mut best = (0.0, b_max, 0.0);
-    for i in 0..7 {
-        let b = ln(f64::from(i)).exp().min(b_max);
-        let k = k_at(b)?;
-        if k > best.0 {
-            best = (k, b, f64::from(i));
-        }
-    }
-    if best.0 == 0.0 {
-        return Ok(None);
-    }
-    // Golden sections in log b over the best's neighbours.
-    let (mut lo, mut hi) = (ln((best.2 + 1.0).min(6.0)), ln((best.2 - 1.0).max(0.0)));
-    let g = 0.618_033_988_749_895;
-    for _ in 0..6 {
-        let (x1, x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
-        let (k1, k2) = (k_at(x1.exp())?, k_at(x2.exp())?);
-        for (k, x) in [(k1, x1), (k2, x2)] {
-            if k > best.0 {
-                best = (k, x.exp().min(b_max), best.2);
-            }
-        }
-        if k1 > k2 {
-            hi = x2;
-        } else {
-            lo = x1;
-        }
-    }
-    Ok(Some((best.0, best.1)))
+    HostAnalysis::new(plant, human, host).best_pair(b_max)
 }
 
 #[cfg(test)]
