@@ -10,7 +10,7 @@ use host_sim::link::{LinkFaults, LocalBoard};
 use host_sim::{pil, Scene};
 use std::f64::consts::TAU;
 use std::path::Path;
-use twoport_control::{Gains, ImpedanceGains};
+use twoport_control::{AdmittanceGains, Gains, ImpedanceGains};
 use twoport_design::network::HumanBound;
 use twoport_design::{Designer, DeviceModel, Plant};
 use twoport_identify::fit::uncertainty::{span, Doubt};
@@ -37,12 +37,35 @@ fn resonances_hz(m: &DeviceModel) -> Vec<f64> {
         .collect()
 }
 
-/// The scene's experiment, run on the Excalibur's board image against
-/// the scene's plant, through its CSV record to the chosen fit.
-fn identified(scene: &str, model: &str, truth: &DeviceModel) -> Fit {
+/// The admittance display: the regulator `(k_p, b_p)` and the coupling's
+/// damping `b` (N/m, N s/m, N s/m).
+#[derive(Clone, Copy)]
+struct Admittance {
+    regulator: (f64, f64),
+    b: f64,
+}
+
+/// The admittance design's coupling mass (kg).
+fn admittance_m(models: Vec<DeviceModel>, a: Admittance) -> f64 {
+    Designer::new(models, None, Some(HumanBound::PAPER))
+        .unwrap()
+        .design_admittance(Some(a.regulator), Some(a.b), 0.0)
+        .unwrap()
+        .coupling
+        .unwrap()
+        .0
+}
+
+/// The scene's experiment, with `handle_kg` clamped on the handle (0 for
+/// none), run on the Excalibur's board image against the scene's plant,
+/// through its CSV record to what it measured.
+fn measured(scene: &str, model: &str, truth: &DeviceModel, handle_kg: f64) -> Measured {
     // (Paths in scenes are the repository root's; tests run in host-sim.)
-    let model = format!("plant.model=\"../{model}\"");
-    let scene = Scene::load(Path::new(scene), &[model]).unwrap();
+    let sets = [
+        format!("plant.model=\"../{model}\""),
+        format!("plant.handle_mass_kg={handle_kg:?}"),
+    ];
+    let scene = Scene::load(Path::new(scene), &sets).unwrap();
     let ticks = (scene.duration_s / 1e-3).round() as u64;
     let r = pil::run(
         scene,
@@ -60,7 +83,18 @@ fn identified(scene: &str, model: &str, truth: &DeviceModel) -> Fit {
     // A 30 s experiment: thirty 1 s periods.
     assert_eq!(log.force_n.len(), 30_000);
     // (Two periods skipped while the hold's mode settles.)
-    let data = Measured::from_log(&log, 2).unwrap();
+    Measured::from_log(&log, 2).unwrap()
+}
+
+/// The scene's experiment through to the chosen fit; with `loaded`, the
+/// same experiment again with that mass (kg) on the handle, fitted with it.
+fn identified(scene: &str, model: &str, truth: &DeviceModel, loaded: Option<f64>) -> Fit {
+    let mut data = measured(scene, model, truth, 0.0);
+    if let Some(kg) = loaded {
+        data = data
+            .with_loaded(kg, measured(scene, model, truth, kg))
+            .unwrap();
+    }
     let base = ModelBase {
         name: format!("identified {}", truth.name),
         period_s: 1e-3,
@@ -75,12 +109,23 @@ fn identified(scene: &str, model: &str, truth: &DeviceModel) -> Fit {
 /// What each device must show: its modes in the band, its resonances
 /// within 2%, the identified model's impedance design at `b` within 3% of
 /// the true model's, the robust design no stiffer than the truth's and
-/// `verify` silent on the true model there, and the friction found.
-fn closes(device: &str, modes: usize, b: f64, friction: (f64, f64)) {
+/// `verify` silent on the true model there, and the friction found. With
+/// an `admittance` display, its design too: within 3% of the truth's, the
+/// robust one no lighter, and `verify` silent on the true model there.
+/// `loaded` is the mass (kg) on the handle of a second, loaded record.
+fn closes(
+    device: &str,
+    modes: usize,
+    b: f64,
+    friction: (f64, f64),
+    admittance: Option<Admittance>,
+    loaded: Option<f64>,
+) {
     let model = format!("models/{device}.toml");
     let truth = DeviceModel::load(Path::new(&format!("../{model}"))).unwrap();
     let scene = format!("../scenes/identify/{device}.toml");
-    let f = identified(&scene, &model, &truth);
+    let f = identified(&scene, &model, &truth, loaded);
+    assert_eq!(f.loaded, loaded.is_some());
     assert_eq!(f.form.modes(), modes, "{:?}", f.form);
     let (want, got) = (resonances_hz(&truth), resonances_hz(&f.model));
     assert_eq!(want.len(), got.len(), "{got:?} against {want:?}");
@@ -93,18 +138,47 @@ fn closes(device: &str, modes: usize, b: f64, friction: (f64, f64)) {
         (k_fit / k_true - 1.0).abs() < 0.03,
         "{k_fit} against {k_true}"
     );
-    let set = span(&f, Doubt::default()).unwrap();
-    let k_robust = impedance_k(set.into_iter().map(|m| m.model).collect(), b);
+    let set: Vec<DeviceModel> = span(&f, Doubt::default())
+        .unwrap()
+        .into_iter()
+        .map(|m| m.model)
+        .collect();
+    let k_robust = impedance_k(set.clone(), b);
     assert!(k_robust <= k_true, "{k_robust} against {k_true}");
-    let verdict = Designer::new(vec![truth], None, Some(HumanBound::PAPER))
-        .unwrap()
-        .verify(&Gains::Impedance(ImpedanceGains {
-            k_npm: k_robust as f32,
-            b_nspm: b as f32,
-        }))
-        .unwrap()
-        .verdict;
+    let on_truth = |g: Gains| {
+        Designer::new(vec![truth.clone()], None, Some(HumanBound::PAPER))
+            .unwrap()
+            .verify(&g)
+            .unwrap()
+            .verdict
+    };
+    let verdict = on_truth(Gains::Impedance(ImpedanceGains {
+        k_npm: k_robust as f32,
+        b_nspm: b as f32,
+    }));
     assert!(!verdict.unstable, "{verdict:?}");
+    if let Some(a) = admittance {
+        let m_true = admittance_m(vec![truth.clone()], a);
+        let m_fit = admittance_m(vec![f.model.clone()], a);
+        assert!(
+            (m_fit / m_true - 1.0).abs() < 0.03,
+            "{m_fit} against {m_true}"
+        );
+        let m_robust = admittance_m(set, a);
+        assert!(m_robust >= m_true, "{m_robust} against {m_true}");
+        let v = on_truth(Gains::Admittance(AdmittanceGains::new(
+            a.regulator.0 as f32,
+            a.regulator.1 as f32,
+            m_robust as f32,
+            a.b as f32,
+        )));
+        assert!(!v.unstable, "{v:?}");
+        eprintln!(
+            "{scene}: m at {} N s/m: true {m_true:.4}, fit {m_fit:.4}, robust \
+             {m_robust:.4}; verify on the truth: radius {}",
+            a.b, v.spectral_radius
+        );
+    }
     let coulomb = f.model.coulomb_friction_n.unwrap();
     assert!((friction.0..friction.1).contains(&coulomb), "{coulomb} N");
     let q = f.model.encoder_quantum_m.unwrap();
@@ -122,7 +196,11 @@ fn closes(device: &str, modes: usize, b: f64, friction: (f64, f64)) {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
 fn the_excalibur_is_identified_from_its_experiment() {
-    closes("excalibur", 3, 90.0, (0.1, 0.3));
+    let paper = Admittance {
+        regulator: (51_000.0, 90.0),
+        b: 500.0,
+    };
+    closes("excalibur", 3, 90.0, (0.1, 0.3), Some(paper), Some(0.5));
 }
 
 /// The capstan handle, one rigid body read by its encoder alone, at its
@@ -130,7 +208,7 @@ fn the_excalibur_is_identified_from_its_experiment() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
 fn the_capstan_is_identified_from_its_experiment() {
-    closes("capstan", 0, 147.9, (0.03, 0.06));
+    closes("capstan", 0, 147.9, (0.03, 0.06), None, None);
 }
 
 /// The two-mass device, whose load cell is its one flexure: one mode, at
@@ -138,5 +216,9 @@ fn the_capstan_is_identified_from_its_experiment() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
 fn the_two_mass_device_is_identified_from_its_experiment() {
-    closes("two_mass", 1, 302.5, (0.07, 0.12));
+    let a = Admittance {
+        regulator: (109_054.0, 302.5),
+        b: 5_000.0,
+    };
+    closes("two_mass", 1, 302.5, (0.07, 0.12), Some(a), None);
 }

@@ -294,6 +294,37 @@ impl DeviceModel {
         out
     }
 
+    /// The device with a rigid mass of `kg` clamped on its handle: `M +
+    /// kg g gᵀ`, `g` the handle force's column of `G`. What a bench adds
+    /// when it loads the handle with a known mass to see the handle's side
+    /// of the device from the actuator. Refused, with the reason, for a
+    /// mass that is not finite and positive, or a handle whose velocity
+    /// output (`C_v`'s first row) is not its force's column (a mass there
+    /// would not be where the handle is read).
+    pub fn with_handle_mass(&self, kg: f64) -> Result<DeviceModel, ModelError> {
+        let err = |message: String| ModelError {
+            source: self.name.clone(),
+            message,
+        };
+        if !(kg.is_finite() && kg > 0.0) {
+            return Err(err(format!(
+                "the handle's added mass {kg} kg must be finite and positive"
+            )));
+        }
+        let g = self.g.column(0).into_owned();
+        let v = self.c_v.row(0).transpose();
+        if (&g - &v).amax() > 1e-12 * g.amax().max(1.0) {
+            return Err(err(
+                "the handle's velocity (C_v's first row) is not where its force enters \
+                 (G's first column): a mass cannot be clamped there"
+                    .into(),
+            ));
+        }
+        let mut loaded = self.clone();
+        loaded.m += &g * g.transpose() * kg;
+        Ok(loaded)
+    }
+
     /// Number of coordinates `n`.
     pub fn dof(&self) -> usize {
         self.m.nrows()
@@ -442,6 +473,28 @@ mod tests {
             let back = DeviceModel::from_toml(&m.to_toml("written\nback"), "written").unwrap();
             assert_eq!(back, m);
         }
+    }
+
+    /// A mass on the handle adds to the handle's coordinate alone: the
+    /// whole device weighs that much more (its rigid-body mass seen through
+    /// `G`'s handle column), and a handle not read where it is pushed, or a
+    /// mass that is no mass, is refused.
+    #[test]
+    fn a_mass_clamps_on_the_handle() {
+        let m = DeviceModel::from_toml(EXCALIBUR, "excalibur.toml").unwrap();
+        let loaded = m.with_handle_mass(0.5).unwrap();
+        let diff = &loaded.m - &m.m;
+        assert!((diff[(4, 4)] - 0.5).abs() < 1e-15);
+        assert_eq!(diff.abs().sum(), diff[(4, 4)]);
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let e = m.with_handle_mass(bad).unwrap_err().to_string();
+            assert!(e.contains("finite and positive"), "{e}");
+        }
+        let mut apart = m.clone();
+        apart.c_v[(0, 4)] = 0.0;
+        apart.c_v[(0, 3)] = 1.0;
+        let e = apart.with_handle_mass(0.5).unwrap_err().to_string();
+        assert!(e.contains("not where its force enters"), "{e}");
     }
 
     #[test]

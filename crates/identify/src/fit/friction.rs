@@ -131,6 +131,13 @@ pub fn without(data: &Measured, coulomb_n: f64) -> Measured {
         friction: Some(s.iter().map(|s| s / (1.0 - coulomb_n * s)).collect()),
         encoder_quantum_m: data.encoder_quantum_m,
         coulomb_n: Some(data.coulomb_n.unwrap_or(0.0) + coulomb_n),
+        // The device's friction is the same with a mass on its handle.
+        loaded: data.loaded.as_ref().map(|l| {
+            Box::new(super::Loaded {
+                added_kg: l.added_kg,
+                data: without(&l.data, coulomb_n),
+            })
+        }),
     }
 }
 

@@ -65,6 +65,19 @@ pub struct Measured {
     /// Coulomb friction already taken out of the responses (N), if any
     /// has been ([`friction::without`]).
     pub coulomb_n: Option<f64>,
+    /// The same experiment with a known mass clamped on the handle, if it
+    /// was played: fitted together with this one, it shows the handle's
+    /// side of the device, which the actuator's push alone barely moves.
+    pub loaded: Option<Box<Loaded>>,
+}
+
+/// An experiment played with a known mass on the handle.
+#[derive(Clone, Debug)]
+pub struct Loaded {
+    /// The mass added (kg).
+    pub added_kg: f64,
+    /// What it measured (its own `loaded` is `None`).
+    pub data: Measured,
 }
 
 /// The physical form of a fitted model.
@@ -153,6 +166,47 @@ impl Measured {
             friction,
             encoder_quantum_m: encoder,
             coulomb_n: None,
+            loaded: None,
+        })
+    }
+
+    /// These responses with `loaded`'s, measured with `added_kg` on the
+    /// handle, to be fitted together. Refused where the mass is not
+    /// finite and positive, or the two did not play the same harmonics or
+    /// read the same sensors.
+    pub fn with_loaded(
+        self,
+        added_kg: f64,
+        loaded: Measured,
+    ) -> Result<Measured, crate::IdentifyError> {
+        let refuse = |why: String| crate::IdentifyError::Log {
+            place: "the loaded record".into(),
+            why,
+        };
+        if !(added_kg.is_finite() && added_kg > 0.0) {
+            return Err(refuse(format!(
+                "the mass on the handle, {added_kg} kg, must be finite and positive"
+            )));
+        }
+        if loaded.position.freq_hz != self.position.freq_hz {
+            return Err(refuse(
+                "it played other harmonics than the bare record: play the same experiment".into(),
+            ));
+        }
+        if loaded.load_cell.is_some() != self.load_cell.is_some() {
+            return Err(refuse(
+                "one record has a load cell and the other has not".into(),
+            ));
+        }
+        Ok(Measured {
+            loaded: Some(Box::new(Loaded {
+                added_kg,
+                data: Measured {
+                    loaded: None,
+                    ..loaded
+                },
+            })),
+            ..self
         })
     }
 }
@@ -217,6 +271,8 @@ pub struct Fit {
     pub params: DVector<f64>,
     /// What the model was built on.
     pub base: ModelBase,
+    /// Whether a loaded record was fitted too (the handle's side seen).
+    pub loaded: bool,
 }
 
 impl Fit {
@@ -228,9 +284,13 @@ impl Fit {
             Form::Chain(c) => {
                 Chain::from_log(c.masses_kg.len(), p, c.load_cell_sign).model(&self.base)
             }
-            Form::Modal(m) => {
-                Modal::from_params(p, m.load_cell_sign, self.base.period_s).model(&self.base)
-            }
+            Form::Modal(m) => Modal::from_params(
+                p,
+                m.load_cell_sign,
+                self.base.period_s,
+                m.bypass_npm.is_some(),
+            )
+            .model(&self.base),
         }?;
         m.coulomb_friction_n = self.model.coulomb_friction_n;
         m.encoder_quantum_m = self.model.encoder_quantum_m;
@@ -316,6 +376,10 @@ fn residuals(model: &DeviceModel, data: &Measured, coulomb_n: f64) -> Option<DVe
             r.push(e.re);
             r.push(e.im);
         }
+    }
+    if let Some(l) = &data.loaded {
+        let loaded = model.with_handle_mass(l.added_kg).ok()?;
+        r.extend(residuals(&loaded, &l.data, coulomb_n)?.iter());
     }
     Some(DVector::from_vec(r))
 }
@@ -466,7 +530,7 @@ pub fn fit_modal(data: &Measured, base: &ModelBase, modes: usize) -> Option<Fit>
     };
     let start = start::modal_start(data, base.period_s, pole, rigid, &omegas)?;
     let sign = start.load_cell_sign;
-    let from = |p: &DVector<f64>| Modal::from_params(p, sign, base.period_s);
+    let from = |p: &DVector<f64>| Modal::from_params(p, sign, base.period_s, false);
     // First with proportional damping, then with the modes' coupling: the
     // coupling is small, and fitting it from a start far off only slows
     // the search.
@@ -495,6 +559,101 @@ pub fn fit_modal(data: &Measured, base: &ModelBase, modes: usize) -> Option<Fit>
         |p| from(p).model(base),
         |p| Form::Modal(from(p)),
     )
+}
+
+/// A bare record's fit `bare` refitted to both records, bare and loaded:
+/// from its parameters, and in the modal form with a
+/// [bypass](Modal::bypass_npm) beside the load cell, which only the loaded
+/// record shows. The bypass starts from a few strengths, the handle's
+/// mass from the bare fit's and from what the load cell weighed (the fit
+/// is not convex in them), and the least misfit is kept.
+fn refit_loaded(bare: &Fit, data: &Measured, loaded: &Loaded) -> Option<Fit> {
+    let base = &bare.base;
+    let encoder_only;
+    let data = if bare.model.force_sensor {
+        data
+    } else {
+        encoder_only = Measured {
+            load_cell: None,
+            loaded: Some(Box::new(Loaded {
+                added_kg: loaded.added_kg,
+                data: Measured {
+                    load_cell: None,
+                    ..loaded.data.clone()
+                },
+            })),
+            ..data.clone()
+        };
+        &encoder_only
+    };
+    let m = match &bare.form {
+        Form::Chain(c) => {
+            let (masses, sign) = (c.masses_kg.len(), c.load_cell_sign);
+            return finish(
+                data,
+                base,
+                bare.params.clone(),
+                |p| Chain::from_log(masses, p, sign).model(base),
+                |p| Form::Chain(Chain::from_log(masses, p, sign)),
+            );
+        }
+        Form::Modal(m) => m,
+    };
+    let sign = m.load_cell_sign;
+    let from = |p: &DVector<f64>| Modal::from_params(p, sign, base.period_s, true);
+    // The lowest mode the bare fit found, or the top of the band.
+    let w = m
+        .modes
+        .iter()
+        .map(|m| m.omega_rad_s)
+        .fold(TAU * data.position.freq_hz.last().copied()?, f64::min);
+    // The load cell weighs the handle: at the lowest harmonics it reads
+    // `m_h` per unit of acceleration bare and `m_h + m` loaded, so the
+    // ratio of the two readings per motion gives `m_h` (the bypass hardly
+    // stretches there). The bare fit's is a start too.
+    let weighed = weighed_handle(data, loaded).filter(|h| (0.2..5.0).contains(&(h / m.handle_kg)));
+    // Every parameter from several starts: the misfit is not convex in
+    // the handle's mass and the bypass, and the modes move with them.
+    [Some(m.handle_kg), weighed]
+        .into_iter()
+        .flatten()
+        .flat_map(|h| [1e-3, 1e-2, 1e-1, 1.0].map(|share| (h, share * h * w * w)))
+        .filter_map(|(handle_kg, kb)| {
+            let start = Modal {
+                handle_kg,
+                bypass_npm: Some(kb),
+                ..m.clone()
+            };
+            finish(
+                data,
+                base,
+                start.to_params(),
+                |p| from(p).model(base),
+                |p| Form::Modal(from(p)),
+            )
+        })
+        .min_by(|a, b| a.chi2.total_cmp(&b.chi2))
+}
+
+/// The handle's mass past the load cell (kg) from the lowest harmonics of
+/// a bare and a loaded record: the load cell's reading per encoder motion
+/// is `m_h ω²` bare and `(m_h + m) ω²` loaded.
+fn weighed_handle(bare: &Measured, loaded: &Loaded) -> Option<f64> {
+    let per_motion = |d: &Measured| -> Option<Vec<Complex64>> {
+        let lc = d.load_cell.as_ref()?;
+        Some(
+            lc.response
+                .iter()
+                .zip(&d.position.response)
+                .take(5)
+                .map(|(f, x)| f / x)
+                .collect(),
+        )
+    };
+    let (b, l) = (per_motion(bare)?, per_motion(&loaded.data)?);
+    let ratio = b.iter().zip(&l).map(|(b, l)| (l / b).re).sum::<f64>() / b.len() as f64;
+    let m = loaded.added_kg / (ratio - 1.0);
+    (m.is_finite() && m > 0.0).then_some(m)
 }
 
 /// Levenberg-Marquardt from `p0` on every parameter, and the fit's
@@ -544,6 +703,7 @@ fn finish(
         bic: sol.cost + parameters as f64 * (residuals as f64).ln(),
         params: q,
         base: base.clone(),
+        loaded: data.loaded.is_some(),
     })
 }
 
@@ -582,6 +742,28 @@ fn lowest_resonance_hz(x: &Frf) -> Option<f64> {
 
 /// [`fit_orders`] on a record with no friction in it.
 fn fit_orders_linear(data: &Measured, base: &ModelBase) -> (Vec<Fit>, Option<usize>) {
+    let Some(loaded) = &data.loaded else {
+        return climb(data, base);
+    };
+    // The order is chosen on the bare record, the one the modes show in
+    // best; the chosen fit is then refitted to both records, and is last.
+    let bare = Measured {
+        loaded: None,
+        ..data.clone()
+    };
+    let (mut fits, best) = climb(&bare, base);
+    match best.and_then(|i| refit_loaded(&fits[i], data, loaded)) {
+        Some(joint) => {
+            fits.push(joint);
+            let last = fits.len() - 1;
+            (fits, Some(last))
+        }
+        None => (fits, best),
+    }
+}
+
+/// The orders climbed on one record.
+fn climb(data: &Measured, base: &ModelBase) -> (Vec<Fit>, Option<usize>) {
     let sensor = data.load_cell.is_some() && base.load_cell_pole_rad_s.is_some();
     // With a load cell, the modes are the device's own and the handle
     // hangs on a stiff flexure; where the handle cannot be taken out of

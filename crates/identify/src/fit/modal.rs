@@ -64,6 +64,13 @@ pub struct Modal {
     /// joints and grip rarely give it, and a lightly damped mode's
     /// residue is complex when they do not.
     pub coupling: Vec<f64>,
+    /// A spring from the handle straight to the actuator (N/m), beside
+    /// the load cell, which does not read what it carries; `None` where
+    /// the fit has none. The actuator's own motion barely stretches it,
+    /// so only an experiment that moves the handle's side (a known mass
+    /// on the handle) can place it; an admittance display, which reads
+    /// the hand's force by the load cell, depends on it.
+    pub bypass_npm: Option<f64>,
 }
 
 /// Pairs of modal coordinates (the rigid body's included) for `r` modes.
@@ -107,18 +114,27 @@ impl Modal {
             ]);
         }
         v.extend(&self.coupling);
+        v.extend(self.bypass_npm.map(f64::ln));
         DVector::from_vec(v)
     }
 
     /// The model from [`to_params`](Self::to_params)'s form, with the
-    /// [`flexure`] for a sample period of `period_s`.
-    pub fn from_params(p: &DVector<f64>, load_cell_sign: f64, period_s: f64) -> Modal {
+    /// [`flexure`] for a sample period of `period_s`; `bypass` says
+    /// whether the last parameter is the [bypass](Self::bypass_npm)'s.
+    pub fn from_params(
+        p: &DVector<f64>,
+        load_cell_sign: f64,
+        period_s: f64,
+        bypass: bool,
+    ) -> Modal {
         let e = |i: usize| p[i].exp();
         let mass_kg = e(0);
         let root = mass_kg.sqrt();
-        // p.len() = GLOBAL + PER_MODE r + r (r + 1) / 2.
+        let bypass_npm = bypass.then(|| e(p.len() - 1));
+        let own = p.len() - usize::from(bypass);
+        // own = GLOBAL + PER_MODE r + r (r + 1) / 2.
         let r = (0..)
-            .find(|r| GLOBAL + PER_MODE * r + pairs(*r) >= p.len())
+            .find(|r| GLOBAL + PER_MODE * r + pairs(*r) >= own)
             .unwrap_or(0);
         let modes = (0..r)
             .map(|i| {
@@ -142,7 +158,8 @@ impl Modal {
             load_cell_nspm,
             load_cell_sign,
             modes,
-            coupling: p.as_slice()[GLOBAL + PER_MODE * r..].to_vec(),
+            coupling: p.as_slice()[GLOBAL + PER_MODE * r..own].to_vec(),
+            bypass_npm,
         }
     }
 
@@ -176,6 +193,13 @@ impl Modal {
         psi[h] = 1.0;
         let flex = &psi * psi.transpose();
         let mut k = &flex * self.load_cell_npm;
+        if let Some(kb) = self.bypass_npm {
+            // Its stretch, q_h - x_a.
+            let mut beta = DVector::zeros(n);
+            beta.rows_mut(0, r + 1).copy_from(&(-&phi_a));
+            beta[h] = 1.0;
+            k += &beta * beta.transpose() * kb;
+        }
         let mut d = &flex * self.load_cell_nspm;
         d[(h, h)] += self.handle_nspm;
         let mut own = vec![self.damping_nspm / self.mass_kg];

@@ -275,6 +275,7 @@ pub fn modal_start(
         load_cell_nspm,
         load_cell_sign: sign,
         coupling: vec![0.0; omega.len() * (omega.len() + 1) / 2],
+        bypass_npm: None,
         modes,
     })
 }

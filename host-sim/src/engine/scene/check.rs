@@ -56,6 +56,12 @@ impl Scene {
             }
         }
         pos("plant.rigid_mass_kg", self.plant.rigid_mass_kg)?;
+        nonneg("plant.handle_mass_kg", self.plant.handle_mass_kg)?;
+        if self.plant.handle_mass_kg > 0.0 && self.plant.linkage.is_some() {
+            return Err(
+                "plant.handle_mass_kg: a mass on a linkage's handle is not modelled".into(),
+            );
+        }
         nonneg("plant.rigid_damping_nspm", self.plant.rigid_damping_nspm)?;
         if self.integrator.substeps == 0 || self.integrator.substeps > 100_000 {
             return Err(sim_err!(

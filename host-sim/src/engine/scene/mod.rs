@@ -69,11 +69,17 @@ impl Scene {
         self.period_s.unwrap_or(1e-3)
     }
 
-    /// The scene's device model, [`twoport_design::DeviceModel::load_or_excalibur`]; the
-    /// error names `plant.model`.
+    /// The scene's device model, [`twoport_design::DeviceModel::load_or_excalibur`],
+    /// with `plant.handle_mass_kg` on its handle; the error names the field.
     pub fn device_model(&self) -> Result<twoport_design::DeviceModel, Error> {
-        twoport_design::DeviceModel::load_or_excalibur(&self.plant.model)
-            .map_err(|e| sim_err!("plant.model: {e}"))
+        let m = twoport_design::DeviceModel::load_or_excalibur(&self.plant.model)
+            .map_err(|e| sim_err!("plant.model: {e}"))?;
+        match self.plant.handle_mass_kg {
+            0.0 => Ok(m),
+            kg => m
+                .with_handle_mass(kg)
+                .map_err(|e| sim_err!("plant.handle_mass_kg: {e}")),
+        }
     }
 
     /// Read a scene file, apply `--set` overrides, and check it.

@@ -91,6 +91,11 @@ pub struct PlantSpec {
     /// (true by default; the proof counts only viscous damping).
     #[serde(default)]
     pub friction: Option<bool>,
+    /// A known rigid mass clamped on the handle (kg; 0, the default, for
+    /// none): the loaded run of an identification experiment, which shows
+    /// the handle's side of the device. Not on a linkage.
+    #[serde(default)]
+    pub handle_mass_kg: f64,
 }
 
 fn default_model() -> PathBuf {
@@ -114,6 +119,7 @@ impl Default for PlantSpec {
             pose_rad: Vec::new(),
             gravity_mps2: 0.0,
             friction: None,
+            handle_mass_kg: 0.0,
         }
     }
 }

@@ -296,7 +296,7 @@ impl<const N: usize> Simulation<N> {
             Device::flexible(&model)?
         } else {
             Device::rigid(
-                scene.plant.rigid_mass_kg,
+                scene.plant.rigid_mass_kg + scene.plant.handle_mass_kg,
                 scene.plant.rigid_damping_nspm,
                 235.0,
             )
