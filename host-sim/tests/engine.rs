@@ -241,6 +241,7 @@ fn bad_scene_files_name_the_line_and_field() {
             "coupling.m=5.0",
             "m belongs to an admittance display's coupling",
         ),
+        ("plant.handle_mass_kg=-0.5", "plant.handle_mass_kg"),
         (
             "coupling.k=",
             "give k and b (impedance display), or kp, bp, m and b",

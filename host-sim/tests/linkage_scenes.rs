@@ -94,6 +94,7 @@ fn a_linkage_scene_refuses_what_does_not_apply() {
     assert!(refused(&["effects.flexibility=true"]).contains("effects.flexibility"));
     assert!(refused(&["plant.pose_rad=[2.0, 0.2, 1.0]"]).contains("outside the joint limits"));
     assert!(refused(&["axes=2", "human.script=[]"]).contains("3 joints"));
+    assert!(refused(&["plant.handle_mass_kg=0.5"]).contains("plant.handle_mass_kg"));
 }
 
 /// The building-block world through the PHANToM, under gravity, at the

@@ -385,6 +385,17 @@ pub(crate) struct IdentifyArgs {
     /// Whole periods skipped at the start, while the transient settles.
     #[arg(long, default_value_t = 2)]
     pub(crate) skip: usize,
+    /// A second record of an axis's experiment, played with a known mass
+    /// clamped on the handle (--added-mass), fitted with the bare record:
+    /// it shows the handle's side of the device (what the handle weighs
+    /// past the load cell, and any path that holds it beside the load
+    /// cell), which an admittance display depends on and the bare
+    /// experiment cannot see. Repeat for each axis that has one.
+    #[arg(long, value_name = "AXIS=PATH")]
+    pub(crate) loaded: Vec<String>,
+    /// The mass clamped on the handle in the --loaded records (kg).
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) added_mass: Option<f64>,
     /// The device's name; by default, from the records' file names.
     #[arg(long)]
     pub(crate) name: Option<String>,

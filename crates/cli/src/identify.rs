@@ -58,6 +58,7 @@ pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
         }
         names.push(name);
     }
+    let loaded = loaded_records(a, &names)?;
     let device = a
         .name
         .clone()
@@ -66,7 +67,13 @@ pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
         .records
         .iter()
         .zip(&names)
-        .map(|(r, name)| axis(a, &amp, r, name, &device))
+        .map(|(r, name)| {
+            let with = loaded
+                .iter()
+                .find(|l| &l.0 == name)
+                .map(|l| (l.1.as_path(), l.2));
+            axis(a, &amp, r, with, name, &device)
+        })
         .collect::<Result<Vec<_>, _>>()?;
 
     let file = |what: &str, models: &dyn Fn(&Axis) -> Vec<String>| {
@@ -147,18 +154,79 @@ struct Axis {
     members: Vec<String>,
 }
 
-/// Identify the axis `name` from `record`, writing its model, its set and
-/// its figures under the output folder's `name/`.
+/// `--loaded AXIS=PATH` read as (axis, record, added mass), each axis one
+/// of the records' and named once; `--added-mass` given exactly when they
+/// are.
+fn loaded_records(
+    a: &IdentifyArgs,
+    names: &[String],
+) -> Result<Vec<(String, PathBuf, f64)>, String> {
+    let mass = match (a.added_mass, a.loaded.is_empty()) {
+        (None, true) => return Ok(Vec::new()),
+        (Some(m), true) => {
+            return Err(format!(
+                "--added-mass {m}: it is the mass on the handle in the --loaded records; give them"
+            ))
+        }
+        (None, false) => {
+            return Err(
+                "--loaded: give the mass clamped on the handle with --added-mass (kg)".into(),
+            )
+        }
+        (Some(m), false) if !(m.is_finite() && m > 0.0) => {
+            return Err(format!("--added-mass {m}: must be a finite number > 0"))
+        }
+        (Some(m), false) => m,
+    };
+    let mut out: Vec<(String, PathBuf, f64)> = Vec::new();
+    for l in &a.loaded {
+        let (axis, path) = l
+            .split_once('=')
+            .filter(|(x, p)| !x.is_empty() && !p.is_empty())
+            .ok_or_else(|| format!("--loaded {l}: give it as AXIS=PATH (x=x-loaded.csv)"))?;
+        if !names.iter().any(|n| n == axis) {
+            return Err(format!(
+                "--loaded {l}: no record names the axis {axis:?} (the records name {})",
+                names.join(", ")
+            ));
+        }
+        if out.iter().any(|o| o.0 == axis) {
+            return Err(format!(
+                "--loaded {l}: the axis {axis:?} has a loaded record already"
+            ));
+        }
+        out.push((axis.to_string(), PathBuf::from(path), mass));
+    }
+    Ok(out)
+}
+
+/// A record read and checked against the amplifier's peak.
+fn read_record(record: &Path, amp: &Amplifier) -> Result<(Log, String), String> {
+    let text = std::fs::read_to_string(record).map_err(|e| format!("{}: {e}", record.display()))?;
+    let source = record.display().to_string();
+    let log = Log::from_csv(&text, &source).map_err(|e| e.to_string())?;
+    let most = log.force_n.iter().fold(0.0_f64, |m, f| m.max(f.abs()));
+    if most > amp.peak {
+        return Err(format!(
+            "{source}: the force reaches {most:.4} N, past --peak-force {} N; give the amplifier's peak",
+            amp.peak
+        ));
+    }
+    Ok((log, source))
+}
+
+/// Identify the axis `name` from `record` (and `loaded`, the same
+/// experiment with a mass in kg on the handle), writing its model, its set
+/// and its figures under the output folder's `name/`.
 fn axis(
     a: &IdentifyArgs,
     amp: &Amplifier,
     record: &Path,
+    loaded: Option<(&Path, f64)>,
     name: &str,
     device: &str,
 ) -> Result<Axis, String> {
-    let text = std::fs::read_to_string(record).map_err(|e| format!("{}: {e}", record.display()))?;
-    let source = record.display().to_string();
-    let log = Log::from_csv(&text, &source).map_err(|e| e.to_string())?;
+    let (log, source) = read_record(record, amp)?;
     let pole = match (&log.load_cell_n, amp.pole) {
         (Some(_), None) => {
             return Err(format!(
@@ -172,14 +240,23 @@ fn axis(
         }
         (lc, p) => p.filter(|_| lc.is_some()),
     };
-    let most = log.force_n.iter().fold(0.0_f64, |m, f| m.max(f.abs()));
-    if most > amp.peak {
-        return Err(format!(
-            "{source}: the force reaches {most:.4} N, past --peak-force {} N; give the amplifier's peak",
-            amp.peak
-        ));
+    let mut data = Measured::from_log(&log, a.skip).map_err(|e| format!("{source}: {e}"))?;
+    let mut sources = source.clone();
+    if let Some((path, kg)) = loaded {
+        let (l, src) = read_record(path, amp)?;
+        if l.period_s != log.period_s {
+            return Err(format!(
+                "{src}: sampled every {} s, the bare record {source} every {} s: play the same experiment",
+                l.period_s, log.period_s
+            ));
+        }
+        let ld = Measured::from_log(&l, a.skip).map_err(|e| format!("{src}: {e}"))?;
+        data = data
+            .with_loaded(kg, ld)
+            .map_err(|e| format!("{src}: {e}"))?;
+        sources = format!("{source} and {src} ({kg} kg on the handle)");
     }
-    let data = Measured::from_log(&log, a.skip).map_err(|e| format!("{source}: {e}"))?;
+    let source = sources;
     let base = ModelBase {
         name: format!("{device}, axis {name}"),
         period_s: log.period_s,
@@ -244,6 +321,9 @@ fn axis(
 fn provenance(source: &str, f: &Fit) -> String {
     let form = match &f.form {
         Form::Chain(_) => "a chain of masses",
+        Form::Modal(m) if m.bypass_npm.is_some() => {
+            "modes, the handle on its load cell and a bypass spring"
+        }
         Form::Modal(_) => "modes, the handle on its load cell",
     };
     format!(
@@ -295,6 +375,11 @@ fn report(
         Form::Chain(_) => "chain",
         Form::Modal(_) => "modal",
     };
+    // What the handle weighs past the load cell, and the bypass beside it.
+    let handle = match &f.form {
+        Form::Modal(m) => Some((m.handle_kg, m.bypass_npm)),
+        Form::Chain(_) => None,
+    };
     let v = json!({
         "record": source,
         "samples": log.force_n.len(),
@@ -305,6 +390,7 @@ fn report(
         "coherence_min_hz": x.freq_hz.get(worst_at),
         "orders": fits.iter().map(|g| json!({
             "modes": g.form.modes(),
+            "loaded": g.loaded,
             "chi2_per_dof": g.reduced_chi2(),
             "bic": g.bic,
         })).collect::<Vec<_>>(),
@@ -314,6 +400,8 @@ fn report(
             "resonances_hz": res.iter().map(|r| r.0).collect::<Vec<_>>(),
             "damping_ratios": res.iter().map(|r| r.1).collect::<Vec<_>>(),
             "chi2_per_dof": f.reduced_chi2(),
+            "handle_kg": handle.map(|h| h.0),
+            "bypass_npm": handle.and_then(|h| h.1),
         },
         "coulomb_friction_n": f.model.coulomb_friction_n,
         "encoder_quantum_m": f.model.encoder_quantum_m,
@@ -340,9 +428,14 @@ fn report(
     let _ = writeln!(t, "  orders fitted (modes: chi2/nu, BIC):");
     for (i, g) in fits.iter().enumerate() {
         let mark = if Some(i) == best { "  <- chosen" } else { "" };
+        let both = if g.loaded {
+            " (with the loaded record)"
+        } else {
+            ""
+        };
         let _ = writeln!(
             t,
-            "    {}: {:.3}, {:.1}{mark}",
+            "    {}{both}: {:.3}, {:.1}{mark}",
             g.form.modes(),
             g.reduced_chi2(),
             g.bic
@@ -351,6 +444,17 @@ fn report(
     let _ = writeln!(t, "  model ({form}), resonances below Nyquist:");
     for (hz, zeta) in &res {
         let _ = writeln!(t, "    {hz:9.3} Hz  damping ratio {zeta:.4}");
+    }
+    if let Some((kg, bypass)) = handle {
+        let _ = write!(t, "  handle past the load cell {kg:.4} kg");
+        match bypass {
+            Some(b) => {
+                let _ = writeln!(t, ", held beside it by {b:.1} N/m to the actuator");
+            }
+            None => {
+                let _ = writeln!(t);
+            }
+        }
     }
     if let Some(c) = f.model.coulomb_friction_n {
         let _ = writeln!(t, "  Coulomb friction {c:.4} N");

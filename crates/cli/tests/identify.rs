@@ -22,8 +22,18 @@ fn capstan_record(
     name: &str,
     tweak: impl Fn(&mut twoport_identify::log::Log),
 ) -> PathBuf {
+    record_of(dir, name, 0.25, tweak)
+}
+
+/// [`capstan_record`] of a handle of `m` kg.
+fn record_of(
+    dir: &std::path::Path,
+    name: &str,
+    m: f64,
+    tweak: impl Fn(&mut twoport_identify::log::Log),
+) -> PathBuf {
     use twoport_control::multisine::Multisine;
-    let (m, b, t, period, periods) = (0.25_f64, 2.0_f64, 1e-3_f64, 1000u32, 8u32);
+    let (b, t, period, periods) = (2.0_f64, 1e-3_f64, 1000u32, 8u32);
     let ms = Multisine::new(period, 1, 100, 2.0).unwrap();
     let a = (-b * t / m).exp();
     let (mut x, mut v) = (0.0_f64, 0.0_f64);
@@ -125,6 +135,47 @@ fn identify_writes_each_axis_and_the_device_files() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// A loaded record (the capstan with 0.1 kg on its handle) is fitted with
+/// the bare one: the chosen fit is the joint one, and the handle's mass
+/// comes back.
+#[test]
+fn identify_fits_a_loaded_record_with_the_bare_one() {
+    let dir = scratch("identify-loaded");
+    let x = capstan_record(&dir, "x", |_| {});
+    let loaded = record_of(&dir, "x-loaded", 0.35, |_| {});
+    let out = dir.join("out");
+    let v = TWOPORT.json(&[
+        "identify",
+        x.to_str().unwrap(),
+        "--loaded",
+        &format!("x={}", loaded.display()),
+        "--added-mass",
+        "0.1",
+        "--out",
+        out.to_str().unwrap(),
+        "--peak-force",
+        "10",
+        "--continuous-force",
+        "4",
+        "--json",
+    ]);
+    let a = &v["axes"][0];
+    let orders = a["orders"].as_array().unwrap();
+    assert_eq!(orders.last().unwrap()["loaded"], true, "{v}");
+    assert_eq!(a["chosen"]["modes"], 0, "{v}");
+    assert!(
+        a["record"]
+            .as_str()
+            .unwrap()
+            .contains("0.1 kg on the handle"),
+        "{v}"
+    );
+    let model = std::fs::read_to_string(out.join("x/model.toml")).unwrap();
+    let fitted = twoport_design::DeviceModel::from_toml(&model, "model.toml").unwrap();
+    assert!((fitted.m[(0, 0)] / 0.25 - 1.0).abs() < 0.01, "{model}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 /// Bad records and arguments are refused with what is wrong.
 #[test]
 fn identify_refuses_bad_records_and_arguments() {
@@ -154,6 +205,24 @@ fn identify_refuses_bad_records_and_arguments() {
         (&["--sigmas", "-1"][..], "--sigmas -1"),
         (&["--damping-doubt", "1"][..], "--damping-doubt 1"),
         (&["--skip", "7"][..], "whole periods"),
+        (&["--added-mass", "0.1"][..], "give them"),
+        (&["--loaded", "capstan=x.csv"][..], "--added-mass (kg)"),
+        (
+            &["--loaded", "capstan=x.csv", "--added-mass", "-1"][..],
+            "--added-mass -1",
+        ),
+        (
+            &["--loaded", "y=x.csv", "--added-mass", "0.1"][..],
+            "no record names the axis \"y\"",
+        ),
+        (
+            &["--loaded", "x.csv", "--added-mass", "0.1"][..],
+            "give it as AXIS=PATH",
+        ),
+        (
+            &["--loaded", "capstan=nowhere.csv", "--added-mass", "0.1"][..],
+            "nowhere.csv",
+        ),
     ] {
         let e = fail(&good, extra);
         assert!(e.contains(want), "{extra:?}: {e}");

@@ -17,6 +17,10 @@ pub(crate) struct PilArgs {
     /// The scene: plant, hand and effects; the board brings its own law.
     #[arg(default_value = "scenes/stiff_wall.toml")]
     pub(crate) scene: PathBuf,
+    /// Override a scene value, e.g. `--set plant.handle_mass_kg=0.5`
+    /// (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub(crate) sets: Vec<String>,
     /// Simulated time (s).
     #[arg(long, default_value_t = 10.0)]
     pub(crate) seconds: f64,
@@ -65,7 +69,7 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
     if !(a.seconds.is_finite() && a.seconds > 0.0 && a.seconds <= 3600.0) {
         return Err(err!("--seconds {}: must be in (0, 3600]", a.seconds));
     }
-    let scene = load(&a.scene, &[])?;
+    let scene = load(&a.scene, &a.sets)?;
     // The board's period: the scene must tick at it.
     let (period, deadline) = if a.fast {
         let f = twoport_board::excalibur::fast::PERIOD_S;
