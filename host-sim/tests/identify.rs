@@ -1,8 +1,8 @@
 //! The chain closed in simulation: the board plays its experiment on a
-//! device (processor in the loop, in-process) with a 1 um encoder and
-//! Coulomb friction (and, on the Excalibur, a noisy load-cell ADC and
-//! cogging) that no fit is told of; its record goes through CSV, the fit
-//! chooses the model, the design on that model is the true model's, and
+//! device (processor in the loop, in-process) with a 1 um encoder,
+//! Coulomb friction and cogging (and, on the Excalibur and the two-mass
+//! device, a noisy load-cell ADC) that no fit is told of; its record goes
+//! through CSV, the fit chooses the model, the design on that model is the true model's, and
 //! the design proven for the set that spans the fit's uncertainty holds
 //! for the true device: `verify` finds nothing there.
 
@@ -109,7 +109,8 @@ fn identified(scene: &str, model: &str, truth: &DeviceModel, loaded: Option<f64>
 /// What each device must show: its modes in the band, its resonances
 /// within 2%, the identified model's impedance design at `b` within 3% of
 /// the true model's, the robust design no stiffer than the truth's and
-/// `verify` silent on the true model there, and the friction found. With
+/// `verify` silent on the true model there, and the friction and the
+/// cogging (`cogging_n`, every 2 mm) found. With
 /// an `admittance` display, its design too: within 3% of the truth's, the
 /// robust one no lighter, and `verify` silent on the true model there.
 /// `loaded` is the mass (kg) on the handle of a second, loaded record.
@@ -118,6 +119,7 @@ fn closes(
     modes: usize,
     b: f64,
     friction: (f64, f64),
+    cogging_n: f64,
     admittance: Option<Admittance>,
     loaded: Option<f64>,
 ) {
@@ -181,12 +183,19 @@ fn closes(
     }
     let coulomb = f.model.coulomb_friction_n.unwrap();
     assert!((friction.0..friction.1).contains(&coulomb), "{coulomb} N");
+    // Each scene's cogging: 2 mm of travel a period.
+    let c = f.cogging.expect("no cogging found");
+    assert!((c.amplitude_n / cogging_n - 1.0).abs() < 0.15, "{c:?}");
+    assert!((c.period_m / 2e-3 - 1.0).abs() < 0.05, "{c:?}");
     let q = f.model.encoder_quantum_m.unwrap();
     assert!((q / 1e-6 - 1.0).abs() < 1e-6, "{q} m");
     eprintln!(
         "{scene}: resonances {got:?} (true {want:?}); k at {b} N s/m: true {k_true:.0}, \
-         fit {k_fit:.0}, robust {k_robust:.0}; verify on the truth: radius {}; friction {coulomb:.3} N",
-        verdict.spectral_radius
+         fit {k_fit:.0}, robust {k_robust:.0}; verify on the truth: radius {}; friction {coulomb:.3} N; \
+         cogging {:.4} N every {:.4} mm",
+        verdict.spectral_radius,
+        c.amplitude_n,
+        c.period_m * 1e3
     );
 }
 
@@ -200,7 +209,15 @@ fn the_excalibur_is_identified_from_its_experiment() {
         regulator: (51_000.0, 90.0),
         b: 500.0,
     };
-    closes("excalibur", 3, 90.0, (0.1, 0.3), Some(paper), Some(0.5));
+    closes(
+        "excalibur",
+        3,
+        90.0,
+        (0.1, 0.3),
+        0.05,
+        Some(paper),
+        Some(0.5),
+    );
 }
 
 /// The capstan handle, one rigid body read by its encoder alone, at its
@@ -208,7 +225,7 @@ fn the_excalibur_is_identified_from_its_experiment() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
 fn the_capstan_is_identified_from_its_experiment() {
-    closes("capstan", 0, 147.9, (0.03, 0.06), None, None);
+    closes("capstan", 0, 147.9, (0.03, 0.06), 0.01, None, None);
 }
 
 /// The two-mass device, whose load cell is its one flexure: one mode, at
@@ -220,5 +237,5 @@ fn the_two_mass_device_is_identified_from_its_experiment() {
         regulator: (109_054.0, 302.5),
         b: 5_000.0,
     };
-    closes("two_mass", 1, 302.5, (0.07, 0.12), Some(a), None);
+    closes("two_mass", 1, 302.5, (0.07, 0.12), 0.02, Some(a), None);
 }

@@ -404,6 +404,8 @@ fn report(
             "bypass_npm": handle.and_then(|h| h.1),
         },
         "coulomb_friction_n": f.model.coulomb_friction_n,
+        "cogging_n": f.cogging.map(|c| c.amplitude_n),
+        "cogging_period_m": f.cogging.map(|c| c.period_m),
         "encoder_quantum_m": f.model.encoder_quantum_m,
         "model": model_path,
         "set_models": set.len(),
@@ -458,6 +460,14 @@ fn report(
     }
     if let Some(c) = f.model.coulomb_friction_n {
         let _ = writeln!(t, "  Coulomb friction {c:.4} N");
+    }
+    if let Some(c) = f.cogging {
+        let _ = writeln!(
+            t,
+            "  cogging {:.4} N every {:.4} mm of the actuator's travel",
+            c.amplitude_n,
+            c.period_m * 1e3
+        );
     }
     if let Some(q) = f.model.encoder_quantum_m {
         let _ = writeln!(t, "  encoder quantum {:.4} um", q * 1e6);

@@ -1,39 +1,71 @@
-//! Coulomb friction, estimated beside the linear model and taken out of
-//! it.
+//! Friction and cogging: forces the device adds that depend on its
+//! motion, estimated beside the linear model and taken out of it.
 //!
 //! Under a periodic force, friction's force is periodic too, so averaging
 //! periods keeps it: left in, it shows as damping the device does not
 //! have (on the Excalibur, 0.2 N of it against a 20 N multisine made the
 //! 79 Hz mode look 10% more damped, and the design 18% too stiff). A proof
 //! must not lean on friction, which vanishes at small motions. So the
-//! device is taken to feel `F - F_c sign(v)`, the push less friction, with
-//! `S` the spectrum of the velocity's sign over the mean period
-//! ([`tick_sign`]): then
-//! `X = H (F - F_c S)` at every harmonic, and
-//! `F/X = Y_rigid + F_c S/X` at the lowest ones, where the device moves
-//! as one body (`Y_rigid = (-m ω² + j ω d) e^{jωT/2}`), is linear in the
-//! mass, the damping and `F_c`.
+//! device is taken to feel the push less each such force, `F - Σ c_j R_j`,
+//! each a known shape over the mean period ([`Regressor`]) times an
+//! amount `c_j` to find: friction is `F_c` times the velocity's sign
+//! ([`tick_sign`]), cogging `a sin(2π x/p) + b cos(2π x/p)` at the
+//! actuator's position ([`super::cogging`]). Then `X = H (F - Σ c_j R_j)`
+//! at every harmonic, and `F/X = Y_rigid + Σ c_j R_j/X` at the lowest
+//! ones, where the device moves as one body (`Y_rigid = (-m ω² + j ω d)
+//! e^{jωT/2}`), is linear in the mass, the damping and the amounts.
 
 use super::Measured;
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use std::f64::consts::TAU;
 
-/// The velocity's sign over each tick of the mean period, averaged
-/// within the tick: what friction opposed while that tick's force acted
-/// (from reading `n` to reading `n + 1`).
-///
-/// Signs read from encoder differences are wrong near every reversal,
-/// and a multisine reverses hundreds of times a second: noise in the
-/// regressor, which biases the friction found toward zero and hands the
-/// rest to the damping (on a 0.25 kg handle, 0.05 N of friction came back
-/// as 0.02 N and the damping 9% too large). So the velocity is taken
-/// from the mean period's position, band-limited to its lowest `top`
-/// harmonics (where the motion is, and little of the quantum), and
-/// evaluated at `SUB` instants across each tick. `None` where there is no
-/// whole period after `skip`, or `top` is not below half the period.
-pub fn tick_sign(position_m: &[f64], period: usize, top: usize, skip: usize) -> Option<Vec<f64>> {
-    const SUB: usize = 8;
+/// Instants a tick is evaluated at, across it.
+pub(crate) const SUB: usize = 8;
+
+/// The shape of a force the device adds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    /// Coulomb friction: the velocity's sign.
+    Coulomb,
+    /// Cogging's sine part, `sin(2π x/p)` at the actuator's position `x`.
+    CoggingSin {
+        /// The spatial period `p` (m).
+        period_m: f64,
+    },
+    /// Cogging's cosine part, `cos(2π x/p)`.
+    CoggingCos {
+        /// The spatial period `p` (m).
+        period_m: f64,
+    },
+}
+
+/// A force the device adds, known up to its amount: its shape's spectrum
+/// per unit push at each played harmonic, and how much of it (N) has been
+/// taken out of the responses already.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Regressor {
+    /// What it is.
+    pub shape: Shape,
+    /// The shape's spectrum over the mean period per the force's, `R/F`.
+    pub per_force: Vec<Complex64>,
+    /// The amount taken out so far (N).
+    pub taken_n: f64,
+}
+
+/// The mean period's position band-limited to its lowest `top` harmonics
+/// (where the motion is, and little of the quantum), at [`SUB`] instants
+/// across each tick (`[instant][tick]`), with its mean; or, with
+/// `derivative`, its rate of change (in units that do not matter to a
+/// sign). `None` where there is no whole period after `skip`, or `top` is
+/// not below half the period.
+pub(crate) fn band_limited(
+    position_m: &[f64],
+    period: usize,
+    top: usize,
+    skip: usize,
+    derivative: bool,
+) -> Option<Vec<Vec<f64>>> {
     let periods = (position_m.len() / period.max(1)).checked_sub(skip)?;
     if periods == 0 || 2 * top >= period {
         return None;
@@ -50,76 +82,123 @@ pub fn tick_sign(position_m: &[f64], period: usize, top: usize, skip: usize) -> 
     let mut planner = rustfft::FftPlanner::new();
     planner.plan_fft_forward(period).process(&mut mean);
     let inverse = planner.plan_fft_inverse(period);
-    let mut sign = vec![0.0; period];
     let mut buf = vec![Complex64::new(0.0, 0.0); period];
-    for j in 0..SUB {
-        let delta = (j as f64 + 0.5) / SUB as f64;
-        buf.iter_mut().for_each(|b| *b = Complex64::new(0.0, 0.0));
-        for k in 1..=top {
-            // d/dt of harmonic k, delayed by delta of a tick (units do not
-            // matter to a sign).
-            let turn = TAU * k as f64 * delta / period as f64;
-            let v = Complex64::new(0.0, k as f64) * mean[k] * Complex64::from_polar(1.0, turn);
-            buf[k] = v;
-            buf[period - k] = v.conj();
-        }
-        inverse.process(&mut buf);
-        for (s, v) in sign.iter_mut().zip(&buf) {
-            *s += v.re.signum() / SUB as f64;
-        }
-    }
-    Some(sign)
+    let out = (0..SUB)
+        .map(|j| {
+            let delta = (j as f64 + 0.5) / SUB as f64;
+            buf.iter_mut().for_each(|b| *b = Complex64::new(0.0, 0.0));
+            if !derivative {
+                buf[0] = mean[0];
+            }
+            for k in 1..=top {
+                // Harmonic k (or its rate), delayed by delta of a tick.
+                let turn = TAU * k as f64 * delta / period as f64;
+                let scale = if derivative {
+                    Complex64::new(0.0, k as f64)
+                } else {
+                    Complex64::new(1.0, 0.0)
+                };
+                let v = scale * mean[k] * Complex64::from_polar(1.0, turn);
+                buf[k] = v;
+                buf[period - k] = v.conj();
+            }
+            inverse.process(&mut buf);
+            buf.iter().map(|v| v.re / period as f64).collect()
+        })
+        .collect();
+    Some(out)
 }
 
-/// The mass (kg), damping (N s/m) and Coulomb friction (N) that explain
-/// the harmonics below `below_hz` as one body, or `None` where there are
-/// fewer than three or the numbers make no sense (a mass not positive).
-pub fn rigid_with_friction(
+/// The velocity's sign over each tick of the mean period, averaged
+/// within the tick: what friction opposed while that tick's force acted
+/// (from reading `n` to reading `n + 1`).
+///
+/// Signs read from encoder differences are wrong near every reversal,
+/// and a multisine reverses hundreds of times a second: noise in the
+/// regressor, which biases the friction found toward zero and hands the
+/// rest to the damping (on a 0.25 kg handle, 0.05 N of friction came back
+/// as 0.02 N and the damping 9% too large). So the velocity is taken
+/// from the mean period's position, band-limited ([`band_limited`]).
+pub fn tick_sign(position_m: &[f64], period: usize, top: usize, skip: usize) -> Option<Vec<f64>> {
+    let v = band_limited(position_m, period, top, skip, true)?;
+    Some(
+        (0..period)
+            .map(|n| v.iter().map(|at| at[n].signum()).sum::<f64>() / SUB as f64)
+            .collect(),
+    )
+}
+
+/// The rigid body that explains the harmonics below `below_hz` with each
+/// of `data`'s forces and any `more`, and `bend` more terms of the
+/// impedance's series, `(jω)^3 e^{jωT/2}` and up, which take up how the
+/// structure's modes bend the band smoothly (so that a force's rough
+/// shape is not asked to): its mass (kg), damping (N s/m), the amount of
+/// each force (N; `data`'s first, then `more`'s), and the
+/// weighted misfit (each harmonic by its measured variance, with the
+/// model floor). `None` where the harmonics (two equations each) leave
+/// fewer than two equations over the unknowns, or the numbers make no
+/// sense (a mass not positive).
+pub fn rigid_with(
     data: &Measured,
+    more: &[&[Complex64]],
+    bend: usize,
     period_s: f64,
     below_hz: f64,
-) -> Option<(f64, f64, f64)> {
-    let s = data.friction.as_ref()?;
+) -> Option<(f64, f64, Vec<f64>, f64)> {
     let x = &data.position;
-    let mut ata = Matrix3::zeros();
-    let mut atb = Vector3::zeros();
-    let mut used = 0;
-    for ((f, h), s) in x.freq_hz.iter().zip(&x.response).zip(s) {
-        if *f >= below_hz {
-            break;
-        }
-        let w = TAU * f;
-        let hold = Complex64::from_polar(1.0, w * period_s / 2.0);
-        // F/X = (1/H): with S/F stored, S/X = (S/F) (F/X).
-        let fx = 1.0 / h;
-        let cols = [-w * w * hold, Complex64::new(0.0, w) * hold, s * fx];
-        // Each harmonic weighted as a relative error of F/X.
-        let wt = 1.0 / fx.norm_sqr();
-        for part in [|c: Complex64| c.re, |c: Complex64| c.im] {
-            let row = Vector3::new(part(cols[0]), part(cols[1]), part(cols[2]));
-            ata += row * row.transpose() * wt;
-            atb += row * part(fx) * wt;
-        }
-        used += 1;
-    }
-    if used < 3 {
+    let shapes: Vec<&[Complex64]> = data
+        .forces
+        .iter()
+        .map(|r| r.per_force.as_slice())
+        .chain(more.iter().copied())
+        .collect();
+    let n = 2 + bend + shapes.len();
+    let used = x.freq_hz.iter().take_while(|f| **f < below_hz).count();
+    if 2 * used < n + 2 {
         return None;
     }
-    let p = ata.cholesky()?.solve(&atb);
-    (p[0] > 0.0 && p.iter().all(|v| v.is_finite())).then_some((p[0], p[1], p[2].max(0.0)))
+    let mut a = DMatrix::zeros(2 * used, n);
+    let mut b = DVector::zeros(2 * used);
+    for i in 0..used {
+        let w = TAU * x.freq_hz[i];
+        let hold = Complex64::from_polar(1.0, w * period_s / 2.0);
+        // F/X = 1/H: with R/F stored, R/X = (R/F) (F/X).
+        let fx = 1.0 / x.response[i];
+        let rel = x.variance[i] / x.response[i].norm_sqr() + super::MODEL_FLOOR.powi(2);
+        // Each harmonic weighted as a relative error of F/X.
+        let wt = 1.0 / (fx.norm() * rel.sqrt());
+        let mut cols = vec![-w * w * hold, Complex64::new(0.0, w) * hold];
+        cols.extend((0..bend).map(|k| Complex64::new(0.0, w).powi(3 + k as i32) * hold));
+        cols.extend(shapes.iter().map(|s| s[i] * fx));
+        for (j, c) in cols.iter().enumerate() {
+            a[(2 * i, j)] = c.re * wt;
+            a[(2 * i + 1, j)] = c.im * wt;
+        }
+        b[2 * i] = fx.re * wt;
+        b[2 * i + 1] = fx.im * wt;
+    }
+    let p = a.clone().svd(true, true).solve(&b, 1e-12).ok()?;
+    let cost = (&a * &p - &b).norm_squared();
+    let ok = p[0] > 0.0 && p.iter().all(|v| v.is_finite());
+    ok.then(|| (p[0], p[1], p.as_slice()[2 + bend..].to_vec(), cost))
 }
 
-/// `data` with friction of `coulomb_n` taken out: each response per the
-/// force the device felt, `X/(F - F_c S)`, and the velocity's sign per
-/// that force, so that more can be taken out later.
-pub fn without(data: &Measured, coulomb_n: f64) -> Measured {
-    let Some(s) = &data.friction else {
-        return data.clone();
+/// `data` with `amounts` (N, one per force of `data`'s, in order) taken
+/// out: each response per the force the device felt, `X/(F - Σ c_j R_j)`,
+/// and each shape per that force, so that more can be taken out later.
+pub fn without(data: &Measured, amounts: &[f64]) -> Measured {
+    let felt = |i: usize| {
+        1.0 - data
+            .forces
+            .iter()
+            .zip(amounts)
+            .map(|(r, c)| c * r.per_force[i])
+            .sum::<Complex64>()
     };
     let scale = |f: &crate::frf::Frf| {
         let mut f = f.clone();
         for (i, h) in f.response.iter_mut().enumerate() {
-            let k = 1.0 - coulomb_n * s[i];
+            let k = felt(i);
             *h /= k;
             f.variance[i] /= k.norm_sqr();
         }
@@ -128,14 +207,29 @@ pub fn without(data: &Measured, coulomb_n: f64) -> Measured {
     Measured {
         position: scale(&data.position),
         load_cell: data.load_cell.as_ref().map(scale),
-        friction: Some(s.iter().map(|s| s / (1.0 - coulomb_n * s)).collect()),
+        forces: data
+            .forces
+            .iter()
+            .zip(amounts.iter().chain(std::iter::repeat(&0.0)))
+            .map(|(r, c)| Regressor {
+                shape: r.shape,
+                per_force: r
+                    .per_force
+                    .iter()
+                    .enumerate()
+                    .map(|(i, s)| s / felt(i))
+                    .collect(),
+                taken_n: r.taken_n + c,
+            })
+            .collect(),
         encoder_quantum_m: data.encoder_quantum_m,
-        coulomb_n: Some(data.coulomb_n.unwrap_or(0.0) + coulomb_n),
-        // The device's friction is the same with a mass on its handle.
+        motion: data.motion.clone(),
+        // The device's friction and cogging are the same with a mass on
+        // its handle (the loaded record's shapes are its own motion's).
         loaded: data.loaded.as_ref().map(|l| {
             Box::new(super::Loaded {
                 added_kg: l.added_kg,
-                data: without(&l.data, coulomb_n),
+                data: without(&l.data, amounts),
             })
         }),
     }
@@ -184,11 +278,12 @@ mod tests {
         };
         // (Past the transient: the hold's lightly damped 2 Hz mode.)
         let data = Measured::from_log(&log, 8).unwrap();
-        let (mm, dd, ff) = rigid_with_friction(&data, t, 41.0).unwrap();
+        let (mm, dd, ff, _) = rigid_with(&data, &[], 0, t, 41.0).unwrap();
+        let ff = ff[0];
         assert!((mm / m - 1.0).abs() < 0.02, "{mm} kg");
         assert!((dd / d - 1.0).abs() < 0.15, "{dd} N s/m");
         assert!((ff / fc - 1.0).abs() < 0.15, "{ff} N");
-        let clean = without(&data, ff);
+        let clean = without(&data, &[ff]);
         // The exact sampled response, the designer's, of the mass-damper.
         let model = twoport_design::DeviceModel::from_toml(
             "name = \"mass\"\nperiod_s = 0.001\npeak_force_n = 50.0\ncontinuous_force_n = 20.0\n\

@@ -31,6 +31,7 @@
 //!    inflated by the misfit (`χ²/ν` where above one).
 
 pub mod chain;
+pub mod cogging;
 pub mod friction;
 pub mod ladder;
 pub mod lm;
@@ -55,16 +56,16 @@ pub struct Measured {
     pub position: Frf,
     /// Actuator force to load cell.
     pub load_cell: Option<Frf>,
-    /// The velocity's sign per unit force, `S/F`, at the same harmonics,
-    /// where the record gave it: what Coulomb friction adds to the force
-    /// ([`friction`]).
-    pub friction: Option<Vec<Complex64>>,
+    /// The forces the device adds that depend on its motion (friction,
+    /// cogging), each known up to its amount ([`friction`]); none where
+    /// the record could not give their shapes.
+    pub forces: Vec<friction::Regressor>,
     /// The encoder's quantum (m), where the record shows it: the least
     /// step between the positions it read.
     pub encoder_quantum_m: Option<f64>,
-    /// Coulomb friction already taken out of the responses (N), if any
-    /// has been ([`friction::without`]).
-    pub coulomb_n: Option<f64>,
+    /// The record's mean motion, where it gave one: cogging's shapes at
+    /// any period come from it.
+    pub motion: Option<cogging::Motion>,
     /// The same experiment with a known mass clamped on the handle, if it
     /// was played: fitted together with this one, it shows the handle's
     /// side of the device, which the actuator's push alone barely moves.
@@ -153,21 +154,36 @@ impl Measured {
             None => None,
         };
         let sign = friction::tick_sign(&log.position_m, e.period_ticks, e.last, skip);
-        let friction = sign.map(|sign| {
-            crate::frf::mean_spectrum(&sign, e.period_ticks, &harmonics, 0)
-                .iter()
-                .zip(&force)
-                .map(|(s, f)| s / f)
-                .collect()
-        });
-        Ok(Measured {
+        let mut forces: Vec<friction::Regressor> = sign
+            .map(|sign| friction::Regressor {
+                shape: friction::Shape::Coulomb,
+                per_force: crate::frf::mean_spectrum(&sign, e.period_ticks, &harmonics, 0)
+                    .iter()
+                    .zip(&force)
+                    .map(|(s, f)| s / f)
+                    .collect(),
+                taken_n: 0.0,
+            })
+            .into_iter()
+            .collect();
+        let motion = cogging::Motion::new(&log.position_m, e.period_ticks, &harmonics, force, skip);
+        let mut data = Measured {
             position,
             load_cell,
-            friction,
+            forces: Vec::new(),
             encoder_quantum_m: encoder,
-            coulomb_n: None,
+            motion,
             loaded: None,
-        })
+        };
+        if let (Some(motion), false) = (&data.motion, forces.is_empty()) {
+            data.forces = forces.clone();
+            let below = rigid_band_hz(&data.position);
+            if let Some(c) = cogging::find(&data, motion, log.period_s, below) {
+                forces.extend(c);
+            }
+        }
+        data.forces = forces;
+        Ok(data)
     }
 
     /// These responses with `loaded`'s, measured with `added_kg` on the
@@ -198,11 +214,34 @@ impl Measured {
                 "one record has a load cell and the other has not".into(),
             ));
         }
+        // The same forces, each shape from the loaded record's own motion.
+        let mut forces = Vec::new();
+        for f in &self.forces {
+            let own = match f.shape {
+                friction::Shape::Coulomb => loaded
+                    .forces
+                    .iter()
+                    .find(|g| g.shape == friction::Shape::Coulomb)
+                    .cloned(),
+                friction::Shape::CoggingSin { period_m } => loaded
+                    .motion
+                    .as_ref()
+                    .map(|m| cogging::shapes(m, period_m)[0].clone()),
+                friction::Shape::CoggingCos { period_m } => loaded
+                    .motion
+                    .as_ref()
+                    .map(|m| cogging::shapes(m, period_m)[1].clone()),
+            };
+            forces.push(own.ok_or_else(|| {
+                refuse("it does not show the motion the bare record's friction needs".into())
+            })?);
+        }
         Ok(Measured {
             loaded: Some(Box::new(Loaded {
                 added_kg,
                 data: Measured {
                     loaded: None,
+                    forces,
                     ..loaded
                 },
             })),
@@ -273,6 +312,8 @@ pub struct Fit {
     pub base: ModelBase,
     /// Whether a loaded record was fitted too (the handle's side seen).
     pub loaded: bool,
+    /// The cogging found beside the model, if the record showed any.
+    pub cogging: Option<cogging::Found>,
 }
 
 impl Fit {
@@ -353,17 +394,21 @@ fn residual(model: Complex64, measured: Complex64, var: f64) -> Complex64 {
     l / rel
 }
 
-/// The weighted residuals of `model` against `data`, with `coulomb_n` more
-/// friction than `data` has had taken out (see [`friction`]).
-fn residuals(model: &DeviceModel, data: &Measured, coulomb_n: f64) -> Option<DVector<f64>> {
+/// The weighted residuals of `model` against `data`, with `amounts` (N)
+/// more of each of its forces than `data` has had taken out (see
+/// [`friction`]).
+fn residuals(model: &DeviceModel, data: &Measured, amounts: &[f64]) -> Option<DVector<f64>> {
     let h = sampled_response(model, &data.position.freq_hz)?;
     let mut r = Vec::with_capacity(4 * h.len());
     for (i, (x, f)) in h.iter().enumerate() {
-        // The device felt the push less friction: X = H (F - F_c S).
-        let felt = match &data.friction {
-            Some(s) if coulomb_n != 0.0 => 1.0 - coulomb_n * s[i],
-            _ => Complex64::new(1.0, 0.0),
-        };
+        // The device felt the push less its forces: X = H (F - Σ c_j R_j).
+        let felt = 1.0
+            - data
+                .forces
+                .iter()
+                .zip(amounts)
+                .map(|(g, c)| c * g.per_force[i])
+                .sum::<Complex64>();
         let e = residual(
             *x * felt,
             data.position.response[i],
@@ -379,7 +424,7 @@ fn residuals(model: &DeviceModel, data: &Measured, coulomb_n: f64) -> Option<DVe
     }
     if let Some(l) = &data.loaded {
         let loaded = model.with_handle_mass(l.added_kg).ok()?;
-        r.extend(residuals(&loaded, &l.data, coulomb_n)?.iter());
+        r.extend(residuals(&loaded, &l.data, amounts)?.iter());
     }
     Some(DVector::from_vec(r))
 }
@@ -400,9 +445,9 @@ fn rigid_estimate(data: &Frf, period_s: f64) -> Option<(f64, f64)> {
     (m > 0.0).then_some((m, d.max(1e-3 * m)))
 }
 
-/// The `modes` most prominent resonances of `|H| ω²` (indices into the
-/// harmonics), in order, each with the deepest dip before it.
-fn features(data: &Frf, modes: usize) -> Option<(Vec<usize>, Vec<usize>)> {
+/// Every peak of `ln(|H| ω²)`: its prominence over the deeper of the
+/// dips either side before a higher point, and its index.
+fn peaks(data: &Frf) -> (Vec<f64>, Vec<(f64, usize)>) {
     let g: Vec<f64> = data
         .response
         .iter()
@@ -410,7 +455,7 @@ fn features(data: &Frf, modes: usize) -> Option<(Vec<usize>, Vec<usize>)> {
         .map(|(h, f)| (h.norm() * f * f).ln())
         .collect();
     let n = g.len();
-    let mut peaks: Vec<(f64, usize)> = (1..n.saturating_sub(1))
+    let peaks = (1..n.saturating_sub(1))
         .filter(|&i| g[i] > g[i - 1] && g[i] >= g[i + 1])
         .map(|i| {
             let side = |range: &mut dyn Iterator<Item = usize>| {
@@ -428,6 +473,13 @@ fn features(data: &Frf, modes: usize) -> Option<(Vec<usize>, Vec<usize>)> {
             (g[i] - left.max(right), i)
         })
         .collect();
+    (g, peaks)
+}
+
+/// The `modes` most prominent resonances of `|H| ω²` (indices into the
+/// harmonics), in order, each with the deepest dip before it.
+fn features(data: &Frf, modes: usize) -> Option<(Vec<usize>, Vec<usize>)> {
+    let (g, mut peaks) = peaks(data);
     peaks.sort_by(|a, b| b.0.total_cmp(&a.0));
     if peaks.len() < modes {
         return None;
@@ -500,7 +552,7 @@ pub fn fit_chain(data: &Measured, base: &ModelBase, modes: usize) -> Option<Fit>
         |d| {
             let mut p = p0.clone();
             p.rows_mut(fixed, d.len()).copy_from(d);
-            model(&p).and_then(|m| residuals(&m, data, 0.0))
+            model(&p).and_then(|m| residuals(&m, data, &[]))
         },
         p0.rows(fixed, p0.len() - fixed).into_owned(),
         50,
@@ -547,7 +599,7 @@ pub fn fit_modal(data: &Measured, base: &ModelBase, modes: usize) -> Option<Fit>
         |p| {
             from(&widen(p))
                 .model(base)
-                .and_then(|m| residuals(&m, data, 0.0))
+                .and_then(|m| residuals(&m, data, &[]))
         },
         plain,
         200,
@@ -665,27 +717,46 @@ fn finish(
     model: impl Fn(&DVector<f64>) -> Option<DeviceModel> + Sync,
     form: impl Fn(&DVector<f64>) -> Form,
 ) -> Option<Fit> {
-    // Where the record shows friction, its amount is a parameter too, the
-    // last: what is left of it once the start's estimate was taken out.
-    let extra = usize::from(data.friction.is_some());
+    // Where the record shows friction or cogging, their amounts are
+    // parameters too, the last: what is left of them once the start's
+    // estimates were taken out.
+    let extra = data.forces.len();
     let k = p0.len();
     let p0 = DVector::from_iterator(
         k + extra,
         p0.iter().copied().chain(std::iter::repeat_n(0.0, extra)),
     );
-    let split = |p: &DVector<f64>| (p.rows(0, k).into_owned(), p.get(k).copied().unwrap_or(0.0));
+    let split = |p: &DVector<f64>| (p.rows(0, k).into_owned(), p.as_slice()[k..].to_vec());
     let sol = lm::minimise(
         |p| {
-            let (q, f_c) = split(p);
-            model(&q).and_then(|m| residuals(&m, data, f_c))
+            let (q, amounts) = split(p);
+            model(&q).and_then(|m| residuals(&m, data, &amounts))
         },
         p0,
         200,
     )?;
     let (q, more) = split(&sol.p);
     let mut found = model(&q)?;
-    found.coulomb_friction_n = data.coulomb_n.map(|f| (f + more).max(0.0));
+    let total = |shape: fn(&friction::Shape) -> bool| {
+        data.forces
+            .iter()
+            .zip(&more)
+            .find(|(g, _)| shape(&g.shape))
+            .map(|(g, c)| g.taken_n + c)
+    };
+    found.coulomb_friction_n = total(|s| *s == friction::Shape::Coulomb).map(|f| f.max(0.0));
     found.encoder_quantum_m = data.encoder_quantum_m;
+    let cogging = data.forces.iter().find_map(|g| match g.shape {
+        friction::Shape::CoggingSin { period_m } => {
+            let a = total(|s| matches!(s, friction::Shape::CoggingSin { .. }))?;
+            let b = total(|s| matches!(s, friction::Shape::CoggingCos { .. }))?;
+            Some(cogging::Found {
+                amplitude_n: a.hypot(b),
+                period_m,
+            })
+        }
+        _ => None,
+    });
     let residuals = sol.jacobian.nrows();
     let parameters = sol.p.len();
     let nu = (residuals - parameters).max(1) as f64;
@@ -704,6 +775,7 @@ fn finish(
         params: q,
         base: base.clone(),
         loaded: data.loaded.is_some(),
+        cogging,
     })
 }
 
@@ -711,33 +783,57 @@ fn finish(
 /// in the form the measurement calls for, and the index of the one the
 /// criterion chooses.
 pub fn fit_orders(data: &Measured, base: &ModelBase) -> (Vec<Fit>, Option<usize>) {
-    // Friction out first, where the record shows the velocity's sign:
+    // Friction and cogging out first, where the record shows them:
     // estimated where the device moves as one body, a quarter of the way
-    // to its lowest resonance.
-    // The start's estimate is refined by each fit's last step.
+    // to its lowest resonance. The start's estimate is refined by each
+    // fit's last step.
     let linear;
-    let data = match &data.friction {
-        Some(_) => {
-            let below = lowest_resonance_hz(&data.position)
-                .or(data.position.freq_hz.last().copied())
-                .unwrap_or(0.0)
-                / 4.0;
-            let f_c =
-                friction::rigid_with_friction(data, base.period_s, below).map_or(0.0, |r| r.2);
-            linear = friction::without(data, f_c);
-            &linear
+    let data = if data.forces.is_empty() {
+        data
+    } else {
+        let below = rigid_band_hz(&data.position);
+        let mut amounts = friction::rigid_with(data, &[], 0, base.period_s, below)
+            .map_or(vec![0.0; data.forces.len()], |r| r.2);
+        // Friction opposes the motion: an estimate below zero is none.
+        for (g, c) in data.forces.iter().zip(amounts.iter_mut()) {
+            if g.shape == friction::Shape::Coulomb {
+                *c = c.max(0.0);
+            }
         }
-        None => data,
+        linear = friction::without(data, &amounts);
+        &linear
     };
     fit_orders_linear(data, base)
 }
 
-/// The lowest of the most prominent resonances seen at the encoder (Hz).
+/// Below where the device moves as one body (Hz): a quarter of the way to
+/// its lowest resonance, or of the band where it shows none.
+fn rigid_band_hz(x: &Frf) -> f64 {
+    lowest_resonance_hz(x)
+        .or(x.freq_hz.last().copied())
+        .unwrap_or(0.0)
+        / 4.0
+}
+
+/// The lowest resonance seen at the encoder (Hz): a peak of `|H| ω²` at
+/// least twice the lower of the least values either side within a factor
+/// of 1.5 in frequency. A rigid body's is flat, and friction, cogging and
+/// the band's ends bend it slowly, not in a peak.
 fn lowest_resonance_hz(x: &Frf) -> Option<f64> {
-    (1..=3)
-        .rev()
-        .find_map(|m| features(x, m))
-        .and_then(|(_, res)| res.first().map(|i| x.freq_hz[*i]))
+    let (g, peaks) = peaks(x);
+    let f = &x.freq_hz;
+    let least = |range: std::ops::Range<usize>| range.map(|j| g[j]).fold(f64::INFINITY, f64::min);
+    peaks
+        .iter()
+        .map(|(_, i)| *i)
+        .filter(|&i| {
+            let lo = f.partition_point(|v| *v < f[i] / 1.5);
+            let hi = f.partition_point(|v| *v <= f[i] * 1.5);
+            let dip = least(lo..i).max(least(i + 1..hi));
+            g[i] - dip > std::f64::consts::LN_2
+        })
+        .map(|i| f[i])
+        .reduce(f64::min)
 }
 
 /// [`fit_orders`] on a record with no friction in it.

@@ -55,9 +55,9 @@ fn measure(truth: &DeviceModel, top_hz: f64, rel: f64) -> Measured {
     Measured {
         position,
         load_cell,
-        friction: None,
+        forces: Vec::new(),
         encoder_quantum_m: None,
-        coulomb_n: None,
+        motion: None,
         loaded: None,
     }
 }

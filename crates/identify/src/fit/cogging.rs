@@ -1,0 +1,269 @@
+//! Cogging: the motor's pull toward its detents, `a sin(2π x/p) + b
+//! cos(2π x/p)` at the actuator's position `x`, repeating every `p` of
+//! travel.
+//!
+//! It is conservative, but under a periodic push it is periodic too, so
+//! averaging keeps it, and left in it corrupts the friction's estimate
+//! (friction not found is read as damping): on a 0.25 kg handle, 0.01 N of
+//! cogging beside 0.05 N of friction brought the friction back as 0.01 N
+//! and the design 10% too stiff. Its shape is known once its period is:
+//! the record's own motion gives `sin` and `cos` of `2π x/p` over the mean
+//! period ([`shapes`]). The period is searched ([`find`]): the one whose
+//! shapes best explain the lowest harmonics with the rigid body and the
+//! friction, kept only if they explain more than a search over that many
+//! periods would find in noise.
+
+use super::friction::{band_limited, rigid_with, Regressor, Shape, SUB};
+use super::Measured;
+use num_complex::Complex64;
+use std::f64::consts::TAU;
+
+/// Cogging as a fit found it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Found {
+    /// Its amplitude (N).
+    pub amplitude_n: f64,
+    /// Its period along the actuator's travel (m).
+    pub period_m: f64,
+}
+
+/// The record's mean motion: what cogging's shapes are computed from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Motion {
+    /// The mean period's position, band-limited to the played harmonics
+    /// with its mean, at [`SUB`] instants across each tick (m).
+    pub at: Vec<Vec<f64>>,
+    /// The force's mean spectrum at the played harmonics.
+    pub force: Vec<Complex64>,
+    /// The played harmonics.
+    pub harmonics: Vec<usize>,
+}
+
+impl Motion {
+    /// The motion of `position_m` under `force` (its mean spectrum at
+    /// `harmonics`), `None` where [`band_limited`] finds none.
+    pub fn new(
+        position_m: &[f64],
+        period: usize,
+        harmonics: &[usize],
+        force: Vec<Complex64>,
+        skip: usize,
+    ) -> Option<Motion> {
+        let top = *harmonics.last()?;
+        Some(Motion {
+            at: band_limited(position_m, period, top, skip, false)?,
+            force,
+            harmonics: harmonics.to_vec(),
+        })
+    }
+
+    /// The travel the mean period spans (m).
+    pub fn span_m(&self) -> f64 {
+        let (lo, hi) = self
+            .at
+            .iter()
+            .flatten()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(*x), hi.max(*x))
+            });
+        hi - lo
+    }
+}
+
+/// Cogging's two shapes at a period of `period_m`, per unit force.
+pub fn shapes(motion: &Motion, period_m: f64) -> [Regressor; 2] {
+    let period = motion.at.first().map_or(0, Vec::len);
+    let k = TAU / period_m;
+    let mean = |f: fn(f64) -> f64| -> Vec<f64> {
+        (0..period)
+            .map(|n| motion.at.iter().map(|at| f(k * at[n])).sum::<f64>() / SUB as f64)
+            .collect()
+    };
+    let per_force = |signal: Vec<f64>| {
+        crate::frf::mean_spectrum(&signal, period, &motion.harmonics, 0)
+            .iter()
+            .zip(&motion.force)
+            .map(|(s, f)| s / f)
+            .collect()
+    };
+    [
+        Regressor {
+            shape: Shape::CoggingSin { period_m },
+            per_force: per_force(mean(f64::sin)),
+            taken_n: 0.0,
+        },
+        Regressor {
+            shape: Shape::CoggingCos { period_m },
+            per_force: per_force(mean(f64::cos)),
+            taken_n: 0.0,
+        },
+    ]
+}
+
+/// Periods searched per span of travel `s`: from `2 s` (half a period
+/// across the motion) to `s/100`, in steps of wavenumber small enough that the
+/// phase across the motion moves by a twentieth of a turn.
+const STEP: f64 = 0.05;
+/// Terms past the rigid body's the search gives the impedance
+/// ([`rigid_with`]).
+const BEND: usize = 3;
+/// The shortest period tried, in encoder quanta.
+const QUANTA: f64 = 10.0;
+
+/// The cogging the lowest harmonics of `data` (below `below_hz`, where
+/// the device moves as one body) show beside its other forces, if any:
+/// its two shapes at the period that explains them best, or `None` where
+/// no period explains more than the search would find in noise.
+pub fn find(
+    data: &Measured,
+    motion: &Motion,
+    period_s: f64,
+    below_hz: f64,
+) -> Option<[Regressor; 2]> {
+    let span = motion.span_m();
+    let q = data.encoder_quantum_m.unwrap_or(0.0);
+    if span.is_nan() || span <= 0.0 {
+        return None;
+    }
+    let (_, _, _, bare) = rigid_with(data, &[], BEND, period_s, below_hz)?;
+    let longest = 2.0 * span;
+    let shortest = (span / 100.0).max(QUANTA * q);
+    if shortest >= longest {
+        return None;
+    }
+    let (from, to, step) = (1.0 / longest, 1.0 / shortest, STEP / span);
+    let tries = ((to - from) / step).ceil() as usize;
+    let cost = |wavenumber: f64| {
+        let [s, c] = shapes(motion, 1.0 / wavenumber);
+        rigid_with(
+            data,
+            &[&s.per_force, &c.per_force],
+            BEND,
+            period_s,
+            below_hz,
+        )
+        .map_or(f64::INFINITY, |r| r.3)
+    };
+    let (mut best, at) = (0..=tries)
+        .map(|i| {
+            let k = from + i as f64 * step;
+            (cost(k), k)
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))?;
+    // Then within a step either side, by golden sections.
+    let (mut lo, mut hi) = (at - step, at + step);
+    let r = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut a, mut b) = (hi - r * (hi - lo), lo + r * (hi - lo));
+    let (mut ca, mut cb) = (cost(a), cost(b));
+    for _ in 0..24 {
+        if ca < cb {
+            (hi, b, cb) = (b, a, ca);
+            a = hi - r * (hi - lo);
+            ca = cost(a);
+        } else {
+            (lo, a, ca) = (a, b, cb);
+            b = lo + r * (hi - lo);
+            cb = cost(b);
+        }
+    }
+    let k = if ca < cb { a } else { b };
+    best = best.min(ca.min(cb));
+    let best = (
+        best,
+        if ca.min(cb) <= best {
+            1.0 / k
+        } else {
+            1.0 / at
+        },
+    );
+    // The criterion: two amounts, and the best of `tries` periods, in
+    // units of the misfit left per degree of freedom with the cogging,
+    // where that is more than the noise's (the band is not quite rigid,
+    // and the cogging could be taking up the model's error).
+    let used = data
+        .position
+        .freq_hz
+        .iter()
+        .take_while(|f| **f < below_hz)
+        .count();
+    let nu = (2 * used)
+        .saturating_sub(4 + BEND + data.forces.len())
+        .max(1) as f64;
+    let charge = (2.0 * ((2 * used) as f64).ln() + 2.0 * (tries.max(1) as f64).ln())
+        * (best.0 / nu).max(1.0);
+    (bare - best.0 > charge).then(|| shapes(motion, best.1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::friction::without;
+    use super::*;
+    use crate::log::{Excitation, Log};
+    use twoport_control::multisine::Multisine;
+
+    /// A 0.25 kg handle with 2 N s/m of damping, 0.05 N of Coulomb
+    /// friction and `cogging_n` of cogging every 2 mm, pushed by an 8 N
+    /// multisine from 1 to 100 Hz, held by a weak spring and read by a
+    /// 1 um encoder.
+    fn record(cogging_n: f64) -> Log {
+        let (m, d, fc, t) = (0.25, 2.0, 0.05, 1e-3);
+        let ms = Multisine::new(1000, 1, 100, 8.0).unwrap();
+        let (mut x, mut v) = (0.0f64, 0.0f64);
+        let (mut force, mut pos) = (Vec::new(), Vec::new());
+        for n in 0..20_000u32 {
+            let y = (x / 1e-6).round() * 1e-6;
+            let f = ms.at(n) as f64 - 300.0 * y - 10.0 * v;
+            force.push(f);
+            pos.push(y);
+            for _ in 0..20 {
+                let cog = cogging_n * (TAU * x / 2e-3).sin();
+                let a = (f - d * v - fc * (v / 1e-4).tanh() + cog) / m;
+                let h = t / 20.0;
+                x += v * h + 0.5 * a * h * h;
+                v += a * h;
+            }
+        }
+        Log {
+            period_s: t,
+            force_n: force,
+            position_m: pos,
+            load_cell_n: None,
+            excitation: Some(Excitation {
+                period_ticks: 1000,
+                first: 1,
+                last: 100,
+            }),
+        }
+    }
+
+    /// Cogging is found near its period and at its amplitude, and with it
+    /// the friction and the mass; a record without cogging shows none.
+    #[test]
+    fn cogging_is_found_at_its_period() {
+        let data = Measured::from_log(&record(0.01), 4).unwrap();
+        let shapes: Vec<_> = data.forces.iter().map(|f| f.shape).collect();
+        let Some(Shape::CoggingSin { period_m }) = shapes.get(1).copied() else {
+            panic!("no cogging: {shapes:?}");
+        };
+        // (Near the period the misfit is at the noise's over a few
+        // percent: the motion spans some ten periods.)
+        assert!((period_m / 2e-3 - 1.0).abs() < 0.05, "{period_m} m");
+        let (mass, _, amounts, _) = rigid_with(&data, &[], 0, 1e-3, 25.0).unwrap();
+        let amplitude = amounts[1].hypot(amounts[2]);
+        assert!((amplitude / 0.01 - 1.0).abs() < 0.1, "{amplitude} N");
+        assert!((amounts[0] / 0.05 - 1.0).abs() < 0.1, "{} N", amounts[0]);
+        assert!((mass / 0.25 - 1.0).abs() < 0.01, "{mass} kg");
+        // Taken out, the shapes are left with nothing to explain.
+        let clean = without(&data, &amounts);
+        let again = rigid_with(&clean, &[], 0, 1e-3, 25.0).unwrap().2;
+        assert!(again.iter().all(|c| c.abs() < 1e-3), "{again:?}");
+
+        let plain = Measured::from_log(&record(0.0), 4).unwrap();
+        assert_eq!(
+            plain.forces.len(),
+            1,
+            "{:?}",
+            plain.forces.iter().map(|f| f.shape).collect::<Vec<_>>()
+        );
+    }
+}
