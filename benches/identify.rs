@@ -2,7 +2,8 @@
 //! flexible Excalibur (simulated once, outside the timing), then what
 //! `identify` does with the record: the frequency responses over its
 //! periods, and the fit of every order with the choice among them. The
-//! goal is the fit of a 5-DOF model in at most 1 s.
+//! goal is the fit of a 5-DOF model in at most 1 s. Then the refit of the
+//! chosen order with a loaded record (0.5 kg on the handle) beside it.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use host_sim::link::{LinkFaults, LocalBoard};
@@ -16,16 +17,20 @@ fn identify(c: &mut Criterion) {
         env!("CARGO_MANIFEST_DIR"),
         "/../scenes/identify/excalibur.toml"
     );
-    let scene = Scene::load(Path::new(path), &[]).unwrap();
-    let ticks = (scene.duration_s / 1e-3).round() as u64;
-    let run = pil::run(
-        scene,
-        ticks,
-        LocalBoard::excalibur().unwrap(),
-        LinkFaults::default(),
-    )
-    .unwrap();
-    let log = run.experiment_log(true).unwrap().unwrap();
+    let record = |sets: &[String]| {
+        let scene = Scene::load(Path::new(path), sets).unwrap();
+        let ticks = (scene.duration_s / 1e-3).round() as u64;
+        let run = pil::run(
+            scene,
+            ticks,
+            LocalBoard::excalibur().unwrap(),
+            LinkFaults::default(),
+        )
+        .unwrap();
+        run.experiment_log(true).unwrap().unwrap()
+    };
+    let log = record(&[]);
+    let loaded_log = record(&["plant.handle_mass_kg=0.5".into()]);
     let base = ModelBase {
         name: "identified".into(),
         period_s: 1e-3,
@@ -41,6 +46,13 @@ fn identify(c: &mut Criterion) {
     c.bench_function("identify: fit every order, Excalibur (5 DOF chosen)", |b| {
         b.iter(|| fit::fit_orders(black_box(&data), &base))
     });
+    let both = data
+        .with_loaded(0.5, Measured::from_log(&loaded_log, 2).unwrap())
+        .unwrap();
+    c.bench_function(
+        "identify: fit every order, then refit with a loaded record",
+        |b| b.iter(|| fit::fit_orders(black_box(&both), &base)),
+    );
 }
 
 criterion_group! {
