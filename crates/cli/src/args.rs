@@ -484,15 +484,16 @@ impl HostArgs {
     /// `(N, d)` at `servo_hz`: the VE period and the delay in ticks, or
     /// why the rate is not a whole multiple of the VE rate.
     pub(crate) fn ticks(&self, servo_hz: f64) -> Result<(u32, u32), String> {
-        let n = servo_hz / self.ve_rate_hz;
-        if (n - n.round()).abs() > 1e-9 * n || n.round() < 1.0 {
-            return Err(format!(
+        use twoport_design::host_ve::{HostLoop, TicksError};
+        HostLoop::ticks_at(1.0 / servo_hz, self.ve_rate_hz, self.delay_s).map_err(|e| match e {
+            TicksError::NotMultiple => format!(
                 "--rates {servo_hz} Hz: not a whole multiple of --ve-rate {} Hz",
                 self.ve_rate_hz
-            ));
-        }
-        let d = (self.delay_s * servo_hz - 1e-9).ceil().max(1.0);
-        Ok((n.round() as u32, d as u32))
+            ),
+            TicksError::BadDelay => {
+                format!("--host-delay {}: must be a time > 0 s", self.delay_s)
+            }
+        })
     }
 }
 

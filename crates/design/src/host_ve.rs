@@ -77,7 +77,37 @@ pub struct HostLoop {
     pub body: HostBody,
 }
 
+/// Why a host's rate or delay does not fit a servo's period.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TicksError {
+    /// The servo's rate is not a whole multiple of the host's.
+    NotMultiple,
+    /// The delay is not a time above zero.
+    BadDelay,
+}
+
 impl HostLoop {
+    /// A host running at `ve_rate_hz` and answering `delay_s` after the
+    /// force it read, in ticks of a servo at `servo_period_s`: its period
+    /// `N` (the servo's rate over the host's, which must be whole to a
+    /// part in 10⁹) and its delay `d` (the delay rounded up to whole ticks,
+    /// at least one).
+    pub fn ticks_at(
+        servo_period_s: f64,
+        ve_rate_hz: f64,
+        delay_s: f64,
+    ) -> Result<(u32, u32), TicksError> {
+        let n = 1.0 / (servo_period_s * ve_rate_hz);
+        if !(n.is_finite() && n >= 0.5 && (n - n.round()).abs() <= 1e-9 * n) {
+            return Err(TicksError::NotMultiple);
+        }
+        if !(delay_s.is_finite() && delay_s > 0.0) {
+            return Err(TicksError::BadDelay);
+        }
+        let d = (delay_s / servo_period_s - 1e-9).ceil().max(1.0);
+        Ok((n.round() as u32, d as u32))
+    }
+
     /// A host at `ve_period_ticks` servo ticks of `servo_period_s`, with
     /// `delay_ticks` of delay, stepping a body of `mass_kg`,
     /// `damping_nspm` and `stiffness_npm`. Refuses a zero period or delay
@@ -403,6 +433,30 @@ mod tests {
         let m = DeviceModel::excalibur().unwrap();
         let p = Plant::new(&m, t).unwrap();
         (m, p)
+    }
+
+    /// A host's rate and delay in servo ticks: a whole multiple within a
+    /// part in 10⁹ (a 1 kHz host on 4 kHz: 4; on 1.5 kHz: refused), the
+    /// delay rounded up to whole ticks and at least one.
+    #[test]
+    fn a_host_rate_and_delay_become_ticks() {
+        assert_eq!(HostLoop::ticks_at(2.5e-4, 1000.0, 0.002), Ok((4, 8)));
+        assert_eq!(HostLoop::ticks_at(1e-3, 1000.0, 0.0021), Ok((1, 3)));
+        assert_eq!(HostLoop::ticks_at(1e-3, 1000.0, 1e-6), Ok((1, 1)));
+        assert_eq!(
+            HostLoop::ticks_at(1.0 / 1500.0, 1000.0, 0.002),
+            Err(TicksError::NotMultiple)
+        );
+        assert_eq!(
+            HostLoop::ticks_at(1e-3, 2000.0, 0.002),
+            Err(TicksError::NotMultiple)
+        );
+        for bad in [0.0, -1.0, f64::NAN] {
+            assert_eq!(
+                HostLoop::ticks_at(1e-3, 1000.0, bad),
+                Err(TicksError::BadDelay)
+            );
+        }
     }
 
     /// A host that never moves its body (all damping) adds nothing: the

@@ -12,7 +12,7 @@ use pyo3::types::PyDict;
 use std::f64::consts::PI;
 use twoport_control::{AdmittanceGains, Gains, ImpedanceGains};
 use twoport_design::analysis::{self, Analysis};
-use twoport_design::host_ve::{check_host_ve, HostLoop};
+use twoport_design::host_ve::{check_host_ve, HostLoop, TicksError};
 use twoport_design::network::HumanBound;
 use twoport_design::verify::{verify_host, Hand};
 use twoport_design::{Designer, DeviceModel};
@@ -479,19 +479,14 @@ pub(crate) fn host_ve(
         .detach(move || {
             let des = designer(m, period, human)?;
             let t = des.period_s();
-            let n = 1.0 / (t * ve_rate);
-            if !(n.is_finite() && n >= 0.5 && (n - n.round()).abs() <= 1e-9 * n) {
-                return Err(format!(
+            let (n, d) = HostLoop::ticks_at(t, ve_rate, host_delay).map_err(|e| match e {
+                TicksError::NotMultiple => format!(
                     "ve_rate {ve_rate} Hz: the servo's {} Hz is not a whole multiple of it",
                     1.0 / t
-                ));
-            }
-            if !(host_delay.is_finite() && host_delay > 0.0) {
-                return Err(format!("host_delay {host_delay}: must be a time > 0 s"));
-            }
-            let d = ((host_delay / t) - 1e-9).ceil().max(1.0) as u32;
-            let host = HostLoop::new(t, n.round() as u32, d, (body.0, body.1, 0.0))
-                .map_err(|e| e.to_string())?;
+                ),
+                TicksError::BadDelay => format!("host_delay {host_delay}: must be a time > 0 s"),
+            })?;
+            let host = HostLoop::new(t, n, d, (body.0, body.1, 0.0)).map_err(|e| e.to_string())?;
             let human = human.then_some(HumanBound::PAPER);
             // The worst pose's proof, and the worst pose's search.
             let mut c: Option<twoport_design::host_ve::HostCheck> = None;
@@ -511,7 +506,7 @@ pub(crate) fn host_ve(
                 }
             }
             let c = c.ok_or("no pose")?;
-            Ok((c, v, host.ve_period_ticks, host.delay_ticks))
+            Ok::<_, String>((c, v, host.ve_period_ticks, host.delay_ticks))
         })
         .map_err(value)?;
     let verify = match v {
