@@ -13,8 +13,9 @@
 //! friction, kept only if they explain more than a search over that many
 //! periods would find in noise.
 
-use super::friction::{band_limited, rigid_with, Regressor, Shape, SUB};
+use super::friction::{band_limited, Regressor, Shape, SUB};
 use super::Measured;
+use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use std::f64::consts::TAU;
 
@@ -104,11 +105,147 @@ pub fn shapes(motion: &Motion, period_m: f64) -> [Regressor; 2] {
 /// across the motion) to `s/100`, in steps of wavenumber small enough that the
 /// phase across the motion moves by a twentieth of a turn.
 const STEP: f64 = 0.05;
-/// Terms past the rigid body's the search gives the impedance
-/// ([`rigid_with`]).
+/// Terms past the rigid body's the search gives the impedance (as
+/// [`rigid_with`](super::friction::rigid_with)'s `bend`).
 const BEND: usize = 3;
 /// The shortest period tried, in encoder quanta.
 const QUANTA: f64 = 10.0;
+
+/// The lowest harmonics' fit as one body with `data`'s forces and the
+/// smooth terms, ready to take two more columns: the weighted base
+/// columns' orthonormal basis, what they leave of the data, and each
+/// harmonic's `F/X` times its weight (what a shape per force is turned
+/// into a column by).
+struct Band {
+    q: DMatrix<f64>,
+    left: DVector<f64>,
+    scale: Vec<Complex64>,
+    used: usize,
+}
+
+impl Band {
+    fn new(data: &Measured, period_s: f64, below_hz: f64) -> Option<Band> {
+        let x = &data.position;
+        let used = x.freq_hz.iter().take_while(|f| **f < below_hz).count();
+        let n = 2 + BEND + data.forces.len();
+        if 2 * used < n + 4 {
+            return None;
+        }
+        let mut a = DMatrix::zeros(2 * used, n);
+        let mut b = DVector::zeros(2 * used);
+        let mut scale = Vec::with_capacity(used);
+        for i in 0..used {
+            let w = TAU * x.freq_hz[i];
+            let hold = Complex64::from_polar(1.0, w * period_s / 2.0);
+            let fx = 1.0 / x.response[i];
+            let rel = x.variance[i] / x.response[i].norm_sqr() + super::MODEL_FLOOR.powi(2);
+            let wt = 1.0 / (fx.norm() * rel.sqrt());
+            let mut cols = vec![-w * w * hold, Complex64::new(0.0, w) * hold];
+            cols.extend((0..BEND).map(|k| Complex64::new(0.0, w).powi(3 + k as i32) * hold));
+            cols.extend(data.forces.iter().map(|r| r.per_force[i] * fx));
+            for (j, c) in cols.iter().enumerate() {
+                a[(2 * i, j)] = c.re * wt;
+                a[(2 * i + 1, j)] = c.im * wt;
+            }
+            b[2 * i] = fx.re * wt;
+            b[2 * i + 1] = fx.im * wt;
+            scale.push(fx * wt);
+        }
+        let q = a.qr().q();
+        let left = &b - &q * (q.transpose() * &b);
+        Some(Band {
+            q,
+            left,
+            scale,
+            used,
+        })
+    }
+
+    /// The misfit with no more columns.
+    fn bare(&self) -> f64 {
+        self.left.norm_squared()
+    }
+
+    /// The misfit with two more shapes (per force, at the harmonics).
+    fn with(&self, s: &[Complex64], c: &[Complex64]) -> f64 {
+        let mut x = DMatrix::zeros(2 * self.used, 2);
+        for i in 0..self.used {
+            for (j, shape) in [s, c].iter().enumerate() {
+                let v = shape[i] * self.scale[i];
+                x[(2 * i, j)] = v.re;
+                x[(2 * i + 1, j)] = v.im;
+            }
+        }
+        // What the base columns leave of the new ones, and the least
+        // squares in those two alone (Frisch-Waugh).
+        let x = &x - &self.q * (self.q.transpose() * &x);
+        let g = x.transpose() * &x;
+        let r = x.transpose() * &self.left;
+        match g.cholesky() {
+            Some(ch) => self.bare() - r.dot(&ch.solve(&r)),
+            None => self.bare(),
+        }
+    }
+}
+
+/// Cogging's two shapes per force at wavenumbers `from + i step`, in
+/// turn, from the motion's phasors: each step turns every instant's
+/// phasor `e^{j k x}` by `e^{j step x}`, and one FFT of their tick means
+/// gives the sine's and the cosine's spectra.
+struct Sweep<'a> {
+    motion: &'a Motion,
+    z: Vec<Vec<Complex64>>,
+    turn: Vec<Vec<Complex64>>,
+    fft: std::sync::Arc<dyn rustfft::Fft<f64>>,
+}
+
+impl<'a> Sweep<'a> {
+    fn new(motion: &'a Motion, from: f64, step: f64) -> Sweep<'a> {
+        let phasors = |k: f64| -> Vec<Vec<Complex64>> {
+            motion
+                .at
+                .iter()
+                .map(|at| {
+                    at.iter()
+                        .map(|x| Complex64::from_polar(1.0, TAU * k * x))
+                        .collect()
+                })
+                .collect()
+        };
+        let period = motion.at.first().map_or(0, Vec::len);
+        Sweep {
+            motion,
+            z: phasors(from),
+            turn: phasors(step),
+            fft: rustfft::FftPlanner::new().plan_fft_forward(period),
+        }
+    }
+
+    /// The current wavenumber's (sine, cosine) per force; then step on.
+    fn next(&mut self) -> (Vec<Complex64>, Vec<Complex64>) {
+        let period = self.z.first().map_or(0, Vec::len);
+        let mut buf: Vec<Complex64> = (0..period)
+            .map(|n| self.z.iter().map(|z| z[n]).sum::<Complex64>() / SUB as f64)
+            .collect();
+        for (z, t) in self.z.iter_mut().zip(&self.turn) {
+            for (a, b) in z.iter_mut().zip(t) {
+                *a *= b;
+            }
+        }
+        self.fft.process(&mut buf);
+        let j = Complex64::new(0.0, 1.0);
+        let mut sin = Vec::with_capacity(self.motion.harmonics.len());
+        let mut cos = Vec::with_capacity(self.motion.harmonics.len());
+        for (&h, f) in self.motion.harmonics.iter().zip(&self.motion.force) {
+            // The tick means' real part is the cosine, the imaginary the
+            // sine: split the one FFT into the two real signals' spectra.
+            let (a, b) = (buf[h], buf[period - h].conj());
+            cos.push((a + b) / 2.0 / f);
+            sin.push((a - b) / (2.0 * j) / f);
+        }
+        (sin, cos)
+    }
+}
 
 /// The cogging the lowest harmonics of `data` (below `below_hz`, where
 /// the device moves as one body) show beside its other forces, if any:
@@ -125,7 +262,8 @@ pub fn find(
     if span.is_nan() || span <= 0.0 {
         return None;
     }
-    let (_, _, _, bare) = rigid_with(data, &[], BEND, period_s, below_hz)?;
+    let band = Band::new(data, period_s, below_hz)?;
+    let bare = band.bare();
     let longest = 2.0 * span;
     let shortest = (span / 100.0).max(QUANTA * q);
     if shortest >= longest {
@@ -133,24 +271,18 @@ pub fn find(
     }
     let (from, to, step) = (1.0 / longest, 1.0 / shortest, STEP / span);
     let tries = ((to - from) / step).ceil() as usize;
-    let cost = |wavenumber: f64| {
-        let [s, c] = shapes(motion, 1.0 / wavenumber);
-        rigid_with(
-            data,
-            &[&s.per_force, &c.per_force],
-            BEND,
-            period_s,
-            below_hz,
-        )
-        .map_or(f64::INFINITY, |r| r.3)
-    };
+    let mut sweep = Sweep::new(motion, from, step);
     let (mut best, at) = (0..=tries)
         .map(|i| {
-            let k = from + i as f64 * step;
-            (cost(k), k)
+            let (s, c) = sweep.next();
+            (band.with(&s, &c), from + i as f64 * step)
         })
         .min_by(|a, b| a.0.total_cmp(&b.0))?;
     // Then within a step either side, by golden sections.
+    let cost = |wavenumber: f64| {
+        let [s, c] = shapes(motion, 1.0 / wavenumber);
+        band.with(&s.per_force, &c.per_force)
+    };
     let (mut lo, mut hi) = (at - step, at + step);
     let r = (5f64.sqrt() - 1.0) / 2.0;
     let (mut a, mut b) = (hi - r * (hi - lo), lo + r * (hi - lo));
@@ -166,37 +298,25 @@ pub fn find(
             cb = cost(b);
         }
     }
-    let k = if ca < cb { a } else { b };
-    best = best.min(ca.min(cb));
-    let best = (
-        best,
-        if ca.min(cb) <= best {
-            1.0 / k
-        } else {
-            1.0 / at
-        },
-    );
+    let (refined, k) = if ca < cb { (ca, a) } else { (cb, b) };
+    let period = if refined <= best { 1.0 / k } else { 1.0 / at };
+    best = best.min(refined);
     // The criterion: two amounts, and the best of `tries` periods, in
     // units of the misfit left per degree of freedom with the cogging,
     // where that is more than the noise's (the band is not quite rigid,
     // and the cogging could be taking up the model's error).
-    let used = data
-        .position
-        .freq_hz
-        .iter()
-        .take_while(|f| **f < below_hz)
-        .count();
+    let used = band.used;
     let nu = (2 * used)
         .saturating_sub(4 + BEND + data.forces.len())
         .max(1) as f64;
-    let charge = (2.0 * ((2 * used) as f64).ln() + 2.0 * (tries.max(1) as f64).ln())
-        * (best.0 / nu).max(1.0);
-    (bare - best.0 > charge).then(|| shapes(motion, best.1))
+    let charge =
+        (2.0 * ((2 * used) as f64).ln() + 2.0 * (tries.max(1) as f64).ln()) * (best / nu).max(1.0);
+    (bare - best > charge).then(|| shapes(motion, period))
 }
 
 #[cfg(test)]
 mod tests {
-    use super::super::friction::without;
+    use super::super::friction::{rigid_with, without};
     use super::*;
     use crate::log::{Excitation, Log};
     use twoport_control::multisine::Multisine;
