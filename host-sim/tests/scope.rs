@@ -14,7 +14,11 @@ use twoport_control::servo::{Gains, ImpedanceGains};
 use twoport_link::{Axes, Message, Mode};
 
 fn harness() -> Harness<'static, (ScopeState, BoardChoice)> {
-    let state = ScopeState::open(Path::new("../scenes/stiff_wall.toml")).unwrap();
+    harness_on("../scenes/stiff_wall.toml")
+}
+
+fn harness_on(scene: &str) -> Harness<'static, (ScopeState, BoardChoice)> {
+    let state = ScopeState::open(Path::new(scene)).unwrap();
     let mut h = Harness::new_ui_state(
         |ui, s: &mut (ScopeState, BoardChoice)| {
             let (state, link) = s;
@@ -360,4 +364,34 @@ fn the_design_plot_draws_only_what_a_log_axis_can_show() {
     assert!(c
         .legend(&bound.label)
         .contains("≤ 0 (not drawn) at 0.05-11.7, 34.7-80.5 Hz"));
+}
+
+/// A scene with an identification experiment offers it: the button plays
+/// it (the board's loop in-process) and fits the record, and the panel
+/// shows the fit's line and its figures; a scene without one says so.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn the_identification_panel_plays_the_experiment_and_shows_the_fit() {
+    let mut h = harness_on("../scenes/identify/excalibur.toml");
+    assert!(h.state().0.identification.is_none());
+    h.get_by_label("Play the experiment and fit").click();
+    h.run();
+    let id = match &h.state().0.identification {
+        Some(Ok(id)) => id,
+        other => panic!(
+            "{:?}",
+            other.as_ref().map(|r| r.as_ref().map(|i| &i.summary))
+        ),
+    };
+    assert!(id.summary.starts_with("3 modes"), "{}", id.summary);
+    assert!(id.summary.contains("cogging"), "{}", id.summary);
+    let names: Vec<&str> = id.figures.iter().map(|f| f.0).collect();
+    assert_eq!(names, ["encoder", "load_cell", "coherence"]);
+    let _shown = h.get_by_label_contains("3 modes (modes, the handle on its load cell)");
+    let _plot = h.get_by_label_contains("Actuator force to encoder");
+
+    let mut plain = ScopeState::open(Path::new("../scenes/stiff_wall.toml")).unwrap();
+    plain.identify();
+    let e = plain.identification.unwrap().err().unwrap();
+    assert!(e.contains("no [identify] section"), "{e}");
 }

@@ -5,15 +5,13 @@
 //! (`set.toml`).
 
 use crate::args::{IdentifyArgs, PlotFormat};
-use num_complex::Complex64;
 use serde_json::json;
 use std::f64::consts::TAU;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
-use twoport_design::plot::{self, Curve, Figure};
+use twoport_design::plot;
 use twoport_design::{DeviceModel, Plant};
 use twoport_identify::fit::{self, chain::ModelBase, uncertainty, Fit, Form, Measured};
-use twoport_identify::frf::Frf;
 use twoport_identify::log::Log;
 
 pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
@@ -484,84 +482,19 @@ fn report(
     (v, t)
 }
 
-/// The measured responses beside the fit's, and the coherence.
+/// The fit's figures (`twoport_identify::figures`), drawn into `out`.
 fn draw(out: &Path, format: PlotFormat, data: &Measured, f: &Fit) -> Result<Vec<PathBuf>, String> {
     let ext = match format {
         PlotFormat::Png => "png",
         PlotFormat::Svg => "svg",
     };
-    let model = fit::sampled_response(&f.model, &data.position.freq_hz)
+    let figures = twoport_identify::figures::figures(data, f)
         .ok_or("the fitted model has no finite response")?;
-    let curve =
-        |label: &str, color, width, dashed, frf: &Frf, value: &dyn Fn(usize) -> f64| Curve {
-            label: label.into(),
-            width,
-            dashed,
-            color,
-            points: frf
-                .freq_hz
-                .iter()
-                .enumerate()
-                .map(|(i, hz)| (*hz, value(i)))
-                .collect(),
-        };
-    let x = &data.position;
     let mut written = Vec::new();
-    let mut figure = |name: &str, fig: Figure| {
+    for (name, fig) in figures {
         let path = out.join(format!("{name}.{ext}"));
         plot::render(&fig, &path).map_err(|e| e.to_string())?;
         written.push(path);
-        Ok::<(), String>(())
-    };
-    // The measured response, the fit's, and the measurement's deviation.
-    let fitted = |frf: &Frf, pick: fn(&(Complex64, Complex64)) -> Complex64| {
-        vec![
-            curve("measured", plot::BLUE, 2, false, frf, &|i| {
-                frf.response[i].norm()
-            }),
-            curve("fit", plot::INK, 2, true, frf, &|i| pick(&model[i]).norm()),
-            curve("measured, 1 sigma", plot::RED, 1, false, frf, &|i| {
-                frf.variance[i].sqrt()
-            }),
-        ]
-    };
-    figure(
-        "encoder",
-        Figure {
-            x_label: "frequency (Hz)".into(),
-            legend: plot::LegendAt::LowerRight,
-            title: "Actuator force to encoder: measured and fitted".into(),
-            y_label: "|X/F| (m/N)".into(),
-            curves: fitted(x, |m| m.0),
-        },
-    )?;
-    // On a log axis as what the coherence leaves, 1 - γ²: the noise's
-    // share of one period's response, from 1e-6 to one half at a glance.
-    let cx = x.coherence();
-    let mut coherence = vec![curve("encoder", plot::BLUE, 2, false, x, &|i| 1.0 - cx[i])];
-    if let Some(lc) = &data.load_cell {
-        figure(
-            "load_cell",
-            Figure {
-                x_label: "frequency (Hz)".into(),
-                legend: plot::LegendAt::LowerRight,
-                title: "Actuator force to load cell: measured and fitted".into(),
-                y_label: "|F_lc/F| (N/N)".into(),
-                curves: fitted(lc, |m| m.1),
-            },
-        )?;
-        let c = lc.coherence();
-        coherence.push(curve("load cell", plot::RED, 2, false, lc, &|i| 1.0 - c[i]));
     }
-    figure(
-        "coherence",
-        Figure {
-            x_label: "frequency (Hz)".into(),
-            legend: plot::LegendAt::LowerRight,
-            title: "What the excitation does not explain: 1 - coherence".into(),
-            y_label: "1 - coherence (noise share)".into(),
-            curves: coherence,
-        },
-    )?;
     Ok(written)
 }

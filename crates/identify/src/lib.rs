@@ -3,6 +3,8 @@
 #![warn(missing_docs)]
 
 mod error;
+#[cfg(feature = "plot")]
+pub mod figures;
 pub mod fit;
 pub mod frf;
 pub mod log;

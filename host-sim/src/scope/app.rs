@@ -75,6 +75,9 @@ pub struct ScopeState {
     pub scenes_root: PathBuf,
     /// The scene running.
     pub scene_path: PathBuf,
+    /// The scene's identification experiment as last played and fitted,
+    /// or why it could not be.
+    pub identification: Option<Result<crate::scope::identify::Identification, String>>,
     scene: Scene,
     sim: Simulation,
     /// The designer's view of the scene's device (the model file's).
@@ -171,10 +174,17 @@ impl ScopeState {
             message: None,
             debt_s: 0.0,
             last: None,
+            identification: None,
         };
         s.sim.track_energy(true);
         s.update_light();
         Ok(s)
+    }
+
+    /// Play the scene's identification experiment and fit its record
+    /// (the board's loop in-process; it takes a second or two).
+    pub fn identify(&mut self) {
+        self.identification = Some(crate::scope::identify::identify(&self.scene));
     }
 
     /// Switch to another scene (keeps the board link).

@@ -2,10 +2,12 @@
 //! (`ui`), the window (`window`), the sample rings it draws from (`rings`)
 //! of the signals it records (`signals`), and its link to a board of any
 //! number of axes (`board`); for a three-axis scene, the world's state
-//! (`world`) and view (`world_ui`).
+//! (`world`) and view (`world_ui`); for a scene with an identification
+//! experiment, its fit (`identify`).
 
 pub mod app;
 pub mod board;
+pub mod identify;
 pub mod rings;
 pub mod signals;
 #[cfg(feature = "gui")]

@@ -421,6 +421,62 @@ pub fn design_panel(ui: &mut Ui, s: &ScopeState) {
         });
 }
 
+/// A figure's curves on log-log axes, framed on what they show.
+fn figure_plot(ui: &mut Ui, id: &str, fig: &twoport_design::plot::Figure) {
+    ui.label(RichText::new(&fig.title).small());
+    Plot::new(id)
+        .height(170.0)
+        .legend(Legend::default().position(egui_plot::Corner::LeftBottom))
+        .y_axis_min_width(40.0)
+        .x_axis_label(fig.x_label.clone())
+        .y_axis_label(fig.y_label.clone())
+        .x_axis_formatter(|m, _| decade_label(m.value))
+        .y_axis_formatter(|m, _| decade_label(m.value))
+        .x_grid_spacer(decades)
+        .y_grid_spacer(decades)
+        .show(ui, |p| {
+            for (i, c) in fig.curves.iter().enumerate() {
+                let color = Color32::from_rgb(c.color.0, c.color.1, c.color.2);
+                let curve = LogCurve::new(&c.points, f64::NEG_INFINITY);
+                let name = curve.legend(&c.label);
+                for (j, run) in curve.runs.into_iter().enumerate() {
+                    p.line(
+                        Line::new(name.clone(), PlotPoints::from(run))
+                            .color(color)
+                            .width(c.width as f32)
+                            .id((id, i, j)),
+                    );
+                }
+            }
+        });
+}
+
+/// A scene's identification experiment: play it, and the fit's figures.
+pub fn identify_panel(ui: &mut Ui, s: &mut ScopeState) {
+    if s.scene().identify.is_none() {
+        return;
+    }
+    ui.heading("Identification");
+    if ui.button("Play the experiment and fit").clicked() {
+        s.identify();
+    }
+    match &s.identification {
+        None => {
+            ui.label("the board plays the scene's multisine in-process, then fits its record");
+        }
+        Some(Err(e)) => {
+            ui.colored_label(Color32::from_rgb(190, 40, 40), e);
+        }
+        Some(Ok(id)) => {
+            ui.label(&id.summary);
+            for (name, fig) in &id.figures {
+                figure_plot(ui, name, fig);
+            }
+        }
+    }
+    ui.separator();
+}
+
 /// Grasp and the mouse push.
 pub fn hand(ui: &mut Ui, s: &mut ScopeState) {
     ui.heading("Hand");
@@ -648,6 +704,7 @@ pub fn scope(ui: &mut Ui, s: &mut ScopeState, link: &mut BoardChoice) {
                 gains(ui, s);
                 design_panel(ui, s);
                 ui.separator();
+                identify_panel(ui, s);
                 hand(ui, s);
                 wall(ui, s);
                 ui.separator();

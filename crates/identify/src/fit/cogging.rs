@@ -32,7 +32,7 @@ pub struct Found {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Motion {
     /// The mean period's position, band-limited to the played harmonics
-    /// with its mean, at [`SUB`] instants across each tick (m).
+    /// with its mean, at eight instants across each tick (m).
     pub at: Vec<Vec<f64>>,
     /// The force's mean spectrum at the played harmonics.
     pub force: Vec<Complex64>,
@@ -42,7 +42,7 @@ pub struct Motion {
 
 impl Motion {
     /// The motion of `position_m` under `force` (its mean spectrum at
-    /// `harmonics`), `None` where [`band_limited`] finds none.
+    /// `harmonics`), `None` where the record has no whole period to average.
     pub fn new(
         position_m: &[f64],
         period: usize,

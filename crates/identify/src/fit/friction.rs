@@ -54,7 +54,7 @@ pub struct Regressor {
 }
 
 /// The mean period's position band-limited to its lowest `top` harmonics
-/// (where the motion is, and little of the quantum), at [`SUB`] instants
+/// (where the motion is, and little of the quantum), at eight instants
 /// across each tick (`[instant][tick]`), with its mean; or, with
 /// `derivative`, its rate of change (in units that do not matter to a
 /// sign). `None` where there is no whole period after `skip`, or `top` is
@@ -118,7 +118,8 @@ pub(crate) fn band_limited(
 /// regressor, which biases the friction found toward zero and hands the
 /// rest to the damping (on a 0.25 kg handle, 0.05 N of friction came back
 /// as 0.02 N and the damping 9% too large). So the velocity is taken
-/// from the mean period's position, band-limited ([`band_limited`]).
+/// from the mean period's position, band-limited to the played
+/// harmonics and evaluated at eight instants across each tick.
 pub fn tick_sign(position_m: &[f64], period: usize, top: usize, skip: usize) -> Option<Vec<f64>> {
     let v = band_limited(position_m, period, top, skip, true)?;
     Some(
