@@ -332,12 +332,12 @@ pub(crate) fn each_axis<A: HasCommon + Clone>(
             out: out.clone(),
         });
         if !json && !args.rust() {
-            println!("axis {}:", axis.name);
+            say!("axis {}:\n", axis.name);
         }
         run(&a).map_err(|e| format!("{}, axis {}: {e}", path.display(), axis.name))?;
     }
     if json {
-        println!("{}", json!({"device": device.name, "axes": out.take()}));
+        say!("{}\n", json!({"device": device.name, "axes": out.take()}));
     }
     Ok(())
 }

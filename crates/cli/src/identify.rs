@@ -112,15 +112,15 @@ pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
             "damping_doubt": a.damping_doubt,
             "axes": axes.iter().map(|x| x.json.clone()).collect::<Vec<_>>(),
         });
-        println!("{v}");
+        say!("{v}\n");
         return Ok(());
     }
     for x in &axes {
-        println!("axis {}:\n{}", x.name, x.text);
+        say!("axis {}:\n{}\n", x.name, x.text);
     }
-    println!(
+    say!(
         "wrote {} (each axis's fit) and {} (each axis's set: +-{} sigma, damping lowered by {}%)\n\
-         prove a coupling for all of them: twoport design impedance --device {}",
+         prove a coupling for all of them: twoport design impedance --device {}\n",
         device_path.display(),
         set_path.display(),
         a.sigmas,

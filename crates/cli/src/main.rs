@@ -1,5 +1,26 @@
 //! `twoport`: design and check virtual couplings for a haptic device.
 
+/// `print!` for a report a reader may stop reading (`| head`): a closed
+/// pipe ends the program quietly, as it does any Unix filter, where
+/// `print!` would panic.
+macro_rules! say {
+    ($($t:tt)*) => {
+        crate::say(format_args!($($t)*))
+    };
+}
+
+/// Text on standard output; see [`say!`].
+fn say(args: std::fmt::Arguments) {
+    use std::io::Write;
+    if let Err(e) = std::io::stdout().lock().write_fmt(args) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("twoport: standard output: {e}");
+        std::process::exit(2);
+    }
+}
+
 mod args;
 mod check;
 mod host;

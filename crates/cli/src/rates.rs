@@ -112,12 +112,12 @@ pub(crate) fn rates(a: &RatesArgs) -> Result<(), String> {
         plot::render(&figure(&rows, &rates), out).map_err(|e| e.to_string())?;
     }
     if a.json {
-        println!("{}", to_json(&rows, &rates));
+        say!("{}\n", to_json(&rows, &rates));
         return Ok(());
     }
-    println!("{}", table(&rows, &rates, host.as_ref()));
+    say!("{}\n", table(&rows, &rates, host.as_ref()));
     if let Some(out) = &a.plot {
-        println!("wrote {}", out.display());
+        say!("wrote {}\n", out.display());
     }
     Ok(())
 }

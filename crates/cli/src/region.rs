@@ -41,14 +41,14 @@ pub(crate) fn region(d: &Display<RegionImpedance, RegionAdmittance>) -> Result<(
                     }
                 })
                 .collect();
-            println!(
-                "/// Axis {}'s proven region.\npub mod axis_{ident} {{\nuse super::*;",
+            say!(
+                "/// Axis {}'s proven region.\npub mod axis_{ident} {{\nuse super::*;\n",
                 a.name
             );
-            print!("{source}");
-            println!("}}");
+            say!("{source}");
+            say!("}}\n");
         }
-        None => print!("{source}"),
+        None => say!("{source}"),
     }
     Ok(())
 }

@@ -49,7 +49,7 @@ pub(crate) fn single<'a>(d: &'a Designer, command: &str) -> Result<&'a Pose, Str
 /// file's axis), or its text.
 pub(crate) fn emit(c: &Common, report: &(impl Serialize + Display)) -> Result<(), String> {
     if !c.json {
-        println!("{report}");
+        say!("{report}\n");
         return Ok(());
     }
     let mut v = serde_json::to_value(report).map_err(|e| e.to_string())?;
@@ -58,7 +58,7 @@ pub(crate) fn emit(c: &Common, report: &(impl Serialize + Display)) -> Result<()
             v["axis"] = json!(a.name);
             a.out.borrow_mut().push(v);
         }
-        None => println!("{v}"),
+        None => say!("{v}\n"),
     }
     Ok(())
 }
