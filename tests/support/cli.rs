@@ -37,6 +37,27 @@ impl Tool {
         serde_json::from_str(&text).unwrap()
     }
 
+    /// Run with `args` and close its standard output before it writes
+    /// (or after: then the report went into the pipe's buffer, and all is
+    /// well too). It must end with code 0 and no panic, as a Unix filter
+    /// whose reader stopped (`| head`) does.
+    #[allow(dead_code)]
+    pub fn closes_quietly(&self, args: &[&str]) {
+        use std::process::Stdio;
+        let mut child = Command::new(self.bin)
+            .current_dir(self.root)
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("run the tool");
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {err}");
+    }
+
     /// Run with `args`; it must fail with exit code 2, print nothing on
     /// stdout, and say why on stderr, which is returned.
     #[allow(dead_code)]

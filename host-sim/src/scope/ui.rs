@@ -403,22 +403,8 @@ pub fn design_panel(ui: &mut Ui, s: &ScopeState) {
         .y_axis_formatter(|m, _| decade_label(m.value))
         .x_grid_spacer(decades)
         .y_grid_spacer(decades)
-        .show(ui, |p| {
-            for (i, c) in fig.curves.iter().enumerate() {
-                let color = Color32::from_rgb(c.color.0, c.color.1, c.color.2);
-                // Just below the frame: a dive leaves through the bottom.
-                let curve = LogCurve::new(&c.points, bottom - 0.5);
-                let name = curve.legend(&c.label);
-                for (j, run) in curve.runs.into_iter().enumerate() {
-                    p.line(
-                        Line::new(name.clone(), PlotPoints::from(run))
-                            .color(color)
-                            .width(c.width as f32)
-                            .id(("design", i, j)),
-                    );
-                }
-            }
-        });
+        // Just below the frame: a dive leaves through the bottom.
+        .show(ui, |p| curves(p, "design", fig, bottom - 0.5));
 }
 
 /// A figure's curves on log-log axes, framed on what they show.
@@ -434,21 +420,25 @@ fn figure_plot(ui: &mut Ui, id: &str, fig: &twoport_design::plot::Figure) {
         .y_axis_formatter(|m, _| decade_label(m.value))
         .x_grid_spacer(decades)
         .y_grid_spacer(decades)
-        .show(ui, |p| {
-            for (i, c) in fig.curves.iter().enumerate() {
-                let color = Color32::from_rgb(c.color.0, c.color.1, c.color.2);
-                let curve = LogCurve::new(&c.points, f64::NEG_INFINITY);
-                let name = curve.legend(&c.label);
-                for (j, run) in curve.runs.into_iter().enumerate() {
-                    p.line(
-                        Line::new(name.clone(), PlotPoints::from(run))
-                            .color(color)
-                            .width(c.width as f32)
-                            .id((id, i, j)),
-                    );
-                }
-            }
-        });
+        .show(ui, |p| curves(p, id, fig, f64::NEG_INFINITY));
+}
+
+/// A figure's curves as log-log lines, each value clamped to `floor`
+/// decades (and left out where not positive).
+fn curves(p: &mut egui_plot::PlotUi, id: &str, fig: &twoport_design::plot::Figure, floor: f64) {
+    for (i, c) in fig.curves.iter().enumerate() {
+        let color = Color32::from_rgb(c.color.0, c.color.1, c.color.2);
+        let curve = LogCurve::new(&c.points, floor);
+        let name = curve.legend(&c.label);
+        for (j, run) in curve.runs.into_iter().enumerate() {
+            p.line(
+                Line::new(name.clone(), PlotPoints::from(run))
+                    .color(color)
+                    .width(c.width as f32)
+                    .id((id, i, j)),
+            );
+        }
+    }
 }
 
 /// A scene's identification experiment: play it, and the fit's figures.

@@ -13,7 +13,7 @@
 //! friction, kept only if they explain more than a search over that many
 //! periods would find in noise.
 
-use super::friction::{band_limited, Regressor, Shape, SUB};
+use super::friction::{band_limited, Regressor, RigidRows, Shape, SUB};
 use super::Measured;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
@@ -125,39 +125,15 @@ struct Band {
 
 impl Band {
     fn new(data: &Measured, period_s: f64, below_hz: f64) -> Option<Band> {
-        let x = &data.position;
-        let used = x.freq_hz.iter().take_while(|f| **f < below_hz).count();
-        let n = 2 + BEND + data.forces.len();
-        if 2 * used < n + 4 {
-            return None;
-        }
-        let mut a = DMatrix::zeros(2 * used, n);
-        let mut b = DVector::zeros(2 * used);
-        let mut scale = Vec::with_capacity(used);
-        for i in 0..used {
-            let w = TAU * x.freq_hz[i];
-            let hold = Complex64::from_polar(1.0, w * period_s / 2.0);
-            let fx = 1.0 / x.response[i];
-            let rel = x.variance[i] / x.response[i].norm_sqr() + super::MODEL_FLOOR.powi(2);
-            let wt = 1.0 / (fx.norm() * rel.sqrt());
-            let mut cols = vec![-w * w * hold, Complex64::new(0.0, w) * hold];
-            cols.extend((0..BEND).map(|k| Complex64::new(0.0, w).powi(3 + k as i32) * hold));
-            cols.extend(data.forces.iter().map(|r| r.per_force[i] * fx));
-            for (j, c) in cols.iter().enumerate() {
-                a[(2 * i, j)] = c.re * wt;
-                a[(2 * i + 1, j)] = c.im * wt;
-            }
-            b[2 * i] = fx.re * wt;
-            b[2 * i + 1] = fx.im * wt;
-            scale.push(fx * wt);
-        }
-        let q = a.qr().q();
-        let left = &b - &q * (q.transpose() * &b);
+        // Room for the two columns to come, and two spare equations.
+        let rows = RigidRows::new(data, &[], BEND, period_s, below_hz, 4)?;
+        let q = rows.a.qr().q();
+        let left = &rows.b - &q * (q.transpose() * &rows.b);
         Some(Band {
             q,
             left,
-            scale,
-            used,
+            scale: rows.scale,
+            used: rows.used,
         })
     }
 

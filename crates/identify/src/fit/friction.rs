@@ -146,42 +146,76 @@ pub fn rigid_with(
     period_s: f64,
     below_hz: f64,
 ) -> Option<(f64, f64, Vec<f64>, f64)> {
-    let x = &data.position;
-    let shapes: Vec<&[Complex64]> = data
-        .forces
-        .iter()
-        .map(|r| r.per_force.as_slice())
-        .chain(more.iter().copied())
-        .collect();
-    let n = 2 + bend + shapes.len();
-    let used = x.freq_hz.iter().take_while(|f| **f < below_hz).count();
-    if 2 * used < n + 2 {
-        return None;
-    }
-    let mut a = DMatrix::zeros(2 * used, n);
-    let mut b = DVector::zeros(2 * used);
-    for i in 0..used {
-        let w = TAU * x.freq_hz[i];
-        let hold = Complex64::from_polar(1.0, w * period_s / 2.0);
-        // F/X = 1/H: with R/F stored, R/X = (R/F) (F/X).
-        let fx = 1.0 / x.response[i];
-        let rel = x.variance[i] / x.response[i].norm_sqr() + super::MODEL_FLOOR.powi(2);
-        // Each harmonic weighted as a relative error of F/X.
-        let wt = 1.0 / (fx.norm() * rel.sqrt());
-        let mut cols = vec![-w * w * hold, Complex64::new(0.0, w) * hold];
-        cols.extend((0..bend).map(|k| Complex64::new(0.0, w).powi(3 + k as i32) * hold));
-        cols.extend(shapes.iter().map(|s| s[i] * fx));
-        for (j, c) in cols.iter().enumerate() {
-            a[(2 * i, j)] = c.re * wt;
-            a[(2 * i + 1, j)] = c.im * wt;
-        }
-        b[2 * i] = fx.re * wt;
-        b[2 * i + 1] = fx.im * wt;
-    }
-    let p = a.clone().svd(true, true).solve(&b, 1e-12).ok()?;
-    let cost = (&a * &p - &b).norm_squared();
+    let rows = RigidRows::new(data, more, bend, period_s, below_hz, 2)?;
+    let (a, b) = (&rows.a, &rows.b);
+    let p = a.clone().svd(true, true).solve(b, 1e-12).ok()?;
+    let cost = (a * &p - b).norm_squared();
     let ok = p[0] > 0.0 && p.iter().all(|v| v.is_finite());
     ok.then(|| (p[0], p[1], p.as_slice()[2 + bend..].to_vec(), cost))
+}
+
+/// The weighted least-squares rows of [`rigid_with`]: two a harmonic
+/// below the band's top (the real and imaginary parts of `F/X`), each
+/// harmonic weighted as a relative error of `F/X` by its measured
+/// variance with the model floor.
+pub(crate) struct RigidRows {
+    /// The columns: mass, damping, the `bend` terms, then each shape.
+    pub a: DMatrix<f64>,
+    /// `F/X`.
+    pub b: DVector<f64>,
+    /// Each harmonic's `F/X` times its weight: a shape per force times it
+    /// is the shape's column.
+    pub scale: Vec<Complex64>,
+    /// Harmonics used.
+    pub used: usize,
+}
+
+impl RigidRows {
+    /// The rows for `data`'s forces and `more`; `None` where they would
+    /// leave fewer than `spare` equations over the unknowns.
+    pub fn new(
+        data: &Measured,
+        more: &[&[Complex64]],
+        bend: usize,
+        period_s: f64,
+        below_hz: f64,
+        spare: usize,
+    ) -> Option<RigidRows> {
+        let x = &data.position;
+        let shapes: Vec<&[Complex64]> = data
+            .forces
+            .iter()
+            .map(|r| r.per_force.as_slice())
+            .chain(more.iter().copied())
+            .collect();
+        let n = 2 + bend + shapes.len();
+        let used = x.freq_hz.iter().take_while(|f| **f < below_hz).count();
+        if 2 * used < n + spare {
+            return None;
+        }
+        let mut a = DMatrix::zeros(2 * used, n);
+        let mut b = DVector::zeros(2 * used);
+        let mut scale = Vec::with_capacity(used);
+        for i in 0..used {
+            let w = TAU * x.freq_hz[i];
+            let hold = Complex64::from_polar(1.0, w * period_s / 2.0);
+            // F/X = 1/H: with R/F stored, R/X = (R/F) (F/X).
+            let fx = 1.0 / x.response[i];
+            let rel = x.variance[i] / x.response[i].norm_sqr() + super::MODEL_FLOOR.powi(2);
+            let wt = 1.0 / (fx.norm() * rel.sqrt());
+            let mut cols = vec![-w * w * hold, Complex64::new(0.0, w) * hold];
+            cols.extend((0..bend).map(|k| Complex64::new(0.0, w).powi(3 + k as i32) * hold));
+            cols.extend(shapes.iter().map(|s| s[i] * fx));
+            for (j, c) in cols.iter().enumerate() {
+                a[(2 * i, j)] = c.re * wt;
+                a[(2 * i + 1, j)] = c.im * wt;
+            }
+            b[2 * i] = fx.re * wt;
+            b[2 * i + 1] = fx.im * wt;
+            scale.push(fx * wt);
+        }
+        Some(RigidRows { a, b, scale, used })
+    }
 }
 
 /// `data` with `amounts` (N, one per force of `data`'s, in order) taken
