@@ -292,44 +292,24 @@ pub fn find(
 
 #[cfg(test)]
 mod tests {
+    use super::super::friction::tests::Bench;
     use super::super::friction::{rigid_with, without};
     use super::*;
-    use crate::log::{Excitation, Log};
-    use twoport_control::multisine::Multisine;
 
     /// A 0.25 kg handle with 2 N s/m of damping, 0.05 N of Coulomb
     /// friction and `cogging_n` of cogging every 2 mm, pushed by an 8 N
-    /// multisine from 1 to 100 Hz, held by a weak spring and read by a
-    /// 1 um encoder.
-    fn record(cogging_n: f64) -> Log {
-        let (m, d, fc, t) = (0.25, 2.0, 0.05, 1e-3);
-        let ms = Multisine::new(1000, 1, 100, 8.0).unwrap();
-        let (mut x, mut v) = (0.0f64, 0.0f64);
-        let (mut force, mut pos) = (Vec::new(), Vec::new());
-        for n in 0..20_000u32 {
-            let y = (x / 1e-6).round() * 1e-6;
-            let f = ms.at(n) as f64 - 300.0 * y - 10.0 * v;
-            force.push(f);
-            pos.push(y);
-            for _ in 0..20 {
-                let cog = cogging_n * (TAU * x / 2e-3).sin();
-                let a = (f - d * v - fc * (v / 1e-4).tanh() + cog) / m;
-                let h = t / 20.0;
-                x += v * h + 0.5 * a * h * h;
-                v += a * h;
-            }
+    /// multisine from 1 to 100 Hz.
+    fn record(cogging_n: f64) -> crate::log::Log {
+        Bench {
+            m: 0.25,
+            d: 2.0,
+            fc: 0.05,
+            cogging: cogging_n,
+            top: 100,
+            peak: 8.0,
+            hold: (300.0, 10.0),
         }
-        Log {
-            period_s: t,
-            force_n: force,
-            position_m: pos,
-            load_cell_n: None,
-            excitation: Some(Excitation {
-                period_ticks: 1000,
-                first: 1,
-                last: 100,
-            }),
-        }
+        .record()
     }
 
     /// Cogging is found near its period and at its amplitude, and with it

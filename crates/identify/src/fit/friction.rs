@@ -271,46 +271,79 @@ pub fn without(data: &Measured, amounts: &[f64]) -> Measured {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::log::{Excitation, Log};
     use twoport_control::multisine::Multisine;
 
-    /// A 2 kg mass with 5 N s/m of damping and 0.5 N of Coulomb friction
-    /// (smoothed over 0.1 mm/s), pushed by a 40 N multisine from 1 to 40 Hz
-    /// and read by a 1 um encoder: the mass, the damping and the friction
-    /// come back, and the response with friction taken out is the linear
-    /// mass-damper's, where left in it is not.
+    /// A handle on a bench: a mass with damping, Coulomb friction
+    /// (smoothed over 0.1 mm/s) and cogging every 2 mm, pushed by a
+    /// multisine of 1 s periods, held by a weak spring-damper, and read
+    /// by a 1 um encoder: twenty seconds of its record.
+    pub(crate) struct Bench {
+        /// Mass (kg), damping (N s/m), friction (N), cogging (N).
+        pub m: f64,
+        pub d: f64,
+        pub fc: f64,
+        pub cogging: f64,
+        /// The multisine's top harmonic and peak (N).
+        pub top: u32,
+        pub peak: f32,
+        /// The hold's stiffness (N/m) and damping (N s/m).
+        pub hold: (f64, f64),
+    }
+
+    impl Bench {
+        pub fn record(&self) -> Log {
+            let t = 1e-3;
+            let ms = Multisine::new(1000, 1, self.top, self.peak).unwrap();
+            let (mut x, mut v) = (0.0f64, 0.0f64);
+            let (mut force, mut pos) = (Vec::new(), Vec::new());
+            for n in 0..20_000u32 {
+                let y = (x / 1e-6).round() * 1e-6;
+                // A weak hold keeps it centred, as the board's does.
+                let f = ms.at(n) as f64 - self.hold.0 * y - self.hold.1 * v;
+                force.push(f);
+                pos.push(y);
+                for _ in 0..20 {
+                    let cog = self.cogging * (TAU * x / 2e-3).sin();
+                    let a = (f - self.d * v - self.fc * (v / 1e-4).tanh() + cog) / self.m;
+                    let h = t / 20.0;
+                    x += v * h + 0.5 * a * h * h;
+                    v += a * h;
+                }
+            }
+            Log {
+                period_s: t,
+                force_n: force,
+                position_m: pos,
+                load_cell_n: None,
+                excitation: Some(Excitation {
+                    period_ticks: 1000,
+                    first: 1,
+                    last: self.top as usize,
+                }),
+            }
+        }
+    }
+
+    /// A 2 kg mass with 5 N s/m of damping and 0.5 N of Coulomb friction,
+    /// pushed by a 40 N multisine from 1 to 40 Hz: the mass, the damping
+    /// and the friction come back, and the response with friction taken
+    /// out is the linear mass-damper's, where left in it is not.
     #[test]
     fn friction_is_found_and_taken_out() {
         let (m, d, fc, t) = (2.0, 5.0, 0.5, 1e-3);
-        let ms = Multisine::new(1000, 1, 40, 40.0).unwrap();
-        let (mut x, mut v) = (0.0f64, 0.0f64);
-        let (mut force, mut pos) = (Vec::new(), Vec::new());
-        for n in 0..20_000u32 {
-            let y = (x / 1e-6).round() * 1e-6;
-            // A weak hold keeps it centred, as the board's does.
-            let f = ms.at(n) as f64 - 300.0 * y;
-            force.push(f);
-            pos.push(y);
-            for _ in 0..20 {
-                let a = (f - d * v - fc * (v / 1e-4).tanh()) / m;
-                let h = t / 20.0;
-                x += v * h + 0.5 * a * h * h;
-                v += a * h;
-            }
+        let log = Bench {
+            m,
+            d,
+            fc,
+            cogging: 0.0,
+            top: 40,
+            peak: 40.0,
+            hold: (300.0, 0.0),
         }
-        let log = Log {
-            period_s: t,
-            force_n: force,
-            position_m: pos,
-            load_cell_n: None,
-            excitation: Some(Excitation {
-                period_ticks: 1000,
-                first: 1,
-                last: 40,
-            }),
-        };
+        .record();
         // (Past the transient: the hold's lightly damped 2 Hz mode.)
         let data = Measured::from_log(&log, 8).unwrap();
         let (mm, dd, ff, _) = rigid_with(&data, &[], 0, t, 41.0).unwrap();
