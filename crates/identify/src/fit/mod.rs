@@ -233,7 +233,10 @@ impl Measured {
                     .map(|m| cogging::shapes(m, period_m)[1].clone()),
             };
             forces.push(own.ok_or_else(|| {
-                refuse("it does not show the motion the bare record's friction needs".into())
+                refuse(
+                    "it does not show the motion the bare record's friction and cogging need"
+                        .into(),
+                )
             })?);
         }
         Ok(Measured {
@@ -306,7 +309,7 @@ pub struct Fit {
     /// The parameters found, in the form's own order
     /// ([`Chain::to_log`], [`Modal::to_params`]); the covariance's first
     /// rows and columns are theirs, and its last, where the record showed
-    /// friction, the friction's.
+    /// friction or cogging, their amounts'.
     pub params: DVector<f64>,
     /// What the model was built on.
     pub base: ModelBase,

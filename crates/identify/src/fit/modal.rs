@@ -16,6 +16,11 @@
 //! Unlike a chain, this form does not assume where along the structure the
 //! handle sits: a mode may move the handle more, less or opposite to the
 //! actuator, as it does on a linkage or a coupled transmission.
+//!
+//! Fitted with a loaded record too, the form may hold the handle by a
+//! second path, a spring straight to the actuator beside the load cell
+//! ([`Modal::bypass_npm`]): what the load cell does not read, and an
+//! admittance display depends on.
 
 use nalgebra::{DMatrix, DVector};
 use twoport_design::DeviceModel;
