@@ -32,9 +32,12 @@
 
 pub mod chain;
 pub mod cogging;
+mod features;
 pub mod friction;
 pub mod ladder;
 pub mod lm;
+mod loaded;
+mod measured;
 pub mod modal;
 pub mod start;
 pub mod uncertainty;
@@ -47,39 +50,8 @@ use num_complex::Complex64;
 use std::f64::consts::TAU;
 use twoport_design::{DeviceModel, Plant};
 
-/// What an experiment measured: the encoder's response to the actuator's
-/// force (m/N) and, where the device has one, the load cell's (N/N), at
-/// the same harmonics.
-#[derive(Clone, Debug)]
-pub struct Measured {
-    /// Actuator force (pushing the actuator toward +x) to encoder.
-    pub position: Frf,
-    /// Actuator force to load cell.
-    pub load_cell: Option<Frf>,
-    /// The forces the device adds that depend on its motion (friction,
-    /// cogging), each known up to its amount ([`friction`]); none where
-    /// the record could not give their shapes.
-    pub forces: Vec<friction::Regressor>,
-    /// The encoder's quantum (m), where the record shows it: the least
-    /// step between the positions it read.
-    pub encoder_quantum_m: Option<f64>,
-    /// The record's mean motion, where it gave one: cogging's shapes at
-    /// any period come from it.
-    pub motion: Option<cogging::Motion>,
-    /// The same experiment with a known mass clamped on the handle, if it
-    /// was played: fitted together with this one, it shows the handle's
-    /// side of the device, which the actuator's push alone barely moves.
-    pub loaded: Option<Box<Loaded>>,
-}
-
-/// An experiment played with a known mass on the handle.
-#[derive(Clone, Debug)]
-pub struct Loaded {
-    /// The mass added (kg).
-    pub added_kg: f64,
-    /// What it measured (its own `loaded` is `None`).
-    pub data: Measured,
-}
+use features::{features, rigid_band_hz};
+pub use measured::{Loaded, Measured};
 
 /// The physical form of a fitted model.
 #[derive(Clone, Debug, PartialEq)]
@@ -106,186 +78,6 @@ impl Form {
             Form::Modal(m) => m.model(base),
         }
     }
-}
-
-impl Measured {
-    /// The responses an experiment's record shows at the harmonics it
-    /// played, averaged over its whole periods after the first `skip` (the
-    /// transient). Refused, with the reason: a record that does not name
-    /// its excitation, or one [`frf::periodic`](crate::frf::periodic)
-    /// refuses.
-    pub fn from_log(log: &crate::log::Log, skip: usize) -> Result<Measured, crate::IdentifyError> {
-        let e = log.excitation.ok_or(crate::IdentifyError::Log {
-            place: "the record".into(),
-            why: "it does not name its excitation (the `# twoport experiment:` line)".into(),
-        })?;
-        clipped(&log.force_n, log.period_s)?;
-        let harmonics: Vec<usize> = (e.first..=e.last).collect();
-        let at = |signal: &[f64]| {
-            crate::frf::periodic(
-                &log.force_n,
-                signal,
-                log.period_s,
-                e.period_ticks,
-                &harmonics,
-                skip,
-            )
-        };
-        let spectrum = |x: &[f64]| crate::frf::mean_spectrum(x, e.period_ticks, &harmonics, skip);
-        let force = spectrum(&log.force_n);
-        // A quantised reading's error repeats with the motion, period after
-        // period, so no averaging removes it: its share of each harmonic,
-        // `N q²/12` (`q` the least step the record shows), is a floor on
-        // that harmonic's variance. Where the response is far below a
-        // count, the harmonic then counts for what it is worth.
-        let floored = |mut f: Frf, signal: &[f64]| {
-            let q = quantum(signal);
-            if let Some(q) = q {
-                let floor = e.period_ticks as f64 * q * q / 12.0;
-                for (v, fm) in f.variance.iter_mut().zip(&force) {
-                    *v += floor / fm.norm_sqr().max(f64::MIN_POSITIVE);
-                }
-            }
-            (f, q)
-        };
-        let (position, encoder) = floored(at(&log.position_m)?, &log.position_m);
-        let load_cell = match log.load_cell_n.as_deref() {
-            Some(lc) => Some(floored(at(lc)?, lc).0),
-            None => None,
-        };
-        let sign = friction::tick_sign(&log.position_m, e.period_ticks, e.last, skip);
-        let mut forces: Vec<friction::Regressor> = sign
-            .map(|sign| friction::Regressor {
-                shape: friction::Shape::Coulomb,
-                per_force: crate::frf::mean_spectrum(&sign, e.period_ticks, &harmonics, 0)
-                    .iter()
-                    .zip(&force)
-                    .map(|(s, f)| s / f)
-                    .collect(),
-                taken_n: 0.0,
-            })
-            .into_iter()
-            .collect();
-        let motion = cogging::Motion::new(&log.position_m, e.period_ticks, &harmonics, force, skip);
-        let mut data = Measured {
-            position,
-            load_cell,
-            forces: Vec::new(),
-            encoder_quantum_m: encoder,
-            motion,
-            loaded: None,
-        };
-        if let (Some(motion), false) = (&data.motion, forces.is_empty()) {
-            data.forces = forces.clone();
-            let below = rigid_band_hz(&data.position);
-            if let Some(c) = cogging::find(&data, motion, log.period_s, below) {
-                forces.extend(c);
-            }
-        }
-        data.forces = forces;
-        Ok(data)
-    }
-
-    /// These responses with `loaded`'s, measured with `added_kg` on the
-    /// handle, to be fitted together. Refused where the mass is not
-    /// finite and positive, or the two did not play the same harmonics or
-    /// read the same sensors.
-    pub fn with_loaded(
-        self,
-        added_kg: f64,
-        loaded: Measured,
-    ) -> Result<Measured, crate::IdentifyError> {
-        let refuse = |why: String| crate::IdentifyError::Log {
-            place: "the loaded record".into(),
-            why,
-        };
-        if !(added_kg.is_finite() && added_kg > 0.0) {
-            return Err(refuse(format!(
-                "the mass on the handle, {added_kg} kg, must be finite and positive"
-            )));
-        }
-        if loaded.position.freq_hz != self.position.freq_hz {
-            return Err(refuse(
-                "it played other harmonics than the bare record: play the same experiment".into(),
-            ));
-        }
-        if loaded.load_cell.is_some() != self.load_cell.is_some() {
-            return Err(refuse(
-                "one record has a load cell and the other has not".into(),
-            ));
-        }
-        // The same forces, each shape from the loaded record's own motion.
-        let mut forces = Vec::new();
-        for f in &self.forces {
-            let own = match f.shape {
-                friction::Shape::Coulomb => loaded
-                    .forces
-                    .iter()
-                    .find(|g| g.shape == friction::Shape::Coulomb)
-                    .cloned(),
-                friction::Shape::CoggingSin { period_m } => loaded
-                    .motion
-                    .as_ref()
-                    .map(|m| cogging::shapes(m, period_m)[0].clone()),
-                friction::Shape::CoggingCos { period_m } => loaded
-                    .motion
-                    .as_ref()
-                    .map(|m| cogging::shapes(m, period_m)[1].clone()),
-            };
-            forces.push(own.ok_or_else(|| {
-                refuse(
-                    "it does not show the motion the bare record's friction and cogging need"
-                        .into(),
-                )
-            })?);
-        }
-        Ok(Measured {
-            loaded: Some(Box::new(Loaded {
-                added_kg,
-                data: Measured {
-                    loaded: None,
-                    forces,
-                    ..loaded
-                },
-            })),
-            ..self
-        })
-    }
-}
-
-/// Refuse a force that sits at its largest magnitude for two samples
-/// running or more: a multisine touches its peak once a period at most,
-/// so a run there is a limit cutting it.
-fn clipped(force_n: &[f64], period_s: f64) -> Result<(), crate::IdentifyError> {
-    let peak = force_n.iter().fold(0.0_f64, |a, f| a.max(f.abs()));
-    if peak == 0.0 {
-        return Ok(());
-    }
-    let at_peak = |f: &f64| f.abs() >= peak * (1.0 - 1e-12);
-    let first = force_n
-        .windows(2)
-        .position(|w| at_peak(&w[0]) && at_peak(&w[1]));
-    match first {
-        None => Ok(()),
-        Some(i) => Err(crate::IdentifyError::Clipped {
-            samples: force_n.iter().filter(|f| at_peak(f)).count(),
-            force_n: force_n[i],
-            at_s: i as f64 * period_s,
-        }),
-    }
-}
-
-/// The least step between the values a quantised signal took, if it
-/// took two.
-fn quantum(signal: &[f64]) -> Option<f64> {
-    let mut levels = signal.to_vec();
-    levels.sort_by(f64::total_cmp);
-    levels.dedup();
-    let q = levels
-        .windows(2)
-        .map(|w| w[1] - w[0])
-        .fold(f64::INFINITY, f64::min);
-    q.is_finite().then_some(q)
 }
 
 /// One order's fit.
@@ -448,57 +240,6 @@ fn rigid_estimate(data: &Frf, period_s: f64) -> Option<(f64, f64)> {
     (m > 0.0).then_some((m, d.max(1e-3 * m)))
 }
 
-/// Every peak of `ln(|H| ω²)`: its prominence over the deeper of the
-/// dips either side before a higher point, and its index.
-fn peaks(data: &Frf) -> (Vec<f64>, Vec<(f64, usize)>) {
-    let g: Vec<f64> = data
-        .response
-        .iter()
-        .zip(&data.freq_hz)
-        .map(|(h, f)| (h.norm() * f * f).ln())
-        .collect();
-    let n = g.len();
-    let peaks = (1..n.saturating_sub(1))
-        .filter(|&i| g[i] > g[i - 1] && g[i] >= g[i + 1])
-        .map(|i| {
-            let side = |range: &mut dyn Iterator<Item = usize>| {
-                let mut low = g[i];
-                for j in range {
-                    if g[j] > g[i] {
-                        break;
-                    }
-                    low = low.min(g[j]);
-                }
-                low
-            };
-            let left = side(&mut (0..i).rev());
-            let right = side(&mut (i + 1..n));
-            (g[i] - left.max(right), i)
-        })
-        .collect();
-    (g, peaks)
-}
-
-/// The `modes` most prominent resonances of `|H| ω²` (indices into the
-/// harmonics), in order, each with the deepest dip before it.
-fn features(data: &Frf, modes: usize) -> Option<(Vec<usize>, Vec<usize>)> {
-    let (g, mut peaks) = peaks(data);
-    peaks.sort_by(|a, b| b.0.total_cmp(&a.0));
-    if peaks.len() < modes {
-        return None;
-    }
-    let mut res: Vec<usize> = peaks[..modes].iter().map(|p| p.1).collect();
-    res.sort_unstable();
-    let mut anti = Vec::with_capacity(modes);
-    let mut from = 0;
-    for &r in &res {
-        let a = (from..r).min_by(|&a, &b| g[a].total_cmp(&g[b]))?;
-        anti.push(a);
-        from = r + 1;
-    }
-    Some((anti, res))
-}
-
 /// Fit a chain of `modes` modes, or `None` where the measurement shows
 /// fewer resonances or the search finds no model. A load cell, if
 /// measured, is the chain's last spring: a flexure in the band.
@@ -616,101 +357,6 @@ pub fn fit_modal(data: &Measured, base: &ModelBase, modes: usize) -> Option<Fit>
     )
 }
 
-/// A bare record's fit `bare` refitted to both records, bare and loaded:
-/// from its parameters, and in the modal form with a
-/// [bypass](Modal::bypass_npm) beside the load cell, which only the loaded
-/// record shows. The bypass starts from a few strengths, the handle's
-/// mass from the bare fit's and from what the load cell weighed (the fit
-/// is not convex in them), and the least misfit is kept.
-fn refit_loaded(bare: &Fit, data: &Measured, loaded: &Loaded) -> Option<Fit> {
-    let base = &bare.base;
-    let encoder_only;
-    let data = if bare.model.force_sensor {
-        data
-    } else {
-        encoder_only = Measured {
-            load_cell: None,
-            loaded: Some(Box::new(Loaded {
-                added_kg: loaded.added_kg,
-                data: Measured {
-                    load_cell: None,
-                    ..loaded.data.clone()
-                },
-            })),
-            ..data.clone()
-        };
-        &encoder_only
-    };
-    let m = match &bare.form {
-        Form::Chain(c) => {
-            let (masses, sign) = (c.masses_kg.len(), c.load_cell_sign);
-            return finish(
-                data,
-                base,
-                bare.params.clone(),
-                |p| Chain::from_log(masses, p, sign).model(base),
-                |p| Form::Chain(Chain::from_log(masses, p, sign)),
-            );
-        }
-        Form::Modal(m) => m,
-    };
-    let sign = m.load_cell_sign;
-    let from = |p: &DVector<f64>| Modal::from_params(p, sign, base.period_s, true);
-    // The lowest mode the bare fit found, or the top of the band.
-    let w = m
-        .modes
-        .iter()
-        .map(|m| m.omega_rad_s)
-        .fold(TAU * data.position.freq_hz.last().copied()?, f64::min);
-    // The load cell weighs the handle: at the lowest harmonics it reads
-    // `m_h` per unit of acceleration bare and `m_h + m` loaded, so the
-    // ratio of the two readings per motion gives `m_h` (the bypass hardly
-    // stretches there). The bare fit's is a start too.
-    let weighed = weighed_handle(data, loaded).filter(|h| (0.2..5.0).contains(&(h / m.handle_kg)));
-    // Every parameter from several starts: the misfit is not convex in
-    // the handle's mass and the bypass, and the modes move with them.
-    [Some(m.handle_kg), weighed]
-        .into_iter()
-        .flatten()
-        .flat_map(|h| [1e-3, 1e-2, 1e-1, 1.0].map(|share| (h, share * h * w * w)))
-        .filter_map(|(handle_kg, kb)| {
-            let start = Modal {
-                handle_kg,
-                bypass_npm: Some(kb),
-                ..m.clone()
-            };
-            finish(
-                data,
-                base,
-                start.to_params(),
-                |p| from(p).model(base),
-                |p| Form::Modal(from(p)),
-            )
-        })
-        .min_by(|a, b| a.chi2.total_cmp(&b.chi2))
-}
-
-/// The handle's mass past the load cell (kg) from the lowest harmonics of
-/// a bare and a loaded record: the load cell's reading per encoder motion
-/// is `m_h ω²` bare and `(m_h + m) ω²` loaded.
-fn weighed_handle(bare: &Measured, loaded: &Loaded) -> Option<f64> {
-    let per_motion = |d: &Measured| -> Option<Vec<Complex64>> {
-        let lc = d.load_cell.as_ref()?;
-        Some(
-            lc.response
-                .iter()
-                .zip(&d.position.response)
-                .take(5)
-                .map(|(f, x)| f / x)
-                .collect(),
-        )
-    };
-    let (b, l) = (per_motion(bare)?, per_motion(&loaded.data)?);
-    let ratio = b.iter().zip(&l).map(|(b, l)| (l / b).re).sum::<f64>() / b.len() as f64;
-    let m = loaded.added_kg / (ratio - 1.0);
-    (m.is_finite() && m > 0.0).then_some(m)
-}
-
 /// Levenberg-Marquardt from `p0` on every parameter, and the fit's
 /// statistics where it ends.
 fn finish(
@@ -809,36 +455,6 @@ pub fn fit_orders(data: &Measured, base: &ModelBase) -> (Vec<Fit>, Option<usize>
     fit_orders_linear(data, base)
 }
 
-/// Below where the device moves as one body (Hz): a quarter of the way to
-/// its lowest resonance, or of the band where it shows none.
-fn rigid_band_hz(x: &Frf) -> f64 {
-    lowest_resonance_hz(x)
-        .or(x.freq_hz.last().copied())
-        .unwrap_or(0.0)
-        / 4.0
-}
-
-/// The lowest resonance seen at the encoder (Hz): a peak of `|H| ω²` at
-/// least twice the lower of the least values either side within a factor
-/// of 1.5 in frequency. A rigid body's is flat, and friction, cogging and
-/// the band's ends bend it slowly, not in a peak.
-fn lowest_resonance_hz(x: &Frf) -> Option<f64> {
-    let (g, peaks) = peaks(x);
-    let f = &x.freq_hz;
-    let least = |range: std::ops::Range<usize>| range.map(|j| g[j]).fold(f64::INFINITY, f64::min);
-    peaks
-        .iter()
-        .map(|(_, i)| *i)
-        .filter(|&i| {
-            let lo = f.partition_point(|v| *v < f[i] / 1.5);
-            let hi = f.partition_point(|v| *v <= f[i] * 1.5);
-            let dip = least(lo..i).max(least(i + 1..hi));
-            g[i] - dip > std::f64::consts::LN_2
-        })
-        .map(|i| f[i])
-        .reduce(f64::min)
-}
-
 /// [`fit_orders`] on a record with no friction in it.
 fn fit_orders_linear(data: &Measured, base: &ModelBase) -> (Vec<Fit>, Option<usize>) {
     let Some(loaded) = &data.loaded else {
@@ -851,7 +467,7 @@ fn fit_orders_linear(data: &Measured, base: &ModelBase) -> (Vec<Fit>, Option<usi
         ..data.clone()
     };
     let (mut fits, best) = climb(&bare, base);
-    match best.and_then(|i| refit_loaded(&fits[i], data, loaded)) {
+    match best.and_then(|i| loaded::refit_loaded(&fits[i], data, loaded)) {
         Some(joint) => {
             fits.push(joint);
             let last = fits.len() - 1;
