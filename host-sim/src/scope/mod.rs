@@ -3,11 +3,17 @@
 //! of the signals it records (`signals`), and its link to a board of any
 //! number of axes (`board`); for a three-axis scene, the world's state
 //! (`world`) and view (`world_ui`); for a scene with an identification
-//! experiment, its fit (`identify`).
+//! experiment, its fit (`identify`) and panel (`identify_ui`); and the
+//! figures on log-log axes the design and identification panels draw
+//! (`log_plot`).
 
 pub mod app;
 pub mod board;
 pub mod identify;
+#[cfg(feature = "gui")]
+pub mod identify_ui;
+#[cfg(feature = "gui")]
+pub mod log_plot;
 pub mod rings;
 pub mod signals;
 #[cfg(feature = "gui")]
