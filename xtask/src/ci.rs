@@ -291,9 +291,19 @@ fn tests() -> Result<(), String> {
             "host_ve",
         ],
         &["test", "--release", "-p", "twoport-identify", "--lib"],
-        // The experiment on the flexible Excalibur, identified and
-        // designed for: release only, as the fits are.
-        &["test", "--release", "-p", "host-sim", "--test", "identify"],
+        // The experiment on the flexible Excalibur and on the linkages
+        // at a pose, identified and designed for: release only, as the
+        // fits are.
+        &[
+            "test",
+            "--release",
+            "-p",
+            "host-sim",
+            "--test",
+            "identify",
+            "--test",
+            "identify_linkage",
+        ],
         &[
             "test",
             "--release",

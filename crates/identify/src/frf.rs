@@ -51,7 +51,7 @@ impl Frf {
 /// first `skip`. One FFT a period (rustfft, any length): a 30 s record at
 /// 1 kHz with 450 harmonics is then milliseconds, where a DFT a harmonic
 /// was seconds.
-fn spectra(
+pub(crate) fn spectra(
     x: &[f64],
     period: usize,
     harmonics: &[usize],

@@ -8,5 +8,6 @@ pub mod figures;
 pub mod fit;
 pub mod frf;
 pub mod log;
+pub mod pose;
 
 pub use error::IdentifyError;

@@ -8,7 +8,9 @@
 //! in 1e-12 rad) and arms it; then, under gravity the board holds up, a
 //! hand that grasps with 2 N s/m (the
 //! images' least grasp) and a 300 N/m spring presses the handle 15 mm
-//! down, through the board's floor 5 mm under the rest pose.
+//! down, through the board's floor 5 mm under the rest pose
+//! ([`Plan::Press`]); or, hands off, the board plays an identification
+//! experiment from the rest pose ([`Plan::Identify`]).
 
 use super::{boot_and_save, zero_after_loss, Run};
 use crate::engine::linkage::{CartesianHand, LinkagePlant};
@@ -58,6 +60,23 @@ impl Device {
 /// stiffness (N/m) and the grasp's damping (N s/m).
 pub const HAND: (f64, f64, f64) = (0.015, 300.0, 2.0);
 
+/// What the run does once the board is armed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Plan {
+    /// The hand ([`HAND`]) presses the handle down through the floor.
+    Press,
+    /// Hands off, the board plays `experiment` from `start_ticks` after
+    /// arming.
+    Identify {
+        /// The experiment, in the link's terms.
+        experiment: twoport_link::Experiment,
+        /// Ticks between arming and the experiment's start.
+        start_ticks: u64,
+        /// Whether the joints' Coulomb friction acts.
+        friction: bool,
+    },
+}
+
 /// Gravity on the arm (m/s², along `-z`).
 pub const GRAVITY_MPS2: f64 = 9.81;
 
@@ -75,7 +94,7 @@ struct Arm {
 }
 
 impl Arm {
-    fn new(device: Device) -> Result<Arm, Error> {
+    fn new(device: Device, plan: Plan) -> Result<Arm, Error> {
         let file = device.file()?;
         let spec = device.spec();
         let rest = spec.rest_rad.map(f64::from);
@@ -86,10 +105,16 @@ impl Arm {
         let (down, k, b) = HAND;
         let mut anchor = x.clone();
         anchor[2] -= down;
-        let hand = CartesianHand {
-            anchor_m: anchor,
-            k_npm: DMatrix::identity(3, 3) * k,
-            b_nspm: DMatrix::identity(3, 3) * b,
+        let hand = match plan {
+            Plan::Press => CartesianHand {
+                anchor_m: anchor,
+                k_npm: DMatrix::identity(3, 3) * k,
+                b_nspm: DMatrix::identity(3, 3) * b,
+            },
+            Plan::Identify { friction, .. } => {
+                plant.friction = friction;
+                CartesianHand::off(3)
+            }
         };
         Ok(Arm {
             plant,
@@ -164,14 +189,26 @@ fn record<P: BoardPort>(
     Ok(())
 }
 
-/// Run `device`'s image at `port` for `ticks`.
+/// Run `device`'s image at `port` for `ticks`, the hand pressing
+/// ([`Plan::Press`]).
 pub fn run<P: BoardPort>(
     device: Device,
     ticks: u64,
     port: P,
     faults: LinkFaults,
 ) -> Result<Run<3>, Error> {
-    let mut arm = Arm::new(device)?;
+    run_plan(device, ticks, port, faults, Plan::Press)
+}
+
+/// Run `device`'s image at `port` for `ticks` under `plan`.
+pub fn run_plan<P: BoardPort>(
+    device: Device,
+    ticks: u64,
+    port: P,
+    faults: LinkFaults,
+    plan: Plan,
+) -> Result<Run<3>, Error> {
+    let mut arm = Arm::new(device, plan)?;
     let mut session = Session::open_axes(port, faults, 3)?;
     let spec = session.spec()?;
     if !spec.linkage {
@@ -190,6 +227,19 @@ pub fn run<P: BoardPort>(
     session.calibrate(Axes::new(pico).unwrap_or_default())?;
     session.arm()?;
     r.armed_at_tick = r.samples.len() as u64;
+    if let Plan::Identify {
+        experiment,
+        start_ticks,
+        ..
+    } = plan
+    {
+        let at = r.armed_at_tick + start_ticks;
+        while (r.samples.len() as u64) < at.min(ticks) {
+            record(&mut session, &mut arm, &mut r)?;
+        }
+        session.identify(experiment)?;
+        r.experiment = Some((experiment, r.samples.len() as u64));
+    }
     while (r.samples.len() as u64) < ticks {
         record(&mut session, &mut arm, &mut r)?;
     }

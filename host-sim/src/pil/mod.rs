@@ -91,7 +91,23 @@ impl<const N: usize> Run<N> {
         with_load_cell: bool,
     ) -> Option<Result<twoport_identify::log::Log, Error>> {
         let (x, _) = self.experiment?;
-        let axis = usize::from(x.axis);
+        Some(self.axis_log(&x, usize::from(x.axis), with_load_cell))
+    }
+
+    /// The experiment's record on every axis, the excited one's and the
+    /// others' (their force is the hold's alone): what a fit of the
+    /// coupling between axes needs.
+    pub fn experiment_axes(&self) -> Option<Result<Vec<twoport_identify::log::Log>, Error>> {
+        let (x, _) = self.experiment?;
+        Some((0..N).map(|a| self.axis_log(&x, a, false)).collect())
+    }
+
+    fn axis_log(
+        &self,
+        x: &twoport_link::Experiment,
+        axis: usize,
+        with_load_cell: bool,
+    ) -> Result<twoport_identify::log::Log, Error> {
         let frames: Vec<&Telemetry> = self
             .telemetry
             .iter()
@@ -101,11 +117,11 @@ impl<const N: usize> Run<N> {
             .windows(2)
             .find(|w| w[1].tick != w[0].tick.wrapping_add(1))
         {
-            return Some(Err(pil_err!(
+            return Err(pil_err!(
                 "the experiment's telemetry jumps from tick {} to {}: its record has a gap",
                 w[0].tick,
                 w[1].tick
-            )));
+            ));
         }
         let get = |f: &dyn Fn(&twoport_link::AxisTelemetry) -> f64| -> Vec<f64> {
             frames
@@ -113,7 +129,7 @@ impl<const N: usize> Run<N> {
                 .map(|t| t.axes.get(axis).map_or(f64::NAN, f))
                 .collect()
         };
-        Some(Ok(twoport_identify::log::Log {
+        Ok(twoport_identify::log::Log {
             // (A PIL scene ticks at the board's 1 kHz.)
             period_s: 1e-3,
             force_n: get(&|a| -f64::from(a.actuator_n)),
@@ -124,7 +140,7 @@ impl<const N: usize> Run<N> {
                 first: x.first as usize,
                 last: x.last as usize,
             }),
-        }))
+        })
     }
 }
 

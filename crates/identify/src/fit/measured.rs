@@ -187,7 +187,7 @@ impl Measured {
 /// Refuse a force that sits at its largest magnitude for two samples
 /// running or more: a multisine touches its peak once a period at most,
 /// so a run there is a limit cutting it.
-fn clipped(force_n: &[f64], period_s: f64) -> Result<(), crate::IdentifyError> {
+pub(crate) fn clipped(force_n: &[f64], period_s: f64) -> Result<(), crate::IdentifyError> {
     let peak = force_n.iter().fold(0.0_f64, |a, f| a.max(f.abs()));
     if peak == 0.0 {
         return Ok(());
@@ -208,7 +208,7 @@ fn clipped(force_n: &[f64], period_s: f64) -> Result<(), crate::IdentifyError> {
 
 /// The least step between the values a quantised signal took, if it
 /// took two.
-fn quantum(signal: &[f64]) -> Option<f64> {
+pub(crate) fn quantum(signal: &[f64]) -> Option<f64> {
     let mut levels = signal.to_vec();
     levels.sort_by(f64::total_cmp);
     levels.dedup();

@@ -37,7 +37,7 @@ pub mod friction;
 pub mod ladder;
 pub mod lm;
 mod loaded;
-mod measured;
+pub(crate) mod measured;
 pub mod modal;
 pub mod start;
 pub mod uncertainty;

@@ -1,0 +1,32 @@
+//! A linkage at one pose: the mass and damping matrices the hand feels
+//! there, `M_x` and `D_x` (kg, N s/m, Cartesian), from one experiment per
+//! axis.
+//!
+//! At a pose, for small motions, a rigid linkage is `M_x x'' + D_x x' = f`
+//! at the handle, `f` the motors' force `J^-T τ` as the board commands it.
+//! Its axes are coupled: a push along `x` moves the handle along `y` and
+//! `z` too. One experiment excites one axis while the board's hold pushes
+//! back on every axis, so the force is a vector in every experiment. With
+//! one experiment per axis, at each harmonic the averaged positions and
+//! forces stack into square matrices, `X = H F`, and `H = X F^-1` is the
+//! response matrix, measured in closed loop against the forces the
+//! motors were asked for ([`PoseMeasured`]).
+//!
+//! The fit ([`fit`]) is the symmetric `M_x` and `D_x` whose exact
+//! sampled response (zero-order hold, [`response::sampled`]) matches `H`
+//! at every harmonic, each entry weighted by its measured variance. The
+//! parameters' covariance bounds it, and [`PoseFit::span`] gives the
+//! models at the edges of that bound: the poses a robust design proves.
+//!
+//! What the fit leaves out: the joints' Coulomb friction (a nonlinear
+//! force the linear model sees as damping at low harmonics), the
+//! Coriolis terms (second order in the speed) and how `M_x` changes over
+//! the few millimetres the handle moves. Each shows in the misfit, which
+//! widens the bound.
+
+pub mod fit;
+mod measured;
+pub mod response;
+
+pub use fit::PoseFit;
+pub use measured::PoseMeasured;
