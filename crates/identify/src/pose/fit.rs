@@ -87,7 +87,8 @@ fn start(data: &PoseMeasured, n: usize) -> Option<DVector<f64>> {
 
 /// Fit `M_x` and `D_x` to `data`: the linear start, then
 /// Levenberg-Marquardt on the exact sampled response, each entry of each
-/// harmonic weighted by its standard deviation (with [`FLOOR`]). `None`
+/// harmonic weighted by its standard deviation (with a floor of 0.2%
+/// of the harmonic's response). `None`
 /// where no positive definite mass fits.
 pub fn fit(data: &PoseMeasured) -> Option<PoseFit> {
     let n = data.response.first()?.nrows();
