@@ -73,4 +73,16 @@ pub enum IdentifyError {
         /// Where the first run of them starts (s).
         at_s: f64,
     },
+    /// The pose's records are not what a linear body gives: its fit
+    /// leaves residuals far past their noise.
+    #[error("the records are not what a linear body at one pose gives: the fit leaves {misfit:.1} times their noise (at most {most} is taken); friction that sticks, or a push that moves the handle far enough to change the pose, does this: push harder against friction, softer against the pose, or hold the handle stiffer")]
+    NotLinear {
+        /// `χ²/ν` of the fit.
+        misfit: f64,
+        /// The most taken.
+        most: f64,
+    },
+    /// No body with a positive definite mass fits the records.
+    #[error("no body with a positive mass in every direction fits the records")]
+    NoBody,
 }

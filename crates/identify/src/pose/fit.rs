@@ -85,12 +85,31 @@ fn start(data: &PoseMeasured, n: usize) -> Option<DVector<f64>> {
     a.svd(true, true).solve(&b, 1e-12).ok()
 }
 
+/// The most `χ²/ν` a pose fit is taken at. The records of a linear body
+/// at one pose give about 1 (0.5 to 1.3 on the simulated PHANToM and
+/// delta); with the joints' friction sticking under a small push, 18 to
+/// 100 and models far from the truth, whose damping is the friction's.
+pub const MOST_MISFIT: f64 = 4.0;
+
 /// Fit `M_x` and `D_x` to `data`: the linear start, then
 /// Levenberg-Marquardt on the exact sampled response, each entry of each
 /// harmonic weighted by its standard deviation (with a floor of 0.2%
-/// of the harmonic's response). `None`
-/// where no positive definite mass fits.
-pub fn fit(data: &PoseMeasured) -> Option<PoseFit> {
+/// of the harmonic's response). Refused where no positive definite mass
+/// fits, or the fit leaves more than [`MOST_MISFIT`] times the noise:
+/// then the records are not a linear body's, and a model of one, its
+/// damping above all, would claim what the device does not have.
+pub fn fit(data: &PoseMeasured) -> Result<PoseFit, crate::IdentifyError> {
+    let f = fit_any(data).ok_or(crate::IdentifyError::NoBody)?;
+    if f.misfit > MOST_MISFIT {
+        return Err(crate::IdentifyError::NotLinear {
+            misfit: f.misfit,
+            most: MOST_MISFIT,
+        });
+    }
+    Ok(f)
+}
+
+fn fit_any(data: &PoseMeasured) -> Option<PoseFit> {
     let n = data.response.first()?.nrows();
     let sigma: Vec<DMatrix<f64>> = data
         .variance
@@ -229,5 +248,15 @@ mod tests {
         assert!(f.misfit < 2.0, "{}", f.misfit);
         let set = f.span(3.0);
         assert_eq!(set.len(), 1 + 2 * 12);
+        // Every other harmonic 5% off: no body fits to the noise, and
+        // none is given.
+        let mut bent = data.clone();
+        for h in bent.response.iter_mut().step_by(2) {
+            *h *= Complex64::new(1.05, 0.0);
+        }
+        match fit(&bent) {
+            Err(crate::IdentifyError::NotLinear { misfit, .. }) => assert!(misfit > MOST_MISFIT),
+            other => panic!("{other:?}"),
+        }
     }
 }
