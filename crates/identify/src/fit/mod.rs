@@ -526,4 +526,4 @@ fn climb(data: &Measured, base: &ModelBase) -> (Vec<Fit>, Option<usize>) {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -17,7 +17,7 @@ fn base(m: &DeviceModel) -> ModelBase {
     }
 }
 
-fn rng(seed: &mut u64) -> f64 {
+pub(crate) fn rng(seed: &mut u64) -> f64 {
     *seed ^= *seed << 13;
     *seed ^= *seed >> 7;
     *seed ^= *seed << 17;

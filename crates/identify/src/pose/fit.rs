@@ -208,18 +208,11 @@ mod tests {
     /// norm), from a start the linear fit gives.
     #[test]
     fn recovers_a_coupled_body() {
-        let m =
-            DMatrix::from_row_slice(3, 3, &[0.3, 0.05, -0.02, 0.05, 0.2, 0.01, -0.02, 0.01, 0.1]);
-        let d = DMatrix::from_row_slice(3, 3, &[2.0, 0.3, 0.0, 0.3, 0.5, -0.1, 0.0, -0.1, 0.2]);
+        let (m, d) = crate::pose::response::tests::coupled_body();
         let freq_hz: Vec<f64> = (1..=450).map(f64::from).collect();
         let exact = sampled(&m, &d, 1e-3, &freq_hz).unwrap();
         let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rnd = move || crate::fit::tests::rng(&mut seed);
         let response: Vec<DMatrix<Complex64>> = exact
             .iter()
             .map(|h| {

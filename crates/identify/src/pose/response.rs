@@ -78,8 +78,17 @@ pub fn sampled(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// A three-axis body whose axes are coupled in both its mass (kg)
+    /// and its damping (N s/m), one direction lightly damped.
+    pub(crate) fn coupled_body() -> (DMatrix<f64>, DMatrix<f64>) {
+        let m =
+            DMatrix::from_row_slice(3, 3, &[0.3, 0.05, -0.02, 0.05, 0.2, 0.01, -0.02, 0.01, 0.1]);
+        let d = DMatrix::from_row_slice(3, 3, &[2.0, 0.3, 0.0, 0.3, 0.5, -0.1, 0.0, -0.1, 0.2]);
+        (m, d)
+    }
 
     /// Against the state-space hold-equivalent computed independently
     /// (the matrix exponential of the augmented system, `C (zI - A_d)^-1
@@ -87,10 +96,7 @@ mod tests {
     /// damping, to 1e-9 relative.
     #[test]
     fn matches_the_state_space_hold_equivalent() {
-        let m =
-            DMatrix::from_row_slice(3, 3, &[0.3, 0.05, -0.02, 0.05, 0.2, 0.01, -0.02, 0.01, 0.1]);
-        let d_some =
-            DMatrix::from_row_slice(3, 3, &[2.0, 0.3, 0.0, 0.3, 0.5, -0.1, 0.0, -0.1, 0.01]);
+        let (m, d_some) = coupled_body();
         let t = 1e-3;
         for d in [d_some, DMatrix::zeros(3, 3)] {
             // States [x; v; f]: the force held by a zero eigenvalue block.
