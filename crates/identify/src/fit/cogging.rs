@@ -73,29 +73,16 @@ impl Motion {
 
 /// Cogging's two shapes at a period of `period_m`, per unit force.
 pub fn shapes(motion: &Motion, period_m: f64) -> [Regressor; 2] {
-    let period = motion.at.first().map_or(0, Vec::len);
-    let k = TAU / period_m;
-    let mean = |f: fn(f64) -> f64| -> Vec<f64> {
-        (0..period)
-            .map(|n| motion.at.iter().map(|at| f(k * at[n])).sum::<f64>() / SUB as f64)
-            .collect()
-    };
-    let per_force = |signal: Vec<f64>| {
-        crate::frf::mean_spectrum(&signal, period, &motion.harmonics, 0)
-            .iter()
-            .zip(&motion.force)
-            .map(|(s, f)| s / f)
-            .collect()
-    };
+    let (sin, cos) = Sweep::new(motion, 1.0 / period_m, 0.0).next();
     [
         Regressor {
             shape: Shape::CoggingSin { period_m },
-            per_force: per_force(mean(f64::sin)),
+            per_force: sin,
             taken_n: 0.0,
         },
         Regressor {
             shape: Shape::CoggingCos { period_m },
-            per_force: per_force(mean(f64::cos)),
+            per_force: cos,
             taken_n: 0.0,
         },
     ]
