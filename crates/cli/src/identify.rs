@@ -6,11 +6,9 @@
 
 use crate::args::{IdentifyArgs, PlotFormat};
 use serde_json::json;
-use std::f64::consts::TAU;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 use twoport_design::plot;
-use twoport_design::{DeviceModel, Plant};
 use twoport_identify::fit::{self, chain::ModelBase, uncertainty, Fit, Form, Measured};
 use twoport_identify::log::Log;
 
@@ -331,19 +329,6 @@ fn provenance(source: &str, f: &Fit) -> String {
     )
 }
 
-/// The lightly damped modes below Nyquist: (Hz, damping ratio).
-fn resonances(m: &DeviceModel) -> Vec<(f64, f64)> {
-    Plant::new(m, m.period_s)
-        .map(|p| {
-            p.modes()
-                .iter()
-                .filter(|x| x.omega_n < std::f64::consts::PI / m.period_s)
-                .map(|x| (x.omega_n / TAU, x.zeta))
-                .collect()
-        })
-        .unwrap_or_default()
-}
-
 /// One axis's report: its JSON and its text.
 #[allow(clippy::too_many_arguments)]
 fn report(
@@ -363,7 +348,7 @@ fn report(
         .iter()
         .enumerate()
         .fold((0, 1.0_f64), |b, (i, c)| if *c < b.1 { (i, *c) } else { b });
-    let res = resonances(&f.model);
+    let res = f.resonances();
     let directions = set
         .iter()
         .filter_map(|m| m.direction)

@@ -6,9 +6,7 @@
 use crate::engine::scene::Scene;
 use crate::link::{LinkFaults, LocalBoard};
 use crate::pil;
-use std::f64::consts::TAU;
 use twoport_design::plot::Figure;
-use twoport_design::Plant;
 use twoport_identify::fit::{self, chain::ModelBase, Form, Measured};
 
 /// What the experiment showed: a line on the fit, and its figures.
@@ -62,16 +60,11 @@ pub fn identify(scene: &Scene) -> Result<Identification, String> {
         f.form.modes(),
         f.reduced_chi2()
     );
-    let res: Vec<String> = Plant::new(&f.model, f.model.period_s)
-        .map(|p| {
-            p.modes()
-                .iter()
-                .map(|m| m.omega_n / TAU)
-                .filter(|hz| *hz < 0.5 / f.model.period_s)
-                .map(|hz| format!("{hz:.1}"))
-                .collect()
-        })
-        .unwrap_or_default();
+    let res: Vec<String> = f
+        .resonances()
+        .iter()
+        .map(|(hz, _)| format!("{hz:.1}"))
+        .collect();
     if !res.is_empty() {
         summary += &format!("; resonances {} Hz", res.join(", "));
     }

@@ -149,6 +149,21 @@ impl Fit {
     pub fn reduced_chi2(&self) -> f64 {
         self.chi2 / self.dof()
     }
+
+    /// The fitted model's resonances below Nyquist, lowest first: each
+    /// one's frequency (Hz) and damping ratio.
+    pub fn resonances(&self) -> Vec<(f64, f64)> {
+        let m = &self.model;
+        Plant::new(m, m.period_s)
+            .map(|p| {
+                p.modes()
+                    .iter()
+                    .map(|x| (x.omega_n / TAU, x.zeta))
+                    .filter(|(hz, _)| *hz < 0.5 / m.period_s)
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
 }
 
 /// Relative floor on each harmonic's standard deviation.
