@@ -90,17 +90,18 @@ pub fn mean_spectrum(
         .collect()
 }
 
-/// The response from `force_n` to `position_m`, sampled every `period_s`,
-/// at `harmonics` of a period of `period` samples, over the whole periods
-/// after the first `skip`.
-pub fn periodic(
+/// The whole periods after the first `skip` that a record of `force_n`
+/// and `position_m` gives at `harmonics` of a period of `period`
+/// samples, or why it gives none: signals of different lengths, a sample
+/// that is not a number, a harmonic at 0 or past Nyquist, fewer than two
+/// periods.
+pub(crate) fn whole_periods(
     force_n: &[f64],
     position_m: &[f64],
-    period_s: f64,
     period: usize,
     harmonics: &[usize],
     skip: usize,
-) -> Result<Frf, IdentifyError> {
+) -> Result<usize, IdentifyError> {
     if position_m.len() != force_n.len() {
         return Err(IdentifyError::Length {
             what: "position",
@@ -133,6 +134,21 @@ pub fn periodic(
             period,
         });
     }
+    Ok(periods)
+}
+
+/// The response from `force_n` to `position_m`, sampled every `period_s`,
+/// at `harmonics` of a period of `period` samples, over the whole periods
+/// after the first `skip`.
+pub fn periodic(
+    force_n: &[f64],
+    position_m: &[f64],
+    period_s: f64,
+    period: usize,
+    harmonics: &[usize],
+    skip: usize,
+) -> Result<Frf, IdentifyError> {
+    let periods = whole_periods(force_n, position_m, period, harmonics, skip)?;
     let hz = |h: usize| h as f64 / (period as f64 * period_s);
     let mut out = Frf {
         freq_hz: Vec::with_capacity(harmonics.len()),

@@ -1,6 +1,6 @@
 //! The response matrix at a pose, from one experiment per axis.
 
-use crate::frf::spectra;
+use crate::frf::{spectra, whole_periods};
 use crate::log::Log;
 use crate::IdentifyError;
 use nalgebra::DMatrix;
@@ -49,6 +49,17 @@ impl PoseMeasured {
                 "it does not name its excitation (the `# twoport experiment:` line)".into(),
             )
         })?;
+        let period = e.period_ticks;
+        let max = period.saturating_sub(1) / 2;
+        if e.first > e.last {
+            return Err(IdentifyError::Harmonic {
+                harmonic: e.last,
+                period,
+                max,
+            });
+        }
+        let harmonics: Vec<usize> = (e.first..=e.last).collect();
+        let mut periods = 0;
         for (j, axes) in experiments.iter().enumerate() {
             if axes.len() != n {
                 return Err(bad(
@@ -80,38 +91,19 @@ impl PoseMeasured {
                         ),
                     ));
                 }
-                for (what, x) in [("force", &log.force_n), ("position", &log.position_m)] {
-                    if let Some((at, v)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-                        return Err(bad(
-                            place,
-                            format!("{what}[{at}] = {v}: not a finite number"),
-                        ));
-                    }
-                }
+                // (The lengths are checked above; a sample that is not a
+                // number is named with its place, the rest as they are.)
+                periods = whole_periods(&log.force_n, &log.position_m, period, &harmonics, skip)
+                    .map_err(|err| match err {
+                        IdentifyError::NotFinite { .. } => bad(place.clone(), err.to_string()),
+                        other => other,
+                    })?;
                 if i == j {
                     crate::fit::measured::clipped(&log.force_n, log.period_s)
                         .map_err(|err| bad(place, err.to_string()))?;
                 }
             }
         }
-        let period = e.period_ticks;
-        let max = period.saturating_sub(1) / 2;
-        if e.first == 0 || e.last > max || e.first > e.last {
-            return Err(IdentifyError::Harmonic {
-                harmonic: if e.first == 0 { 0 } else { e.last },
-                period,
-                max,
-            });
-        }
-        let periods = (first.force_n.len() / period.max(1)).saturating_sub(skip);
-        if periods < 2 {
-            return Err(IdentifyError::TooShort {
-                periods,
-                skipped: skip,
-                period,
-            });
-        }
-        let harmonics: Vec<usize> = (e.first..=e.last).collect();
         let spec = |x: &[f64]| spectra(x, period, &harmonics, skip, periods);
         // The harmonics the multisine leaves out, past its band: what the
         // position shows there is noise that repeats period after period
