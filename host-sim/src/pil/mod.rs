@@ -91,7 +91,10 @@ impl<const N: usize> Run<N> {
         with_load_cell: bool,
     ) -> Option<Result<twoport_identify::log::Log, Error>> {
         let (x, _) = self.experiment?;
-        Some(self.axis_log(&x, usize::from(x.axis), with_load_cell))
+        Some(
+            self.experiment_frames()
+                .map(|frames| axis_log(&x, &frames, usize::from(x.axis), with_load_cell)),
+        )
     }
 
     /// The experiment's record on every axis, the excited one's and the
@@ -99,15 +102,15 @@ impl<const N: usize> Run<N> {
     /// coupling between axes needs.
     pub fn experiment_axes(&self) -> Option<Result<Vec<twoport_identify::log::Log>, Error>> {
         let (x, _) = self.experiment?;
-        Some((0..N).map(|a| self.axis_log(&x, a, false)).collect())
+        Some(
+            self.experiment_frames()
+                .map(|frames| (0..N).map(|a| axis_log(&x, &frames, a, false)).collect()),
+        )
     }
 
-    fn axis_log(
-        &self,
-        x: &twoport_link::Experiment,
-        axis: usize,
-        with_load_cell: bool,
-    ) -> Result<twoport_identify::log::Log, Error> {
+    /// The telemetry of every tick the experiment played, or the gap in
+    /// it.
+    fn experiment_frames(&self) -> Result<Vec<&Telemetry>, Error> {
         let frames: Vec<&Telemetry> = self
             .telemetry
             .iter()
@@ -123,24 +126,34 @@ impl<const N: usize> Run<N> {
                 w[1].tick
             ));
         }
-        let get = |f: &dyn Fn(&twoport_link::AxisTelemetry) -> f64| -> Vec<f64> {
-            frames
-                .iter()
-                .map(|t| t.axes.get(axis).map_or(f64::NAN, f))
-                .collect()
-        };
-        Ok(twoport_identify::log::Log {
-            // (A PIL scene ticks at the board's 1 kHz.)
-            period_s: 1e-3,
-            force_n: get(&|a| -f64::from(a.actuator_n)),
-            position_m: get(&|a| a.position_pm as f64 * 1e-12),
-            load_cell_n: with_load_cell.then(|| get(&|a| f64::from(a.load_cell_n))),
-            excitation: Some(twoport_identify::log::Excitation {
-                period_ticks: x.period_ticks as usize,
-                first: x.first as usize,
-                last: x.last as usize,
-            }),
-        })
+        Ok(frames)
+    }
+}
+
+/// One axis's record of experiment `x` from its `frames`.
+fn axis_log(
+    x: &twoport_link::Experiment,
+    frames: &[&Telemetry],
+    axis: usize,
+    with_load_cell: bool,
+) -> twoport_identify::log::Log {
+    let get = |f: &dyn Fn(&twoport_link::AxisTelemetry) -> f64| -> Vec<f64> {
+        frames
+            .iter()
+            .map(|t| t.axes.get(axis).map_or(f64::NAN, f))
+            .collect()
+    };
+    twoport_identify::log::Log {
+        // (A PIL scene ticks at the board's 1 kHz.)
+        period_s: 1e-3,
+        force_n: get(&|a| -f64::from(a.actuator_n)),
+        position_m: get(&|a| a.position_pm as f64 * 1e-12),
+        load_cell_n: with_load_cell.then(|| get(&|a| f64::from(a.load_cell_n))),
+        excitation: Some(twoport_identify::log::Excitation {
+            period_ticks: x.period_ticks as usize,
+            first: x.first as usize,
+            last: x.last as usize,
+        }),
     }
 }
 
