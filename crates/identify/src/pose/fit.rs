@@ -18,8 +18,8 @@ const FLOOR: f64 = 2e-3;
 /// damping at a pose is biased past its noise: on the simulated PHANToM
 /// the least damping came out 0.0044 to 0.015 N s/m where the joints give
 /// 0.0038 (the encoders' quantum and the pose moving under the push), and
-/// the joints' friction, which no pose fit here separates, is larger
-/// still. The damping the proof credits bounds the stiffness nearly in
+/// the joints' friction, which this fit does not separate (the joints'
+/// losses, [`losses`](super::losses), do), is larger still. The damping the proof credits bounds the stiffness nearly in
 /// proportion, so a robust design at a pose credits none: the grasp's
 /// least damping, which the dead-man switch assures, carries it.
 pub const POSE_DOUBT: Doubt = Doubt {
@@ -98,6 +98,21 @@ fn start(data: &PoseMeasured, n: usize) -> Option<DVector<f64>> {
     let a = DMatrix::from_fn(rows.len(), np, |r, c| rows[r][c]);
     let b = DVector::from_vec(rhs);
     a.svd(true, true).solve(&b, 1e-12).ok()
+}
+
+/// `M_x` alone, from the linear start: for records whose damping is not
+/// a linear body's (the joints' friction, whose describing function at
+/// a sine is damping, in quadrature with the mass), such as the sines
+/// [`losses`](super::losses) takes the damping from. Refused where it is
+/// not positive definite.
+pub fn mass(data: &PoseMeasured) -> Result<DMatrix<f64>, crate::IdentifyError> {
+    let n = data.response.first().map_or(0, |h| h.nrows());
+    let p = start(data, n).ok_or(crate::IdentifyError::NoBody)?;
+    let (m, _) = matrices(n, &p);
+    m.clone()
+        .cholesky()
+        .map(|_| m)
+        .ok_or(crate::IdentifyError::NoBody)
 }
 
 /// The most `χ²/ν` a pose fit is taken at. The records of a linear body

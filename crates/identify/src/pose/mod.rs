@@ -22,11 +22,19 @@
 //! force the linear model sees as damping at low harmonics), the
 //! Coriolis terms (second order in the speed) and how `M_x` changes over
 //! the few millimetres the handle moves. Each shows in the misfit, which
-//! widens the bound.
+//! widens the bound; past [`fit::MOST_MISFIT`] the records are refused.
+//!
+//! Where the joints stick, [`losses`] takes the damping from sines played
+//! at several levels: the energy each period dissipates gives every
+//! joint's viscous damping and Coulomb friction, and
+//! [`JointLosses::damping_nspm`] the damping at the handle; [`fit::mass`]
+//! gives `M_x` from the same sines.
 
 pub mod fit;
+pub mod losses;
 mod measured;
 pub mod response;
 
 pub use fit::PoseFit;
+pub use losses::JointLosses;
 pub use measured::PoseMeasured;

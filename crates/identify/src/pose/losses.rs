@@ -1,0 +1,431 @@
+//! A linkage's joint losses, viscous and Coulomb, from the energy its
+//! periodic motions dissipate.
+//!
+//! Over one period of a periodic motion the inertial, Coriolis and
+//! gravity forces and the hold's spring do no net work: whatever the
+//! motors put in, `∮ f · dx`, the joints dissipate. A joint with viscous
+//! damping `b` and Coulomb friction `c` dissipates `b q'² + c |q'|` on
+//! average, so each experiment gives one equation, linear in every
+//! joint's `b` and `c`:
+//!
+//! `P = Σ_j b_j <q_j'²> + c_j <|q_j'|>`
+//!
+//! exact for any periodic orbit, whatever the mass matrix does over it.
+//! Friction's share falls with the speed and damping's grows with it, so
+//! the same sine played at several levels tells the two apart. The force
+//! is the one the board commanded, held for a tick (zero-order hold), so
+//! a tick's work is `f_n · (x_{n+1} - x_n)` exactly.
+
+use crate::frf::{mean_spectrum, whole_periods};
+use crate::log::Log;
+use crate::IdentifyError;
+use nalgebra::{DMatrix, DVector};
+
+/// How many harmonics of the excitation's highest one give the joints'
+/// rates: the sine's harmonics that friction's corners add, and not the
+/// quantisation's steps past them (which averaging does not remove: a
+/// periodic motion crosses the same steps each period).
+pub const RATE_HARMONICS: usize = 8;
+
+/// A singular value of the (column-scaled) equations below this share of
+/// the largest is a combination of the losses the experiments do not
+/// resolve: the least-norm solution is taken along it, and its standard
+/// deviation is the one this threshold gives.
+const RESOLVED: f64 = 1e-2;
+
+/// What one experiment dissipated and how fast each joint moved.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dissipation {
+    /// The mean power the motors put in (W).
+    pub power_w: f64,
+    /// Its standard deviation from the periods' spread (W).
+    pub power_sd_w: f64,
+    /// Each joint's mean squared rate, `<q'²>` (rad²/s²).
+    pub rate_sq: Vec<f64>,
+    /// Each joint's mean absolute rate, `<|q'|>` (rad/s).
+    pub rate_abs: Vec<f64>,
+}
+
+/// The joints' losses fitted to every experiment's [`Dissipation`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointLosses {
+    /// Each joint's viscous damping (N m s/rad).
+    pub damping_nmsprad: Vec<f64>,
+    /// Each joint's Coulomb friction (N m).
+    pub friction_nm: Vec<f64>,
+    /// Their standard deviations, damping then friction, from the
+    /// residuals (a combination the experiments do not resolve gets a
+    /// large one).
+    pub sd: Vec<f64>,
+    /// The residuals' rms as a share of each experiment's power.
+    pub misfit: f64,
+    /// How many combinations of the losses the experiments do not
+    /// resolve (joints that every experiment moves alike).
+    pub unresolved: usize,
+    /// Each experiment's measurement.
+    pub experiments: Vec<Dissipation>,
+}
+
+fn bad(place: String, why: String) -> IdentifyError {
+    IdentifyError::Log { place, why }
+}
+
+/// Experiment `place`'s dissipation: `axes` every axis's record (force the
+/// board commanded, N; position, m), `jacobian_inv` the pose's `J^-1`
+/// (joint rates from handle velocities), averaged over whole periods
+/// after the first `skip`.
+pub fn dissipation(
+    axes: &[Log],
+    jacobian_inv: &DMatrix<f64>,
+    skip: usize,
+    place: &str,
+) -> Result<Dissipation, IdentifyError> {
+    let n = jacobian_inv.ncols();
+    if axes.len() != n {
+        return Err(bad(
+            place.into(),
+            format!("{} axes recorded, but the pose has {n}", axes.len()),
+        ));
+    }
+    let e = axes[0].excitation.ok_or_else(|| {
+        bad(
+            format!("{place}, axis 0"),
+            "it does not name its excitation (the `# twoport experiment:` line)".into(),
+        )
+    })?;
+    let period = e.period_ticks;
+    let max = period.saturating_sub(1) / 2;
+    let top = e.last.saturating_mul(RATE_HARMONICS).min(max);
+    let harmonics: Vec<usize> = (1..=top).collect();
+    let t = axes[0].period_s;
+    let mut periods = usize::MAX;
+    for (i, log) in axes.iter().enumerate() {
+        let at = format!("{place}, axis {i}");
+        if log.excitation != Some(e)
+            || log.period_s != t
+            || log.force_n.len() != axes[0].force_n.len()
+        {
+            return Err(bad(
+                at,
+                "it played another excitation, period or length than axis 0's".into(),
+            ));
+        }
+        let p = whole_periods(&log.force_n, &log.position_m, period, &harmonics, skip)
+            .map_err(|err| bad(at, err.to_string()))?;
+        periods = periods.min(p);
+    }
+    // A period's last tick moves the handle to the next period's first
+    // sample: the periods whose end is recorded.
+    let len = axes[0].force_n.len();
+    let worked = periods.min((len - 1) / period - skip);
+    if worked < 2 {
+        return Err(bad(
+            place.into(),
+            "fewer than two whole periods with their end recorded".into(),
+        ));
+    }
+    let work: Vec<f64> = (skip..skip + worked)
+        .map(|k| {
+            (k * period..(k + 1) * period)
+                .map(|s| {
+                    axes.iter()
+                        .map(|l| l.force_n[s] * (l.position_m[s + 1] - l.position_m[s]))
+                        .sum::<f64>()
+                })
+                .sum()
+        })
+        .collect();
+    let duration = period as f64 * t;
+    let mean = work.iter().sum::<f64>() / worked as f64;
+    let var = work.iter().map(|w| (w - mean).powi(2)).sum::<f64>() / (worked as f64 - 1.0);
+    // The mean period's velocity, band-limited, at every tick.
+    let velocity: Vec<Vec<f64>> = axes
+        .iter()
+        .map(|l| {
+            let c = mean_spectrum(&l.position_m, period, &harmonics, skip);
+            (0..period)
+                .map(|s| {
+                    c.iter()
+                        .zip(&harmonics)
+                        .map(|(c, &h)| {
+                            let w = std::f64::consts::TAU * h as f64 / duration;
+                            let ph = std::f64::consts::TAU * (h * s) as f64 / period as f64;
+                            // x = (2/N) Re(c e^{jφ}); x' = (2/N) Re(jω c e^{jφ})
+                            -2.0 * w / period as f64 * (c.re * ph.sin() + c.im * ph.cos())
+                        })
+                        .sum()
+                })
+                .collect()
+        })
+        .collect();
+    let mut rate_sq = vec![0.0; n];
+    let mut rate_abs = vec![0.0; n];
+    let rates = (0..period).map(|s| jacobian_inv * DVector::from_fn(n, |i, _| velocity[i][s]));
+    for q in rates {
+        for ((sq, abs), r) in rate_sq.iter_mut().zip(&mut rate_abs).zip(q.iter()) {
+            *sq += r * r / period as f64;
+            *abs += r.abs() / period as f64;
+        }
+    }
+    Ok(Dissipation {
+        power_w: mean / duration,
+        power_sd_w: (var / worked as f64).sqrt() / duration,
+        rate_sq,
+        rate_abs,
+    })
+}
+
+/// Fit every joint's damping and friction to the experiments (each one
+/// every axis's record), at the pose whose Jacobian is `jacobian`
+/// (handle velocity from joint rates). Each experiment's equation is
+/// weighted by its power (the rates' band-limiting errs by a share of
+/// it), the least-norm solution taken where the experiments do not tell
+/// joints apart, and no loss is negative.
+pub fn fit(
+    experiments: &[Vec<Log>],
+    jacobian: &DMatrix<f64>,
+    skip: usize,
+) -> Result<JointLosses, IdentifyError> {
+    let n = jacobian.ncols();
+    let inv = jacobian.clone().try_inverse().ok_or_else(|| {
+        bad(
+            "the pose".into(),
+            "its Jacobian is singular: no joint rates follow".into(),
+        )
+    })?;
+    let dis = experiments
+        .iter()
+        .enumerate()
+        .map(|(k, axes)| dissipation(axes, &inv, skip, &format!("experiment {k}")))
+        .collect::<Result<Vec<_>, _>>()?;
+    if let Some(k) = dis
+        .iter()
+        .position(|d| d.power_w.is_nan() || d.power_w <= 0.0)
+    {
+        return Err(bad(
+            format!("experiment {k}"),
+            format!(
+                "the motors put in {} W over a period: a passive device takes power in",
+                dis[k].power_w
+            ),
+        ));
+    }
+    if dis.len() < 2 {
+        return Err(bad(
+            "the records".into(),
+            "one experiment cannot tell damping from friction: play the sine at two levels or more"
+                .into(),
+        ));
+    }
+    let rows = DMatrix::from_fn(dis.len(), 2 * n, |r, c| {
+        let d = &dis[r];
+        (if c < n {
+            d.rate_sq[c]
+        } else {
+            d.rate_abs[c - n]
+        }) / d.power_w
+    });
+    let rhs = DVector::from_element(dis.len(), 1.0);
+    // The standard deviations are the unconstrained fit's: a loss held
+    // at zero is not known to be zero.
+    let mut free: Vec<usize> = (0..2 * n).collect();
+    let (mut p, sd, unresolved) = solve(&rows, &rhs, &free);
+    while let Some(c) = free
+        .iter()
+        .copied()
+        .filter(|&c| p[c] < 0.0)
+        .min_by(|&a, &b| p[a].total_cmp(&p[b]))
+    {
+        free.retain(|&f| f != c);
+        p = solve(&rows, &rhs, &free).0;
+    }
+    let res = &rows * &p - &rhs;
+    Ok(JointLosses {
+        damping_nmsprad: p.rows(0, n).iter().copied().collect(),
+        friction_nm: p.rows(n, n).iter().copied().collect(),
+        sd,
+        misfit: (res.norm_squared() / dis.len() as f64).sqrt(),
+        unresolved,
+        experiments: dis,
+    })
+}
+
+/// The least-norm least squares over the columns `free` (the others
+/// zero): the parameters, their standard deviations (every column's) and
+/// how many combinations it did not resolve.
+fn solve(
+    rows: &DMatrix<f64>,
+    rhs: &DVector<f64>,
+    free: &[usize],
+) -> (DVector<f64>, Vec<f64>, usize) {
+    let m = rows.nrows();
+    let scale: Vec<f64> = free
+        .iter()
+        .map(|&c| rows.column(c).norm().max(f64::MIN_POSITIVE))
+        .collect();
+    let a = DMatrix::from_fn(m, free.len(), |r, k| rows[(r, free[k])] / scale[k]);
+    let svd = a.svd(true, true);
+    let top = svd.singular_values.max();
+    let cut = RESOLVED * top;
+    let x = svd
+        .solve(rhs, cut)
+        .unwrap_or_else(|_| DVector::zeros(free.len()));
+    let res = DMatrix::from_fn(m, free.len(), |r, k| rows[(r, free[k])] / scale[k]) * &x - rhs;
+    let resolved = svd.singular_values.iter().filter(|&&s| s > cut).count();
+    let unresolved = free.len() - resolved;
+    // The residuals' variance, at least the share the rates' errors give
+    // (0.5% a row): a fit that happens to close exactly is not exact.
+    let dof = m.saturating_sub(resolved).max(1) as f64;
+    let s2 = (res.norm_squared() / dof).max(0.005f64.powi(2));
+    let v_t = svd.v_t.expect("asked for");
+    let mut p = DVector::zeros(rows.ncols());
+    let mut sd = vec![0.0; rows.ncols()];
+    for (k, &c) in free.iter().enumerate() {
+        p[c] = x[k] / scale[k];
+        let var: f64 = svd
+            .singular_values
+            .iter()
+            .enumerate()
+            .map(|(i, &s)| v_t[(i, k)].powi(2) / s.max(cut).powi(2))
+            .sum();
+        sd[c] = (s2 * var).sqrt() / scale[k];
+    }
+    (p, sd, unresolved)
+}
+
+impl JointLosses {
+    /// The damping the handle feels at a pose, `J^-T B J^-1` (N s/m), `B`
+    /// the joints' damping less `sigmas` standard deviations (none below
+    /// zero): `sigmas = 0` the fit's, larger the least the data allow
+    /// (the damping matrix only grows with each joint's).
+    pub fn damping_nspm(&self, jacobian: &DMatrix<f64>, sigmas: f64) -> Option<DMatrix<f64>> {
+        let inv = jacobian.clone().try_inverse()?;
+        let b = DVector::from_iterator(
+            self.damping_nmsprad.len(),
+            self.damping_nmsprad
+                .iter()
+                .zip(&self.sd)
+                .map(|(b, s)| (b - sigmas * s).max(0.0)),
+        );
+        let d = inv.transpose() * DMatrix::from_diagonal(&b) * &inv;
+        Some((&d + d.transpose()) * 0.5)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::log::Excitation;
+
+    /// One sine experiment on a body of `mass` (kg) with viscous damping
+    /// `b` (N s/m) and Coulomb friction `c` (N, rising over 1 mm/s), held
+    /// at 1 kHz by 100 N/m and 1 N s/m on its reading (1 µm steps), the
+    /// sine `peak` (N) at 10 Hz for 24 periods.
+    fn sine(mass: f64, b: f64, c: f64, peak: f64) -> Log {
+        let (t, period, periods, sub) = (1e-3, 100, 24, 200);
+        let (mut x, mut v, mut prev) = (0.0f64, 0.0f64, 0.0f64);
+        let (mut force, mut position) = (Vec::new(), Vec::new());
+        for n in 0..period * periods {
+            let read = (x * 1e6).round() / 1e6;
+            let phase = std::f64::consts::TAU * (n % period) as f64 / period as f64;
+            let f = peak * phase.sin() - 100.0 * read - (read - prev) / t;
+            prev = read;
+            force.push(f);
+            position.push(read);
+            let h = t / sub as f64;
+            for _ in 0..sub {
+                let a = (f - b * v - c * (v / 1e-3).tanh()) / mass;
+                v += a * h;
+                x += v * h;
+            }
+        }
+        Log {
+            period_s: t,
+            force_n: force,
+            position_m: position,
+            load_cell_n: None,
+            excitation: Some(Excitation {
+                period_ticks: period,
+                first: 1,
+                last: 1,
+            }),
+        }
+    }
+
+    fn one_axis(levels: &[f64], b: f64, c: f64) -> Vec<Vec<Log>> {
+        levels.iter().map(|&p| vec![sine(0.1, b, c, p)]).collect()
+    }
+
+    #[test]
+    fn damping_and_friction_come_apart_over_the_levels() {
+        let j = DMatrix::from_element(1, 1, 1.0);
+        let l = fit(&one_axis(&[0.5, 1.0, 2.0], 0.5, 0.1), &j, 4).unwrap();
+        let (b, c) = (l.damping_nmsprad[0], l.friction_nm[0]);
+        assert!((b / 0.5 - 1.0).abs() < 0.03, "{l:?}");
+        assert!((c / 0.1 - 1.0).abs() < 0.03, "{l:?}");
+        assert!(l.misfit < 0.01 && l.unresolved == 0, "{l:?}");
+        // Within a few standard deviations, and they are not nothing.
+        assert!((b - 0.5).abs() < 4.0 * l.sd[0] && l.sd[0] > 0.0, "{l:?}");
+    }
+
+    #[test]
+    fn a_frictionless_body_gets_none() {
+        let j = DMatrix::from_element(1, 1, 1.0);
+        let l = fit(&one_axis(&[0.5, 1.0, 2.0], 0.5, 0.0), &j, 4).unwrap();
+        assert!((l.damping_nmsprad[0] / 0.5 - 1.0).abs() < 0.03, "{l:?}");
+        assert!(l.friction_nm[0] < 2.0 * l.sd[1], "{l:?}");
+    }
+
+    #[test]
+    fn the_handle_feels_the_joints_damping_through_the_jacobian() {
+        let l = JointLosses {
+            damping_nmsprad: vec![2.0, 0.5],
+            friction_nm: vec![0.0, 0.0],
+            sd: vec![0.1, 1.0, 0.0, 0.0],
+            misfit: 0.0,
+            unresolved: 0,
+            experiments: Vec::new(),
+        };
+        // x = (q0 + q1, 2 q1): J = [[1, 1], [0, 2]].
+        let j = DMatrix::from_row_slice(2, 2, &[1.0, 1.0, 0.0, 2.0]);
+        let d = l.damping_nspm(&j, 0.0).unwrap();
+        // The power at joint rates q' is q'ᵀ B q' = x'ᵀ D x'.
+        let q = DVector::from_vec(vec![0.3, -0.7]);
+        let x = &j * &q;
+        let joint = 2.0 * 0.09 + 0.5 * 0.49;
+        assert!(((x.transpose() * &d * &x)[0] - joint).abs() < 1e-12);
+        // Three deviations down: joint 0 at 1.7, joint 1 at none.
+        let least = l.damping_nspm(&j, 3.0).unwrap();
+        let joint = 1.7 * 0.09;
+        assert!(((x.transpose() * &least * &x)[0] - joint).abs() < 1e-12);
+    }
+
+    #[test]
+    fn records_that_cannot_be_fitted_are_refused() {
+        let j = DMatrix::from_element(1, 1, 1.0);
+        let why = |e: IdentifyError| e.to_string();
+        // One level: damping and friction are not told apart.
+        let err = why(fit(&one_axis(&[1.0], 0.5, 0.1), &j, 4).unwrap_err());
+        assert!(err.contains("two levels"), "{err}");
+        // A record the motors took power from.
+        let mut e = one_axis(&[0.5, 1.0], 0.5, 0.1);
+        e[1][0].force_n.iter_mut().for_each(|f| *f = -*f);
+        let err = why(fit(&e, &j, 4).unwrap_err());
+        assert!(
+            err.contains("experiment 1") && err.contains("passive"),
+            "{err}"
+        );
+        // A sample that is not a number, named with its place.
+        let mut e = one_axis(&[0.5, 1.0], 0.5, 0.1);
+        e[0][0].position_m[1000] = f64::NAN;
+        let err = why(fit(&e, &j, 4).unwrap_err());
+        assert!(err.contains("experiment 0, axis 0"), "{err}");
+        // Too few periods with their end recorded.
+        let err = why(fit(&one_axis(&[0.5, 1.0], 0.5, 0.1), &j, 23).unwrap_err());
+        assert!(err.contains("periods"), "{err}");
+        // A record with another count of axes than the pose's joints.
+        let j2 = DMatrix::identity(2, 2);
+        let err = why(fit(&one_axis(&[0.5, 1.0], 0.5, 0.1), &j2, 4).unwrap_err());
+        assert!(err.contains("1 axes"), "{err}");
+    }
+}
