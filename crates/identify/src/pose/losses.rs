@@ -96,6 +96,13 @@ pub fn dissipation(
     let period = e.period_ticks;
     let max = period.saturating_sub(1) / 2;
     let top = e.last.saturating_mul(RATE_HARMONICS).min(max);
+    if e.first == 0 || e.last > max {
+        return Err(IdentifyError::Harmonic {
+            harmonic: e.last.max(e.first),
+            period,
+            max,
+        });
+    }
     let harmonics: Vec<usize> = (1..=top).collect();
     let t = axes[0].period_s;
     let mut periods = usize::MAX;
@@ -117,7 +124,7 @@ pub fn dissipation(
     // A period's last tick moves the handle to the next period's first
     // sample: the periods whose end is recorded.
     let len = axes[0].force_n.len();
-    let worked = periods.min((len - 1) / period - skip);
+    let worked = periods.min(((len - 1) / period).saturating_sub(skip));
     if worked < 2 {
         return Err(bad(
             place.into(),
@@ -264,29 +271,33 @@ fn solve(
         .map(|&c| rows.column(c).norm().max(f64::MIN_POSITIVE))
         .collect();
     let a = DMatrix::from_fn(m, free.len(), |r, k| rows[(r, free[k])] / scale[k]);
-    let svd = a.svd(true, true);
+    let svd = a.clone().svd(true, true);
     let top = svd.singular_values.max();
     let cut = RESOLVED * top;
     let x = svd
         .solve(rhs, cut)
         .unwrap_or_else(|_| DVector::zeros(free.len()));
-    let res = DMatrix::from_fn(m, free.len(), |r, k| rows[(r, free[k])] / scale[k]) * &x - rhs;
+    let res = &a * &x - rhs;
     let resolved = svd.singular_values.iter().filter(|&&s| s > cut).count();
     let unresolved = free.len() - resolved;
     // The residuals' variance, at least the share the rates' errors give
     // (0.5% a row): a fit that happens to close exactly is not exact.
     let dof = m.saturating_sub(resolved).max(1) as f64;
     let s2 = (res.norm_squared() / dof).max(0.005f64.powi(2));
-    let v_t = svd.v_t.expect("asked for");
+    // Every direction's variance, the null space's too (fewer
+    // experiments than losses): the eigenvectors of `AᵀA`, each eigenvalue
+    // at least the threshold's square.
+    let ata = a.transpose() * &a;
+    let eig = ata.symmetric_eigen();
     let mut p = DVector::zeros(rows.ncols());
     let mut sd = vec![0.0; rows.ncols()];
     for (k, &c) in free.iter().enumerate() {
         p[c] = x[k] / scale[k];
-        let var: f64 = svd
-            .singular_values
+        let var: f64 = eig
+            .eigenvalues
             .iter()
             .enumerate()
-            .map(|(i, &s)| v_t[(i, k)].powi(2) / s.max(cut).powi(2))
+            .map(|(i, &l)| eig.eigenvectors[(k, i)].powi(2) / l.max(cut * cut))
             .sum();
         sd[c] = (s2 * var).sqrt() / scale[k];
     }
@@ -374,6 +385,33 @@ mod tests {
         let l = fit(&one_axis(&[0.5, 1.0, 2.0], 0.5, 0.0), &j, 4).unwrap();
         assert!((l.damping_nmsprad[0] / 0.5 - 1.0).abs() < 0.03, "{l:?}");
         assert!(l.friction_nm[0] < 2.0 * l.sd[1], "{l:?}");
+    }
+
+    #[test]
+    fn a_joint_no_experiment_moves_is_not_credited() {
+        // Two axes, the second never moved nor pushed.
+        let still = |l: &Log| Log {
+            force_n: vec![0.0; l.force_n.len()],
+            position_m: vec![0.0; l.position_m.len()],
+            ..l.clone()
+        };
+        let e: Vec<Vec<Log>> = [0.5, 1.0, 2.0]
+            .iter()
+            .map(|&p| {
+                let l = sine(0.1, 0.5, 0.1, p);
+                vec![still(&l), l].into_iter().rev().collect()
+            })
+            .collect();
+        let j = DMatrix::identity(2, 2);
+        let l = fit(&e, &j, 4).unwrap();
+        assert_eq!(l.unresolved, 2, "{l:?}");
+        assert!((l.damping_nmsprad[0] / 0.5 - 1.0).abs() < 0.03, "{l:?}");
+        // Its deviation is the threshold's, many times the moved joint's,
+        // and the least damping the data allow gives it none.
+        assert!(l.sd[1] > 10.0 * l.sd[0], "{l:?}");
+        let least = l.damping_nspm(&j, 3.0).unwrap();
+        assert_eq!(least[(1, 1)], 0.0);
+        assert!(least[(0, 0)] > 0.4, "{least}");
     }
 
     #[test]
