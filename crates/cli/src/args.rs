@@ -571,3 +571,42 @@ impl RatesArgs {
             .ok_or_else(|| format!("--min-grasp {g}: a damping (N s/m), 0 or more"))
     }
 }
+
+/// `identify-pose`: a linkage's sines at one pose to the mass, damping and
+/// joint losses there, and the coupling proven on them.
+#[derive(Args, Clone)]
+pub(crate) struct IdentifyPoseArgs {
+    /// The linkage file: its kinematics take the handle's motion to the
+    /// joints, and its period and motors are the design's.
+    #[arg(long)]
+    pub(crate) linkage: PathBuf,
+    /// The joint angles the experiments were played at (rad),
+    /// comma-separated.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        required = true,
+        allow_negative_numbers = true
+    )]
+    pub(crate) pose_rad: Vec<f64>,
+    /// A folder of one level's sines: one experiment per Cartesian axis,
+    /// each with every axis's record, named PUSHED-AXIS.csv (x-x.csv,
+    /// x-y.csv, ..., z-z.csv). Give two levels or more, lowest first: the
+    /// levels tell the joints' damping from their friction.
+    #[arg(long, required = true)]
+    pub(crate) level: Vec<PathBuf>,
+    /// Whole periods skipped at the start of each record: the hold's own
+    /// mode must have died away.
+    #[arg(long, default_value_t = 8)]
+    pub(crate) skip: usize,
+    /// The least damping (N s/m) every hand grasps with: the dead-man
+    /// switch's promise, which the design credits.
+    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
+    pub(crate) min_grasp: f64,
+    /// Standard deviations the set's damping is lowered by.
+    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
+    pub(crate) sigmas: f64,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub(crate) json: bool,
+}

@@ -25,6 +25,7 @@ mod args;
 mod check;
 mod host;
 mod identify;
+mod identify_pose;
 mod plots;
 mod rates;
 mod region;
@@ -70,6 +71,10 @@ pub(crate) enum Cmd {
     /// a set of models that spans what the fit does not know, and the
     /// figures of the fit.
     Identify(IdentifyArgs),
+    /// Identify a linkage at a pose from sines played at several levels:
+    /// its mass and damping matrices, its joints' damping and friction,
+    /// and the coupling proven on them.
+    IdentifyPose(IdentifyPoseArgs),
     /// What the servo rate buys: each device's proven coupling at each
     /// servo rate, as a table and a figure.
     Rates(RatesArgs),
@@ -121,6 +126,7 @@ fn main() -> ExitCode {
         }
         Cmd::Verify(d) => each_axis(d, verify::verify),
         Cmd::Identify(a) => identify::identify(a),
+        Cmd::IdentifyPose(a) => identify_pose::identify_pose(a),
         Cmd::Rates(a) => rates::rates(a),
         Cmd::HostVe(a) => one_axis(a, host::host_ve),
     };

@@ -14,12 +14,15 @@
 //! Friction's share falls with the speed and damping's grows with it, so
 //! the same sine played at several levels tells the two apart. The force
 //! is the one the board commanded, held for a tick (zero-order hold), so
-//! a tick's work is `f_n · (x_{n+1} - x_n)` exactly.
+//! a tick's work is `f_n · (x_{n+1} - x_n)` exactly; it is summed in the
+//! harmonics the motion has, where the reading's quantisation does not
+//! reach.
 
-use crate::frf::{mean_spectrum, whole_periods};
+use crate::frf::{spectra, whole_periods};
 use crate::log::Log;
 use crate::IdentifyError;
 use nalgebra::{DMatrix, DVector};
+use num_complex::Complex64;
 
 /// How many harmonics of the excitation's highest one give the joints'
 /// rates: the sine's harmonics that friction's corners add, and not the
@@ -121,35 +124,54 @@ pub fn dissipation(
             .map_err(|err| bad(at, err.to_string()))?;
         periods = periods.min(p);
     }
-    // A period's last tick moves the handle to the next period's first
-    // sample: the periods whose end is recorded.
-    let len = axes[0].force_n.len();
-    let worked = periods.min(((len - 1) / period).saturating_sub(skip));
-    if worked < 2 {
-        return Err(bad(
-            place.into(),
-            "fewer than two whole periods with their end recorded".into(),
-        ));
+    if periods < 2 {
+        return Err(bad(place.into(), "fewer than two whole periods".into()));
     }
-    let work: Vec<f64> = (skip..skip + worked)
-        .map(|k| {
-            (k * period..(k + 1) * period)
-                .map(|s| {
-                    axes.iter()
-                        .map(|l| l.force_n[s] * (l.position_m[s + 1] - l.position_m[s]))
-                        .sum::<f64>()
-                })
-                .sum()
-        })
-        .collect();
+    // A period's work, `Σ f_n (x_{n+1} - x_n)`, in its harmonics:
+    // `(2/N) Σ_h Re(X_h (z_h - 1) conj(F_h))`, `z_h = e^{j2πh/N}`, over the
+    // band the rates are taken in. Past it, the reading's quantisation
+    // and the hold's damping on it would add a power of their own
+    // (`b q²/12T²` for steps `q` that differ tick to tick), which the
+    // joints never took. The estimate is the mean spectra's; the periods'
+    // own give its spread.
+    let cycle = |h: usize| {
+        Complex64::from_polar(1.0, std::f64::consts::TAU * h as f64 / period as f64) - 1.0
+    };
+    let work = |x: &[Complex64], f: &[Complex64]| -> f64 {
+        x.iter()
+            .zip(f)
+            .zip(&harmonics)
+            .map(|((x, f), &h)| (x * cycle(h) * f.conj()).re)
+            .sum::<f64>()
+            * 2.0
+            / period as f64
+    };
+    let spectra = |s: &[f64]| spectra(s, period, &harmonics, skip, periods);
+    let mean_of = |s: &[Vec<Complex64>]| -> Vec<Complex64> {
+        (0..harmonics.len())
+            .map(|i| s.iter().map(|p| p[i]).sum::<Complex64>() / periods as f64)
+            .collect()
+    };
+    let mut per_period = vec![0.0; periods];
+    let mut mean = 0.0;
+    // Each axis's mean position spectrum, for the rates below.
+    let mut positions = Vec::with_capacity(n);
+    for l in axes {
+        let (x, f) = (spectra(&l.position_m), spectra(&l.force_n));
+        for (w, (x, f)) in per_period.iter_mut().zip(x.iter().zip(&f)) {
+            *w += work(x, f);
+        }
+        let xm = mean_of(&x);
+        mean += work(&xm, &mean_of(&f));
+        positions.push(xm);
+    }
+    let avg = per_period.iter().sum::<f64>() / periods as f64;
+    let var = per_period.iter().map(|w| (w - avg).powi(2)).sum::<f64>() / (periods as f64 - 1.0);
     let duration = period as f64 * t;
-    let mean = work.iter().sum::<f64>() / worked as f64;
-    let var = work.iter().map(|w| (w - mean).powi(2)).sum::<f64>() / (worked as f64 - 1.0);
     // The mean period's velocity, band-limited, at every tick.
-    let velocity: Vec<Vec<f64>> = axes
+    let velocity: Vec<Vec<f64>> = positions
         .iter()
-        .map(|l| {
-            let c = mean_spectrum(&l.position_m, period, &harmonics, skip);
+        .map(|c| {
             (0..period)
                 .map(|s| {
                     c.iter()
@@ -176,7 +198,7 @@ pub fn dissipation(
     }
     Ok(Dissipation {
         power_w: mean / duration,
-        power_sd_w: (var / worked as f64).sqrt() / duration,
+        power_sd_w: (var / periods as f64).sqrt() / duration,
         rate_sq,
         rate_abs,
     })
