@@ -16,9 +16,12 @@
 //! dissipate (`pose::losses`) and `M_x` from their fundamentals, and the
 //! chain closes with the friction on.
 
+#[path = "../../tests/support/cli.rs"]
+mod support;
+
 use host_sim::engine::scene::IdentifySpec;
-use host_sim::link::{LinkFaults, LocalDelta, LocalSerialArm};
-use host_sim::pil::linkage::{self, Device, Plan};
+use host_sim::link::LinkFaults;
+use host_sim::pil::linkage::{self, Device, Plan, Sines};
 use nalgebra::DMatrix;
 use twoport_design::linkage::{
     bounded_workspace_design, verify_linkage, HandAssumption, PoseDynamics,
@@ -45,18 +48,6 @@ fn spec(axis: u8) -> IdentifySpec {
     }
 }
 
-/// A 10 Hz sine on `axis` peaking at `peak_n`, held as [`spec`]'s, for
-/// twenty-four periods (2.4 s): what the joints' losses are fitted to.
-fn sine(axis: u8, peak_n: f64) -> IdentifySpec {
-    IdentifySpec {
-        period_s: 0.1,
-        band_hz: [10.0, 10.0],
-        peak_n,
-        periods: 24,
-        ..spec(axis)
-    }
-}
-
 /// Every axis's record of experiment `s`, the joints' friction acting or
 /// not.
 fn record(device: Device, s: IdentifySpec, friction: bool) -> Vec<Log> {
@@ -70,18 +61,7 @@ fn record(device: Device, s: IdentifySpec, friction: bool) -> Vec<Log> {
     // once they are played, and the arm falls.
     let played = (experiment.periods * experiment.period_ticks) as usize;
     let ticks = 1 + 300 + played as u64;
-    let f = LinkFaults::default();
-    let r = match device {
-        Device::SerialArm => linkage::run_plan(
-            device,
-            ticks,
-            LocalSerialArm::serial_arm().unwrap(),
-            f,
-            plan,
-        ),
-        Device::Delta => linkage::run_plan(device, ticks, LocalDelta::delta().unwrap(), f, plan),
-    }
-    .unwrap();
+    let r = linkage::run_local(device, ticks, LinkFaults::default(), plan).unwrap();
     let logs = r.experiment_axes().unwrap().unwrap();
     assert!(logs.iter().all(|l| l.force_n.len() == played));
     logs
@@ -255,14 +235,15 @@ fn the_linkages_close_with_their_joints_friction() {
         let file = device.file().unwrap();
         let truth = truth(device);
         for friction in [true, false] {
-            let runs: Vec<Vec<Vec<Log>>> = levels
-                .iter()
-                .map(|&peak| {
-                    (0..3)
-                        .map(|a| record(device, sine(a, peak), friction))
-                        .collect()
-                })
-                .collect();
+            let runs = Sines {
+                hz: 10.0,
+                periods: 24,
+                levels_n: levels.to_vec(),
+                hold: (100.0, 1.0),
+                friction,
+            }
+            .play(device)
+            .unwrap();
             let masses: Vec<_> = runs
                 .iter()
                 .map(|r| mass(&PoseMeasured::from_logs(r, SKIP).unwrap()).unwrap())
@@ -301,4 +282,68 @@ fn the_linkages_close_with_their_joints_friction() {
             );
         }
     }
+}
+
+/// `host-sim pil --linkage delta --sines 1,2,4 --log DIR` writes each
+/// level's records where `twoport identify-pose` reads them, and they fit
+/// to the delta's joints' friction within 2%; a missing folder or a level
+/// that is no force is refused.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn host_sim_writes_the_sines_identify_pose_reads() {
+    use twoport_identify::pose::{losses, record_file};
+    let tool = support::Tool {
+        bin: env!("CARGO_BIN_EXE_host-sim"),
+        root: concat!(env!("CARGO_MANIFEST_DIR"), "/.."),
+    };
+    let dir = support::scratch("sines");
+    let d = dir.to_str().unwrap();
+    let v = tool.json(&[
+        "pil",
+        "--linkage",
+        "delta",
+        "--sines",
+        "1,2,4",
+        "--log",
+        d,
+        "--json",
+    ]);
+    let folders = v["folders"].as_array().unwrap();
+    assert_eq!(folders.len(), 3, "{v}");
+    let mut records = Vec::new();
+    for f in folders {
+        let f = std::path::Path::new(f.as_str().unwrap());
+        for pushed in 0..3 {
+            let axes: Vec<Log> = (0..3)
+                .map(|axis| {
+                    let path = f.join(record_file(pushed, axis).unwrap());
+                    let text = std::fs::read_to_string(&path).unwrap();
+                    Log::from_csv(&text, &path.display().to_string()).unwrap()
+                })
+                .collect();
+            records.push(axes);
+        }
+    }
+    let truth = truth(Device::Delta);
+    let l = losses::fit(&records, &truth.jacobian, 8).unwrap();
+    let c = Device::Delta.file().unwrap().joints.friction_nm;
+    for (got, want) in l.friction_nm.iter().zip(&c) {
+        assert!((got / want - 1.0).abs() < 0.02, "{l:?}");
+    }
+    for (args, want) in [
+        (&["--sines", "1,2"][..], "--log"),
+        (&["--sines", "1,-2", "--log", d][..], "--sines -2"),
+        (
+            &["--sines", "1,2", "--log", d, "--port", "/dev/null"][..],
+            "in-process",
+        ),
+    ] {
+        let mut all = vec!["pil", "--linkage", "delta"];
+        all.extend(args);
+        let e = tool.failure(&all);
+        assert!(e.contains(want), "{args:?}: {e}");
+    }
+    let e = tool.failure(&["pil", "--sines", "1,2", "--log", d]);
+    assert!(e.contains("--linkage"), "{e}");
+    std::fs::remove_dir_all(dir).unwrap();
 }

@@ -4,7 +4,7 @@
 //! serial-arm|delta --check`).
 
 use host_sim::engine::linkage::LinkagePlant;
-use host_sim::link::{LinkError, LinkFaults, LocalDelta, LocalSerialArm, Session};
+use host_sim::link::{LinkError, LinkFaults, LocalSerialArm, Session};
 use host_sim::pil::{self, linkage};
 use linkage::Device;
 use nalgebra::DVector;
@@ -13,12 +13,7 @@ use twoport_control::linkage::Gravity;
 use twoport_link::{Axes, ModeRefusal, ModeRequest};
 
 fn run(device: Device, ticks: u64, faults: LinkFaults) -> pil::Run<3> {
-    match device {
-        Device::SerialArm => {
-            linkage::run(device, ticks, LocalSerialArm::serial_arm().unwrap(), faults).unwrap()
-        }
-        Device::Delta => linkage::run(device, ticks, LocalDelta::delta().unwrap(), faults).unwrap(),
-    }
+    linkage::run_local(device, ticks, faults, linkage::Plan::Press).unwrap()
 }
 
 /// The hand presses the handle through the floor the image holds 5 mm

@@ -11,10 +11,7 @@ use std::path::Path;
 use twoport_design::linkage::{bounded_workspace_design, LinkageFile, PoseDynamics};
 use twoport_design::network::HumanBound;
 use twoport_identify::log::Log;
-use twoport_identify::pose::{fit::mass, losses, PoseMeasured};
-
-/// The Cartesian axes' names, as the records' file names give them.
-const AXES: [&str; 3] = ["x", "y", "z"];
+use twoport_identify::pose::{fit::mass, losses, record_file, PoseMeasured, AXES};
 
 pub(crate) fn identify_pose(a: &IdentifyPoseArgs) -> Result<(), String> {
     if !(a.min_grasp.is_finite() && a.min_grasp >= 0.0) {
@@ -52,7 +49,7 @@ pub(crate) fn identify_pose(a: &IdentifyPoseArgs) -> Result<(), String> {
     let levels = a
         .level
         .iter()
-        .map(|dir| level(dir, &AXES[..n]))
+        .map(|dir| level(dir, n))
         .collect::<Result<Vec<_>, _>>()?;
     let masses = levels
         .iter()
@@ -129,9 +126,10 @@ pub(crate) fn identify_pose(a: &IdentifyPoseArgs) -> Result<(), String> {
         say!("{v}\n");
         return Ok(());
     }
+    // (An eigenvalue that is zero may round below it: no "-0.0000".)
     let list = |v: &[f64], scale: f64| {
         v.iter()
-            .map(|x| format!("{:.4}", x * scale))
+            .map(|x| format!("{:.4}", if x.abs() < 1e-12 { 0.0 } else { x * scale }))
             .collect::<Vec<_>>()
             .join(", ")
     };
@@ -167,14 +165,15 @@ pub(crate) fn identify_pose(a: &IdentifyPoseArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// One level's records: `[pushed][axis]`, each read from `PUSHED-AXIS.csv`
-/// in `dir`.
-fn level(dir: &Path, axes: &[&str]) -> Result<Vec<Vec<Log>>, String> {
-    axes.iter()
+/// One level's records of `n` axes: `[pushed][axis]`, each read from
+/// its [`record_file`] in `dir`.
+fn level(dir: &Path, n: usize) -> Result<Vec<Vec<Log>>, String> {
+    (0..n)
         .map(|pushed| {
-            axes.iter()
+            (0..n)
                 .map(|axis| {
-                    let path = dir.join(format!("{pushed}-{axis}.csv"));
+                    let name = record_file(pushed, axis).expect("three axes at most");
+                    let path = dir.join(name);
                     let text = std::fs::read_to_string(&path)
                         .map_err(|e| format!("{}: {e}", path.display()))?;
                     Log::from_csv(&text, &path.display().to_string()).map_err(|e| e.to_string())

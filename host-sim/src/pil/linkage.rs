@@ -249,3 +249,90 @@ pub fn run_plan<P: BoardPort>(
     r.zero_after_loss_ticks = zero_after_loss(&r.duties, faults);
     Ok(r)
 }
+
+/// [`run_plan`] against `device`'s image in-process.
+pub fn run_local(
+    device: Device,
+    ticks: u64,
+    faults: LinkFaults,
+    plan: Plan,
+) -> Result<Run<3>, Error> {
+    use crate::link::{LocalDelta, LocalSerialArm};
+    match device {
+        Device::SerialArm => run_plan(device, ticks, LocalSerialArm::serial_arm()?, faults, plan),
+        Device::Delta => run_plan(device, ticks, LocalDelta::delta()?, faults, plan),
+    }
+}
+
+/// The sines a linkage's joint losses are fitted to
+/// (`twoport_identify::pose::losses`): one sine on each Cartesian axis at
+/// each level, hands off from the calibration pose, the board's hold on
+/// every axis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sines {
+    /// The sine's frequency (Hz), a whole number of ticks a period.
+    pub hz: f64,
+    /// Periods played at each level.
+    pub periods: u32,
+    /// Each level's peak force (N), lowest first.
+    pub levels_n: Vec<f64>,
+    /// The hold's stiffness (N/m) and damping (N s/m).
+    pub hold: (f64, f64),
+    /// Whether the joints' Coulomb friction acts.
+    pub friction: bool,
+}
+
+/// Ticks from arming to a sine's start.
+const SINE_START_TICKS: u64 = 300;
+
+impl Sines {
+    /// The experiment on `axis` at `level_n` (N).
+    pub fn spec(&self, axis: u8, level_n: f64) -> crate::engine::scene::IdentifySpec {
+        crate::engine::scene::IdentifySpec {
+            axis,
+            start_s: SINE_START_TICKS as f64 * f64::from(image::PERIOD_S),
+            period_s: 1.0 / self.hz,
+            band_hz: [self.hz, self.hz],
+            peak_n: level_n,
+            periods: self.periods,
+            hold_k_npm: self.hold.0,
+            hold_b_nspm: self.hold.1,
+        }
+    }
+
+    /// Every level's records on `device`'s image in-process:
+    /// `[level][pushed axis][recorded axis]`, each run from the arm at
+    /// rest at the calibration pose and stopped at the sine's last period
+    /// (the board then disarms, and the arm would fall).
+    pub fn play(&self, device: Device) -> Result<Vec<Vec<Vec<twoport_identify::log::Log>>>, Error> {
+        let tick = f64::from(image::PERIOD_S);
+        self.levels_n
+            .iter()
+            .map(|&level| {
+                (0..3u8)
+                    .map(|axis| {
+                        let experiment = self.spec(axis, level).experiment(tick)?;
+                        let plan = Plan::Identify {
+                            experiment,
+                            start_ticks: SINE_START_TICKS,
+                            friction: self.friction,
+                        };
+                        let played =
+                            u64::from(experiment.periods) * u64::from(experiment.period_ticks);
+                        let r = run_local(
+                            device,
+                            1 + SINE_START_TICKS + played,
+                            LinkFaults::default(),
+                            plan,
+                        )?;
+                        r.experiment_axes().unwrap_or_else(|| {
+                            Err(pil_err!(
+                                "{device:?}: the board played no sine on axis {axis} at {level} N"
+                            ))
+                        })
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+}

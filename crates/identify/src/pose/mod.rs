@@ -35,6 +35,17 @@ pub mod losses;
 mod measured;
 pub mod response;
 
+/// The Cartesian axes' names in a pose's record files.
+pub const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// The file that keeps axis `axis`'s record of the experiment that
+/// pushed axis `pushed`, in a folder of one level's experiments:
+/// `PUSHED-AXIS.csv` (`x-y.csv`: the push along `x`, the record of `y`).
+/// None past the three Cartesian axes.
+pub fn record_file(pushed: usize, axis: usize) -> Option<String> {
+    Some(format!("{}-{}.csv", AXES.get(pushed)?, AXES.get(axis)?))
+}
+
 pub use fit::PoseFit;
 pub use losses::JointLosses;
 pub use measured::PoseMeasured;

@@ -51,9 +51,20 @@ pub(crate) struct PilArgs {
     pub(crate) host_ve_hz: Option<f64>,
     /// Write the identification experiment's record (the scene's
     /// `[identify]`) to this CSV file: the board's over the port where
-    /// there is one, else the in-process loop's.
+    /// there is one, else the in-process loop's. With --sines, the folder
+    /// the levels' records go into.
     #[arg(long)]
     pub(crate) log: Option<PathBuf>,
+    /// With --linkage: instead of the press, the image plays a sine on
+    /// each Cartesian axis at each of these peak forces (N, lowest first),
+    /// hands off from its calibration pose, the joints' friction acting,
+    /// in-process; each level's records go into --log's folder as
+    /// LEVELN/PUSHED-AXIS.csv, what `twoport identify-pose` reads.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    pub(crate) sines: Vec<f64>,
+    /// The sines' frequency (Hz).
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
+    pub(crate) sine_hz: f64,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub(crate) json: bool,
@@ -64,8 +75,76 @@ pub(crate) struct PilArgs {
     pub(crate) check: bool,
 }
 
+/// `--linkage --sines`: every level's records written for
+/// `twoport identify-pose`.
+fn sines(a: &PilArgs, device: host_sim::pil::linkage::Device) -> Result<(), Error> {
+    use twoport_identify::pose::record_file;
+    let dir = a
+        .log
+        .as_ref()
+        .ok_or_else(|| err!("--sines: give --log, the folder the records go into"))?;
+    if a.port.is_some() {
+        return Err(err!("--sines: the sines run in-process (no --port)"));
+    }
+    if let Some(l) = a.sines.iter().find(|l| !(l.is_finite() && **l > 0.0)) {
+        return Err(err!(
+            "--sines {l}: each level must be a finite force > 0 (N)"
+        ));
+    }
+    let s = host_sim::pil::linkage::Sines {
+        hz: a.sine_hz,
+        periods: 24,
+        levels_n: a.sines.clone(),
+        hold: (100.0, 1.0),
+        friction: true,
+    };
+    let levels = s.play(device)?;
+    let mut folders = Vec::new();
+    for (level, runs) in a.sines.iter().zip(&levels) {
+        let folder = dir.join(format!("{level}N"));
+        std::fs::create_dir_all(&folder).map_err(|e| err!("--log {}: {e}", folder.display()))?;
+        for (pushed, axes) in runs.iter().enumerate() {
+            for (axis, log) in axes.iter().enumerate() {
+                let path = folder.join(record_file(pushed, axis).expect("three axes"));
+                std::fs::write(&path, log.to_csv())
+                    .map_err(|e| err!("--log {}: {e}", path.display()))?;
+            }
+        }
+        folders.push(folder);
+    }
+    if a.json {
+        let v = serde_json::json!({
+            "linkage": device,
+            "sine_hz": s.hz,
+            "periods": s.periods,
+            "levels_n": s.levels_n,
+            "folders": folders,
+        });
+        say!("{v}");
+    } else {
+        say!(
+            "{device:?}: a {} Hz sine on each axis at {:?} N, {} periods each; records in {}",
+            s.hz,
+            s.levels_n,
+            s.periods,
+            folders
+                .iter()
+                .map(|f| f.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    Ok(())
+}
+
 pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
     use host_sim::pil;
+    if !a.sines.is_empty() {
+        let device = a
+            .linkage
+            .ok_or_else(|| err!("--sines: the sines play on a linkage image (give --linkage)"))?;
+        return sines(a, device);
+    }
     if !(a.seconds.is_finite() && a.seconds > 0.0 && a.seconds <= 3600.0) {
         return Err(err!("--seconds {}: must be in (0, 3600]", a.seconds));
     }
@@ -151,16 +230,11 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
         return pil_report(a, ticks, faults, reference, run, local_s, start, deadline);
     }
     if let Some(device) = a.linkage {
-        use host_sim::pil::linkage::{self, Device};
+        use host_sim::pil::linkage;
         if a.passivity {
             return Err("--passivity: the linkage images have no passivity build".into());
         }
-        let reference = match device {
-            Device::SerialArm => {
-                linkage::run(device, ticks, link::LocalSerialArm::serial_arm()?, faults)?
-            }
-            Device::Delta => linkage::run(device, ticks, link::LocalDelta::delta()?, faults)?,
-        };
+        let reference = linkage::run_local(device, ticks, faults, linkage::Plan::Press)?;
         let local_s = start.elapsed().as_secs_f64();
         let run = port
             .map(|p| linkage::run(device, ticks, p, faults))
