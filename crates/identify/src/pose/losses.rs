@@ -39,7 +39,8 @@ const RESOLVED: f64 = 1e-2;
 /// What one experiment dissipated and how fast each joint moved.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Dissipation {
-    /// The mean power the motors put in (W).
+    /// The mean power the motors put in (W), summed in the harmonics the
+    /// rates are taken in.
     pub power_w: f64,
     /// Its standard deviation from the periods' spread (W).
     pub power_sd_w: f64,
