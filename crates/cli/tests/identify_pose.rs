@@ -2,6 +2,8 @@
 //! in, the mass and joint losses there and the coupling proven on them
 //! out, and bad arguments and records refused with what is wrong.
 
+#[path = "../../../tests/support/sine_body.rs"]
+mod body;
 #[path = "../../../tests/support/cli.rs"]
 mod support;
 
@@ -23,11 +25,11 @@ fn hapkit() -> LinkageFile {
     LinkageFile::load(&Path::new(TWOPORT.root).join(HAPKIT)).unwrap()
 }
 
-/// A level of the Hapkit's sines at its centre: its handle as the file
-/// has it there (the mass and damping of its pose, the motor's friction
-/// at the handle, rising over 1 mm/s), read in the sensor's steps, held
-/// by 100 N/m and 1 N s/m, a 10 Hz sine of `peak` (N) for 24 periods at
-/// 1 kHz, written as `x-x.csv` in `dir`.
+/// A level of the Hapkit's sines at its centre ([`body::sine_body`]):
+/// its handle as the file has it there (the mass and damping of its
+/// pose, the motor's friction at the handle), read in the sensor's
+/// steps, the sine peaking at `peak` (N), written as `x-x.csv` in a
+/// folder of `dir`.
 fn level(dir: &Path, peak: f64) -> PathBuf {
     let file = hapkit();
     let pose = file.pose(&[0.0]).unwrap();
@@ -35,22 +37,8 @@ fn level(dir: &Path, peak: f64) -> PathBuf {
     let j = pose.jacobian[(0, 0)];
     let c = file.joints.friction_nm[0] / j;
     let quantum = j * std::f64::consts::TAU / f64::from(file.motors.encoder_counts_per_rev);
-    let (t, period, periods, sub) = (1e-3, 100, 24, 200);
-    let (mut x, mut v, mut prev) = (0.0f64, 0.0f64, 0.0f64);
-    let (mut force, mut position) = (Vec::new(), Vec::new());
-    for n in 0..period * periods {
-        let read = (x / quantum).round() * quantum;
-        let phase = std::f64::consts::TAU * (n % period) as f64 / period as f64;
-        let f = peak * phase.sin() - 100.0 * read - (read - prev) / t;
-        prev = read;
-        force.push(f);
-        position.push(read);
-        let h = t / f64::from(sub);
-        for _ in 0..sub {
-            v += (f - b * v - c * (v / 1e-3).tanh()) / m * h;
-            x += v * h;
-        }
-    }
+    let (force, position) = body::sine_body(m, b, c, quantum, peak);
+    let (t, period, _) = body::SINE;
     let log = Log {
         period_s: t,
         force_n: force,
@@ -130,48 +118,26 @@ fn identify_pose_refuses_bad_arguments_and_records() {
         args.extend(extra);
         TWOPORT.failure(&args)
     };
+    let both = ["--level", low, "--level", high];
+    // At the pose `q`, both levels, and `more`.
+    let with = |q: &'static str, more: &[&'static str]| -> Vec<&str> {
+        let mut v = vec!["--pose-rad", q];
+        v.extend(both);
+        v.extend(more);
+        v
+    };
     for (extra, want) in [
+        (with("0,1", &[]), "has 1 joints"),
+        (with("20", &[]), "outside"),
+        (vec!["--pose-rad", "0", "--level", low], "two levels"),
         (
-            &["--pose-rad", "0,1", "--level", low, "--level", high][..],
-            "has 1 joints",
-        ),
-        (
-            &["--pose-rad", "20", "--level", low, "--level", high][..],
-            "outside",
-        ),
-        (&["--pose-rad", "0", "--level", low][..], "two levels"),
-        (
-            &["--pose-rad", "0", "--level", low, "--level", empty][..],
+            vec!["--pose-rad", "0", "--level", low, "--level", empty],
             "x-x.csv",
         ),
-        (
-            &[
-                "--pose-rad",
-                "0",
-                "--level",
-                low,
-                "--level",
-                high,
-                "--min-grasp",
-                "-1",
-            ][..],
-            "--min-grasp -1",
-        ),
-        (
-            &[
-                "--pose-rad",
-                "0",
-                "--level",
-                low,
-                "--level",
-                high,
-                "--skip",
-                "30",
-            ][..],
-            "periods",
-        ),
+        (with("0", &["--min-grasp", "-1"]), "--min-grasp -1"),
+        (with("0", &["--skip", "30"]), "periods"),
     ] {
-        let e = run(extra);
+        let e = run(&extra);
         assert!(e.contains(want), "{extra:?}: {e}");
     }
     let e = TWOPORT.failure(&[

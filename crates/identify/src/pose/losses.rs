@@ -346,33 +346,22 @@ impl JointLosses {
     }
 }
 
+// (The body the tests simulate is the CLI tests' too.)
+#[cfg(test)]
+#[path = "../../../../tests/support/sine_body.rs"]
+mod sine_body;
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::log::Excitation;
 
-    /// One sine experiment on a body of `mass` (kg) with viscous damping
-    /// `b` (N s/m) and Coulomb friction `c` (N, rising over 1 mm/s), held
-    /// at 1 kHz by 100 N/m and 1 N s/m on its reading (1 µm steps), the
-    /// sine `peak` (N) at 10 Hz for 24 periods.
+    use super::sine_body as support;
+
+    /// [`support::sine_body`] of 0.1 kg read in 1 µm steps, as a record.
     fn sine(mass: f64, b: f64, c: f64, peak: f64) -> Log {
-        let (t, period, periods, sub) = (1e-3, 100, 24, 200);
-        let (mut x, mut v, mut prev) = (0.0f64, 0.0f64, 0.0f64);
-        let (mut force, mut position) = (Vec::new(), Vec::new());
-        for n in 0..period * periods {
-            let read = (x * 1e6).round() / 1e6;
-            let phase = std::f64::consts::TAU * (n % period) as f64 / period as f64;
-            let f = peak * phase.sin() - 100.0 * read - (read - prev) / t;
-            prev = read;
-            force.push(f);
-            position.push(read);
-            let h = t / sub as f64;
-            for _ in 0..sub {
-                let a = (f - b * v - c * (v / 1e-3).tanh()) / mass;
-                v += a * h;
-                x += v * h;
-            }
-        }
+        let (force, position) = support::sine_body(mass, b, c, 1e-6, peak);
+        let (t, period, _) = support::SINE;
         Log {
             period_s: t,
             force_n: force,

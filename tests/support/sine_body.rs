@@ -1,0 +1,34 @@
+//! A sine experiment on a body of one axis with viscous damping and
+//! Coulomb friction, as the joint-loss tests need it: held at 1 kHz by
+//! 100 N/m and 1 N s/m on its reading, a 10 Hz sine for 24 periods,
+//! integrated in 200 steps a tick. Included with `#[path]` by the
+//! identify crate's unit tests and the CLI's, so that both simulate the
+//! one body.
+
+/// The period (s), ticks a period, and periods.
+pub const SINE: (f64, usize, usize) = (1e-3, 100, 24);
+
+/// The force the board commanded (N) and the reading (m) each tick, for
+/// a body of `mass` (kg) with damping `b` (N s/m) and friction `c` (N,
+/// rising over 1 mm/s) read in steps of `quantum` (m), under a sine of
+/// `peak` (N).
+pub fn sine_body(mass: f64, b: f64, c: f64, quantum: f64, peak: f64) -> (Vec<f64>, Vec<f64>) {
+    let (t, period, periods) = SINE;
+    let sub = 200;
+    let (mut x, mut v, mut prev) = (0.0f64, 0.0f64, 0.0f64);
+    let (mut force, mut position) = (Vec::new(), Vec::new());
+    for n in 0..period * periods {
+        let read = (x / quantum).round() * quantum;
+        let phase = std::f64::consts::TAU * (n % period) as f64 / period as f64;
+        let f = peak * phase.sin() - 100.0 * read - (read - prev) / t;
+        prev = read;
+        force.push(f);
+        position.push(read);
+        let h = t / sub as f64;
+        for _ in 0..sub {
+            v += (f - b * v - c * (v / 1e-3).tanh()) / mass * h;
+            x += v * h;
+        }
+    }
+    (force, position)
+}
