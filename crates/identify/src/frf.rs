@@ -84,9 +84,14 @@ pub fn mean_spectrum(
     if periods == 0 || harmonics.iter().any(|h| *h >= period) {
         return vec![Complex64::new(0.0, 0.0); harmonics.len()];
     }
-    let s = spectra(signal, period, harmonics, skip, periods);
-    (0..harmonics.len())
-        .map(|i| s.iter().map(|p| p[i]).sum::<Complex64>() / periods as f64)
+    mean_of(&spectra(signal, period, harmonics, skip, periods))
+}
+
+/// The average over the periods of [`spectra`]' `[period][harmonic]`.
+pub(crate) fn mean_of(spectra: &[Vec<Complex64>]) -> Vec<Complex64> {
+    let harmonics = spectra.first().map_or(0, Vec::len);
+    (0..harmonics)
+        .map(|i| spectra.iter().map(|p| p[i]).sum::<Complex64>() / spectra.len() as f64)
         .collect()
 }
 

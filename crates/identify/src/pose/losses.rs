@@ -18,7 +18,7 @@
 //! harmonics the motion has, where the reading's quantisation does not
 //! reach.
 
-use crate::frf::{spectra, whole_periods};
+use crate::frf::{mean_of, spectra, whole_periods};
 use crate::log::Log;
 use crate::IdentifyError;
 use nalgebra::{DMatrix, DVector};
@@ -148,11 +148,6 @@ pub fn dissipation(
             / period as f64
     };
     let spectra = |s: &[f64]| spectra(s, period, &harmonics, skip, periods);
-    let mean_of = |s: &[Vec<Complex64>]| -> Vec<Complex64> {
-        (0..harmonics.len())
-            .map(|i| s.iter().map(|p| p[i]).sum::<Complex64>() / periods as f64)
-            .collect()
-    };
     let mut per_period = vec![0.0; periods];
     let mut mean = 0.0;
     // Each axis's mean position spectrum, for the rates below.
