@@ -94,15 +94,6 @@ fn truth(device: Device) -> PoseDynamics {
     device.file().unwrap().pose(&rest).unwrap()
 }
 
-/// `truth` with another mass (kg) and damping (N s/m).
-fn with(truth: &PoseDynamics, m: &DMatrix<f64>, d: &DMatrix<f64>) -> PoseDynamics {
-    PoseDynamics {
-        mass_kg: m.clone(),
-        damping_nspm: d.clone(),
-        ..truth.clone()
-    }
-}
-
 /// The designs at the images' least grasp on the true pose, the
 /// identified one and the set, and `verify`'s spectral radius on the
 /// true pose at the set's.
@@ -166,11 +157,11 @@ fn the_linkages_close_at_their_calibration_pose() {
         let data = PoseMeasured::from_logs(&logs, 2).unwrap();
         let f = fit(&data).unwrap();
         let truth = truth(device);
-        let ident = with(&truth, &f.mass_kg, &f.damping_nspm);
+        let ident = truth.with_body(&f.mass_kg, &f.damping_nspm);
         let set: Vec<PoseDynamics> = f
             .span(POSE_DOUBT)
             .iter()
-            .map(|(m, d)| with(&truth, m, d))
+            .map(|(m, d)| truth.with_body(m, d))
             .collect();
         let c = closes(device, &ident, &set, heavy_tol);
         let least = |p: &PoseDynamics| eigen(&p.damping_nspm)[0];
@@ -252,8 +243,9 @@ fn the_linkages_close_with_their_joints_friction() {
             let m = masses.last().unwrap();
             let d = l.damping_nspm(&truth.jacobian, 0.0).unwrap();
             let least = l.damping_nspm(&truth.jacobian, 3.0).unwrap();
-            let set: Vec<PoseDynamics> = masses.iter().map(|m| with(&truth, m, &least)).collect();
-            let c = closes(device, &with(&truth, m, &d), &set, heavy_tol);
+            let set: Vec<PoseDynamics> =
+                masses.iter().map(|m| truth.with_body(m, &least)).collect();
+            let c = closes(device, &truth.with_body(m, &d), &set, heavy_tol);
             eprintln!(
                 "{device:?}, friction {friction}: masses {:?} kg (true {:?}); joints' damping \
                  {:?} ± {:?} N m s/rad (true {:?}), friction {:?} ± {:?} N m (true {:?}), misfit \

@@ -70,12 +70,7 @@ pub(crate) fn identify_pose(a: &IdentifyPoseArgs) -> Result<(), String> {
         .damping_nspm(&own.jacobian, a.sigmas)
         .ok_or_else(singular)?;
     let top = masses.last().expect("one level or more (clap)");
-    let with = |m: &DMatrix<f64>, d: &DMatrix<f64>| PoseDynamics {
-        mass_kg: m.clone(),
-        damping_nspm: d.clone(),
-        ..own.clone()
-    };
-    let set: Vec<PoseDynamics> = masses.iter().map(|m| with(m, &least)).collect();
+    let set: Vec<PoseDynamics> = masses.iter().map(|m| own.with_body(m, &least)).collect();
     let design = |poses: &[PoseDynamics]| {
         bounded_workspace_design(&file, poses, 0.0, a.min_grasp, HumanBound::PAPER)
             .map(|d| d.k_c_npm)
@@ -83,7 +78,7 @@ pub(crate) fn identify_pose(a: &IdentifyPoseArgs) -> Result<(), String> {
     };
     let (k_own, k_fit, k_set) = (
         design(std::slice::from_ref(&own))?,
-        design(&[with(top, &d)])?,
+        design(&[own.with_body(top, &d)])?,
         design(&set)?,
     );
     let eig = |m: &DMatrix<f64>| {

@@ -25,6 +25,19 @@ pub struct PoseDynamics {
     pub damping_nspm: DMatrix<f64>,
 }
 
+impl PoseDynamics {
+    /// This pose (its angles, position and Jacobian) with another mass
+    /// (kg) and damping (N s/m) at the handle: an identified body, or one
+    /// of the set a robust design proves.
+    pub fn with_body(&self, mass_kg: &DMatrix<f64>, damping_nspm: &DMatrix<f64>) -> Self {
+        PoseDynamics {
+            mass_kg: mass_kg.clone(),
+            damping_nspm: damping_nspm.clone(),
+            ..self.clone()
+        }
+    }
+}
+
 /// The handle's position and the Jacobian at `q` for the file's geometry.
 pub fn forward(
     geometry: &Geometry,

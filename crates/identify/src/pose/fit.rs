@@ -19,9 +19,10 @@ const FLOOR: f64 = 2e-3;
 /// the least damping came out 0.0044 to 0.015 N s/m where the joints give
 /// 0.0038 (the encoders' quantum and the pose moving under the push), and
 /// the joints' friction, which this fit does not separate (the joints'
-/// losses, [`losses`](super::losses), do), is larger still. The damping the proof credits bounds the stiffness nearly in
-/// proportion, so a robust design at a pose credits none: the grasp's
-/// least damping, which the dead-man switch assures, carries it.
+/// losses, [`losses`](super::losses), do), is larger still. The damping
+/// the proof credits bounds the stiffness nearly in proportion, so a
+/// robust design at a pose credits none: the grasp's least damping,
+/// which the dead-man switch assures, carries it.
 pub const POSE_DOUBT: Doubt = Doubt {
     sigmas: 3.0,
     damping: 1.0,
