@@ -8,10 +8,20 @@ const SERIAL_BELOW: usize = 512;
 /// `f(0), ..., f(n - 1)` in order, computed on up to the machine's
 /// available cores (at most 8) in contiguous chunks.
 pub(crate) fn map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    map_from(n, SERIAL_BELOW, f)
+}
+
+/// [`map`] for items that each cost enough to split from `serial_below`
+/// items up.
+pub(crate) fn map_from<T: Send>(
+    n: usize,
+    serial_below: usize,
+    f: impl Fn(usize) -> T + Sync,
+) -> Vec<T> {
     let threads = std::thread::available_parallelism()
         .map_or(1, |p| p.get())
         .min(8);
-    if threads < 2 || n < SERIAL_BELOW {
+    if threads < 2 || n < serial_below {
         return (0..n).map(f).collect();
     }
     let chunk = n.div_ceil(threads);

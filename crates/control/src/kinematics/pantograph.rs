@@ -72,7 +72,11 @@ impl<R: Real> Kinematics<R, 2> for Pantograph {
         let (a1x, a1y) = (x[0] - p1x, x[1] - p1y);
         let (a2x, a2y) = (x[0] - p2x, x[1] - p2y);
         let det = a1x * a2y - a1y * a2x;
-        if det.abs() < R::of(self.det_floor) {
+        // Written as a clearance, as every check here is: the designer
+        // runs this code over a whole box of poses, where a comparison
+        // holds if it may hold, and a box that may be clear must go on.
+        let clear_of_singularity = det.abs() >= R::of(self.det_floor);
+        if !clear_of_singularity {
             return Err(KinematicsFault::Singular);
         }
         // Rows of A = [a1; a2], right-hand sides b_i = a_i·ṗ_i per unit q_i'.

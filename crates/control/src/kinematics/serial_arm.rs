@@ -62,7 +62,11 @@ impl<R: Real> Kinematics<R, 3> for SerialArm {
         ];
         // det J = reach · l1 l2 (s2 s3 + c2 c3) = reach l1 l2 cos(q2 - q3).
         let det = reach * l1 * l2 * (s2 * s3 + c2 * c3);
-        if det.abs() < R::of(self.det_floor) {
+        // Written as a clearance, as every check here is: the designer
+        // runs this code over a whole box of poses, where a comparison
+        // holds if it may hold, and a box that may be clear must go on.
+        let clear_of_singularity = det.abs() >= R::of(self.det_floor);
+        if !clear_of_singularity {
             return Err(KinematicsFault::Singular);
         }
         Ok(Jointed {

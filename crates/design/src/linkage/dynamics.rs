@@ -3,6 +3,7 @@
 
 use nalgebra::Matrix3;
 use twoport_control::kinematics::{Kinematics, KinematicsFault, SerialArm};
+use twoport_control::Real;
 
 /// The PHANToM-type serial arm's masses and inertias (Cavusoglu, Feygin &
 /// Tendick 2002, for the PHANToM Premium 1.5), with the motors' rotor
@@ -50,11 +51,19 @@ impl SerialArmDynamics {
 
     /// The joint-space mass matrix at `q` (rad), rotors included (kg m²).
     pub fn joint_mass(&self, q: [f64; 3]) -> Matrix3<f64> {
+        let m = self.joint_mass_in(q);
+        Matrix3::from_fn(|r, c| m[r][c])
+    }
+
+    /// [`joint_mass`](Self::joint_mass) in any scalar the kinematics run
+    /// in: the workspace proof encloses it over a box of angles.
+    pub fn joint_mass_in<R: Real + From<f64>>(&self, q: [R; 3]) -> [[R; 3]; 3] {
+        let c = R::from;
         let (l1, l2, l3) = (self.l1_m, self.l2_m, self.l3_m);
         let [ma, mc, _, _] = self.masses_kg;
         let [ia, ic, ibe, idf] = self.inertias_kgm2;
         let (xx, yy, zz) = (0, 1, 2);
-        let m11 = (4.0 * ia[yy]
+        let constant = (4.0 * ia[yy]
             + 4.0 * ia[zz]
             + 8.0 * self.base_yy_kgm2
             + 4.0 * ibe[yy]
@@ -67,33 +76,29 @@ impl SerialArmDynamics {
             + l2 * l2 * ma
             + l1 * l1 * mc
             + 4.0 * l3 * l3 * mc)
-            / 8.0
-            + (4.0 * ibe[yy] - 4.0 * ibe[zz] + 4.0 * ic[yy] - 4.0 * ic[zz]
-                + l1 * l1 * (4.0 * ma + mc))
-                / 8.0
-                * (2.0 * q[1]).cos()
-            + (4.0 * ia[yy] - 4.0 * ia[zz] + 4.0 * idf[yy]
-                - 4.0 * idf[zz]
-                - l2 * l2 * ma
-                - 4.0 * l3 * l3 * mc)
-                / 8.0
-                * (2.0 * q[2]).cos()
-            + l1 * (l2 * ma + l3 * mc) * q[1].cos() * q[2].sin();
+            / 8.0;
+        let by_2q2 = (4.0 * ibe[yy] - 4.0 * ibe[zz] + 4.0 * ic[yy] - 4.0 * ic[zz]
+            + l1 * l1 * (4.0 * ma + mc))
+            / 8.0;
+        let by_2q3 = (4.0 * ia[yy] - 4.0 * ia[zz] + 4.0 * idf[yy]
+            - 4.0 * idf[zz]
+            - l2 * l2 * ma
+            - 4.0 * l3 * l3 * mc)
+            / 8.0;
+        let coupled = l1 * (l2 * ma + l3 * mc);
+        let m11 = c(constant)
+            + c(by_2q2) * (c(2.0) * q[1]).cos()
+            + c(by_2q3) * (c(2.0) * q[2]).cos()
+            + c(coupled) * q[1].cos() * q[2].sin();
         let m22 = (4.0 * (ibe[xx] + ic[xx] + l1 * l1 * ma) + l1 * l1 * mc) / 4.0;
-        let m23 = -0.5 * l1 * (l2 * ma + l3 * mc) * (q[1] - q[2]).sin();
+        let m23 = c(-0.5 * l1 * (l2 * ma + l3 * mc)) * (q[1] - q[2]).sin();
         let m33 = (4.0 * ia[xx] + 4.0 * idf[xx] + l2 * l2 * ma + 4.0 * l3 * l3 * mc) / 4.0;
         let r = self.ratios.map(|n| n * n * self.rotor_kgm2);
-        Matrix3::new(
-            m11 + r[0],
-            0.0,
-            0.0,
-            0.0,
-            m22 + r[1],
-            m23,
-            0.0,
-            m23,
-            m33 + r[2],
-        )
+        [
+            [m11 + c(r[0]), R::ZERO, R::ZERO],
+            [R::ZERO, c(m22 + r[1]), m23],
+            [R::ZERO, m23, c(m33 + r[2])],
+        ]
     }
 
     /// The mass the hand feels at the handle at `q`: `J^-T M_q J^-1` (kg),

@@ -3,20 +3,28 @@
 //! kinematics (the same Jacobian the board will run).
 
 mod bounded;
+mod cell;
 mod dynamics;
 mod file;
+mod interval;
 mod pose;
 mod proof;
 mod report;
+mod search;
+mod taylor;
 mod verify;
 
 pub use bounded::{bound_at, stiffest, stiffest_at, theta_grid, PoseRanges};
+pub use cell::{CellBounds, Undecided};
 pub use dynamics::SerialArmDynamics;
 pub use file::{Geometry, Inertia, Joints, LinkageFile, Motors, RelativeLimit};
+pub use interval::Interval;
 pub use pose::{forward, PoseDynamics};
 pub use proof::{
-    bounded_workspace_design, workspace_design, workspace_poses, Binding, WorkspaceDesign,
-    BOUNDED_GRID, DESIGN_GRID,
+    bounded_workspace_design, certified_design, workspace_design, workspace_poses, Binding,
+    Certificate, WorkspaceDesign, BOUNDED_GRID, DESIGN_GRID,
 };
 pub use report::{stiffness, LinkageDesign};
+pub use search::{least, Least, Objective, SearchError, BUDGET, TOLERANCE};
+pub use taylor::Taylor;
 pub use verify::{loop_radius, verify_linkage, HandAssumption, LinkageHand, LinkageVerdict};

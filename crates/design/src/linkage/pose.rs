@@ -2,12 +2,12 @@
 //! board runs), its joint-space mass and damping, and the mass and damping
 //! the hand feels at the handle, `M_x = J^-T M_q J^-1`, `D_x = J^-T D_q J^-1`.
 
+use super::cell::OnKinematics;
 use super::file::{Geometry, Inertia, LinkageFile};
+use super::taylor::Taylor;
 use super::SerialArmDynamics;
 use nalgebra::DMatrix;
-use twoport_control::kinematics::{
-    Capstan, Delta, Kinematics, KinematicsFault, Pantograph, SerialArm,
-};
+use twoport_control::kinematics::{Kinematics, KinematicsFault};
 
 /// The handle's position, the Jacobian, and the Cartesian mass and damping
 /// at one pose.
@@ -43,41 +43,24 @@ pub fn forward(
     geometry: &Geometry,
     q: &[f64],
 ) -> Result<(Vec<f64>, DMatrix<f64>), KinematicsFault> {
-    fn run<K: Kinematics<f64, N>, const N: usize>(
-        k: K,
-        q: &[f64],
-    ) -> Result<(Vec<f64>, DMatrix<f64>), KinematicsFault> {
-        let q: [f64; N] = q.try_into().map_err(|_| KinematicsFault::NotFinite)?;
-        let j = k.forward(&q)?;
-        Ok((
-            j.position_m.to_vec(),
-            DMatrix::from_fn(N, N, |r, c| j.jacobian[r][c]),
-        ))
-    }
-    let f = |x: f64| x as f32;
-    let bad = |_| KinematicsFault::NotFinite;
-    match *geometry {
-        Geometry::Capstan {
-            r_h_m,
-            r_p_m,
-            r_s_m,
-        } => run::<_, 1>(Capstan::new(f(r_h_m), f(r_p_m), f(r_s_m)).map_err(bad)?, q),
-        Geometry::Pantograph { l_m, big_l_m, d_m } => {
-            run::<_, 2>(Pantograph::new(f(l_m), f(big_l_m), f(d_m)).map_err(bad)?, q)
+    struct Forward<'a>(&'a [f64]);
+    impl OnKinematics for Forward<'_> {
+        type Out = Result<(Vec<f64>, DMatrix<f64>), KinematicsFault>;
+        fn run<K, const N: usize>(self, k: K) -> Self::Out
+        where
+            K: Kinematics<f64, N> + Kinematics<Taylor<N>, N>,
+        {
+            let q: [f64; N] = self.0.try_into().map_err(|_| KinematicsFault::NotFinite)?;
+            let j = Kinematics::<f64, N>::forward(&k, &q)?;
+            Ok((
+                j.position_m.to_vec(),
+                DMatrix::from_fn(N, N, |r, c| j.jacobian[r][c]),
+            ))
         }
-        Geometry::SerialArm { l1_m, l2_m } => {
-            run::<_, 3>(SerialArm::new(f(l1_m), f(l2_m)).map_err(bad)?, q)
-        }
-        Geometry::Delta {
-            base_m,
-            effector_m,
-            upper_m,
-            lower_m,
-        } => run::<_, 3>(
-            Delta::new(f(base_m), f(effector_m), f(upper_m), f(lower_m)).map_err(bad)?,
-            q,
-        ),
     }
+    geometry
+        .on_kinematics(Forward(q))
+        .unwrap_or(Err(KinematicsFault::NotFinite))
 }
 
 impl LinkageFile {

@@ -21,8 +21,10 @@
 //! `linkage::bounded`. `docs/linkages.md` has the argument.
 
 use super::bounded::{stiffest, theta_grid, PoseRanges};
+use super::cell::CellBounds;
 use super::file::LinkageFile;
 use super::pose::PoseDynamics;
+use super::search::{least, Least, Objective, SearchError};
 use crate::network::HumanBound;
 use nalgebra::DVector;
 
@@ -63,6 +65,9 @@ pub struct WorkspaceDesign {
     pub mass_range_kg: (f64, f64),
     /// The least and most damped the handle is, over the poses (N s/m).
     pub damping_range_nspm: (f64, f64),
+    /// How the design is proven over the workspace; `None` for a design
+    /// over given poses.
+    pub certificate: Option<Certificate>,
 }
 
 /// Angles per joint on the grid `design` proves a linkage over.
@@ -181,6 +186,7 @@ pub fn workspace_design(
         poses: poses.len(),
         mass_range_kg: (m_lo, m_hi),
         damping_range_nspm: (d_lo, d_hi),
+        certificate: None,
     })
 }
 
@@ -249,6 +255,185 @@ pub fn bounded_workspace_design(
     })
 }
 
+/// How the workspace design is proven: the branch and bound's bound and
+/// the best pose it found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Certificate {
+    /// The stiffness found at the binding pose (N/m): the design's
+    /// `k_c_npm` is proven, and at most `gap` below this.
+    pub found_k_c_npm: f64,
+    /// `(found - proven)/found`.
+    pub gap: f64,
+    /// The box of joint angles whose bound is the design (rad).
+    pub binding_box_rad: Vec<[f64; 2]>,
+    /// Boxes bounded.
+    pub boxes: usize,
+}
+
+/// The hands-off (or least-grasp) boundary `2 (λ_min(D_x) + b_g - b_c)/T`.
+struct Colgate {
+    period_s: f64,
+    b_c_nspm: f64,
+    min_grasp_nspm: f64,
+}
+
+impl Colgate {
+    fn of(&self, damping_nspm: f64) -> f64 {
+        2.0 * (damping_nspm + self.min_grasp_nspm - self.b_c_nspm) / self.period_s
+    }
+}
+
+/// The least damping in any direction (N s/m): what the hands-off and
+/// least-grasp boundaries rest on.
+struct LeastDamping;
+
+impl Objective for LeastDamping {
+    const MASS: bool = false;
+    fn over(&self, cell: &CellBounds) -> f64 {
+        cell.damping_nspm.0
+    }
+    fn at(&self, pose: &PoseDynamics) -> f64 {
+        pose.damping_nspm.clone().symmetric_eigenvalues().min()
+    }
+}
+
+/// The boundary under the paper's bound on the grasp at `b_c`: the alias
+/// sum's stiffest over the ranges a box or a pose allows, and never below
+/// the hands-off boundary (every bounded hand is passive).
+struct Bounded {
+    floor: Colgate,
+    human: HumanBound,
+    thetas: Vec<f64>,
+}
+
+impl Bounded {
+    fn of(&self, mass_kg: (f64, f64), damping_nspm: (f64, f64)) -> Option<(f64, f64)> {
+        if !(mass_kg.1.is_finite() && damping_nspm.1.is_finite() && mass_kg.0 > 0.0) {
+            return None;
+        }
+        let g = self.floor.min_grasp_nspm;
+        let ranges = PoseRanges {
+            mass_kg,
+            damping_nspm: (damping_nspm.0 + g, damping_nspm.1 + g),
+        };
+        stiffest(
+            &ranges,
+            &self.human,
+            self.floor.b_c_nspm,
+            self.floor.period_s,
+            &self.thetas,
+        )
+    }
+
+    fn ranges(pose: &PoseDynamics) -> ((f64, f64), (f64, f64)) {
+        let m = pose.mass_kg.clone().symmetric_eigenvalues();
+        let d = pose.damping_nspm.clone().symmetric_eigenvalues();
+        ((m.min(), m.max()), (d.min(), d.max()))
+    }
+}
+
+impl Objective for Bounded {
+    const MASS: bool = true;
+    fn over(&self, cell: &CellBounds) -> f64 {
+        // (Rounded down by far more than the three operations' rounding.)
+        let floor = self.floor.of(cell.damping_nspm.0);
+        let floor = floor - 1e-12 * floor.abs();
+        match self.of(cell.mass_kg, cell.damping_nspm) {
+            Some((k, _)) => k.max(floor),
+            None => floor,
+        }
+    }
+    fn at(&self, pose: &PoseDynamics) -> f64 {
+        let (m, d) = Self::ranges(pose);
+        let floor = self.floor.of(d.0);
+        self.of(m, d).map_or(floor, |(k, _)| k.max(floor))
+    }
+}
+
+/// The design over the whole workspace, proven by branch and bound (see
+/// `cell`): at `b_c` for every passive hand that grasps with at least
+/// `min_grasp` (N s/m), and no stiffer than `human` if given. The design's
+/// stiffness is the proven lower bound over every pose inside the joint
+/// and relative limits; the binding pose is the least found, within the
+/// certificate's gap of it.
+pub fn certified_design(
+    file: &LinkageFile,
+    b_c_nspm: f64,
+    min_grasp_nspm: f64,
+    human: Option<HumanBound>,
+) -> Result<WorkspaceDesign, crate::Error> {
+    for (name, value) in [("b", b_c_nspm), ("min-grasp", min_grasp_nspm)] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(crate::Error::Gain { name, value });
+        }
+    }
+    let floor = Colgate {
+        period_s: file.period_s,
+        b_c_nspm,
+        min_grasp_nspm,
+    };
+    let found = match human {
+        None => least(file, &LeastDamping).map(|d| Least {
+            bound: {
+                let k = floor.of(d.bound);
+                k - 1e-12 * k.abs()
+            },
+            found: floor.of(d.found),
+            ..d
+        }),
+        Some(h) => least(
+            file,
+            &Bounded {
+                floor,
+                human: h,
+                thetas: theta_grid(file.period_s, BOUNDED_GRID),
+            },
+        ),
+    }
+    .map_err(|SearchError::NoPose| crate::Error::NoPose)?;
+    let pose = found.pose;
+    let mut design = workspace_design(file, std::slice::from_ref(&pose), b_c_nspm, min_grasp_nspm)?;
+    // The ranges the report gives, over the design grid's poses.
+    let mut sampled = file.workspace(DESIGN_GRID);
+    sampled.push(pose.clone());
+    let spread = workspace_design(file, &sampled, b_c_nspm, min_grasp_nspm)?;
+    (design.mass_range_kg, design.damping_range_nspm) =
+        (spread.mass_range_kg, spread.damping_range_nspm);
+    if found.bound.is_nan() || found.bound <= 0.0 {
+        return Err(crate::Error::Coupling(format!(
+            "{}: b_c = {b_c_nspm} N s/m leaves no stiffness: the handle's least damped \
+             direction has {:.4} N s/m (at q = {:?} rad) and the grasp at least \
+             {min_grasp_nspm}; the coupling's damping must stay below their sum",
+            file.name, design.binding.damping_nspm, pose.q_rad
+        )));
+    }
+    if let Some(h) = human {
+        let (m, d) = Bounded::ranges(&pose);
+        let b = Bounded {
+            floor: Colgate {
+                period_s: file.period_s,
+                b_c_nspm,
+                min_grasp_nspm,
+            },
+            human: h,
+            thetas: theta_grid(file.period_s, BOUNDED_GRID),
+        };
+        design.human = Some(h);
+        design.binding.frequency_hz = b
+            .of(m, d)
+            .map(|(_, theta)| theta / (2.0 * std::f64::consts::PI * file.period_s));
+    }
+    design.k_c_npm = found.bound;
+    design.poses = found.boxes;
+    design.certificate = Some(Certificate {
+        found_k_c_npm: found.found,
+        gap: found.gap,
+        binding_box_rad: found.binding_box_rad,
+        boxes: found.boxes,
+    });
+    Ok(design)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -313,6 +498,83 @@ mod tests {
             );
         }
         assert!(workspace_design(&shipped(SHIPPED[0]), &[], 0.0, 0.0).is_err());
+    }
+
+    /// The certificate is a lower bound: no pose of a fine grid, nor of a
+    /// thousand random poses inside the limits, is less damped, on every
+    /// shipped linkage; it is within the tolerance of the least damped
+    /// pose it found; and that pose's own boundary is the one reported.
+    #[test]
+    fn the_certificate_is_below_every_pose_and_close_to_one() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        // (The delta's bounds are too loose for the search to close within
+        // its budget yet: docs/linkages.md says so.)
+        for name in SHIPPED.iter().filter(|n| !n.starts_with("falcon")) {
+            let l = shipped(name);
+            let d = certified_design(&l, 0.0, 0.0, None).unwrap();
+            let c = d.certificate.clone().unwrap();
+            assert!(
+                c.gap >= 0.0 && c.gap <= crate::linkage::TOLERANCE,
+                "{name}: {c:?}"
+            );
+            let k_at = |p: &PoseDynamics| {
+                2.0 * p.damping_nspm.clone().symmetric_eigenvalues().min() / l.period_s
+            };
+            assert!((k_at(&d.binding.pose) - c.found_k_c_npm).abs() <= 1e-12 * c.found_k_c_npm);
+            let mut poses = l.workspace(17);
+            for _ in 0..1000 {
+                let q: Vec<f64> = l
+                    .joints
+                    .limits_rad
+                    .iter()
+                    .map(|[lo, hi]| lo + (hi - lo) * rnd())
+                    .collect();
+                if l.within_limits(&q) {
+                    if let Ok(p) = l.pose(&q) {
+                        poses.push(p);
+                    }
+                }
+            }
+            for p in &poses {
+                assert!(
+                    k_at(p) >= d.k_c_npm,
+                    "{name}: {} < {} at {:?}",
+                    k_at(p),
+                    d.k_c_npm,
+                    p.q_rad
+                );
+            }
+        }
+    }
+
+    /// The PHANToM Premium 1.5's least damped pose lies on its
+    /// parallelogram's limit `q3 - q2 = 0.9599`, near `q2 = 0.27`,
+    /// `q3 = 1.23` rad, where a search along the joints stops short: the
+    /// certificate is at most 7.4072 N/m hands off and 4,007.4072 N/m with
+    /// a 2 N s/m grasp, and binds there.
+    #[test]
+    fn the_phantoms_certificate_binds_on_its_parallelogram_limit() {
+        let l = shipped("phantom_premium_1_5.toml");
+        let d = certified_design(&l, 0.0, 0.0, None).unwrap();
+        assert!(d.k_c_npm <= 7.4072 && d.k_c_npm > 7.406, "{}", d.k_c_npm);
+        let q = &d.binding.pose.q_rad;
+        assert!((q[2] - q[1] - 0.9599).abs() < 1e-3, "{q:?}");
+        assert!(
+            (q[1] - 0.2686).abs() < 0.02 && (q[2] - 1.2285).abs() < 0.02,
+            "{q:?}"
+        );
+        let g = certified_design(&l, 0.0, 2.0, None).unwrap();
+        assert!(
+            g.k_c_npm <= 4007.4072 && g.k_c_npm > 4007.40,
+            "{}",
+            g.k_c_npm
+        );
     }
 
     /// The refined coarse grid finds the least damped pose a grid twice as

@@ -1,0 +1,514 @@
+//! Bounds on a linkage's Cartesian damping and mass over a box of joint
+//! angles, rigorous: every pose in the box (inside the relative limits)
+//! has eigenvalues within them.
+//!
+//! Both matrices are taken through their inverses, which need no inverse
+//! Jacobian: `D_x^-1 = J D_q^-1 J^T` and `M_x^-1 = J M_q^-1 J^T`. For
+//! either, call it `A(q)`, the box's centre `c` and half-widths `h`:
+//!
+//! - Taylor's theorem with the Lagrange remainder gives
+//!   `A(c + Δ) = A(c) + Σ_k ∂_k A(c) Δ_k + R(Δ)`, where each entry of `R`
+//!   is at most `½ Σ_kl |∂_kl A|_box h_k h_l`, the Hessian enclosed over
+//!   the whole box by [`Taylor`] arithmetic on the board's own kinematics.
+//! - The affine part `L(Δ)` is a symmetric matrix affine in `Δ`, so its
+//!   largest eigenvalue is convex in `Δ` and its least concave: both take
+//!   their extremes over the feasible set (the box cut by the relative
+//!   limits, a polytope) at its vertices.
+//! - Weyl's inequality moves each eigenvalue by at most `‖R‖₂`, which is at
+//!   most the largest row sum of the entrywise bound.
+//!
+//! So `λ_max(A) ≤ max_v λ_max(L(v)) + ‖R‖` and `λ_min(A) ≥ min_v
+//! λ_min(L(v)) - ‖R‖`, with an allowance for the eigen-solver's rounding.
+//! The remainder is second order in the box's size, so halving a box near
+//! the least damped pose quarters the gap.
+
+use super::file::{Geometry, Inertia, LinkageFile};
+use super::interval::Interval;
+use super::taylor::Taylor;
+use nalgebra::{DMatrix, DVector};
+use twoport_control::kinematics::{Capstan, Delta, Kinematics, Pantograph, SerialArm};
+use twoport_control::Real;
+
+/// The eigenvalue bounds over a box.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CellBounds {
+    /// `(λ_min lower bound, λ_max upper bound)` of `D_x` (N s/m); the
+    /// upper end is `∞` where the box may reach a pose that sees no
+    /// damping in some direction.
+    pub damping_nspm: (f64, f64),
+    /// The same for `M_x` (kg).
+    pub mass_kg: (f64, f64),
+    /// The feasible vertex at which the damping's bound binds (rad): where
+    /// to look for the box's least damped pose.
+    pub least_damped_q_rad: Vec<f64>,
+    /// The joint whose side adds most to the bounds' looseness: the one
+    /// to split.
+    pub split: usize,
+}
+
+/// Why a box has no bounds: no pose in it is driven.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Undecided {
+    /// The box lies wholly outside the relative limits.
+    Infeasible,
+    /// The kinematics refuse every pose in the box (past a singularity's
+    /// floor, or unreachable): the board drives none of them.
+    Refused,
+}
+
+/// Joint-space quantities in the Taylor scalar over a box.
+type Mat<const N: usize> = [[Taylor<N>; N]; N];
+
+/// `J X^-1 J^T` for a symmetric positive definite `X` (Gauss-Jordan; the
+/// pivot order is chosen on midpoints, which only decides tightness).
+fn congruence<const N: usize>(j: &Mat<N>, x: &Mat<N>) -> Option<Mat<N>> {
+    // Solve X Y = J^T for Y = X^-1 J^T.
+    let mut a = *x;
+    let mut y: Mat<N> = core::array::from_fn(|r| core::array::from_fn(|c| j[c][r]));
+    for col in 0..N {
+        let p = (col..N).max_by(|&r, &s| {
+            a[r][col]
+                .v
+                .mag()
+                .partial_cmp(&a[s][col].v.mag())
+                .unwrap_or(std::cmp::Ordering::Equal)
+        })?;
+        a.swap(col, p);
+        y.swap(col, p);
+        let pivot = a[col][col];
+        if pivot.v.contains_zero() {
+            return None;
+        }
+        for k in 0..N {
+            a[col][k] = a[col][k] / pivot;
+            y[col][k] = y[col][k] / pivot;
+        }
+        for r in 0..N {
+            if r == col {
+                continue;
+            }
+            let f = a[r][col];
+            for k in 0..N {
+                a[r][k] = a[r][k] - f * a[col][k];
+                y[r][k] = y[r][k] - f * y[col][k];
+            }
+        }
+    }
+    Some(core::array::from_fn(|r| {
+        core::array::from_fn(|c| {
+            let mut s = Taylor::ZERO;
+            for k in 0..N {
+                s += j[r][k] * y[k][c];
+            }
+            s
+        })
+    }))
+}
+
+/// `M_q` over the box given `J` there.
+fn joint_mass<const N: usize>(file: &LinkageFile, j: &Mat<N>, q: &[Taylor<N>; N]) -> Mat<N> {
+    let c = |x: f64| Taylor::<N>::from(x);
+    let rotor = |i: usize| c(file.motors.ratios[i].powi(2) * file.motors.rotor_inertia_kgm2);
+    let m: Mat<N> = match (&file.inertia, file.geometry) {
+        (
+            Inertia::Lumped {
+                handle_mass_kg,
+                link_inertia_kgm2,
+            },
+            _,
+        ) => core::array::from_fn(|r| {
+            core::array::from_fn(|col| {
+                let mut s = Taylor::ZERO;
+                for row in j {
+                    s += row[r] * row[col];
+                }
+                let diag = if r == col {
+                    c(link_inertia_kgm2[r]) + rotor(r)
+                } else {
+                    Taylor::ZERO
+                };
+                diag + s * c(*handle_mass_kg)
+            })
+        }),
+        (
+            Inertia::SerialArmLinks {
+                l3_m,
+                masses_kg,
+                inertias_kgm2,
+                base_yy_kgm2,
+                ..
+            },
+            Geometry::SerialArm { l1_m, l2_m },
+        ) if N == 3 => {
+            let arm = super::SerialArmDynamics {
+                l1_m,
+                l2_m,
+                l3_m: *l3_m,
+                masses_kg: *masses_kg,
+                inertias_kgm2: *inertias_kgm2,
+                base_yy_kgm2: *base_yy_kgm2,
+                rotor_kgm2: file.motors.rotor_inertia_kgm2,
+                ratios: [0, 1, 2].map(|i| file.motors.ratios[i]),
+            };
+            let m = arm.joint_mass_in([q[0], q[1], q[2]]);
+            core::array::from_fn(|r| core::array::from_fn(|col| m[r][col]))
+        }
+        _ => core::array::from_fn(|r| {
+            core::array::from_fn(|col| if r == col { rotor(r) } else { Taylor::ZERO })
+        }),
+    };
+    m
+}
+
+/// The inverse Cartesian damping and mass, `J D_q^-1 J^T` and
+/// `J M_q^-1 J^T`, over the box `q`; `None` for the damping where a joint
+/// has none (then `D_x` is singular at every pose).
+#[allow(clippy::type_complexity)]
+fn inverses<K: Kinematics<Taylor<N>, N>, const N: usize>(
+    file: &LinkageFile,
+    k: &K,
+    q: &[Taylor<N>; N],
+    mass: bool,
+) -> Result<(Option<Mat<N>>, Option<Mat<N>>), Undecided> {
+    let j = k.forward(q).map_err(|_| Undecided::Refused)?.jacobian;
+    let b = &file.joints.damping_nmsprad;
+    let d = if b.iter().all(|&b| b > 0.0) {
+        let d: Mat<N> = core::array::from_fn(|r| {
+            core::array::from_fn(|c| {
+                if r == c {
+                    Taylor::from(b[r])
+                } else {
+                    Taylor::ZERO
+                }
+            })
+        });
+        Some(congruence(&j, &d).ok_or(Undecided::Refused)?)
+    } else {
+        None
+    };
+    let m = if mass {
+        let m = joint_mass(file, &j, q);
+        Some(congruence(&j, &m).ok_or(Undecided::Refused)?)
+    } else {
+        None
+    };
+    Ok((d, m))
+}
+
+/// The vertices of `{Δ : |Δ_k| ≤ h_k} ∩ {relative limits}` about the
+/// centre `c`: the box's corners where no relative limit cuts it, else
+/// every intersection of `N` of the constraints' planes that meets all of
+/// them.
+fn vertices(file: &LinkageFile, c: &[f64], h: &[f64]) -> Vec<Vec<f64>> {
+    let n = c.len();
+    // Rows `a Δ <= b`.
+    let mut rows: Vec<(Vec<f64>, f64)> = Vec::new();
+    for k in 0..n {
+        let mut e = vec![0.0; n];
+        e[k] = 1.0;
+        rows.push((e.clone(), h[k]));
+        rows.push((e.iter().map(|x| -x).collect(), h[k]));
+    }
+    let mut cut = false;
+    for r in &file.joints.relative {
+        let [i, j] = r.joints;
+        let mid = c[j] - c[i];
+        let (lo, hi) = (mid - h[i] - h[j], mid + h[i] + h[j]);
+        if hi < r.rad[0] || lo > r.rad[1] {
+            return Vec::new();
+        }
+        if lo < r.rad[0] || hi > r.rad[1] {
+            cut = true;
+            let mut a = vec![0.0; n];
+            a[j] = 1.0;
+            a[i] = -1.0;
+            rows.push((a.clone(), r.rad[1] - mid));
+            rows.push((a.iter().map(|x| -x).collect(), mid - r.rad[0]));
+        }
+    }
+    if !cut {
+        return (0..1usize << n)
+            .map(|bits| {
+                (0..n)
+                    .map(|k| if bits >> k & 1 == 1 { h[k] } else { -h[k] })
+                    .collect()
+            })
+            .collect();
+    }
+    let scale = h.iter().fold(0.0f64, |a, &b| a.max(b)).max(1e-300);
+    let mut out: Vec<Vec<f64>> = Vec::new();
+    let m = rows.len();
+    let mut pick: Vec<usize> = (0..n).collect();
+    loop {
+        let a = DMatrix::from_fn(n, n, |r, k| rows[pick[r]].0[k]);
+        let b = DVector::from_fn(n, |r, _| rows[pick[r]].1);
+        if let Some(x) = a.lu().solve(&b) {
+            let ok = rows.iter().all(|(a, b)| {
+                let lhs: f64 = a.iter().zip(x.iter()).map(|(a, x)| a * x).sum();
+                lhs <= b + 1e-9 * scale
+            });
+            if ok && x.iter().all(|v| v.is_finite()) {
+                out.push(x.iter().copied().collect());
+            }
+        }
+        // The next combination of n rows out of m.
+        let mut i = n;
+        loop {
+            if i == 0 {
+                return out;
+            }
+            i -= 1;
+            if pick[i] < m - n + i {
+                break;
+            }
+        }
+        pick[i] += 1;
+        for k in i + 1..n {
+            pick[k] = pick[k - 1] + 1;
+        }
+    }
+}
+
+/// The extreme eigenvalues of a symmetric `A(c + Δ)` over the feasible
+/// vertices `vs` given the enclosures at the centre (`at`) and over the
+/// box (`over`): `(λ_min lower bound, λ_max upper bound, the vertex where
+/// λ_max binds)`.
+fn eigen_bounds<const N: usize>(
+    at: &Mat<N>,
+    over: &Mat<N>,
+    h: &[f64],
+    vs: &[Vec<f64>],
+) -> (f64, f64, usize, [f64; N]) {
+    // The remainder's entrywise bound, and the centre's own rounding; and
+    // each joint's share of it.
+    let mut rad = [[0.0f64; N]; N];
+    let mut share = [0.0f64; N];
+    for r in 0..N {
+        for c in 0..N {
+            let mut s = 0.5 * (at[r][c].v.hi - at[r][c].v.lo);
+            for k in 0..N {
+                s += 0.5 * (at[r][c].g[k].hi - at[r][c].g[k].lo) * h[k];
+                for l in 0..N {
+                    let x = 0.5 * over[r][c].h[k][l].mag() * h[k] * h[l];
+                    s += x;
+                    share[k] += x;
+                }
+            }
+            rad[r][c] = s;
+        }
+    }
+    // ‖R‖₂ ≤ max row sum of the symmetric entrywise bound (rounded up:
+    // the relative 1e-12 covers the sums' rounding many times over).
+    let norm = (0..N)
+        .map(|r| (0..N).map(|c| rad[r][c].max(rad[c][r])).sum::<f64>())
+        .fold(0.0f64, f64::max)
+        * (1.0 + 1e-12);
+    let (mut lo, mut hi, mut at_hi) = (f64::INFINITY, f64::NEG_INFINITY, 0);
+    for (i, v) in vs.iter().enumerate() {
+        let l = DMatrix::from_fn(N, N, |r, c| {
+            let e = |m: &Mat<N>| {
+                let (a, b) = (&m[r][c], &m[c][r]);
+                let mut x = 0.5 * (a.v.mid() + b.v.mid());
+                for k in 0..N {
+                    x += 0.5 * (a.g[k].mid() + b.g[k].mid()) * v[k];
+                }
+                x
+            };
+            e(at)
+        });
+        // The symmetric eigen-solver is backward stable: its eigenvalues
+        // are within a few ε‖L‖ of the exact ones; 1e-12 ‖L‖_F is ample.
+        let slack = 1e-12 * l.norm();
+        let e = l.symmetric_eigenvalues();
+        lo = lo.min(e.min() - slack);
+        if e.max() + slack > hi {
+            (hi, at_hi) = (e.max() + slack, i);
+        }
+    }
+    (lo - norm, hi + norm, at_hi, share)
+}
+
+/// What to do with a geometry's kinematics, whatever its joint count.
+pub(crate) trait OnKinematics {
+    /// The result.
+    type Out;
+    /// Run with the kinematics of `N` joints.
+    fn run<K, const N: usize>(self, k: K) -> Self::Out
+    where
+        K: Kinematics<f64, N> + Kinematics<Taylor<N>, N>;
+}
+
+impl Geometry {
+    /// `job` run on this geometry's kinematics (its lengths in `f32`, as
+    /// the board holds them), or `None` where its parameters are refused.
+    pub(crate) fn on_kinematics<J: OnKinematics>(&self, job: J) -> Option<J::Out> {
+        let f = |x: f64| x as f32;
+        Some(match *self {
+            Geometry::Capstan {
+                r_h_m,
+                r_p_m,
+                r_s_m,
+            } => job.run::<_, 1>(Capstan::new(f(r_h_m), f(r_p_m), f(r_s_m)).ok()?),
+            Geometry::Pantograph { l_m, big_l_m, d_m } => {
+                job.run::<_, 2>(Pantograph::new(f(l_m), f(big_l_m), f(d_m)).ok()?)
+            }
+            Geometry::SerialArm { l1_m, l2_m } => {
+                job.run::<_, 3>(SerialArm::new(f(l1_m), f(l2_m)).ok()?)
+            }
+            Geometry::Delta {
+                base_m,
+                effector_m,
+                upper_m,
+                lower_m,
+            } => {
+                job.run::<_, 3>(Delta::new(f(base_m), f(effector_m), f(upper_m), f(lower_m)).ok()?)
+            }
+        })
+    }
+}
+
+/// Bound one box `[lo, hi]` of joint angles.
+struct Bound<'a> {
+    file: &'a LinkageFile,
+    lo: &'a [f64],
+    hi: &'a [f64],
+    mass: bool,
+}
+
+impl OnKinematics for Bound<'_> {
+    type Out = Result<CellBounds, Undecided>;
+    fn run<K, const N: usize>(self, k: K) -> Self::Out
+    where
+        K: Kinematics<f64, N> + Kinematics<Taylor<N>, N>,
+    {
+        let c: Vec<f64> = (0..N)
+            .map(|i| 0.5 * self.lo[i] + 0.5 * self.hi[i])
+            .collect();
+        // Half-widths, rounded up so that [c - h, c + h] holds the box.
+        let h: Vec<f64> = (0..N)
+            .map(|i| (self.hi[i] - c[i]).max(c[i] - self.lo[i]).next_up())
+            .collect();
+        let vs = vertices(self.file, &c, &h);
+        if vs.is_empty() {
+            return Err(Undecided::Infeasible);
+        }
+        let over: [Taylor<N>; N] =
+            core::array::from_fn(|i| Taylor::variable(i, Interval::new(c[i] - h[i], c[i] + h[i])));
+        let at: [Taylor<N>; N] =
+            core::array::from_fn(|i| Taylor::variable(i, Interval::point(c[i])));
+        let (d_over, m_over) = inverses(self.file, &k, &over, self.mass)?;
+        let (d_at, m_at) = inverses(self.file, &k, &at, self.mass)?;
+        // 1/x rounded toward the bound's side.
+        let inv = |x: f64| if x > 0.0 { 1.0 / x } else { f64::INFINITY };
+        let bounds = |lo: f64, hi: f64| (inv(hi).next_down().max(0.0), inv(lo).next_up());
+        let mut share = [0.0; N];
+        let (damping_nspm, vertex) = match (d_at, d_over) {
+            (Some(at), Some(over)) => {
+                let (lo, hi, v, s) = eigen_bounds(&at, &over, &h, &vs);
+                share = s;
+                (bounds(lo, hi), v)
+            }
+            _ => ((0.0, f64::INFINITY), 0),
+        };
+        let mass_kg = match (m_at, m_over) {
+            (Some(at), Some(over)) => {
+                let (lo, hi, _, s) = eigen_bounds(&at, &over, &h, &vs);
+                if share.iter().all(|&x| x == 0.0) {
+                    share = s;
+                }
+                bounds(lo, hi)
+            }
+            _ => (0.0, f64::INFINITY),
+        };
+        // (A box with no remainder, or an unbounded one, splits its widest
+        // side.)
+        let measured = share.iter().all(|x| x.is_finite()) && share.iter().any(|&x| x > 0.0);
+        let weight = |i: usize| if measured { share[i] } else { h[i] };
+        Ok(CellBounds {
+            damping_nspm,
+            mass_kg,
+            least_damped_q_rad: (0..N).map(|i| c[i] + vs[vertex][i]).collect(),
+            split: (0..N)
+                .max_by(|&a, &b| weight(a).total_cmp(&weight(b)))
+                .unwrap_or(0),
+        })
+    }
+}
+
+impl LinkageFile {
+    /// Rigorous bounds on the Cartesian damping's eigenvalues, and the
+    /// mass's if `mass` (else `(0, ∞)`), over the box of joint angles
+    /// `[lo, hi]` (rad), cut by the file's relative limits.
+    pub fn cell_bounds(&self, lo: &[f64], hi: &[f64], mass: bool) -> Result<CellBounds, Undecided> {
+        self.geometry
+            .on_kinematics(Bound {
+                file: self,
+                lo,
+                hi,
+                mass,
+            })
+            .unwrap_or(Err(Undecided::Refused))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn shipped(name: &str) -> LinkageFile {
+        let path = format!(
+            "{}/../../models/linkages/{name}.toml",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        LinkageFile::load(std::path::Path::new(&path)).unwrap()
+    }
+
+    /// Every pose sampled inside a box has its damping's and mass's
+    /// eigenvalues within the box's bounds, for boxes of several sizes on
+    /// each shipped linkage, and the bounds close on the pose's values as
+    /// the box shrinks (second order: a tenth the size, about a hundredth
+    /// the gap).
+    #[test]
+    fn a_box_holds_every_pose_in_it() {
+        for name in ["phantom_premium_1_5", "falcon_like", "haply_2diy", "hapkit"] {
+            let file = shipped(name);
+            let poses = file.workspace(4);
+            for p in poses.iter().step_by(3) {
+                let mut gaps = Vec::new();
+                for w in [0.1, 0.01] {
+                    let lo: Vec<f64> = p.q_rad.iter().map(|q| q - w).collect();
+                    let hi: Vec<f64> = p.q_rad.iter().map(|q| q + w).collect();
+                    let Ok(b) = file.cell_bounds(&lo, &hi, true) else {
+                        continue;
+                    };
+                    let n = lo.len();
+                    for s in 0..3usize.pow(n as u32) {
+                        let q: Vec<f64> = (0..n)
+                            .map(|k| lo[k] + w * (s / 3usize.pow(k as u32) % 3) as f64)
+                            .collect();
+                        if !file.within_limits(&q) {
+                            continue;
+                        }
+                        let Ok(at) = file.pose(&q) else { continue };
+                        let d = at.damping_nspm.clone().symmetric_eigenvalues();
+                        let m = at.mass_kg.clone().symmetric_eigenvalues();
+                        let tol = |x: f64| 1e-9 * x.abs();
+                        assert!(d.min() >= b.damping_nspm.0 - tol(d.min()), "{name} {q:?}");
+                        assert!(d.max() <= b.damping_nspm.1 + tol(d.max()), "{name} {q:?}");
+                        assert!(m.min() >= b.mass_kg.0 - tol(m.min()), "{name} {q:?}");
+                        assert!(m.max() <= b.mass_kg.1 + tol(m.max()), "{name} {q:?}");
+                    }
+                    let at = p.damping_nspm.clone().symmetric_eigenvalues().min();
+                    gaps.push((at - b.damping_nspm.0) / at);
+                }
+                if let [wide, narrow] = gaps[..] {
+                    assert!(
+                        narrow < 0.2 * wide + 1e-9,
+                        "{name} at {:?}: gap {wide} then {narrow}",
+                        p.q_rad
+                    );
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,317 @@
+//! A quantity's value, gradient and Hessian with respect to the joint
+//! angles, each enclosed over a box of angles: second-order forward-mode
+//! differentiation in interval arithmetic.
+//!
+//! It implements the control crate's [`Real`], so the workspace proof runs
+//! the board's own kinematics over a box and gets enclosures of the
+//! Jacobian and of its first and second derivatives there, with no second
+//! copy of the kinematics to drift from the first. A comparison (`<`,
+//! `>=` ...) is true where it holds for some point of the operands: the
+//! kinematics write each check as a clearance (`if !clear { fault }`), so a
+//! box that may be clear goes on (its bound then covers some refused poses
+//! too, which only loosens it), and a box that faults is refused at every
+//! pose in it.
+
+use super::interval::Interval;
+use std::cmp::Ordering;
+use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
+use twoport_control::Real;
+
+/// Value, gradient and Hessian over a box of `N` joint angles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Taylor<const N: usize> {
+    /// The value.
+    pub v: Interval,
+    /// `∂/∂q_k`.
+    pub g: [Interval; N],
+    /// `∂²/∂q_k ∂q_l` (symmetric).
+    pub h: [[Interval; N]; N],
+}
+
+impl<const N: usize> Taylor<N> {
+    /// A constant.
+    pub const fn constant(x: Interval) -> Self {
+        Taylor {
+            v: x,
+            g: [Interval::ZERO; N],
+            h: [[Interval::ZERO; N]; N],
+        }
+    }
+
+    /// Joint `k` over `range`: its gradient is the unit vector `e_k`.
+    pub fn variable(k: usize, range: Interval) -> Self {
+        let mut t = Self::constant(range);
+        t.g[k] = Interval::point(1.0);
+        t
+    }
+
+    /// `f(self)` given `f`, `f'` and `f''` enclosed over the value's range.
+    fn chain(self, f: Interval, d1: Interval, d2: Interval) -> Self {
+        let mut out = Self::constant(f);
+        for k in 0..N {
+            out.g[k] = d1 * self.g[k];
+            let d2g = d2 * self.g[k];
+            for l in k..N {
+                out.h[k][l] = d2g * self.g[l] + d1 * self.h[k][l];
+                out.h[l][k] = out.h[k][l];
+            }
+        }
+        out
+    }
+
+    fn recip(self) -> Self {
+        let r = self.v.recip();
+        let r2 = r * r;
+        self.chain(r, -r2, Interval::point(2.0) * r2 * r)
+    }
+}
+
+impl<const N: usize> Default for Taylor<N> {
+    fn default() -> Self {
+        Self::constant(Interval::ZERO)
+    }
+}
+
+impl<const N: usize> From<f64> for Taylor<N> {
+    fn from(x: f64) -> Self {
+        Self::constant(Interval::point(x))
+    }
+}
+
+impl<const N: usize> Add for Taylor<N> {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
+        let mut out = self;
+        out.v = self.v + o.v;
+        for k in 0..N {
+            out.g[k] = self.g[k] + o.g[k];
+            for l in k..N {
+                out.h[k][l] = self.h[k][l] + o.h[k][l];
+                out.h[l][k] = out.h[k][l];
+            }
+        }
+        out
+    }
+}
+
+impl<const N: usize> AddAssign for Taylor<N> {
+    fn add_assign(&mut self, o: Self) {
+        *self = *self + o;
+    }
+}
+
+impl<const N: usize> Neg for Taylor<N> {
+    type Output = Self;
+    fn neg(self) -> Self {
+        let mut out = self;
+        out.v = -self.v;
+        for k in 0..N {
+            out.g[k] = -self.g[k];
+            for l in 0..N {
+                out.h[k][l] = -self.h[k][l];
+            }
+        }
+        out
+    }
+}
+
+impl<const N: usize> Sub for Taylor<N> {
+    type Output = Self;
+    fn sub(self, o: Self) -> Self {
+        self + (-o)
+    }
+}
+
+impl<const N: usize> Mul for Taylor<N> {
+    type Output = Self;
+    fn mul(self, o: Self) -> Self {
+        let mut out = Self::constant(self.v * o.v);
+        for k in 0..N {
+            out.g[k] = self.g[k] * o.v + self.v * o.g[k];
+            for l in k..N {
+                out.h[k][l] = self.h[k][l] * o.v
+                    + self.g[k] * o.g[l]
+                    + self.g[l] * o.g[k]
+                    + self.v * o.h[k][l];
+                out.h[l][k] = out.h[k][l];
+            }
+        }
+        out
+    }
+}
+
+impl<const N: usize> Div for Taylor<N> {
+    type Output = Self;
+    fn div(self, o: Self) -> Self {
+        self * o.recip()
+    }
+}
+
+impl<const N: usize> PartialOrd for Taylor<N> {
+    /// Ordered only where every point of one lies below every point of the
+    /// other (or both are the same point); the operators below say what
+    /// may hold.
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        if self.v.hi < o.v.lo {
+            Some(Ordering::Less)
+        } else if self.v.lo > o.v.hi {
+            Some(Ordering::Greater)
+        } else if self.v.lo == self.v.hi && self.v == o.v {
+            Some(Ordering::Equal)
+        } else {
+            None
+        }
+    }
+    fn lt(&self, o: &Self) -> bool {
+        self.v.lo < o.v.hi
+    }
+    fn le(&self, o: &Self) -> bool {
+        self.v.lo <= o.v.hi
+    }
+    fn gt(&self, o: &Self) -> bool {
+        self.v.hi > o.v.lo
+    }
+    fn ge(&self, o: &Self) -> bool {
+        self.v.hi >= o.v.lo
+    }
+}
+
+impl<const N: usize> Real for Taylor<N> {
+    const ZERO: Self = Self::constant(Interval::point(0.0));
+    const ONE: Self = Self::constant(Interval::point(1.0));
+    const HALF: Self = Self::constant(Interval::point(0.5));
+    const M_PER_NM: Self = Self::constant(Interval::point(1.0e-9));
+    const NM_PER_M: Self = Self::constant(Interval::point(1.0e9));
+
+    fn of(x: f32) -> Self {
+        Self::from(f64::from(x))
+    }
+    fn to_f32(self) -> f32 {
+        self.v.mid() as f32
+    }
+    fn to_f64(self) -> f64 {
+        self.v.mid()
+    }
+    fn from_i32(i: i32) -> Self {
+        Self::from(f64::from(i))
+    }
+    fn from_i64(i: i64) -> Self {
+        // (Only small integers reach the kinematics; one rounding is
+        // covered by the ulp either side.)
+        let x = i as f64;
+        Self::constant(Interval::new(x.next_down(), x.next_up()))
+    }
+    fn trunc_i32(self) -> i32 {
+        self.v.mid() as i32
+    }
+    fn abs(self) -> Self {
+        if self.v.lo >= 0.0 {
+            self
+        } else if self.v.hi <= 0.0 {
+            -self
+        } else {
+            // A kink inside: the slope is anywhere in [-1, 1] and the
+            // curvature unbounded.
+            let mut out = Self::constant(self.v.abs());
+            let slope = Interval::new(-1.0, 1.0);
+            for k in 0..N {
+                out.g[k] = slope * self.g[k];
+                for l in 0..N {
+                    out.h[k][l] = Interval::ENTIRE;
+                }
+            }
+            out
+        }
+    }
+    fn is_finite(self) -> bool {
+        self.v.is_finite()
+            && self.g.iter().all(|g| g.is_finite())
+            && self.h.iter().flatten().all(|h| h.is_finite())
+    }
+    fn sin(self) -> Self {
+        self.sin_cos().0
+    }
+    fn cos(self) -> Self {
+        self.sin_cos().1
+    }
+    fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = self.v.sin_cos();
+        (self.chain(s, c, -s), self.chain(c, -s, -c))
+    }
+    fn sqrt(self) -> Self {
+        let r = self.v.sqrt();
+        let d1 = Interval::point(0.5) * r.recip();
+        let d2 = Interval::point(-0.25) * (r * self.v).recip();
+        self.chain(r, d1, d2)
+    }
+    fn atan2(self, x: Self) -> Self {
+        // Not on the kinematics' path: every angle, and unknown slopes.
+        let mut out = Self::constant(Interval::new(
+            -std::f64::consts::PI.next_up(),
+            std::f64::consts::PI.next_up(),
+        ));
+        let _ = x;
+        for k in 0..N {
+            out.g[k] = Interval::ENTIRE;
+            for l in 0..N {
+                out.h[k][l] = Interval::ENTIRE;
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The enclosures hold the exact value, gradient and Hessian of a
+    /// function of two angles that uses every operation the kinematics do,
+    /// at sampled points of the box (derivatives by central differences).
+    #[test]
+    fn value_gradient_and_hessian_contain_the_function_s() {
+        fn f<R: Real + From<f64>>(a: R, b: R) -> R {
+            let (s, c) = a.sin_cos();
+            let r = (R::from(2.0) + s * b).sqrt();
+            (c * r - b * b) / (R::from(3.0) + a * a)
+        }
+        let (ra, rb) = (Interval::new(0.2, 0.5), Interval::new(-0.4, 0.1));
+        let t = f(Taylor::<2>::variable(0, ra), Taylor::<2>::variable(1, rb));
+        let inside = |x: f64, i: Interval, slack: f64| x >= i.lo - slack && x <= i.hi + slack;
+        let e = 1e-4;
+        for i in 0..=6 {
+            for j in 0..=6 {
+                let a = ra.lo + (ra.hi - ra.lo) * i as f64 / 6.0;
+                let b = rb.lo + (rb.hi - rb.lo) * j as f64 / 6.0;
+                assert!(inside(f(a, b), t.v, 0.0));
+                let ga = (f(a + e, b) - f(a - e, b)) / (2.0 * e);
+                let gb = (f(a, b + e) - f(a, b - e)) / (2.0 * e);
+                assert!(inside(ga, t.g[0], 1e-6) && inside(gb, t.g[1], 1e-6));
+                let haa = (f(a + e, b) - 2.0 * f(a, b) + f(a - e, b)) / (e * e);
+                let hab = (f(a + e, b + e) - f(a + e, b - e) - f(a - e, b + e) + f(a - e, b - e))
+                    / (4.0 * e * e);
+                assert!(inside(haa, t.h[0][0], 1e-4), "{haa} vs {:?}", t.h[0][0]);
+                assert!(inside(hab, t.h[0][1], 1e-4) && inside(hab, t.h[1][0], 1e-4));
+            }
+        }
+        // At a point the enclosure is the value to rounding.
+        let p = f(
+            Taylor::<2>::variable(0, Interval::point(0.3)),
+            Taylor::<2>::variable(1, Interval::point(0.0)),
+        );
+        assert!(p.v.hi - p.v.lo < 1e-14);
+    }
+
+    /// A comparison holds where it may hold for some points; ordering
+    /// is reported only where it holds for all.
+    #[test]
+    fn comparisons_say_what_may_hold() {
+        let a = Taylor::<1>::constant(Interval::new(0.0, 1.0));
+        let b = Taylor::<1>::constant(Interval::new(0.5, 2.0));
+        let c = Taylor::<1>::constant(Interval::new(3.0, 4.0));
+        assert!(a < b && a >= b && b <= a && b > a);
+        assert!(a < c && !(a >= c) && !(c < a) && c > b);
+        assert_eq!(a.partial_cmp(&b), None);
+        assert_eq!(a.partial_cmp(&c), Some(Ordering::Less));
+    }
+}
