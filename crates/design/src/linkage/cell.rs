@@ -130,29 +130,15 @@ fn joint_mass<const N: usize>(file: &LinkageFile, j: &Mat<N>, q: &[Taylor<N>; N]
                 diag + s * c(*handle_mass_kg)
             })
         }),
-        (
-            Inertia::SerialArmLinks {
-                l3_m,
-                masses_kg,
-                inertias_kgm2,
-                base_yy_kgm2,
-                ..
-            },
-            Geometry::SerialArm { l1_m, l2_m },
-        ) if N == 3 => {
-            let arm = super::SerialArmDynamics {
-                l1_m,
-                l2_m,
-                l3_m: *l3_m,
-                masses_kg: *masses_kg,
-                inertias_kgm2: *inertias_kgm2,
-                base_yy_kgm2: *base_yy_kgm2,
-                rotor_kgm2: file.motors.rotor_inertia_kgm2,
-                ratios: [0, 1, 2].map(|i| file.motors.ratios[i]),
-            };
-            let m = arm.joint_mass_in([q[0], q[1], q[2]]);
-            core::array::from_fn(|r| core::array::from_fn(|col| m[r][col]))
-        }
+        (Inertia::SerialArmLinks { .. }, _) if N == 3 => match file.serial_arm_dynamics() {
+            Some(arm) => {
+                let m = arm.joint_mass_in([q[0], q[1], q[2]]);
+                core::array::from_fn(|r| core::array::from_fn(|col| m[r][col]))
+            }
+            None => core::array::from_fn(|r| {
+                core::array::from_fn(|col| if r == col { rotor(r) } else { Taylor::ZERO })
+            }),
+        },
         _ => core::array::from_fn(|r| {
             core::array::from_fn(|col| if r == col { rotor(r) } else { Taylor::ZERO })
         }),
@@ -305,16 +291,14 @@ fn eigen_bounds<const N: usize>(
         * (1.0 + 1e-12);
     let (mut lo, mut hi, mut at_hi) = (f64::INFINITY, f64::NEG_INFINITY, 0);
     for (i, v) in vs.iter().enumerate() {
+        // The affine part at the vertex, symmetrised.
         let l = DMatrix::from_fn(N, N, |r, c| {
-            let e = |m: &Mat<N>| {
-                let (a, b) = (&m[r][c], &m[c][r]);
-                let mut x = 0.5 * (a.v.mid() + b.v.mid());
-                for k in 0..N {
-                    x += 0.5 * (a.g[k].mid() + b.g[k].mid()) * v[k];
-                }
-                x
-            };
-            e(at)
+            let (a, b) = (&at[r][c], &at[c][r]);
+            let slope = a.g.iter().zip(&b.g).zip(v);
+            0.5 * (a.v.mid() + b.v.mid())
+                + slope
+                    .map(|((ga, gb), dv)| 0.5 * (ga.mid() + gb.mid()) * dv)
+                    .sum::<f64>()
         });
         // The symmetric eigen-solver is backward stable: its eigenvalues
         // are within a few ε‖L‖ of the exact ones; 1e-12 ‖L‖_F is ample.

@@ -101,7 +101,7 @@ impl Interval {
 
     /// `1/x`.
     pub fn recip(self) -> Self {
-        if self.contains_zero() || !(self.lo <= self.hi) {
+        if self.contains_zero() || self.lo.is_nan() || self.hi.is_nan() {
             return Interval::ENTIRE;
         }
         Interval {

@@ -87,6 +87,22 @@ impl LinkageFile {
                     + rotors
                     + jacobian.transpose() * jacobian * *handle_mass_kg
             }
+            (Inertia::SerialArmLinks { .. }, _) => match self.serial_arm_dynamics() {
+                Some(arm) => {
+                    let m = arm.joint_mass([q[0], q[1], q[2]]);
+                    DMatrix::from_fn(3, 3, |r, c| m[(r, c)])
+                }
+                // (The file's check allows link parameters on a serial arm
+                // only.)
+                None => rotors,
+            },
+        }
+    }
+
+    /// A serial arm's links and rotors as [`SerialArmDynamics`]; `None`
+    /// for a lumped inertia or another geometry.
+    pub fn serial_arm_dynamics(&self) -> Option<SerialArmDynamics> {
+        match (&self.inertia, self.geometry) {
             (
                 Inertia::SerialArmLinks {
                     l3_m,
@@ -96,22 +112,17 @@ impl LinkageFile {
                     ..
                 },
                 Geometry::SerialArm { l1_m, l2_m },
-            ) => {
-                let arm = SerialArmDynamics {
-                    l1_m,
-                    l2_m,
-                    l3_m: *l3_m,
-                    masses_kg: *masses_kg,
-                    inertias_kgm2: *inertias_kgm2,
-                    base_yy_kgm2: *base_yy_kgm2,
-                    rotor_kgm2: self.motors.rotor_inertia_kgm2,
-                    ratios: [0, 1, 2].map(|i| self.motors.ratios[i]),
-                };
-                let m = arm.joint_mass([q[0], q[1], q[2]]);
-                DMatrix::from_fn(3, 3, |r, c| m[(r, c)])
-            }
-            // (The file's check allows link parameters on a serial arm only.)
-            (Inertia::SerialArmLinks { .. }, _) => rotors,
+            ) if self.motors.ratios.len() == 3 => Some(SerialArmDynamics {
+                l1_m,
+                l2_m,
+                l3_m: *l3_m,
+                masses_kg: *masses_kg,
+                inertias_kgm2: *inertias_kgm2,
+                base_yy_kgm2: *base_yy_kgm2,
+                rotor_kgm2: self.motors.rotor_inertia_kgm2,
+                ratios: [0, 1, 2].map(|i| self.motors.ratios[i]),
+            }),
+            _ => None,
         }
     }
 
