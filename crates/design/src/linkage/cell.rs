@@ -22,11 +22,11 @@
 //! The remainder is second order in the box's size, so halving a box near
 //! the least damped pose quarters the gap.
 
-use super::file::{Geometry, Inertia, LinkageFile};
+use super::file::{Inertia, LinkageFile, OnKinematics};
 use super::interval::Interval;
 use super::taylor::Taylor;
 use nalgebra::{DMatrix, DVector};
-use twoport_control::kinematics::{Capstan, Delta, Kinematics, Pantograph, SerialArm};
+use twoport_control::kinematics::Kinematics;
 use twoport_control::Real;
 
 /// The eigenvalue bounds over a box.
@@ -310,45 +310,6 @@ fn eigen_bounds<const N: usize>(
         }
     }
     (lo - norm, hi + norm, at_hi, share)
-}
-
-/// What to do with a geometry's kinematics, whatever its joint count.
-pub(crate) trait OnKinematics {
-    /// The result.
-    type Out;
-    /// Run with the kinematics of `N` joints.
-    fn run<K, const N: usize>(self, k: K) -> Self::Out
-    where
-        K: Kinematics<f64, N> + Kinematics<Taylor<N>, N>;
-}
-
-impl Geometry {
-    /// `job` run on this geometry's kinematics (its lengths in `f32`, as
-    /// the board holds them), or `None` where its parameters are refused.
-    pub(crate) fn on_kinematics<J: OnKinematics>(&self, job: J) -> Option<J::Out> {
-        let f = |x: f64| x as f32;
-        Some(match *self {
-            Geometry::Capstan {
-                r_h_m,
-                r_p_m,
-                r_s_m,
-            } => job.run::<_, 1>(Capstan::new(f(r_h_m), f(r_p_m), f(r_s_m)).ok()?),
-            Geometry::Pantograph { l_m, big_l_m, d_m } => {
-                job.run::<_, 2>(Pantograph::new(f(l_m), f(big_l_m), f(d_m)).ok()?)
-            }
-            Geometry::SerialArm { l1_m, l2_m } => {
-                job.run::<_, 3>(SerialArm::new(f(l1_m), f(l2_m)).ok()?)
-            }
-            Geometry::Delta {
-                base_m,
-                effector_m,
-                upper_m,
-                lower_m,
-            } => {
-                job.run::<_, 3>(Delta::new(f(base_m), f(effector_m), f(upper_m), f(lower_m)).ok()?)
-            }
-        })
-    }
 }
 
 /// Bound one box `[lo, hi]` of joint angles.

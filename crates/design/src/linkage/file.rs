@@ -2,9 +2,11 @@
 //! drives it (motors, encoders, transmissions) and its joints, read from
 //! TOML and checked field by field.
 
+use super::taylor::Taylor;
 use crate::ModelError;
 use serde::Deserialize;
-use twoport_control::kinematics::{Capstan, Delta, Pantograph, SerialArm};
+use twoport_control::kinematics::{Capstan, Delta, Kinematics, Pantograph, SerialArm};
+use twoport_control::ParamError;
 
 /// A linkage device file.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
@@ -147,7 +149,48 @@ pub struct RelativeLimit {
     pub rad: [f64; 2],
 }
 
+/// What to do with a geometry's kinematics, whatever its joint count.
+pub trait OnKinematics {
+    /// The result.
+    type Out;
+    /// Run with the kinematics of `N` joints, which answer in `f64` and
+    /// over a box of poses in [`Taylor`] arithmetic.
+    fn run<K, const N: usize>(self, k: K) -> Self::Out
+    where
+        K: Kinematics<f64, N> + Kinematics<Taylor<N>, N>;
+}
+
 impl Geometry {
+    /// `job` run on this geometry's kinematics (its lengths in `f32`, as
+    /// the board holds them), or why the kinematics refuse the lengths.
+    pub fn on_kinematics<J: OnKinematics>(&self, job: J) -> Result<J::Out, ParamError> {
+        let f = |x: f64| x as f32;
+        Ok(match *self {
+            Geometry::Capstan {
+                r_h_m,
+                r_p_m,
+                r_s_m,
+            } => job.run::<_, 1>(Capstan::new(f(r_h_m), f(r_p_m), f(r_s_m))?),
+            Geometry::Pantograph { l_m, big_l_m, d_m } => {
+                job.run::<_, 2>(Pantograph::new(f(l_m), f(big_l_m), f(d_m))?)
+            }
+            Geometry::SerialArm { l1_m, l2_m } => {
+                job.run::<_, 3>(SerialArm::new(f(l1_m), f(l2_m))?)
+            }
+            Geometry::Delta {
+                base_m,
+                effector_m,
+                upper_m,
+                lower_m,
+            } => job.run::<_, 3>(Delta::new(
+                f(base_m),
+                f(effector_m),
+                f(upper_m),
+                f(lower_m),
+            )?),
+        })
+    }
+
     /// How many joints (and Cartesian axes) the kind has.
     pub fn joints(&self) -> usize {
         match self {
@@ -160,24 +203,16 @@ impl Geometry {
     /// Build the kind's kinematics, to check its dimensions as the board
     /// will.
     fn check(&self) -> Result<(), String> {
-        let f = |x: f64| x as f32;
-        let r = match *self {
-            Geometry::Capstan {
-                r_h_m,
-                r_p_m,
-                r_s_m,
-            } => Capstan::new(f(r_h_m), f(r_p_m), f(r_s_m)).map(|_| ()),
-            Geometry::Pantograph { l_m, big_l_m, d_m } => {
-                Pantograph::new(f(l_m), f(big_l_m), f(d_m)).map(|_| ())
+        struct Build;
+        impl OnKinematics for Build {
+            type Out = ();
+            fn run<K, const N: usize>(self, _: K) -> Self::Out
+            where
+                K: Kinematics<f64, N> + Kinematics<Taylor<N>, N>,
+            {
             }
-            Geometry::SerialArm { l1_m, l2_m } => SerialArm::new(f(l1_m), f(l2_m)).map(|_| ()),
-            Geometry::Delta {
-                base_m,
-                effector_m,
-                upper_m,
-                lower_m,
-            } => Delta::new(f(base_m), f(effector_m), f(upper_m), f(lower_m)).map(|_| ()),
-        };
+        }
+        let r = self.on_kinematics(Build);
         r.map_err(|e| {
             let field = e
                 .name

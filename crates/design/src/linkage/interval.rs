@@ -178,11 +178,6 @@ impl Interval {
         let (s1, c1) = (self.hi.sin(), self.hi.cos());
         (range(s0, s1, hits(FRAC_PI_2)), range(c0, c1, hits(0.0)))
     }
-
-    /// The convex hull of two intervals.
-    pub fn hull(self, o: Self) -> Self {
-        Interval::new(self.lo.min(o.lo), self.hi.max(o.hi))
-    }
 }
 
 impl Add for Interval {

@@ -17,7 +17,7 @@ mod verify;
 pub use bounded::{bound_at, stiffest, stiffest_at, theta_grid, PoseRanges};
 pub use cell::{CellBounds, Undecided};
 pub use dynamics::SerialArmDynamics;
-pub use file::{Geometry, Inertia, Joints, LinkageFile, Motors, RelativeLimit};
+pub use file::{Geometry, Inertia, Joints, LinkageFile, Motors, OnKinematics, RelativeLimit};
 pub use interval::Interval;
 pub use pose::{forward, PoseDynamics};
 pub use proof::{

@@ -2,8 +2,7 @@
 //! board runs), its joint-space mass and damping, and the mass and damping
 //! the hand feels at the handle, `M_x = J^-T M_q J^-1`, `D_x = J^-T D_q J^-1`.
 
-use super::cell::OnKinematics;
-use super::file::{Geometry, Inertia, LinkageFile};
+use super::file::{Geometry, Inertia, LinkageFile, OnKinematics};
 use super::taylor::Taylor;
 use super::SerialArmDynamics;
 use nalgebra::DMatrix;
@@ -60,7 +59,7 @@ pub fn forward(
     }
     geometry
         .on_kinematics(Forward(q))
-        .unwrap_or(Err(KinematicsFault::NotFinite))
+        .map_err(|_| KinematicsFault::NotFinite)?
 }
 
 impl LinkageFile {

@@ -262,7 +262,9 @@ pub struct Certificate {
     /// The stiffness found at the binding pose (N/m): the design's
     /// `k_c_npm` is proven, and at most `gap` below this.
     pub found_k_c_npm: f64,
-    /// `(found - proven)/found`.
+    /// The relative gap between the least found at a pose and the bound,
+    /// on the quantity searched: the least damping (hands off or with a
+    /// least grasp), or the stiffness (under the paper's bound).
     pub gap: f64,
     /// The box of joint angles whose bound is the design (rad).
     pub binding_box_rad: Vec<[f64; 2]>,
@@ -271,6 +273,7 @@ pub struct Certificate {
 }
 
 /// The hands-off (or least-grasp) boundary `2 (λ_min(D_x) + b_g - b_c)/T`.
+#[derive(Clone, Copy)]
 struct Colgate {
     period_s: f64,
     b_c_nspm: f64,
@@ -280,6 +283,13 @@ struct Colgate {
 impl Colgate {
     fn of(&self, damping_nspm: f64) -> f64 {
         2.0 * (damping_nspm + self.min_grasp_nspm - self.b_c_nspm) / self.period_s
+    }
+
+    /// [`of`](Self::of) a proven damping bound, rounded down by far more
+    /// than its three operations' rounding: a proven stiffness bound.
+    fn proven(&self, damping_nspm: f64) -> f64 {
+        let k = self.of(damping_nspm);
+        k - 1e-12 * k.abs()
     }
 }
 
@@ -335,9 +345,7 @@ impl Bounded {
 impl Objective for Bounded {
     const MASS: bool = true;
     fn over(&self, cell: &CellBounds) -> f64 {
-        // (Rounded down by far more than the three operations' rounding.)
-        let floor = self.floor.of(cell.damping_nspm.0);
-        let floor = floor - 1e-12 * floor.abs();
+        let floor = self.floor.proven(cell.damping_nspm.0);
         match self.of(cell.mass_kg, cell.damping_nspm) {
             Some((k, _)) => k.max(floor),
             None => floor,
@@ -372,23 +380,18 @@ pub fn certified_design(
         b_c_nspm,
         min_grasp_nspm,
     };
-    let found = match human {
+    let bounded = human.map(|human| Bounded {
+        floor,
+        human,
+        thetas: theta_grid(file.period_s, BOUNDED_GRID),
+    });
+    let found = match &bounded {
         None => least(file, &LeastDamping).map(|d| Least {
-            bound: {
-                let k = floor.of(d.bound);
-                k - 1e-12 * k.abs()
-            },
+            bound: floor.proven(d.bound),
             found: floor.of(d.found),
             ..d
         }),
-        Some(h) => least(
-            file,
-            &Bounded {
-                floor,
-                human: h,
-                thetas: theta_grid(file.period_s, BOUNDED_GRID),
-            },
-        ),
+        Some(b) => least(file, b),
     }
     .map_err(|SearchError::NoPose| crate::Error::NoPose)?;
     let pose = found.pose;
@@ -407,18 +410,9 @@ pub fn certified_design(
             file.name, design.binding.damping_nspm, pose.q_rad
         )));
     }
-    if let Some(h) = human {
+    if let Some(b) = &bounded {
         let (m, d) = Bounded::ranges(&pose);
-        let b = Bounded {
-            floor: Colgate {
-                period_s: file.period_s,
-                b_c_nspm,
-                min_grasp_nspm,
-            },
-            human: h,
-            thetas: theta_grid(file.period_s, BOUNDED_GRID),
-        };
-        design.human = Some(h);
+        design.human = Some(b.human);
         design.binding.frequency_hz = b
             .of(m, d)
             .map(|(_, theta)| theta / (2.0 * std::f64::consts::PI * file.period_s));

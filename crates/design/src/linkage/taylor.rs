@@ -247,13 +247,12 @@ impl<const N: usize> Real for Taylor<N> {
         let d2 = Interval::point(-0.25) * (r * self.v).recip();
         self.chain(r, d1, d2)
     }
-    fn atan2(self, x: Self) -> Self {
+    fn atan2(self, _x: Self) -> Self {
         // Not on the kinematics' path: every angle, and unknown slopes.
         let mut out = Self::constant(Interval::new(
             -std::f64::consts::PI.next_up(),
             std::f64::consts::PI.next_up(),
         ));
-        let _ = x;
         for k in 0..N {
             out.g[k] = Interval::ENTIRE;
             for l in 0..N {
