@@ -4,6 +4,8 @@
 
 mod device;
 mod error;
+mod in_process;
+mod local;
 mod port;
 mod session;
 mod simulated;
@@ -12,6 +14,7 @@ pub use device::{
     AxisState, Board, State, VeSetting, HEARTBEAT_PERIOD, HEARTBEAT_POLLS, STATE_BUFFER,
 };
 pub use error::LinkError;
+pub use local::{LocalBoard, LocalDelta, LocalFast, LocalSerialArm};
 pub use port::{BoardPort, SerialBoard};
 pub use session::{LinkFaults, Session, ANSWER_TIMEOUT, HEARTBEAT_EVERY};
 pub use simulated::{Pace, SimulatedBoard};

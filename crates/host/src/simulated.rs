@@ -3,11 +3,11 @@
 //! host application is tried on without hardware or an emulator, and
 //! what the device object's tests drive.
 
+use crate::in_process::ByteQueues;
 use crate::{BoardPort, LinkError};
-use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 use twoport_board::excalibur::{self, REGION_POINTS};
-use twoport_board::{Board, BoardSupport, IoScale, RawSensors, SimAxis, Simulated};
+use twoport_board::{Board, IoScale, SimAxis, Simulated};
 use twoport_control::ve::UnilateralWall;
 
 /// How a simulated board's ticks keep time.
@@ -21,41 +21,12 @@ pub enum Pace {
     RealTime,
 }
 
-/// The simulated board's link: two byte queues.
-#[derive(Default)]
-struct Wire {
-    rx: VecDeque<u8>,
-    out: Vec<u8>,
-}
-
-impl BoardSupport<1> for Wire {
-    // (The simulated device in front of it reads the sensors.)
-    fn sample(&mut self) -> RawSensors<1> {
-        RawSensors::default()
-    }
-    fn set_duty(&mut self, _: [i16; 1]) {}
-    fn set_outputs(&mut self, _: bool) {}
-    fn feed_watchdog(&mut self) {}
-    fn read_byte(&mut self) -> Option<u8> {
-        self.rx.pop_front()
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        self.out.extend_from_slice(bytes);
-    }
-    fn cycles(&mut self) -> u32 {
-        0
-    }
-    fn cycles_per_tick(&self) -> u32 {
-        0
-    }
-}
-
 /// The shipped Excalibur image (its wall, its proven region, its safety
 /// layer) running on one simulated axis: the actuator's 0.93 kg with
 /// 4 N s/m, a hand pushing with a constant force, a 1 µm encoder.
 pub struct SimulatedBoard {
     board: Board<UnilateralWall, REGION_POINTS>,
-    io: Simulated<Wire, 1>,
+    io: Simulated<ByteQueues, 1>,
     pace: Pace,
     last: Option<Instant>,
     ticks: u64,
@@ -68,7 +39,7 @@ impl SimulatedBoard {
         let board = excalibur::stiff_wall_board()
             .map_err(|e| LinkError::Image(format!("the Excalibur board image: {e:?}")))?;
         let io = Simulated::new(
-            Wire::default(),
+            ByteQueues::default(),
             [SimAxis::excalibur(hand_n)],
             [IoScale::EXCALIBUR],
             excalibur::ENCODER,
@@ -111,7 +82,7 @@ impl SimulatedBoard {
 
 impl BoardPort for SimulatedBoard {
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
-        self.io.inner().rx.extend(bytes);
+        self.io.inner().send(bytes);
         Ok(())
     }
 
@@ -134,10 +105,6 @@ impl BoardPort for SimulatedBoard {
         // (The board answers what it has already read even with no tick.)
         self.board.poll_link(&mut self.io);
         self.board.flush(&mut self.io);
-        let out = &mut self.io.inner().out;
-        let k = buf.len().min(out.len());
-        buf[..k].copy_from_slice(&out[..k]);
-        out.drain(..k);
-        Ok(k)
+        Ok(self.io.inner().take(buf))
     }
 }

@@ -2,12 +2,12 @@
 //! [`BoardPort`] as a serial board: the reference a processor-in-the-loop
 //! run holds the firmware to, bit for bit.
 
-use super::{BoardPort, LinkError};
-use std::collections::VecDeque;
+use crate::in_process::ByteQueues;
+use crate::{BoardPort, LinkError};
 use std::time::Duration;
 use twoport_board::excalibur::{self, fast, xyz, REGION_POINTS};
 use twoport_board::linkage::{self as linkage_image, DeltaBoard, SerialArmBoard};
-use twoport_board::{Board, BoardSupport, RawSensors};
+use twoport_board::Board;
 use twoport_config::{RamFlash, Store};
 use twoport_control::drive::Drive;
 use twoport_control::kinematics::{Delta, SerialArm};
@@ -28,42 +28,9 @@ pub struct LocalBoard<
     const R: usize = REGION_POINTS,
 > {
     board: Board<W, R, N, L, D>,
-    link: HostLink,
+    link: ByteQueues,
     /// Its stored configuration, in RAM as on the QEMU images.
     store: Store<RamFlash<512, 256>>,
-}
-
-/// The in-process board's only peripheral: its link, as two byte queues.
-#[derive(Default)]
-struct HostLink {
-    rx: VecDeque<u8>,
-    out: Vec<u8>,
-}
-
-impl<const N: usize> BoardSupport<N> for HostLink {
-    // A processor-in-the-loop board reads no sensors of its own.
-    fn sample(&mut self) -> RawSensors<N> {
-        RawSensors::default()
-    }
-    // The duties go back in the board's actuator frame.
-    fn set_duty(&mut self, _: [i16; N]) {}
-    // So do the outputs: a disarmed board answers zero duty.
-    fn set_outputs(&mut self, _: bool) {}
-    // The host's loop cannot hang unseen: no watchdog.
-    fn feed_watchdog(&mut self) {}
-    // The host paces the ticks.
-    fn cycles_per_tick(&self) -> u32 {
-        0
-    }
-    fn read_byte(&mut self) -> Option<u8> {
-        self.rx.pop_front()
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        self.out.extend_from_slice(bytes);
-    }
-    fn cycles(&mut self) -> u32 {
-        0
-    }
 }
 
 impl<W, L, D, const N: usize, const R: usize> LocalBoard<W, N, L, D, R>
@@ -80,7 +47,7 @@ where
         board.boot_config(&mut store);
         LocalBoard {
             board,
-            link: HostLink::default(),
+            link: ByteQueues::default(),
             store,
         }
     }
@@ -185,7 +152,7 @@ where
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
         // What the images do: the control tick runs each sensor frame as
         // it completes, and the main loop sends what was queued.
-        self.link.rx.extend(bytes);
+        self.link.send(bytes);
         loop {
             let ready = self.board.poll_link(&mut self.link);
             if ready {
@@ -195,16 +162,12 @@ where
             }
             self.board.service_config(&mut self.store);
             self.board.flush(&mut self.link);
-            if !ready && self.link.rx.is_empty() {
+            if !ready && self.link.drained() {
                 return Ok(());
             }
         }
     }
     fn recv(&mut self, buf: &mut [u8], _: Duration) -> Result<usize, LinkError> {
-        let out = &mut self.link.out;
-        let n = buf.len().min(out.len());
-        buf[..n].copy_from_slice(&out[..n]);
-        out.drain(..n);
-        Ok(n)
+        Ok(self.link.take(buf))
     }
 }
