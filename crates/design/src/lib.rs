@@ -20,6 +20,8 @@ pub mod plant;
 pub mod plot;
 pub mod rational;
 pub mod sampled;
+#[cfg(test)]
+mod test_rng;
 pub mod verify;
 
 pub use designer::Designer;

@@ -232,13 +232,7 @@ mod tests {
     /// with a scan of the rectangle's inside (the minimum is on the edge).
     #[test]
     fn the_rounded_minimum_matches_a_scan() {
-        let mut seed = 7u64;
-        let mut r = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut r = crate::test_rng::uniform(7u64);
         for _ in 0..100 {
             let c = Complex64::from_polar(1.0, -PI * r());
             let x1 = 0.01 + r();

@@ -453,13 +453,8 @@ mod tests {
     /// damping, and the boundary is Colgate's `2 (b - b_c)/T`.
     #[test]
     fn the_workspace_binds_at_its_least_damped_direction() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut draw = crate::test_rng::uniform(0x2545_f491_4f6c_dd1du64);
+        let mut rnd = move || draw() - 0.5;
         for name in SHIPPED {
             let l = shipped(name);
             let poses = l.workspace(7);
@@ -500,13 +495,7 @@ mod tests {
     /// pose it found; and that pose's own boundary is the one reported.
     #[test]
     fn the_certificate_is_below_every_pose_and_close_to_one() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::test_rng::uniform(0x9e37_79b9_7f4a_7c15u64);
         // (The delta's bounds are too loose for the search to close within
         // its budget yet: docs/linkages.md says so.)
         for name in SHIPPED.iter().filter(|n| !n.starts_with("falcon")) {

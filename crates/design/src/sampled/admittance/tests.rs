@@ -71,13 +71,7 @@ fn the_bound_holds_for_sampled_hands_of_the_relaxation() {
         (shipped("two_mass.toml"), (39_739.0, 42.9)),
         (DeviceModel::excalibur().unwrap(), (51_000.0, 90.0)),
     ];
-    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-    let mut rnd = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rnd = crate::test_rng::uniform(0x9e37_79b9_7f4a_7c15u64);
     for (model, (kp_, bp)) in &cases {
         let plant = Plant::new(model, 1e-3).unwrap();
         let kp = crate::analysis::regulator_tf(*kp_, *bp, 1e-3).unwrap();
