@@ -148,7 +148,9 @@ fn joint_mass<const N: usize>(file: &LinkageFile, j: &Mat<N>, q: &[Taylor<N>; N]
 
 /// The inverse Cartesian damping and mass, `J D_q^-1 J^T` and
 /// `J M_q^-1 J^T`, over the box `q`; `None` for the damping where a joint
-/// has none (then `D_x` is singular at every pose).
+/// has none (then `D_x` is singular at every pose), and for either where
+/// the box is too wide to bound it; `Refused` where the kinematics refuse
+/// every pose in the box.
 #[allow(clippy::type_complexity)]
 fn inverses<K: Kinematics<Taylor<N>, N>, const N: usize>(
     file: &LinkageFile,
@@ -168,13 +170,14 @@ fn inverses<K: Kinematics<Taylor<N>, N>, const N: usize>(
                 }
             })
         });
-        Some(congruence(&j, &d).ok_or(Undecided::Refused)?)
+        congruence(&j, &d)
     } else {
         None
     };
+    // (A pivot the box cannot keep from zero leaves that matrix unbounded
+    // here, `None`, and the box is split: its poses are still driven.)
     let m = if mass {
-        let m = joint_mass(file, &j, q);
-        Some(congruence(&j, &m).ok_or(Undecided::Refused)?)
+        congruence(&j, &joint_mass(file, &j, q))
     } else {
         None
     };
@@ -285,6 +288,11 @@ fn eigen_bounds<const N: usize>(
     }
     // ‖R‖₂ ≤ max row sum of the symmetric entrywise bound (rounded up:
     // the relative 1e-12 covers the sums' rounding many times over).
+    // (An unbounded or NaN entry, from a box that reaches where the
+    // kinematics blow up, bounds nothing: f64::max would pass a NaN over.)
+    if rad.iter().flatten().any(|x| !x.is_finite()) {
+        return (f64::NEG_INFINITY, f64::INFINITY, 0, [f64::INFINITY; N]);
+    }
     let norm = (0..N)
         .map(|r| (0..N).map(|c| rad[r][c].max(rad[c][r])).sum::<f64>())
         .fold(0.0f64, f64::max)
@@ -300,6 +308,9 @@ fn eigen_bounds<const N: usize>(
                     .map(|((ga, gb), dv)| 0.5 * (ga.mid() + gb.mid()) * dv)
                     .sum::<f64>()
         });
+        if l.iter().any(|x| !x.is_finite()) {
+            return (f64::NEG_INFINITY, f64::INFINITY, 0, [f64::INFINITY; N]);
+        }
         // The symmetric eigen-solver is backward stable: its eigenvalues
         // are within a few ε‖L‖ of the exact ones; 1e-12 ‖L‖_F is ample.
         let slack = 1e-12 * l.norm();
@@ -409,10 +420,11 @@ mod tests {
     }
 
     /// Every pose sampled inside a box has its damping's and mass's
-    /// eigenvalues within the box's bounds, for boxes of several sizes on
-    /// each shipped linkage, and the bounds close on the pose's values as
-    /// the box shrinks (second order: a tenth the size, about a hundredth
-    /// the gap).
+    /// eigenvalues within the box's bounds, for boxes of several sizes
+    /// about poses of each shipped linkage (inside its joint limits, as
+    /// the search's boxes are), and the bounds close on the pose's values
+    /// as the box shrinks (second order: a tenth the size, about a
+    /// hundredth the gap).
     #[test]
     fn a_box_holds_every_pose_in_it() {
         for name in ["phantom_premium_1_5", "falcon_like", "haply_2diy", "hapkit"] {
@@ -421,15 +433,29 @@ mod tests {
             for p in poses.iter().step_by(3) {
                 let mut gaps = Vec::new();
                 for w in [0.1, 0.01] {
-                    let lo: Vec<f64> = p.q_rad.iter().map(|q| q - w).collect();
-                    let hi: Vec<f64> = p.q_rad.iter().map(|q| q + w).collect();
+                    let limits = &file.joints.limits_rad;
+                    let lo: Vec<f64> = p
+                        .q_rad
+                        .iter()
+                        .zip(limits)
+                        .map(|(q, l)| (q - w).max(l[0]))
+                        .collect();
+                    let hi: Vec<f64> = p
+                        .q_rad
+                        .iter()
+                        .zip(limits)
+                        .map(|(q, l)| (q + w).min(l[1]))
+                        .collect();
                     let Ok(b) = file.cell_bounds(&lo, &hi, true) else {
                         continue;
                     };
                     let n = lo.len();
                     for s in 0..3usize.pow(n as u32) {
                         let q: Vec<f64> = (0..n)
-                            .map(|k| lo[k] + w * (s / 3usize.pow(k as u32) % 3) as f64)
+                            .map(|k| {
+                                let step = (s / 3usize.pow(k as u32) % 3) as f64;
+                                lo[k] + 0.5 * (hi[k] - lo[k]) * step
+                            })
                             .collect();
                         if !file.within_limits(&q) {
                             continue;
