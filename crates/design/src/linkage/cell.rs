@@ -160,20 +160,21 @@ fn inverses<K: Kinematics<Taylor<N>, N>, const N: usize>(
 ) -> Result<(Option<Mat<N>>, Option<Mat<N>>), Undecided> {
     let j = k.forward(q).map_err(|_| Undecided::Refused)?.jacobian;
     let b = &file.joints.damping_nmsprad;
-    let d = if b.iter().all(|&b| b > 0.0) {
-        let d: Mat<N> = core::array::from_fn(|r| {
-            core::array::from_fn(|c| {
-                if r == c {
-                    Taylor::from(b[r])
-                } else {
-                    Taylor::ZERO
+    // `D_q` is diagonal: `J D_q^-1 J^T = Σ_k J_:k J_:k^T / b_k`.
+    let d = b.iter().all(|&b| b > 0.0).then(|| {
+        let mut out: Mat<N> = [[Taylor::ZERO; N]; N];
+        for r in 0..N {
+            for c in r..N {
+                let mut s = Taylor::ZERO;
+                for (k, &b) in b.iter().enumerate() {
+                    let inv = Taylor::constant(Interval::point(b).recip());
+                    s += j[r][k] * j[c][k] * inv;
                 }
-            })
-        });
-        congruence(&j, &d)
-    } else {
-        None
-    };
+                (out[r][c], out[c][r]) = (s, s);
+            }
+        }
+        out
+    });
     // (A pivot the box cannot keep from zero leaves that matrix unbounded
     // here, `None`, and the box is split: its poses are still driven.)
     let m = if mass {
@@ -259,12 +260,11 @@ fn vertices(file: &LinkageFile, c: &[f64], h: &[f64]) -> Vec<Vec<f64>> {
 }
 
 /// The extreme eigenvalues of a symmetric `A(c + Δ)` over the feasible
-/// vertices `vs` given the enclosures at the centre (`at`) and over the
-/// box (`over`): `(λ_min lower bound, λ_max upper bound, the vertex where
+/// vertices `vs` given its entries' enclosures (their value and gradient
+/// at the centre, their Hessian over the box): `(λ_min lower bound, λ_max upper bound, the vertex where
 /// λ_max binds)`.
 fn eigen_bounds<const N: usize>(
-    at: &Mat<N>,
-    over: &Mat<N>,
+    a: &Mat<N>,
     h: &[f64],
     vs: &[Vec<f64>],
 ) -> (f64, f64, usize, [f64; N]) {
@@ -274,11 +274,12 @@ fn eigen_bounds<const N: usize>(
     let mut share = [0.0f64; N];
     for r in 0..N {
         for c in 0..N {
-            let mut s = 0.5 * (at[r][c].v.hi - at[r][c].v.lo);
+            let e = &a[r][c];
+            let mut s = 0.5 * (e.vc.hi - e.vc.lo);
             for k in 0..N {
-                s += 0.5 * (at[r][c].g[k].hi - at[r][c].g[k].lo) * h[k];
+                s += 0.5 * (e.gc[k].hi - e.gc[k].lo) * h[k];
                 for l in 0..N {
-                    let x = 0.5 * over[r][c].h[k][l].mag() * h[k] * h[l];
+                    let x = 0.5 * e.h[k][l].mag() * h[k] * h[l];
                     s += x;
                     share[k] += x;
                 }
@@ -301,9 +302,9 @@ fn eigen_bounds<const N: usize>(
     for (i, v) in vs.iter().enumerate() {
         // The affine part at the vertex, symmetrised.
         let l = DMatrix::from_fn(N, N, |r, c| {
-            let (a, b) = (&at[r][c], &at[c][r]);
-            let slope = a.g.iter().zip(&b.g).zip(v);
-            0.5 * (a.v.mid() + b.v.mid())
+            let (a, b) = (&a[r][c], &a[c][r]);
+            let slope = a.gc.iter().zip(&b.gc).zip(v);
+            0.5 * (a.vc.mid() + b.vc.mid())
                 + slope
                     .map(|((ga, gb), dv)| 0.5 * (ga.mid() + gb.mid()) * dv)
                     .sum::<f64>()
@@ -340,41 +341,41 @@ impl OnKinematics for Bound<'_> {
         let c: Vec<f64> = (0..N)
             .map(|i| 0.5 * self.lo[i] + 0.5 * self.hi[i])
             .collect();
-        // Half-widths, rounded up so that [c - h, c + h] holds the box.
+        // Half-widths, rounded up so that [c - h, c + h] holds the box (a
+        // joint the search holds fixed keeps none).
         let h: Vec<f64> = (0..N)
-            .map(|i| (self.hi[i] - c[i]).max(c[i] - self.lo[i]).next_up())
+            .map(|i| match (self.hi[i] - c[i]).max(c[i] - self.lo[i]) {
+                0.0 if self.lo[i] == self.hi[i] => 0.0,
+                h => h.next_up(),
+            })
             .collect();
         let vs = vertices(self.file, &c, &h);
         if vs.is_empty() {
             return Err(Undecided::Infeasible);
         }
-        let over: [Taylor<N>; N] =
-            core::array::from_fn(|i| Taylor::variable(i, Interval::new(c[i] - h[i], c[i] + h[i])));
-        let at: [Taylor<N>; N] =
-            core::array::from_fn(|i| Taylor::variable(i, Interval::point(c[i])));
-        let (d_over, m_over) = inverses(self.file, &k, &over, self.mass)?;
-        let (d_at, m_at) = inverses(self.file, &k, &at, self.mass)?;
+        let q: [Taylor<N>; N] = core::array::from_fn(|i| Taylor::variable(i, c[i], h[i]));
+        let (d, m) = inverses(self.file, &k, &q, self.mass)?;
         // 1/x rounded toward the bound's side.
         let inv = |x: f64| if x > 0.0 { 1.0 / x } else { f64::INFINITY };
         let bounds = |lo: f64, hi: f64| (inv(hi).next_down().max(0.0), inv(lo).next_up());
         let mut share = [0.0; N];
-        let (damping_nspm, vertex) = match (d_at, d_over) {
-            (Some(at), Some(over)) => {
-                let (lo, hi, v, s) = eigen_bounds(&at, &over, &h, &vs);
+        let (damping_nspm, vertex) = match d {
+            Some(d) => {
+                let (lo, hi, v, s) = eigen_bounds(&d, &h, &vs);
                 share = s;
                 (bounds(lo, hi), v)
             }
-            _ => ((0.0, f64::INFINITY), 0),
+            None => ((0.0, f64::INFINITY), 0),
         };
-        let mass_kg = match (m_at, m_over) {
-            (Some(at), Some(over)) => {
-                let (lo, hi, _, s) = eigen_bounds(&at, &over, &h, &vs);
+        let mass_kg = match m {
+            Some(m) => {
+                let (lo, hi, _, s) = eigen_bounds(&m, &h, &vs);
                 if share.iter().all(|&x| x == 0.0) {
                     share = s;
                 }
                 bounds(lo, hi)
             }
-            _ => (0.0, f64::INFINITY),
+            None => (0.0, f64::INFINITY),
         };
         // (A box with no remainder, or an unbounded one, splits its widest
         // side.)

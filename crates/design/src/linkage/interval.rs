@@ -83,6 +83,27 @@ impl Interval {
         self.lo.is_finite() && self.hi.is_finite() && self.lo <= self.hi
     }
 
+    /// The intersection with another enclosure of the same quantity:
+    /// `self` where either has a NaN (an undefined value stays so) or
+    /// where rounding leaves them apart.
+    pub fn meet(self, o: Interval) -> Interval {
+        let nan = |i: Interval| i.lo.is_nan() || i.hi.is_nan();
+        if nan(self) || nan(o) {
+            return self;
+        }
+        let (lo, hi) = (self.lo.max(o.lo), self.hi.min(o.hi));
+        if lo <= hi {
+            Interval { lo, hi }
+        } else {
+            self
+        }
+    }
+
+    /// `[-d, d]`.
+    pub fn span(d: f64) -> Interval {
+        Interval { lo: -d, hi: d }
+    }
+
     /// Whether 0 is inside.
     pub fn contains_zero(self) -> bool {
         self.lo <= 0.0 && self.hi >= 0.0
@@ -211,7 +232,13 @@ impl Sub for Interval {
 
 impl Mul for Interval {
     type Output = Interval;
+    #[inline]
     fn mul(self, o: Interval) -> Interval {
+        // Exact where an operand is the point zero (most partial
+        // derivatives of a quantity of one joint are).
+        if self == Interval::ZERO || o == Interval::ZERO {
+            return Interval::ZERO;
+        }
         let p = [
             end_product(self.lo, o.lo),
             end_product(self.lo, o.hi),
@@ -226,12 +253,11 @@ impl Mul for Interval {
         }
         let lo = p.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = p.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        // Exact where a point operand is zero; otherwise one ulp out
-        // (which also covers a product that underflowed to zero).
-        let exact = self == Interval::ZERO || o == Interval::ZERO;
+        // One ulp out (which also covers a product that underflowed to
+        // zero).
         Interval {
-            lo: down(lo, exact),
-            hi: up(hi, exact),
+            lo: lo.next_down(),
+            hi: hi.next_up(),
         }
     }
 }

@@ -11,6 +11,7 @@ mod pose;
 mod proof;
 mod report;
 mod search;
+mod symmetry;
 mod taylor;
 mod verify;
 

@@ -307,9 +307,9 @@ impl Objective for LeastDamping {
     }
 }
 
-/// The boundary under the paper's bound on the grasp at `b_c`: the alias
-/// sum's stiffest over the ranges a box or a pose allows, and never below
-/// the hands-off boundary (every bounded hand is passive).
+/// The stiffness under the paper's bound on the grasp at `b_c` at one
+/// pose, over the frequency grid: the alias sum's stiffest, and where it
+/// binds. (Sampled in frequency, so it is reported, not certified.)
 struct Bounded {
     floor: Colgate,
     human: HumanBound,
@@ -317,14 +317,13 @@ struct Bounded {
 }
 
 impl Bounded {
-    fn of(&self, mass_kg: (f64, f64), damping_nspm: (f64, f64)) -> Option<(f64, f64)> {
-        if !(mass_kg.1.is_finite() && damping_nspm.1.is_finite() && mass_kg.0 > 0.0) {
-            return None;
-        }
+    fn at(&self, pose: &PoseDynamics) -> Option<(f64, f64)> {
+        let m = pose.mass_kg.clone().symmetric_eigenvalues();
+        let d = pose.damping_nspm.clone().symmetric_eigenvalues();
         let g = self.floor.min_grasp_nspm;
         let ranges = PoseRanges {
-            mass_kg,
-            damping_nspm: (damping_nspm.0 + g, damping_nspm.1 + g),
+            mass_kg: (m.min(), m.max()),
+            damping_nspm: (d.min() + g, d.max() + g),
         };
         stiffest(
             &ranges,
@@ -333,28 +332,6 @@ impl Bounded {
             self.floor.period_s,
             &self.thetas,
         )
-    }
-
-    fn ranges(pose: &PoseDynamics) -> ((f64, f64), (f64, f64)) {
-        let m = pose.mass_kg.clone().symmetric_eigenvalues();
-        let d = pose.damping_nspm.clone().symmetric_eigenvalues();
-        ((m.min(), m.max()), (d.min(), d.max()))
-    }
-}
-
-impl Objective for Bounded {
-    const MASS: bool = true;
-    fn over(&self, cell: &CellBounds) -> f64 {
-        let floor = self.floor.proven(cell.damping_nspm.0);
-        match self.of(cell.mass_kg, cell.damping_nspm) {
-            Some((k, _)) => k.max(floor),
-            None => floor,
-        }
-    }
-    fn at(&self, pose: &PoseDynamics) -> f64 {
-        let (m, d) = Self::ranges(pose);
-        let floor = self.floor.of(d.0);
-        self.of(m, d).map_or(floor, |(k, _)| k.max(floor))
     }
 }
 
@@ -380,20 +357,17 @@ pub fn certified_design(
         b_c_nspm,
         min_grasp_nspm,
     };
-    let bounded = human.map(|human| Bounded {
-        floor,
-        human,
-        thetas: theta_grid(file.period_s, BOUNDED_GRID),
-    });
-    let found = match &bounded {
-        None => least(file, &LeastDamping).map(|d| Least {
+    // Every hand the paper's bound allows is passive, so the hands-off
+    // (or least-grasp) certificate holds under it too: the bound's own
+    // alias sum is sampled in frequency, and lifts the stiffness by at
+    // most 0.1 % on the shipped linkages, so it is reported, not certified.
+    let found = least(file, &LeastDamping)
+        .map(|d| Least {
             bound: floor.proven(d.bound),
             found: floor.of(d.found),
             ..d
-        }),
-        Some(b) => least(file, b),
-    }
-    .map_err(|SearchError::NoPose| crate::Error::NoPose)?;
+        })
+        .map_err(|SearchError::NoPose| crate::Error::NoPose)?;
     let pose = found.pose;
     let mut design = workspace_design(file, std::slice::from_ref(&pose), b_c_nspm, min_grasp_nspm)?;
     // The ranges the report gives, over the design grid's poses.
@@ -410,11 +384,15 @@ pub fn certified_design(
             file.name, design.binding.damping_nspm, pose.q_rad
         )));
     }
-    if let Some(b) = &bounded {
-        let (m, d) = Bounded::ranges(&pose);
-        design.human = Some(b.human);
+    if let Some(human) = human {
+        let b = Bounded {
+            floor,
+            human,
+            thetas: theta_grid(file.period_s, BOUNDED_GRID),
+        };
+        design.human = Some(human);
         design.binding.frequency_hz = b
-            .of(m, d)
+            .at(&pose)
             .map(|(_, theta)| theta / (2.0 * std::f64::consts::PI * file.period_s));
     }
     design.k_c_npm = found.bound;
@@ -496,9 +474,7 @@ mod tests {
     #[test]
     fn the_certificate_is_below_every_pose_and_close_to_one() {
         let mut rnd = crate::test_rng::uniform(0x9e37_79b9_7f4a_7c15u64);
-        // (The delta's bounds are too loose for the search to close within
-        // its budget yet: docs/linkages.md says so.)
-        for name in SHIPPED.iter().filter(|n| !n.starts_with("falcon")) {
+        for name in SHIPPED {
             let l = shipped(name);
             let d = certified_design(&l, 0.0, 0.0, None).unwrap();
             let c = d.certificate.clone().unwrap();

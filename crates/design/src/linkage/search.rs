@@ -90,6 +90,14 @@ struct Search<'a, O> {
 const BATCH: usize = 32;
 
 impl<O: Objective + Sync> Search<'_, O> {
+    /// The bound a box must reach to need no split: the least value found,
+    /// less the tolerance.
+    fn cut(&self) -> f64 {
+        self.best
+            .as_ref()
+            .map_or(f64::INFINITY, |(b, _)| b - TOLERANCE * b.abs())
+    }
+
     /// Evaluate the objective at `q` if it is a pose the board drives.
     fn consider(&mut self, q: &[f64]) {
         if !self.file.within_limits(q) {
@@ -117,8 +125,12 @@ impl<O: Objective + Sync> Search<'_, O> {
             let mid: Vec<f64> = lo.iter().zip(&hi).map(|(a, b)| 0.5 * (a + b)).collect();
             match b {
                 Ok((bound, cell)) => {
-                    self.consider(&cell.least_damped_q_rad);
-                    self.consider(&mid);
+                    // (A box proven past the cut holds no pose the
+                    // certificate needs.)
+                    if bound < self.cut() {
+                        self.consider(&cell.least_damped_q_rad);
+                        self.consider(&mid);
+                    }
                     self.open.push(Open {
                         bound,
                         lo,
@@ -146,6 +158,8 @@ fn halves(cell: Open) -> [(Vec<f64>, Vec<f64>); 2] {
 /// The least of `objective` over `file`'s workspace, to [`TOLERANCE`] or
 /// until [`BUDGET`] boxes.
 pub fn least<O: Objective + Sync>(file: &LinkageFile, objective: &O) -> Result<Least, SearchError> {
+    // (A symmetric family of poses shares its eigenvalues: one of each.)
+    let file = &file.fundamental_domain();
     let mut s = Search {
         file,
         objective,
@@ -182,10 +196,7 @@ pub fn least<O: Objective + Sync>(file: &LinkageFile, objective: &O) -> Result<L
         }
         // Split the least-bounded boxes that are still too far below the
         // best pose (at least the least of them).
-        let cut = s
-            .best
-            .as_ref()
-            .map_or(f64::INFINITY, |(b, _)| b - TOLERANCE * b.abs());
+        let cut = s.cut();
         let mut split = Vec::new();
         while split.len() < 2 * BATCH {
             match s.open.peek() {
