@@ -1,7 +1,8 @@
 //! Designer speed: the Excalibur 2x2 frequency response on 10,000 points
 //! (goal <= 2 ms), the discrete terms, a full design of both displays
 //! (goal <= 20 ms), a design over 8 poses against one (goal: at most 8
-//! times), and `verify` on the Excalibur (goal <= 2 s).
+//! times), `verify` on the Excalibur (goal <= 2 s), and the workspace
+//! certificate of the PHANToM and the Falcon-like delta (goal <= 1 s).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use num_complex::Complex64;
@@ -119,44 +120,26 @@ fn verify(c: &mut Criterion) {
     group.finish();
 }
 
-/// A rigid linkage proven at 1,000 poses: each linearised (kinematics,
-/// `J^-T M_q J^-1`, `J^-T D_q J^-1`) and the workspace proven (goal: 2 s).
+/// The workspace certificate of the two 3-DOF linkages: a branch and
+/// bound over every pose inside the limits, to a gap of 1e-4 (goal: 1 s
+/// each).
 fn linkage(c: &mut Criterion) {
-    use twoport_design::linkage::{bounded_workspace_design, workspace_design, LinkageFile};
-    let file = LinkageFile::from_toml(
-        include_str!("../models/linkages/phantom_premium_1_5.toml"),
-        "phantom",
-    )
-    .unwrap();
-    let qs: Vec<Vec<f64>> = file
-        .workspace(16)
-        .into_iter()
-        .take(1000)
-        .map(|p| p.q_rad)
-        .collect();
-    assert_eq!(qs.len(), 1000);
-    c.bench_function("PHANToM 1.5: 1,000 poses linearised and proven", |b| {
-        b.iter(|| {
-            let poses: Vec<_> = qs.iter().map(|q| file.pose(q).unwrap()).collect();
-            black_box(workspace_design(&file, &poses, 0.0, 1.0).unwrap().k_c_npm)
-        })
-    });
-    // The same under the paper's bound on the grasp: an alias sum per pose
-    // over 160 frequencies, the poses whose hands-off floor is past the
-    // least found skipped.
-    let poses: Vec<_> = qs.iter().map(|q| file.pose(q).unwrap()).collect();
-    c.bench_function(
-        "PHANToM 1.5: 1,000 poses proven under the grasp bound",
-        |b| {
-            b.iter(|| {
-                black_box(
-                    bounded_workspace_design(&file, &poses, 0.0, 0.0, HumanBound::PAPER)
-                        .unwrap()
-                        .k_c_npm,
-                )
-            })
-        },
-    );
+    use twoport_design::linkage::{certified_design, LinkageFile};
+    for (name, text) in [
+        (
+            "PHANToM 1.5",
+            include_str!("../models/linkages/phantom_premium_1_5.toml"),
+        ),
+        (
+            "Falcon-like delta",
+            include_str!("../models/linkages/falcon_like.toml"),
+        ),
+    ] {
+        let file = LinkageFile::from_toml(text, name).unwrap();
+        c.bench_function(&format!("{name}: workspace certificate"), |b| {
+            b.iter(|| black_box(certified_design(&file, 0.0, 0.0, None).unwrap().k_c_npm))
+        });
+    }
 }
 
 fn excalibur_model() -> DeviceModel {

@@ -91,7 +91,7 @@ const MAP_PER_JOINT: [usize; 3] = [41, 41, 15];
 /// its own, over the workspace (a 3-DOF linkage seen from above), the
 /// pose that binds `design`'s proof marked.
 pub(crate) fn plot_workspace(p: &PlotArgs) -> Result<(), String> {
-    use twoport_design::linkage::{workspace_design, workspace_poses, LinkageFile, DESIGN_GRID};
+    use twoport_design::linkage::{certified_design, workspace_design, LinkageFile};
     let path = p
         .common
         .device
@@ -109,11 +109,11 @@ pub(crate) fn plot_workspace(p: &PlotArgs) -> Result<(), String> {
         }
     };
     let n = file.geometry.joints();
-    // The design's poses (so that the mark is the design's binding pose)
-    // and a finer grid to draw.
-    let mut poses = workspace_poses(&file, DESIGN_GRID);
-    poses.extend(file.workspace(MAP_PER_JOINT[n - 1]));
-    let whole = workspace_design(&file, &poses, 0.0, grasp).map_err(|e| e.to_string())?;
+    // The certified design (its binding pose is the mark) and a grid to
+    // draw.
+    let whole = certified_design(&file, 0.0, grasp, None).map_err(|e| e.to_string())?;
+    let mut poses = file.workspace(MAP_PER_JOINT[n - 1]);
+    poses.push(whole.binding.pose.clone());
     let at = |x: &[f64]| {
         let mm = |i: usize| x.get(i).copied().unwrap_or(0.0) * 1e3;
         (mm(0), mm(1))

@@ -14,7 +14,7 @@ use crate::args::{HostArgs, RatesArgs};
 use serde_json::{json, Value};
 use std::path::Path;
 use twoport_design::host_ve::{host_best_pair, HostLoop};
-use twoport_design::linkage::{workspace_design, workspace_poses, LinkageFile, DESIGN_GRID};
+use twoport_design::linkage::{certified_design_from, least_damping, LinkageFile};
 use twoport_design::network::HumanBound;
 use twoport_design::plot::{self, Curve, Figure, BLUE, GREY, INK, RED};
 use twoport_design::{Designer, DeviceModel, Plant};
@@ -79,10 +79,12 @@ fn model_row(path: &Path, rates: &[f64], host: Option<&HostArgs>) -> Result<Row,
 fn linkage_row(path: &Path, rates: &[f64], grasp: f64) -> Result<Row, String> {
     let mut file = LinkageFile::load(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut at = Vec::new();
+    // (The workspace's least damping does not depend on the rate.)
+    let damping = least_damping(&file).map_err(|e| format!("{}: {e}", path.display()))?;
     for r in rates {
         file.period_s = 1.0 / r;
-        let poses = workspace_poses(&file, DESIGN_GRID);
-        let d = workspace_design(&file, &poses, 0.0, grasp).map_err(|e| e.to_string())?;
+        let d =
+            certified_design_from(&file, &damping, 0.0, grasp, None).map_err(|e| e.to_string())?;
         at.push(((d.k_c_npm, 0.0), d.k_c_npm));
     }
     Ok(Row {

@@ -29,21 +29,16 @@ pub(crate) fn design_admittance(a: &DesignAdmittance) -> Result<(), String> {
 /// `design impedance --device LINKAGE`: the proof over the linkage's
 /// workspace, hands off or for a least grasp.
 pub(crate) fn design_linkage(a: &DesignImpedance) -> Result<(), String> {
-    use twoport_design::linkage::{
-        bounded_workspace_design, workspace_design, workspace_poses, LinkageDesign, DESIGN_GRID,
-    };
+    use twoport_design::linkage::{certified_design, LinkageDesign};
     use twoport_design::network::HumanBound;
     let margin = a.margin.fraction()?;
     let file = linkage_file(&a.common)?;
-    let poses = workspace_poses(&file, DESIGN_GRID);
     let b = a.b.unwrap_or(0.0);
     // A least grasp alone, hands off, or (by default, as for every
-    // device) the paper's bound on how stiff the grasp is.
-    let d = match (a.min_grasp, a.common.no_human) {
-        (Some(g), _) => workspace_design(&file, &poses, b, g),
-        (None, true) => workspace_design(&file, &poses, b, 0.0),
-        (None, false) => bounded_workspace_design(&file, &poses, b, 0.0, HumanBound::PAPER),
-    }
-    .map_err(|e| e.to_string())?;
+    // device) the paper's bound on how stiff the grasp is, whose
+    // certificate is the hands-off one.
+    let human = (a.min_grasp.is_none() && !a.common.no_human).then_some(HumanBound::PAPER);
+    let d =
+        certified_design(&file, b, a.min_grasp.unwrap_or(0.0), human).map_err(|e| e.to_string())?;
     emit(&a.common, &LinkageDesign::new(&file, &d, margin))
 }

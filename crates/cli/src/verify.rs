@@ -45,8 +45,7 @@ pub(crate) fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(),
 /// design under the same hand assumption and at every tenth pose.
 pub(crate) fn verify_linkage(a: &ImpedanceGains) -> Result<(), String> {
     use twoport_design::linkage::{
-        bounded_workspace_design, verify_linkage, workspace_design, workspace_poses,
-        HandAssumption, DESIGN_GRID,
+        certified_design, verify_linkage, HandAssumption, PoseDynamics, DESIGN_GRID,
     };
     use twoport_design::network::HumanBound;
     let file = linkage_file(&a.common)?;
@@ -60,16 +59,23 @@ pub(crate) fn verify_linkage(a: &ImpedanceGains) -> Result<(), String> {
         g => g.unwrap_or(0.0),
     };
     let human = (!a.common.no_human && a.min_grasp.is_none()).then_some(HumanBound::PAPER);
-    let poses = workspace_poses(&file, DESIGN_GRID);
-    // The pose that binds the design under the same assumption leads.
-    let d = match human {
-        Some(h) => bounded_workspace_design(&file, &poses, 0.0, grasp, h),
-        None => workspace_design(&file, &poses, 0.0, grasp),
+    // The certificate's binding pose leads, then the corners of the box
+    // that binds it, then every tenth pose of a grid.
+    let d = certified_design(&file, 0.0, grasp, human).map_err(|e| e.to_string())?;
+    let mut sample: Vec<PoseDynamics> = vec![d.binding.pose.clone()];
+    if let Some(c) = &d.certificate {
+        let n = c.binding_box_rad.len();
+        for bits in 0..1usize << n {
+            let q: Vec<f64> = (0..n)
+                .map(|i| c.binding_box_rad[i][(bits >> i) & 1])
+                .collect();
+            if file.within_limits(&q) {
+                sample.extend(file.pose(&q).ok());
+            }
+        }
     }
-    .map_err(|e| e.to_string())?;
-    let sample: Vec<_> = std::iter::once(&d.binding.pose)
-        .chain(poses.iter().step_by(10))
-        .collect();
+    sample.extend(file.workspace(DESIGN_GRID).into_iter().step_by(10));
+    let sample: Vec<&PoseDynamics> = sample.iter().collect();
     let assumption = HandAssumption {
         min_grasp_nspm: grasp,
         human,

@@ -22,8 +22,9 @@ pub use file::{Geometry, Inertia, Joints, LinkageFile, Motors, OnKinematics, Rel
 pub use interval::Interval;
 pub use pose::{forward, PoseDynamics};
 pub use proof::{
-    bounded_workspace_design, certified_design, workspace_design, workspace_poses, Binding,
-    Certificate, WorkspaceDesign, BOUNDED_GRID, DESIGN_GRID,
+    bounded_workspace_design, certified_design, certified_design_from, least_damping,
+    workspace_design, workspace_poses, Binding, Certificate, WorkspaceDesign, BOUNDED_GRID,
+    DESIGN_GRID,
 };
 pub use report::{stiffness, LinkageDesign};
 pub use search::{least, Least, Objective, SearchError, BUDGET, TOLERANCE};

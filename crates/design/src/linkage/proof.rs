@@ -262,9 +262,8 @@ pub struct Certificate {
     /// The stiffness found at the binding pose (N/m): the design's
     /// `k_c_npm` is proven, and at most `gap` below this.
     pub found_k_c_npm: f64,
-    /// The relative gap between the least found at a pose and the bound,
-    /// on the quantity searched: the least damping (hands off or with a
-    /// least grasp), or the stiffness (under the paper's bound).
+    /// The relative gap between the stiffness the least damped pose found
+    /// proves and the certified one.
     pub gap: f64,
     /// The box of joint angles whose bound is the design (rad).
     pub binding_box_rad: Vec<[f64; 2]>,
@@ -335,14 +334,36 @@ impl Bounded {
     }
 }
 
-/// The design over the whole workspace, proven by branch and bound (see
-/// `cell`): at `b_c` for every passive hand that grasps with at least
-/// `min_grasp` (N s/m), and no stiffer than `human` if given. The design's
-/// stiffness is the proven lower bound over every pose inside the joint
-/// and relative limits; the binding pose is the least found, within the
+/// The least damping in any direction over the whole workspace, proven by
+/// branch and bound (see `cell`): a lower bound over every pose inside the
+/// joint and relative limits, within [`TOLERANCE`](super::TOLERANCE) of
+/// the least found at a pose. It does not depend on the servo's period,
+/// the coupling or the grasp: [`certified_design_from`] turns it into a
+/// design for each.
+pub fn least_damping(file: &LinkageFile) -> Result<Least, crate::Error> {
+    least(file, &LeastDamping).map_err(|SearchError::NoPose| crate::Error::NoPose)
+}
+
+/// The design over the whole workspace, proven by branch and bound: at
+/// `b_c` for every passive hand that grasps with at least `min_grasp`
+/// (N s/m), and reported under `human` if given. The design's stiffness
+/// is the proven lower bound over every pose inside the joint and
+/// relative limits; the binding pose is the least found, within the
 /// certificate's gap of it.
 pub fn certified_design(
     file: &LinkageFile,
+    b_c_nspm: f64,
+    min_grasp_nspm: f64,
+    human: Option<HumanBound>,
+) -> Result<WorkspaceDesign, crate::Error> {
+    certified_design_from(file, &least_damping(file)?, b_c_nspm, min_grasp_nspm, human)
+}
+
+/// [`certified_design`] from the file's [`least_damping`] certificate
+/// (at the file's period).
+pub fn certified_design_from(
+    file: &LinkageFile,
+    damping: &Least,
     b_c_nspm: f64,
     min_grasp_nspm: f64,
     human: Option<HumanBound>,
@@ -361,13 +382,13 @@ pub fn certified_design(
     // (or least-grasp) certificate holds under it too: the bound's own
     // alias sum is sampled in frequency, and lifts the stiffness by at
     // most 0.1 % on the shipped linkages, so it is reported, not certified.
-    let found = least(file, &LeastDamping)
-        .map(|d| Least {
-            bound: floor.proven(d.bound),
-            found: floor.of(d.found),
-            ..d
-        })
-        .map_err(|SearchError::NoPose| crate::Error::NoPose)?;
+    let (bound, at) = (floor.proven(damping.bound), floor.of(damping.found));
+    let found = Least {
+        bound,
+        found: at,
+        gap: (at - bound) / at.abs().max(f64::MIN_POSITIVE),
+        ..damping.clone()
+    };
     let pose = found.pose;
     let mut design = workspace_design(file, std::slice::from_ref(&pose), b_c_nspm, min_grasp_nspm)?;
     // The ranges the report gives, over the design grid's poses.

@@ -18,8 +18,15 @@ pub struct LinkageDesign {
     pub min_grasp_nspm: f64,
     /// The servo's period (s).
     pub period_s: f64,
-    /// Poses proven.
+    /// Boxes of joint angles the certificate bounded (for a design over
+    /// given poses, the poses).
     pub poses: usize,
+    /// Where the design is certified over the whole workspace: the
+    /// stiffness the least damped pose found proves (N/m), which the
+    /// design is at most `certificate_gap` (relative) below.
+    pub found_k_c_npm: Option<f64>,
+    /// The certificate's relative gap.
+    pub certificate_gap: Option<f64>,
     /// The boundary stiffness (N/m) at `b_c_nspm`.
     pub k_c_npm: f64,
     /// The coupling's damping (N s/m).
@@ -74,6 +81,8 @@ impl LinkageDesign {
             min_grasp_nspm: design.min_grasp_nspm,
             period_s: file.period_s,
             poses: design.poses,
+            found_k_c_npm: design.certificate.as_ref().map(|c| c.found_k_c_npm),
+            certificate_gap: design.certificate.as_ref().map(|c| c.gap),
             k_c_npm: design.k_c_npm,
             b_c_nspm: design.b_c_nspm,
             recommended_k_c_npm: design.k_c_npm * (1.0 - margin),
@@ -117,10 +126,21 @@ impl fmt::Display for LinkageDesign {
             self.period_s * 1e3,
             self.human
         )?;
+        match (self.found_k_c_npm, self.certificate_gap) {
+            (Some(found), Some(gap)) => writeln!(
+                f,
+                "  workspace: every pose inside the limits, by branch and bound over {} box{} \
+                 (the least damped pose found proves {} N/m; the certificate is {:.1e} below it)",
+                self.poses,
+                if self.poses == 1 { "" } else { "es" },
+                stiffness(found),
+                gap
+            )?,
+            _ => writeln!(f, "  workspace: {} poses", self.poses)?,
+        }
         writeln!(
             f,
-            "  workspace: {} poses; the handle weighs {:.1} to {:.1} g, damping {:.4} to {:.4} N s/m",
-            self.poses,
+            "  the handle weighs {:.1} to {:.1} g, damping {:.4} to {:.4} N s/m (over a grid)",
             self.mass_range_kg.0 * 1e3,
             self.mass_range_kg.1 * 1e3,
             self.damping_range_nspm.0,
