@@ -3,7 +3,7 @@
 
 use super::*;
 use nalgebra::{DMatrix, DVector};
-use twoport_design::linkage::{workspace_design, workspace_poses, LinkageFile, DESIGN_GRID};
+use twoport_design::linkage::{certified_design, LinkageFile, DESIGN_GRID};
 
 const SHIPPED: [&str; 4] = ["phantom_premium_1_5", "falcon_like", "haply_2diy", "hapkit"];
 
@@ -160,8 +160,8 @@ fn the_binding_pose_holds_at_the_design_and_breaks_past_it() {
     for name in SHIPPED {
         let file = shipped(name);
         let n = file.geometry.joints();
-        let poses = workspace_poses(&file, DESIGN_GRID);
-        let d = workspace_design(&file, &poses, 0.0, 2.0).unwrap();
+        let poses = file.workspace(DESIGN_GRID);
+        let d = certified_design(&file, 0.0, 2.0, None).unwrap();
         // The binding pose can sit on a joint limit or the kinematics'
         // singular edge, where any motion leaves what the servo serves:
         // start toward the workspace's centre, by tenths, until every pose
