@@ -165,4 +165,47 @@ mod tests {
         delta.joints.limits_rad[1][1] = 1.1;
         assert_eq!(delta.fundamental_domain(), delta);
     }
+
+    /// Files that keep no symmetry (a relative limit on the PHANToM's base,
+    /// a delta with one leg damped more) are certified over their whole
+    /// box: no pose of a grid or of 300 random ones is less damped than
+    /// the certificate, which is within the tolerance of a pose found.
+    #[test]
+    #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+    fn a_file_without_a_symmetry_is_certified_over_its_whole_box() {
+        let mut arm = shipped("phantom_premium_1_5");
+        arm.joints.relative.push(RelativeLimit {
+            joints: [0, 2],
+            rad: [-1.0, 3.0],
+        });
+        let mut delta = shipped("falcon_like");
+        delta.joints.damping_nmsprad[2] *= 1.5;
+        let mut rnd = crate::test_rng::uniform(0x2545_f491_4f6c_dd1du64);
+        for file in [arm, delta] {
+            assert_eq!(file.fundamental_domain(), file);
+            let c = crate::linkage::least_damping(&file).unwrap();
+            assert!(c.gap <= crate::linkage::TOLERANCE, "{}: {c:?}", file.name);
+            let mut qs: Vec<Vec<f64>> = file.workspace(9).into_iter().map(|p| p.q_rad).collect();
+            for _ in 0..300 {
+                qs.push(
+                    file.joints
+                        .limits_rad
+                        .iter()
+                        .map(|[lo, hi]| lo + (hi - lo) * rnd())
+                        .collect(),
+                );
+            }
+            for q in qs.iter().filter(|q| file.within_limits(q)) {
+                if let Some((d, _)) = eigenvalues(&file, q) {
+                    assert!(
+                        d[0] >= c.bound,
+                        "{}: {} < {} at {q:?}",
+                        file.name,
+                        d[0],
+                        c.bound
+                    );
+                }
+            }
+        }
+    }
 }
