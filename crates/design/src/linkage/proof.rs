@@ -341,7 +341,13 @@ impl Bounded {
 /// the coupling or the grasp: [`certified_design_from`] turns it into a
 /// design for each.
 pub fn least_damping(file: &LinkageFile) -> Result<Least, crate::Error> {
-    least(file, &LeastDamping).map_err(|SearchError::NoPose| crate::Error::NoPose)
+    least(file, &LeastDamping).map_err(|SearchError::NoPose| {
+        crate::Error::Coupling(format!(
+            "{}: no pose inside the joint limits (and the relative ones) is one the \
+             kinematics drive: check joints.limits_rad, joints.relative and the geometry",
+            file.name
+        ))
+    })
 }
 
 /// The design over the whole workspace, proven by branch and bound: at
@@ -531,6 +537,22 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A file whose limits leave no pose the kinematics drive is refused
+    /// by name.
+    #[test]
+    fn a_file_with_no_pose_is_refused_by_name() {
+        let mut l = shipped("phantom_premium_1_5.toml");
+        l.joints.relative = vec![crate::linkage::RelativeLimit {
+            joints: [1, 2],
+            rad: [10.0, 11.0],
+        }];
+        let e = certified_design(&l, 0.0, 0.0, None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no pose inside the joint limits"), "{e}");
+        assert!(e.contains("PHANToM"), "{e}");
     }
 
     /// The PHANToM Premium 1.5's least damped pose lies on its
