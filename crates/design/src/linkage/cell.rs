@@ -410,15 +410,7 @@ impl LinkageFile {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
-
-    fn shipped(name: &str) -> LinkageFile {
-        let path = format!(
-            "{}/../../models/linkages/{name}.toml",
-            env!("CARGO_MANIFEST_DIR")
-        );
-        LinkageFile::load(std::path::Path::new(&path)).unwrap()
-    }
+    use crate::linkage::test_files::{shipped, SHIPPED};
 
     /// Every pose sampled inside a box has its damping's and mass's
     /// eigenvalues within the box's bounds, for boxes of several sizes
@@ -428,7 +420,7 @@ mod tests {
     /// hundredth the gap).
     #[test]
     fn a_box_holds_every_pose_in_it() {
-        for name in ["phantom_premium_1_5", "falcon_like", "haply_2diy", "hapkit"] {
+        for name in SHIPPED {
             let file = shipped(name);
             let poses = file.workspace(4);
             for p in poses.iter().step_by(3) {

@@ -30,3 +30,22 @@ pub use report::{stiffness, LinkageDesign};
 pub use search::{least, Least, Objective, SearchError, BUDGET, TOLERANCE};
 pub use taylor::Taylor;
 pub use verify::{loop_radius, verify_linkage, HandAssumption, LinkageHand, LinkageVerdict};
+
+/// The shipped linkage files, for the tests.
+#[cfg(test)]
+pub(crate) mod test_files {
+    use super::LinkageFile;
+
+    /// Their names, without `.toml`.
+    pub(crate) const SHIPPED: [&str; 4] =
+        ["phantom_premium_1_5", "falcon_like", "haply_2diy", "hapkit"];
+
+    /// `models/linkages/{name}.toml`.
+    pub(crate) fn shipped(name: &str) -> LinkageFile {
+        let path = format!(
+            "{}/../../models/linkages/{name}.toml",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        LinkageFile::load(std::path::Path::new(&path)).unwrap()
+    }
+}

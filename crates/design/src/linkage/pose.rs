@@ -345,12 +345,8 @@ mod tests {
         let dist = |a: &[f64; 3], b: &[f64; 3]| {
             ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
         };
-        for name in ["phantom_premium_1_5", "falcon_like", "haply_2diy", "hapkit"] {
-            let path = format!(
-                "{}/../../models/linkages/{name}.toml",
-                env!("CARGO_MANIFEST_DIR")
-            );
-            let file = LinkageFile::load(std::path::Path::new(&path)).unwrap();
+        for name in crate::linkage::test_files::SHIPPED {
+            let file = crate::linkage::test_files::shipped(name);
             let poses = file.workspace(5);
             assert!(poses.len() > 3, "{name}");
             for p in poses {

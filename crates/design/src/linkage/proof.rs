@@ -436,21 +436,7 @@ pub fn certified_design_from(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn shipped(file: &str) -> LinkageFile {
-        let path = format!(
-            "{}/../../models/linkages/{file}",
-            env!("CARGO_MANIFEST_DIR")
-        );
-        LinkageFile::load(std::path::Path::new(&path)).unwrap()
-    }
-
-    const SHIPPED: [&str; 4] = [
-        "hapkit.toml",
-        "haply_2diy.toml",
-        "phantom_premium_1_5.toml",
-        "falcon_like.toml",
-    ];
+    use crate::linkage::test_files::{shipped, SHIPPED};
 
     /// The proof binds at the least damped direction of the least damped
     /// pose: no pose and no direction is less damped (random directions
@@ -543,7 +529,7 @@ mod tests {
     /// by name.
     #[test]
     fn a_file_with_no_pose_is_refused_by_name() {
-        let mut l = shipped("phantom_premium_1_5.toml");
+        let mut l = shipped("phantom_premium_1_5");
         l.joints.relative = vec![crate::linkage::RelativeLimit {
             joints: [1, 2],
             rad: [10.0, 11.0],
@@ -562,7 +548,7 @@ mod tests {
     /// a 2 N s/m grasp, and binds there.
     #[test]
     fn the_phantoms_certificate_binds_on_its_parallelogram_limit() {
-        let l = shipped("phantom_premium_1_5.toml");
+        let l = shipped("phantom_premium_1_5");
         let d = certified_design(&l, 0.0, 0.0, None).unwrap();
         assert!(d.k_c_npm <= 7.4072 && d.k_c_npm > 7.406, "{}", d.k_c_npm);
         let q = &d.binding.pose.q_rad;

@@ -85,14 +85,7 @@ impl LinkageFile {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn shipped(name: &str) -> LinkageFile {
-        let path = format!(
-            "{}/../../models/linkages/{name}.toml",
-            env!("CARGO_MANIFEST_DIR")
-        );
-        LinkageFile::load(std::path::Path::new(&path)).unwrap()
-    }
+    use crate::linkage::test_files::shipped;
 
     fn eigenvalues(file: &LinkageFile, q: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
         let p = file.pose(q).ok()?;

@@ -274,15 +274,8 @@ pub fn verify_linkage(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::linkage::{certified_design, LinkageFile, DESIGN_GRID};
-
-    fn shipped(file: &str) -> LinkageFile {
-        let path = format!(
-            "{}/../../models/linkages/{file}",
-            env!("CARGO_MANIFEST_DIR")
-        );
-        LinkageFile::load(std::path::Path::new(&path)).unwrap()
-    }
+    use crate::linkage::test_files::{shipped, SHIPPED};
+    use crate::linkage::{certified_design, DESIGN_GRID};
 
     /// On every shipped linkage, under each hand assumption (hands off; a
     /// 2 N s/m grasp; the paper's bound), the search finds nothing 0.1 %
@@ -292,12 +285,7 @@ mod tests {
     #[test]
     #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
     fn verify_finds_nothing_at_the_design_and_breaks_it_past() {
-        for name in [
-            "phantom_premium_1_5.toml",
-            "falcon_like.toml",
-            "haply_2diy.toml",
-            "hapkit.toml",
-        ] {
+        for name in SHIPPED {
             let l = shipped(name);
             let poses = l.workspace(DESIGN_GRID);
             for (grasp, human) in [(0.0, None), (2.0, None), (0.0, Some(HumanBound::PAPER))] {
@@ -323,7 +311,7 @@ mod tests {
     /// certificate's binding pose: 2 % past the proven 7.4066.
     #[test]
     fn the_old_phantom_certificate_breaks_at_the_binding_pose() {
-        let l = shipped("phantom_premium_1_5.toml");
+        let l = shipped("phantom_premium_1_5");
         let d = certified_design(&l, 0.0, 0.0, None).unwrap();
         assert!(d.k_c_npm <= 7.4072 && d.k_c_npm > 7.40, "{}", d.k_c_npm);
         let a = HandAssumption {
