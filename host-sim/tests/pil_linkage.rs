@@ -59,8 +59,8 @@ fn a_linkage_board_holds_the_floor_and_stops_after_a_link_loss() {
         // `J^T f_h`, the hand's force through the plant's own Jacobian at
         // each tick's pose: its spring toward the anchor and its damper on
         // the handle's velocity (a backward difference).
-        let (down, k, b) = linkage::HAND;
-        let anchor = [x0[0], x0[1], x0[2] - down];
+        let (k, b) = (linkage::HAND.stiffness_npm, linkage::HAND.grasp_nspm);
+        let anchor = [x0[0], x0[1], x0[2] - linkage::HAND.down_m];
         let mut plant = LinkagePlant::at_rest(&file, &rest);
         let (mut got, mut want, mut hand_z) = ([0.0; 3], [0.0; 3], 0.0);
         let window = 2300..2500;
@@ -136,27 +136,13 @@ fn a_linkage_board_refuses_homing_and_a_pose_it_cannot_serve() {
 #[test]
 fn the_images_are_their_device_files_and_their_proof() {
     use twoport_board::linkage::{region, GRASP_NSPM, PERIOD_S};
-    use twoport_design::linkage::{workspace_design, workspace_poses, Geometry, DESIGN_GRID};
+    use twoport_design::linkage::{certified_design_from, least_damping, Geometry};
     for device in [Device::SerialArm, Device::Delta] {
         let file = device.file().unwrap();
         let spec = device.spec();
         let close = |a: f32, b: f64| (f64::from(a) - b).abs() <= 1e-6 * b.abs().max(1e-3);
         assert!(close(PERIOD_S, file.period_s));
-        assert!(close(
-            spec.counts_per_rev,
-            file.motors.encoder_counts_per_rev as f64
-        ));
-        assert!(close(spec.motor_torque_nm.0, file.motors.peak_torque_nm));
-        assert!(close(
-            spec.motor_torque_nm.1,
-            file.motors.continuous_torque_nm
-        ));
-        for i in 0..3 {
-            assert!(close(spec.ratios[i], file.motors.ratios[i]), "{device:?}");
-            for e in 0..2 {
-                assert!(close(spec.limits_rad[i][e], file.joints.limits_rad[i][e]));
-            }
-        }
+        assert_eq!(file.hardware::<3>(), Some(spec.hardware), "{device:?}");
         let rest = spec.rest_rad.map(f64::from);
         assert!(file.within_limits(&rest), "{device:?}");
         // The gravity the image holds up is the file's, at the rest pose.
@@ -201,14 +187,24 @@ fn the_images_are_their_device_files_and_their_proof() {
             }
             (d, g) => panic!("{d:?} is not {g:?}"),
         }
-        let poses = workspace_poses(&file, DESIGN_GRID);
+        // The image claims no more damping than the certificate proves,
+        // and gives away at most 0.1 % of it.
+        let least = least_damping(&file).unwrap();
+        let claimed = f64::from(spec.least_damping_nspm);
+        assert!(
+            claimed <= least.bound && claimed >= 0.999 * least.bound,
+            "{device:?}: the image claims {claimed} N s/m, the certificate {}",
+            least.bound
+        );
         let r = region(spec).unwrap();
         // On its grid the region is the proof; between grid points, the
         // stiffer neighbour's less 1 %, never more than the proof.
         let total = spec.least_damping_nspm + GRASP_NSPM;
         let grid = (0..5).map(|i| 0.01 + 0.24 * total * i as f32);
         for (b_c, on_grid) in grid.map(|b| (b, true)).chain([(0.5, false), (1.3, false)]) {
-            let d = workspace_design(&file, &poses, f64::from(b_c), f64::from(GRASP_NSPM)).unwrap();
+            let d =
+                certified_design_from(&file, &least, f64::from(b_c), f64::from(GRASP_NSPM), None)
+                    .unwrap();
             let kmax = f64::from(r.limit_at(b_c).unwrap());
             let ok = if on_grid {
                 (kmax - d.k_c_npm).abs() <= 1e-4 * d.k_c_npm

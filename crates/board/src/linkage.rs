@@ -14,9 +14,7 @@ use crate::io::IoScale;
 use crate::region::{Bound, Region};
 use crate::Board;
 use twoport_control::kinematics::{Delta, Kinematics, SerialArm};
-use twoport_control::linkage::{
-    Gravity, JointEncoder, JointEncoderError, LinkageError, LinkageServo, MotorConfig,
-};
+use twoport_control::linkage::{Gravity, Hardware, LinkageError, LinkageServo};
 use twoport_control::servo::ImpedanceGains;
 use twoport_control::ve::{Solid, UnilateralWall};
 use twoport_control::world::PerAxis;
@@ -44,16 +42,11 @@ pub const COUNTER_BITS: u8 = 32;
 /// What an image needs of its device file.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Spec {
-    /// Encoder counts per motor revolution (quadrature).
-    pub counts_per_rev: f32,
-    /// Transmission ratio of each joint (motor turns per joint turn).
-    pub ratios: [f32; 3],
-    /// Each joint's limits (rad), as the proof covered them.
-    pub limits_rad: [[f32; 2]; 3],
-    /// Each motor's peak and continuous torque (N m, at the motor).
-    pub motor_torque_nm: (f32, f32),
+    /// The encoders, transmissions, joint limits and motors.
+    pub hardware: Hardware<3>,
     /// The least damping the handle has anywhere in the workspace, in its
-    /// least damped direction (N s/m): `λ_min(D_x)` at the binding pose.
+    /// least damped direction (N s/m): the designer's certified lower
+    /// bound on `λ_min(D_x)`, rounded down.
     pub least_damping_nspm: f32,
     /// The calibration pose (rad): where the host puts the arm.
     pub rest_rad: [f32; 3],
@@ -65,11 +58,14 @@ pub struct Spec {
 // (The base's limits are the file's 1.5708 rad, as published, not π/2.)
 #[allow(clippy::approx_constant)]
 pub const PHANTOM: Spec = Spec {
-    counts_per_rev: 2000.0,
-    ratios: [13.3, 11.2, 11.2],
-    limits_rad: [[-1.5708, 1.5708], [-2.1642, 2.0769], [-0.5061, 3.7350]],
-    motor_torque_nm: (0.129, 0.0286),
-    least_damping_nspm: 0.003_781,
+    hardware: Hardware {
+        counts_per_rev: 2000.0,
+        ratios: [13.3, 11.2, 11.2],
+        limits_rad: [[-1.5708, 1.5708], [-2.1642, 2.0769], [-0.5061, 3.7350]],
+        peak_torque_nm: 0.129,
+        continuous_torque_nm: 0.0286,
+    },
+    least_damping_nspm: 0.003_703,
     rest_rad: [0.0, 0.3, 1.2],
     // g (l1 m_a + l5 m_be + l1 m_c/2), g (l2 m_a/2 + l3 m_c - l6 m_df):
     // both counterweighted past balance.
@@ -83,11 +79,14 @@ pub const PHANTOM_ARM: (f32, f32) = (0.215, 0.170);
 
 /// The Falcon-like delta (`falcon_like.toml`).
 pub const FALCON: Spec = Spec {
-    counts_per_rev: 1280.0,
-    ratios: [7.72, 7.72, 7.72],
-    limits_rad: [[-0.3, 1.2], [-0.3, 1.2], [-0.3, 1.2]],
-    motor_torque_nm: (0.1, 0.04),
-    least_damping_nspm: 0.087_78,
+    hardware: Hardware {
+        counts_per_rev: 1280.0,
+        ratios: [7.72, 7.72, 7.72],
+        limits_rad: [[-0.3, 1.2], [-0.3, 1.2], [-0.3, 1.2]],
+        peak_torque_nm: 0.1,
+        continuous_torque_nm: 0.04,
+    },
+    least_damping_nspm: 0.087_77,
     rest_rad: [0.45, 0.45, 0.45],
     // The lumped handle's 60 g.
     gravity: Gravity::Handle { weight_n: 0.5886 },
@@ -118,8 +117,6 @@ pub enum BuildError {
     Param(ParamError),
     /// The servo's.
     Linkage(LinkageError),
-    /// A joint's encoder.
-    Joint(JointEncoderError),
     /// The region table.
     Region(crate::RegionError),
     /// The rest pose is not one the kinematics serve.
@@ -149,8 +146,8 @@ pub fn region(spec: &Spec) -> Result<Region<REGION_POINTS>, crate::RegionError> 
 
 /// Each motor's duty scale: full scale at its peak torque at the joint.
 pub fn io(spec: &Spec) -> [IoScale; 3] {
-    spec.ratios.map(|n| IoScale {
-        force_full_scale_n: spec.motor_torque_nm.0 * n,
+    spec.hardware.ratios.map(|n| IoScale {
+        force_full_scale_n: spec.hardware.peak_torque_nm * n,
         ..IoScale::EXCALIBUR
     })
 }
@@ -176,27 +173,13 @@ pub fn board<K: Kinematics<f32, 3>>(
         wall(far, Solid::Above, p(at[1])?)?,
         wall(p(at[2] - below)?, Solid::Below, p(at[2])?)?,
     ]);
-    let joint = |i: usize| {
-        JointEncoder::new(
-            COUNTER_BITS,
-            spec.counts_per_rev * spec.ratios[i],
-            0,
-            spec.rest_rad[i],
-        )
-        .map_err(BuildError::Joint)
-    };
-    let joints = [joint(0)?, joint(1)?, joint(2)?];
-    let motors = spec.ratios.map(|n| {
-        let (peak, held) = spec.motor_torque_nm;
-        MotorConfig::new(peak * n, held * n)
-    });
-    let servo = LinkageServo::new(
+    let servo = LinkageServo::on(
         kinematics,
-        joints,
-        spec.limits_rad,
+        &spec.hardware,
+        COUNTER_BITS,
+        spec.rest_rad,
         [COUPLING.into(); 3],
         [safety(); 3],
-        motors,
         world,
     )
     .map_err(BuildError::Linkage)?

@@ -416,16 +416,21 @@ pub unsafe extern "C" fn tp_board_set_ve_param(
     param: u8,
     value: f64,
 ) -> TpResult {
-    use twoport_host::VeSetting;
+    use twoport_host::VeParam;
     with_board(b, |b| {
         let setting = match param {
-            TP_VE_SURFACE => VeSetting::Surface(value),
-            TP_VE_STIFFNESS => VeSetting::Stiffness(value),
-            TP_VE_DAMPING => VeSetting::Damping(value),
+            TP_VE_SURFACE => VeParam::surface_m(value),
+            TP_VE_STIFFNESS => VeParam::stiffness_npm(value),
+            TP_VE_DAMPING => VeParam::damping_nspm(value),
             _ => return bad("param is not TP_VE_SURFACE, TP_VE_STIFFNESS or TP_VE_DAMPING"),
         };
-        b.0.set_ve_param(axis, setting)
-            .map_or_else(|e| fail(&e), |_| TpResult::Ok)
+        match setting {
+            Ok(p) => {
+                b.0.set_ve_param(axis, p)
+                    .map_or_else(|e| fail(&e), |_| TpResult::Ok)
+            }
+            Err(e) => bad(&e.to_string()),
+        }
     })
 }
 

@@ -38,7 +38,7 @@ fn the_spec_and_the_boards_own_ve_through_the_c_abi() {
     assert!(last_error().contains("TP_VE_SURFACE"), "{}", last_error());
     assert_eq!(set(TP_VE_STIFFNESS, -1.0), TpResult::Argument);
     assert!(
-        last_error().contains("must be a finite number"),
+        last_error().contains("VE stiffness (N/m) = -1 must be finite and >= 0"),
         "{}",
         last_error()
     );

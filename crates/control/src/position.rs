@@ -28,6 +28,7 @@ pub const NM_PER_M: f32 = 1.0e9;
 /// (1 nm = 1e-9 m). Range ±2.147 m (`i32`); arithmetic saturates at the
 /// ends. Positive is the axis' positive direction.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Position(pub i32);
 
 impl Position {

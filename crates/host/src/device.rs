@@ -11,17 +11,6 @@ use twoport_link::{
     VeParam, VeSource,
 };
 
-/// A setting of the board's own VE, in SI: [`Board::set_ve_param`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum VeSetting {
-    /// Where its surface (or anchor) is (m).
-    Surface(f64),
-    /// Its stiffness (N/m).
-    Stiffness(f64),
-    /// Its damping (N s/m).
-    Damping(f64),
-}
-
 /// States kept for the application before the oldest are dropped (about
 /// a minute of a 1 kHz stream).
 pub const STATE_BUFFER: usize = 1 << 16;
@@ -318,10 +307,11 @@ impl<P: BoardPort> Board<P> {
     }
 
     /// Set one parameter of the board's own VE on `axis` (disarmed only):
-    /// its surface (m), stiffness (N/m) or damping (N s/m). A value out of
-    /// range is refused here, by name; a parameter the board's VE does not
-    /// have, by the board (`BadVeParam`).
-    pub fn set_ve_param(&mut self, axis: usize, param: VeSetting) -> Result<VeParam, LinkError> {
+    /// its surface, stiffness or damping, built from SI by
+    /// [`VeParam::surface_m`] and its siblings. A value out of range is
+    /// refused here, by name; a parameter the board's VE does not have, by
+    /// the board (`BadVeParam`).
+    pub fn set_ve_param(&mut self, axis: usize, param: VeParam) -> Result<VeParam, LinkError> {
         let what = "set_ve_param";
         if axis >= self.axes() {
             return Err(LinkError::Axes {
@@ -330,31 +320,11 @@ impl<P: BoardPort> Board<P> {
                 board: self.axes(),
             });
         }
-        let p = match param {
-            VeSetting::Surface(x) => {
-                if !(x.is_finite() && x.abs() < 2.147) {
-                    return Err(LinkError::OutOfRange {
-                        what: what.into(),
-                        axis,
-                        value_m: x,
-                    });
-                }
-                VeParam::SurfacePm((x * 1e12).round() as i64)
-            }
-            VeSetting::Stiffness(v) | VeSetting::Damping(v) if !(v.is_finite() && v >= 0.0) => {
-                let named = match param {
-                    VeSetting::Stiffness(_) => format!("stiffness {v} N/m"),
-                    _ => format!("damping {v} N s/m"),
-                };
-                return Err(LinkError::BadValue {
-                    what: format!("{what}: {named}"),
-                    why: "must be a finite number, 0 or more".into(),
-                });
-            }
-            VeSetting::Stiffness(k) => VeParam::StiffnessNpm(k as f32),
-            VeSetting::Damping(b) => VeParam::DampingNspm(b as f32),
-        };
-        self.session.set_ve_param(axis as u8, p)
+        let param = param.checked().map_err(|e| LinkError::BadValue {
+            what: what.into(),
+            why: e.to_string(),
+        })?;
+        self.session.set_ve_param(axis as u8, param)
     }
 
     /// Give the VE back to the board's image (disarmed only).

@@ -10,9 +10,7 @@ mod port;
 mod session;
 mod simulated;
 
-pub use device::{
-    AxisState, Board, State, VeSetting, HEARTBEAT_PERIOD, HEARTBEAT_POLLS, STATE_BUFFER,
-};
+pub use device::{AxisState, Board, State, HEARTBEAT_PERIOD, HEARTBEAT_POLLS, STATE_BUFFER};
 pub use error::LinkError;
 pub use local::{LocalBoard, LocalDelta, LocalFast, LocalSerialArm};
 pub use port::{BoardPort, SerialBoard};

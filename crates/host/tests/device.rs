@@ -167,20 +167,21 @@ fn homing_finds_the_stop_and_calibrates() {
 /// board has not too, and an armed board refuses.
 #[test]
 fn the_boards_own_wall_is_set_from_the_host() {
-    use twoport_host::VeSetting;
+    use twoport_host::VeParam;
     let mut b = open(2.0);
     b.calibrate(&[0.0]).unwrap();
-    let e = b.set_ve_param(0, VeSetting::Stiffness(-1.0)).unwrap_err();
+    let e = b.set_ve_param(0, VeParam::Stiffness(-1.0)).unwrap_err();
     assert!(
         e.to_string()
-            .contains("stiffness -1 N/m must be a finite number"),
+            .contains("VE stiffness (N/m) = -1 must be finite and >= 0"),
         "{e}"
     );
-    let e = b.set_ve_param(1, VeSetting::Damping(1.0)).unwrap_err();
+    let e = b.set_ve_param(1, VeParam::Damping(1.0)).unwrap_err();
     assert!(matches!(e, LinkError::Axes { .. }), "{e}");
-    let e = b.set_ve_param(0, VeSetting::Surface(3.0)).unwrap_err();
-    assert!(matches!(e, LinkError::OutOfRange { .. }), "{e}");
-    b.set_ve_param(0, VeSetting::Surface(WALL_M)).unwrap();
+    let e = VeParam::surface_m(3.0).unwrap_err();
+    assert!(e.to_string().contains("VE surface (m) = 3"), "{e}");
+    b.set_ve_param(0, VeParam::surface_m(WALL_M).unwrap())
+        .unwrap();
     b.stream(1).unwrap();
     b.arm().unwrap();
     for _ in 0..3000 {
@@ -188,7 +189,7 @@ fn the_boards_own_wall_is_set_from_the_host() {
     }
     let x = b.latest().unwrap().axes[0].position_m;
     assert!((x - WALL_M - 2.0 / 51_000.0).abs() < 10e-6, "at {x} m");
-    let e = b.set_ve_param(0, VeSetting::Damping(1.0)).unwrap_err();
+    let e = b.set_ve_param(0, VeParam::Damping(1.0)).unwrap_err();
     assert!(e.to_string().contains("NotDisarmed"), "{e}");
 }
 

@@ -24,35 +24,16 @@ pub enum VeSource {
     },
 }
 
-/// One parameter of the board's own VE on one axis (protocol 9): its
-/// surface (or anchor), stiffness or damping. A disarmed board takes it
+/// One parameter of the board's own VE on one axis (protocol 9; its
+/// surface in nanometres, as the VE holds it, since protocol 10): the VE
+/// law's own type, on the wire as it is. A disarmed board takes it
 /// ([`Message::SetVeParam`](crate::Message::SetVeParam)); any value in
 /// range keeps the VE passive, so the proven coupling holds.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub enum VeParam {
-    /// Where the surface or anchor is (pm, within ±2.147 m).
-    SurfacePm(i64),
-    /// The stiffness (N/m, not negative).
-    StiffnessNpm(f32),
-    /// The damping (N s/m, not negative).
-    DampingNspm(f32),
-}
+pub use twoport_control::ve::VeParam;
 
 /// What an axis's surface in a [`VeUpdate`] is to the VE point the
-/// coupling holds.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Contact {
-    /// The point is the surface, rigid: the host moves it.
-    #[default]
-    Held,
-    /// The VE is solid above the surface: below it the point follows the
-    /// handle with no force, and it stops at the surface.
-    Above,
-    /// Solid below the surface: free above it, stopped at it.
-    Below,
-    /// No surface: the point follows the handle with no force.
-    Free,
-}
+/// coupling holds: the held world's own type, on the wire as it is.
+pub use twoport_control::world::Contact;
 
 /// One update of the host's VE: each axis's surface and what it is. The
 /// board solves the VE point against it at its servo's rate, so a surface

@@ -170,15 +170,15 @@ fn all_messages() -> Vec<Message> {
         }),
         Message::SetVeParam {
             axis: u8::MAX,
-            param: VeParam::SurfacePm(i64::MIN),
+            param: VeParam::Surface(twoport_control::Position(i32::MIN)),
         },
         Message::SetVeParam {
             axis: 0,
-            param: VeParam::StiffnessNpm(f32::MAX),
+            param: VeParam::Stiffness(f32::MAX),
         },
         Message::VeParamSet {
             axis: 2,
-            param: VeParam::DampingNspm(-0.0),
+            param: VeParam::Damping(-0.0),
         },
     ]
 }

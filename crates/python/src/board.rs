@@ -185,17 +185,18 @@ impl Board {
     /// Set one parameter of the board's own VE on `axis` (disarmed only):
     /// "surface" (m), "stiffness" (N/m) or "damping" (N s/m).
     fn set_ve_param(&mut self, axis: usize, name: &str, value: f64) -> PyResult<()> {
-        use twoport_host::VeSetting;
+        use twoport_host::VeParam;
         let setting = match name {
-            "surface" => VeSetting::Surface(value),
-            "stiffness" => VeSetting::Stiffness(value),
-            "damping" => VeSetting::Damping(value),
+            "surface" => VeParam::surface_m(value),
+            "stiffness" => VeParam::stiffness_npm(value),
+            "damping" => VeParam::damping_nspm(value),
             other => {
                 return Err(PyValueError::new_err(format!(
                     "{other:?}: one of \"surface\", \"stiffness\", \"damping\""
                 )))
             }
-        };
+        }
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
         match self.open()?.set_ve_param(axis, setting) {
             Ok(_) => Ok(()),
             Err(

@@ -4,25 +4,22 @@
 
 use crate::engine::blocks::{Block, Blocks};
 use crate::engine::layer::SceneLayer;
-use crate::engine::linkage::{AnyKinematics, Shifted};
-use crate::engine::scene::{
-    Discretization, Integration, LayerPort, Precision, Scene, SolidSide, VeSpec,
-};
+use crate::engine::linkage::{AnyKinematics, LinkageArm, Shifted};
+use crate::engine::scene::{Discretization, Integration, LayerPort, Precision, Scene, VeSpec};
 use crate::engine::ve::SceneVe;
 use crate::engine::world::SceneWorld;
 use crate::Error;
 use twoport_control::kinematics::Kinematics;
-use twoport_control::linkage::{JointEncoder, LinkageServo, MotorConfig};
+use twoport_control::linkage::LinkageServo;
 use twoport_control::passivity::{ParallelLimits, PassiveVe};
 use twoport_control::servo::{Gains, PortLayer, SensorFrame, Servo, ServoOutput};
 use twoport_control::ve::{
-    BilateralConstraint, CursorMass, ExplicitCursor, LosslessCursor, Solid, Spring,
-    TrapezoidalSpring, UnilateralWall,
+    BilateralConstraint, CursorMass, ExplicitCursor, LosslessCursor, Spring, TrapezoidalSpring,
+    UnilateralWall,
 };
 use twoport_control::world::vbb::Block as Block3;
 use twoport_control::world::World;
 use twoport_control::{Encoder, Position, Real, SafetyConfig};
-use twoport_design::linkage::LinkageFile;
 
 /// The board's code for the scene's display on `N` axes, enabled.
 #[derive(Clone, Debug)]
@@ -243,58 +240,35 @@ impl<const N: usize> SceneServo<N> {
         }
     }
 
-    /// A linkage scene's servo: the file's joints, limits and motors, the
-    /// scene's gains and world, the Cartesian frame's zero where the world
-    /// starts, the moving masses held up where the scene has gravity.
-    pub fn linkage(scene: &Scene, file: &LinkageFile, safety: SafetyConfig) -> Result<Self, Error> {
+    /// A linkage scene's servo on `arm`: the file's joints, limits and
+    /// motors, the scene's gains and world, the Cartesian frame's zero
+    /// where the world starts, the moving masses held up where the scene
+    /// has gravity.
+    pub fn linkage(
+        scene: &Scene,
+        arm: &LinkageArm<N>,
+        safety: SafetyConfig,
+    ) -> Result<Self, Error> {
         let t = safety.period_s;
         let world = SceneWorld::new(scene, t, |_| axis_ve(scene, &safety))?;
         let start = world.positions();
-        let q0 = &scene.plant.pose_rad;
+        let file = arm.plant.file();
         let kinematics = AnyKinematics::new(&file.geometry)?;
-        let at = Shifted {
+        let mut at = Shifted {
             kinematics,
             origin_m: [0.0; 3],
         };
-        let q32: [f32; N] = core::array::from_fn(|i| q0[i] as f32);
-        let x0 = Kinematics::<f32, N>::forward(&at, &q32)
+        let q0 = arm.zero_rad().map(|q| q as f32);
+        let x0 = Kinematics::<f32, N>::forward(&at, &q0)
             .map_err(|f| sim_err!("plant.pose_rad: {f:?}"))?
             .position_m;
-        let mut origin = [0.0f32; 3];
         for i in 0..N {
-            origin[i] = x0[i] - start[i].m();
+            at.origin_m[i] = x0[i] - start[i].m();
         }
-        let kinematics = Shifted {
-            kinematics,
-            origin_m: origin,
-        };
-        let joint = |i: usize| {
-            let cpr = file.motors.encoder_counts_per_rev as f32 * file.motors.ratios[i] as f32;
-            JointEncoder::new(32, cpr, 0, q32[i]).map_err(|e| sim_err!("joint {i}: {e:?}"))
-        };
-        let mut joints = [joint(0)?; N];
-        for (i, j) in joints.iter_mut().enumerate() {
-            *j = joint(i)?;
-        }
-        let limits = core::array::from_fn(|i| file.joints.limits_rad[i].map(|x| x as f32));
-        let motors = core::array::from_fn(|i| {
-            let n = file.motors.ratios[i];
-            MotorConfig::new(
-                (file.motors.peak_torque_nm * n) as f32,
-                (file.motors.continuous_torque_nm * n) as f32,
-            )
-        });
         let gains = core::array::from_fn(|a| scene.gains_of(a));
-        let mut s = LinkageServo::new(
-            kinematics,
-            joints,
-            limits,
-            gains,
-            [safety; N],
-            motors,
-            world,
-        )
-        .map_err(|e| sim_err!("plant.linkage: {e}"))?;
+        let mut s = arm
+            .servo(at, gains, [safety; N], world)
+            .map_err(|e| sim_err!("plant.linkage: {e}"))?;
         if scene.plant.gravity_mps2 > 0.0 {
             s = s
                 .with_gravity(file.gravity_compensation(scene.plant.gravity_mps2))
@@ -477,10 +451,7 @@ fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, Error> {
             damping_nspm,
             solid,
         } => {
-            let side = match solid {
-                SolidSide::Above => Solid::Above,
-                SolidSide::Below => Solid::Below,
-            };
+            let side = *solid;
             SceneVe::Wall(
                 UnilateralWall::new_in(
                     *stiffness_npm as f32,

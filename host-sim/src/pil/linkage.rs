@@ -13,7 +13,7 @@
 //! experiment from the rest pose ([`Plan::Identify`]).
 
 use super::{boot_and_save, zero_after_loss, Run};
-use crate::engine::linkage::{CartesianHand, LinkagePlant};
+use crate::engine::linkage::{CartesianHand, LinkageArm};
 use crate::link::{BoardPort, LinkFaults, Session};
 use crate::{Error, Sample};
 use nalgebra::DMatrix;
@@ -56,9 +56,24 @@ impl Device {
     }
 }
 
-/// How far down the hand's spring pulls (m below the rest pose), its
-/// stiffness (N/m) and the grasp's damping (N s/m).
-pub const HAND: (f64, f64, f64) = (0.015, 300.0, 2.0);
+/// The hand that presses the handle down ([`Plan::Press`]): a spring to
+/// an anchor below the rest pose, and a grasp.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PressingHand {
+    /// How far below the rest pose the spring's anchor is (m).
+    pub down_m: f64,
+    /// The spring's stiffness on every axis (N/m).
+    pub stiffness_npm: f64,
+    /// The grasp's damping on every axis (N s/m).
+    pub grasp_nspm: f64,
+}
+
+/// The hand PIL presses with.
+pub const HAND: PressingHand = PressingHand {
+    down_m: 0.015,
+    stiffness_npm: 300.0,
+    grasp_nspm: 2.0,
+};
 
 /// What the run does once the board is armed.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -83,56 +98,43 @@ pub const GRAVITY_MPS2: f64 = 9.81;
 /// Runge-Kutta sub-steps per tick.
 const SUBSTEPS: u32 = 8;
 
-/// The plant, its encoders and the hand.
-struct Arm {
-    plant: LinkagePlant,
+/// The arm at this end of the link and the hand on it.
+struct PilArm {
+    arm: LinkageArm<3>,
     hand: CartesianHand,
-    rest: [f64; 3],
-    counts_per_rad: [f64; 3],
     io: [IoScale; 3],
     period_s: f64,
 }
 
-impl Arm {
-    fn new(device: Device, plan: Plan) -> Result<Arm, Error> {
+impl PilArm {
+    fn new(device: Device, plan: Plan) -> Result<PilArm, Error> {
         let file = device.file()?;
         let spec = device.spec();
-        let rest = spec.rest_rad.map(f64::from);
-        let mut plant = LinkagePlant::at_rest(&file, &rest);
+        let mut arm =
+            LinkageArm::at_rest(&file, spec.rest_rad.map(f64::from)).map_err(plant_err)?;
         // (The images hold the moving masses up: gravity acts.)
-        plant.gravity_mps2 = GRAVITY_MPS2;
-        let (x, _) = plant.kinematics(&plant.q).map_err(plant_err)?;
-        let (down, k, b) = HAND;
-        let mut anchor = x.clone();
-        anchor[2] -= down;
+        arm.plant.gravity_mps2 = GRAVITY_MPS2;
+        let (x, _) = arm.handle().map_err(plant_err)?;
         let hand = match plan {
-            Plan::Press => CartesianHand {
-                anchor_m: anchor,
-                k_npm: DMatrix::identity(3, 3) * k,
-                b_nspm: DMatrix::identity(3, 3) * b,
-            },
+            Plan::Press => {
+                let mut anchor = x.to_vec();
+                anchor[2] -= HAND.down_m;
+                CartesianHand {
+                    anchor_m: anchor,
+                    k_npm: DMatrix::identity(3, 3) * HAND.stiffness_npm,
+                    b_nspm: DMatrix::identity(3, 3) * HAND.grasp_nspm,
+                }
+            }
             Plan::Identify { friction, .. } => {
-                plant.friction = friction;
+                arm.plant.friction = friction;
                 CartesianHand::off(3)
             }
         };
-        Ok(Arm {
-            plant,
+        Ok(PilArm {
+            arm,
             hand,
-            rest,
-            counts_per_rad: core::array::from_fn(|i| {
-                f64::from(spec.counts_per_rev * spec.ratios[i]) / std::f64::consts::TAU
-            }),
             io: image::io(spec),
             period_s: f64::from(image::PERIOD_S),
-        })
-    }
-
-    /// Each joint's counter: counts from the rest pose, where it read 0.
-    fn raw(&self) -> [u32; 3] {
-        core::array::from_fn(|i| {
-            let c = ((self.plant.q[i] - self.rest[i]) * self.counts_per_rad[i]).round();
-            c as i64 as i32 as u32
         })
     }
 
@@ -145,7 +147,7 @@ impl Arm {
         let tick = session.tick_heartbeat()?;
         let sensors = PilSensors {
             tick: tick as u32,
-            encoder_raw: Axes::new(self.raw()).unwrap_or_default(),
+            encoder_raw: Axes::new(self.arm.counts()).unwrap_or_default(),
             load_cell_raw: Axes::new([0; 3]).unwrap_or_default(),
             dead_man_closed: true,
             index_raw: Axes::new([None; 3]).unwrap_or_default(),
@@ -154,13 +156,14 @@ impl Arm {
         let tau: [f64; 3] = core::array::from_fn(|i| {
             f64::from(self.io[i].force_n(duty.get(i).copied().unwrap_or(0)))
         });
-        self.plant
-            .step(&tau, &self.hand, self.period_s, SUBSTEPS)
+        let hand = &self.hand;
+        self.arm
+            .step(&tau, &|x, v| hand.force(x, v), self.period_s, SUBSTEPS)
             .map_err(plant_err)?;
-        let (x, _) = self.plant.kinematics(&self.plant.q).map_err(plant_err)?;
+        let (x, _) = self.arm.handle().map_err(plant_err)?;
         let sample = Sample {
             t_s: (tick + 1) as f64 * self.period_s,
-            handle_m: [x[0], x[1], x[2]],
+            handle_m: x,
             actuator_n: tau,
             ..Sample::default()
         };
@@ -175,7 +178,7 @@ fn plant_err(e: crate::engine::linkage::PlantError) -> Error {
 /// One tick recorded, with the telemetry the board sent.
 fn record<P: BoardPort>(
     session: &mut Session<P>,
-    arm: &mut Arm,
+    arm: &mut PilArm,
     r: &mut Run<3>,
 ) -> Result<(), Error> {
     let (s, duty) = arm.step(session)?;
@@ -208,7 +211,7 @@ pub fn run_plan<P: BoardPort>(
     faults: LinkFaults,
     plan: Plan,
 ) -> Result<Run<3>, Error> {
-    let mut arm = Arm::new(device, plan)?;
+    let mut arm = PilArm::new(device, plan)?;
     let mut session = Session::open_axes(port, faults, 3)?;
     let spec = session.spec()?;
     if !spec.linkage {
@@ -223,7 +226,7 @@ pub fn run_plan<P: BoardPort>(
         ..Run::default()
     };
     record(&mut session, &mut arm, &mut r)?;
-    let pico = arm.rest.map(|q| (q * 1e12).round() as i64);
+    let pico = arm.arm.zero_rad().map(|q| (q * 1e12).round() as i64);
     session.calibrate(Axes::new(pico).unwrap_or_default())?;
     session.arm()?;
     r.armed_at_tick = r.samples.len() as u64;

@@ -176,17 +176,10 @@ impl HostVe {
     /// The scene's wall as the host's surface: where it is (pm) and which
     /// side is solid; other VEs have no surface to send.
     fn surface(scene: &Scene) -> Result<(i64, twoport_link::Contact), Error> {
-        use crate::engine::scene::SolidSide;
         match scene.ve {
             VeSpec::Wall {
                 position_m, solid, ..
-            } => Ok((
-                (position_m * 1e12).round() as i64,
-                match solid {
-                    SolidSide::Above => twoport_link::Contact::Above,
-                    SolidSide::Below => twoport_link::Contact::Below,
-                },
-            )),
+            } => Ok(((position_m * 1e12).round() as i64, solid.into())),
             _ => Err(Error::Pil(
                 "a host VE run sends the scene's wall: set ve.kind = \"wall\"".into(),
             )),

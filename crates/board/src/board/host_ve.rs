@@ -6,19 +6,9 @@
 use super::Board;
 use twoport_control::drive::Drive;
 use twoport_control::servo::PortLayer;
-use twoport_control::world::{Contact, Held, World};
+use twoport_control::world::{Held, World};
 use twoport_control::{Faults, Position};
 use twoport_link::{Message, Mode, ModeRefusal, ModeRequest, VeSource, VeUpdate};
-
-/// The wire's contact as the held world's.
-fn contact_law(c: twoport_link::Contact) -> Contact {
-    match c {
-        twoport_link::Contact::Held => Contact::Held,
-        twoport_link::Contact::Above => Contact::Above,
-        twoport_link::Contact::Below => Contact::Below,
-        twoport_link::Contact::Free => Contact::Free,
-    }
-}
 
 /// The host's VE as the board holds it.
 #[derive(Clone, Copy, Debug)]
@@ -108,7 +98,7 @@ where
             }
         }
         if newer {
-            h.world.set(points, contact.map(contact_law));
+            h.world.set(points, contact);
             h.age_ticks = 0;
             h.seq = Some(u.seq);
         }

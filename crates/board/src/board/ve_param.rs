@@ -5,9 +5,7 @@
 use super::Board;
 use twoport_control::drive::Drive;
 use twoport_control::servo::PortLayer;
-use twoport_control::ve::VeParam as Law;
 use twoport_control::world::World;
-use twoport_control::Position;
 use twoport_link::{Message, Mode, ModeRefusal, ModeRequest, VeParam};
 
 impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
@@ -16,25 +14,17 @@ where
     L: PortLayer,
     D: Drive<N, World = W, Layer = L>,
 {
-    /// `SetVeParam`: disarmed only; an axis the board has not, a surface
-    /// past ±2.147 m, a value out of range or a parameter its VE has not
-    /// are refused (`BadVeParam`), the VE unchanged.
+    /// `SetVeParam`: disarmed only; an axis the board has not, a value
+    /// out of range or a parameter its VE has not are refused
+    /// (`BadVeParam`), the VE unchanged.
     pub(super) fn set_ve_param(&mut self, axis: u8, param: VeParam) {
         if self.mode != Mode::Disarmed {
             let mode = self.mode;
             return self.refuse(ModeRequest::SetVeParam, ModeRefusal::NotDisarmed { mode });
         }
-        let law = match param {
-            VeParam::SurfacePm(pm) => match i32::try_from(pm / 1000) {
-                Ok(nm) => Law::Surface(Position::from_nm(nm)),
-                Err(_) => return self.refuse(ModeRequest::SetVeParam, ModeRefusal::OutOfRange),
-            },
-            VeParam::StiffnessNpm(k) => Law::Stiffness(k),
-            VeParam::DampingNspm(b) => Law::Damping(b),
-        };
         let a = usize::from(axis);
         let world = self.servo.servo_mut().world_mut();
-        if a >= N || world.set_axis_param(a, law).is_err() {
+        if a >= N || world.set_axis_param(a, param).is_err() {
             return self.refuse(ModeRequest::SetVeParam, ModeRefusal::BadVeParam);
         }
         self.queue(Message::VeParamSet { axis, param });

@@ -14,12 +14,14 @@
 //! torque.
 
 mod gravity;
+mod hardware;
 mod joints;
 mod motors;
 #[cfg(test)]
 mod tests;
 
 pub use gravity::Gravity;
+pub use hardware::Hardware;
 pub use joints::{JointEncoder, JointEncoderError};
 pub use motors::{LimitedTorques, MotorConfig, MotorLimits};
 
@@ -57,6 +59,8 @@ pub enum LinkageError {
     Motor(AxisError),
     /// A joint limit that is not a finite `lo < hi`.
     JointLimit(usize),
+    /// A joint's encoder (its counts per turn or its zero).
+    Joint(usize, JointEncoderError),
 }
 
 impl core::fmt::Display for LinkageError {
@@ -67,6 +71,7 @@ impl core::fmt::Display for LinkageError {
             LinkageError::JointLimit(j) => {
                 write!(f, "joints.limits_rad[{j}] must be finite with lo < hi")
             }
+            LinkageError::Joint(j, e) => write!(f, "joint {j}'s encoder: {e}"),
         }
     }
 }
@@ -140,6 +145,30 @@ impl<K: Kinematics<f32, N>, W: World<f32, N>, const N: usize> LinkageServo<K, W,
         world: W,
     ) -> Result<Self, LinkageError> {
         Self::new_in(kinematics, joints, limits, gains, safety, motors, world)
+    }
+
+    /// A disabled f32 servo on `hardware`: its encoders on `bits`-wide
+    /// counters that read the pose `zero_rad` (rad) where they count 0, its
+    /// joint limits and its motors.
+    pub fn on(
+        kinematics: K,
+        hardware: &Hardware<N>,
+        bits: u8,
+        zero_rad: [f32; N],
+        gains: [Gains; N],
+        safety: [SafetyConfig; N],
+        world: W,
+    ) -> Result<Self, LinkageError> {
+        let joints = hardware.encoders(bits, zero_rad)?;
+        Self::new(
+            kinematics,
+            joints,
+            hardware.limits_rad,
+            gains,
+            safety,
+            hardware.motors(),
+            world,
+        )
     }
 }
 

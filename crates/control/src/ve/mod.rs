@@ -94,7 +94,20 @@ impl<R: Real> Port<R> {
 /// One parameter of a VE a host may set on a disarmed board. Any value in
 /// range keeps the VE passive (its laws are passive for every stiffness
 /// and damping not negative), so the proven coupling holds.
+///
+/// It is the one type for the concept: the application builds it (from
+/// SI, by [`surface_m`](Self::surface_m) and its siblings), the link
+/// carries it as it is (protocol 10), and the board's VE takes it.
+///
+/// ```
+/// use twoport_control::ve::VeParam;
+/// assert!(VeParam::surface_m(0.005).is_ok());
+/// let e = VeParam::stiffness_npm(-1.0).unwrap_err();
+/// assert_eq!(e.to_string(), "VE stiffness (N/m) = -1 must be finite and >= 0");
+/// assert!(VeParam::surface_m(3.0).is_err());
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum VeParam {
     /// Where its surface or anchor is.
     Surface(Position),
@@ -105,6 +118,41 @@ pub enum VeParam {
 }
 
 impl VeParam {
+    /// Its surface or anchor at `x_m` (m), within ±2.147 m.
+    pub fn surface_m(x_m: f64) -> Result<Self, ParamError> {
+        Position::from_m_f64(x_m)
+            .map(VeParam::Surface)
+            .ok_or(ParamError {
+                name: "VE surface (m)",
+                value: x_m as f32,
+                problem: "must be finite and within +-2.147 m",
+            })
+    }
+
+    /// Its stiffness `k_npm` (N/m), finite and not negative.
+    pub fn stiffness_npm(k_npm: f64) -> Result<Self, ParamError> {
+        VeParam::Stiffness(k_npm as f32).checked()
+    }
+
+    /// Its damping `b_nspm` (N s/m), finite and not negative.
+    pub fn damping_nspm(b_nspm: f64) -> Result<Self, ParamError> {
+        VeParam::Damping(b_nspm as f32).checked()
+    }
+
+    /// Itself, or why no passive VE takes it: a stiffness or damping
+    /// that is negative or not finite.
+    pub fn checked(self) -> Result<Self, ParamError> {
+        match self {
+            VeParam::Stiffness(v) | VeParam::Damping(v) if !(v.is_finite() && v >= 0.0) => {
+                Err(ParamError {
+                    problem: "must be finite and >= 0",
+                    ..self.unsupported()
+                })
+            }
+            _ => Ok(self),
+        }
+    }
+
     /// The refusal of a VE that has no such parameter.
     pub fn unsupported(self) -> ParamError {
         ParamError {

@@ -6,6 +6,11 @@ use crate::{param, Integrator, ParamError, Position, Real, ZTransfer};
 
 /// Which side of the wall surface is solid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Deserialize),
+    serde(rename_all = "snake_case")
+)]
 pub enum Solid {
     /// Positions above the surface are inside the wall.
     Above,

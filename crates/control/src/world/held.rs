@@ -8,8 +8,10 @@ use super::World;
 use crate::ve::{Port, VeOutput, VeTransfer};
 use crate::{Position, Real, ZTransfer};
 
-/// What an axis's held surface is to its VE point.
+/// What an axis's held surface is to its VE point. It crosses the link as
+/// it is (protocol 8's `VeUpdate`), so its variants' order is the wire's.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Contact {
     /// The point is the surface: rigid ground that does not yield to the
     /// coupling (admittance zero), moved only by the host.
@@ -22,6 +24,16 @@ pub enum Contact {
     Below,
     /// No surface: the point follows the coupling freely (no force).
     Free,
+}
+
+impl From<crate::ve::Solid> for Contact {
+    /// A wall's surface: solid on the same side.
+    fn from(s: crate::ve::Solid) -> Self {
+        match s {
+            crate::ve::Solid::Above => Contact::Above,
+            crate::ve::Solid::Below => Contact::Below,
+        }
+    }
 }
 
 /// Surfaces the host moves, held between its updates, and the VE points

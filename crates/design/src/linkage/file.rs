@@ -6,6 +6,7 @@ use super::taylor::Taylor;
 use crate::ModelError;
 use serde::Deserialize;
 use twoport_control::kinematics::{Capstan, Delta, Kinematics, Pantograph, SerialArm};
+use twoport_control::linkage::Hardware;
 use twoport_control::ParamError;
 
 /// A linkage device file.
@@ -263,6 +264,22 @@ impl LinkageFile {
     pub fn load(path: &std::path::Path) -> Result<Self, ModelError> {
         let (text, source) = crate::model::read(path)?;
         Self::from_toml(&text, &source)
+    }
+
+    /// The drive train as a board of `N` joints holds it (f32), or `None`
+    /// where the file has another number of joints.
+    pub fn hardware<const N: usize>(&self) -> Option<Hardware<N>> {
+        if self.geometry.joints() != N {
+            return None;
+        }
+        let m = &self.motors;
+        Some(Hardware {
+            counts_per_rev: m.encoder_counts_per_rev as f32,
+            ratios: core::array::from_fn(|i| m.ratios[i] as f32),
+            limits_rad: core::array::from_fn(|i| self.joints.limits_rad[i].map(|x| x as f32)),
+            peak_torque_nm: m.peak_torque_nm as f32,
+            continuous_torque_nm: m.continuous_torque_nm as f32,
+        })
     }
 
     fn check(&self) -> Result<(), String> {

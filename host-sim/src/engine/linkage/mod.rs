@@ -1,12 +1,13 @@
-//! Linkage devices in simulation: their nonlinear joint-space dynamics,
-//! and runs that close the loop through the board's linkage servo.
+//! Linkage devices in simulation: their nonlinear joint-space dynamics
+//! and the encoders on their joints, one arm that a scene's servo, a
+//! board in the loop or a test closes the loop through.
 
+mod arm;
 mod kinematics;
 mod plant;
-mod run;
 #[cfg(test)]
 mod tests;
 
+pub use arm::LinkageArm;
 pub use kinematics::{AnyKinematics, Shifted};
 pub use plant::{CartesianHand, LinkagePlant, PlantError};
-pub use run::{run_linkage, LinkageScene, LinkageTrace, RunError};

@@ -51,9 +51,11 @@ impl CartesianHand {
         }
     }
 
-    fn force(&self, x: &[f64], v: &DVector<f64>) -> DVector<f64> {
+    /// The hand's force on the handle (N) at position `x` (m) and
+    /// velocity `v` (m/s).
+    pub fn force(&self, x: &[f64], v: &[f64]) -> DVector<f64> {
         let dx = DVector::from_iterator(x.len(), x.iter().zip(&self.anchor_m).map(|(a, b)| a - b));
-        -(&self.k_npm * dx) - &self.b_nspm * v
+        -(&self.k_npm * dx) - &self.b_nspm * DVector::from_column_slice(v)
     }
 }
 
@@ -67,6 +69,13 @@ pub enum PlantError {
     /// The linkage reached a pose with no kinematics (singular or out of
     /// reach) at the joint angles given.
     Pose(Vec<f64>),
+    /// The file has `file` joints; the run was built for `run`.
+    Joints {
+        /// The file's joints.
+        file: usize,
+        /// The run's.
+        run: usize,
+    },
 }
 
 /// A linkage's state and its dynamics.
@@ -97,6 +106,11 @@ impl LinkagePlant {
             gravity_mps2: 0.0,
             friction: false,
         }
+    }
+
+    /// The device file it integrates.
+    pub fn file(&self) -> &LinkageFile {
+        &self.file
     }
 
     /// The handle's position (m) and the Jacobian at `q`.
@@ -178,8 +192,7 @@ impl LinkagePlant {
         dt: f64,
         substeps: u32,
     ) -> Result<(), PlantError> {
-        let force = |x: &[f64], v: &[f64]| hand.force(x, &DVector::from_column_slice(v));
-        self.step_with(tau_a, &force, dt, substeps)
+        self.step_with(tau_a, &|x, v| hand.force(x, v), dt, substeps)
     }
 
     /// [`step`](Self::step) with the hand's force on the handle (N) as a

@@ -6,6 +6,7 @@ use crate::engine::plant::Method;
 use serde::Deserialize;
 use std::path::PathBuf;
 use twoport_control::servo::{AdmittanceGains, Display, Gains, ImpedanceGains};
+use twoport_control::ve::Solid;
 
 /// The passivity layer between the device's port and the display's
 /// element: the series damper on an impedance display, the parallel damper
@@ -279,16 +280,6 @@ impl TryFrom<CouplingKeys> for Coupling {
     }
 }
 
-/// Which side of a wall is solid.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SolidSide {
-    /// Positions above the surface are inside.
-    Above,
-    /// Positions below the surface are inside.
-    Below,
-}
-
 /// One block of the building-block world.
 #[derive(Clone, Copy, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -352,7 +343,7 @@ pub enum VeSpec {
         damping_nspm: f64,
         /// Solid side.
         #[serde(default = "default_solid")]
-        solid: SolidSide,
+        solid: Solid,
     },
     /// A fixed point.
     Bilateral,
@@ -439,8 +430,8 @@ fn default_friction() -> f64 {
     0.3
 }
 
-fn default_solid() -> SolidSide {
-    SolidSide::Above
+fn default_solid() -> Solid {
+    Solid::Above
 }
 fn default_floor() -> f64 {
     5.0

@@ -7,67 +7,50 @@
 //! [`SceneServo::Linkage`]: crate::engine::servo::SceneServo::Linkage
 
 use super::{Sample, Simulation};
-use crate::engine::linkage::LinkagePlant;
+use crate::engine::linkage::LinkageArm;
 use crate::engine::scene::Scene;
 use crate::Error;
 use nalgebra::DVector;
 use twoport_control::servo::SensorFrame;
-use twoport_design::linkage::LinkageFile;
 
-/// The arm, its encoders and where its handle started.
+/// The scene's arm and where its handle started.
 #[derive(Clone, Debug)]
-pub(super) struct Arm {
-    pub(super) plant: LinkagePlant,
-    /// Joint angles at the start, where each counter read 0 (rad).
-    q0: Vec<f64>,
-    /// Counts per radian at each joint.
-    counts_per_rad: Vec<f64>,
+pub(super) struct SceneArm<const N: usize> {
+    pub(super) arm: LinkageArm<N>,
     /// The handle's position at the start (m).
-    x0: Vec<f64>,
+    x0: [f64; N],
     /// Where the scene's frame has its zero, in the kinematics' (m): the
     /// handle's start less where the world starts its point.
     origin: [f64; 3],
-    file: LinkageFile,
 }
 
-impl Arm {
-    /// The scene's arm at its start pose, at rest, the world starting its
-    /// point at `start_m` (m).
-    pub(super) fn new(scene: &Scene, file: &LinkageFile, start_m: &[f64]) -> Result<Arm, Error> {
-        let q0 = scene.plant.pose_rad.clone();
-        let mut plant = LinkagePlant::at_rest(file, &q0);
-        plant.gravity_mps2 = scene.plant.gravity_mps2;
-        plant.friction = scene.plant.friction.unwrap_or(true);
-        let (x0, _) = plant
-            .kinematics(&plant.q)
+impl<const N: usize> SceneArm<N> {
+    /// The scene's arm at its start pose, at rest, under the scene's
+    /// gravity and friction.
+    pub(super) fn at_rest(
+        scene: &Scene,
+        file: &twoport_design::linkage::LinkageFile,
+    ) -> Result<LinkageArm<N>, Error> {
+        let q = &scene.plant.pose_rad;
+        let q0: [f64; N] = q[..]
+            .try_into()
+            .map_err(|_| sim_err!("plant.pose_rad: {} angles for {N} joints", q.len()))?;
+        let mut arm =
+            LinkageArm::at_rest(file, q0).map_err(|e| sim_err!("plant.pose_rad: {e:?}"))?;
+        arm.plant.gravity_mps2 = scene.plant.gravity_mps2;
+        arm.plant.friction = scene.plant.friction.unwrap_or(true);
+        Ok(arm)
+    }
+
+    /// `arm` in a scene whose world starts its point at `start_m` (m).
+    pub(super) fn new(arm: LinkageArm<N>, start_m: &[f64]) -> Result<Self, Error> {
+        let (x0, _) = arm
+            .handle()
             .map_err(|e| sim_err!("plant.pose_rad: {e:?}"))?;
-        let counts_per_rad = file
-            .motors
-            .ratios
-            .iter()
-            .map(|n| file.motors.encoder_counts_per_rev as f64 * n / std::f64::consts::TAU)
-            .collect();
         let origin = core::array::from_fn(|i| {
             x0.get(i).copied().unwrap_or(0.0) - start_m.get(i).copied().unwrap_or(0.0)
         });
-        Ok(Arm {
-            plant,
-            q0,
-            counts_per_rad,
-            x0,
-            origin,
-            file: file.clone(),
-        })
-    }
-
-    /// The handle's position from its start and velocity (m, m/s).
-    fn handle(&self) -> Option<(Vec<f64>, Vec<f64>)> {
-        let (x, j) = self.plant.kinematics(&self.plant.q).ok()?;
-        let v = &j * &self.plant.qd;
-        Some((
-            x.iter().zip(&self.x0).map(|(x, o)| x - o).collect(),
-            v.iter().copied().collect(),
-        ))
+        Ok(SceneArm { arm, x0, origin })
     }
 }
 
@@ -76,7 +59,7 @@ impl<const N: usize> Simulation<N> {
     /// world's): polylines through its joints to the handle (m).
     pub fn linkage_skeleton(&self) -> Option<Vec<Vec<[f64; 3]>>> {
         let arm = self.linkage.as_ref()?;
-        let lines = arm.file.skeleton(arm.plant.q.as_slice());
+        let lines = arm.arm.plant.file().skeleton(arm.arm.plant.q.as_slice());
         Some(
             lines
                 .into_iter()
@@ -96,13 +79,9 @@ impl<const N: usize> Simulation<N> {
         let Some(arm) = self.linkage.as_mut() else {
             return s;
         };
-        let raw: [u32; N] = core::array::from_fn(|i| {
-            let c = ((arm.plant.q[i] - arm.q0[i]) * arm.counts_per_rad[i]).round();
-            c as i64 as i32 as u32
-        });
         let frame = SensorFrame {
             tick: self.tick as u32,
-            encoder_raw: raw,
+            encoder_raw: arm.arm.counts(),
             load_cell_n: [0.0; N],
             dead_man_closed: true,
         };
@@ -125,16 +104,17 @@ impl<const N: usize> Simulation<N> {
                 h
             })
             .collect();
-        let x0 = arm.x0.clone();
+        let x0 = arm.x0;
         let hand = |x: &[f64], v: &[f64]| -> DVector<f64> {
             DVector::from_fn(N, |i, _| hands[i].force_on(x[i] - x0[i], v[i]))
         };
-        let stepped = arm
-            .plant
-            .step_with(&torque, &hand, self.period, self.substeps);
-        let handle = arm.handle();
+        let stepped = arm.arm.step(&torque, &hand, self.period, self.substeps);
+        let handle = arm.arm.handle().map(|(x, v)| {
+            let dx: [f64; N] = core::array::from_fn(|i| x[i] - x0[i]);
+            (dx, v)
+        });
         match (stepped, handle) {
-            (Ok(()), Some((x, v))) => {
+            (Ok(()), Ok((x, v))) => {
                 for (i, axis) in self.axes.iter_mut().enumerate() {
                     let f_h = hands[i].force_on(x[i], v[i]);
                     let p = f_h * v[i];
@@ -150,9 +130,9 @@ impl<const N: usize> Simulation<N> {
                 self.failure
                     .get_or_insert(format!("the arm left what it can reach: {e:?}"));
             }
-            (_, None) => {
+            (_, Err(e)) => {
                 self.failure
-                    .get_or_insert("the arm left what it can reach".to_string());
+                    .get_or_insert(format!("the arm left what it can reach: {e:?}"));
             }
         }
         self.tick += 1;

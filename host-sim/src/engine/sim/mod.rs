@@ -213,7 +213,7 @@ pub struct Simulation<const N: usize = 1> {
     /// The scope's grasp, instead of the script's.
     grasp_override: Option<GraspKind>,
     /// A linkage scene's arm, in place of the axes' models.
-    linkage: Option<Box<linkage::Arm>>,
+    linkage: Option<Box<linkage::SceneArm<N>>>,
 }
 
 /// Round half away from zero without a libm call.
@@ -349,10 +349,10 @@ impl<const N: usize> Simulation<N> {
             Some(path) => {
                 let file = twoport_design::linkage::LinkageFile::load(path)
                     .map_err(|e| sim_err!("plant.linkage: {e}"))?;
-                let servo = SceneServo::linkage(&scene, &file, safety)?;
+                let arm = linkage::SceneArm::at_rest(&scene, &file)?;
+                let servo = SceneServo::linkage(&scene, &arm, safety)?;
                 let start: Vec<f64> = servo.ve_position().iter().map(|p| p.m() as f64).collect();
-                let arm = linkage::Arm::new(&scene, &file, &start)?;
-                (servo, Some(Box::new(arm)))
+                (servo, Some(Box::new(linkage::SceneArm::new(arm, &start)?)))
             }
             None => (SceneServo::new(&scene, encoder, safety)?, None),
         };
