@@ -31,21 +31,27 @@
 //! passive hand, `Re(1/Z_in) >= e(θ_m) = Re(1/Z_cI) - S(θ_m)` (`S` the
 //! designer's sound bound, `e > 0` where the coupling is proven), so
 //! `Z_in(θ_m)` lies in the disk through 0 of diameter `1/e`, and
-//! `Re(c_m Z_in) >= -(|c_m| - Re c_m) / (2 e)`. The host's body (its
-//! impedance `Z_b`, [`HostBody::tf`]) closes the loop `1 + Z_env/Z_b`, so
-//! the two-rate loop is stable for every passive hand when
+//! `c_m Z_in` in that disk turned and scaled by `c_m`: centre `a_m`, radius
+//! `|a_m|`, with `a_m = c_m / (2 e)`. Their sum, where `Z_env` lies, is the
+//! disk of centre `Σ a_m` and radius `Σ |a_m|`, through 0 too. The host's
+//! body (its impedance `Z_b`, [`HostBody::tf`]) closes the loop
+//! `1 + Z_env/Z_b`. Scale the body's admittance from 0 (a still surface:
+//! the proven single-rate loop) to its own, `λ/Z_b` with `λ` in `(0, 1]`:
+//! a pole crosses the unit circle only where `Z_env = -Z_b/λ`. The disk is
+//! convex and holds 0, so when `-Z_b` lies outside it, so does all of
+//! `-Z_b/λ`, and the two-rate loop is stable for every passive hand when
 //!
 //! ```text
-//! Re Z_b(θ_h) > W(θ) = Σ_m (|c_m| - Re c_m) / (2 e(θ_m))   for all θ in (0, π/N].
+//! |Z_b(θ_h) + Σ a_m| > Σ |a_m|   for all θ in (0, π/N].
 //! ```
 //!
-//! (Scaling the body's admittance from 0, a still surface and the proven
-//! loop, to its own keeps `Re(Z_b/τ + Z_env) > 0` on the way, so no pole
-//! crosses the circle.) `Z_b`'s real part is its damping plus what its
-//! integration dissipates, `B + M (1 - cos θ_h)/T_h` for a free body; near
-//! DC, `W → (k τ)² / (4 b)` with `τ = (d + N - 1) T`: a body the host moves
-//! needs damping against the coupling's spring delayed by the host's
-//! period and the link, whatever its mass.
+//! (Computed as `(Σ|a_m|)² - |Σ a_m|²` summed pair by pair, which does not
+//! cancel where the disks are large.) The disk reaches into the left
+//! half-plane by `W = Σ (|a_m| - Re a_m)`, and `Re Z_b > W` is enough, but
+//! the test asks less: near DC `W → (k τ)² / (4 b)` with
+//! `τ = (d + N - 1) T` (the coupling's spring delayed by the host's period
+//! and the link), yet there the disk reaches left only far below the real
+//! axis, and a body's reactance keeps `-Z_b` clear of it.
 //!
 //! The frequencies evaluated: 256 uniform in `(0, π/N]` and every point of
 //! the designer's grid folded into it, so every frequency the designer
@@ -174,20 +180,108 @@ impl HostLoop {
     }
 }
 
+/// Where `Z_env` can lie at one host frequency for every passive hand:
+/// the sum of the disks `c_m Z_in(θ_m)` ranges over, itself a disk
+/// through 0 (each is), of centre `Σ a_m` and radius `Σ |a_m|` with
+/// `a_m = c_m / (2 e_m)`.
+struct Disk {
+    /// `Σ a_m`.
+    centre: Complex64,
+    /// `Σ |a_m|`.
+    radius: f64,
+    /// `radius² - |centre|² >= 0`, summed pair by pair so that disks of
+    /// nearly one direction do not cancel.
+    slack: f64,
+}
+
+impl Disk {
+    /// The disk of the terms `(c_m, e_m)`; `None` where a weighted term's
+    /// `e_m <= 0` (the coupling is not proven for every passive VE there).
+    fn of(terms: &[(Complex64, f64)]) -> Option<Disk> {
+        let mut a = Vec::with_capacity(terms.len());
+        for &(c, e) in terms {
+            if e > 0.0 {
+                a.push(c / (2.0 * e));
+            } else if c.norm() != 0.0 {
+                return None;
+            }
+        }
+        // |p||q| - Re(p q*) without the cancellation of nearly parallel
+        // terms.
+        let apart = |p: Complex64, q: Complex64| {
+            let w = p * q.conj();
+            if w.re > 0.0 {
+                w.im * w.im / (w.norm() + w.re)
+            } else {
+                w.norm() - w.re
+            }
+        };
+        let slack = a
+            .iter()
+            .flat_map(|p| a.iter().map(move |q| apart(*p, *q)))
+            .sum();
+        Some(Disk {
+            centre: a.iter().sum(),
+            radius: a.iter().map(|p| p.norm()).sum(),
+            slack,
+        })
+    }
+
+    /// `radius² - |z + centre|²`: positive where `-z` is inside.
+    fn inside(&self, z: Complex64) -> f64 {
+        self.slack - z.norm_sqr() - 2.0 * (z * self.centre.conj()).re
+    }
+
+    /// How far `-z_b` lies outside the disk (N s/m; negative inside).
+    fn margin(&self, z_b: Complex64) -> f64 {
+        let n = self.inside(z_b);
+        if n.is_nan() {
+            return f64::NEG_INFINITY;
+        }
+        -n / ((z_b + self.centre).norm() + self.radius)
+    }
+
+    /// The least damping `B` (N s/m) from which on `-(z_0 + B)` lies
+    /// outside the disk: the upper end of the dampings that put it
+    /// inside, 0 where none does. (`B` only moves `-z_b` along the real
+    /// axis.)
+    fn least_damping(&self, z_0: Complex64) -> f64 {
+        let s = z_0 + self.centre;
+        let disc = self.radius * self.radius - s.im * s.im;
+        if disc.is_nan() {
+            return f64::INFINITY;
+        }
+        if disc <= 0.0 {
+            return 0.0;
+        }
+        // Inside for B in -Re s ± √disc; the upper end, by the product of
+        // the roots where Re s > 0 (where both are large and nearly equal).
+        let upper = if s.re > 0.0 {
+            self.inside(z_0) / (s.re + disc.sqrt())
+        } else {
+            -s.re + disc.sqrt()
+        };
+        upper.max(0.0)
+    }
+}
+
 /// What [`check_host_ve`] found.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct HostCheck {
-    /// Whether `Re Z_b > W` at every frequency evaluated (and the coupling
-    /// is proven for every passive VE there).
+    /// Whether `-Z_b` lies outside the disk `Z_env` can reach at every
+    /// frequency evaluated (and the coupling is proven for every passive
+    /// VE there).
     pub proven: bool,
-    /// The least of `Re Z_b - W` over them (N s/m).
+    /// The least distance of `-Z_b` outside that disk over them (N s/m;
+    /// negative inside).
     pub min_margin_nspm: f64,
     /// The base frequency where it is least (Hz, in `(0, 1/(2 N T)]`).
     pub worst_frequency_hz: f64,
-    /// The least body damping that proves the loop with this body's mass
-    /// and spring (N s/m): the largest `W - Re Z_b` with the damping taken
-    /// out (`Re Z_b` is linear in it). Infinite where the coupling is not
-    /// proven for every passive VE at some frequency.
+    /// The least body damping from which on the loop is proven with this
+    /// body's mass and spring (N s/m): at each frequency, the upper end of
+    /// the dampings that put `-Z_b` inside the disk (damping moves it
+    /// along the real axis). Infinite where the coupling is not proven for
+    /// every passive VE at some frequency.
     pub least_damping_nspm: f64,
     /// How many base frequencies were evaluated.
     pub frequencies: usize,
@@ -229,8 +323,8 @@ pub struct HostAnalysis<'a> {
     bound: Vec<f64>,
     /// `c_m`, laid out as `z`.
     weights: Vec<Complex64>,
-    /// `Re Z_b` at each base frequency's host frequency.
-    re_zb: Vec<f64>,
+    /// `Z_b` at each base frequency's host frequency.
+    zb: Vec<Complex64>,
     /// The single-rate analysis and its bound, for the searches.
     single: std::cell::OnceCell<(Analysis, Vec<f64>)>,
 }
@@ -252,9 +346,9 @@ impl<'a> HostAnalysis<'a> {
         let a = Analysis::on(plant, &omegas);
         let bound = a.impedance_bound(human);
         let weights = bases.iter().flat_map(|&th| host.weights(th, t)).collect();
-        let re_zb = bases
+        let zb = bases
             .iter()
-            .map(|&th| host.body_impedance(f64::from(host.ve_period_ticks) * th).re)
+            .map(|&th| host.body_impedance(f64::from(host.ve_period_ticks) * th))
             .collect();
         HostAnalysis {
             plant,
@@ -264,7 +358,7 @@ impl<'a> HostAnalysis<'a> {
             z: a.points.iter().map(|p| p.z).collect(),
             bound,
             weights,
-            re_zb,
+            zb,
             single: std::cell::OnceCell::new(),
         }
     }
@@ -278,34 +372,18 @@ impl<'a> HostAnalysis<'a> {
         let damping = f64::from(self.host.body.damping_nspm());
         let (mut worst, mut least_damping) = ((f64::INFINITY, 0.0), f64::NEG_INFINITY);
         for (i, &th) in self.bases.iter().enumerate() {
-            let mut w = 0.0;
-            for m in i * n..(i + 1) * n {
-                let (c, e) = (self.weights[m], zc.eval(self.z[m]).inv().re - self.bound[m]);
-                // |c| - Re c without the cancellation near DC.
-                let short = if c.re > 0.0 {
-                    c.im * c.im / (c.norm() + c.re)
-                } else {
-                    c.norm() - c.re
-                };
-                w += if e > 0.0 {
-                    short / (2.0 * e)
-                } else if short == 0.0 {
-                    0.0
-                } else {
-                    f64::INFINITY
-                };
-            }
-            let re_zb = self.re_zb[i];
-            let margin = re_zb - w;
-            let margin = if margin.is_nan() {
-                f64::NEG_INFINITY
-            } else {
-                margin
+            let terms: Vec<(Complex64, f64)> = (i * n..(i + 1) * n)
+                .map(|m| (self.weights[m], zc.eval(self.z[m]).inv().re - self.bound[m]))
+                .collect();
+            let zb = self.zb[i];
+            let (margin, least) = match Disk::of(&terms) {
+                Some(disk) => (disk.margin(zb), disk.least_damping(zb - damping)),
+                None => (f64::NEG_INFINITY, f64::INFINITY),
             };
             if margin < worst.0 {
                 worst = (margin, th / (2.0 * PI * t));
             }
-            least_damping = least_damping.max(w - (re_zb - damping));
+            least_damping = least_damping.max(least);
         }
         Ok(HostCheck {
             proven: worst.0 > 0.0,
