@@ -44,7 +44,7 @@ fn a_linkage_board_holds_the_floor_and_stops_after_a_link_loss() {
         let rest = device.spec().rest_rad.map(f64::from);
         let start = LinkagePlant::at_rest(&file, &rest);
         let (x0, _) = start.kinematics(&start.q).unwrap();
-        let floor = x0[2] - f64::from(FLOOR.0);
+        let floor = x0[2] - f64::from(FLOOR.below_m);
         let s = &r.samples[2400];
         let into = floor - s.handle_m[2];
         assert!(
@@ -169,8 +169,8 @@ fn the_images_are_their_device_files_and_their_proof() {
         }
         match (device, &file.geometry) {
             (Device::SerialArm, Geometry::SerialArm { l1_m, l2_m }) => {
-                let (a, b) = twoport_board::linkage::PHANTOM_ARM;
-                assert!(close(a, *l1_m) && close(b, *l2_m));
+                let arm = twoport_board::linkage::PHANTOM_ARM;
+                assert!(close(arm.l1_m, *l1_m) && close(arm.l2_m, *l2_m));
             }
             (
                 Device::Delta,
@@ -181,9 +181,9 @@ fn the_images_are_their_device_files_and_their_proof() {
                     lower_m,
                 },
             ) => {
-                let (r, e, a, b) = twoport_board::linkage::FALCON_DELTA;
-                assert!(close(r, *base_m) && close(e, *effector_m));
-                assert!(close(a, *upper_m) && close(b, *lower_m));
+                let d = twoport_board::linkage::FALCON_DELTA;
+                assert!(close(d.base_m, *base_m) && close(d.effector_m, *effector_m));
+                assert!(close(d.upper_m, *upper_m) && close(d.lower_m, *lower_m));
             }
             (d, g) => panic!("{d:?} is not {g:?}"),
         }

@@ -4,7 +4,7 @@
 //! the stiff wall of the default scene (`scenes/stiff_wall.toml`), and the
 //! region of gains the designer proved absolutely stable.
 
-use crate::io::IoScale;
+use crate::io::{EncoderScale, IoScale};
 use crate::region::{Bound, Region, RegionError};
 use crate::Board;
 use twoport_control::homing::HomingConfig;
@@ -60,13 +60,30 @@ pub mod region {
 
 /// Control period (s).
 pub const PERIOD_S: f32 = 1.0e-3;
-/// Encoder counter width (bits) and resolution (pm per count): 1 um.
-pub const ENCODER: (u8, i64) = (16, 1_000_000);
+/// The encoder: a 16-bit counter of 1 um counts.
+pub const ENCODER: EncoderScale = EncoderScale {
+    bits: 16,
+    pm_per_count: 1_000_000,
+};
 /// The coupling: the paper's design.
 pub const COUPLING: ImpedanceGains = ImpedanceGains::new(51_000.0, 90.0);
-/// The wall: surface (nm, 1 cm), stiffness (N/m), damping (N s/m); solid
-/// above.
-pub const WALL: (i32, f32, f32) = (10_000_000, 5.0e6, 200.0);
+/// The image's wall, solid above its surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StiffWall {
+    /// Where its surface is (nm).
+    pub surface_nm: i32,
+    /// Its stiffness (N/m).
+    pub stiffness_npm: f32,
+    /// Its damping (N s/m).
+    pub damping_nspm: f32,
+}
+
+/// The wall: 1 cm up, 5 MN/m and 200 N s/m.
+pub const WALL: StiffWall = StiffWall {
+    surface_nm: 10_000_000,
+    stiffness_npm: 5.0e6,
+    damping_nspm: 200.0,
+};
 /// Ticks without a host heartbeat before the board forces zero (50 ms).
 pub const HEARTBEAT_TIMEOUT_TICKS: u32 = 50;
 /// Homing: the hard stop is 20 mm below the origin (the wall's surface is
@@ -118,13 +135,11 @@ pub(crate) fn wall_servo(
     coupling: ImpedanceGains,
     safety: SafetyConfig,
 ) -> Result<Servo<UnilateralWall>, BuildError> {
-    let (bits, pm) = ENCODER;
-    let enc = Encoder::new(bits, pm, 0, Position::ZERO)?;
-    let (x, k, b) = WALL;
+    let enc = Encoder::new(ENCODER.bits, ENCODER.pm_per_count, 0, Position::ZERO)?;
     let ve = UnilateralWall::new(
-        k,
-        b,
-        Position::from_nm(x),
+        WALL.stiffness_npm,
+        WALL.damping_nspm,
+        Position::from_nm(WALL.surface_nm),
         Solid::Above,
         safety.period_s,
         Position::ZERO,
@@ -132,18 +147,29 @@ pub(crate) fn wall_servo(
     Ok(Servo::new([coupling.into()], [enc], [safety], ve)?)
 }
 
-/// The actuator's port as the passivity layer sees it: the moving mass at
-/// the encoder (kg, the model's actuator inertia) and a lower bound of its
-/// own viscous damping (N s/m).
-pub const ACTUATOR_PORT: (f32, f32) = (0.93, 4.0);
+/// A device's port as the passivity layer sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DevicePort {
+    /// The moving mass at the encoder (kg).
+    pub mass_kg: f32,
+    /// A lower bound of its own viscous damping (N s/m).
+    pub damping_nspm: f32,
+}
+
+/// The actuator's port: the model's actuator inertia, and 4 N s/m of its
+/// damping.
+pub const ACTUATOR_PORT: DevicePort = DevicePort {
+    mass_kg: 0.93,
+    damping_nspm: 4.0,
+};
 
 /// The stiff wall's servo with the passivity layer (the series damper) at
 /// the actuator's port: the passivity image's.
 pub fn stiff_wall_servo_with_passivity(
 ) -> Result<Servo<UnilateralWall, f32, 1, SeriesDamper>, BuildError> {
-    let (mass_kg, damping_nspm) = ACTUATOR_PORT;
-    let mut limits = PassivityLimits::for_device(mass_kg, PERIOD_S, safety().peak_force_n)?;
-    limits.device_damping_nspm = damping_nspm;
+    let port = ACTUATOR_PORT;
+    let mut limits = PassivityLimits::for_device(port.mass_kg, PERIOD_S, safety().peak_force_n)?;
+    limits.device_damping_nspm = port.damping_nspm;
     let layer = SeriesDamper::new(limits)?;
     Ok(stiff_wall_servo()?.with_layers([layer])?)
 }

@@ -101,3 +101,13 @@ mod tests {
         assert_eq!(o.load_cell_n(i32::MIN), i32::MIN as f32 * 1e-3);
     }
 }
+
+/// A linear encoder as an image reads it: its counter's width and its
+/// resolution.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EncoderScale {
+    /// The counter's width (bits).
+    pub bits: u8,
+    /// Picometres per count.
+    pub pm_per_count: i64,
+}

@@ -12,7 +12,7 @@ mod simulated;
 mod support;
 
 pub use board::{Board, Frame, TX_FRAMES};
-pub use io::{IoScale, DUTY_FULL_SCALE};
+pub use io::{EncoderScale, IoScale, DUTY_FULL_SCALE};
 pub use region::{check_axes, Bound, Region, RegionError};
 pub use simulated::{SimAxis, Simulated};
 pub use support::{BoardSupport, RawSensors};

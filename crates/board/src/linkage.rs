@@ -27,9 +27,23 @@ pub const PERIOD_S: f32 = 1.0e-3;
 pub const GRASP_NSPM: f32 = 2.0;
 /// The coupling both images run: inside their regions at 2 N s/m.
 pub const COUPLING: ImpedanceGains = ImpedanceGains::new(2_000.0, 0.5);
-/// The floor under the rest pose (m below the handle there), its
-/// stiffness (N/m) and damping (N s/m).
-pub const FLOOR: (f32, f32, f32) = (0.005, 1.0e5, 10.0);
+/// The floor a linkage image renders under its rest pose.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Floor {
+    /// How far under the handle's rest position its surface is (m).
+    pub below_m: f32,
+    /// Its stiffness (N/m).
+    pub stiffness_npm: f32,
+    /// Its damping (N s/m).
+    pub damping_nspm: f32,
+}
+
+/// The floor: 5 mm under the rest pose, 100 kN/m and 10 N s/m.
+pub const FLOOR: Floor = Floor {
+    below_m: 0.005,
+    stiffness_npm: 1.0e5,
+    damping_nspm: 10.0,
+};
 /// Ticks without a host heartbeat before the board forces zero (50 ms).
 pub const HEARTBEAT_TIMEOUT_TICKS: u32 = 50;
 /// Telemetry every this many ticks (100 Hz).
@@ -74,8 +88,20 @@ pub const PHANTOM: Spec = Spec {
         fore_nm: -0.073_755,
     },
 };
-/// Its arm: `l1`, `l2` (m).
-pub const PHANTOM_ARM: (f32, f32) = (0.215, 0.170);
+/// A serial arm's two links (m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ArmLengths {
+    /// The upper arm, `l1` (m).
+    pub l1_m: f32,
+    /// The forearm, `l2` (m).
+    pub l2_m: f32,
+}
+
+/// Its arm.
+pub const PHANTOM_ARM: ArmLengths = ArmLengths {
+    l1_m: 0.215,
+    l2_m: 0.170,
+};
 
 /// The Falcon-like delta (`falcon_like.toml`).
 pub const FALCON: Spec = Spec {
@@ -91,8 +117,26 @@ pub const FALCON: Spec = Spec {
     // The lumped handle's 60 g.
     gravity: Gravity::Handle { weight_n: 0.5886 },
 };
-/// Its geometry: base and effector radii, upper and lower arms (m).
-pub const FALCON_DELTA: (f32, f32, f32, f32) = (0.040, 0.02309, 0.060, 0.1025);
+/// A rotary delta's geometry (m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DeltaLengths {
+    /// The base's radius to each motor's axis (m).
+    pub base_m: f32,
+    /// The effector's radius to each lower arm's joint (m).
+    pub effector_m: f32,
+    /// Each upper arm (m).
+    pub upper_m: f32,
+    /// Each lower arm (m).
+    pub lower_m: f32,
+}
+
+/// Its geometry.
+pub const FALCON_DELTA: DeltaLengths = DeltaLengths {
+    base_m: 0.040,
+    effector_m: 0.02309,
+    upper_m: 0.060,
+    lower_m: 0.1025,
+};
 
 /// The images' world: a wall on each Cartesian axis, only the floor (z)
 /// within reach.
@@ -162,7 +206,11 @@ pub fn board<K: Kinematics<f32, 3>>(
         .forward(&spec.rest_rad)
         .map_err(|_| BuildError::RestPose)?
         .position_m;
-    let (below, k, b) = FLOOR;
+    let Floor {
+        below_m: below,
+        stiffness_npm: k,
+        damping_nspm: b,
+    } = FLOOR;
     let p = |x: f32| Position::from_m(x).ok_or(BuildError::RestPose);
     let far = p(0.5)?;
     let wall = |surface, solid, probe| {
@@ -191,13 +239,18 @@ pub fn board<K: Kinematics<f32, 3>>(
 
 /// The serial-arm image: the PHANToM Premium 1.5.
 pub fn serial_arm_board() -> Result<SerialArmBoard, BuildError> {
-    let arm = SerialArm::new(PHANTOM_ARM.0, PHANTOM_ARM.1).map_err(BuildError::Param)?;
+    let arm = SerialArm::new(PHANTOM_ARM.l1_m, PHANTOM_ARM.l2_m).map_err(BuildError::Param)?;
     board(&PHANTOM, arm)
 }
 
 /// The delta image: the Falcon-like delta.
 pub fn delta_board() -> Result<DeltaBoard, BuildError> {
-    let (r, e, a, b) = FALCON_DELTA;
+    let DeltaLengths {
+        base_m: r,
+        effector_m: e,
+        upper_m: a,
+        lower_m: b,
+    } = FALCON_DELTA;
     board(&FALCON, Delta::new(r, e, a, b).map_err(BuildError::Param)?)
 }
 

@@ -5,7 +5,7 @@
 //! real board does (the QEMU board a host application drives), and a host
 //! test runs it in-process the same way.
 
-use crate::io::IoScale;
+use crate::io::{EncoderScale, IoScale};
 use crate::support::{BoardSupport, RawSensors};
 
 /// One axis of the simulated device: a rigid mass with viscous damping,
@@ -56,8 +56,8 @@ pub struct Simulated<S, const N: usize> {
     inner: S,
     axes: [SimAxis; N],
     io: [IoScale; N],
-    /// The encoder: counter bits and pm per count.
-    encoder: (u8, i64),
+    /// The encoder.
+    encoder: EncoderScale,
     period_s: f32,
     x_m: [f32; N],
     v_mps: [f32; N],
@@ -67,12 +67,12 @@ pub struct Simulated<S, const N: usize> {
 
 impl<S, const N: usize> Simulated<S, N> {
     /// `axes` simulated behind `inner`, their motors scaled by `io`, read by
-    /// an encoder of `(bits, pm per count)`, stepped every `period_s` (s).
+    /// `encoder`, stepped every `period_s` (s).
     pub fn new(
         inner: S,
         axes: [SimAxis; N],
         io: [IoScale; N],
-        encoder: (u8, i64),
+        encoder: EncoderScale,
         period_s: f32,
     ) -> Self {
         Simulated {
@@ -105,7 +105,10 @@ impl<S, const N: usize> Simulated<S, N> {
 
     /// The encoder's count for `x_m`, wrapped to its counter.
     fn count(&self, x_m: f32) -> u32 {
-        let (bits, pm) = self.encoder;
+        let EncoderScale {
+            bits,
+            pm_per_count: pm,
+        } = self.encoder;
         // The nearest count: floor(y + 1/2), without libm.
         let y = f64::from(x_m) * 1e12 / pm as f64 + 0.5;
         let t = y as i64;
@@ -216,7 +219,7 @@ mod tests {
             Nothing,
             [SimAxis::excalibur(hand_n)],
             [IoScale::EXCALIBUR],
-            (16, 1_000_000),
+            crate::excalibur::ENCODER,
             1e-3,
         )
     }

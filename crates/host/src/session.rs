@@ -259,14 +259,14 @@ impl<P: BoardPort> Session<P> {
     /// The scene's encoder has an index mark at `index_m` (m): send the
     /// count it latches in the sensor frame of each tick that passes it.
     pub fn set_index(&mut self, index_m: Option<f64>) {
-        let (_, pm) = excalibur::ENCODER;
+        let pm = excalibur::ENCODER.pm_per_count;
         self.index = index_m.map(|m| ((m * 1e12 / pm as f64).round() as i64, None));
     }
 
     /// The count the index latched this tick, if the axis passed it
     /// between the last frame's `raw` and this one.
     pub fn index_crossing(&mut self, raw: u32) -> Option<u32> {
-        let (bits, _) = excalibur::ENCODER;
+        let bits = excalibur::ENCODER.bits;
         let (mark, last) = self.index.as_mut()?;
         let shift = 32 - u32::from(bits);
         let now = match *last {

@@ -291,7 +291,10 @@ impl Start {
 /// simulates (the scene's grab and release times cannot reach it over the
 /// link).
 pub fn check_scene(scene: &Scene) -> Result<(), Error> {
-    let (bits, pm) = excalibur::ENCODER;
+    let twoport_board::EncoderScale {
+        bits,
+        pm_per_count: pm,
+    } = excalibur::ENCODER;
     match scene.effects.encoder {
         Some(e) if e.bits == bits && (e.resolution_m * 1e12).round() as i64 == pm => {}
         _ => {

@@ -66,8 +66,7 @@ const BLOCK: BuildError = BuildError::Param(ParamError {
 /// The three-axis servo: the impedance display on the world, disabled
 /// until the host enables it.
 pub fn servo() -> Result<XyzServo, BuildError> {
-    let (bits, pm) = ENCODER;
-    let enc = Encoder::new(bits, pm, 0, Position::ZERO)?;
+    let enc = Encoder::new(ENCODER.bits, ENCODER.pm_per_count, 0, Position::ZERO)?;
     Ok(Servo::new(
         [COUPLING.into(); 3],
         [enc; 3],
