@@ -7,6 +7,7 @@ use thiserror::Error;
 /// Why the simulator, a study, a PIL run or the scope refused or stopped,
 /// naming what is wrong and where.
 #[derive(Clone, Debug, PartialEq, Error)]
+#[non_exhaustive]
 pub enum Error {
     /// A scene file that is not a scene: the file and the line or field.
     #[error(transparent)]

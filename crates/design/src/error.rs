@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// Why the designer refused a question, naming the input that is wrong.
 #[derive(Clone, Debug, PartialEq, Error)]
+#[non_exhaustive]
 pub enum Error {
     /// A model file could not be read or is not a device.
     #[error(transparent)]

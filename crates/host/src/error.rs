@@ -5,6 +5,7 @@ use twoport_link::{AxisRefusal, ModeRefusal, ModeRequest};
 
 /// Why a call to a board failed.
 #[derive(Clone, Debug, PartialEq, Error)]
+#[non_exhaustive]
 pub enum LinkError {
     /// The serial port would not open.
     #[error("serial port {path}: {why}")]

@@ -2,6 +2,7 @@
 
 /// Why a record could not be identified.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum IdentifyError {
     /// The signals' lengths differ.
     #[error("{what}: {len} samples, but the force has {force}")]
