@@ -1,12 +1,11 @@
 //! The command line's arguments, the checks on them, and the run over a
 //! device file's axes.
 
+use crate::run::{print, Reported};
 use clap::{Args, Subcommand, ValueEnum};
-use serde_json::{json, Value};
-use std::cell::RefCell;
+use serde_json::json;
 use std::path::PathBuf;
-use std::rc::Rc;
-use twoport_design::{Device, DeviceModel};
+use twoport_design::{Device, DeviceAxis};
 
 pub(crate) const DEFAULT_MODEL: &str = twoport_design::model::EXCALIBUR_PATH;
 
@@ -22,9 +21,6 @@ pub(crate) struct Common {
     /// one object with an entry per axis. In place of --model.
     #[arg(long, conflicts_with = "model")]
     pub(crate) device: Option<PathBuf>,
-    /// The axis of a device file this run is for (set by `each_axis`).
-    #[arg(skip)]
-    pub(crate) axis: Option<AxisRun>,
     /// Sample period (s); the model's by default.
     #[arg(long, allow_negative_numbers = true)]
     pub(crate) period: Option<f64>,
@@ -222,19 +218,9 @@ pub(crate) struct PlotArgs {
     pub(crate) common: Common,
 }
 
-/// One axis of a device file, as one run of a command sees it.
-#[derive(Clone, Debug)]
-pub(crate) struct AxisRun {
-    pub(crate) name: String,
-    /// The axis's models (its poses), read once with the device file.
-    pub(crate) models: Vec<(PathBuf, DeviceModel)>,
-    /// Where a JSON run puts its object, for the device's one object.
-    pub(crate) out: Rc<RefCell<Vec<Value>>>,
-}
-
 /// What a command's arguments share.
 pub(crate) trait HasCommon {
-    fn common(&mut self) -> &mut Common;
+    fn common(&self) -> &Common;
     /// Whether the command prints Rust source (a module per axis then,
     /// with no text heading).
     fn rust(&self) -> bool {
@@ -245,8 +231,8 @@ pub(crate) trait HasCommon {
 macro_rules! has_common {
     ($($t:ty),*) => {$(
         impl HasCommon for $t {
-            fn common(&mut self) -> &mut Common {
-                &mut self.common
+            fn common(&self) -> &Common {
+                &self.common
             }
         }
     )*};
@@ -262,8 +248,8 @@ has_common!(
 );
 
 impl HasCommon for RegionImpedance {
-    fn common(&mut self) -> &mut Common {
-        &mut self.common
+    fn common(&self) -> &Common {
+        &self.common
     }
     fn rust(&self) -> bool {
         self.grid.rust
@@ -271,8 +257,8 @@ impl HasCommon for RegionImpedance {
 }
 
 impl HasCommon for RegionAdmittance {
-    fn common(&mut self) -> &mut Common {
-        &mut self.common
+    fn common(&self) -> &Common {
+        &self.common
     }
     fn rust(&self) -> bool {
         self.grid.rust
@@ -280,19 +266,19 @@ impl HasCommon for RegionAdmittance {
 }
 
 impl HasCommon for ZrangeImpedance {
-    fn common(&mut self) -> &mut Common {
+    fn common(&self) -> &Common {
         self.gains.common()
     }
 }
 
 impl HasCommon for ZrangeAdmittance {
-    fn common(&mut self) -> &mut Common {
+    fn common(&self) -> &Common {
         self.gains.common()
     }
 }
 
 impl<I: Args + HasCommon, A: Args + HasCommon> HasCommon for Display<I, A> {
-    fn common(&mut self) -> &mut Common {
+    fn common(&self) -> &Common {
         match self {
             Display::Impedance(i) => i.common(),
             Display::Admittance(a) => a.common(),
@@ -306,40 +292,50 @@ impl<I: Args + HasCommon, A: Args + HasCommon> HasCommon for Display<I, A> {
     }
 }
 
-/// `run` on `args`, or, given a device file, on each of its axes in turn:
-/// the text under a heading per axis, the JSON as one object.
-pub(crate) fn each_axis<A: HasCommon + Clone>(
-    args: &A,
-    run: fn(&A) -> Result<(), String>,
-) -> Result<(), String> {
-    let mut a = args.clone();
-    let Some(path) = a.common().device.clone() else {
-        return run(args);
+/// A command run on the `--model` files (no axis), or on one axis of a
+/// device file.
+pub(crate) type OnAxis<A> = fn(&A, Option<&DeviceAxis>) -> Reported;
+
+/// `run` on `args` and its report printed; given a device file, `run` on
+/// each of its axes in turn: the text under a heading per axis, the JSON
+/// as one object with an entry per axis.
+pub(crate) fn each_axis<A: HasCommon>(args: &A, run: OnAxis<A>) -> Result<(), String> {
+    let c = args.common();
+    let Some(path) = &c.device else {
+        return print(c.json, &*run(args, None)?);
     };
-    let device = Device::load(&path).map_err(|e| e.to_string())?;
-    let out = Rc::new(RefCell::new(Vec::new()));
-    let json = a.common().json;
+    let device = Device::load(path).map_err(|e| e.to_string())?;
+    let mut axes = Vec::new();
     for axis in &device.axes {
-        let c = a.common();
-        c.axis = Some(AxisRun {
-            name: axis.name.clone(),
-            models: axis
-                .model_paths
-                .iter()
-                .cloned()
-                .zip(axis.models.iter().cloned())
-                .collect(),
-            out: out.clone(),
-        });
-        if !json && !args.rust() {
-            say!("axis {}:\n", axis.name);
+        let report = run(args, Some(axis))
+            .map_err(|e| format!("{}, axis {}: {e}", path.display(), axis.name))?;
+        if c.json {
+            let mut v = report.json()?;
+            v["axis"] = json!(axis.name);
+            axes.push(v);
+        } else {
+            if !args.rust() {
+                say!("axis {}:\n", axis.name);
+            }
+            print(false, &*report)?;
         }
-        run(&a).map_err(|e| format!("{}, axis {}: {e}", path.display(), axis.name))?;
     }
-    if json {
-        say!("{}\n", json!({"device": device.name, "axes": out.take()}));
+    if c.json {
+        say!("{}\n", json!({"device": device.name, "axes": axes}));
     }
     Ok(())
+}
+
+/// `run` on `args`, refusing a device file: the command draws one axis.
+pub(crate) fn one_axis<A: HasCommon>(args: &A, run: OnAxis<A>) -> Result<(), String> {
+    let c = args.common();
+    match &c.device {
+        Some(p) => Err(format!(
+            "--device {}: this command draws one axis; give that axis's --model",
+            p.display()
+        )),
+        None => print(c.json, &*run(args, None)?),
+    }
 }
 
 /// Check gains for sign and finiteness before any analysis.

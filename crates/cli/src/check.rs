@@ -3,14 +3,25 @@
 
 use crate::args::*;
 use crate::run::*;
+use twoport_design::DeviceAxis;
 
-pub(crate) fn check(g: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
-    let (common, r) = match g {
-        Display::Impedance(g) => (&g.common, designer(&g.common)?.check_impedance(g.k, g.b)),
-        Display::Admittance(g) => (
-            &g.common,
-            designer(&g.common)?.check_admittance((g.kp, g.bp), g.m, g.b),
-        ),
+pub(crate) fn check(
+    g: &Display<ImpedanceGains, AdmittanceGains>,
+    axis: Option<&DeviceAxis>,
+) -> Reported {
+    let r = match g {
+        Display::Impedance(g) => {
+            let (k, b) = (gain("k", g.k)?, gain("b", g.b)?);
+            designer(&g.common, axis)?.check_impedance(k, b)
+        }
+        Display::Admittance(g) => {
+            let kp = (gain("kp", g.kp)?, gain("bp", g.bp)?);
+            let b = gain("b", g.b)?;
+            if !(g.m.is_finite() && g.m > 0.0) {
+                return Err(format!("--m {}: must be a finite mass > 0 kg", g.m));
+            }
+            designer(&g.common, axis)?.check_admittance(kp, g.m, b)
+        }
     };
-    emit(common, &r.map_err(|e| e.to_string())?)
+    reported(r.map_err(|e| e.to_string())?)
 }

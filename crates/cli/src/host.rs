@@ -12,6 +12,7 @@ use twoport_design::host_ve::{
 };
 use twoport_design::network::HumanBound;
 use twoport_design::verify::{verify_host, HostVerdict};
+use twoport_design::DeviceAxis;
 
 /// What `host-ve` found on one pose.
 #[derive(Serialize)]
@@ -24,7 +25,7 @@ struct PoseReport {
 
 /// What `host-ve` found.
 #[derive(Serialize)]
-struct Report {
+struct HostVeReport {
     period_s: f64,
     ve_period_ticks: u32,
     delay_ticks: u32,
@@ -38,7 +39,7 @@ struct Report {
     poses: Vec<PoseReport>,
 }
 
-impl fmt::Display for Report {
+impl fmt::Display for HostVeReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
@@ -86,12 +87,12 @@ impl fmt::Display for Report {
     }
 }
 
-pub(crate) fn host_ve(a: &HostVeArgs) -> Result<(), String> {
+pub(crate) fn host_ve(a: &HostVeArgs, _: Option<&DeviceAxis>) -> Reported {
     let h = a
         .host
         .get()?
         .ok_or("--host-body: give the host body's mass (kg) and damping (N s/m), e.g. 1,10")?;
-    let d = designer(&a.common)?;
+    let d = designer(&a.common, None)?;
     let t = d.period_s();
     let (n, delay) = h.ticks(1.0 / t)?;
     let host = HostLoop::new(t, n, delay, (h.body.0, h.body.1, 0.0)).map_err(|e| e.to_string())?;
@@ -141,7 +142,7 @@ pub(crate) fn host_ve(a: &HostVeArgs) -> Result<(), String> {
             verify,
         });
     }
-    let report = Report {
+    let report = HostVeReport {
         period_s: t,
         ve_period_ticks: n,
         delay_ticks: delay,
@@ -153,5 +154,5 @@ pub(crate) fn host_ve(a: &HostVeArgs) -> Result<(), String> {
         proven: out.iter().all(|p| p.check.proven),
         poses: out,
     };
-    emit(&a.common, &report)
+    reported(report)
 }

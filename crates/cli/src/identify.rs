@@ -5,14 +5,14 @@
 //! (`set.toml`).
 
 use crate::args::{IdentifyArgs, PlotFormat};
-use serde_json::json;
-use std::fmt::Write;
+use serde::Serialize;
+use std::fmt;
 use std::path::{Path, PathBuf};
 use twoport_design::plot;
 use twoport_identify::fit::{self, chain::ModelBase, uncertainty, Fit, Form, Measured};
 use twoport_identify::log::Log;
 
-pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
+pub(crate) fn identify(a: &IdentifyArgs) -> Result<IdentifyReport, String> {
     let positive = |name: &str, v: f64| {
         (v.is_finite() && v > 0.0)
             .then_some(v)
@@ -78,7 +78,7 @@ pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
             let list: Vec<String> = models(x).iter().map(|m| format!("  {m:?},")).collect();
             t += &format!(
                 "\n[[axis]]\nname = {:?}\nmodels = [\n{}\n]\n",
-                x.name,
+                x.report.axis,
                 list.join("\n")
             );
         }
@@ -88,7 +88,7 @@ pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
         a.out.join("device.toml"),
         file(
             "The fitted model of each axis, as `twoport identify` found it.",
-            &|x| vec![format!("{}/model.toml", x.name)],
+            &|x| vec![format!("{}/model.toml", x.report.axis)],
         ),
     )?;
     let set_path = write_file(
@@ -102,30 +102,45 @@ pub(crate) fn identify(a: &IdentifyArgs) -> Result<(), String> {
     for p in [&device_path, &set_path] {
         twoport_design::Device::load(p).map_err(|e| e.to_string())?;
     }
-    if a.json {
-        let v = json!({
-            "device": device_path,
-            "set": set_path,
-            "sigmas": a.sigmas,
-            "damping_doubt": a.damping_doubt,
-            "axes": axes.iter().map(|x| x.json.clone()).collect::<Vec<_>>(),
-        });
-        say!("{v}\n");
-        return Ok(());
+    Ok(IdentifyReport {
+        device: device_path,
+        set: set_path,
+        sigmas: a.sigmas,
+        damping_doubt: a.damping_doubt,
+        axes: axes.into_iter().map(|x| x.report).collect(),
+    })
+}
+
+/// What `identify` wrote, and each axis's fit.
+#[derive(Serialize)]
+pub(crate) struct IdentifyReport {
+    /// The device file of every axis's fit.
+    device: PathBuf,
+    /// The device file of every axis's set.
+    set: PathBuf,
+    /// How far the set reaches along each direction (standard deviations).
+    sigmas: f64,
+    /// The fraction by which the set's damping is lowered.
+    damping_doubt: f64,
+    axes: Vec<AxisReport>,
+}
+
+impl fmt::Display for IdentifyReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for x in &self.axes {
+            writeln!(f, "axis {}:\n{x}", x.axis)?;
+        }
+        write!(
+            f,
+            "wrote {} (each axis's fit) and {} (each axis's set: +-{} sigma, damping lowered by {}%)\n\
+             prove a coupling for all of them: twoport design impedance --device {}",
+            self.device.display(),
+            self.set.display(),
+            self.sigmas,
+            100.0 * self.damping_doubt,
+            self.set.display()
+        )
     }
-    for x in &axes {
-        say!("axis {}:\n{}\n", x.name, x.text);
-    }
-    say!(
-        "wrote {} (each axis's fit) and {} (each axis's set: +-{} sigma, damping lowered by {}%)\n\
-         prove a coupling for all of them: twoport design impedance --device {}\n",
-        device_path.display(),
-        set_path.display(),
-        a.sigmas,
-        100.0 * a.damping_doubt,
-        set_path.display()
-    );
-    Ok(())
 }
 
 /// Write `text` to `path`, an error naming the file.
@@ -144,9 +159,7 @@ struct Amplifier {
 /// One axis identified: its report, and its set's files (relative to the
 /// output folder).
 struct Axis {
-    name: String,
-    json: serde_json::Value,
-    text: String,
+    report: AxisReport,
     members: Vec<String>,
 }
 
@@ -295,22 +308,10 @@ fn axis(
         Some(format) => draw(&dir, format, &data, chosen)?,
         None => Vec::new(),
     };
-    let (json, text) = report(
-        &source,
-        &log,
-        &data,
-        &fits,
-        best,
-        &set,
-        &model_path,
-        &figures,
+    let report = AxisReport::new(
+        name, source, &log, &data, &fits, best, &set, model_path, figures,
     );
-    Ok(Axis {
-        name: name.to_string(),
-        json,
-        text,
-        members,
-    })
+    Ok(Axis { report, members })
 }
 
 /// The header of every model file written: where it came from.
@@ -329,142 +330,200 @@ fn provenance(source: &str, f: &Fit) -> String {
     )
 }
 
-/// One axis's report: its JSON and its text.
-#[allow(clippy::too_many_arguments)]
-fn report(
-    source: &str,
-    log: &Log,
-    data: &Measured,
-    fits: &[Fit],
-    best: Option<usize>,
-    set: &[uncertainty::Member],
-    model_path: &Path,
-    figures: &[PathBuf],
-) -> (serde_json::Value, String) {
-    let f = &fits[best.unwrap_or(0)];
-    let x = &data.position;
-    let coherence = x.coherence();
-    let (worst_at, worst) = coherence
-        .iter()
-        .enumerate()
-        .fold((0, 1.0_f64), |b, (i, c)| if *c < b.1 { (i, *c) } else { b });
-    let res = f.resonances();
-    let directions = set
-        .iter()
-        .filter_map(|m| m.direction)
-        .max()
-        .map_or(0, |d| d + 1);
-    let form = match f.form {
-        Form::Chain(_) => "chain",
-        Form::Modal(_) => "modal",
-    };
-    // What the handle weighs past the load cell, and the bypass beside it.
-    let handle = match &f.form {
-        Form::Modal(m) => Some((m.handle_kg, m.bypass_npm)),
-        Form::Chain(_) => None,
-    };
-    let v = json!({
-        "record": source,
-        "samples": log.force_n.len(),
-        "period_s": log.period_s,
-        "harmonics_hz": [x.freq_hz.first(), x.freq_hz.last()],
-        "periods_averaged": x.periods,
-        "coherence_min": worst,
-        "coherence_min_hz": x.freq_hz.get(worst_at),
-        "orders": fits.iter().map(|g| json!({
-            "modes": g.form.modes(),
-            "loaded": g.loaded,
-            "chi2_per_dof": g.reduced_chi2(),
-            "bic": g.bic,
-        })).collect::<Vec<_>>(),
-        "chosen": {
-            "form": form,
-            "modes": f.form.modes(),
-            "resonances_hz": res.iter().map(|r| r.0).collect::<Vec<_>>(),
-            "damping_ratios": res.iter().map(|r| r.1).collect::<Vec<_>>(),
-            "chi2_per_dof": f.reduced_chi2(),
-            "handle_kg": handle.map(|h| h.0),
-            "bypass_npm": handle.and_then(|h| h.1),
-        },
-        "coulomb_friction_n": f.model.coulomb_friction_n,
-        "cogging_n": f.cogging.map(|c| c.amplitude_n),
-        "cogging_period_m": f.cogging.map(|c| c.period_m),
-        "encoder_quantum_m": f.model.encoder_quantum_m,
-        "model": model_path,
-        "set_models": set.len(),
-        "set_directions": directions,
-        "figures": figures,
-    });
-    let mut t = String::new();
-    let _ = writeln!(
-        t,
-        "  record {source}: {} samples at {:.0} Hz, harmonics {:.3} to {:.3} Hz, {} periods averaged",
-        log.force_n.len(),
-        1.0 / log.period_s,
-        x.freq_hz.first().copied().unwrap_or(0.0),
-        x.freq_hz.last().copied().unwrap_or(0.0),
-        x.periods
-    );
-    let _ = writeln!(
-        t,
-        "  coherence (encoder): lowest {worst:.3} at {:.3} Hz",
-        x.freq_hz.get(worst_at).copied().unwrap_or(0.0)
-    );
-    let _ = writeln!(t, "  orders fitted (modes: chi2/nu, BIC):");
-    for (i, g) in fits.iter().enumerate() {
-        let mark = if Some(i) == best { "  <- chosen" } else { "" };
-        let both = if g.loaded {
-            " (with the loaded record)"
-        } else {
-            ""
+/// One axis's fit: the record, the orders tried, the model chosen and
+/// what was written.
+#[derive(Serialize)]
+struct AxisReport {
+    axis: String,
+    record: String,
+    samples: usize,
+    period_s: f64,
+    /// The lowest and highest harmonic read.
+    harmonics_hz: [Option<f64>; 2],
+    periods_averaged: usize,
+    /// The encoder's least coherence over the harmonics, and where.
+    coherence_min: f64,
+    coherence_min_hz: Option<f64>,
+    orders: Vec<Order>,
+    chosen: Chosen,
+    coulomb_friction_n: Option<f64>,
+    cogging_n: Option<f64>,
+    cogging_period_m: Option<f64>,
+    encoder_quantum_m: Option<f64>,
+    /// The model file written.
+    model: PathBuf,
+    set_models: usize,
+    set_directions: usize,
+    figures: Vec<PathBuf>,
+}
+
+/// One order fitted.
+#[derive(Serialize)]
+struct Order {
+    modes: usize,
+    /// Fitted with the loaded record too.
+    loaded: bool,
+    chi2_per_dof: f64,
+    bic: f64,
+    chosen: bool,
+}
+
+/// The model chosen.
+#[derive(Serialize)]
+struct Chosen {
+    /// "chain" or "modal".
+    form: &'static str,
+    modes: usize,
+    /// Resonances below Nyquist and their damping ratios.
+    resonances_hz: Vec<f64>,
+    damping_ratios: Vec<f64>,
+    chi2_per_dof: f64,
+    /// What the handle weighs past the load cell (modal form).
+    handle_kg: Option<f64>,
+    /// The spring that holds the handle beside the load cell, if any.
+    bypass_npm: Option<f64>,
+}
+
+impl AxisReport {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        axis: &str,
+        record: String,
+        log: &Log,
+        data: &Measured,
+        fits: &[Fit],
+        best: Option<usize>,
+        set: &[uncertainty::Member],
+        model: PathBuf,
+        figures: Vec<PathBuf>,
+    ) -> Self {
+        let f = &fits[best.unwrap_or(0)];
+        let x = &data.position;
+        let (worst_at, worst) = x
+            .coherence()
+            .iter()
+            .enumerate()
+            .fold((0, 1.0_f64), |b, (i, c)| if *c < b.1 { (i, *c) } else { b });
+        let res = f.resonances();
+        let handle = match &f.form {
+            Form::Modal(m) => Some((m.handle_kg, m.bypass_npm)),
+            Form::Chain(_) => None,
         };
-        let _ = writeln!(
-            t,
-            "    {}{both}: {:.3}, {:.1}{mark}",
-            g.form.modes(),
-            g.reduced_chi2(),
-            g.bic
-        );
-    }
-    let _ = writeln!(t, "  model ({form}), resonances below Nyquist:");
-    for (hz, zeta) in &res {
-        let _ = writeln!(t, "    {hz:9.3} Hz  damping ratio {zeta:.4}");
-    }
-    if let Some((kg, bypass)) = handle {
-        let _ = write!(t, "  handle past the load cell {kg:.4} kg");
-        match bypass {
-            Some(b) => {
-                let _ = writeln!(t, ", held beside it by {b:.1} N/m to the actuator");
-            }
-            None => {
-                let _ = writeln!(t);
-            }
+        AxisReport {
+            axis: axis.to_string(),
+            record,
+            samples: log.force_n.len(),
+            period_s: log.period_s,
+            harmonics_hz: [x.freq_hz.first().copied(), x.freq_hz.last().copied()],
+            periods_averaged: x.periods,
+            coherence_min: worst,
+            coherence_min_hz: x.freq_hz.get(worst_at).copied(),
+            orders: fits
+                .iter()
+                .enumerate()
+                .map(|(i, g)| Order {
+                    modes: g.form.modes(),
+                    loaded: g.loaded,
+                    chi2_per_dof: g.reduced_chi2(),
+                    bic: g.bic,
+                    chosen: Some(i) == best,
+                })
+                .collect(),
+            chosen: Chosen {
+                form: match f.form {
+                    Form::Chain(_) => "chain",
+                    Form::Modal(_) => "modal",
+                },
+                modes: f.form.modes(),
+                resonances_hz: res.iter().map(|r| r.0).collect(),
+                damping_ratios: res.iter().map(|r| r.1).collect(),
+                chi2_per_dof: f.reduced_chi2(),
+                handle_kg: handle.map(|h| h.0),
+                bypass_npm: handle.and_then(|h| h.1),
+            },
+            coulomb_friction_n: f.model.coulomb_friction_n,
+            cogging_n: f.cogging.map(|c| c.amplitude_n),
+            cogging_period_m: f.cogging.map(|c| c.period_m),
+            encoder_quantum_m: f.model.encoder_quantum_m,
+            model,
+            set_models: set.len(),
+            set_directions: set
+                .iter()
+                .filter_map(|m| m.direction)
+                .max()
+                .map_or(0, |d| d + 1),
+            figures,
         }
     }
-    if let Some(c) = f.model.coulomb_friction_n {
-        let _ = writeln!(t, "  Coulomb friction {c:.4} N");
+}
+
+impl fmt::Display for AxisReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let [lo, hi] = self.harmonics_hz.map(|h| h.unwrap_or(0.0));
+        writeln!(
+            f,
+            "  record {}: {} samples at {:.0} Hz, harmonics {lo:.3} to {hi:.3} Hz, {} periods averaged",
+            self.record,
+            self.samples,
+            1.0 / self.period_s,
+            self.periods_averaged
+        )?;
+        writeln!(
+            f,
+            "  coherence (encoder): lowest {:.3} at {:.3} Hz",
+            self.coherence_min,
+            self.coherence_min_hz.unwrap_or(0.0)
+        )?;
+        writeln!(f, "  orders fitted (modes: chi2/nu, BIC):")?;
+        for g in &self.orders {
+            let mark = if g.chosen { "  <- chosen" } else { "" };
+            let both = if g.loaded {
+                " (with the loaded record)"
+            } else {
+                ""
+            };
+            writeln!(
+                f,
+                "    {}{both}: {:.3}, {:.1}{mark}",
+                g.modes, g.chi2_per_dof, g.bic
+            )?;
+        }
+        let c = &self.chosen;
+        writeln!(f, "  model ({}), resonances below Nyquist:", c.form)?;
+        for (hz, zeta) in c.resonances_hz.iter().zip(&c.damping_ratios) {
+            writeln!(f, "    {hz:9.3} Hz  damping ratio {zeta:.4}")?;
+        }
+        if let Some(kg) = c.handle_kg {
+            write!(f, "  handle past the load cell {kg:.4} kg")?;
+            match c.bypass_npm {
+                Some(b) => writeln!(f, ", held beside it by {b:.1} N/m to the actuator")?,
+                None => writeln!(f)?,
+            }
+        }
+        if let Some(c) = self.coulomb_friction_n {
+            writeln!(f, "  Coulomb friction {c:.4} N")?;
+        }
+        if let (Some(a), Some(p)) = (self.cogging_n, self.cogging_period_m) {
+            writeln!(
+                f,
+                "  cogging {a:.4} N every {:.4} mm of the actuator's travel",
+                p * 1e3
+            )?;
+        }
+        if let Some(q) = self.encoder_quantum_m {
+            writeln!(f, "  encoder quantum {:.4} um", q * 1e6)?;
+        }
+        writeln!(f, "  wrote {}", self.model.display())?;
+        write!(
+            f,
+            "  its set: {} models, along {} principal directions",
+            self.set_models, self.set_directions
+        )?;
+        for p in &self.figures {
+            write!(f, "\n  wrote {}", p.display())?;
+        }
+        Ok(())
     }
-    if let Some(c) = f.cogging {
-        let _ = writeln!(
-            t,
-            "  cogging {:.4} N every {:.4} mm of the actuator's travel",
-            c.amplitude_n,
-            c.period_m * 1e3
-        );
-    }
-    if let Some(q) = f.model.encoder_quantum_m {
-        let _ = writeln!(t, "  encoder quantum {:.4} um", q * 1e6);
-    }
-    let _ = writeln!(t, "  wrote {}", model_path.display());
-    let _ = write!(
-        t,
-        "  its set: {} models, along {directions} principal directions",
-        set.len()
-    );
-    for p in figures {
-        let _ = write!(t, "\n  wrote {}", p.display());
-    }
-    (v, t)
 }
 
 /// The fit's figures (`twoport_identify::figures`), drawn into `out`.

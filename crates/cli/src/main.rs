@@ -34,6 +34,7 @@ mod synthesis;
 mod verify;
 
 use crate::args::*;
+use crate::run::{print, show};
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
@@ -84,50 +85,33 @@ pub(crate) enum Cmd {
     HostVe(HostVeArgs),
 }
 
-/// `run` on `args`, refusing a device file: the command draws one axis.
-pub(crate) fn one_axis<A: HasCommon + Clone>(
-    args: &A,
-    run: fn(&A) -> Result<(), String>,
-) -> Result<(), String> {
-    match args.clone().common().device.clone() {
-        Some(p) => Err(format!(
-            "--device {}: this command draws one axis; give that axis's --model",
-            p.display()
-        )),
-        None => run(args),
-    }
-}
-
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    let linkage = |c: &Common| {
+        c.device
+            .as_deref()
+            .is_some_and(twoport_design::linkage::LinkageFile::is_linkage)
+    };
     let r = match &cli.cmd {
-        Cmd::Design(Display::Impedance(a))
-            if a.common
-                .device
-                .as_deref()
-                .is_some_and(twoport_design::linkage::LinkageFile::is_linkage) =>
-        {
-            synthesis::design_linkage(a)
+        Cmd::Design(Display::Impedance(a)) if linkage(&a.common) => {
+            show(a.common.json, synthesis::design_linkage(a))
         }
         Cmd::Design(Display::Impedance(a)) => each_axis(a, synthesis::design_impedance),
         Cmd::Design(Display::Admittance(a)) => each_axis(a, synthesis::design_admittance),
         Cmd::Check(d) => each_axis(d, check::check),
         Cmd::Zrange(d) => one_axis(d, plots::zrange),
-        Cmd::Plot(p) if matches!(p.figure, Fig::Workspace) => plots::plot_workspace(p),
+        Cmd::Plot(p) if matches!(p.figure, Fig::Workspace) => {
+            show(p.common.json, plots::plot_workspace(p))
+        }
         Cmd::Plot(p) => one_axis(p, plots::plot_fig),
         Cmd::Region(d) => each_axis(d, region::region),
-        Cmd::Verify(Display::Impedance(a))
-            if a.common
-                .device
-                .as_deref()
-                .is_some_and(twoport_design::linkage::LinkageFile::is_linkage) =>
-        {
-            verify::verify_linkage(a)
+        Cmd::Verify(Display::Impedance(a)) if linkage(&a.common) => {
+            show(a.common.json, verify::verify_linkage(a))
         }
         Cmd::Verify(d) => each_axis(d, verify::verify),
-        Cmd::Identify(a) => identify::identify(a),
-        Cmd::IdentifyPose(a) => identify_pose::identify_pose(a),
-        Cmd::Rates(a) => rates::rates(a),
+        Cmd::Identify(a) => identify::identify(a).and_then(|r| print(a.json, &r)),
+        Cmd::IdentifyPose(a) => identify_pose::identify_pose(a).and_then(|r| print(a.json, &r)),
+        Cmd::Rates(a) => rates::rates(a).and_then(|r| print(a.json, &r)),
         Cmd::HostVe(a) => one_axis(a, host::host_ve),
     };
     match r {

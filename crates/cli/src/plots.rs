@@ -3,13 +3,19 @@
 
 use crate::args::*;
 use crate::run::*;
-use serde_json::json;
+use serde::Serialize;
 use std::f64::consts::PI;
+use std::fmt;
+use std::path::PathBuf;
 use twoport_design::analysis::{self, Analysis};
 use twoport_design::network::HumanBound;
+use twoport_design::DeviceAxis;
 use twoport_design::{figures, plot};
 
-pub(crate) fn zrange(d: &Display<ZrangeImpedance, ZrangeAdmittance>) -> Result<(), String> {
+pub(crate) fn zrange(
+    d: &Display<ZrangeImpedance, ZrangeAdmittance>,
+    _: Option<&DeviceAxis>,
+) -> Reported {
     let (common, points) = match d {
         Display::Impedance(z) => (&z.gains.common, z.points),
         Display::Admittance(z) => (&z.gains.common, z.points),
@@ -17,7 +23,7 @@ pub(crate) fn zrange(d: &Display<ZrangeImpedance, ZrangeAdmittance>) -> Result<(
     if points < 2 {
         return Err(format!("--points {points}: need at least 2"));
     }
-    let s = designer(common)?;
+    let s = designer(common, None)?;
     let pose = single(&s, "zrange")?;
     let nyq = pose.plant.nyquist();
     let lo = 2.0 * PI * 0.1;
@@ -38,25 +44,40 @@ pub(crate) fn zrange(d: &Display<ZrangeImpedance, ZrangeAdmittance>) -> Result<(
         }
     }
     .ok_or("the gains do not make a valid coupling")?;
-    let freq: Vec<f64> = omegas.iter().map(|w| w / (2.0 * PI)).collect();
     let pair = |c: num_complex::Complex64| [c.re, c.im];
-    let v = json!({
-        "freq_hz": freq,
-        "z_min": range.iter().map(|r| pair(r.0)).collect::<Vec<_>>(),
-        "z_max": range.iter().map(|r| pair(r.1)).collect::<Vec<_>>(),
-    });
-    let mut text = format!(
-        "{:>12} {:>14} {:>14}",
-        "freq (Hz)", "|Z_min| N s/m", "|Z_max| N s/m"
-    );
-    for (f, r) in freq.iter().zip(&range) {
-        text += &format!("\n{f:>12.3} {:>14.4e} {:>14.4e}", r.0.norm(), r.1.norm());
-    }
-    emit(common, &Printed(v, text))
+    reported(ZRange {
+        frequency_hz: omegas.iter().map(|w| w / (2.0 * PI)).collect(),
+        z_min: range.iter().map(|r| pair(r.0)).collect(),
+        z_max: range.iter().map(|r| pair(r.1)).collect(),
+    })
 }
 
-pub(crate) fn plot_fig(p: &PlotArgs) -> Result<(), String> {
-    let s = designer(&p.common)?;
+/// The impedance range over frequency: `Z_min` and `Z_max` (N s/m) as
+/// `[re, im]` pairs.
+#[derive(Serialize)]
+struct ZRange {
+    frequency_hz: Vec<f64>,
+    z_min: Vec<[f64; 2]>,
+    z_max: Vec<[f64; 2]>,
+}
+
+impl fmt::Display for ZRange {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{:>12} {:>14} {:>14}",
+            "freq (Hz)", "|Z_min| N s/m", "|Z_max| N s/m"
+        )?;
+        let norm = |z: &[f64; 2]| z[0].hypot(z[1]);
+        for ((hz, lo), hi) in self.frequency_hz.iter().zip(&self.z_min).zip(&self.z_max) {
+            write!(f, "\n{hz:>12.3} {:>14.4e} {:>14.4e}", norm(lo), norm(hi))?;
+        }
+        Ok(())
+    }
+}
+
+pub(crate) fn plot_fig(p: &PlotArgs, _: Option<&DeviceAxis>) -> Reported {
+    let s = designer(&p.common, None)?;
     let a = &single(&s, "plot")?.analysis;
     let t = s.period_s();
     let bi = a.impedance_bound(Some(HumanBound::PAPER));
@@ -75,13 +96,39 @@ pub(crate) fn plot_fig(p: &PlotArgs) -> Result<(), String> {
     }
     .map_err(|e| e.to_string())?;
     plot::render(&fig, &p.out).map_err(|e| e.to_string())?;
-    let v = json!({"out": p.out, "k_c": k, "b_c": b, "m_c": m, "b_cA": p.b_admittance});
-    let text = format!(
-        "wrote {} (k_c = {k:.0} N/m, b_c = {b} N s/m, m_c = {m:.3} kg, b_cA = {} N s/m)",
-        p.out.display(),
-        p.b_admittance
-    );
-    emit(&p.common, &Printed(v, text))
+    reported(PaperFigure {
+        out: p.out.clone(),
+        k_c_npm: k,
+        b_c_nspm: b,
+        m_c_kg: m,
+        b_ca_nspm: p.b_admittance,
+    })
+}
+
+/// One of the paper's figures written, and the couplings it drew.
+#[derive(Serialize)]
+struct PaperFigure {
+    out: PathBuf,
+    /// The impedance coupling drawn.
+    k_c_npm: f64,
+    b_c_nspm: f64,
+    /// The admittance coupling drawn.
+    m_c_kg: f64,
+    b_ca_nspm: f64,
+}
+
+impl fmt::Display for PaperFigure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "wrote {} (k_c = {:.0} N/m, b_c = {} N s/m, m_c = {:.3} kg, b_cA = {} N s/m)",
+            self.out.display(),
+            self.k_c_npm,
+            self.b_c_nspm,
+            self.m_c_kg,
+            self.b_ca_nspm
+        )
+    }
 }
 
 /// Poses per joint on a workspace map's grid, by joint count.
@@ -90,7 +137,7 @@ const MAP_PER_JOINT: [usize; 3] = [41, 41, 15];
 /// `plot workspace --device LINKAGE`: the stiffness each pose proves on
 /// its own, over the workspace (a 3-DOF linkage seen from above), the
 /// pose that binds `design`'s proof marked.
-pub(crate) fn plot_workspace(p: &PlotArgs) -> Result<(), String> {
+pub(crate) fn plot_workspace(p: &PlotArgs) -> Reported {
     use twoport_design::linkage::{certified_design, workspace_design, LinkageFile};
     let path = p
         .common
@@ -140,12 +187,34 @@ pub(crate) fn plot_workspace(p: &PlotArgs) -> Result<(), String> {
         mark: Some(at(&whole.binding.pose.position_m)),
     };
     plot::render_map(&map, &p.out).map_err(|e| e.to_string())?;
-    let v = json!({"out": p.out, "poses": poses.len(), "k_c": whole.k_c_npm, "min_grasp": grasp});
-    let text = format!(
-        "wrote {} ({} poses; the whole workspace is proven at k_c = {} N/m)",
-        p.out.display(),
-        poses.len(),
-        twoport_design::linkage::stiffness(whole.k_c_npm)
-    );
-    emit(&p.common, &Printed(v, text))
+    reported(WorkspaceMap {
+        out: p.out.clone(),
+        poses: poses.len(),
+        k_c_npm: whole.k_c_npm,
+        min_grasp_nspm: grasp,
+    })
+}
+
+/// A workspace map written, and the stiffness the whole workspace proves.
+#[derive(Serialize)]
+struct WorkspaceMap {
+    out: PathBuf,
+    /// Poses drawn.
+    poses: usize,
+    /// The certified stiffness over the whole workspace, at b_c = 0.
+    k_c_npm: f64,
+    /// The least grasp proven for (0: every passive hand).
+    min_grasp_nspm: f64,
+}
+
+impl fmt::Display for WorkspaceMap {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "wrote {} ({} poses; the whole workspace is proven at k_c = {} N/m)",
+            self.out.display(),
+            self.poses,
+            twoport_design::linkage::stiffness(self.k_c_npm)
+        )
+    }
 }

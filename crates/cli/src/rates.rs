@@ -11,8 +11,9 @@
 //! docs/host.md).
 
 use crate::args::{HostArgs, RatesArgs};
-use serde_json::{json, Value};
-use std::path::Path;
+use serde::Serialize;
+use std::fmt;
+use std::path::{Path, PathBuf};
 use twoport_design::host_ve::{host_best_pair, HostLoop};
 use twoport_design::linkage::{certified_design_from, least_damping, LinkageFile};
 use twoport_design::network::HumanBound;
@@ -94,7 +95,7 @@ fn linkage_row(path: &Path, rates: &[f64], grasp: f64) -> Result<Row, String> {
     })
 }
 
-pub(crate) fn rates(a: &RatesArgs) -> Result<(), String> {
+pub(crate) fn rates(a: &RatesArgs) -> Result<RatesReport, String> {
     let rates = a.rates()?;
     let grasp = a.grasp()?;
     let host = a.host.get()?;
@@ -113,61 +114,113 @@ pub(crate) fn rates(a: &RatesArgs) -> Result<(), String> {
     if let Some(out) = &a.plot {
         plot::render(&figure(&rows, &rates), out).map_err(|e| e.to_string())?;
     }
-    if a.json {
-        say!("{}\n", to_json(&rows, &rates));
-        return Ok(());
-    }
-    say!("{}\n", table(&rows, &rates, host.as_ref()));
-    if let Some(out) = &a.plot {
-        say!("wrote {}\n", out.display());
-    }
-    Ok(())
-}
-
-fn to_json(rows: &[Row], rates: &[f64]) -> Value {
-    json!({
-        "rates_hz": rates,
-        "devices": rows.iter().map(|r| {
-            let mut o = json!({
-                "name": r.name,
-                "k_npm": r.at.iter().map(|a| a.0 .0).collect::<Vec<_>>(),
-                "b_nspm": r.at.iter().map(|a| a.0 .1).collect::<Vec<_>>(),
-                "k_at_first_b_npm": r.at.iter().map(|a| a.1).collect::<Vec<_>>(),
-            });
-            if let Some(h) = &r.host {
-                o["with_host_body"] = json!(h.iter().map(|p| p.map(|(k, b)| json!({"k_npm": k, "b_nspm": b}))).collect::<Vec<_>>());
-            }
-            o
-        }).collect::<Vec<_>>(),
+    Ok(RatesReport {
+        host: host.map(|h| HostBody {
+            mass_kg: h.body.0,
+            damping_nspm: h.body.1,
+            ve_rate_hz: h.ve_rate_hz,
+            delay_s: h.delay_s,
+        }),
+        devices: rows
+            .into_iter()
+            .map(|r| DeviceRates {
+                name: r.name,
+                k_npm: r.at.iter().map(|a| a.0 .0).collect(),
+                b_nspm: r.at.iter().map(|a| a.0 .1).collect(),
+                k_at_first_b_npm: r.at.iter().map(|a| a.1).collect(),
+                with_host_body: r.host.map(|h| {
+                    h.into_iter()
+                        .map(|p| p.map(|(k_npm, b_nspm)| Pair { k_npm, b_nspm }))
+                        .collect()
+                }),
+            })
+            .collect(),
+        rates_hz: rates,
+        figure: a.plot.clone(),
     })
 }
 
-fn table(rows: &[Row], rates: &[f64], host: Option<&HostArgs>) -> String {
-    let mut s = String::from("proven impedance coupling k (N/m) at b (N s/m), per servo rate\n");
-    if let Some(h) = host {
-        s += &format!(
-            "with a host body of {} kg and {} N s/m at {} Hz, {} s from read to answer\n",
-            h.body.0, h.body.1, h.ve_rate_hz, h.delay_s
-        );
-    }
-    for r in rows {
-        s += &format!("\n{}\n", r.name);
-        for (i, (rate, ((k, b), k_same))) in rates.iter().zip(&r.at).enumerate() {
-            s += &format!(
-                "  {:>6.0} Hz: {:>12.0} N/m at {:>7.1} N s/m; {:>12.0} N/m at the first rate's damping",
-                rate, k, b, k_same
-            );
-            match r.host.as_ref().map(|h| h[i]) {
-                Some(Some((kh, bh))) => {
-                    s += &format!("; with the host body {kh:>9.0} N/m at {bh:>6.1} N s/m")
-                }
-                Some(None) => s += "; none proven with the host body",
-                None => {}
-            }
-            s += "\n";
+/// Each device's proven coupling at each servo rate.
+#[derive(Serialize)]
+pub(crate) struct RatesReport {
+    rates_hz: Vec<f64>,
+    /// The body the host moves, where one is given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    host: Option<HostBody>,
+    devices: Vec<DeviceRates>,
+    /// The figure written, if one was asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    figure: Option<PathBuf>,
+}
+
+/// A body the host moves with the handle, and its link.
+#[derive(Serialize)]
+struct HostBody {
+    mass_kg: f64,
+    damping_nspm: f64,
+    ve_rate_hz: f64,
+    /// From the tick the host reads to the tick that takes its answer.
+    delay_s: f64,
+}
+
+/// One device's couplings, one per rate.
+#[derive(Serialize)]
+struct DeviceRates {
+    name: String,
+    /// The best pair at each rate (a linkage: its one k, at b = 0).
+    k_npm: Vec<f64>,
+    b_nspm: Vec<f64>,
+    /// k at the first rate's best damping.
+    k_at_first_b_npm: Vec<f64>,
+    /// The best pair proven against the host's body (None: none is).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    with_host_body: Option<Vec<Option<Pair>>>,
+}
+
+/// A coupling: stiffness and damping.
+#[derive(Clone, Copy, Serialize)]
+struct Pair {
+    k_npm: f64,
+    b_nspm: f64,
+}
+
+impl fmt::Display for RatesReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "proven impedance coupling k (N/m) at b (N s/m), per servo rate"
+        )?;
+        if let Some(h) = &self.host {
+            write!(
+                f,
+                "\nwith a host body of {} kg and {} N s/m at {} Hz, {} s from read to answer",
+                h.mass_kg, h.damping_nspm, h.ve_rate_hz, h.delay_s
+            )?;
         }
+        for d in &self.devices {
+            write!(f, "\n\n{}", d.name)?;
+            for (i, rate) in self.rates_hz.iter().enumerate() {
+                write!(
+                    f,
+                    "\n  {:>6.0} Hz: {:>12.0} N/m at {:>7.1} N s/m; {:>12.0} N/m at the first rate's damping",
+                    rate, d.k_npm[i], d.b_nspm[i], d.k_at_first_b_npm[i]
+                )?;
+                match d.with_host_body.as_ref().map(|h| h[i]) {
+                    Some(Some(p)) => write!(
+                        f,
+                        "; with the host body {:>9.0} N/m at {:>6.1} N s/m",
+                        p.k_npm, p.b_nspm
+                    )?,
+                    Some(None) => write!(f, "; none proven with the host body")?,
+                    None => {}
+                }
+            }
+        }
+        if let Some(out) = &self.figure {
+            write!(f, "\n\nwrote {}", out.display())?;
+        }
+        Ok(())
     }
-    s
 }
 
 fn figure(rows: &[Row], rates: &[f64]) -> Figure {

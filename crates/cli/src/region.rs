@@ -4,21 +4,31 @@ use crate::args::*;
 use crate::run::*;
 use twoport_design::analysis;
 use twoport_design::designer::RegionBound;
+use twoport_design::DeviceAxis;
 
-pub(crate) fn region(d: &Display<RegionImpedance, RegionAdmittance>) -> Result<(), String> {
+pub(crate) fn region(
+    d: &Display<RegionImpedance, RegionAdmittance>,
+    axis: Option<&DeviceAxis>,
+) -> Reported {
     let (grid, common) = match d {
         Display::Impedance(r) => (&r.grid, &r.common),
         Display::Admittance(r) => (&r.grid, &r.common),
     };
-    let range = (grid.b_from, grid.b_to);
-    let s = designer(common)?;
+    let range = (gain("b-from", grid.b_from)?, gain("b-to", grid.b_to)?);
+    if !(range.0 > 0.0 && range.0 < range.1 && (2..=1000).contains(&grid.points)) {
+        return Err(format!(
+            "--b-from {} --b-to {} --points {}: need 0 < --b-from < --b-to and 2..=1000 --points",
+            range.0, range.1, grid.points
+        ));
+    }
+    let s = designer(common, axis)?;
     let r = match d {
         Display::Impedance(_) => s.region_impedance(range, grid.points),
         Display::Admittance(a) => s.region_admittance((a.kp, a.bp), range, grid.points),
     }
     .map_err(|e| e.to_string())?;
     if !grid.rust {
-        return emit(common, &r);
+        return reported(r);
     }
     let how = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
     let source = analysis::region_rust_source(
@@ -27,7 +37,7 @@ pub(crate) fn region(d: &Display<RegionImpedance, RegionAdmittance>) -> Result<(
         r.regulator,
         &format!("twoport {how}"),
     );
-    match &common.axis {
+    Ok(Box::new(RustSource(match axis {
         // A device file: one module per axis, for a board's regions.
         Some(a) => {
             let ident: String = a
@@ -41,14 +51,24 @@ pub(crate) fn region(d: &Display<RegionImpedance, RegionAdmittance>) -> Result<(
                     }
                 })
                 .collect();
-            say!(
-                "/// Axis {}'s proven region.\npub mod axis_{ident} {{\nuse super::*;\n",
+            format!(
+                "/// Axis {}'s proven region.\npub mod axis_{ident} {{\nuse super::*;\n{source}}}",
                 a.name
-            );
-            say!("{source}");
-            say!("}}\n");
+            )
         }
-        None => say!("{source}"),
+        None => source.trim_end().to_string(),
+    })))
+}
+
+/// A region as Rust source for a board image: text only (`--rust` and
+/// `--json` exclude each other).
+struct RustSource(String);
+
+impl Report for RustSource {
+    fn json(&self) -> Result<serde_json::Value, String> {
+        Err("--rust prints Rust source, not JSON".into())
     }
-    Ok(())
+    fn text(&self) -> String {
+        self.0.clone()
+    }
 }

@@ -3,17 +3,23 @@
 
 use crate::args::*;
 use serde::Serialize;
-use serde_json::json;
+use serde_json::Value;
 use std::fmt::Display;
 use twoport_design::designer::Pose;
+use twoport_design::device::DeviceAxis;
 use twoport_design::network::HumanBound;
 use twoport_design::{Designer, DeviceModel};
 
-/// The designer on the command's poses: its `--model` files, or the axis
-/// of a device file it runs on.
-pub(crate) fn designer(c: &Common) -> Result<Designer, String> {
-    let models = match &c.axis {
-        Some(a) => a.models.iter().map(|(_, m)| m.clone()).collect(),
+/// The designer on the command's poses: the axis of a device file it runs
+/// on, or its `--model` files.
+pub(crate) fn designer(c: &Common, axis: Option<&DeviceAxis>) -> Result<Designer, String> {
+    if let Some(t) = c.period.filter(|t| !(t.is_finite() && *t > 0.0)) {
+        return Err(format!(
+            "--period {t}: must be a positive number of seconds"
+        ));
+    }
+    let models = match axis {
+        Some(a) => a.models.clone(),
         None => c
             .model
             .iter()
@@ -45,35 +51,43 @@ pub(crate) fn single<'a>(d: &'a Designer, command: &str) -> Result<&'a Pose, Str
     }
 }
 
-/// Print `report`: its JSON (into the device's one object, on a device
-/// file's axis), or its text.
-pub(crate) fn emit(c: &Common, report: &(impl Serialize + Display)) -> Result<(), String> {
-    if !c.json {
-        say!("{report}\n");
-        return Ok(());
+/// What a command answers: one value that prints as JSON (`--json`) or as
+/// text, so that the two never say different things.
+pub(crate) trait Report {
+    /// The report as one JSON value.
+    fn json(&self) -> Result<Value, String>;
+    /// The report as text.
+    fn text(&self) -> String;
+}
+
+impl<T: Serialize + Display> Report for T {
+    fn json(&self) -> Result<Value, String> {
+        serde_json::to_value(self).map_err(|e| e.to_string())
     }
-    let mut v = serde_json::to_value(report).map_err(|e| e.to_string())?;
-    match &c.axis {
-        Some(a) => {
-            v["axis"] = json!(a.name);
-            a.out.borrow_mut().push(v);
-        }
-        None => say!("{v}\n"),
+    fn text(&self) -> String {
+        self.to_string()
+    }
+}
+
+/// A command's report, or why it has none.
+pub(crate) type Reported = Result<Box<dyn Report>, String>;
+
+/// `report`, boxed as a command returns it.
+pub(crate) fn reported(report: impl Report + 'static) -> Reported {
+    Ok(Box::new(report))
+}
+
+/// Print `report` as JSON or as text.
+pub(crate) fn print(json: bool, report: &dyn Report) -> Result<(), String> {
+    if json {
+        say!("{}\n", report.json()?);
+    } else {
+        say!("{}\n", report.text());
     }
     Ok(())
 }
 
-/// A command's own output: its JSON and its text.
-pub(crate) struct Printed(pub(crate) serde_json::Value, pub(crate) String);
-
-impl Serialize for Printed {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        self.0.serialize(s)
-    }
-}
-
-impl Display for Printed {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.1)
-    }
+/// Print a command's report, or pass on why it has none.
+pub(crate) fn show(json: bool, report: Reported) -> Result<(), String> {
+    print(json, &*report?)
 }

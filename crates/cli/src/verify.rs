@@ -3,8 +3,12 @@
 use crate::args::*;
 use crate::run::*;
 use twoport_control::{AdmittanceGains as Adm, Gains, ImpedanceGains as Imp};
+use twoport_design::DeviceAxis;
 
-pub(crate) fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(), String> {
+pub(crate) fn verify(
+    d: &Display<ImpedanceGains, AdmittanceGains>,
+    axis: Option<&DeviceAxis>,
+) -> Reported {
     if let Display::Impedance(ImpedanceGains {
         min_grasp: Some(g), ..
     }) = d
@@ -34,16 +38,17 @@ pub(crate) fn verify(d: &Display<ImpedanceGains, AdmittanceGains>) -> Result<(),
             )
         }
     };
-    let r = designer(common)?
-        .verify(&gains)
-        .map_err(|e| e.to_string())?;
-    emit(common, &r)
+    reported(
+        designer(common, axis)?
+            .verify(&gains)
+            .map_err(|e| e.to_string())?,
+    )
 }
 
 /// `verify impedance --device LINKAGE`: the search on the exact discrete
 /// loop of the linearised linkage, at the binding pose of the workspace
 /// design under the same hand assumption and at every tenth pose.
-pub(crate) fn verify_linkage(a: &ImpedanceGains) -> Result<(), String> {
+pub(crate) fn verify_linkage(a: &ImpedanceGains) -> Reported {
     use twoport_design::linkage::{
         certified_design, verify_linkage, HandAssumption, PoseDynamics, DESIGN_GRID,
     };
@@ -82,5 +87,5 @@ pub(crate) fn verify_linkage(a: &ImpedanceGains) -> Result<(), String> {
     };
     let v = verify_linkage(&sample, &assumption, (k, b), file.period_s)
         .ok_or("no pose could be searched")?;
-    emit(&a.common, &v)
+    reported(v)
 }

@@ -31,9 +31,9 @@ fn design_impedance_json() {
     assert_eq!(v["feasible"], true);
     assert_eq!(v["human_model"], true);
     assert_eq!(v["period_s"], 0.001);
-    let k = v["k_c"].as_f64().unwrap();
+    let k = v["k_c_npm"].as_f64().unwrap();
     assert!((k - 51_000.0).abs() < 0.03 * 51_000.0, "{k}");
-    assert_eq!(v["b_c"], 90.0);
+    assert_eq!(v["b_c_nspm"], 90.0);
 }
 
 #[test]
@@ -56,13 +56,13 @@ fn design_admittance_json_and_infeasible_without_human() {
     let v = paper(&[]);
     assert_eq!(v["display"], "admittance");
     assert_eq!(v["feasible"], true);
-    assert_eq!(v["kp"], 51_000.0);
-    assert_eq!(v["bp"], 90.0);
-    let m = v["m_c"].as_f64().unwrap();
+    assert_eq!(v["kp_npm"], 51_000.0);
+    assert_eq!(v["bp_nspm"], 90.0);
+    let m = v["m_c_kg"].as_f64().unwrap();
     assert!((m - 5.0).abs() < 0.15, "{m}");
     let v = paper(&["--no-human"]);
     assert_eq!(v["feasible"], false);
-    assert!(v.get("m_c").is_none(), "no made-up number: {v}");
+    assert!(v.get("m_c_kg").is_none(), "no made-up number: {v}");
     // The reason is the low-frequency limit, not the search range.
     let why = v["message"].as_str().unwrap();
     assert!(
@@ -89,7 +89,7 @@ fn check_json_both_displays() {
 #[test]
 fn zrange_json_runs_from_a_tenth_of_a_hertz_to_nyquist() {
     let v = TWOPORT.json(&paper_admittance("zrange", &["--points", "50", "--json"]));
-    let f = v["freq_hz"].as_array().unwrap();
+    let f = v["frequency_hz"].as_array().unwrap();
     assert_eq!(f.len(), 50);
     assert!((f[0].as_f64().unwrap() - 0.1).abs() < 1e-12);
     assert!((f[49].as_f64().unwrap() - 500.0).abs() < 1e-9);
@@ -201,10 +201,10 @@ fn region_tables_for_a_board() {
         "6",
         "--json",
     ]);
-    assert_eq!(v["bound"], "max_stiffness_npm");
+    assert_eq!(v["bound"], "k_max_npm");
     let (b, k) = (
-        v["damping_nspm"].as_array().unwrap(),
-        v["limit"].as_array().unwrap(),
+        v["b_nspm"].as_array().unwrap(),
+        v["k_max_npm"].as_array().unwrap(),
     );
     assert_eq!((b.len(), k.len()), (6, 6));
     assert!(k.iter().all(|x| x.as_f64().unwrap() > 1e4));
@@ -223,9 +223,9 @@ fn region_tables_for_a_board() {
         "4",
         "--json",
     ]);
-    assert_eq!(v["bound"], "min_mass_kg");
+    assert_eq!(v["bound"], "m_min_kg");
     assert_eq!(v["regulator"], serde_json::json!([51000.0, 90.0]));
-    let m: Vec<f64> = v["limit"]
+    let m: Vec<f64> = v["m_min_kg"]
         .as_array()
         .unwrap()
         .iter()
@@ -248,9 +248,9 @@ fn several_poses_design_for_all() {
     let (e, t) = (k(&["models/excalibur.toml"]), k(&["models/two_mass.toml"]));
     let both = k(&["models/two_mass.toml", "models/excalibur.toml"]);
     let (ke, kt, kb) = (
-        e["k_c"].as_f64().unwrap(),
-        t["k_c"].as_f64().unwrap(),
-        both["k_c"].as_f64().unwrap(),
+        e["k_c_npm"].as_f64().unwrap(),
+        t["k_c_npm"].as_f64().unwrap(),
+        both["k_c_npm"].as_f64().unwrap(),
     );
     // The worst pose's limit, to the search's 1e-6.
     let want = ke.min(kt);
@@ -286,11 +286,11 @@ fn a_device_without_a_force_sensor() {
     let v = TWOPORT.json(&words(
         "design impedance --no-human --model models/capstan.toml --json",
     ));
-    let k = v["k_c"].as_f64().unwrap();
-    assert_eq!(v["b_c"], 0.0);
+    let k = v["k_c_npm"].as_f64().unwrap();
+    assert_eq!(v["b_c_nspm"], 0.0);
     assert!((k - 2.0 * 2.0 / 1e-3).abs() < 0.002 * k, "{v}");
     assert_eq!(v["binding_bound"], "sampled-data");
-    assert!(v["paper_k_c"].as_f64().unwrap() > 1.1 * k, "{v}");
+    assert!(v["paper_k_c_npm"].as_f64().unwrap() > 1.1 * k, "{v}");
 }
 
 /// A device file designs each axis on its own model: the shipped
@@ -305,7 +305,7 @@ fn a_device_file_designs_every_axis_on_its_own_model() {
     assert_eq!(axes.len(), 3);
     for (a, name) in axes.iter().zip(["x", "y", "z"]) {
         assert_eq!(a["axis"], name);
-        assert_eq!(a["k_c"], one["k_c"], "axis {name}");
+        assert_eq!(a["k_c_npm"], one["k_c_npm"], "axis {name}");
     }
 
     let dir = std::env::temp_dir().join(format!("twoport-device-{}", std::process::id()));
@@ -326,9 +326,9 @@ fn a_device_file_designs_every_axis_on_its_own_model() {
     let v = design(&format!("design impedance --b 90 --device {mixed} --json"));
     let capstan = design("design impedance --b 90 --model models/capstan.toml --json");
     let (x, y) = (&v["axes"][0], &v["axes"][1]);
-    assert_eq!(y["k_c"], capstan["k_c"]);
+    assert_eq!(y["k_c_npm"], capstan["k_c_npm"]);
     assert!(
-        x["k_c"].as_f64().unwrap() > 2.0 * y["k_c"].as_f64().unwrap(),
+        x["k_c_npm"].as_f64().unwrap() > 2.0 * y["k_c_npm"].as_f64().unwrap(),
         "{v}"
     );
 
@@ -382,8 +382,8 @@ fn design_recommends_a_margin_and_check_reports_it() {
         "--json",
     ]);
     let (k, rec) = (
-        d["k_c"].as_f64().unwrap(),
-        d["recommended_k_c"].as_f64().unwrap(),
+        d["k_c_npm"].as_f64().unwrap(),
+        d["recommended_k_c_npm"].as_f64().unwrap(),
     );
     assert!((rec - 0.8 * k).abs() <= 1e-9 * k, "{d}");
     let check = |k: f64| {
@@ -527,7 +527,10 @@ fn linkages_are_proven_over_their_workspace() {
         out.to_str().unwrap(),
         "--json",
     ]);
-    assert!((v["k_c"].as_f64().unwrap() - k0).abs() < 0.1 * k0, "{v}");
+    assert!(
+        (v["k_c_npm"].as_f64().unwrap() - k0).abs() < 0.1 * k0,
+        "{v}"
+    );
     assert!(std::fs::read_to_string(&out).unwrap().contains("k_c (N/m)"));
     let e = TWOPORT.failure(&["plot", "workspace", "--out", out.to_str().unwrap()]);
     assert!(e.contains("--device LINKAGE"), "{e}");

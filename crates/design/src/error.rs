@@ -19,7 +19,7 @@ pub enum Error {
     #[error("no device model was given")]
     NoPose,
     /// Poses of one board with different periods.
-    #[error("{} has period_s = {} but {} has {}: poses share one board, give --period", .other.0, .other.1, .first.0, .first.1)]
+    #[error("{} has period_s = {} but {} has {}: poses share one board, give one period", .other.0, .other.1, .first.0, .first.1)]
     PeriodsDiffer {
         /// The first pose's model name and period (s).
         first: (String, f64),
@@ -27,7 +27,7 @@ pub enum Error {
         other: (String, f64),
     },
     /// A period that is not a positive time.
-    #[error("--period {0}: must be a positive number of seconds")]
+    #[error("period {0}: must be a positive number of seconds")]
     Period(f64),
     /// A model whose dynamics do not discretise.
     #[error("{model}: {why}")]
@@ -41,21 +41,22 @@ pub enum Error {
     #[error("{0}: the model has no force sensor (no C_f), and an admittance display needs one to measure the hand's force; design an impedance display instead")]
     NoForceSensor(String),
     /// An admittance design with no impedance design to take `K_p` from.
-    #[error("no impedance design exists to take K_p from (eq 30); give --kp and --bp")]
+    #[error("no impedance design exists to take K_p from (eq 30); give kp and bp")]
     NoRegulator,
     /// A gain that is negative or not finite.
-    #[error("--{name} {value}: must be a finite number >= 0")]
+    #[error("{name} {value}: must be a finite number >= 0")]
     Gain {
-        /// The gain's name (its command-line flag).
+        /// The gain's name (as the designer's calls and the command line
+        /// name it).
         name: &'static str,
         /// Its value.
         value: f64,
     },
     /// A design margin out of range.
-    #[error("--margin {0}: must be a fraction from 0 to 0.9")]
+    #[error("margin {0}: must be a fraction from 0 to 0.9")]
     Margin(f64),
     /// A region's damping range or point count out of range.
-    #[error("need 0 < --b-from < --b-to and 2..=1000 --points")]
+    #[error("a region needs 0 < b_from < b_to (N s/m) and 2..=1000 points")]
     RegionGrid,
     /// Gains that make no coupling.
     #[error("{0}")]

@@ -23,12 +23,12 @@ fn a_designs_json_and_text_say_the_same() {
     let r = d.design_impedance(Some(90.0), 0.1).unwrap();
     let (k, b) = r.coupling.expect("a design");
     let v = serde_json::to_value(&r).unwrap();
-    assert_eq!(v["k_c"].as_f64(), Some(k));
-    assert_eq!(v["b_c"].as_f64(), Some(b));
+    assert_eq!(v["k_c_npm"].as_f64(), Some(k));
+    assert_eq!(v["b_c_nspm"].as_f64(), Some(b));
     assert_eq!(v["feasible"], true);
     let rec = r.recommended().unwrap();
     assert!((rec - 0.9 * k).abs() < 1e-9 * k);
-    assert_eq!(v["recommended_k_c"].as_f64(), Some(rec));
+    assert_eq!(v["recommended_k_c_npm"].as_f64(), Some(rec));
     let text = r.to_string();
     assert!(text.contains(&Limit::Stiffness.text(k)), "{text}");
     assert!(text.contains(&Limit::Stiffness.text(rec)), "{text}");
@@ -42,8 +42,8 @@ fn a_designs_json_and_text_say_the_same() {
     let reg = a.regulator.unwrap();
     assert_eq!((reg.kp, reg.bp), best);
     let v = serde_json::to_value(&a).unwrap();
-    assert_eq!(v["kp"].as_f64(), Some(best.0));
-    assert_eq!(v["m_c"].as_f64(), a.coupling.map(|c| c.0));
+    assert_eq!(v["kp_npm"].as_f64(), Some(best.0));
+    assert_eq!(v["m_c_kg"].as_f64(), a.coupling.map(|c| c.0));
 }
 
 /// A check inside the boundary has a positive gain margin, one past it a
@@ -62,7 +62,7 @@ fn a_check_reports_its_margin_to_the_boundary() {
     assert!((inside.gain_margin.unwrap() - 0.2).abs() < 1e-9);
     assert!((past.gain_margin.unwrap() + 0.2).abs() < 1e-9);
     assert_eq!(
-        serde_json::to_value(&past).unwrap()["boundary_k_c"].as_f64(),
+        serde_json::to_value(&past).unwrap()["boundary_k_c_npm"].as_f64(),
         Some(k)
     );
     assert!(past.to_string().contains("past the boundary"), "{past}");
@@ -79,7 +79,7 @@ fn bad_questions_are_refused_by_name() {
         Error::Margin(2.0)
     );
     let e = d.check_impedance(-1.0, 90.0).unwrap_err();
-    assert_eq!(e.to_string(), "--k -1: must be a finite number >= 0");
+    assert_eq!(e.to_string(), "k -1: must be a finite number >= 0");
     assert_eq!(
         d.region_impedance((100.0, 10.0), 8).unwrap_err(),
         Error::RegionGrid
@@ -154,7 +154,7 @@ fn a_design_limited_by_a_lightly_damped_mode_says_which() {
     let v = serde_json::to_value(&r).unwrap();
     assert!(v["limited_by"]["damping_ratio"].as_f64().unwrap() < 1e-5);
     assert_eq!(v["feasible"], false);
-    assert_eq!(v["limited_to_k_c"].as_f64(), Some(k));
+    assert_eq!(v["limited_to_k_c_npm"].as_f64(), Some(k));
     let e = excalibur().design_impedance(Some(90.0), 0.1).unwrap();
     assert_eq!(e.limited_by(), None);
 }

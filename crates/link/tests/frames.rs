@@ -4,6 +4,8 @@
 use proptest::prelude::*;
 use twoport_link::*;
 
+/// Every message, at its extremes: the session, the gains, the modes and
+/// the PIL frames here, the rest in [`spec_and_ve_messages`].
 fn all_messages() -> Vec<Message> {
     let gi = Gains::Impedance {
         k_npm: 51_000.0,
@@ -108,6 +110,15 @@ fn all_messages() -> Vec<Message> {
             duty: Axes::new([-32_767, 32_767, 0]).unwrap(),
             session: 0x5A5A,
         }),
+    ]
+    .into_iter()
+    .chain(spec_and_ve_messages())
+    .collect()
+}
+
+/// Every message of the spec, the stream and the VE, at its extremes.
+fn spec_and_ve_messages() -> Vec<Message> {
+    vec![
         Message::GetSpec,
         // The widest spec: every axis admittance, every number full width.
         Message::Spec(Spec {

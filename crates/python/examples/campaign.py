@@ -26,12 +26,12 @@ RATES_HZ = [1000.0, 4000.0]
 def job(model: str, rate_hz: float) -> dict:
     """Design the best coupling of `model` at `rate_hz` and verify it."""
     d = twoport.design_impedance(model, period=1.0 / rate_hz, margin=0.1)
-    v = twoport.verify(k=d.recommended, b=d.b_nspm, model=model, period=1.0 / rate_hz)
+    v = twoport.verify(k=d.recommended_k_c_npm, b=d.b_c_nspm, model=model, period=1.0 / rate_hz)
     return {
         "model": pathlib.Path(model).stem,
         "rate_hz": rate_hz,
-        "k_npm": d.recommended,
-        "b_nspm": d.b_nspm,
+        "k_npm": d.recommended_k_c_npm,
+        "b_nspm": d.b_c_nspm,
         "unstable": v.unstable,
         "spectral_radius": v.spectral_radius,
         "loops": v.evaluations,

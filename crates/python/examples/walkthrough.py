@@ -16,17 +16,17 @@ EXCALIBUR = str(ROOT / "models" / "excalibur.toml")
 best = twoport.design_impedance(EXCALIBUR)
 paper = twoport.design_impedance(EXCALIBUR, b=90.0)
 print(best)
-print(paper, "recommended", round(paper.recommended))
+print(paper, "recommended", round(paper.recommended_k_c_npm))
 
 # 2. Check it, and let verify try to break it on the exact sampled loop.
-print(twoport.check_impedance(paper.recommended, 90.0, model=EXCALIBUR))
-print(twoport.verify(k=paper.recommended, b=90.0, model=EXCALIBUR))
+print(twoport.check_impedance(paper.recommended_k_c_npm, 90.0, model=EXCALIBUR))
+print(twoport.verify(k=paper.recommended_k_c_npm, b=90.0, model=EXCALIBUR))
 
 # 3. The region: the stiffest proven coupling at each damping.
 region = twoport.region(EXCALIBUR, b_from=10.0, b_to=500.0, points=24)
 
 # 4. The impedance range the hand can feel through that coupling.
-z = twoport.zrange(paper.recommended, 90.0, model=EXCALIBUR, points=200)
+z = twoport.zrange(paper.recommended_k_c_npm, 90.0, model=EXCALIBUR, points=200)
 
 # 5. The default scene (the hand pushing into a stiff wall), as arrays.
 signals, report = twoport.simulate(str(ROOT / "scenes" / "stiff_wall.toml"))
@@ -40,7 +40,7 @@ rigid = twoport.Model.from_arrays(
 print(twoport.design_impedance(rigid, b=5.0, human=False))
 
 # 7. A body the host moves, at 1 kHz and 2 ms: how much damping it needs.
-print(twoport.host_ve(paper.recommended, 90.0, (1.0, 10.0), model=EXCALIBUR))
+print(twoport.host_ve(paper.recommended_k_c_npm, 90.0, (1.0, 10.0), model=EXCALIBUR))
 print(twoport.host_ve(20_000.0, 60.0, (1.0, 10.0), model=EXCALIBUR))
 
 try:
@@ -53,7 +53,7 @@ except ImportError:
 if plt is not None:
     fig, ax = plt.subplots(1, 3, figsize=(13, 3.8))
     ax[0].loglog(region["b_nspm"], region["k_max_npm"], "b-")
-    ax[0].plot([paper.b_nspm], [paper.limit], "ro")
+    ax[0].plot([paper.b_c_nspm], [paper.k_c_npm], "ro")
     ax[0].set(xlabel="coupling damping b (N s/m)", ylabel="stiffest proven k (N/m)",
               title="The proven region")
     ax[1].loglog(z["frequency_hz"], np.abs(z["z_min"]), label="|Z_min|")

@@ -18,18 +18,26 @@ use twoport_design::verify::{verify_host, Hand};
 use twoport_design::{Designer, DeviceModel};
 
 /// A proven virtual coupling: the boundary the designer proved, and the
-/// gain it recommends inside it.
+/// gain it recommends inside it. Its names are those of `twoport design
+/// --json`: the impedance display's stiffness `k_c_npm`, the admittance
+/// display's mass `m_c_kg` (the other is `None`).
 #[pyclass(frozen, get_all, module = "twoport")]
 #[derive(Clone)]
 pub(crate) struct Design {
     /// "impedance" or "admittance".
     display: String,
-    /// The boundary's stiffness (N/m; impedance) or mass (kg; admittance).
-    limit: f64,
+    /// The boundary's stiffness (N/m; impedance).
+    k_c_npm: Option<f64>,
+    /// The boundary's mass (kg; admittance).
+    m_c_kg: Option<f64>,
     /// The coupling damping it is proven at (N s/m).
-    b_nspm: f64,
-    /// The recommended gain, `margin` inside the boundary.
-    recommended: f64,
+    b_c_nspm: f64,
+    /// The recommended stiffness, `margin` below the boundary (N/m).
+    recommended_k_c_npm: Option<f64>,
+    /// The recommended mass, `margin` above the boundary (kg).
+    recommended_m_c_kg: Option<f64>,
+    /// The recommended gain's margin inside the boundary (a fraction).
+    margin: f64,
     /// The sample period it is proven for (s).
     period_s: f64,
     /// Where the design binds (Hz), if it does.
@@ -41,14 +49,14 @@ pub(crate) struct Design {
 #[pymethods]
 impl Design {
     fn __repr__(&self) -> String {
-        let unit = if self.display == "impedance" {
-            "N/m"
-        } else {
-            "kg"
+        let limit = match (self.k_c_npm, self.m_c_kg) {
+            (Some(k), _) => format!("k_c = {k:.6} N/m"),
+            (None, Some(m)) => format!("m_c = {m:.6} kg"),
+            (None, None) => "no limit".into(),
         };
         format!(
-            "Design({}: {:.6} {unit} at {} N s/m, T = {} s)",
-            self.display, self.limit, self.b_nspm, self.period_s
+            "Design({}: {limit} at b_c = {} N s/m, T = {} s)",
+            self.display, self.b_c_nspm, self.period_s
         )
     }
 }
@@ -62,8 +70,10 @@ pub(crate) struct Check {
     min_margin: f64,
     /// Where it is least (Hz).
     worst_frequency_hz: f64,
-    /// The boundary's gain at this damping (N/m or kg), if any.
-    boundary: Option<f64>,
+    /// The boundary's stiffness at this damping (N/m; impedance), if any.
+    boundary_k_c_npm: Option<f64>,
+    /// The boundary's mass at this damping (kg; admittance), if any.
+    boundary_m_c_kg: Option<f64>,
     /// How far inside the boundary, as a fraction of its gain.
     gain_margin: Option<f64>,
     /// The pose that binds, on a device of several.
@@ -72,11 +82,14 @@ pub(crate) struct Check {
 
 impl From<twoport_design::designer::CheckReport> for Check {
     fn from(r: twoport_design::designer::CheckReport) -> Self {
+        use twoport_design::designer::DisplayKind;
+        let impedance = r.context.display == DisplayKind::Impedance;
         Check {
             absolutely_stable: r.check.absolutely_stable,
             min_margin: r.check.min_margin,
             worst_frequency_hz: r.check.worst_frequency_hz,
-            boundary: r.boundary,
+            boundary_k_c_npm: r.boundary.filter(|_| impedance),
+            boundary_m_c_kg: r.boundary.filter(|_| !impedance),
             gain_margin: r.gain_margin,
             worst_pose: r.worst_pose,
         }
@@ -173,21 +186,22 @@ fn designer(poses: Vec<DeviceModel>, period: Option<f64>, human: bool) -> Result
 fn to_design(
     d: twoport_design::designer::Design,
     display: &str,
-    margin: f64,
     period_s: f64,
 ) -> Result<Design, String> {
-    let (limit, b_nspm) = d
+    use twoport_design::designer::Limit;
+    let (limit, b_c_nspm) = d
         .coupling
         .ok_or_else(|| d.message.clone().unwrap_or("no coupling is proven".into()))?;
+    let recommended = d.recommended();
+    let stiffness = d.limit == Limit::Stiffness;
     Ok(Design {
         display: display.into(),
-        limit,
-        b_nspm,
-        recommended: if display == "impedance" {
-            limit * (1.0 - margin)
-        } else {
-            limit * (1.0 + margin)
-        },
+        k_c_npm: stiffness.then_some(limit),
+        m_c_kg: (!stiffness).then_some(limit),
+        b_c_nspm,
+        recommended_k_c_npm: recommended.filter(|_| stiffness),
+        recommended_m_c_kg: recommended.filter(|_| !stiffness),
+        margin: d.margin,
         period_s,
         binding_frequency_hz: d.binds_at.map(|x| x.frequency_hz),
         regulator: d.regulator.map(|r| (r.kp, r.bp)),
@@ -214,7 +228,7 @@ pub(crate) fn design_impedance(
     py.detach(move || {
         let d = designer(m, period, human)?;
         let r = d.design_impedance(b, margin).map_err(|e| e.to_string())?;
-        to_design(r, "impedance", margin, d.period_s())
+        to_design(r, "impedance", d.period_s())
     })
     .map_err(value)
 }
@@ -247,7 +261,7 @@ pub(crate) fn design_admittance(
         let r = d
             .design_admittance(regulator, b, margin)
             .map_err(|e| e.to_string())?;
-        to_design(r, "admittance", margin, d.period_s())
+        to_design(r, "admittance", d.period_s())
     })
     .map_err(value)
 }

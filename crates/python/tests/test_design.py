@@ -26,14 +26,14 @@ def test_a_model_from_arrays_meets_colgates_closed_form():
     m = rigid()
     assert (m.dof, m.period_s, m.name) == (1, 1e-3, "rigid")
     d = twoport.design_impedance(m, b=5.0, human=False)
-    assert abs(d.limit / 30_000.0 - 1.0) < 0.01, d
-    inside = twoport.check_impedance(0.9 * d.limit, 5.0, model=m, human=False)
-    past = twoport.check_impedance(1.1 * d.limit, 5.0, model=m, human=False)
+    assert abs(d.k_c_npm / 30_000.0 - 1.0) < 0.01, d
+    inside = twoport.check_impedance(0.9 * d.k_c_npm, 5.0, model=m, human=False)
+    past = twoport.check_impedance(1.1 * d.k_c_npm, 5.0, model=m, human=False)
     assert inside.absolutely_stable and not past.absolutely_stable
-    assert abs(inside.boundary - d.limit) < 1e-6 * d.limit
+    assert abs(inside.boundary_k_c_npm - d.k_c_npm) < 1e-6 * d.k_c_npm
     # verify, independent of the proof, agrees on both sides.
-    assert not twoport.verify(k=0.9 * d.limit, b=5.0, model=m, human=False).unstable
-    assert twoport.verify(k=1.5 * d.limit, b=5.0, model=m, human=False).unstable
+    assert not twoport.verify(k=0.9 * d.k_c_npm, b=5.0, model=m, human=False).unstable
+    assert twoport.verify(k=1.5 * d.k_c_npm, b=5.0, model=m, human=False).unstable
 
 
 def test_bad_arrays_and_arguments_are_named():
@@ -59,14 +59,14 @@ def test_bad_arrays_and_arguments_are_named():
 
 def test_admittance_zrange_and_region_come_back_as_arrays():
     a = twoport.design_admittance(EXCALIBUR)
-    assert a.display == "admittance" and a.limit > 0 and a.regulator is not None
+    assert a.display == "admittance" and a.m_c_kg > 0 and a.regulator is not None
     kp, bp = a.regulator
-    assert twoport.check_admittance(kp, bp, a.recommended, a.b_nspm, model=EXCALIBUR).absolutely_stable
-    assert not twoport.check_admittance(kp, bp, 0.8 * a.limit, a.b_nspm,
+    assert twoport.check_admittance(kp, bp, a.recommended_m_c_kg, a.b_c_nspm, model=EXCALIBUR).absolutely_stable
+    assert not twoport.check_admittance(kp, bp, 0.8 * a.m_c_kg, a.b_c_nspm,
                                         model=EXCALIBUR).absolutely_stable
     ra = twoport.region(EXCALIBUR, b_from=1.0, b_to=50.0, points=6, kp=kp, bp=bp)
     assert ra["m_min_kg"].shape == ra["b_nspm"].shape and np.all(ra["m_min_kg"] > 0)
-    za = twoport.zrange(m=a.recommended, b=a.b_nspm, kp=kp, bp=bp, model=EXCALIBUR, points=20)
+    za = twoport.zrange(m=a.recommended_m_c_kg, b=a.b_c_nspm, kp=kp, bp=bp, model=EXCALIBUR, points=20)
     assert za["z_max"].shape == (20,)
     z = twoport.zrange(51_000.0, 90.0, model=EXCALIBUR, points=50)
     assert z["frequency_hz"].shape == (50,) and z["z_min"].dtype == np.complex128
@@ -103,12 +103,12 @@ def test_a_device_files_axes_and_a_list_of_poses_are_designed_for_together():
     dev = twoport.load_device(str(ROOT / "models" / "devices" / "excalibur_xyz.toml"))
     assert list(dev["axes"]) == ["x", "y", "z"] and len(dev["axes"]["x"]) == 1
     x = twoport.design_impedance(dev["axes"]["x"], b=90.0)
-    assert abs(x.limit - 51_073.0) < 1.0, x
+    assert abs(x.k_c_npm - 51_073.0) < 1.0, x
     # Two poses: proven for both, so no stiffer than the softer alone.
     two = str(ROOT / "models" / "two_mass.toml")
     both = twoport.design_impedance([EXCALIBUR, two], b=90.0)
-    alone = [twoport.design_impedance(m, b=90.0).limit for m in (EXCALIBUR, two)]
-    assert abs(both.limit - min(alone)) <= 1e-6 * min(alone), (both, alone)
+    alone = [twoport.design_impedance(m, b=90.0).k_c_npm for m in (EXCALIBUR, two)]
+    assert abs(both.k_c_npm - min(alone)) <= 1e-6 * min(alone), (both, alone)
     with pytest.raises(ValueError, match="empty list"):
         twoport.design_impedance([])
     with pytest.raises(ValueError, match="one pose"):

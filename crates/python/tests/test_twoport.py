@@ -16,12 +16,12 @@ EXCALIBUR = str(ROOT / "models" / "excalibur.toml")
 def test_the_paper_design_comes_back_from_python():
     d = twoport.design_impedance(EXCALIBUR, b=90.0, margin=0.0)
     assert d.display == "impedance"
-    assert d.b_nspm == 90.0
-    assert abs(d.limit - 51_073.0) < 0.001 * 51_073.0
+    assert d.b_c_nspm == 90.0
+    assert abs(d.k_c_npm - 51_073.0) < 0.001 * 51_073.0
     assert d.period_s == 0.001
     # The best pair at twice the rate is the rate table's.
     fast = twoport.design_impedance(EXCALIBUR, period=0.0005, margin=0.0)
-    assert abs(fast.limit - 181_606.0) < 0.001 * 181_606.0
+    assert abs(fast.k_c_npm - 181_606.0) < 0.001 * 181_606.0
     assert "N/m" in repr(d)
 
 

@@ -481,6 +481,88 @@ impl<R: Real, const B: usize> Vbb<R, B> {
     }
 }
 
+impl<R: Real, const B: usize> Vbb<R, B> {
+    /// The implicit step with no contact, `m (v - v0) = T (f0 - z v + w)`
+    /// with the held block's weight `weight` on z: each axis's
+    /// denominator and velocity. The explicit scheme's end-of-tick
+    /// velocity, where it runs; the velocity is then the mean of the
+    /// tick's two, the one the port sees.
+    #[inline]
+    fn free_step(&self, ports: &[Port<R>; 3], m: R, weight: R) -> ([R; 3], [R; 3], [R; 3]) {
+        let t = self.t;
+        let mut den = [R::ONE; 3];
+        let mut v = [R::ZERO; 3];
+        let mut v_end = [R::ZERO; 3];
+        for a in 0..3 {
+            let ext = if a == 2 { weight } else { R::ZERO };
+            let v0 = self.velocity_mps[a];
+            if self.cfg.explicit {
+                den[a] = m;
+                v_end[a] = v0 + t * (self.last_force_n[a] + ext) / m;
+                v[a] = (v0 + v_end[a]) * R::HALF;
+            } else {
+                den[a] = m + t * ports[a].z_nspm;
+                v[a] = (m * v0 + t * (ports[a].f0_n + ext)) / den[a];
+            }
+        }
+        (den, v, v_end)
+    }
+
+    /// The knobs on a held block, pressed with `normal_z_n` (N) against
+    /// the block it is `seated` on or the one `below` it: pulled up hard
+    /// enough they let go; pressed onto an aligned block's knobs they give
+    /// way, and it drops onto the top from the next tick (returned, to
+    /// snap once the tick's motion is done).
+    #[inline]
+    fn knobs(
+        &mut self,
+        k: Knobs,
+        (seated, below): (Option<usize>, Option<usize>),
+        normal_z_n: R,
+        rising: bool,
+        resting: bool,
+    ) -> Option<(usize, usize, Knobs)> {
+        let h = self.held?;
+        match (seated, below) {
+            (Some(_), _) if rising && normal_z_n > R::of(k.part_force_n) => {
+                self.on[h] = None;
+                None
+            }
+            (None, Some(j))
+                if resting && normal_z_n > R::of(k.mate_force_n) && self.aligned(h, j, &k) =>
+            {
+                self.on[h] = Some(j);
+                Some((h, j, k))
+            }
+            _ => None,
+        }
+    }
+
+    /// Coulomb friction on the axes with no contact of their own,
+    /// implicit: it holds the body while the pull is inside the cone, else
+    /// takes mu N off its velocity.
+    #[inline]
+    fn friction(&self, v: &mut [R; 3], normal_n: &[R; 3], den: &[R; 3]) {
+        let mu = R::of(self.cfg.friction);
+        for a in 0..3 {
+            let n: R = (0..3)
+                .filter(|&b| b != a)
+                .fold(R::ZERO, |s, b| s + normal_n[b]);
+            if normal_n[a] > R::ZERO || n == R::ZERO {
+                continue;
+            }
+            let dv = self.t * mu * n / den[a];
+            v[a] = if v[a].abs() <= dv {
+                R::ZERO
+            } else if v[a] > R::ZERO {
+                v[a] - dv
+            } else {
+                v[a] + dv
+            };
+        }
+    }
+}
+
 impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
     fn step_axes(&mut self, ports: &[Port<R>; 3]) -> [VeOutput<R>; 3] {
         if !ports
@@ -495,24 +577,7 @@ impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
             Some(i) if self.cfg.held_weight => -R::of(self.blocks[i].mass_kg) * self.g,
             _ => R::ZERO,
         };
-        // The implicit step with no contact: m (v - v0) = T (f0 - z v + w).
-        let mut den = [R::ONE; 3];
-        let mut v = [R::ZERO; 3];
-        // The explicit scheme's end-of-tick velocity, where it runs; `v`
-        // is then the mean of the tick's two, the one the port sees.
-        let mut v_end = [R::ZERO; 3];
-        for a in 0..3 {
-            let ext = if a == 2 { weight } else { R::ZERO };
-            let v0 = self.velocity_mps[a];
-            if self.cfg.explicit {
-                den[a] = m;
-                v_end[a] = v0 + t * (self.last_force_n[a] + ext) / m;
-                v[a] = (v0 + v_end[a]) * R::HALF;
-            } else {
-                den[a] = m + t * ports[a].z_nspm;
-                v[a] = (m * v0 + t * (ports[a].f0_n + ext)) / den[a];
-            }
-        }
+        let (den, mut v, v_end) = self.free_step(ports, m, weight);
         let free = v;
         // Contacts: an axis whose step would cross a face stops at it, and
         // the face's push on the body is the normal force.
@@ -528,7 +593,6 @@ impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
             None => None,
         };
         let mut below = None;
-        let mut snap = None;
         let mated = self.held.and_then(|h| self.on[h]);
         let rising = v[2] > R::ZERO;
         // (Knobs answer a steady push, not the impulse of landing on them.)
@@ -552,42 +616,11 @@ impl<R: Real, const B: usize> World<R, 3> for Vbb<R, B> {
                 stop[a] = Some(x[a].offset_nm((dir * gap) as i32));
             }
         }
-        if let (Some(h), Some(k)) = (self.held, self.cfg.knobs) {
-            match (seated, below) {
-                // Pulled up hard enough: the knobs let go.
-                (Some(_), _) if rising && normal_n[2] > R::of(k.part_force_n) => {
-                    self.on[h] = None;
-                }
-                // Pressed onto an aligned block's knobs: they give way, and
-                // it drops onto the top from the next tick.
-                (None, Some(j))
-                    if resting && normal_n[2] > R::of(k.mate_force_n) && self.aligned(h, j, &k) =>
-                {
-                    self.on[h] = Some(j);
-                    snap = Some((h, j, k));
-                }
-                _ => {}
-            }
-        }
-        // Coulomb friction on the other axes, implicit: it holds the body
-        // while the pull is inside the cone, else takes mu N off it.
-        let mu = R::of(self.cfg.friction);
-        for a in 0..3 {
-            let n: R = (0..3)
-                .filter(|&b| b != a)
-                .fold(R::ZERO, |s, b| s + normal_n[b]);
-            if normal_n[a] > R::ZERO || n == R::ZERO {
-                continue;
-            }
-            let dv = t * mu * n / den[a];
-            v[a] = if v[a].abs() <= dv {
-                R::ZERO
-            } else if v[a] > R::ZERO {
-                v[a] - dv
-            } else {
-                v[a] + dv
-            };
-        }
+        let snap = self
+            .cfg
+            .knobs
+            .and_then(|k| self.knobs(k, (seated, below), normal_n[2], rising, resting));
+        self.friction(&mut v, &normal_n, &den);
         let out = [0, 1, 2].map(|a| ports[a].at(v[a]));
         for a in 0..3 {
             // (Explicit: a face or friction that changed the step ends it

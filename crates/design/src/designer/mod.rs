@@ -438,7 +438,7 @@ impl Designer {
         let (c, pose) = self
             .worst_check(|p| analysis::check_impedance(&p.analysis, k, b, self.human))
             .ok_or(Error::Coupling(format!(
-                "--k {k} --b {b}: not a valid coupling (k T + b must be > 0)"
+                "k {k} N/m, b {b} N s/m: not a valid coupling (k T + b must be > 0)"
             )))?;
         let boundary = self
             .impedance_on(&self.with(self.impedance_bounds(Bound::Sound)), Some(b))
@@ -469,7 +469,7 @@ impl Designer {
         let b = gain("b", b)?;
         if !(m.is_finite() && m > 0.0) {
             return Err(Error::Coupling(format!(
-                "--m {m}: must be a finite mass > 0 kg"
+                "m {m}: must be a finite mass > 0 kg"
             )));
         }
         let k = analysis::regulator_tf(kp.0, kp.1, self.period_s())?;
@@ -479,7 +479,7 @@ impl Designer {
                 analysis::check_admittance(&p.plant, a, kp, (m, b), self.human)
             })
             .ok_or(Error::Coupling(
-                "--b must be > 0 for the admittance coupling".into(),
+                "b must be > 0 N s/m for the admittance coupling".into(),
             ))?;
         let boundary = self
             .admittance_on(
@@ -623,7 +623,7 @@ fn fraction(v: f64) -> Result<f64, Error> {
 
 /// A region's damping range and point count, checked.
 fn region_range((lo, hi): (f64, f64), points: usize) -> Result<(f64, f64), Error> {
-    let (lo, hi) = (gain("b-from", lo)?, gain("b-to", hi)?);
+    let (lo, hi) = (gain("b_from", lo)?, gain("b_to", hi)?);
     if lo > 0.0 && hi > lo && (2..=1000).contains(&points) {
         Ok((lo, hi))
     } else {

@@ -135,7 +135,7 @@ pub fn workspace_design(
     b_c_nspm: f64,
     min_grasp_nspm: f64,
 ) -> Result<WorkspaceDesign, crate::Error> {
-    for (name, value) in [("b", b_c_nspm), ("min-grasp", min_grasp_nspm)] {
+    for (name, value) in [("b", b_c_nspm), ("min_grasp", min_grasp_nspm)] {
         if !(value.is_finite() && value >= 0.0) {
             return Err(crate::Error::Gain { name, value });
         }
@@ -374,7 +374,7 @@ pub fn certified_design_from(
     min_grasp_nspm: f64,
     human: Option<HumanBound>,
 ) -> Result<WorkspaceDesign, crate::Error> {
-    for (name, value) in [("b", b_c_nspm), ("min-grasp", min_grasp_nspm)] {
+    for (name, value) in [("b", b_c_nspm), ("min_grasp", min_grasp_nspm)] {
         if !(value.is_finite() && value >= 0.0) {
             return Err(crate::Error::Gain { name, value });
         }

@@ -155,6 +155,9 @@ fn handle_inertia(model: &DeviceModel, w: f64) -> f64 {
     }
 }
 
+/// A hand held off the handle, as `[log m, log k, log b]`.
+const HELD_OFF: [f64; 3] = [-4.0, -1.0, -4.0];
+
 /// Search for the termination that makes `gains` least stable on
 /// `model` at `period_s`. With `human`, hands are the bound in series with
 /// a passive mass-spring-damper (the paper's Fig. 3); without, any passive
@@ -182,66 +185,16 @@ pub fn verify(
         two: false,
     };
     // Check the loop can be built at all (gains the board accepts).
-    let off = [-4.0, -1.0, -4.0];
     radius(
         model,
         period_s,
         gains,
-        &s.termination(VeKind::Constraint, &off),
+        &s.termination(VeKind::Constraint, &HELD_OFF),
         delay_samples,
     )?;
-    let nyq_hz = 0.5 / period_s;
-    let freqs: Vec<f64> = (0..24)
-        .map(|i| (4.0 * nyq_hz).powf(i as f64 / 23.0))
-        .collect();
-    let mut hands: Vec<[f64; 3]> = vec![off];
-    // Resonances across the band, and exactly at multiples of Nyquist,
-    // where the sampled poles of the hand's resonance meet on the real
-    // axis (the narrowest and worst hands): there the spring is tuned to
-    // the hand's mass plus the device's inertia at the handle.
-    let mut tuned: Vec<(f64, bool)> = freqs.iter().map(|f| (*f, false)).collect();
-    tuned.extend((1..=8).map(|j| (j as f64 * nyq_hz, true)));
-    for (f, exact) in tuned {
-        let w = 2.0 * PI * f;
-        let inertia = if exact && human.is_none() {
-            handle_inertia(model, w)
-        } else {
-            0.0
-        };
-        for m in [-3.0, -2.0, -1.0, 0.0] {
-            let k = (10f64.powf(m) + inertia) * w * w;
-            hands.push([m, k.log10(), -2.0]);
-        }
-    }
-    let mut ves: Vec<(VeKind, Vec<f64>)> = vec![(VeKind::Constraint, vec![])];
-    for m in [-2.0, -1.0, 0.0, 1.0] {
-        ves.push((VeKind::Cursor, vec![m]));
-        ves.push((VeKind::LosslessMass, vec![m]));
-    }
-    for i in 0..13 {
-        let k = 2.0 + 0.5 * i as f64;
-        ves.push((VeKind::Spring, vec![k, -2.0]));
-        ves.push((VeKind::Trapezoidal, vec![k, -2.0]));
-    }
-    // VEs tuned to resonate with the coupling across the band, as the
-    // hands are: a mass on the impedance display's spring, a spring on the
-    // admittance display's mass (the narrow terminations a coarse sweep
-    // steps over).
-    for f in &freqs {
-        let w2 = (2.0 * PI * f).powi(2);
-        match gains {
-            Gains::Impedance(g) => {
-                let m = (g.k_npm as f64 / w2).log10();
-                ves.push((VeKind::Cursor, vec![m]));
-                ves.push((VeKind::LosslessMass, vec![m]));
-            }
-            Gains::Admittance(g) => {
-                let k = (g.m_kg as f64 * w2).log10();
-                ves.push((VeKind::Spring, vec![k, -4.0]));
-                ves.push((VeKind::Trapezoidal, vec![k, -4.0]));
-            }
-        }
-    }
+    let freqs = band(period_s);
+    let hands = hand_starts(model, period_s, human, &freqs);
+    let ves = ve_starts(gains, &freqs);
     let mut starts: Vec<(f64, VeKind, Vec<f64>)> = Vec::new();
     for h in &hands {
         for (kind, vp) in &ves {
@@ -281,36 +234,11 @@ pub fn verify(
         .take(5)
         .map(|(_, kind, p, _)| s.termination(*kind, p).hand)
         .collect();
-    // Then, where nothing was found, hands with two resonances: the best
-    // one-resonance terminations with a second mass tuned to the loop's
-    // worst frequency or one of its aliases (where the sound bound lets
-    // the hand take its worst value at two frequencies at once), refined
-    // in all their parameters. Only a counterexample replaces the first
-    // search's answer: a radius climbed toward 1 by a nearly lossless hand
-    // mode of its own says nothing.
+    // Then, where nothing was found, hands with two resonances.
     let mut best = (kind, p, r, false);
     if !r.unstable {
-        s.two = true;
-        let fs = 1.0 / period_s;
-        let mut starts: Vec<(f64, VeKind, Vec<f64>)> = Vec::new();
-        for (_, kind, p, f) in finals.iter().take(3) {
-            for f2 in [*f, fs - f, fs + f, 2.0 * fs - f] {
-                let w2 = (2.0 * PI * f2.max(0.1)).powi(2);
-                for m in [-3.0, -2.0, -1.0] {
-                    let k = (10f64.powf(m) * w2).log10();
-                    let mut q: Vec<f64> = p[..3].iter().chain(&[m, k, -4.0]).copied().collect();
-                    q.extend_from_slice(&p[3..]);
-                    let r = s.eval(*kind, &mut q);
-                    starts.push((r.score, *kind, q));
-                }
-            }
-        }
-        starts.sort_by(|a, b| b.0.total_cmp(&a.0));
-        for (_, kind, p) in starts.iter().take(2) {
-            let (q, r) = s.refine(*kind, p, 60 * (6 + kind.dims()));
-            if r.unstable && !best.2.unstable {
-                best = (*kind, q, r, true);
-            }
+        if let Some((kind, q, r)) = two_resonances(&mut s, &finals, period_s) {
+            best = (kind, q, r, true);
         }
     }
     let (kind, p, r, two) = best;
@@ -336,5 +264,111 @@ pub fn verify(
         frequency_hz: r.frequency_hz,
         termination: s.termination(kind, &p),
         evaluations: s.evaluations,
+    })
+}
+
+/// 24 frequencies log-spaced from 1 Hz to twice the sample rate (Hz).
+fn band(period_s: f64) -> Vec<f64> {
+    let nyq_hz = 0.5 / period_s;
+    (0..24)
+        .map(|i| (4.0 * nyq_hz).powf(i as f64 / 23.0))
+        .collect()
+}
+
+/// The hands the search starts from, as `[log m, log k, log b]`: one held
+/// off, and resonances across `freqs` and exactly at multiples of
+/// Nyquist, where the sampled poles of the hand's resonance meet on the
+/// real axis (the narrowest and worst hands): there the spring is tuned
+/// to the hand's mass plus the device's inertia at the handle.
+fn hand_starts(
+    model: &DeviceModel,
+    period_s: f64,
+    human: Option<HumanBound>,
+    freqs: &[f64],
+) -> Vec<[f64; 3]> {
+    let nyq_hz = 0.5 / period_s;
+    let mut hands: Vec<[f64; 3]> = vec![HELD_OFF];
+    let mut tuned: Vec<(f64, bool)> = freqs.iter().map(|f| (*f, false)).collect();
+    tuned.extend((1..=8).map(|j| (j as f64 * nyq_hz, true)));
+    for (f, exact) in tuned {
+        let w = 2.0 * PI * f;
+        let inertia = if exact && human.is_none() {
+            handle_inertia(model, w)
+        } else {
+            0.0
+        };
+        for m in [-3.0, -2.0, -1.0, 0.0] {
+            let k = (10f64.powf(m) + inertia) * w * w;
+            hands.push([m, k.log10(), -2.0]);
+        }
+    }
+    hands
+}
+
+/// The VEs the search starts from: each family across its range, and
+/// VEs tuned to resonate with the coupling across `freqs`, as the hands
+/// are: a mass on the impedance display's spring, a spring on the
+/// admittance display's mass (the narrow terminations a coarse sweep
+/// steps over).
+fn ve_starts(gains: &Gains, freqs: &[f64]) -> Vec<(VeKind, Vec<f64>)> {
+    let mut ves: Vec<(VeKind, Vec<f64>)> = vec![(VeKind::Constraint, vec![])];
+    for m in [-2.0, -1.0, 0.0, 1.0] {
+        ves.push((VeKind::Cursor, vec![m]));
+        ves.push((VeKind::LosslessMass, vec![m]));
+    }
+    for i in 0..13 {
+        let k = 2.0 + 0.5 * i as f64;
+        ves.push((VeKind::Spring, vec![k, -2.0]));
+        ves.push((VeKind::Trapezoidal, vec![k, -2.0]));
+    }
+    for f in freqs {
+        let w2 = (2.0 * PI * f).powi(2);
+        match gains {
+            Gains::Impedance(g) => {
+                let m = (g.k_npm as f64 / w2).log10();
+                ves.push((VeKind::Cursor, vec![m]));
+                ves.push((VeKind::LosslessMass, vec![m]));
+            }
+            Gains::Admittance(g) => {
+                let k = (g.m_kg as f64 * w2).log10();
+                ves.push((VeKind::Spring, vec![k, -4.0]));
+                ves.push((VeKind::Trapezoidal, vec![k, -4.0]));
+            }
+        }
+    }
+    ves
+}
+
+/// Hands with two resonances: the best one-resonance terminations
+/// (`finals`, worst first, each with its frequency) with a second mass
+/// tuned to the loop's worst frequency or one of its aliases (where the
+/// sound bound lets the hand take its worst value at two frequencies at
+/// once), refined in all their parameters. Only a counterexample is
+/// returned: a radius climbed toward 1 by a nearly lossless hand mode of
+/// its own says nothing.
+fn two_resonances(
+    s: &mut Search<'_>,
+    finals: &[(f64, VeKind, Vec<f64>, f64)],
+    period_s: f64,
+) -> Option<(VeKind, Vec<f64>, Radius)> {
+    s.two = true;
+    let fs = 1.0 / period_s;
+    let mut starts: Vec<(f64, VeKind, Vec<f64>)> = Vec::new();
+    for (_, kind, p, f) in finals.iter().take(3) {
+        for f2 in [*f, fs - f, fs + f, 2.0 * fs - f] {
+            let w2 = (2.0 * PI * f2.max(0.1)).powi(2);
+            for m in [-3.0, -2.0, -1.0] {
+                let k = (10f64.powf(m) * w2).log10();
+                let mut q: Vec<f64> = p[..3].iter().chain(&[m, k, -4.0]).copied().collect();
+                q.extend_from_slice(&p[3..]);
+                let r = s.eval(*kind, &mut q);
+                starts.push((r.score, *kind, q));
+            }
+        }
+    }
+    starts.sort_by(|a, b| b.0.total_cmp(&a.0));
+    starts.iter().take(2).find_map(|(_, kind, p)| {
+        let (q, r) = s.refine(*kind, p, 60 * (6 + kind.dims()));
+        r.unstable.then_some((*kind, q, r))
     })
 }

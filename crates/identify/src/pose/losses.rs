@@ -164,14 +164,35 @@ pub fn dissipation(
     let avg = per_period.iter().sum::<f64>() / periods as f64;
     let var = per_period.iter().map(|w| (w - avg).powi(2)).sum::<f64>() / (periods as f64 - 1.0);
     let duration = period as f64 * t;
-    // The mean period's velocity, band-limited, at every tick.
+    let (rate_sq, rate_abs) = joint_rates(&positions, jacobian_inv, &harmonics, period, duration);
+    Ok(Dissipation {
+        power_w: mean / duration,
+        power_sd_w: (var / periods as f64).sqrt() / duration,
+        rate_sq,
+        rate_abs,
+    })
+}
+
+/// The joints' mean square and mean absolute rates (rad²/s², rad/s) over
+/// the mean period whose Cartesian position spectra (at `harmonics` of a
+/// `period`-tick period lasting `duration` s) are `positions`: the
+/// velocity band-limited to the harmonics, at every tick, taken to the
+/// joints by `jacobian_inv`.
+fn joint_rates(
+    positions: &[Vec<Complex64>],
+    jacobian_inv: &DMatrix<f64>,
+    harmonics: &[usize],
+    period: usize,
+    duration: f64,
+) -> (Vec<f64>, Vec<f64>) {
+    let n = positions.len();
     let velocity: Vec<Vec<f64>> = positions
         .iter()
         .map(|c| {
             (0..period)
                 .map(|s| {
                     c.iter()
-                        .zip(&harmonics)
+                        .zip(harmonics)
                         .map(|(c, &h)| {
                             let w = std::f64::consts::TAU * h as f64 / duration;
                             let ph = std::f64::consts::TAU * (h * s) as f64 / period as f64;
@@ -192,12 +213,7 @@ pub fn dissipation(
             *abs += r.abs() / period as f64;
         }
     }
-    Ok(Dissipation {
-        power_w: mean / duration,
-        power_sd_w: (var / periods as f64).sqrt() / duration,
-        rate_sq,
-        rate_abs,
-    })
+    (rate_sq, rate_abs)
 }
 
 /// Fit every joint's damping and friction to the experiments (each one

@@ -1,7 +1,7 @@
 //! The response matrix at a pose, from one experiment per axis.
 
 use crate::frf::{spectra, whole_periods};
-use crate::log::Log;
+use crate::log::{Excitation, Log};
 use crate::IdentifyError;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
@@ -59,51 +59,7 @@ impl PoseMeasured {
             });
         }
         let harmonics: Vec<usize> = (e.first..=e.last).collect();
-        let mut periods = 0;
-        for (j, axes) in experiments.iter().enumerate() {
-            if axes.len() != n {
-                return Err(bad(
-                    format!("experiment {j}"),
-                    format!(
-                        "{} axes recorded, but there are {n} experiments: one is needed per axis",
-                        axes.len()
-                    ),
-                ));
-            }
-            for (i, log) in axes.iter().enumerate() {
-                let place = format!("experiment {j}, axis {i}");
-                if log.excitation != Some(e) || log.period_s != first.period_s {
-                    return Err(bad(
-                        place,
-                        "it played another excitation or period than experiment 0's".into(),
-                    ));
-                }
-                if log.force_n.len() != first.force_n.len()
-                    || log.position_m.len() != log.force_n.len()
-                {
-                    return Err(bad(
-                        place,
-                        format!(
-                            "{} force and {} position samples, but experiment 0 has {}",
-                            log.force_n.len(),
-                            log.position_m.len(),
-                            first.force_n.len()
-                        ),
-                    ));
-                }
-                // (The lengths are checked above; a sample that is not a
-                // number is named with its place, the rest as they are.)
-                periods = whole_periods(&log.force_n, &log.position_m, period, &harmonics, skip)
-                    .map_err(|err| match err {
-                        IdentifyError::NotFinite { .. } => bad(place.clone(), err.to_string()),
-                        other => other,
-                    })?;
-                if i == j {
-                    crate::fit::measured::clipped(&log.force_n, log.period_s)
-                        .map_err(|err| bad(place, err.to_string()))?;
-                }
-            }
-        }
+        let periods = checked(experiments, first, e, &harmonics, skip)?;
         let spec = |x: &[f64]| spectra(x, period, &harmonics, skip, periods);
         // The harmonics the multisine leaves out, past its band: what the
         // position shows there is noise that repeats period after period
@@ -112,21 +68,7 @@ impl PoseMeasured {
         // power per harmonic in each axis's mean spectrum is a floor on
         // the excited harmonics' variance.
         let quiet: Vec<usize> = (e.last + 1..=max).collect();
-        let noise: Vec<f64> = (0..n)
-            .map(|i| {
-                if quiet.is_empty() {
-                    return 0.0;
-                }
-                let per_experiment = experiments.iter().map(|axes| {
-                    crate::frf::mean_spectrum(&axes[i].position_m, period, &quiet, skip)
-                        .iter()
-                        .map(|c| c.norm_sqr())
-                        .sum::<f64>()
-                        / quiet.len() as f64
-                });
-                per_experiment.fold(0.0, f64::max)
-            })
-            .collect();
+        let noise = repeating_noise(experiments, period, &quiet, skip);
         // [experiment][axis][period][harmonic]
         let (f, x): (Vec<Vec<_>>, Vec<Vec<_>>) = experiments
             .iter()
@@ -186,4 +128,87 @@ impl PoseMeasured {
         }
         Ok(out)
     }
+}
+
+/// Every record of `experiments` checked against `first` (the same
+/// excitation, period and length, one record per axis, finite samples,
+/// the pushed axis's force not clipped); the whole periods averaged.
+fn checked(
+    experiments: &[Vec<Log>],
+    first: &Log,
+    e: Excitation,
+    harmonics: &[usize],
+    skip: usize,
+) -> Result<usize, IdentifyError> {
+    let (n, period) = (experiments.len(), e.period_ticks);
+    let mut periods = 0;
+    for (j, axes) in experiments.iter().enumerate() {
+        if axes.len() != n {
+            return Err(bad(
+                format!("experiment {j}"),
+                format!(
+                    "{} axes recorded, but there are {n} experiments: one is needed per axis",
+                    axes.len()
+                ),
+            ));
+        }
+        for (i, log) in axes.iter().enumerate() {
+            let place = format!("experiment {j}, axis {i}");
+            if log.excitation != Some(e) || log.period_s != first.period_s {
+                return Err(bad(
+                    place,
+                    "it played another excitation or period than experiment 0's".into(),
+                ));
+            }
+            if log.force_n.len() != first.force_n.len() || log.position_m.len() != log.force_n.len()
+            {
+                return Err(bad(
+                    place,
+                    format!(
+                        "{} force and {} position samples, but experiment 0 has {}",
+                        log.force_n.len(),
+                        log.position_m.len(),
+                        first.force_n.len()
+                    ),
+                ));
+            }
+            // (The lengths are checked above; a sample that is not a
+            // number is named with its place, the rest as they are.)
+            periods = whole_periods(&log.force_n, &log.position_m, period, harmonics, skip)
+                .map_err(|err| match err {
+                    IdentifyError::NotFinite { .. } => bad(place.clone(), err.to_string()),
+                    other => other,
+                })?;
+            if i == j {
+                crate::fit::measured::clipped(&log.force_n, log.period_s)
+                    .map_err(|err| bad(place, err.to_string()))?;
+            }
+        }
+    }
+    Ok(periods)
+}
+
+/// Each axis's power per harmonic at the `quiet` harmonics (m²), the
+/// most over the experiments: noise that repeats period after period.
+fn repeating_noise(
+    experiments: &[Vec<Log>],
+    period: usize,
+    quiet: &[usize],
+    skip: usize,
+) -> Vec<f64> {
+    (0..experiments.len())
+        .map(|i| {
+            if quiet.is_empty() {
+                return 0.0;
+            }
+            let per_experiment = experiments.iter().map(|axes| {
+                crate::frf::mean_spectrum(&axes[i].position_m, period, quiet, skip)
+                    .iter()
+                    .map(|c| c.norm_sqr())
+                    .sum::<f64>()
+                    / quiet.len() as f64
+            });
+            per_experiment.fold(0.0, f64::max)
+        })
+        .collect()
 }

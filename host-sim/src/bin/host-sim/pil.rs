@@ -159,37 +159,9 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
     } else {
         (1e-3, twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS)
     };
-    let host_ve = match a.host_ve_hz {
-        None => None,
-        Some(hz) => {
-            let every = 1.0 / (period * hz);
-            if !(every.is_finite()
-                && every >= 1.0 - 1e-6
-                && (every - every.round()).abs() < 1e-6 * every)
-            {
-                return Err(err!(
-                    "--host-ve-hz {hz}: the board's {} Hz is not a whole multiple of it",
-                    1.0 / period
-                ));
-            }
-            let every = every.round() as u32;
-            // Ten of the host's periods on one update.
-            Some(pil::HostVe {
-                every_ticks: every,
-                deadline_ticks: 10 * every,
-            })
-        }
-    };
+    let host_ve = host_ve(a, period)?;
     let ticks = (a.seconds / period).round() as u64;
-    let link_loss_at = match a.link_loss_at_s {
-        Some(t) if t.is_finite() && t >= 0.0 && t < a.seconds => Some((t / period).round() as u64),
-        Some(t) => return Err(err!("--link-loss-at-s {t}: must be in [0, --seconds)")),
-        None => None,
-    };
-    let faults = link::LinkFaults {
-        corrupt_every: a.corrupt_every,
-        link_loss_at,
-    };
+    let faults = faults(a, period)?;
     let port = a.port.as_deref().map(link::SerialBoard::open).transpose()?;
     let start = std::time::Instant::now();
     // (The board's f32 period, to its rounding.)
@@ -283,6 +255,40 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
         std::fs::write(path, log.to_csv()).map_err(|e| err!("--log {}: {e}", path.display()))?;
     }
     pil_report(a, ticks, faults, reference, run, local_s, start, deadline)
+}
+
+/// `--host-ve-hz` as the host's VE period in board ticks (`period` s),
+/// with ten of them as its deadline.
+fn host_ve(a: &PilArgs, period: f64) -> Result<Option<host_sim::pil::HostVe>, Error> {
+    let Some(hz) = a.host_ve_hz else {
+        return Ok(None);
+    };
+    let every = 1.0 / (period * hz);
+    if !(every.is_finite() && every >= 1.0 - 1e-6 && (every - every.round()).abs() < 1e-6 * every) {
+        return Err(err!(
+            "--host-ve-hz {hz}: the board's {} Hz is not a whole multiple of it",
+            1.0 / period
+        ));
+    }
+    let every = every.round() as u32;
+    Ok(Some(host_sim::pil::HostVe {
+        every_ticks: every,
+        deadline_ticks: 10 * every,
+    }))
+}
+
+/// The faults `--corrupt-every` and `--link-loss-at-s` put on the link,
+/// in ticks of `period` s.
+fn faults(a: &PilArgs, period: f64) -> Result<link::LinkFaults, Error> {
+    let link_loss_at = match a.link_loss_at_s {
+        Some(t) if t.is_finite() && t >= 0.0 && t < a.seconds => Some((t / period).round() as u64),
+        Some(t) => return Err(err!("--link-loss-at-s {t}: must be in [0, --seconds)")),
+        None => None,
+    };
+    Ok(link::LinkFaults {
+        corrupt_every: a.corrupt_every,
+        link_loss_at,
+    })
 }
 
 /// A PIL run's report, compared with the in-process `reference`: the

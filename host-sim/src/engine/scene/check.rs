@@ -9,28 +9,6 @@ use twoport_control::servo::Display;
 impl Scene {
     /// Physical checks beyond the types; the message names the field.
     pub(super) fn check(&self) -> Result<(), Error> {
-        let pos = |name: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(sim_err!("{name} = {v} must be finite and > 0"))
-            }
-        };
-        let nonneg = |name: &str, v: f64| {
-            if v.is_finite() && v >= 0.0 {
-                Ok(())
-            } else {
-                Err(sim_err!("{name} = {v} must be finite and >= 0"))
-            }
-        };
-        // A spring VE anchored at `at` (m, named `at_name`).
-        let spring = |at_name: &str, at: f64, k: f64, b: f64| {
-            if !at.is_finite() {
-                return Err(sim_err!("{at_name} = {at} must be finite"));
-            }
-            nonneg("ve.stiffness_npm", k)?;
-            nonneg("ve.damping_nspm", b)
-        };
         if !(1..=MAX_AXES).contains(&self.axes) {
             return Err(sim_err!(
                 "axes = {}: the simulator runs devices of 1 to {MAX_AXES} axes",
@@ -90,6 +68,21 @@ impl Scene {
             );
         }
         self.check_script()?;
+        self.check_ve()?;
+        self.check_effects()?;
+        self.check_passivity()
+    }
+
+    /// The VE's fields.
+    fn check_ve(&self) -> Result<(), Error> {
+        // A spring VE anchored at `at` (m, named `at_name`).
+        let spring = |at_name: &str, at: f64, k: f64, b: f64| {
+            if !at.is_finite() {
+                return Err(sim_err!("{at_name} = {at} must be finite"));
+            }
+            nonneg("ve.stiffness_npm", k)?;
+            nonneg("ve.damping_nspm", b)
+        };
         match &self.ve {
             VeSpec::Cursor { mass_kg, .. } => pos("ve.mass_kg", *mass_kg)?,
             VeSpec::Wall {
@@ -179,6 +172,11 @@ impl Scene {
                 nonneg("ve.friction", *friction)?;
             }
         }
+        Ok(())
+    }
+
+    /// The effects' fields, and the effects that need another.
+    fn check_effects(&self) -> Result<(), Error> {
         let e = &self.effects;
         if let Some(x) = e.encoder {
             pos("effects.encoder.resolution_m", x.resolution_m)?;
@@ -243,6 +241,11 @@ impl Scene {
                 return Err("effects.element_delay delays the impedance display's element; an admittance display has none to delay".into());
             }
         }
+        Ok(())
+    }
+
+    /// The passivity layer's fields, and where it may sit.
+    fn check_passivity(&self) -> Result<(), Error> {
         if let Some(p) = &self.passivity {
             if p.port == LayerPort::Ve {
                 if self.display != Display::Impedance {
@@ -269,20 +272,8 @@ impl Scene {
     /// One axis's coupling, named `name` in errors: the scene's display's,
     /// with gains that make a coupling.
     fn check_coupling(&self, name: &str, c: &Coupling) -> Result<(), Error> {
-        let nonneg = |field: &str, v: f64| {
-            if v.is_finite() && v >= 0.0 {
-                Ok(())
-            } else {
-                Err(sim_err!("{name}.{field} = {v} must be finite and >= 0"))
-            }
-        };
-        let pos = |field: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(sim_err!("{name}.{field} = {v} must be finite and > 0"))
-            }
-        };
+        let nonneg = |field: &str, v: f64| nonneg(&format!("{name}.{field}"), v);
+        let pos = |field: &str, v: f64| pos(&format!("{name}.{field}"), v);
         match (*c, self.display) {
             (Coupling::Impedance { k, b }, Display::Impedance) => {
                 nonneg("k", k)?;
@@ -405,5 +396,23 @@ impl Scene {
             return Err("human.arm: a linkage's hand has no arm yet".into());
         }
         Ok(())
+    }
+}
+
+/// `Ok` where `v` (the field `name`) is finite and > 0.
+fn pos(name: &str, v: f64) -> Result<(), Error> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(sim_err!("{name} = {v} must be finite and > 0"))
+    }
+}
+
+/// `Ok` where `v` (the field `name`) is finite and >= 0.
+fn nonneg(name: &str, v: f64) -> Result<(), Error> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(sim_err!("{name} = {v} must be finite and >= 0"))
     }
 }

@@ -267,6 +267,59 @@ pub fn integrator_warning(sys: &System, method: Method, h: f64) -> Option<String
     ))
 }
 
+/// The scene's plant: its model's flexible device (whose own delay joins
+/// the scene's delay effect), or the rigid reduction.
+fn device_of(scene: &mut Scene) -> Result<Device, Error> {
+    if !scene.effects.flexibility {
+        return Ok(Device::rigid(
+            scene.plant.rigid_mass_kg + scene.plant.handle_mass_kg,
+            scene.plant.rigid_damping_nspm,
+            235.0,
+        ));
+    }
+    let model = scene.device_model()?;
+    // The model's own measurement-to-actuation delay is part of the
+    // device: it runs as the delay effect, after any the scene adds.
+    if model.delay_samples > 0 {
+        let extra = scene.effects.delay.map_or(0, |d| d.ticks);
+        scene.effects.delay = Some(crate::engine::scene::DelayEffect {
+            ticks: extra + model.delay_samples,
+        });
+    }
+    Device::flexible(&model)
+}
+
+/// The integrator and its sub-steps a tick: the exact hold on a linear
+/// plant unless the scene asks otherwise; on a linkage's arm, which is
+/// nonlinear, fourth-order Runge-Kutta with at least 4 sub-steps.
+fn integrator_of(scene: &Scene, nonlinear: bool) -> (Method, u32) {
+    if scene.plant.linkage.is_some() {
+        (Method::Rk4, scene.integrator.substeps.max(4))
+    } else if nonlinear || scene.integrator.on_linear {
+        (scene.integrator.method, scene.integrator.substeps)
+    } else {
+        (Method::ExactZoh, 1)
+    }
+}
+
+/// The board's encoder for the scene's effects, the mask of its count
+/// and its picometres per count: ideal sensing counts 1 nm, the
+/// resolution of a Position.
+fn encoder_of(e: &crate::engine::scene::Effects) -> Result<(Encoder, u32, f64), Error> {
+    let (bits, pm_per_count) = match e.encoder {
+        Some(enc) => (enc.bits, (enc.resolution_m * 1e12).round()),
+        None => (32, 1000.0),
+    };
+    let mask = if bits >= 32 {
+        u32::MAX
+    } else {
+        (1u32 << bits) - 1
+    };
+    let encoder = Encoder::new(bits, pm_per_count as i64, 0, Position::ZERO)
+        .map_err(|e| format!("effects.encoder: {e:?}"))?;
+    Ok((encoder, mask, pm_per_count))
+}
+
 impl Simulation {
     /// Build a simulation for a one-axis `scene`.
     pub fn new(scene: Scene) -> Result<Self, Error> {
@@ -283,37 +336,12 @@ impl<const N: usize> Simulation<N> {
                 scene.axes
             ));
         }
-        let device = if scene.effects.flexibility {
-            let model = scene.device_model()?;
-            // The model's own measurement-to-actuation delay is part of the
-            // device: it runs as the delay effect, after any the scene adds.
-            if model.delay_samples > 0 {
-                let extra = scene.effects.delay.map_or(0, |d| d.ticks);
-                scene.effects.delay = Some(crate::engine::scene::DelayEffect {
-                    ticks: extra + model.delay_samples,
-                });
-            }
-            Device::flexible(&model)?
-        } else {
-            Device::rigid(
-                scene.plant.rigid_mass_kg + scene.plant.handle_mass_kg,
-                scene.plant.rigid_damping_nspm,
-                235.0,
-            )
-        };
+        let device = device_of(&mut scene)?;
         let e = scene.effects.clone();
         let period = scene.period();
         let humans = scene.humans()?;
         let nonlinear = scene.nonlinear();
-        let (method, substeps) = if scene.plant.linkage.is_some() {
-            // A linkage's arm is nonlinear: fourth-order Runge-Kutta, at
-            // least 4 sub-steps a tick.
-            (Method::Rk4, scene.integrator.substeps.max(4))
-        } else if nonlinear || scene.integrator.on_linear {
-            (scene.integrator.method, scene.integrator.substeps)
-        } else {
-            (Method::ExactZoh, 1)
-        };
+        let (method, substeps) = integrator_of(&scene, nonlinear);
         let h = period / substeps as f64;
         let mut warning = None;
         // Every axis's hand has the same grips (they come from one script).
@@ -328,18 +356,7 @@ impl<const N: usize> Simulation<N> {
                 Ok((g, Stepper::new(&sys, method, h)?))
             })
             .collect::<Result<_, Error>>()?;
-        let (bits, pm_per_count) = match e.encoder {
-            Some(enc) => (enc.bits, (enc.resolution_m * 1e12).round()),
-            // Ideal sensing: 1 nm counts, the resolution of a Position.
-            None => (32, 1000.0),
-        };
-        let mask = if bits >= 32 {
-            u32::MAX
-        } else {
-            (1u32 << bits) - 1
-        };
-        let encoder = Encoder::new(bits, pm_per_count as i64, 0, Position::ZERO)
-            .map_err(|e| format!("effects.encoder: {e:?}"))?;
+        let (encoder, mask, pm_per_count) = encoder_of(&e)?;
         let t32 = period as f32;
         let safety = SafetyConfig {
             period_s: t32,

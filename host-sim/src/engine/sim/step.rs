@@ -2,6 +2,7 @@
 
 use super::{round_counts, EffectCost, PassivityReport, Report, Sample, Simulation};
 use crate::engine::effects::Effect;
+use crate::engine::human::HandState;
 use crate::engine::servo::{frame_f32, output_f64};
 use crate::engine::stability::Verdict;
 use std::time::Instant;
@@ -60,7 +61,6 @@ impl<const N: usize> Simulation<N> {
             return self.step_linkage();
         }
         let t = self.time_of(self.tick);
-        let n = self.device.n;
         let timing = self.timing();
         let frame = self.sense(timing);
         let frame = self.effects.delay(frame, timing);
@@ -85,78 +85,12 @@ impl<const N: usize> Simulation<N> {
         };
         let mut s = Sample::<N>::default();
         let t0 = timing.then(Instant::now);
-        let dir = &self.actuator_dir;
-        for (i, axis) in self.axes.iter_mut().enumerate() {
-            let mut hand = axis.human.at(t);
-            if let Some(g) = self.grasp_override {
-                hand.grasp = g;
-            }
-            hand.push_n += axis.push_n;
-            hand.position_m += axis.offset_m;
-            // Behind an arm the hand is still: only pushes reach the handle.
-            let u = [
-                if axis.human.has_arm() {
-                    hand.push_n
-                } else {
-                    hand.input_force()
-                },
-                applied[i],
-            ];
-            let at = match axis.current {
-                Some((g, at)) if g == hand.grasp => at,
-                _ => {
-                    let at = self
-                        .steppers
-                        .iter()
-                        .position(|(g, _)| *g == hand.grasp)
-                        .expect("a stepper for every grasp in the script");
-                    axis.current = Some((hand.grasp, at));
-                    at
-                }
-            };
-            let stepper = &mut self.steppers[at].1;
-            match self.effects.forces() {
-                Some((forces, _)) => {
-                    let mut nl = |x: &[f64], f: &mut [f64]| forces.add(n, dir, x, f);
-                    for _ in 0..self.substeps {
-                        stepper.step(&mut axis.x, u, Some(&mut nl));
-                    }
-                }
-                None => {
-                    for _ in 0..self.substeps {
-                        stepper.step(&mut axis.x, u, None);
-                    }
-                }
-            }
-            let x_h = self.handle.of(&axis.x[..n]);
-            let v_h = self.handle.of(&axis.x[n..2 * n]);
-            let f_h = match axis.human.grasp_of(hand.grasp).arm {
-                Some(_) => {
-                    let g = hand.grasp.grasp();
-                    let at = 2 * n + usize::from(self.load_cell);
-                    g.stiffness_npm * (axis.x[at] - x_h)
-                        + g.damping_nspm * (axis.x[at + 1] - v_h)
-                        + hand.push_n
-                }
-                None => hand.force_on(x_h, v_h),
-            };
-            let p = f_h * v_h;
-            axis.energy_in += 0.5 * (p + axis.last_power) * self.period;
-            axis.last_power = p;
-            self.peak_force = self.peak_force.max(delivered[i].abs());
-            axis.detector.push(delivered[i]);
-            if self.failure.is_none() && (!x_h.is_finite() || x_h.abs() > 10.0 || !v_h.is_finite())
-            {
-                let on = if N == 1 {
-                    String::new()
-                } else {
-                    format!(" (axis {i})")
-                };
-                self.failure = Some(match &self.warning {
-                    Some(w) => format!("diverged{on}: the integrator is unstable ({w})"),
-                    None => format!("diverged{on}: the device ran 10 m away"),
-                });
-            }
+        for i in 0..N {
+            let hand = self.hand_of(i, t);
+            self.integrate(i, &hand, applied[i]);
+            let (x_h, v_h, f_h) = self.at_handle(i, &hand);
+            self.account(i, (x_h, v_h, f_h), delivered[i]);
+            let axis = &self.axes[i];
             (s.handle_m[i], s.handle_mps[i], s.human_n[i]) = (x_h, v_h, f_h);
             s.energy_in_j += axis.energy_in;
             if self.track_energy {
@@ -166,6 +100,7 @@ impl<const N: usize> Simulation<N> {
                 Some(l) if !is_external => {
                     // (The scene has a layer: the common case has none.)
                     let (e, a) = (l.energy_in_j(), l.added());
+                    let axis = &mut self.axes[i];
                     axis.layer_active += u64::from(a > 0.0);
                     axis.layer_lowest = axis.layer_lowest.min(e);
                     (e, a)
@@ -194,6 +129,104 @@ impl<const N: usize> Simulation<N> {
         s.ve_n = out.ve_force_n;
         s.coupling_n = out.coupling_force_n;
         s
+    }
+
+    /// Axis `i`'s hand at `t`: the script's, with the scope's grasp, push
+    /// and drag on it.
+    fn hand_of(&self, i: usize, t: f64) -> HandState {
+        let axis = &self.axes[i];
+        let mut hand = axis.human.at(t);
+        if let Some(g) = self.grasp_override {
+            hand.grasp = g;
+        }
+        hand.push_n += axis.push_n;
+        hand.position_m += axis.offset_m;
+        hand
+    }
+
+    /// Axis `i`'s plant through one tick, pushed by `hand` and the
+    /// actuator's `force_n`, on the stepper of the hand's grasp.
+    fn integrate(&mut self, i: usize, hand: &HandState, force_n: f64) {
+        let n = self.device.n;
+        let axis = &mut self.axes[i];
+        // Behind an arm the hand is still: only pushes reach the handle.
+        let u = [
+            if axis.human.has_arm() {
+                hand.push_n
+            } else {
+                hand.input_force()
+            },
+            force_n,
+        ];
+        let at = match axis.current {
+            Some((g, at)) if g == hand.grasp => at,
+            _ => {
+                let at = self
+                    .steppers
+                    .iter()
+                    .position(|(g, _)| *g == hand.grasp)
+                    .expect("a stepper for every grasp in the script");
+                axis.current = Some((hand.grasp, at));
+                at
+            }
+        };
+        let stepper = &mut self.steppers[at].1;
+        let dir = &self.actuator_dir;
+        match self.effects.forces() {
+            Some((forces, _)) => {
+                let mut nl = |x: &[f64], f: &mut [f64]| forces.add(n, dir, x, f);
+                for _ in 0..self.substeps {
+                    stepper.step(&mut axis.x, u, Some(&mut nl));
+                }
+            }
+            None => {
+                for _ in 0..self.substeps {
+                    stepper.step(&mut axis.x, u, None);
+                }
+            }
+        }
+    }
+
+    /// Axis `i`'s handle: position (m), velocity (m/s) and the force the
+    /// hand puts on it (N).
+    fn at_handle(&self, i: usize, hand: &HandState) -> (f64, f64, f64) {
+        let n = self.device.n;
+        let axis = &self.axes[i];
+        let x_h = self.handle.of(&axis.x[..n]);
+        let v_h = self.handle.of(&axis.x[n..2 * n]);
+        let f_h = match axis.human.grasp_of(hand.grasp).arm {
+            Some(_) => {
+                let g = hand.grasp.grasp();
+                let at = 2 * n + usize::from(self.load_cell);
+                g.stiffness_npm * (axis.x[at] - x_h)
+                    + g.damping_nspm * (axis.x[at + 1] - v_h)
+                    + hand.push_n
+            }
+            None => hand.force_on(x_h, v_h),
+        };
+        (x_h, v_h, f_h)
+    }
+
+    /// The energy the hand put into axis `i`, the force it was given, and
+    /// a handle that ran away.
+    fn account(&mut self, i: usize, (x_h, v_h, f_h): (f64, f64, f64), delivered_n: f64) {
+        let axis = &mut self.axes[i];
+        let p = f_h * v_h;
+        axis.energy_in += 0.5 * (p + axis.last_power) * self.period;
+        axis.last_power = p;
+        self.peak_force = self.peak_force.max(delivered_n.abs());
+        axis.detector.push(delivered_n);
+        if self.failure.is_none() && (!x_h.is_finite() || x_h.abs() > 10.0 || !v_h.is_finite()) {
+            let on = if N == 1 {
+                String::new()
+            } else {
+                format!(" (axis {i})")
+            };
+            self.failure = Some(match &self.warning {
+                Some(w) => format!("diverged{on}: the integrator is unstable ({w})"),
+                None => format!("diverged{on}: the device ran 10 m away"),
+            });
+        }
     }
 
     /// Run to the scene's end (or the first failure), passing each sample

@@ -113,8 +113,8 @@ impl Limit {
     /// The JSON key of the limit.
     fn key(self) -> &'static str {
         match self {
-            Limit::Stiffness => "k_c",
-            Limit::Mass => "m_c",
+            Limit::Stiffness => "k_c_npm",
+            Limit::Mass => "m_c_kg",
         }
     }
 
@@ -303,17 +303,17 @@ impl Serialize for Design {
         m.serialize_entry("feasible", &self.coupling.is_some())?;
         let key = self.limit.key();
         if let Some(r) = &self.regulator {
-            m.serialize_entry("kp", &r.kp)?;
-            m.serialize_entry("bp", &r.bp)?;
+            m.serialize_entry("kp_npm", &r.kp)?;
+            m.serialize_entry("bp_nspm", &r.bp)?;
             m.serialize_entry("regulator_pole_radius", &r.pole_radius)?;
         }
         if let Some((l, b)) = self.paper {
             m.serialize_entry(&format!("paper_{key}"), &l)?;
-            m.serialize_entry("paper_b_c", &b)?;
+            m.serialize_entry("paper_b_c_nspm", &b)?;
         }
         if let Some((l, b)) = self.coupling {
             m.serialize_entry(key, &l)?;
-            m.serialize_entry("b_c", &b)?;
+            m.serialize_entry("b_c_nspm", &b)?;
         }
         m.serialize_entry("binding_bound", &self.binding)?;
         m.serialize_entry("aliasing_effect", &self.aliasing_effect)?;

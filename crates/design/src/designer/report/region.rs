@@ -10,18 +10,18 @@ use std::fmt;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum RegionBound {
     /// The impedance display's greatest coupling stiffness (N/m).
-    #[serde(rename = "max_stiffness_npm")]
+    #[serde(rename = "k_max_npm")]
     MaxStiffness,
     /// The admittance display's least coupling mass (kg).
-    #[serde(rename = "min_mass_kg")]
+    #[serde(rename = "m_min_kg")]
     MinMass,
 }
 
 impl RegionBound {
     fn name(self) -> &'static str {
         match self {
-            RegionBound::MaxStiffness => "max_stiffness_npm",
-            RegionBound::MinMass => "min_mass_kg",
+            RegionBound::MaxStiffness => "k_max_npm",
+            RegionBound::MinMass => "m_min_kg",
         }
     }
 }
@@ -50,8 +50,8 @@ impl Serialize for Region {
                 .map(|r| if i == 0 { r.0 } else { r.1 })
                 .collect()
         };
-        m.serialize_entry("damping_nspm", &column(0))?;
-        m.serialize_entry("limit", &column(1))?;
+        m.serialize_entry("b_nspm", &column(0))?;
+        m.serialize_entry(self.bound.name(), &column(1))?;
         m.serialize_entry("regulator", &self.regulator)?;
         m.end()
     }
