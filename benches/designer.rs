@@ -120,9 +120,9 @@ fn verify(c: &mut Criterion) {
     group.finish();
 }
 
-/// The workspace certificate of the two 3-DOF linkages: a branch and
-/// bound over every pose inside the limits, to a gap of 1e-4 (goal: 1 s
-/// each).
+/// The workspace certificate of each shipped linkage: a branch and bound
+/// over every pose inside the limits, to a gap of 1e-4 (goal: 1 s for a
+/// 3-DOF arm).
 fn linkage(c: &mut Criterion) {
     use twoport_design::linkage::{certified_design, LinkageFile};
     for (name, text) in [
@@ -134,6 +134,11 @@ fn linkage(c: &mut Criterion) {
             "Falcon-like delta",
             include_str!("../models/linkages/falcon_like.toml"),
         ),
+        (
+            "Haply-2DIY-like pantograph",
+            include_str!("../models/linkages/haply_2diy.toml"),
+        ),
+        ("Hapkit", include_str!("../models/linkages/hapkit.toml")),
     ] {
         let file = LinkageFile::from_toml(text, name).unwrap();
         c.bench_function(&format!("{name}: workspace certificate"), |b| {
