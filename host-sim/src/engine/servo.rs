@@ -44,10 +44,12 @@ pub type LinkageSceneServo<const N: usize> = LinkageServo<Shifted, SceneWorld<f3
 /// in `R`.
 pub type LayeredServo<R, const N: usize = 1> = Servo<SceneWorld<R, N>, R, N, SceneLayer<R>>;
 
-/// `$e` on the (Cartesian) servo whatever its variant.
+/// `$e` on the (Cartesian) servo whatever its variant, borrowed as the
+/// call says: `each_servo!(&self, s => ...)` or
+/// `each_servo!(&mut self, s => ...)`.
 macro_rules! each_servo {
-    ($self:expr, $s:ident => $e:expr) => {
-        match $self {
+    (&$self:ident, $s:ident => $e:expr) => {
+        match &*$self {
             SceneServo::F32($s) => $e,
             SceneServo::F64($s) => $e,
             SceneServo::F32Layered($s) => $e,
@@ -58,12 +60,8 @@ macro_rules! each_servo {
             }
         }
     };
-}
-
-/// The same, to change it.
-macro_rules! each_servo_mut {
-    ($self:expr, $s:ident => $e:expr) => {
-        match $self {
+    (&mut $self:ident, $s:ident => $e:expr) => {
+        match &mut *$self {
             SceneServo::F32($s) => $e,
             SceneServo::F64($s) => $e,
             SceneServo::F32Layered($s) => $e,
@@ -281,12 +279,12 @@ impl<const N: usize> SceneServo<N> {
 
     /// The point each axis's coupling holds in the world.
     pub fn ve_position(&self) -> [Position; N] {
-        each_servo!(self, s => s.world().positions())
+        each_servo!(&self, s => s.world().positions())
     }
 
     /// The gains in force on each axis.
     pub fn gains(&self) -> [Gains; N] {
-        each_servo!(self, s => s.gains())
+        each_servo!(&self, s => s.gains())
     }
 
     /// The 3-D building-block world, where the scene runs it, as the
@@ -302,18 +300,18 @@ impl<const N: usize> SceneServo<N> {
                 cursor: b.cursor(),
             })
         }
-        each_servo!(self, s => view(s.world()))
+        each_servo!(&self, s => view(s.world()))
     }
 
     /// Grab the block the world's cursor touches (the scope's button);
     /// whether one was there.
     pub fn grab(&mut self) -> bool {
-        each_servo_mut!(self, s => s.world_mut().blocks_mut().is_some_and(|w| w.grab()))
+        each_servo!(&mut self, s => s.world_mut().blocks_mut().is_some_and(|w| w.grab()))
     }
 
     /// Let go of the world's held block.
     pub fn release(&mut self) {
-        each_servo_mut!(self, s => {
+        each_servo!(&mut self, s => {
             if let Some(w) = s.world_mut().blocks_mut() {
                 w.release();
             }
@@ -341,7 +339,7 @@ impl<const N: usize> SceneServo<N> {
     /// Change every axis's gains while running (the scope's sliders); they
     /// must be for the scene's display.
     pub fn set_gains(&mut self, g: [Gains; N]) -> Result<(), Error> {
-        each_servo_mut!(self, s => s.set_gains(g)).map_err(|e| Error::Sim(e.error.to_string()))
+        each_servo!(&mut self, s => s.set_gains(g)).map_err(|e| Error::Sim(e.error.to_string()))
     }
 
     /// Move the wall and change its stiffness on every axis while running
@@ -351,7 +349,7 @@ impl<const N: usize> SceneServo<N> {
             "wall position {surface_m} m is out of range (±2.147 m)"
         ))?;
         let k = stiffness_npm as f32;
-        each_servo_mut!(self, s => {
+        each_servo!(&mut self, s => {
             let ves = s.world_mut().axis_ves_mut();
             if ves.is_empty() {
                 return Err("the scene's VE is not a wall".into());

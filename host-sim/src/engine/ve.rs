@@ -33,10 +33,18 @@ pub enum SceneVe<R: Real = f32> {
     Passive(Box<PassiveVe<SceneVe<R>, R>>),
 }
 
-/// `$e` on the VE in any variant but the blocks, `$blocks` on those.
+/// `$e` on the VE in any variant but the blocks, `$blocks` on those,
+/// borrowed as the call says: `each!(&self, ...)` or
+/// `each!(&mut self, ...)`.
 macro_rules! each {
-    ($self:expr, $v:ident => $e:expr, $b:ident => $blocks:expr) => {
-        match $self {
+    (&mut $self:ident, $v:ident => $e:expr, $b:ident => $blocks:expr) => {
+        each!(@on &mut *$self, $v => $e, $b => $blocks)
+    };
+    (&$self:ident, $v:ident => $e:expr, $b:ident => $blocks:expr) => {
+        each!(@on &*$self, $v => $e, $b => $blocks)
+    };
+    (@on $borrowed:expr, $v:ident => $e:expr, $b:ident => $blocks:expr) => {
+        match $borrowed {
             SceneVe::Cursor($v) => $e,
             SceneVe::ExplicitCursor($v) => $e,
             SceneVe::LosslessCursor($v) => $e,
@@ -76,10 +84,10 @@ impl<'a, T> Unbox for &'a mut Box<T> {
 
 impl<R: Real> VirtualEnvironment<R> for SceneVe<R> {
     fn causality(&self) -> Causality {
-        each!(self, v => VirtualEnvironment::<R>::causality(v), b => b.causality())
+        each!(&self, v => VirtualEnvironment::<R>::causality(v), b => b.causality())
     }
     fn step(&mut self, port: Port<R>) -> VeOutput<R> {
-        each!(self, v => v.step(port), b => {
+        each!(&mut self, v => v.step(port), b => {
             let o = b.step(Port {
                 f0_n: port.f0_n.to_f32(),
                 z_nspm: port.z_nspm.to_f32(),
@@ -91,15 +99,15 @@ impl<R: Real> VirtualEnvironment<R> for SceneVe<R> {
         })
     }
     fn reset(&mut self, x: Position) {
-        each!(self, v => VirtualEnvironment::<R>::reset(v, x), b => b.reset(x))
+        each!(&mut self, v => VirtualEnvironment::<R>::reset(v, x), b => b.reset(x))
     }
     fn position(&self) -> Position {
-        each!(self, v => VirtualEnvironment::<R>::position(v), b => b.position())
+        each!(&self, v => VirtualEnvironment::<R>::position(v), b => b.position())
     }
     fn offset_m(&self, from: Position) -> R {
-        each!(self, v => VirtualEnvironment::<R>::offset_m(v, from), b => R::of(b.offset_m(from)))
+        each!(&self, v => VirtualEnvironment::<R>::offset_m(v, from), b => R::of(b.offset_m(from)))
     }
     fn tf(&self) -> VeTransfer {
-        each!(self, v => VirtualEnvironment::<R>::tf(v), b => b.tf())
+        each!(&self, v => VirtualEnvironment::<R>::tf(v), b => b.tf())
     }
 }
