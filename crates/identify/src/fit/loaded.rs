@@ -52,7 +52,7 @@ pub(super) fn refit_loaded(bare: &Fit, data: &Measured, loaded: &Loaded) -> Opti
     let w = m
         .modes
         .iter()
-        .map(|m| m.omega_rad_s)
+        .map(|m| m.mode.omega_n)
         .fold(TAU * data.position.freq_hz.last().copied()?, f64::min);
     // The load cell weighs the handle: at the lowest harmonics it reads
     // `m_h` per unit of acceleration bare and `m_h + m` loaded, so the

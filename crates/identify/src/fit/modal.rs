@@ -23,17 +23,16 @@
 //! admittance display depends on.
 
 use nalgebra::{DMatrix, DVector};
+use twoport_design::plant::Mode;
 use twoport_design::DeviceModel;
 
 use super::chain::ModelBase;
 
-/// One flexible mode.
+/// One flexible mode and its shape at the two points the fit sees.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Mode {
-    /// Natural frequency (rad/s).
-    pub omega_rad_s: f64,
-    /// Damping ratio.
-    pub zeta: f64,
+pub struct ModeShape {
+    /// The mode: its natural frequency (rad/s) and damping ratio.
+    pub mode: Mode,
     /// The mode's amplitude at the actuator (1/√kg; positive by choice of
     /// the mode's sign).
     pub actuator: f64,
@@ -62,7 +61,7 @@ pub struct Modal {
     /// `+1` if the load cell reads `k_lc (q_h − x_s)`, `−1` if the opposite.
     pub load_cell_sign: f64,
     /// The flexible modes, in no particular order.
-    pub modes: Vec<Mode>,
+    pub modes: Vec<ModeShape>,
     /// Damping that couples the modes (the rigid body first), as a share
     /// of the geometric mean of the two modes' own: `ρ_ij` for each pair
     /// `i < j`, row by row. Zero is proportional damping; a device's
@@ -112,8 +111,8 @@ impl Modal {
         let root = self.mass_kg.sqrt();
         for m in &self.modes {
             v.extend([
-                m.omega_rad_s.ln(),
-                m.zeta.max(1e-300).ln(),
+                m.mode.omega_n.ln(),
+                m.mode.zeta.max(1e-300).ln(),
                 (m.actuator * root).max(1e-300).ln(),
                 m.load_cell * root,
             ]);
@@ -144,9 +143,11 @@ impl Modal {
         let modes = (0..r)
             .map(|i| {
                 let at = GLOBAL + PER_MODE * i;
-                Mode {
-                    omega_rad_s: e(at),
-                    zeta: e(at + 1),
+                ModeShape {
+                    mode: Mode {
+                        omega_n: e(at),
+                        zeta: e(at + 1),
+                    },
                     actuator: e(at + 2) / root,
                     load_cell: p[at + 3] / root,
                 }
@@ -209,7 +210,7 @@ impl Modal {
         d[(h, h)] += self.handle_nspm;
         let mut own = vec![self.damping_nspm / self.mass_kg];
         for m in &self.modes {
-            own.push(2.0 * m.zeta * m.omega_rad_s);
+            own.push(2.0 * m.mode.zeta * m.mode.omega_n);
         }
         let mut modal = DMatrix::from_diagonal(&DVector::from_vec(own.clone()));
         let mut rho = self.coupling.iter();
@@ -229,7 +230,7 @@ impl Modal {
             }
         }
         for (i, m) in self.modes.iter().enumerate() {
-            k[(i + 1, i + 1)] += m.omega_rad_s * m.omega_rad_s;
+            k[(i + 1, i + 1)] += m.mode.omega_n * m.mode.omega_n;
         }
         let mut g = DMatrix::zeros(n, 2);
         g[(h, 0)] = 1.0;

@@ -6,13 +6,14 @@
 //! load cell, not a continuous-time approximation that is off near
 //! Nyquist.
 
-use super::modal::{Modal, Mode};
+use super::modal::{Modal, ModeShape};
 use super::Measured;
 use crate::frf::Frf;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use num_complex::Complex64;
 use std::f64::consts::TAU;
 use twoport_design::linalg::expm_balanced;
+use twoport_design::plant::Mode;
 
 /// A pole of one basis response: `s² + a1 s + a0`.
 #[derive(Clone, Copy, Debug)]
@@ -254,9 +255,11 @@ pub fn modal_start(
         .enumerate()
         .map(|(i, (w, z))| {
             let actuator = rx[i + 1].max(1e-6 * rx[0]).sqrt();
-            Mode {
-                omega_rad_s: *w,
-                zeta: *z,
+            ModeShape {
+                mode: Mode {
+                    omega_n: *w,
+                    zeta: *z,
+                },
                 actuator,
                 load_cell: -rf[i + 1] / (sign * handle_kg * actuator),
             }
