@@ -1,7 +1,7 @@
 //! The command line's arguments, the checks on them, and the run over a
 //! device file's axes.
 
-use crate::run::{print, Reported};
+use crate::run::{print, show, Reported};
 use clap::{Args, Subcommand, ValueEnum};
 use serde_json::json;
 use std::path::PathBuf;
@@ -302,7 +302,7 @@ pub(crate) type OnAxis<A> = fn(&A, Option<&DeviceAxis>) -> Reported;
 pub(crate) fn each_axis<A: HasCommon>(args: &A, run: OnAxis<A>) -> Result<(), String> {
     let c = args.common();
     let Some(path) = &c.device else {
-        return print(c.json, &*run(args, None)?);
+        return show(c.json, run(args, None));
     };
     let device = Device::load(path).map_err(|e| e.to_string())?;
     let mut axes = Vec::new();
@@ -334,7 +334,7 @@ pub(crate) fn one_axis<A: HasCommon>(args: &A, run: OnAxis<A>) -> Result<(), Str
             "--device {}: this command draws one axis; give that axis's --model",
             p.display()
         )),
-        None => print(c.json, &*run(args, None)?),
+        None => show(c.json, run(args, None)),
     }
 }
 
