@@ -74,6 +74,10 @@ pub fn least(points: &[PlantPoint], v: &[f64]) -> (f64, f64) {
             continue;
         }
         let (x0, x1, x2) = (points[i - 1].omega, p.omega, points[i + 1].omega);
+        // (Nearly coincident points give a parabola of rounding noise.)
+        if (x1 - x0).min(x2 - x1) <= grid::COINCIDENT * x1 {
+            continue;
+        }
         let (y0, y1, y2) = (v[i - 1], *y, v[i + 1]);
         if !(y0.is_finite() && y1.is_finite() && y2.is_finite()) {
             continue;

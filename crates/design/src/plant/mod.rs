@@ -4,10 +4,12 @@
 
 mod features;
 mod modal;
+mod precise;
 
 pub use features::Feature;
 
 use modal::Modal;
+use precise::Precise;
 
 use crate::linalg::{balance, expm_balanced, hessenberg_shift_solve, lu_solve};
 use crate::DeviceModel;
@@ -128,6 +130,8 @@ pub struct Plant {
     /// the output rows for `-x_a` and `f_m`: kept for a second method.
     zoh: (usize, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>),
     modal: Option<Modal>,
+    /// The terms in double-double, for the limit toward DC.
+    precise: Option<Precise>,
     modes: Vec<Mode>,
     discrete_angles: Vec<f64>,
     features: Vec<Feature>,
@@ -242,7 +246,7 @@ impl Plant {
             c_xa.clone(),
             c_fm.clone(),
         );
-        let fma = Siso::new(ad.clone(), bd_act, c_fm);
+        let fma = Siso::new(ad.clone(), bd_act, c_fm.clone());
 
         let a_q = a.view((0, 0), (2 * n, 2 * n)).into_owned();
         let unsettled = "the device's poles could not be found (a number is not finite, or the eigenvalue iteration did not settle)";
@@ -275,6 +279,7 @@ impl Plant {
         }
         c_out[(2, 2 * n)] = 1.0;
         let modal = Modal::new(&a, &b, &c_out);
+        let precise = Precise::new(model, period_s, &c_xa, &c_fm);
         let mut plant = Plant {
             n,
             period_s,
@@ -289,6 +294,7 @@ impl Plant {
             fma,
             zoh,
             modal,
+            precise,
             modes,
             discrete_angles,
             features,
@@ -463,6 +469,20 @@ impl Plant {
             fma_d: self.fma.eval(z, work),
             delay: z.powi(-(self.delay_samples as i32)),
         }
+    }
+
+    /// [`at`](Self::at) with the device's terms in double-double
+    /// arithmetic, rounded to `f64`: for the lowest frequencies, where the
+    /// design inequality is the small difference of terms that grow toward
+    /// DC. There a floating stiff device's terms in `f64` lose the rigid
+    /// body's double pole at `z = 1` to its stiffness's rounding (see
+    /// `precise`). `None` where the double-double model cannot be built.
+    pub fn at_precise(&self, omega: f64, work: &mut Scratch) -> Option<PlantPoint> {
+        let p = self.precise.as_ref()?;
+        let mut point = self.at(omega, work);
+        (point.y, point.f) = p.continuous(omega);
+        (point.xaa_d, point.fma_d) = p.eval(omega * self.period_s);
+        Some(point)
     }
 
     /// `X_aa^d` and `F_ma^d` alone at `omega` (rad/s), as [`at`](Self::at)
