@@ -573,12 +573,13 @@ impl Designer {
         let mut worst: Option<(crate::verify::Verdict, &str)> = None;
         let mut evaluations = 0;
         for p in &self.poses {
-            let v = crate::verify::verify(
+            let v = crate::verify::verify_near(
                 &p.model,
                 self.period_s(),
                 gains,
                 self.human,
                 p.model.delay_samples as usize,
+                &self.binding_hz(p, gains),
             )?;
             evaluations += v.evaluations;
             let worse = worst.as_ref().is_none_or(|w| {
@@ -595,6 +596,39 @@ impl Designer {
             verdict,
             worst_pose: self.pose_name(pose),
         })
+    }
+}
+
+impl Designer {
+    /// Where the proof binds at `gains` in `pose`: the frequency of the
+    /// least margin on its grid (and the regulated loop's extra points, on
+    /// the admittance display); none where the gains cannot be checked.
+    fn binding_hz(&self, pose: &Pose, gains: &Gains) -> Vec<f64> {
+        let check = match *gains {
+            Gains::Impedance(g) => analysis::check_impedance(
+                &pose.analysis,
+                f64::from(g.k_npm),
+                f64::from(g.b_nspm),
+                self.human,
+            ),
+            Gains::Admittance(g) => {
+                let kp = (f64::from(g.kp_npm), f64::from(g.bp_nspm));
+                let Ok(k) = analysis::regulator_tf(kp.0, kp.1, self.period_s()) else {
+                    return Vec::new();
+                };
+                let reg = self.regulated(kp, &k);
+                let at = (f64::from(g.m_kg), f64::from(g.b_nspm));
+                return reg
+                    .analyses(&self.poses)
+                    .filter(|(p, _)| std::ptr::eq(*p, pose))
+                    .filter_map(|(p, a)| {
+                        analysis::check_admittance(&p.plant, a, kp, at, self.human)
+                    })
+                    .map(|c| c.worst_frequency_hz)
+                    .collect();
+            }
+        };
+        check.map(|c| c.worst_frequency_hz).into_iter().collect()
     }
 }
 

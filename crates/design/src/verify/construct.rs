@@ -154,52 +154,65 @@ pub fn construct(
         grasp: human,
         delay: delay_samples,
     };
-    let (w, (m, k), _) = frequencies_hz
+    let mut candidates: Vec<(f64, (f64, f64), f64)> = frequencies_hz
         .iter()
         .map(|f| 2.0 * PI * f)
         .filter_map(|w| set.worst_hand(w, &seeds).map(|(h, r)| (w, h, r)))
         .filter(|(_, _, r)| *r > 0.0)
-        .max_by(|a, b| a.2.total_cmp(&b.2))?;
-    // A root of Re S on a path from there to where Re S < 0: the hand
-    // scaled toward zero (it lets go, and the open device with its
-    // coupling is stable), or, where even the free hand violates it, the
-    // frequency moved off the violation with the hand kept.
-    let re = |scale: f64, w: f64| set.s(&set.hand((m * scale, k * scale)), w).map(|s| s.re);
-    let (scale, w) = if re(1e-12, w)? < 0.0 {
-        let l = root(|l| re(l.exp(), w), (1e-12f64).ln(), 0.0)?;
-        (l.exp(), w)
-    } else {
-        let off = (1..=60)
-            .map(|i| w * (1.0 + 0.002 * f64::from(i / 2) * if i % 2 == 0 { 1.0 } else { -1.0 }))
-            .find(|&v| v > 0.0 && v * period_s <= PI && re(1.0, v).is_some_and(|r| r < 0.0))?;
-        (1.0, root(|v| re(1.0, v), off, w)?)
-    };
-    let hand = set.hand((m * scale, k * scale));
-    let s = set.s(&hand, w)?;
-    let half = 0.5 * w * period_s;
-    // The lossless VE of immittance j Im S, as an admittance j β: a
-    // lossless mass below the real axis, a lossless spring above it.
-    let beta = match gains {
-        Gains::Impedance(_) => s.im,
-        Gains::Admittance(_) => -1.0 / s.im,
-    };
-    let ve = if beta < 0.0 {
-        Ve::LosslessMass {
-            mass_kg: period_s / (2.0 * half.tan() * -beta),
-        }
-    } else {
-        Ve::TrapezoidalSpring {
-            stiffness_npm: 2.0 * half.tan() / (period_s * beta),
-            damping_nspm: 0.0,
-        }
-    };
-    let termination = Termination { hand, ve };
-    let r: Radius = radius(model, period_s, &gains, &termination, delay_samples).ok()?;
-    Some(Constructed {
-        frequency_hz: w / (2.0 * PI),
-        termination,
-        spectral_radius: r.spectral_radius,
-    })
+        .collect();
+    candidates.sort_by(|a, b| b.2.total_cmp(&a.2));
+    // The worst violation first; where no root can be had there, the next.
+    candidates
+        .into_iter()
+        .find_map(|(w, hand, _)| set.pole_on_circle(w, hand))
+}
+
+impl Setting<'_> {
+    /// The hand `(m, k)` scaled, or the frequency `w` moved, to the root
+    /// of `Re S`, and the lossless VE that closes a pole there.
+    fn pole_on_circle(&self, w: f64, (m, k): (f64, f64)) -> Option<Constructed> {
+        let period_s = self.t;
+        // A root of Re S on a path from there to where Re S < 0: the hand
+        // scaled toward zero (it lets go, and the open device with its
+        // coupling is stable), or, where even the free hand violates it, the
+        // frequency moved off the violation with the hand kept.
+        let re = |scale: f64, w: f64| self.s(&self.hand((m * scale, k * scale)), w).map(|s| s.re);
+        let (scale, w) = if re(1e-12, w)? < 0.0 {
+            let l = root(|l| re(l.exp(), w), (1e-12f64).ln(), 0.0)?;
+            (l.exp(), w)
+        } else {
+            let off = (1..=60)
+                .map(|i| w * (1.0 + 0.002 * f64::from(i / 2) * if i % 2 == 0 { 1.0 } else { -1.0 }))
+                .find(|&v| v > 0.0 && v * period_s <= PI && re(1.0, v).is_some_and(|r| r < 0.0))?;
+            (1.0, root(|v| re(1.0, v), off, w)?)
+        };
+        let hand = self.hand((m * scale, k * scale));
+        let s = self.s(&hand, w)?;
+        let half = 0.5 * w * period_s;
+        // The lossless VE of immittance j Im S, as an admittance j β: a
+        // lossless mass below the real axis, a lossless spring above it.
+        let beta = match self.gains {
+            Gains::Impedance(_) => s.im,
+            Gains::Admittance(_) => -1.0 / s.im,
+        };
+        let ve = if beta < 0.0 {
+            Ve::LosslessMass {
+                mass_kg: period_s / (2.0 * half.tan() * -beta),
+            }
+        } else {
+            Ve::TrapezoidalSpring {
+                stiffness_npm: 2.0 * half.tan() / (period_s * beta),
+                damping_nspm: 0.0,
+            }
+        };
+        let termination = Termination { hand, ve };
+        let r: Radius = radius(self.model, period_s, &self.gains, &termination, self.delay).ok()?;
+        Some(Constructed {
+            frequency_hz: w / (2.0 * PI),
+            termination,
+            spectral_radius: r.spectral_radius,
+        })
+    }
 }
 
 /// The root of `f` between `neg` (where `f < 0`) and `pos` (where

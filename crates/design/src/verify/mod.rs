@@ -171,7 +171,7 @@ pub(crate) use simplex::maximise as simplex_maximise;
 use closed_loop::{closed_loop, judge};
 pub use construct::{construct, Constructed};
 pub use host::{host_radius, monodromy, verify_host, HostVerdict};
-pub use search::verify;
+pub use search::{verify, verify_near};
 
 /// The closed loop's spectral radius for one termination.
 pub fn radius(

@@ -169,6 +169,23 @@ pub fn verify(
     human: Option<HumanBound>,
     delay_samples: usize,
 ) -> Result<Verdict, crate::Error> {
+    verify_near(model, period_s, gains, human, delay_samples, &[])
+}
+
+/// [`verify`], first at `binding_hz`: the frequencies where the proof
+/// binds at these gains (the designer's check knows them). Hands resonant
+/// there and at their aliases join the sweep, and the constructive search
+/// tries them before the frequencies the sweep found: a counterexample
+/// just past a tight design sits at the design's own binding frequency,
+/// where a sweep of resonances may never land.
+pub fn verify_near(
+    model: &DeviceModel,
+    period_s: f64,
+    gains: &Gains,
+    human: Option<HumanBound>,
+    delay_samples: usize,
+    binding_hz: &[f64],
+) -> Result<Verdict, crate::Error> {
     if !(period_s.is_finite() && period_s > 0.0) {
         return Err(crate::Error::Verify {
             model: model.name.clone(),
@@ -193,8 +210,8 @@ pub fn verify(
         delay_samples,
     )?;
     let freqs = band(period_s);
-    let hands = hand_starts(model, period_s, human, &freqs);
-    let ves = ve_starts(gains, &freqs);
+    let hands = hand_starts(model, period_s, human, &freqs, binding_hz);
+    let ves = ve_starts(gains, freqs.iter().chain(binding_hz));
     let mut starts: Vec<(f64, VeKind, Vec<f64>)> = Vec::new();
     for h in &hands {
         for (kind, vp) in &ves {
@@ -245,7 +262,8 @@ pub fn verify(
     s.two = two;
     // The constructive search, from the worst hands found and a sweep of
     // its own, at the frequencies they bind.
-    let mut freqs: Vec<f64> = finals.iter().take(5).map(|f| f.3).collect();
+    let mut freqs: Vec<f64> = binding_hz.to_vec();
+    freqs.extend(finals.iter().take(5).map(|f| f.3));
     freqs.push(r.frequency_hz);
     let constructed = construct(
         model,
@@ -278,18 +296,31 @@ fn band(period_s: f64) -> Vec<f64> {
 /// The hands the search starts from, as `[log m, log k, log b]`: one held
 /// off, and resonances across `freqs` and exactly at multiples of
 /// Nyquist, where the sampled poles of the hand's resonance meet on the
-/// real axis (the narrowest and worst hands): there the spring is tuned
-/// to the hand's mass plus the device's inertia at the handle.
+/// real axis (the narrowest and worst hands), and at the proof's
+/// `binding_hz` and their aliases: there the spring is tuned to the
+/// hand's mass plus the device's inertia at the handle.
 fn hand_starts(
     model: &DeviceModel,
     period_s: f64,
     human: Option<HumanBound>,
     freqs: &[f64],
+    binding_hz: &[f64],
 ) -> Vec<[f64; 3]> {
     let nyq_hz = 0.5 / period_s;
     let mut hands: Vec<[f64; 3]> = vec![HELD_OFF];
     let mut tuned: Vec<(f64, bool)> = freqs.iter().map(|f| (*f, false)).collect();
     tuned.extend((1..=8).map(|j| (j as f64 * nyq_hz, true)));
+    // The binding frequencies and their aliases, tuned to the device's
+    // inertia there as at Nyquist's multiples.
+    let fs = 2.0 * nyq_hz;
+    for f in binding_hz.iter().filter(|f| f.is_finite() && **f > 0.0) {
+        for alias in [*f, fs - f, fs + f, 2.0 * fs - f] {
+            if alias > 0.0 {
+                tuned.push((alias, true));
+                tuned.push((alias, false));
+            }
+        }
+    }
     for (f, exact) in tuned {
         let w = 2.0 * PI * f;
         let inertia = if exact && human.is_none() {
@@ -310,7 +341,7 @@ fn hand_starts(
 /// are: a mass on the impedance display's spring, a spring on the
 /// admittance display's mass (the narrow terminations a coarse sweep
 /// steps over).
-fn ve_starts(gains: &Gains, freqs: &[f64]) -> Vec<(VeKind, Vec<f64>)> {
+fn ve_starts<'a>(gains: &Gains, freqs: impl Iterator<Item = &'a f64>) -> Vec<(VeKind, Vec<f64>)> {
     let mut ves: Vec<(VeKind, Vec<f64>)> = vec![(VeKind::Constraint, vec![])];
     for m in [-2.0, -1.0, 0.0, 1.0] {
         ves.push((VeKind::Cursor, vec![m]));
