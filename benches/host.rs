@@ -7,9 +7,9 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use std::time::Duration;
-use twoport_host::{Axes, Board, BoardPort, Contact, LinkError};
+use twoport_host::{Axes, BoardPort, Contact, HostBoard, LinkError};
 use twoport_link::{
-    encode, AxisTelemetry, Decoder, Message, Mode, Telemetry, MAX_FRAME, PROTOCOL_VERSION,
+    encode, AxisTelemetry, BoardMode, Decoder, Message, Telemetry, MAX_FRAME, PROTOCOL_VERSION,
 };
 
 /// A board that answers the handshake and the spec request as the
@@ -69,7 +69,7 @@ impl BoardPort for Replay {
                     actuator_n: 1.989,
                     ve_position_pm: 5_000_000_000,
                 }),
-                mode: Mode::Armed,
+                mode: BoardMode::Armed,
                 session: self.session,
                 ve_seq: self.tick,
                 ..Telemetry::default()
@@ -91,7 +91,7 @@ fn host(c: &mut Criterion) {
         tick: 0,
         seq: 0,
     };
-    let mut b = Board::open(port, 1).unwrap();
+    let mut b = HostBoard::open(port, 1).unwrap();
     c.bench_function("host: one streamed state read (poll)", |bench| {
         bench.iter(|| {
             let n = b.poll().unwrap();

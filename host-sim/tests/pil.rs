@@ -157,7 +157,7 @@ fn an_uncalibrated_board_refuses_to_arm_by_name() {
         "{e}"
     );
     session.calibrate(Axes::one(0)).unwrap();
-    assert_eq!(session.arm().unwrap().mode, twoport_link::Mode::Armed);
+    assert_eq!(session.arm().unwrap().mode, twoport_link::BoardMode::Armed);
 }
 
 /// An in-process board that reboots (a fresh image, as after a watchdog
@@ -223,7 +223,7 @@ fn a_rebooted_board_is_seen_by_its_session_not_by_timing() {
 #[ignore = "needs the watchdog-test image in QEMU; run by `cargo xtask watchdog`"]
 fn a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed() {
     use twoport_control::Faults as F;
-    use twoport_link::Mode;
+    use twoport_link::BoardMode;
     let pty = std::env::var("TWOPORT_PTY").expect("TWOPORT_PTY names the board's pty");
     let open = || {
         link::Session::open(
@@ -272,7 +272,7 @@ fn a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed() {
     drop(s);
     let mut s = open().expect("the board answers again after the reset");
     let st = s.status().unwrap();
-    assert_eq!((st.mode, st.calibrated), (Mode::Disarmed, false));
+    assert_eq!((st.mode, st.calibrated), (BoardMode::Disarmed, false));
     // The reset latched first. (The frame that showed the host the reset
     // carried the plant's position, 10 mm from where the rebooted
     // encoder's count starts: that tick's velocity latches too.)
@@ -304,7 +304,7 @@ fn a_hung_loop_is_reset_by_the_watchdog_and_comes_back_disarmed() {
     // Seen and cleared, it arms again.
     s.send(&twoport_link::Message::ClearFaults).unwrap();
     assert_eq!(s.status().unwrap().faults, 0);
-    assert_eq!(s.arm().unwrap().mode, Mode::Armed);
+    assert_eq!(s.arm().unwrap().mode, BoardMode::Armed);
 }
 
 /// A board homing on its encoder's index: it stops at the first pulse,
@@ -350,7 +350,7 @@ fn the_board_plays_the_scenes_experiment_and_streams_every_tick() {
     )
     .unwrap();
     let (played, at) = r.experiment.unwrap();
-    assert_eq!(played, twoport_link::Experiment { periods: 3, ..x });
+    assert_eq!(played, twoport_link::ExperimentRequest { periods: 3, ..x });
     assert_eq!(at, r.armed_at_tick + 300);
     let log = r.experiment_log(true).unwrap().unwrap();
     assert_eq!(log.force_n.len(), 3000);
@@ -362,7 +362,7 @@ fn the_board_plays_the_scenes_experiment_and_streams_every_tick() {
         assert!((f - want).abs() < 2e-3, "tick {n}: {f} against {want}");
     }
     let last = r.telemetry.last().unwrap();
-    assert_eq!(last.mode, twoport_link::Mode::Disarmed);
+    assert_eq!(last.mode, twoport_link::BoardMode::Disarmed);
     let c = pil::compare(&r, &r);
     assert!(pil::failures(&r, &c, 4000, LinkFaults::default(), 0).is_empty());
 }
@@ -435,7 +435,7 @@ fn the_fast_image_holds_a_wall_sent_from_the_host_at_1_khz() {
     let ve_max = r
         .telemetry
         .iter()
-        .filter(|t| t.mode == twoport_link::Mode::Armed)
+        .filter(|t| t.mode == twoport_link::BoardMode::Armed)
         .map(|t| t.axes[0].ve_position_pm)
         .max();
     assert_eq!(ve_max, Some(10_000_000_000));

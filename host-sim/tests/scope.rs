@@ -7,11 +7,11 @@ use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use host_sim::scope::app::{ScopeState, Speed, RING_SAMPLES};
 use host_sim::scope::board::BoardChoice;
-use host_sim::scope::board::BoardMode;
+use host_sim::scope::board::WithBoard;
 use host_sim::scope::signals::{BoardSignal, Signal};
 use std::path::Path;
 use twoport_control::servo::{Gains, ImpedanceGains};
-use twoport_link::{Axes, Message, Mode};
+use twoport_link::{Axes, BoardMode, Message};
 
 fn harness() -> Harness<'static, (ScopeState, BoardChoice)> {
     harness_on("../scenes/stiff_wall.toml")
@@ -171,7 +171,7 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
         assert!(s.tick(), "{:?}", s.message);
     }
     let b = s.board.as_ref().unwrap();
-    assert_eq!(b.status.map(|st| st.mode), Some(Mode::Disarmed));
+    assert_eq!(b.status.map(|st| st.mode), Some(BoardMode::Disarmed));
     assert_eq!(b.refusal.as_deref(), Some("Arm refused: NotCalibrated"));
     // Calibrated where it stands (at rest at 0), it arms.
     s.tell_board(Message::Calibrate {
@@ -183,7 +183,10 @@ fn board_mode_shows_telemetry_and_the_boards_gain_answers() {
     }
     let b = s.board.as_ref().unwrap();
     let st = b.status.expect("the board's status");
-    assert_eq!((st.mode, st.calibrated, st.faults), (Mode::Armed, true, 0));
+    assert_eq!(
+        (st.mode, st.calibrated, st.faults),
+        (BoardMode::Armed, true, 0)
+    );
     let t = b.telemetry.expect("telemetry from the board");
     assert!(t.tick >= 1900, "tick {}", t.tick);
     assert!(s.board_ring(BoardSignal::Actuator).len() >= 150);

@@ -6,7 +6,7 @@
 
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
-use host_sim::scope::board::BoardMode;
+use host_sim::scope::board::WithBoard;
 use host_sim::scope::world::WorldState;
 use host_sim::Scene;
 use std::path::Path;
@@ -78,7 +78,7 @@ fn the_grab_button_and_the_drag_move_the_block() {
 #[test]
 fn board_mode_drives_a_three_axis_board_and_plots_every_axis() {
     use host_sim::link::LocalBoard;
-    use twoport_link::{Message, Mode};
+    use twoport_link::{BoardMode, Message};
     let scene = Scene::load(Path::new("../scenes/xyz/pil_blocks.toml"), &[]).unwrap();
     let mut s = WorldState::<3>::new(scene).unwrap();
     let board = LocalBoard::excalibur_xyz().unwrap();
@@ -98,7 +98,7 @@ fn board_mode_drives_a_three_axis_board_and_plots_every_axis() {
     }
     assert_eq!(s.message, None);
     let b = s.board.as_ref().unwrap();
-    assert_eq!(b.status.map(|st| st.mode), Some(Mode::Armed));
+    assert_eq!(b.status.map(|st| st.mode), Some(BoardMode::Armed));
     assert_eq!(b.telemetry.expect("telemetry").axes.len(), 3);
     let peak = |r: &host_sim::scope::rings::Ring| r.iter().map(|p| p.1.abs()).fold(0.0, f64::max);
     for a in 0..3 {

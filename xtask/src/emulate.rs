@@ -307,7 +307,9 @@ pub(crate) fn device(args: &[String]) -> Result<(), String> {
     };
     with_device(&elf, |pty| {
         let Some((exe, lib)) = &example else {
-            eprintln!("xtask: open {pty} with twoport_host::Board::open_serial; Ctrl-C stops it");
+            eprintln!(
+                "xtask: open {pty} with twoport_host::HostBoard::open_serial; Ctrl-C stops it"
+            );
             loop {
                 std::thread::sleep(std::time::Duration::from_secs(3600));
             }

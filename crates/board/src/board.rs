@@ -19,8 +19,8 @@ use twoport_control::servo::{Direct, Gains, SensorFrame, Servo, ServoOutput};
 use twoport_control::world::World;
 use twoport_control::{Faults, Position};
 use twoport_link::{
-    encode, ActuatorFrame, Axes, AxisRefusal, AxisTelemetry, Decoder, GainsReply, LinkStats,
-    Message, Mode, Refusal, Stats, Telemetry, MAX_AXES, MAX_FRAME, NO_SESSION,
+    encode, ActuatorFrame, Axes, AxisRefusal, AxisTelemetry, BoardMode, Decoder, GainsReply,
+    LinkStats, Message, Refusal, Stats, Telemetry, MAX_AXES, MAX_FRAME, NO_SESSION,
 };
 
 /// One encoded frame, delimiter included.
@@ -66,19 +66,19 @@ pub struct Board<W, const R: usize, const N: usize = 1, L = Direct, D = Servo<W,
     /// Ticks run from the board's own sensors (their frame's `tick`).
     ticks: u32,
     /// The state machine: disarmed at boot.
-    mode: Mode,
+    mode: BoardMode,
     /// The host's session, stamped on every answer ([`NO_SESSION`] from
     /// boot until a handshake): a host sees a reset by it.
     session: u16,
     /// Whether the encoder's offset is known.
     calibrated: bool,
     /// How each axis homes, and the run in progress (in
-    /// [`Mode::Homing`]): an axis that has homed holds no force while the
+    /// [`BoardMode::Homing`]): an axis that has homed holds no force while the
     /// others go on.
     homing_cfg: [HomingConfig; N],
     homing: Option<[Option<Homing>; N]>,
     /// The identification experiment in progress (in
-    /// [`Mode::Identifying`]).
+    /// [`BoardMode::Identifying`]).
     experiment: Option<Experiment<N>>,
     /// The host's VE, when the coupling holds it instead of the image's
     /// (protocol 8).
@@ -176,7 +176,7 @@ where
             pil_refused: 0,
             pending: None,
             ticks: 0,
-            mode: Mode::Disarmed,
+            mode: BoardMode::Disarmed,
             session: NO_SESSION,
             calibrated: false,
             homing_cfg: [HomingConfig::gentle(Position::ZERO, period_s); N],
@@ -371,7 +371,7 @@ where
                 // the host's call waits for one.)
                 let was = self.mode;
                 self.disarm();
-                if was == Mode::Disarmed {
+                if was == BoardMode::Disarmed {
                     self.queue_status();
                 }
             }
@@ -561,7 +561,7 @@ where
         self.motor = driven.motor;
         // (Telemetry of this tick goes out in the experiment's mode, even
         // on the tick that ends it.)
-        let identifying = self.mode == Mode::Identifying;
+        let identifying = self.mode == BoardMode::Identifying;
         self.after_experiment_tick();
         self.after_tick(&out);
         if !out.faults.is_empty() && out.faults != self.reported {
@@ -594,7 +594,7 @@ where
                     faults: out.faults.0,
                     loop_cycles: self.loop_cycles,
                     mode: if identifying {
-                        Mode::Identifying
+                        BoardMode::Identifying
                     } else {
                         self.mode
                     },

@@ -7,47 +7,11 @@
 use crate::io::{EncoderScale, IoScale};
 use crate::region::{Bound, Region, RegionError};
 use crate::Board;
+use crate::BuildError;
 use twoport_control::homing::HomingConfig;
 use twoport_control::passivity::{PassivityLimits, SeriesDamper};
-use twoport_control::servo::GainsError;
 use twoport_control::ve::{Solid, UnilateralWall};
-use twoport_control::{
-    AxisError, Encoder, EncoderError, ImpedanceGains, ParamError, Position, SafetyConfig, Servo,
-};
-
-/// Why the board image could not be built (a constant here is wrong).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum BuildError {
-    /// A law's parameter.
-    Param(ParamError),
-    /// The encoder's.
-    Encoder(EncoderError),
-    /// The shipped region table.
-    Region(RegionError),
-    /// The servo's gains or port layer, on the axis it names.
-    Servo(AxisError<GainsError>),
-}
-
-impl From<ParamError> for BuildError {
-    fn from(e: ParamError) -> Self {
-        BuildError::Param(e)
-    }
-}
-impl From<EncoderError> for BuildError {
-    fn from(e: EncoderError) -> Self {
-        BuildError::Encoder(e)
-    }
-}
-impl From<AxisError<GainsError>> for BuildError {
-    fn from(e: AxisError<GainsError>) -> Self {
-        BuildError::Servo(e)
-    }
-}
-impl From<RegionError> for BuildError {
-    fn from(e: RegionError) -> Self {
-        BuildError::Region(e)
-    }
-}
+use twoport_control::{Encoder, ImpedanceGains, Position, SafetyConfig, Servo};
 
 pub mod fast;
 pub mod xyz;

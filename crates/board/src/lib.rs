@@ -4,6 +4,7 @@
 #![warn(missing_docs)]
 
 mod board;
+mod build_error;
 pub mod excalibur;
 mod io;
 pub mod linkage;
@@ -12,6 +13,7 @@ mod simulated;
 mod support;
 
 pub use board::{Board, Frame, TX_FRAMES};
+pub use build_error::BuildError;
 pub use io::{EncoderScale, IoScale, DUTY_FULL_SCALE};
 pub use region::{check_axes, Bound, Region, RegionError};
 pub use simulated::{SimAxis, Simulated};

@@ -12,13 +12,13 @@
 
 use crate::io::IoScale;
 use crate::region::{Bound, Region};
-use crate::Board;
+use crate::{Board, BuildError};
 use twoport_control::kinematics::{Delta, Kinematics, SerialArm};
-use twoport_control::linkage::{Gravity, Hardware, LinkageError, LinkageServo};
+use twoport_control::linkage::{Gravity, Hardware, LinkageServo};
 use twoport_control::servo::ImpedanceGains;
 use twoport_control::ve::{Solid, UnilateralWall};
 use twoport_control::world::PerAxis;
-use twoport_control::{ParamError, Position, SafetyConfig};
+use twoport_control::{Position, SafetyConfig};
 
 /// Control period (s): both devices' 1 kHz loop.
 pub const PERIOD_S: f32 = 1.0e-3;
@@ -55,7 +55,7 @@ pub const COUNTER_BITS: u8 = 32;
 
 /// What an image needs of its device file.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Spec {
+pub struct ImageSpec {
     /// The encoders, transmissions, joint limits and motors.
     pub hardware: Hardware<3>,
     /// The least damping the handle has anywhere in the workspace, in its
@@ -71,7 +71,7 @@ pub struct Spec {
 /// The PHANToM Premium 1.5 (`phantom_premium_1_5.toml`).
 // (The base's limits are the file's 1.5708 rad, as published, not π/2.)
 #[allow(clippy::approx_constant)]
-pub const PHANTOM: Spec = Spec {
+pub const PHANTOM: ImageSpec = ImageSpec {
     hardware: Hardware {
         counts_per_rev: 2000.0,
         ratios: [13.3, 11.2, 11.2],
@@ -104,7 +104,7 @@ pub const PHANTOM_ARM: ArmLengths = ArmLengths {
 };
 
 /// The Falcon-like delta (`falcon_like.toml`).
-pub const FALCON: Spec = Spec {
+pub const FALCON: ImageSpec = ImageSpec {
     hardware: Hardware {
         counts_per_rev: 1280.0,
         ratios: [7.72, 7.72, 7.72],
@@ -140,32 +140,20 @@ pub const FALCON_DELTA: DeltaLengths = DeltaLengths {
 
 /// The images' world: a wall on each Cartesian axis, only the floor (z)
 /// within reach.
-pub type World = PerAxis<UnilateralWall, 3>;
+pub type LinkageWorld = PerAxis<UnilateralWall, 3>;
 
 /// A linkage image's servo.
-pub type Servo<K> = LinkageServo<K, World, f32, 3>;
+pub type LinkageImageServo<K> = LinkageServo<K, LinkageWorld, f32, 3>;
 
 /// A linkage image's board.
-pub type LinkageBoard<K> = Board<World, REGION_POINTS, 3, twoport_control::servo::Direct, Servo<K>>;
+pub type LinkageBoard<K> =
+    Board<LinkageWorld, REGION_POINTS, 3, twoport_control::servo::Direct, LinkageImageServo<K>>;
 
 /// The serial-arm image's board.
 pub type SerialArmBoard = LinkageBoard<SerialArm>;
 
 /// The delta image's board.
 pub type DeltaBoard = LinkageBoard<Delta>;
-
-/// Why a linkage image could not be built (a constant here is wrong).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum BuildError {
-    /// A law's or a kinematics' parameter.
-    Param(ParamError),
-    /// The servo's.
-    Linkage(LinkageError),
-    /// The region table.
-    Region(crate::RegionError),
-    /// The rest pose is not one the kinematics serve.
-    RestPose,
-}
 
 /// The Cartesian limits every axis runs: 10 N peak, 4 N held, 2 m/s, the
 /// link watchdog and the dead-man switch on.
@@ -181,7 +169,7 @@ pub fn safety() -> SafetyConfig {
 /// The proven region of `spec`: at each coupling damping `b_c`, the
 /// stiffest `k_c = 2 (λ_min + b_g - b_c)/T` (the workspace proof for
 /// every grasp of at least [`GRASP_NSPM`]).
-pub fn region(spec: &Spec) -> Result<Region<REGION_POINTS>, crate::RegionError> {
+pub fn region(spec: &ImageSpec) -> Result<Region<REGION_POINTS>, crate::RegionError> {
     let total = spec.least_damping_nspm + GRASP_NSPM;
     let b: [f32; REGION_POINTS] = core::array::from_fn(|i| 0.01 + 0.24 * total * i as f32);
     let k = b.map(|b| 2.0 * (total - b) / PERIOD_S);
@@ -189,7 +177,7 @@ pub fn region(spec: &Spec) -> Result<Region<REGION_POINTS>, crate::RegionError> 
 }
 
 /// Each motor's duty scale: full scale at its peak torque at the joint.
-pub fn io(spec: &Spec) -> [IoScale; 3] {
+pub fn io(spec: &ImageSpec) -> [IoScale; 3] {
     spec.hardware.ratios.map(|n| IoScale {
         force_full_scale_n: spec.hardware.peak_torque_nm * n,
         ..IoScale::EXCALIBUR
@@ -199,7 +187,7 @@ pub fn io(spec: &Spec) -> [IoScale; 3] {
 /// The board for `spec` on `kinematics`, disarmed and uncalibrated, its
 /// joints reading the rest pose until the host calibrates them.
 pub fn board<K: Kinematics<f32, 3>>(
-    spec: &Spec,
+    spec: &ImageSpec,
     kinematics: K,
 ) -> Result<LinkageBoard<K>, BuildError> {
     let at = kinematics

@@ -6,7 +6,7 @@ use twoport_board::{BoardSupport, IoScale, RawSensors};
 use twoport_control::homing::HomingConfig;
 use twoport_control::{Faults, Position, SafetyConfig};
 use twoport_link::{
-    encode, Axes, Decoder, Message, Mode, ModeRefusal, ModeRequest, Status, MAX_FRAME,
+    encode, Axes, BoardMode, Decoder, Message, ModeRefusal, ModeRequest, Status, MAX_FRAME,
 };
 
 const T: f32 = 1e-3;
@@ -202,7 +202,7 @@ fn statuses(msgs: &[Message]) -> Vec<Status> {
 fn boots_disarmed_with_outputs_off_and_names_why_it_will_not_arm() {
     let mut b = board();
     let mut io = Bench::new(None);
-    assert_eq!(b.mode(), Mode::Disarmed);
+    assert_eq!(b.mode(), BoardMode::Disarmed);
     assert!(!b.outputs_on() && !b.calibrated());
     // Before any tick the dead-man is unknown; before calibration it may
     // not arm at all. The first reason that holds is the one named.
@@ -234,7 +234,7 @@ fn boots_disarmed_with_outputs_off_and_names_why_it_will_not_arm() {
     assert_eq!(
         statuses(&msgs),
         [Status {
-            mode: Mode::Armed,
+            mode: BoardMode::Armed,
             calibrated: true,
             faults: 0,
             first_fault: 0,
@@ -254,7 +254,7 @@ fn gains_outside_the_proven_region_never_arm() {
         refused(&ask_to_arm(&mut b, &mut io)),
         [(ModeRequest::Arm, ModeRefusal::GainsNotProven)]
     );
-    assert_eq!(b.mode(), Mode::Disarmed);
+    assert_eq!(b.mode(), BoardMode::Disarmed);
 }
 
 /// Armed and pushing, the dead-man opens: the fault latches, the board
@@ -273,12 +273,12 @@ fn any_fault_disarms_and_latches_until_cleared_and_re_armed() {
         io.x_m = (k as f64 * 1e-5).min(0.002);
         io.v_mps = 0.0;
     }
-    assert_eq!(b.mode(), Mode::Armed);
+    assert_eq!(b.mode(), BoardMode::Armed);
     assert!(io.force_n().abs() > 50.0, "{} N", io.force_n());
     io.heard();
     io.dead_man_closed = false;
     tick(&mut b, &mut io);
-    assert_eq!(b.mode(), Mode::Disarmed);
+    assert_eq!(b.mode(), BoardMode::Disarmed);
     assert_eq!(io.force_n(), 0.0);
     assert_eq!(
         (io.duty, io.outputs_calls.as_slice()),
@@ -287,7 +287,7 @@ fn any_fault_disarms_and_latches_until_cleared_and_re_armed() {
     let msgs = io.heard();
     let s = statuses(&msgs);
     assert_eq!(s.len(), 1);
-    assert_eq!(s[0].mode, Mode::Disarmed);
+    assert_eq!(s[0].mode, BoardMode::Disarmed);
     assert_eq!(Faults(s[0].faults), Faults::DEAD_MAN);
     assert_eq!(Faults(s[0].faults).to_string(), "dead-man switch released");
     io.dead_man_closed = true;
@@ -302,10 +302,10 @@ fn any_fault_disarms_and_latches_until_cleared_and_re_armed() {
     );
     io.say(Message::ClearFaults);
     tick(&mut b, &mut io);
-    assert_eq!(b.mode(), Mode::Disarmed);
+    assert_eq!(b.mode(), BoardMode::Disarmed);
     io.say(Message::Arm);
     tick(&mut b, &mut io);
-    assert_eq!(b.mode(), Mode::Armed, "{:?}", io.heard());
+    assert_eq!(b.mode(), BoardMode::Armed, "{:?}", io.heard());
 }
 
 /// The stop is 15 mm below where the axis powered on, and the board's
@@ -322,12 +322,12 @@ fn homing_finds_the_stop_gently_and_calibrates_the_encoder() {
     loop {
         tick(&mut b, &mut io);
         ticks += 1;
-        if b.mode() != Mode::Homing || ticks > 5000 {
+        if b.mode() != BoardMode::Homing || ticks > 5000 {
             break;
         }
     }
     assert!(b.calibrated(), "after {ticks} ticks: {:?}", io.heard());
-    assert_eq!(b.mode(), Mode::Disarmed);
+    assert_eq!(b.mode(), BoardMode::Disarmed);
     assert!(b.servo().safety().faults().is_empty());
     // 15 mm at 20 mm/s, the stall time and the ramp-in.
     assert!((800..1100).contains(&ticks), "{ticks} ticks");
@@ -336,7 +336,7 @@ fn homing_finds_the_stop_gently_and_calibrates_the_encoder() {
     let s = statuses(&io.heard());
     assert_eq!(
         s.iter().map(|s| (s.mode, s.calibrated)).collect::<Vec<_>>(),
-        [(Mode::Homing, false), (Mode::Disarmed, true)]
+        [(BoardMode::Homing, false), (BoardMode::Disarmed, true)]
     );
     // Walk the axis back to where it powered on, at 15 mm/s: the board
     // reads -5 mm.
@@ -351,7 +351,7 @@ fn homing_finds_the_stop_gently_and_calibrates_the_encoder() {
     // Homed, it arms.
     io.say(Message::Arm);
     tick(&mut b, &mut io);
-    assert_eq!(b.mode(), Mode::Armed);
+    assert_eq!(b.mode(), BoardMode::Armed);
 }
 
 #[test]
@@ -364,7 +364,7 @@ fn homing_without_a_stop_times_out_as_a_named_fault() {
     for _ in 0..600 {
         tick(&mut b, &mut io);
     }
-    assert_eq!(b.mode(), Mode::Disarmed);
+    assert_eq!(b.mode(), BoardMode::Disarmed);
     assert!(!b.calibrated());
     assert_eq!(b.servo().safety().faults(), Faults::HOMING_FAILED);
     assert_eq!(io.force_n(), 0.0);
@@ -384,14 +384,16 @@ fn calibrate_and_home_need_a_disarmed_board_and_disarm_stops_homing() {
     let mut io = Bench::new(Some(-0.015));
     start_homing(&mut b, &mut io);
     tick(&mut b, &mut io);
-    assert_eq!(b.mode(), Mode::Homing);
+    assert_eq!(b.mode(), BoardMode::Homing);
     io.say(Message::Calibrate {
         position_pm: Axes::one(0),
     });
     io.say(Message::Home);
     io.say(Message::Arm);
     tick(&mut b, &mut io);
-    let busy = ModeRefusal::NotDisarmed { mode: Mode::Homing };
+    let busy = ModeRefusal::NotDisarmed {
+        mode: BoardMode::Homing,
+    };
     assert_eq!(
         refused(&io.heard()),
         [
@@ -405,7 +407,7 @@ fn calibrate_and_home_need_a_disarmed_board_and_disarm_stops_homing() {
     }
     io.say(Message::Disarm);
     tick(&mut b, &mut io);
-    assert_eq!((b.mode(), b.calibrated()), (Mode::Disarmed, false));
+    assert_eq!((b.mode(), b.calibrated()), (BoardMode::Disarmed, false));
     assert_eq!(io.force_n(), 0.0);
     // A position beyond the board's range is refused by name.
     io.say(Message::Calibrate {
@@ -432,7 +434,7 @@ fn homing_on_an_index_pulse_calibrates_to_the_count_before_the_stop() {
     while ticks < 5000 {
         tick(&mut b, &mut io);
         ticks += 1;
-        if b.mode() != Mode::Homing {
+        if b.mode() != BoardMode::Homing {
             break;
         }
     }
@@ -460,13 +462,13 @@ fn homing_on_an_index_that_never_pulses_fails_at_the_stop() {
     }
     assert!(!b.calibrated());
     assert_eq!(b.servo().safety().faults(), Faults::HOMING_FAILED);
-    assert_eq!(b.mode(), Mode::Disarmed);
+    assert_eq!(b.mode(), BoardMode::Disarmed);
 }
 
 /// An experiment the test boards can play: 5 N of harmonics 1 to 20 of
 /// 200 ticks, three periods, held by 2,000 N/m and 30 N s/m.
-fn experiment() -> twoport_link::Experiment {
-    twoport_link::Experiment {
+fn experiment() -> twoport_link::ExperimentRequest {
+    twoport_link::ExperimentRequest {
         axis: 0,
         period_ticks: 200,
         first: 1,
@@ -511,12 +513,12 @@ fn an_armed_board_plays_an_experiment_and_disarms_at_its_end() {
         tick(&mut b, &mut io);
         heard.extend(io.heard());
     }
-    let modes: Vec<Mode> = statuses(&heard).iter().map(|s| s.mode).collect();
-    assert_eq!(modes, [Mode::Identifying, Mode::Disarmed]);
+    let modes: Vec<BoardMode> = statuses(&heard).iter().map(|s| s.mode).collect();
+    assert_eq!(modes, [BoardMode::Identifying, BoardMode::Disarmed]);
     let t = telemetry(&heard);
     assert_eq!(t.len(), 600, "one frame per tick of the experiment");
     assert!(t.windows(2).all(|w| w[1].tick == w[0].tick + 1));
-    assert!(t.iter().all(|t| t.mode == Mode::Identifying));
+    assert!(t.iter().all(|t| t.mode == BoardMode::Identifying));
     let m = twoport_control::multisine::Multisine::new(200, 1, 20, 5.0).unwrap();
     for (n, t) in t.iter().enumerate() {
         let a = t.axes[0];
@@ -528,7 +530,10 @@ fn an_armed_board_plays_an_experiment_and_disarms_at_its_end() {
             a.actuator_n
         );
     }
-    assert_eq!((b.mode(), io.duty, io.outputs), (Mode::Disarmed, 0, false));
+    assert_eq!(
+        (b.mode(), io.duty, io.outputs),
+        (BoardMode::Disarmed, 0, false)
+    );
     assert!(b.experiment().is_none());
 }
 
@@ -547,38 +552,38 @@ fn an_experiment_is_refused_with_the_reason() {
         [(
             ModeRequest::Identify,
             ModeRefusal::NotArmed {
-                mode: Mode::Disarmed
+                mode: BoardMode::Disarmed
             }
         )]
     );
     assert_eq!(refused(&ask_to_arm(&mut b, &mut io)), []);
     let bad = [
-        twoport_link::Experiment {
+        twoport_link::ExperimentRequest {
             last: 100,
             ..experiment()
         },
-        twoport_link::Experiment {
+        twoport_link::ExperimentRequest {
             peak_n: 1e4,
             ..experiment()
         },
         // An amplitude whose rms is past the peak the host claims.
-        twoport_link::Experiment {
+        twoport_link::ExperimentRequest {
             amplitude_n: 5.0,
             ..experiment()
         },
-        twoport_link::Experiment {
+        twoport_link::ExperimentRequest {
             hold_k_npm: 60_000.0,
             ..experiment()
         },
-        twoport_link::Experiment {
+        twoport_link::ExperimentRequest {
             hold_b_nspm: f32::NAN,
             ..experiment()
         },
-        twoport_link::Experiment {
+        twoport_link::ExperimentRequest {
             axis: 1,
             ..experiment()
         },
-        twoport_link::Experiment {
+        twoport_link::ExperimentRequest {
             periods: 0,
             ..experiment()
         },
@@ -591,7 +596,7 @@ fn an_experiment_is_refused_with_the_reason() {
             [(ModeRequest::Identify, ModeRefusal::BadExperiment)],
             "{x:?}"
         );
-        assert_eq!(b.mode(), Mode::Armed);
+        assert_eq!(b.mode(), BoardMode::Armed);
     }
 }
 
@@ -607,11 +612,11 @@ fn releasing_the_handle_ends_an_experiment_at_zero_force() {
     for _ in 0..300 {
         tick(&mut b, &mut io);
     }
-    assert_eq!(b.mode(), Mode::Identifying);
+    assert_eq!(b.mode(), BoardMode::Identifying);
     assert!(io.force_n().abs() > 0.5, "{} N", io.force_n());
     io.dead_man_closed = false;
     tick(&mut b, &mut io);
-    assert_eq!((b.mode(), io.force_n()), (Mode::Disarmed, 0.0));
+    assert_eq!((b.mode(), io.force_n()), (BoardMode::Disarmed, 0.0));
     assert!(b.experiment().is_none());
     let s = statuses(&io.heard());
     assert_eq!(Faults(s.last().unwrap().faults), Faults::DEAD_MAN);

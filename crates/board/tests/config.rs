@@ -6,8 +6,8 @@ use twoport_config::record::{encode, MAX_RECORD};
 use twoport_config::{Config, RamFlash, Store};
 use twoport_control::SafetyConfig;
 use twoport_link::{
-    encode as frame, Axes, ConfigFallback, ConfigSource, Decoder, Gains, GainsReply, Message, Mode,
-    ModeRefusal, ModeRequest, MAX_FRAME,
+    encode as frame, Axes, BoardMode, ConfigFallback, ConfigSource, Decoder, Gains, GainsReply,
+    Message, ModeRefusal, ModeRequest, MAX_FRAME,
 };
 
 type Flash = RamFlash<512, 256>;
@@ -87,7 +87,7 @@ fn saved_gains_come_back_at_the_next_boot() {
         },
     );
     say(&mut again, Message::Arm);
-    assert_eq!(again.mode(), Mode::Armed);
+    assert_eq!(again.mode(), BoardMode::Armed);
     heard(&mut again);
     say(&mut again, Message::SaveConfig);
     again.service_config(&mut st);
@@ -95,7 +95,9 @@ fn saved_gains_come_back_at_the_next_boot() {
         heard(&mut again),
         [Message::ModeRefused {
             asked: ModeRequest::SaveConfig,
-            why: ModeRefusal::NotDisarmed { mode: Mode::Armed }
+            why: ModeRefusal::NotDisarmed {
+                mode: BoardMode::Armed
+            }
         }]
     );
     // Disarmed, a save that loses power half-way is reported.

@@ -4,7 +4,7 @@
 
 use twoport_control::{Faults, SafetyConfig};
 use twoport_link::{
-    Axes, AxisSpec, Contact, Message, Mode, ModeRefusal, ModeRequest, ProvenRegion, Spec,
+    Axes, AxisSpec, BoardMode, Contact, Message, ModeRefusal, ModeRequest, ProvenRegion, Spec,
     Telemetry, VeSource, VeUpdate,
 };
 
@@ -36,7 +36,7 @@ fn armed(mut b: TestBoard, raw: u32) -> TestBoard {
         },
     );
     send(&mut b, 101, Message::Arm);
-    assert_eq!(b.mode(), Mode::Armed, "{:?}", replies(&mut b));
+    assert_eq!(b.mode(), BoardMode::Armed, "{:?}", replies(&mut b));
     replies(&mut b);
     b
 }
@@ -138,7 +138,9 @@ fn the_ve_moves_to_the_host_only_disarmed_and_with_a_deadline() {
         replies(&mut b),
         vec![Message::ModeRefused {
             asked: ModeRequest::SetVe,
-            why: ModeRefusal::NotDisarmed { mode: Mode::Armed }
+            why: ModeRefusal::NotDisarmed {
+                mode: BoardMode::Armed
+            }
         }]
     );
     assert_eq!(b.ve_source(), VeSource::Board);
@@ -228,14 +230,14 @@ fn updates_move_the_point_and_a_late_host_faults_to_zero_force() {
     assert!(f < -25.0, "{f} N");
     for tick in 2..=3 {
         let out = b.tick(&frame(tick, 0));
-        assert_eq!(b.mode(), Mode::Armed, "tick {tick}");
+        assert_eq!(b.mode(), BoardMode::Armed, "tick {tick}");
         assert!((out.commanded_force_n[0] + 25.5).abs() < 0.01, "{out:?}");
     }
     // The fourth tick on one update, with a deadline of three.
     let out = b.tick(&frame(4, 0));
     assert_eq!(out.actuator_force_n, [0.0]);
     assert!(out.faults.contains(Faults::VE_STALE), "{:?}", out.faults);
-    assert_eq!(b.mode(), Mode::Disarmed);
+    assert_eq!(b.mode(), BoardMode::Disarmed);
     let r = replies(&mut b);
     assert!(
         r.iter()
@@ -248,7 +250,7 @@ fn updates_move_the_point_and_a_late_host_faults_to_zero_force() {
     send(&mut b, 7, Message::Arm);
     replies(&mut b);
     let out = b.tick(&frame(5, 0));
-    assert_eq!(b.mode(), Mode::Armed);
+    assert_eq!(b.mode(), BoardMode::Armed);
     assert_eq!(out.commanded_force_n, [0.0]);
 }
 
@@ -261,14 +263,14 @@ fn disarm_is_answered_even_when_the_board_is_disarmed_already() {
     send(&mut b, 0, Message::Disarm);
     let r = replies(&mut b);
     assert!(
-        matches!(r.as_slice(), [Message::Status(s)] if s.mode == Mode::Disarmed),
+        matches!(r.as_slice(), [Message::Status(s)] if s.mode == BoardMode::Disarmed),
         "{r:?}"
     );
     let mut b = armed(b, 0);
     send(&mut b, 1, Message::Disarm);
     let r = replies(&mut b);
     assert!(
-        matches!(r.as_slice(), [Message::Status(s)] if s.mode == Mode::Disarmed),
+        matches!(r.as_slice(), [Message::Status(s)] if s.mode == BoardMode::Disarmed),
         "{r:?}"
     );
 }

@@ -4,8 +4,8 @@ use twoport_board::{Board, BoardSupport, Bound, RawSensors, Region};
 use twoport_control::ve::BilateralConstraint;
 use twoport_control::{AdmittanceGains, Encoder, Faults, Position, SafetyConfig, Servo};
 use twoport_link::{
-    encode, Axes, AxisRefusal, Decoder, Gains, GainsReply, Message, Mode, Refusal, Role, MAX_FRAME,
-    PROTOCOL_VERSION,
+    encode, Axes, AxisRefusal, BoardMode, Decoder, Gains, GainsReply, Message, Refusal, Role,
+    MAX_FRAME, PROTOCOL_VERSION,
 };
 
 mod common;
@@ -36,7 +36,7 @@ fn arm(b: &mut Board<BilateralConstraint, 3>, raw: u32) {
         },
     );
     send(b, 101, Message::Arm);
-    assert_eq!(b.mode(), Mode::Armed, "{:?}", replies(b));
+    assert_eq!(b.mode(), BoardMode::Armed, "{:?}", replies(b));
     replies(b);
 }
 

@@ -5,7 +5,7 @@ use twoport_board::excalibur;
 use twoport_control::servo::SensorFrame;
 use twoport_control::Position;
 use twoport_link::{
-    encode, Axes, Decoder, Message, Mode, ModeRefusal, ModeRequest, VeParam, MAX_FRAME,
+    encode, Axes, BoardMode, Decoder, Message, ModeRefusal, ModeRequest, VeParam, MAX_FRAME,
 };
 
 type Wall = twoport_board::Board<twoport_control::ve::UnilateralWall, { excalibur::REGION_POINTS }>;
@@ -52,7 +52,7 @@ fn force_at_zero(surface_nm: Option<i32>) -> f32 {
         );
     }
     send(&mut b, 3, Message::Arm);
-    assert_eq!(b.mode(), Mode::Armed);
+    assert_eq!(b.mode(), BoardMode::Armed);
     let mut f = 0.0;
     for t in 1..300 {
         send(&mut b, 4 + t as u16, Message::Heartbeat);
@@ -101,7 +101,9 @@ fn bad_parameters_and_an_armed_board_are_refused() {
     send(&mut b, 6, Message::Arm);
     assert_eq!(
         send(&mut b, 7, set(0, VeParam::Damping(1.0))),
-        refused(ModeRefusal::NotDisarmed { mode: Mode::Armed })
+        refused(ModeRefusal::NotDisarmed {
+            mode: BoardMode::Armed
+        })
     );
 }
 

@@ -8,8 +8,8 @@ use twoport_board::{BoardSupport, IoScale, RawSensors};
 use twoport_config::{RamFlash, Store};
 use twoport_control::Faults;
 use twoport_link::{
-    encode, Axes, AxisRefusal, ConfigFallback, ConfigSource, Decoder, Gains, GainsReply, Message,
-    Mode, ModeRefusal, ModeRequest, Refusal, Role, MAX_FRAME,
+    encode, Axes, AxisRefusal, BoardMode, ConfigFallback, ConfigSource, Decoder, Gains, GainsReply,
+    Message, ModeRefusal, ModeRequest, Refusal, Role, MAX_FRAME,
 };
 
 const T: f64 = 1e-3;
@@ -193,12 +193,12 @@ fn every_axis_homes_onto_its_own_stop() {
             homed_at = Some(k);
             break;
         }
-        assert_eq!(b.mode(), Mode::Homing, "tick {k}: {:?}", io.heard());
+        assert_eq!(b.mode(), BoardMode::Homing, "tick {k}: {:?}", io.heard());
     }
     let k = homed_at.expect("homed within 3 s");
     // The slowest axis creeps 9 mm at 20 mm/s, then waits out its stall.
     assert!(k > 400, "homed after {k} ticks");
-    assert_eq!(b.mode(), Mode::Disarmed);
+    assert_eq!(b.mode(), BoardMode::Disarmed);
     assert!(io.peak_force_n <= 5.0 + 0.01, "{} N", io.peak_force_n);
     // One more tick to read the calibrated positions.
     tick(&mut b, &mut io);
@@ -270,7 +270,7 @@ fn a_fault_on_one_axis_zeroes_every_axis() {
     });
     io.say(Message::Arm);
     tick(&mut b, &mut io);
-    assert_eq!(b.mode(), Mode::Armed, "{:?}", io.heard());
+    assert_eq!(b.mode(), BoardMode::Armed, "{:?}", io.heard());
     // The cube's face is 39 mm along x from the cursor's centre, the
     // floor 9 mm below it: the hand goes 1.5 mm and 2 mm past them.
     for k in 0..400 {
@@ -284,7 +284,7 @@ fn a_fault_on_one_axis_zeroes_every_axis() {
     io.broken_encoder = true;
     tick(&mut b, &mut io);
     assert_eq!(b.duty(), [0; 3]);
-    assert_eq!(b.mode(), Mode::Disarmed);
+    assert_eq!(b.mode(), BoardMode::Disarmed);
     assert!(b.last_output().faults.contains(Faults::ENCODER_INVALID));
 }
 

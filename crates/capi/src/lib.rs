@@ -11,7 +11,7 @@ use std::ffi::{c_char, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::Duration;
 use twoport_host::{
-    Board, BoardPort, Contact, Gains, LinkError, Pace, SerialBoard, SimulatedBoard,
+    BoardPort, Contact, Gains, HostBoard, LinkError, Pace, SerialBoard, SimulatedBoard,
 };
 pub use types::{
     TpAxisSpec, TpAxisState, TpDisplay, TpMode, TpResult, TpSpec, TpState, TP_CONTACT_ABOVE,
@@ -22,7 +22,7 @@ pub use types::{
 /// A board, opened by `tp_board_open_serial` or `tp_board_open_simulated`
 /// and freed by `tp_board_close`. Use it from one thread at a time (any
 /// thread).
-pub struct TpBoard(Board<Box<dyn BoardPort + Send>>);
+pub struct TpBoard(HostBoard<Box<dyn BoardPort + Send>>);
 
 thread_local! {
     static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
@@ -90,7 +90,7 @@ unsafe fn slice<'a, T>(p: *const T, n: usize) -> Option<&'a [T]> {
 
 /// Open `result` into `out`.
 fn opened(
-    result: Result<Board<Box<dyn BoardPort + Send>>, LinkError>,
+    result: Result<HostBoard<Box<dyn BoardPort + Send>>, LinkError>,
     out: *mut *mut TpBoard,
 ) -> TpResult {
     if out.is_null() {
@@ -135,7 +135,7 @@ pub unsafe extern "C" fn tp_board_open_serial(
             return bad("path is not UTF-8");
         };
         let port = SerialBoard::open(path).map(|p| Box::new(p) as Box<dyn BoardPort + Send>);
-        opened(port.and_then(|p| Board::open(p, axes)), out)
+        opened(port.and_then(|p| HostBoard::open(p, axes)), out)
     })
 }
 
@@ -151,7 +151,7 @@ pub unsafe extern "C" fn tp_board_open_simulated(hand_n: f32, out: *mut *mut TpB
     guard(|| {
         let port = SimulatedBoard::excalibur(hand_n, Pace::RealTime)
             .map(|p| Box::new(p) as Box<dyn BoardPort + Send>);
-        opened(port.and_then(|p| Board::open(p, 1)), out)
+        opened(port.and_then(|p| HostBoard::open(p, 1)), out)
     })
 }
 

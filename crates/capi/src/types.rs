@@ -1,7 +1,7 @@
 //! The C ABI's plain data: what a board can do, its state at one tick, and
 //! the codes every call returns. Units are SI.
 
-use twoport_host::{Contact, Mode, Spec, State};
+use twoport_host::{BoardMode, Contact, Spec, State};
 
 /// The most axes a board has (a three-axis device).
 pub const TP_MAX_AXES: usize = 3;
@@ -254,10 +254,10 @@ impl From<&State> for TpState {
             tick: s.tick,
             faults: s.faults,
             mode: match s.mode {
-                Mode::Disarmed => TpMode::Disarmed,
-                Mode::Homing => TpMode::Homing,
-                Mode::Armed => TpMode::Armed,
-                Mode::Identifying => TpMode::Identifying,
+                BoardMode::Disarmed => TpMode::Disarmed,
+                BoardMode::Homing => TpMode::Homing,
+                BoardMode::Armed => TpMode::Armed,
+                BoardMode::Identifying => TpMode::Identifying,
             },
             ve_seq: s.ve_seq,
             deadline_misses: s.deadline_misses,

@@ -113,7 +113,7 @@ pub fn with_admittance_coupling(g: &Matrix2, zc: Complex64) -> Matrix2 {
 /// variables are the inputs: port 1 `(f_1, v_1)`, port 2 `(f_2, v_2)` with
 /// the paper's signs (`f_e*`, `-v_e*` at the VE port).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Form {
+pub enum Immittance {
     /// Impedance: velocities in, forces out.
     Z,
     /// Admittance: forces in, velocities out.
@@ -124,12 +124,12 @@ pub enum Form {
     G,
 }
 
-impl Form {
+impl Immittance {
     /// Whether port `k` (0 or 1) takes its velocity as the input.
     fn velocity_in(self, k: usize) -> bool {
         match (self, k) {
-            (Form::Z, _) | (Form::H, 0) | (Form::G, 1) => true,
-            (Form::Y, _) | (Form::H, 1) | (Form::G, 0) => false,
+            (Immittance::Z, _) | (Immittance::H, 0) | (Immittance::G, 1) => true,
+            (Immittance::Y, _) | (Immittance::H, 1) | (Immittance::G, 0) => false,
             _ => unreachable!("a two-port has ports 0 and 1"),
         }
     }
@@ -154,7 +154,7 @@ fn pivot(p: &Matrix2, k: usize) -> Option<Matrix2> {
 
 /// Convert a two-port matrix from one immittance form to another; `None`
 /// where the target form does not exist.
-pub fn convert(p: &Matrix2, from: Form, to: Form) -> Option<Matrix2> {
+pub fn convert(p: &Matrix2, from: Immittance, to: Immittance) -> Option<Matrix2> {
     let mut q = *p;
     for k in 0..2 {
         if from.velocity_in(k) != to.velocity_in(k) {
@@ -194,19 +194,19 @@ mod tests {
     fn conversions_match_the_textbook_formulas() {
         let z = sample(1);
         let det = z[0][0] * z[1][1] - z[0][1] * z[1][0];
-        let y = convert(&z, Form::Z, Form::Y).unwrap();
+        let y = convert(&z, Immittance::Z, Immittance::Y).unwrap();
         let want_y = [
             [z[1][1] / det, -z[0][1] / det],
             [-z[1][0] / det, z[0][0] / det],
         ];
         assert!(close(&y, &want_y));
-        let h = convert(&z, Form::Z, Form::H).unwrap();
+        let h = convert(&z, Immittance::Z, Immittance::H).unwrap();
         let want_h = [
             [det / z[1][1], z[0][1] / z[1][1]],
             [-z[1][0] / z[1][1], z[1][1].inv()],
         ];
         assert!(close(&h, &want_h));
-        let g = convert(&z, Form::Z, Form::G).unwrap();
+        let g = convert(&z, Immittance::Z, Immittance::G).unwrap();
         let want_g = [
             [z[0][0].inv(), -z[0][1] / z[0][0]],
             [z[1][0] / z[0][0], det / z[0][0]],
@@ -218,12 +218,12 @@ mod tests {
     /// the same in all four (absolute stability does not depend on the form).
     #[test]
     fn round_trips_and_eta_invariance() {
-        let forms = [Form::Z, Form::Y, Form::H, Form::G];
+        let forms = [Immittance::Z, Immittance::Y, Immittance::H, Immittance::G];
         for seed in 1..200 {
             let z = sample(seed);
             let eta = llewellyn_margin(&z);
             for &a in &forms {
-                let pa = convert(&z, Form::Z, a).unwrap();
+                let pa = convert(&z, Immittance::Z, a).unwrap();
                 for &b in &forms {
                     let pb = convert(&pa, a, b).unwrap();
                     assert!(
@@ -250,6 +250,6 @@ mod tests {
     #[test]
     fn a_missing_form_is_none() {
         let z = [[c(0.0, 0.0), c(1.0, 0.0)], [c(1.0, 0.0), c(2.0, 0.0)]];
-        assert!(convert(&z, Form::Z, Form::G).is_none());
+        assert!(convert(&z, Immittance::Z, Immittance::G).is_none());
     }
 }

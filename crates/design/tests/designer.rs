@@ -1,7 +1,7 @@
 //! The designer's reports: what the JSON says is what the text says and
 //! what the report holds, and bad questions are refused by name.
 
-use twoport_design::designer::{Binding, Designer, Limit};
+use twoport_design::designer::{BindingBound, Designer, Limit};
 use twoport_design::network::HumanBound;
 use twoport_design::{DeviceModel, Error};
 
@@ -33,7 +33,7 @@ fn a_designs_json_and_text_say_the_same() {
     assert!(text.contains(&Limit::Stiffness.text(k)), "{text}");
     assert!(text.contains(&Limit::Stiffness.text(rec)), "{text}");
     assert_eq!(
-        r.binding == Binding::SampledData,
+        r.binding == BindingBound::SampledData,
         v["binding_bound"] == "sampled-data"
     );
 

@@ -7,7 +7,7 @@ use crate::{BoardPort, LinkError, LinkFaults, SerialBoard, Session};
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 use twoport_link::{
-    Axes, ConfigSource, Contact, Gains, GainsReply, Message, Mode, Spec, Status, Telemetry,
+    Axes, BoardMode, ConfigSource, Contact, Gains, GainsReply, Message, Spec, Status, Telemetry,
     VeParam, VeSource,
 };
 
@@ -49,7 +49,7 @@ pub struct State {
     /// Latched fault bits (`twoport_control::Faults`).
     pub faults: u16,
     /// What the board was doing.
-    pub mode: Mode,
+    pub mode: BoardMode,
     /// The host VE update the board held.
     pub ve_seq: u32,
     /// Ticks since boot that overran their period, or came more than
@@ -90,7 +90,7 @@ impl From<&Telemetry> for State {
 /// the board streams and keeps its watchdog fed: an application calls it
 /// at least every 20 ms while the board is armed, or the board gives zero
 /// force. Dropping the object disarms the board.
-pub struct Board<P: BoardPort> {
+pub struct HostBoard<P: BoardPort> {
     session: Session<P>,
     spec: Spec,
     states: VecDeque<State>,
@@ -102,15 +102,15 @@ pub struct Board<P: BoardPort> {
     closed: bool,
 }
 
-impl Board<SerialBoard> {
+impl HostBoard<SerialBoard> {
     /// Open the board of `axes` axes at the serial port `path` (a real
     /// board, or the firmware in QEMU through its pty).
     pub fn open_serial(path: &str, axes: u8) -> Result<Self, LinkError> {
-        Board::open(SerialBoard::open(path)?, axes)
+        HostBoard::open(SerialBoard::open(path)?, axes)
     }
 }
 
-impl<P: BoardPort> Board<P> {
+impl<P: BoardPort> HostBoard<P> {
     /// Shake hands with the board of `axes` axes at `port` and ask what it
     /// can do. A board of another protocol or axis count is refused, both
     /// named.
@@ -120,7 +120,7 @@ impl<P: BoardPort> Board<P> {
         // waits for an answer.
         session.heartbeat_while_waiting(HEARTBEAT_PERIOD);
         let spec = session.spec()?;
-        Ok(Board {
+        Ok(HostBoard {
             session,
             spec,
             states: VecDeque::new(),
@@ -176,7 +176,7 @@ impl<P: BoardPort> Board<P> {
             if s.faults != 0 {
                 return Err(LinkError::Faulted(s.faults));
             }
-            if s.mode == Mode::Disarmed && s.calibrated {
+            if s.mode == BoardMode::Disarmed && s.calibrated {
                 return Ok(s);
             }
             if Instant::now() > end {
@@ -197,7 +197,7 @@ impl<P: BoardPort> Board<P> {
     /// Disarm: zero force at once.
     pub fn disarm(&mut self) -> Result<Status, LinkError> {
         self.session.call(&Message::Disarm, "Disarm", |m| match m {
-            Message::Status(s) if s.mode == Mode::Disarmed => Some(*s),
+            Message::Status(s) if s.mode == BoardMode::Disarmed => Some(*s),
             _ => None,
         })
     }
@@ -395,7 +395,7 @@ impl<P: BoardPort> Board<P> {
     }
 }
 
-impl<P: BoardPort> Drop for Board<P> {
+impl<P: BoardPort> Drop for HostBoard<P> {
     /// A board let go is disarmed: no force outlives its application.
     fn drop(&mut self) {
         if !self.closed {

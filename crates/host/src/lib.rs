@@ -10,7 +10,7 @@ mod port;
 mod session;
 mod simulated;
 
-pub use device::{AxisState, Board, State, HEARTBEAT_PERIOD, HEARTBEAT_POLLS, STATE_BUFFER};
+pub use device::{AxisState, HostBoard, State, HEARTBEAT_PERIOD, HEARTBEAT_POLLS, STATE_BUFFER};
 pub use error::LinkError;
 pub use local::{LocalBoard, LocalDelta, LocalFast, LocalSerialArm};
 pub use port::{BoardPort, SerialBoard};
@@ -19,5 +19,5 @@ pub use simulated::{Pace, SimulatedBoard};
 
 /// The link's types an application meets in this crate's calls.
 pub use twoport_link::{
-    Axes, AxisSpec, Contact, Gains, Mode, ProvenRegion, Spec, Status, VeParam, VeSource,
+    Axes, AxisSpec, BoardMode, Contact, Gains, ProvenRegion, Spec, Status, VeParam, VeSource,
 };

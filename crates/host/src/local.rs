@@ -98,7 +98,7 @@ impl LocalFast {
     }
 }
 
-impl LocalBoard<xyz::World, 3> {
+impl LocalBoard<xyz::XyzWorld, 3> {
     /// The three-axis image ([`xyz::board`]).
     pub fn excalibur_xyz() -> Result<Self, LinkError> {
         xyz::board()
@@ -109,19 +109,19 @@ impl LocalBoard<xyz::World, 3> {
 
 /// The serial-arm image's loop.
 pub type LocalSerialArm = LocalBoard<
-    linkage_image::World,
+    linkage_image::LinkageWorld,
     3,
     Direct,
-    linkage_image::Servo<SerialArm>,
+    linkage_image::LinkageImageServo<SerialArm>,
     { linkage_image::REGION_POINTS },
 >;
 
 /// The delta image's loop.
 pub type LocalDelta = LocalBoard<
-    linkage_image::World,
+    linkage_image::LinkageWorld,
     3,
     Direct,
-    linkage_image::Servo<Delta>,
+    linkage_image::LinkageImageServo<Delta>,
     { linkage_image::REGION_POINTS },
 >;
 

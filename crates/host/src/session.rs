@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicU16, Ordering};
 use std::time::{Duration, Instant};
 use twoport_board::excalibur;
 use twoport_link::{
-    encode, Axes, ConfigSource, Contact, Decoder, LinkStats, Message, Mode, ModeRequest,
+    encode, Axes, BoardMode, ConfigSource, Contact, Decoder, LinkStats, Message, ModeRequest,
     PilSensors, Role, Spec, Status, VeParam, VeSource, VeUpdate, MAX_FRAME, NO_SESSION,
 };
 
@@ -141,21 +141,25 @@ impl<P: BoardPort> Session<P> {
 
     /// Arm the board (it must have had a tick, to see its dead-man).
     pub fn arm(&mut self) -> Result<Status, LinkError> {
-        self.ask(Message::Arm, ModeRequest::Arm, |s| s.mode == Mode::Armed)
+        self.ask(Message::Arm, ModeRequest::Arm, |s| {
+            s.mode == BoardMode::Armed
+        })
     }
 
     /// Start an identification experiment on an armed board; the caller
     /// runs its ticks, the board streaming each.
-    pub fn identify(&mut self, x: twoport_link::Experiment) -> Result<Status, LinkError> {
+    pub fn identify(&mut self, x: twoport_link::ExperimentRequest) -> Result<Status, LinkError> {
         self.ask(Message::Identify(x), ModeRequest::Identify, |s| {
-            s.mode == Mode::Identifying
+            s.mode == BoardMode::Identifying
         })
     }
 
     /// Start homing; the caller runs ticks until the board's status says
     /// it has homed.
     pub fn home(&mut self) -> Result<Status, LinkError> {
-        self.ask(Message::Home, ModeRequest::Home, |s| s.mode == Mode::Homing)
+        self.ask(Message::Home, ModeRequest::Home, |s| {
+            s.mode == BoardMode::Homing
+        })
     }
 
     /// Where the board's configuration came from.

@@ -3,14 +3,14 @@
 
 use std::time::Duration;
 use twoport_control::Faults;
-use twoport_host::{Board, LinkError, Pace, SimulatedBoard};
-use twoport_link::{Contact, Gains, Mode, ProvenRegion, Refusal, VeSource};
+use twoport_host::{HostBoard, LinkError, Pace, SimulatedBoard};
+use twoport_link::{BoardMode, Contact, Gains, ProvenRegion, Refusal, VeSource};
 
 /// The wall the host's VE renders (m): solid above.
 const WALL_M: f64 = 0.005;
 
-fn open(hand_n: f32) -> Board<SimulatedBoard> {
-    Board::open(
+fn open(hand_n: f32) -> HostBoard<SimulatedBoard> {
+    HostBoard::open(
         SimulatedBoard::excalibur(hand_n, Pace::PerRead(1)).unwrap(),
         1,
     )
@@ -37,7 +37,7 @@ fn an_application_renders_a_wall_from_the_host_and_lets_go() {
     b.calibrate(&[0.0]).unwrap();
     b.stream(1).unwrap();
     b.host_ve(1, 20).unwrap();
-    assert_eq!(b.arm().unwrap().mode, Mode::Armed);
+    assert_eq!(b.arm().unwrap().mode, BoardMode::Armed);
     b.take_states();
     let mut sent = 0;
     for _ in 0..3000 {
@@ -57,7 +57,7 @@ fn an_application_renders_a_wall_from_the_host_and_lets_go() {
         .unwrap();
     let reach = hit.axes[0].velocity_mps * (0.93f64 / 51_000.0).sqrt();
     let last = states.last().unwrap();
-    assert_eq!((last.mode, last.faults), (Mode::Armed, 0));
+    assert_eq!((last.mode, last.faults), (BoardMode::Armed, 0));
     let x = last.axes[0].position_m;
     let press = 2.0 / 51_000.0;
     assert!((x - WALL_M - press).abs() < 10e-6, "at {x} m");
@@ -97,7 +97,7 @@ fn a_host_that_falls_silent_gets_zero_force_not_a_stale_wall() {
     assert!(states[faulted..]
         .iter()
         .all(|s| s.axes[0].actuator_n == 0.0));
-    assert_eq!(states.last().unwrap().mode, Mode::Disarmed);
+    assert_eq!(states.last().unwrap().mode, BoardMode::Disarmed);
     let e = b.home(Duration::from_secs(1)).unwrap_err();
     assert!(e.to_string().contains("host VE late"), "{e}");
 }
@@ -152,7 +152,7 @@ fn wrong_calls_are_named_and_refusals_carry_the_boards_reason() {
 fn homing_finds_the_stop_and_calibrates() {
     let mut b = open(2.0);
     let s = b.home(Duration::from_secs(60)).unwrap();
-    assert!(s.calibrated && s.mode == Mode::Disarmed, "{s:?}");
+    assert!(s.calibrated && s.mode == BoardMode::Disarmed, "{s:?}");
     b.stream(1).unwrap();
     for _ in 0..20 {
         b.poll().unwrap();
@@ -245,7 +245,7 @@ fn a_call_that_waits_keeps_sending_heartbeats() {
         hold_until: None,
         heartbeats_while_held: 0,
     };
-    let mut b = Board::open(port, 1).unwrap();
+    let mut b = HostBoard::open(port, 1).unwrap();
     b.gains().unwrap();
     let sent = b.port().heartbeats_while_held;
     assert!(sent >= 1, "{sent} heartbeats while the answer was held");

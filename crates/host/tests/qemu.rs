@@ -5,8 +5,8 @@
 //! nothing here counts on how many ticks a second of the host's brings.
 
 use std::time::{Duration, Instant};
-use twoport_host::Board;
-use twoport_link::{Contact, Mode, ProvenRegion, VeSource};
+use twoport_host::HostBoard;
+use twoport_link::{BoardMode, Contact, ProvenRegion, VeSource};
 
 /// The wall the host's VE renders (m): solid above. The image's hand
 /// pushes 2 N along +x.
@@ -21,7 +21,7 @@ const WALL_M: f64 = 0.005;
 #[ignore = "needs the sim-device image in QEMU (cargo xtask device --check)"]
 fn an_application_drives_the_free_running_board_in_qemu() {
     let pty = std::env::var("TWOPORT_PTY").expect("TWOPORT_PTY: the board's pty");
-    let mut b = Board::open_serial(&pty, 1).unwrap();
+    let mut b = HostBoard::open_serial(&pty, 1).unwrap();
     let spec = *b.spec();
     assert_eq!(
         (spec.period_ns, spec.linkage, spec.ve),
@@ -37,7 +37,7 @@ fn an_application_drives_the_free_running_board_in_qemu() {
     // board waits for heartbeats: QEMU and this test share the machine's
     // cores, and a busy machine stalls either.
     b.host_ve(1, 500).unwrap();
-    assert_eq!(b.arm().unwrap().mode, Mode::Armed);
+    assert_eq!(b.arm().unwrap().mode, BoardMode::Armed);
     let start = Instant::now();
     let mut last_seq = 0;
     while start.elapsed() < Duration::from_secs(2) {
@@ -47,7 +47,7 @@ fn an_application_drives_the_free_running_board_in_qemu() {
     }
     let states = b.take_states();
     let last = states.last().copied().unwrap();
-    assert_eq!((last.mode, last.faults), (Mode::Armed, 0), "{last:?}");
+    assert_eq!((last.mode, last.faults), (BoardMode::Armed, 0), "{last:?}");
     let x = last.axes[0].position_m;
     let press = 2.0 / 51_000.0;
     assert!(
@@ -56,6 +56,6 @@ fn an_application_drives_the_free_running_board_in_qemu() {
         states.len()
     );
     assert!(last.ve_seq > 0 && last.ve_seq <= last_seq);
-    assert_eq!(b.disarm().unwrap().mode, Mode::Disarmed);
+    assert_eq!(b.disarm().unwrap().mode, BoardMode::Disarmed);
     b.close().unwrap();
 }

@@ -14,9 +14,9 @@ pub use axes::{Axes, MAX_AXES};
 pub use crc::crc16;
 pub use frame::{encode, Decoder, Envelope, FrameError, Stats, MAX_FRAME, MAX_PAYLOAD};
 pub use message::{
-    ActuatorFrame, AxisRefusal, AxisTelemetry, ConfigFallback, ConfigSource, Experiment, Gains,
-    GainsReply, HandshakeError, LinkStats, Message, Mode, ModeRefusal, ModeRequest, PilSensors,
-    Refusal, Role, Status, Telemetry, NO_SESSION, PROTOCOL_VERSION,
+    ActuatorFrame, AxisRefusal, AxisTelemetry, BoardMode, ConfigFallback, ConfigSource,
+    ExperimentRequest, Gains, GainsReply, HandshakeError, LinkStats, Message, ModeRefusal,
+    ModeRequest, PilSensors, Refusal, Role, Status, Telemetry, NO_SESSION, PROTOCOL_VERSION,
 };
 pub use spec::{AxisSpec, ProvenRegion, Spec};
 pub use ve::{Contact, VeParam, VeSource, VeUpdate};

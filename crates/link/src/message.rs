@@ -62,7 +62,7 @@ pub struct Telemetry {
     /// Cycles (or instructions, in QEMU) the last tick took.
     pub loop_cycles: u32,
     /// What the board is doing (protocol 3).
-    pub mode: Mode,
+    pub mode: BoardMode,
     /// The last tick's stages, in the same count: reading the sensors,
     /// the law and the safety layer, driving the amplifier and queueing
     /// the answer (protocol 3).
@@ -85,7 +85,7 @@ pub struct Telemetry {
 /// The board's state machine (protocol 3). A board boots disarmed with its
 /// outputs off; any fault returns it here.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Mode {
+pub enum BoardMode {
     /// Outputs off, zero force.
     #[default]
     Disarmed,
@@ -134,7 +134,7 @@ pub enum ModeRefusal {
     /// Only a disarmed board may do this.
     NotDisarmed {
         /// The mode it is in.
-        mode: Mode,
+        mode: BoardMode,
     },
     /// The position is beyond the board's range (±2.147 m).
     OutOfRange,
@@ -151,7 +151,7 @@ pub enum ModeRefusal {
     /// Only an armed board may do this (protocol 7).
     NotArmed {
         /// The mode it is in.
-        mode: Mode,
+        mode: BoardMode,
     },
     /// The experiment asked for cannot be played: an axis the board does
     /// not have, a band past Nyquist, a peak past the axis's force limit,
@@ -213,7 +213,7 @@ pub enum ConfigFallback {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Status {
     /// Where the state machine is.
-    pub mode: Mode,
+    pub mode: BoardMode,
     /// Whether the encoder offset is known (homed or calibrated).
     pub calibrated: bool,
     /// Latched fault bits (`twoport_control::Faults`).
@@ -325,7 +325,7 @@ pub struct ActuatorFrame {
 /// stood by a spring-damper of `hold_k_npm` (N/m) and `hold_b_nspm`
 /// (N s/m), which must lie in the axis's proven region.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Experiment {
+pub struct ExperimentRequest {
     /// The axis excited.
     pub axis: u8,
     /// The multisine's period (ticks).
@@ -438,9 +438,9 @@ pub enum Message {
     Stats(LinkStats),
     /// Play an identification experiment: an armed board, calibrated, its
     /// dead-man switch closed and no fault latched, switches to
-    /// [`Mode::Identifying`] and sends telemetry every tick until it ends
+    /// [`BoardMode::Identifying`] and sends telemetry every tick until it ends
     /// (protocol 7).
-    Identify(Experiment),
+    Identify(ExperimentRequest),
     /// Ask for the board's [`Spec`] (protocol 8).
     GetSpec,
     /// What the board can do and what it will accept (protocol 8).

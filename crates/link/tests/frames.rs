@@ -39,7 +39,7 @@ fn all_messages() -> Vec<Message> {
             .unwrap(),
             faults: 0xFFFF,
             loop_cycles: 1234,
-            mode: Mode::Homing,
+            mode: BoardMode::Homing,
             stage_cycles: [u32::MAX; 3],
             deadline_misses: u32::MAX,
             worst_jitter_cycles: u32::MAX,
@@ -77,7 +77,7 @@ fn all_messages() -> Vec<Message> {
             why: ConfigFallback::OlderVersion { found: 0 },
         }),
         Message::Status(Status {
-            mode: Mode::Armed,
+            mode: BoardMode::Armed,
             calibrated: true,
             faults: 0xFFFF,
             first_fault: 0x8000,
@@ -89,7 +89,9 @@ fn all_messages() -> Vec<Message> {
         },
         Message::ModeRefused {
             asked: ModeRequest::Calibrate,
-            why: ModeRefusal::NotDisarmed { mode: Mode::Homing },
+            why: ModeRefusal::NotDisarmed {
+                mode: BoardMode::Homing,
+            },
         },
         Message::Sensors(PilSensors {
             tick: 7,

@@ -7,7 +7,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::time::Duration;
 use twoport_host::{
-    Board as HostBoard, BoardPort, Contact, LinkError, Pace, SerialBoard, SimulatedBoard, State,
+    BoardPort, Contact, HostBoard, LinkError, Pace, SerialBoard, SimulatedBoard, State,
 };
 
 /// A board: a real one over a serial port, the firmware in QEMU through

@@ -108,7 +108,7 @@ where
         // ticks, as a loop stuck in a bug would.
         #[cfg(feature = "watchdog-test")]
         {
-            if board.mode() == twoport_link::Mode::Armed {
+            if board.mode() == twoport_link::BoardMode::Armed {
                 armed_ticks += 1;
             }
             if armed_ticks == 1500 {

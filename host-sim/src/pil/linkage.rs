@@ -17,7 +17,7 @@ use crate::engine::linkage::{CartesianHand, LinkageArm};
 use crate::link::{BoardPort, LinkFaults, Session};
 use crate::{Error, Sample};
 use nalgebra::DMatrix;
-use twoport_board::linkage::{self as image, Spec};
+use twoport_board::linkage::{self as image, ImageSpec};
 use twoport_board::IoScale;
 use twoport_design::linkage::LinkageFile;
 use twoport_link::{Axes, Message, PilSensors};
@@ -48,7 +48,7 @@ impl Device {
     }
 
     /// The board image's constants.
-    pub fn spec(self) -> &'static Spec {
+    pub fn spec(self) -> &'static ImageSpec {
         match self {
             Device::SerialArm => &image::PHANTOM,
             Device::Delta => &image::FALCON,
@@ -84,7 +84,7 @@ pub enum Plan {
     /// arming.
     Identify {
         /// The experiment, in the link's terms.
-        experiment: twoport_link::Experiment,
+        experiment: twoport_link::ExperimentRequest,
         /// Ticks between arming and the experiment's start.
         start_ticks: u64,
         /// Whether the joints' Coulomb friction acts.

@@ -20,7 +20,9 @@ use crate::{Sample, Scene, Simulation};
 use twoport_board::excalibur::{self, xyz};
 use twoport_control::servo::{SensorFrame, ServoOutput};
 use twoport_control::Faults as BoardFaults;
-use twoport_link::{Axes, ConfigSource, LinkStats, Message, Mode, PilSensors, Status, Telemetry};
+use twoport_link::{
+    Axes, BoardMode, ConfigSource, LinkStats, Message, PilSensors, Status, Telemetry,
+};
 
 /// How far a homed board's position may be from the plant's: the stop's
 /// give under the homing force (25 µm on the scenes' 2e5 N/m stop) and a
@@ -56,7 +58,7 @@ pub struct Run<const N: usize = 1> {
     pub homing: Option<(u64, f64)>,
     /// The identification experiment the scene asked for, and the tick
     /// the board started it at.
-    pub experiment: Option<(twoport_link::Experiment, u64)>,
+    pub experiment: Option<(twoport_link::ExperimentRequest, u64)>,
     /// What the board said it can do, asked before its first tick.
     pub spec: Option<twoport_link::Spec>,
     /// Host VE updates sent (0: the board's own VE ran).
@@ -117,7 +119,7 @@ impl<const N: usize> Run<N> {
         let frames: Vec<&Telemetry> = self
             .telemetry
             .iter()
-            .filter(|t| t.mode == Mode::Identifying)
+            .filter(|t| t.mode == BoardMode::Identifying)
             .collect();
         if let Some(w) = frames
             .windows(2)
@@ -135,7 +137,7 @@ impl<const N: usize> Run<N> {
 
 /// One axis's record of experiment `x` from its `frames`.
 fn axis_log(
-    x: &twoport_link::Experiment,
+    x: &twoport_link::ExperimentRequest,
     frames: &[&Telemetry],
     axis: usize,
     with_load_cell: bool,
@@ -354,7 +356,7 @@ pub fn check_scene(scene: &Scene) -> Result<(), Error> {
 /// goes on, the error where it failed.
 pub fn homed(statuses: &[Status]) -> Option<Result<(), Error>> {
     statuses.iter().find_map(|s| match s.mode {
-        Mode::Homing => None,
+        BoardMode::Homing => None,
         _ if s.faults != 0 => Some(Err(pil_err!(
             "homing ended with faults: {}",
             BoardFaults(s.faults)

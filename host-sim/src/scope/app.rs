@@ -5,7 +5,7 @@
 
 use crate::engine::human::GraspKind;
 use crate::engine::scene::{Scene, VeSpec};
-use crate::scope::board::{BoardLink, BoardMode};
+use crate::scope::board::{BoardLink, WithBoard};
 use crate::scope::rings::{last_trigger, Edge, Ring};
 use crate::scope::signals::{BoardSignal, Signal};
 use crate::Error;
@@ -460,7 +460,7 @@ impl ScopeState {
     }
 }
 
-impl BoardMode for ScopeState {
+impl WithBoard for ScopeState {
     fn board_parts(&mut self) -> (&mut Option<BoardLink>, &mut Option<String>, &Scene) {
         (&mut self.board, &mut self.message, &self.scene)
     }

@@ -114,10 +114,10 @@ impl BoardLink {
     }
 }
 
-/// A scope state with a board mode: the link, where its problems are
+/// A scope state that can hold a board: the link, where its problems are
 /// said, and the scene whose device a lockstep board must be. Connecting,
 /// leaving and talking to the board are written once, here.
-pub trait BoardMode {
+pub trait WithBoard {
     /// The link, the state's message line, and its scene.
     fn board_parts(&mut self) -> (&mut Option<BoardLink>, &mut Option<String>, &Scene);
 

@@ -3,7 +3,7 @@
 
 use crate::engine::human::GraspKind;
 use crate::scope::app::{list_ports, ScopeState, Speed};
-use crate::scope::board::BoardMode;
+use crate::scope::board::WithBoard;
 use crate::scope::board::{BoardChoice, BoardLink};
 use crate::scope::rings::{minmax, Edge, Ring};
 use crate::scope::signals::{BoardSignal, Signal};
@@ -479,14 +479,14 @@ pub fn board_choice(ui: &mut Ui, link: &mut BoardChoice) -> Option<(String, bool
 /// name, and the buttons that move it; what a button asks the board.
 pub fn board_state(ui: &mut Ui, b: &BoardLink) -> Option<twoport_link::Message> {
     use twoport_control::Faults;
-    use twoport_link::{Message, Mode};
+    use twoport_link::{BoardMode, Message};
     let st = b.status.unwrap_or_default();
     let mode = b.telemetry.map_or(st.mode, |t| t.mode);
     let colour = match mode {
-        Mode::Armed => Color32::GREEN,
-        Mode::Homing => Color32::YELLOW,
-        Mode::Identifying => Color32::LIGHT_BLUE,
-        Mode::Disarmed => Color32::GRAY,
+        BoardMode::Armed => Color32::GREEN,
+        BoardMode::Homing => Color32::YELLOW,
+        BoardMode::Identifying => Color32::LIGHT_BLUE,
+        BoardMode::Disarmed => Color32::GRAY,
     };
     ui.colored_label(
         colour,

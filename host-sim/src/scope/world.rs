@@ -7,7 +7,7 @@
 //! simulation's.
 
 use crate::engine::servo::WorldView;
-use crate::scope::board::{BoardChoice, BoardLink, BoardMode};
+use crate::scope::board::{BoardChoice, BoardLink, WithBoard};
 use crate::scope::rings::Ring;
 use crate::Error;
 use crate::{Sample, Scene, Simulation};
@@ -204,7 +204,7 @@ impl<const N: usize> WorldState<N> {
     }
 }
 
-impl<const N: usize> BoardMode for WorldState<N> {
+impl<const N: usize> WithBoard for WorldState<N> {
     fn board_parts(&mut self) -> (&mut Option<BoardLink>, &mut Option<String>, &Scene) {
         (&mut self.board, &mut self.message, self.sim.scene())
     }

@@ -5,7 +5,7 @@
 //! mode), and the board panel. Dragging in a projection drags the hand
 //! along its two axes.
 
-use crate::scope::board::BoardMode;
+use crate::scope::board::WithBoard;
 use crate::scope::ui;
 use crate::scope::world::WorldState;
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, Ui, Vec2};

@@ -21,7 +21,7 @@ use twoport_control::servo::PortLayer;
 use twoport_control::servo::ServoOutput;
 use twoport_control::world::World;
 use twoport_control::Faults;
-use twoport_link::{Axes, Message, Mode, ModeRefusal, ModeRequest, Status};
+use twoport_link::{Axes, BoardMode, Message, ModeRefusal, ModeRequest, Status};
 
 impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
 where
@@ -30,7 +30,7 @@ where
     D: Drive<N, World = W, Layer = L>,
 {
     /// Where the state machine is.
-    pub fn mode(&self) -> Mode {
+    pub fn mode(&self) -> BoardMode {
         self.mode
     }
 
@@ -74,7 +74,7 @@ where
         self.queue(Message::ModeRefused { asked, why });
     }
 
-    pub(super) fn set_mode(&mut self, mode: Mode) {
+    pub(super) fn set_mode(&mut self, mode: BoardMode) {
         if self.mode != mode {
             self.mode = mode;
             self.queue_status();
@@ -92,7 +92,7 @@ where
         let why = self
             .latched()
             .or(match self.mode {
-                Mode::Homing | Mode::Identifying => {
+                BoardMode::Homing | BoardMode::Identifying => {
                     Some(ModeRefusal::NotDisarmed { mode: self.mode })
                 }
                 _ => None,
@@ -108,10 +108,10 @@ where
         }
         match (self.mode, self.servo.servo_mut().enable()) {
             // Armed already: the answer is the status.
-            (Mode::Armed, Ok(())) => self.queue_status(),
+            (BoardMode::Armed, Ok(())) => self.queue_status(),
             (_, Ok(())) => {
                 self.host_ve_armed();
-                self.set_mode(Mode::Armed);
+                self.set_mode(BoardMode::Armed);
             }
             (_, Err(f)) => self.refuse(ModeRequest::Arm, ModeRefusal::Faulted { faults: f.0 }),
         }
@@ -124,7 +124,7 @@ where
         self.servo.servo_mut().disable();
         self.homing = None;
         self.experiment = None;
-        self.set_mode(Mode::Disarmed);
+        self.set_mode(BoardMode::Disarmed);
     }
 
     /// `Home`: a disarmed board without faults starts every axis's homing
@@ -134,7 +134,7 @@ where
             .then_some(ModeRefusal::Unsupported)
             .or(self.latched())
             .or(match self.mode {
-                Mode::Disarmed => None,
+                BoardMode::Disarmed => None,
                 m => Some(ModeRefusal::NotDisarmed { mode: m }),
             });
         if let Some(why) = why {
@@ -156,7 +156,7 @@ where
         match self.servo.servo_mut().enable() {
             Ok(()) => {
                 self.homing = Some(runs);
-                self.set_mode(Mode::Homing);
+                self.set_mode(BoardMode::Homing);
             }
             Err(f) => self.refuse(ModeRequest::Home, ModeRefusal::Faulted { faults: f.0 }),
         }
@@ -165,7 +165,7 @@ where
     /// `Calibrate`: a disarmed board takes the host's word for where each
     /// axis stands (all of them or, naming why, none).
     pub(super) fn calibrate(&mut self, position_pm: Axes<i64>) {
-        if self.mode != Mode::Disarmed {
+        if self.mode != BoardMode::Disarmed {
             let mode = self.mode;
             return self.refuse(ModeRequest::Calibrate, ModeRefusal::NotDisarmed { mode });
         }
@@ -224,14 +224,14 @@ where
                 self.disarm();
             }
         }
-        if self.mode != Mode::Disarmed && !out.faults.is_empty() {
+        if self.mode != BoardMode::Disarmed && !out.faults.is_empty() {
             self.disarm();
         }
     }
 
     /// Switch the outputs to follow the mode.
     pub(super) fn drive_outputs(&mut self, io: &mut impl BoardSupport<N>) {
-        let on = self.mode != Mode::Disarmed;
+        let on = self.mode != BoardMode::Disarmed;
         if on != self.outputs_on {
             io.set_outputs(on);
             self.outputs_on = on;

@@ -8,7 +8,7 @@ use twoport_control::drive::Drive;
 use twoport_control::servo::PortLayer;
 use twoport_control::world::{Held, World};
 use twoport_control::{Faults, Position};
-use twoport_link::{Message, Mode, ModeRefusal, ModeRequest, VeSource, VeUpdate};
+use twoport_link::{BoardMode, Message, ModeRefusal, ModeRequest, VeSource, VeUpdate};
 
 /// The host's VE as the board holds it.
 #[derive(Clone, Copy, Debug)]
@@ -49,7 +49,7 @@ where
 
     /// `SetVe`: a disarmed board switches its VE, and says which it runs.
     pub(super) fn set_ve(&mut self, source: VeSource) {
-        if self.mode != Mode::Disarmed {
+        if self.mode != BoardMode::Disarmed {
             let mode = self.mode;
             return self.refuse(ModeRequest::SetVe, ModeRefusal::NotDisarmed { mode });
         }
@@ -117,7 +117,7 @@ where
     /// The deadline's part of a tick, before the law runs: an armed board
     /// past it faults, so the tick's force is zero.
     pub(super) fn host_ve_tick(&mut self) {
-        let armed = self.mode == Mode::Armed;
+        let armed = self.mode == BoardMode::Armed;
         if let Some(h) = self.host.as_mut() {
             h.age_ticks = h.age_ticks.saturating_add(1);
             if armed && h.age_ticks > h.deadline_ticks {

@@ -21,7 +21,7 @@ use twoport_control::multisine::Multisine;
 use twoport_control::servo::{Display, Gains, ImpedanceGains, PortLayer};
 use twoport_control::world::World;
 use twoport_control::ImpedanceCoupling;
-use twoport_link::{Experiment as Request, Mode, ModeRefusal, ModeRequest};
+use twoport_link::{BoardMode, ExperimentRequest as Request, ModeRefusal, ModeRequest};
 
 impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
 where
@@ -40,7 +40,7 @@ where
         let why = self
             .latched()
             .or(match self.mode {
-                Mode::Armed => None,
+                BoardMode::Armed => None,
                 mode => Some(ModeRefusal::NotArmed { mode }),
             })
             .or((!self.calibrated).then_some(ModeRefusal::NotCalibrated))
@@ -51,7 +51,7 @@ where
         match self.experiment_for(&req) {
             Some(x) => {
                 self.experiment = Some(x);
-                self.set_mode(Mode::Identifying);
+                self.set_mode(BoardMode::Identifying);
             }
             None => self.refuse(ModeRequest::Identify, ModeRefusal::BadExperiment),
         }

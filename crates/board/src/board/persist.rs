@@ -12,7 +12,7 @@ use twoport_control::servo::Gains;
 use twoport_control::servo::PortLayer;
 use twoport_control::world::World;
 use twoport_control::{Position, SafetyConfig};
-use twoport_link::{ConfigFallback, ConfigSource, Message, Mode, ModeRefusal, ModeRequest};
+use twoport_link::{BoardMode, ConfigFallback, ConfigSource, Message, ModeRefusal, ModeRequest};
 
 impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
 where
@@ -61,7 +61,7 @@ where
     /// none: each axis's gains must lie in its proven region and every
     /// value must hold. Disarmed only.
     pub fn apply_config(&mut self, cfg: &[Config; N]) -> Result<(), ConfigFallback> {
-        if self.mode != Mode::Disarmed || cfg.iter().any(|c| c.validate().is_err()) {
+        if self.mode != BoardMode::Disarmed || cfg.iter().any(|c| c.validate().is_err()) {
             return Err(ConfigFallback::Invalid);
         }
         let gains = cfg.map(|c| Gains::from(c.gains));
@@ -132,7 +132,7 @@ where
     /// `SaveConfig`: remembered for the main loop, which owns the flash.
     pub(super) fn request_save(&mut self) {
         match self.mode {
-            Mode::Disarmed => self.save_pending = true,
+            BoardMode::Disarmed => self.save_pending = true,
             mode => self.refuse(ModeRequest::SaveConfig, ModeRefusal::NotDisarmed { mode }),
         }
     }
@@ -144,7 +144,7 @@ where
         if !core::mem::take(&mut self.save_pending) {
             return;
         }
-        if self.mode != Mode::Disarmed {
+        if self.mode != BoardMode::Disarmed {
             let mode = self.mode;
             return self.refuse(ModeRequest::SaveConfig, ModeRefusal::NotDisarmed { mode });
         }

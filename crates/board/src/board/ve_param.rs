@@ -6,7 +6,7 @@ use super::Board;
 use twoport_control::drive::Drive;
 use twoport_control::servo::PortLayer;
 use twoport_control::world::World;
-use twoport_link::{Message, Mode, ModeRefusal, ModeRequest, VeParam};
+use twoport_link::{BoardMode, Message, ModeRefusal, ModeRequest, VeParam};
 
 impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
 where
@@ -18,7 +18,7 @@ where
     /// out of range or a parameter its VE has not are refused
     /// (`BadVeParam`), the VE unchanged.
     pub(super) fn set_ve_param(&mut self, axis: u8, param: VeParam) {
-        if self.mode != Mode::Disarmed {
+        if self.mode != BoardMode::Disarmed {
             let mode = self.mode;
             return self.refuse(ModeRequest::SetVeParam, ModeRefusal::NotDisarmed { mode });
         }

@@ -36,17 +36,17 @@ pub const HOMING: [HomingConfig; 3] = [
 pub const MAX_BLOCKS: usize = BLOCKS.len();
 
 /// The image's world type.
-pub type World = Vbb<f32, MAX_BLOCKS>;
+pub type XyzWorld = Vbb<f32, MAX_BLOCKS>;
 
 /// The image's servo type.
-pub type XyzServo = Servo<World, f32, 3>;
+pub type XyzServo = Servo<XyzWorld, f32, 3>;
 
 /// The image's board type.
-pub type XyzBoard = Board<World, REGION_POINTS, 3>;
+pub type XyzBoard = Board<XyzWorld, REGION_POINTS, 3>;
 
 /// The image's world, its cursor at rest at the workspace's centre, 10 mm
 /// above the floor.
-pub fn world() -> Result<World, BuildError> {
+pub fn world() -> Result<XyzWorld, BuildError> {
     let block =
         |(at, size, mass): ([f32; 3], [f32; 3], f32)| Block::new(at, size, mass).ok_or(BLOCK);
     let mut blocks = [block(BLOCKS[0])?; MAX_BLOCKS];

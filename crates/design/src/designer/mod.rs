@@ -523,14 +523,18 @@ impl Designer {
 
     /// The impedance display's proven region: the greatest stiffness at
     /// each of `points` log-spaced dampings over `range` (N s/m).
-    pub fn region_impedance(&self, range: (f64, f64), points: usize) -> Result<Region, Error> {
+    pub fn region_impedance(
+        &self,
+        range: (f64, f64),
+        points: usize,
+    ) -> Result<RegionReport, Error> {
         let range = region_range(range, points)?;
         let rows = analysis::region_impedance(
             &self.with(self.impedance_bounds(Bound::Sound)),
             range,
             points,
         );
-        Ok(Region {
+        Ok(RegionReport {
             context: self.context(DisplayKind::Impedance),
             bound: RegionBound::MaxStiffness,
             rows,
@@ -545,13 +549,13 @@ impl Designer {
         (kp, bp): (f64, f64),
         range: (f64, f64),
         points: usize,
-    ) -> Result<Region, Error> {
+    ) -> Result<RegionReport, Error> {
         let range = region_range(range, points)?;
         self.force_sensor()?;
         let (kp, bp) = (gain("kp", kp)?, gain("bp", bp)?);
         let k = analysis::regulator_tf(kp, bp, self.period_s())?;
         let reg = self.regulated((kp, bp), &k);
-        Ok(Region {
+        Ok(RegionReport {
             context: self.context(DisplayKind::Admittance),
             bound: RegionBound::MinMass,
             rows: analysis::region_admittance(&reg.with(&self.poses, Bound::Sound), range, points),

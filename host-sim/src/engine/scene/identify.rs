@@ -38,7 +38,7 @@ fn default_start() -> f64 {
 impl IdentifySpec {
     /// The experiment in the link's terms at the control period `tick_s`,
     /// or why it cannot be played (naming the field).
-    pub fn experiment(&self, tick_s: f64) -> Result<twoport_link::Experiment, Error> {
+    pub fn experiment(&self, tick_s: f64) -> Result<twoport_link::ExperimentRequest, Error> {
         let period = self.period_s / tick_s;
         if !(period.is_finite() && period >= 4.0 && period <= u32::MAX as f64) {
             return Err(sim_err!(
@@ -80,7 +80,7 @@ impl IdentifySpec {
             self.peak_n as f32,
         )
         .map_err(|e| sim_err!("identify: {e}"))?;
-        Ok(twoport_link::Experiment {
+        Ok(twoport_link::ExperimentRequest {
             axis: self.axis,
             period_ticks,
             first: lo as u32,

@@ -1,7 +1,7 @@
 //! `check`'s report: given gains, proven or not, and how far inside the
 //! boundary.
 
-use super::{Binding, Context, DisplayKind, Limit};
+use super::{BindingBound, Context, DisplayKind, Limit};
 use crate::analysis::Check;
 use crate::limit_cycle::LimitCycle;
 use serde::ser::{SerializeMap, Serializer};
@@ -83,9 +83,9 @@ impl Serialize for CheckReport {
         m.serialize_entry("min_margin", &c.min_margin)?;
         m.serialize_entry("worst_frequency_hz", &c.worst_frequency_hz)?;
         let binding = if c.sampled_binds() {
-            Binding::SampledData
+            BindingBound::SampledData
         } else {
-            Binding::Both
+            BindingBound::Both
         };
         m.serialize_entry("binding_bound", &binding)?;
         m.serialize_entry("paper_absolutely_stable", &c.paper.absolutely_stable)?;

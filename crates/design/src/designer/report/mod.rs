@@ -11,7 +11,7 @@ mod region;
 mod verify;
 
 pub use check::CheckReport;
-pub use region::{Region, RegionBound};
+pub use region::{RegionBound, RegionReport};
 pub use verify::VerifyReport;
 
 /// Which display a report is for.
@@ -144,7 +144,7 @@ impl Limit {
 
 /// Which bound set a design: the sampled-data one alone, or both alike.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-pub enum Binding {
+pub enum BindingBound {
     /// The sound bound binds: the paper's approximation claims more.
     #[serde(rename = "sampled-data")]
     SampledData,
@@ -183,7 +183,7 @@ pub struct Design {
     /// Where the design binds.
     pub binds_at: Option<Binds>,
     /// Which bound binds.
-    pub binding: Binding,
+    pub binding: BindingBound,
     /// By how much the paper's approximation claims more (a fraction).
     pub aliasing_effect: f64,
     /// Why there is no design, where there is none.
@@ -239,13 +239,13 @@ impl Design {
             (Some((s, _)), Some((p, _))) => {
                 let by = limit.claims_more(s, p);
                 if by > 1e-5 {
-                    (Binding::SampledData, by)
+                    (BindingBound::SampledData, by)
                 } else {
-                    (Binding::Both, by.max(0.0))
+                    (BindingBound::Both, by.max(0.0))
                 }
             }
-            (None, Some(_)) => (Binding::SampledData, 1.0),
-            _ => (Binding::Both, 0.0),
+            (None, Some(_)) => (BindingBound::SampledData, 1.0),
+            _ => (BindingBound::Both, 0.0),
         };
         Design {
             context,
@@ -400,7 +400,7 @@ impl fmt::Display for Design {
         let by = 100.0 * self.aliasing_effect;
         let (what, unit) = (limit.what(), limit.unit());
         match self.paper {
-            Some((p, _)) if self.binding == Binding::SampledData => write!(
+            Some((p, _)) if self.binding == BindingBound::SampledData => write!(
                 f,
                 "  the sampled-data analysis binds: the paper's approximation (aliasing at the handle neglected) gives {p:.4} {unit}; the proven {what} is {by:.1}% {}",
                 if limit == Limit::Mass { "higher" } else { "lower" }

@@ -28,7 +28,7 @@ impl RegionBound {
 
 /// The proven region a board ships with: the limit at each damping.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Region {
+pub struct RegionReport {
     /// The device and display.
     pub context: Context,
     /// What the limit is.
@@ -39,7 +39,7 @@ pub struct Region {
     pub regulator: Option<(f64, f64)>,
 }
 
-impl Serialize for Region {
+impl Serialize for RegionReport {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let mut m = s.serialize_map(None)?;
         self.context.entries(&mut m)?;
@@ -57,7 +57,7 @@ impl Serialize for Region {
     }
 }
 
-impl fmt::Display for Region {
+impl fmt::Display for RegionReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{:>14} {:>16}", "b (N s/m)", self.bound.name())?;
         for (b, l) in &self.rows {
