@@ -33,6 +33,7 @@ pub struct Region<const N: usize> {
 
 /// Why a region could not be built.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum RegionError {
     /// The damping grid is not strictly increasing and positive.
     Grid,

@@ -489,6 +489,10 @@ impl HostArgs {
             TicksError::BadDelay => {
                 format!("--host-delay {}: must be a time > 0 s", self.delay_s)
             }
+            other => format!(
+                "--rates {servo_hz} Hz, --ve-rate {} Hz, --host-delay {}: {other:?}",
+                self.ve_rate_hz, self.delay_s
+            ),
         })
     }
 }

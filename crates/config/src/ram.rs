@@ -9,6 +9,7 @@ use embedded_storage::nor_flash::{
 
 /// Why the RAM flash refused an operation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum RamFlashError {
     /// Misaligned or out of bounds.
     Kind(NorFlashErrorKind),

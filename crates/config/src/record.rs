@@ -85,6 +85,7 @@ pub struct Limits {
 
 /// Why bytes are not a record this crate can use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum RecordError {
     /// No record: the magic word is absent (erased, or a write that never
     /// finished).

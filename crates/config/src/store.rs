@@ -15,6 +15,7 @@ use twoport_link::{ConfigFallback, ConfigSource};
 
 /// Why a save did not commit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum SaveError {
     /// The config does not validate (the field is named).
     Invalid(&'static str),

@@ -5,6 +5,7 @@ use crate::Position;
 
 /// Why an encoder configuration or reading was refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum EncoderError {
     /// The counter width is not between 2 and 32 bits.
     BadWidth(u8),

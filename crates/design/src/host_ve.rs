@@ -85,6 +85,7 @@ pub struct HostLoop {
 
 /// Why a host's rate or delay does not fit a servo's period.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum TicksError {
     /// The servo's rate is not a whole multiple of the host's.
     NotMultiple,

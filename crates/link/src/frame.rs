@@ -21,6 +21,7 @@ pub struct Envelope {
 
 /// Why a frame could not be sent or was dropped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum FrameError {
     /// The output buffer is too small, or the message exceeds `MAX_PAYLOAD`.
     TooLong,

@@ -563,6 +563,7 @@ impl Message {
 
 /// Why a host will not drive a board.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum HandshakeError {
     /// The board speaks another protocol version.
     Version {

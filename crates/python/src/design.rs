@@ -499,6 +499,7 @@ pub(crate) fn host_ve(
                     1.0 / t
                 ),
                 TicksError::BadDelay => format!("host_delay {host_delay}: must be a time > 0 s"),
+                other => format!("ve_rate {ve_rate} Hz, host_delay {host_delay}: {other:?}"),
             })?;
             let host = HostLoop::new(t, n, d, (body.0, body.1, 0.0)).map_err(|e| e.to_string())?;
             let human = human.then_some(HumanBound::PAPER);

@@ -83,6 +83,7 @@ impl JointEncoder {
 
 /// Why a joint encoder's configuration was refused.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum JointEncoderError {
     /// A parameter out of its range.
     Param(ParamError),

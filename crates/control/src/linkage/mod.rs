@@ -52,6 +52,7 @@ pub struct LinkageOutput<R, const N: usize> {
 
 /// Why a linkage servo was refused.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum LinkageError {
     /// A Cartesian axis's gains or limits.
     Cartesian(AxisError<GainsError>),

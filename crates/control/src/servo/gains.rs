@@ -127,6 +127,7 @@ impl From<AdmittanceGains> for Gains {
 
 /// Why a servo refused new gains; it keeps its old ones.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum GainsError {
     /// The gains are for the other display.
     WrongDisplay {

@@ -72,6 +72,7 @@ impl Ord for Open {
 
 /// Why the search has no answer.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum SearchError {
     /// No pose inside the limits where the kinematics answer.
     NoPose,

@@ -65,6 +65,7 @@ pub type HandForce<'a> = dyn Fn(&[f64], &[f64]) -> DVector<f64> + 'a;
 
 /// Why the plant cannot go on.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum PlantError {
     /// The linkage reached a pose with no kinematics (singular or out of
     /// reach) at the joint angles given.
