@@ -1,11 +1,7 @@
-//! The command line's arguments, the checks on them, and the run over a
-//! device file's axes.
+//! The command line's arguments and the checks on them.
 
-use crate::run::{print, show, Reported};
 use clap::{Args, Subcommand, ValueEnum};
-use serde_json::json;
 use std::path::PathBuf;
-use twoport_design::{Device, DeviceAxis};
 
 pub(crate) const DEFAULT_MODEL: &str = twoport_design::model::EXCALIBUR_PATH;
 
@@ -289,52 +285,6 @@ impl<I: Args + HasCommon, A: Args + HasCommon> HasCommon for Display<I, A> {
             Display::Impedance(i) => i.rust(),
             Display::Admittance(a) => a.rust(),
         }
-    }
-}
-
-/// A command run on the `--model` files (no axis), or on one axis of a
-/// device file.
-pub(crate) type OnAxis<A> = fn(&A, Option<&DeviceAxis>) -> Reported;
-
-/// `run` on `args` and its report printed; given a device file, `run` on
-/// each of its axes in turn: the text under a heading per axis, the JSON
-/// as one object with an entry per axis.
-pub(crate) fn each_axis<A: HasCommon>(args: &A, run: OnAxis<A>) -> Result<(), String> {
-    let c = args.common();
-    let Some(path) = &c.device else {
-        return show(c.json, run(args, None));
-    };
-    let device = Device::load(path).map_err(|e| e.to_string())?;
-    let mut axes = Vec::new();
-    for axis in &device.axes {
-        let report = run(args, Some(axis))
-            .map_err(|e| format!("{}, axis {}: {e}", path.display(), axis.name))?;
-        if c.json {
-            let mut v = report.json()?;
-            v["axis"] = json!(axis.name);
-            axes.push(v);
-        } else {
-            if !args.rust() {
-                say!("axis {}:\n", axis.name);
-            }
-            print(false, &*report)?;
-        }
-    }
-    if c.json {
-        say!("{}\n", json!({"device": device.name, "axes": axes}));
-    }
-    Ok(())
-}
-
-/// `run` on `args`, refusing a device file: the command draws one axis.
-pub(crate) fn one_axis<A: HasCommon>(args: &A, run: OnAxis<A>) -> Result<(), String> {
-    let c = args.common();
-    match &c.device {
-        Some(p) => Err(format!(
-            "--device {}: this command draws one axis; give that axis's --model",
-            p.display()
-        )),
-        None => show(c.json, run(args, None)),
     }
 }
 

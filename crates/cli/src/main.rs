@@ -34,7 +34,7 @@ mod synthesis;
 mod verify;
 
 use crate::args::*;
-use crate::run::{print, show};
+use crate::run::{each_axis, one_axis, print, show};
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 

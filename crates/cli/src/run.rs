@@ -1,14 +1,15 @@
 //! What every command shares: the designer opened from the common
-//! arguments, and a report printed as JSON or text.
+//! arguments, a report printed as JSON or text, and the run over a device
+//! file's axes.
 
 use crate::args::*;
 use serde::Serialize;
-use serde_json::Value;
+use serde_json::{json, Value};
 use std::fmt::Display;
 use twoport_design::designer::Pose;
 use twoport_design::device::DeviceAxis;
 use twoport_design::network::HumanBound;
-use twoport_design::{Designer, DeviceModel};
+use twoport_design::{Designer, Device, DeviceModel};
 
 /// The designer on the command's poses: the axis of a device file it runs
 /// on, or its `--model` files.
@@ -90,4 +91,50 @@ pub(crate) fn print(json: bool, report: &dyn Report) -> Result<(), String> {
 /// Print a command's report, or pass on why it has none.
 pub(crate) fn show(json: bool, report: Reported) -> Result<(), String> {
     print(json, &*report?)
+}
+
+/// A command run on the `--model` files (no axis), or on one axis of a
+/// device file.
+pub(crate) type OnAxis<A> = fn(&A, Option<&DeviceAxis>) -> Reported;
+
+/// `run` on `args` and its report printed; given a device file, `run` on
+/// each of its axes in turn: the text under a heading per axis, the JSON
+/// as one object with an entry per axis.
+pub(crate) fn each_axis<A: HasCommon>(args: &A, run: OnAxis<A>) -> Result<(), String> {
+    let c = args.common();
+    let Some(path) = &c.device else {
+        return show(c.json, run(args, None));
+    };
+    let device = Device::load(path).map_err(|e| e.to_string())?;
+    let mut axes = Vec::new();
+    for axis in &device.axes {
+        let report = run(args, Some(axis))
+            .map_err(|e| format!("{}, axis {}: {e}", path.display(), axis.name))?;
+        if c.json {
+            let mut v = report.json()?;
+            v["axis"] = json!(axis.name);
+            axes.push(v);
+        } else {
+            if !args.rust() {
+                say!("axis {}:\n", axis.name);
+            }
+            print(false, &*report)?;
+        }
+    }
+    if c.json {
+        say!("{}\n", json!({"device": device.name, "axes": axes}));
+    }
+    Ok(())
+}
+
+/// `run` on `args`, refusing a device file: the command draws one axis.
+pub(crate) fn one_axis<A: HasCommon>(args: &A, run: OnAxis<A>) -> Result<(), String> {
+    let c = args.common();
+    match &c.device {
+        Some(p) => Err(format!(
+            "--device {}: this command draws one axis; give that axis's --model",
+            p.display()
+        )),
+        None => show(c.json, run(args, None)),
+    }
 }

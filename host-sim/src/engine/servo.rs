@@ -2,21 +2,17 @@
 //! the float type the scene names (the board's f32, or f64 to take the
 //! laws' rounding out of a study).
 
-use crate::engine::blocks::{Block, Blocks};
 use crate::engine::layer::SceneLayer;
 use crate::engine::linkage::{AnyKinematics, LinkageArm, Shifted};
-use crate::engine::scene::{Discretization, Integration, LayerPort, Precision, Scene, VeSpec};
+use crate::engine::scene::{Precision, Scene, VeSpec};
+use crate::engine::ve::from_scene::{axis_ve, set_wall};
 use crate::engine::ve::SceneVe;
 use crate::engine::world::SceneWorld;
 use crate::Error;
 use twoport_control::kinematics::Kinematics;
 use twoport_control::linkage::LinkageServo;
-use twoport_control::passivity::{ParallelLimits, PassiveVe};
+use twoport_control::passivity::PassiveVe;
 use twoport_control::servo::{Gains, PortLayer, SensorFrame, Servo, ServoOutput};
-use twoport_control::ve::{
-    BilateralConstraint, CursorMass, ExplicitCursor, LosslessCursor, Spring, TrapezoidalSpring,
-    UnilateralWall,
-};
 use twoport_control::world::vbb::Block as Block3;
 use twoport_control::world::World;
 use twoport_control::{Encoder, Position, Real, SafetyConfig};
@@ -119,26 +115,6 @@ where
     Ok(servo)
 }
 
-/// One axis's VE: the scene's, behind the passivity layer at its port
-/// where the scene puts one there.
-fn axis_ve<R: Real>(scene: &Scene, safety: &SafetyConfig) -> Result<SceneVe<R>, Error> {
-    let ve = scene_ve(scene, safety.period_s)?;
-    Ok(match (&scene.passivity, &scene.ve) {
-        (Some(p), VeSpec::Cursor { mass_kg, .. }) if p.enabled && p.port == LayerPort::Ve => {
-            let limits = ParallelLimits::for_display(
-                *mass_kg as f32,
-                safety.period_s,
-                safety.max_velocity_mps,
-            )
-            .map_err(|e| e.to_string())?;
-            SceneVe::Passive(Box::new(
-                PassiveVe::new(ve, limits).map_err(|e| e.to_string())?,
-            ))
-        }
-        _ => ve,
-    })
-}
-
 fn enabled<W: World<R, N>, R: Real, L: PortLayer<R>, const N: usize>(
     mut s: Servo<W, R, N, L>,
 ) -> Result<Box<Servo<W, R, N, L>>, Error> {
@@ -155,16 +131,6 @@ where
     SceneWorld<R, N>: World<R, N>,
 {
     enabled(s.with_layers(layers).map_err(|e| e.error.to_string())?)
-}
-
-fn set_wall<R: Real>(ve: &mut SceneVe<R>, surface: Position, k_npm: f32) -> Result<(), Error> {
-    let SceneVe::Wall(w) = ve else {
-        return Err("the scene's VE is not a wall".into());
-    };
-    let (_, b) = w.gains();
-    w.set_gains(k_npm, b).map_err(|e| e.to_string())?;
-    w.set_surface(surface);
-    Ok(())
 }
 
 /// The sensors as the f32 board reads them.
@@ -415,104 +381,4 @@ impl LayerView<'_> {
             LayerView::Ve64(p) => p.dissipated_j(),
         }
     }
-}
-
-/// The scene's VE, computing in `R`.
-fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, Error> {
-    let pos = |m: f64| {
-        Position::from_m_f64(m).ok_or(format!("position {m} m is out of range (±2.147 m)"))
-    };
-    Ok(match &scene.ve {
-        VeSpec::Cursor {
-            mass_kg,
-            integration: Integration::Implicit,
-        } => SceneVe::Cursor(
-            CursorMass::new_in(*mass_kg as f32, t32, Position::ZERO).map_err(|e| e.to_string())?,
-        ),
-        VeSpec::Cursor {
-            mass_kg,
-            integration: Integration::Lossless,
-        } => SceneVe::LosslessCursor(
-            LosslessCursor::new_in(*mass_kg as f32, t32, Position::ZERO)
-                .map_err(|e| e.to_string())?,
-        ),
-        VeSpec::Cursor {
-            mass_kg,
-            integration: Integration::Explicit,
-        } => SceneVe::ExplicitCursor(
-            ExplicitCursor::new_in(*mass_kg as f32, t32, Position::ZERO)
-                .map_err(|e| e.to_string())?,
-        ),
-        VeSpec::Wall {
-            position_m,
-            stiffness_npm,
-            damping_nspm,
-            solid,
-        } => {
-            let side = *solid;
-            SceneVe::Wall(
-                UnilateralWall::new_in(
-                    *stiffness_npm as f32,
-                    *damping_nspm as f32,
-                    pos(*position_m)?,
-                    side,
-                    t32,
-                    Position::ZERO,
-                )
-                .map_err(|e| e.to_string())?,
-            )
-        }
-        VeSpec::Bilateral => SceneVe::Bilateral(BilateralConstraint::new(Position::ZERO)),
-        VeSpec::Spring {
-            anchor_m,
-            stiffness_npm,
-            damping_nspm,
-            discretization,
-        } => {
-            let (k, b, a) = (*stiffness_npm as f32, *damping_nspm as f32, pos(*anchor_m)?);
-            match discretization {
-                Discretization::BackwardEuler => SceneVe::Spring(
-                    Spring::new_in(k, b, a, t32, Position::ZERO).map_err(|e| e.to_string())?,
-                ),
-                Discretization::Trapezoidal => SceneVe::TrapezoidalSpring(
-                    TrapezoidalSpring::new_in(k, b, a, t32, Position::ZERO)
-                        .map_err(|e| e.to_string())?,
-                ),
-            }
-        }
-        VeSpec::World { .. } => {
-            return Err("ve.kind = \"world\" is a 3-D world, not one axis's VE".into())
-        }
-        VeSpec::Blocks {
-            cursor_mass_kg,
-            blocks,
-            limits_m,
-            stick_force_n,
-            floor_damping_nspm,
-            grab_at_s,
-            release_at_s,
-        } => {
-            let bs = blocks
-                .iter()
-                .map(|b| {
-                    Ok(Block {
-                        left: pos(b.at_m)?,
-                        width_nm: pos(b.width_m)?.nm(),
-                        mass_kg: b.mass_kg as f32,
-                        velocity_mps: 0.0,
-                    })
-                })
-                .collect::<Result<Vec<_>, Error>>()?;
-            SceneVe::Blocks(Box::new(Blocks::new(
-                t32,
-                *cursor_mass_kg as f32,
-                bs,
-                [pos(limits_m[0])?, pos(limits_m[1])?],
-                *stick_force_n as f32,
-                *floor_damping_nspm as f32,
-                *grab_at_s,
-                *release_at_s,
-            )?))
-        }
-    })
 }

@@ -1,5 +1,7 @@
 //! The scene's VE: the control crate's VEs, or the building-block world.
 
+pub(crate) mod from_scene;
+
 use crate::engine::blocks::Blocks;
 use twoport_control::passivity::PassiveVe;
 use twoport_control::ve::{
