@@ -255,11 +255,6 @@ where
         core::array::from_fn(|i| self.io[i].duty(self.motor[i]))
     }
 
-    /// Each motor's held command (N, or N m at a joint).
-    pub fn motor_command(&self) -> [f32; N] {
-        self.motor
-    }
-
     /// The Cartesian servo (gains, safety state).
     pub fn servo(&self) -> &Servo<W, f32, N, L> {
         self.servo.servo()

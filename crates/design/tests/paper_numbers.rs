@@ -124,6 +124,35 @@ fn relative_margin_has_the_sign_of_llewellyn_eta() {
     }
 }
 
+/// The same on the admittance display: at the paper's regulator, a mass
+/// clearly inside and one clearly past the boundary.
+#[test]
+fn admittance_margin_has_the_sign_of_llewellyn_eta() {
+    let e = excalibur();
+    let bound = e.a.admittance_bound(&paper_kp(), HUMAN);
+    for m in [1.1 * PAPER_M, PAPER_M / 1.2] {
+        let eta = llewellyn_admittance(&e.a, (PAPER_K, PAPER_B), (m, PAPER_BA), HUMAN).unwrap();
+        let zc = admittance_coupling_tf(m, PAPER_BA, 1e-3).unwrap();
+        let (mut compared, mut past) = (0, 0);
+        for ((p, eta), b) in e.a.points.iter().zip(&eta).zip(&bound) {
+            let rel = relative_margin(zc.eval(p.z).re, *b);
+            if rel.abs() > 1e-6 && eta.abs() > 1e-6 {
+                compared += 1;
+                past += usize::from(rel < 0.0);
+                assert_eq!(
+                    rel > 0.0,
+                    *eta > 0.0,
+                    "m {m} at {} Hz: rel {rel}, eta-1 {eta}",
+                    p.omega / (2.0 * PI)
+                );
+            }
+        }
+        assert!(compared > 100, "m {m}: {compared} points compared");
+        // The light mass fails somewhere: both signs are compared.
+        assert_eq!(past > 0, m < PAPER_M, "m {m}: {past} points past");
+    }
+}
+
 fn at_hz(e: &Excalibur, f: f64) -> Analysis {
     Analysis::on(&e.plant, &[2.0 * PI * f])
 }

@@ -131,11 +131,6 @@ impl Device {
         self
     }
 
-    /// The actuator's column of `G` (force on the coordinates per N of `f_a`).
-    pub fn actuator_input(&self) -> Vec<f64> {
-        (0..self.n).map(|i| self.g[(i, 1)]).collect()
-    }
-
     /// Kinetic plus elastic energy of the device in state `x` (J).
     pub fn energy(&self, x: &[f64]) -> f64 {
         let n = self.n;

@@ -191,11 +191,6 @@ impl<W: World<R, N>, R: Real, const N: usize, L: PortLayer<R>> Servo<W, R, N, L>
         &self.layers
     }
 
-    /// The layers, to change them between ticks.
-    pub fn layers_mut(&mut self) -> &mut [L; N] {
-        &mut self.layers
-    }
-
     /// Enable force output on every axis (ramping in), re-aligning the laws
     /// to the device if it was disabled. Refused while a fault is latched.
     pub fn enable(&mut self) -> Result<(), Faults> {

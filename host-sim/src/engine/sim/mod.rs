@@ -439,15 +439,6 @@ impl<const N: usize> Simulation<N> {
         tick as i64 as f64 * self.period
     }
 
-    /// Names of the effects this scene simulates.
-    pub fn effect_names(&self) -> Vec<String> {
-        self.effects
-            .costs
-            .per_tick(1.0)
-            .map(|(e, _)| e.name().to_string())
-            .collect()
-    }
-
     /// Effects are timed on one tick in [`TIMING_STRIDE`] and the time is
     /// scaled up: a clock read costs more than most effects do.
     fn timing(&self) -> bool {
@@ -528,22 +519,8 @@ impl<const N: usize> Simulation<N> {
         self.axes.get(axis).map_or(&[], |a| &a.x)
     }
 
-    /// Each axis's actuator position (m).
-    pub fn actuator_m(&self) -> [f64; N] {
-        let n = self.device.n;
-        core::array::from_fn(|a| self.actuator.of(&self.axes[a].x[..n]))
-    }
-
     /// The scene this simulation runs.
     pub fn scene(&self) -> &Scene {
         &self.scene
-    }
-
-    /// Set axis `axis`'s plant state (tests); `x` must be as long as
-    /// [`state`](Self::state).
-    pub fn set_state(&mut self, axis: usize, x: &[f64]) {
-        if let Some(a) = self.axes.get_mut(axis) {
-            a.x.copy_from_slice(x);
-        }
     }
 }
