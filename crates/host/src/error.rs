@@ -24,6 +24,10 @@ pub enum LinkError {
     /// No board image to run in-process.
     #[error("{0}")]
     Image(String),
+    /// The device a loop on the PC drives failed (it stopped answering,
+    /// or answered nonsense): the loop has stopped with zero force.
+    #[error("device: {0}")]
+    Device(String),
     /// No answer to the handshake.
     #[error("no handshake answer from the board (this host speaks protocol {0})")]
     NoHandshake(u16),

@@ -1,7 +1,8 @@
 //! The link of a board image run in this process: two byte queues, and
-//! no other peripheral. Both in-process boards stand on it: the lockstep
-//! [`LocalBoard`](crate::LocalBoard) and the free-running
-//! [`SimulatedBoard`](crate::SimulatedBoard).
+//! no other peripheral. Every in-process board stands on it: the lockstep
+//! [`LocalBoard`](crate::LocalBoard), the free-running
+//! [`SimulatedBoard`](crate::SimulatedBoard), and the PC's loop
+//! [`PcBoard`](crate::PcBoard).
 
 use std::collections::VecDeque;
 use twoport_board::{BoardSupport, RawSensors};
@@ -23,6 +24,16 @@ impl ByteQueues {
     /// Whether the board has read everything sent.
     pub(crate) fn drained(&self) -> bool {
         self.rx.is_empty()
+    }
+
+    /// The board reads a byte the host sent.
+    pub(crate) fn host_byte(&mut self) -> Option<u8> {
+        self.rx.pop_front()
+    }
+
+    /// The board writes `bytes` for the host.
+    pub(crate) fn board_write(&mut self, bytes: &[u8]) {
+        self.out.extend_from_slice(bytes);
     }
 
     /// The host takes what fits in `buf` of what the board wrote.
@@ -54,9 +65,9 @@ impl<const N: usize> BoardSupport<N> for ByteQueues {
         0
     }
     fn read_byte(&mut self) -> Option<u8> {
-        self.rx.pop_front()
+        self.host_byte()
     }
     fn write(&mut self, bytes: &[u8]) {
-        self.out.extend_from_slice(bytes);
+        self.board_write(bytes);
     }
 }

@@ -6,6 +6,7 @@ mod device;
 mod error;
 mod in_process;
 mod local;
+mod pc_loop;
 mod port;
 mod session;
 mod simulated;
@@ -13,9 +14,10 @@ mod simulated;
 pub use device::{AxisState, HostBoard, State, HEARTBEAT_PERIOD, HEARTBEAT_POLLS, STATE_BUFFER};
 pub use error::LinkError;
 pub use local::{LocalBoard, LocalDelta, LocalFast, LocalSerialArm};
+pub use pc_loop::{DeviceIo, LoopTiming, PcBoard, Percentiles, LATE_PERIODS, TIMING_WINDOW};
 pub use port::{BoardPort, SerialBoard};
 pub use session::{LinkFaults, Session, ANSWER_TIMEOUT, HEARTBEAT_EVERY};
-pub use simulated::{Pace, SimulatedBoard};
+pub use simulated::{Pace, SimulatedBoard, SimulatedDevice};
 
 /// The link's types an application meets in this crate's calls.
 pub use twoport_link::{

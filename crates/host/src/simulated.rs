@@ -4,10 +4,10 @@
 //! what the device object's tests drive.
 
 use crate::in_process::ByteQueues;
-use crate::{BoardPort, LinkError};
+use crate::{BoardPort, DeviceIo, LinkError};
 use std::time::{Duration, Instant};
 use twoport_board::excalibur::{self, REGION_POINTS};
-use twoport_board::{Board, IoScale, SimAxis, Simulated};
+use twoport_board::{Board, BoardSupport, IoScale, RawSensors, SimAxis, Simulated};
 use twoport_control::ve::UnilateralWall;
 
 /// How a simulated board's ticks keep time.
@@ -106,5 +106,38 @@ impl BoardPort for SimulatedBoard {
         self.board.poll_link(&mut self.io);
         self.board.flush(&mut self.io);
         Ok(self.io.inner().take(buf))
+    }
+}
+
+/// A simulated device for the PC's loop ([`PcBoard`](crate::PcBoard)):
+/// the same simulated axes a [`SimulatedBoard`] runs on, exchanged with
+/// over [`DeviceIo`] as a USB device is. Each exchange advances it one
+/// period under the duty the loop sent.
+pub struct SimulatedDevice<const N: usize = 1> {
+    sim: Simulated<ByteQueues, N>,
+}
+
+impl SimulatedDevice {
+    /// One Excalibur axis ([`SimAxis::excalibur`]) that the hand pushes
+    /// along +x with `hand_n` (N), read and driven as the Excalibur image
+    /// expects.
+    pub fn excalibur(hand_n: f32) -> Self {
+        SimulatedDevice {
+            sim: Simulated::new(
+                ByteQueues::default(),
+                [SimAxis::excalibur(hand_n)],
+                [IoScale::EXCALIBUR],
+                excalibur::ENCODER,
+                excalibur::PERIOD_S,
+            ),
+        }
+    }
+}
+
+impl<const N: usize> DeviceIo<N> for SimulatedDevice<N> {
+    fn exchange(&mut self, duty: [i16; N], on: bool) -> Result<RawSensors<N>, String> {
+        self.sim.set_outputs(on);
+        self.sim.set_duty(duty);
+        Ok(self.sim.sample())
     }
 }

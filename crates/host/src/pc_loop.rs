@@ -1,0 +1,332 @@
+//! A board image's loop run on the PC, in a thread of its own, against a
+//! device the PC drives over USB: the servo loop of the devices whose
+//! firmware leaves the loop to the host (a Falcon, a Haply board, a
+//! Touch). Behind the same [`BoardPort`] as a board on a wire, so an
+//! application holds it as it holds any board.
+//!
+//! Each tick the thread does what a board's control interrupt does: one
+//! exchange with the device (the duty computed last tick out, the
+//! sensors in: a USB round trip puts the loop one tick late on the
+//! device, as a board's is), one tick of the image's law, and the link
+//! served. A device that fails an exchange stops the loop: it is sent
+//! zero force with its outputs off, and the application's next read of
+//! the link gets [`LinkError::Device`] naming what failed.
+
+use crate::in_process::ByteQueues;
+use crate::{BoardPort, LinkError};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+use twoport_board::{Board, BoardSupport, RawSensors};
+use twoport_control::drive::Drive;
+use twoport_control::servo::PortLayer;
+use twoport_control::world::World;
+
+/// A device's I/O as the PC's loop uses it: one exchange a tick.
+pub trait DeviceIo<const N: usize>: Send {
+    /// Command each axis's `duty` (as a board's amplifiers take it:
+    /// ±[`DUTY_FULL_SCALE`](twoport_board::DUTY_FULL_SCALE) at full-scale
+    /// force), with the amplifiers' outputs `on` or off, and read the
+    /// sensors. An error stops the loop; its text is what the application
+    /// is told, so it names the device and what to do.
+    fn exchange(&mut self, duty: [i16; N], on: bool) -> Result<RawSensors<N>, String>;
+}
+
+/// How many ticks' times the statistics are taken over (the latest).
+pub const TIMING_WINDOW: usize = 4096;
+
+/// A tick that starts this many periods after the one before is late.
+pub const LATE_PERIODS: f64 = 1.5;
+
+/// The loop's timing: the period between ticks' starts and the time of
+/// each tick's device exchange, over the latest [`TIMING_WINDOW`] ticks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LoopTiming {
+    /// Ticks run.
+    pub ticks: u64,
+    /// Ticks that started more than [`LATE_PERIODS`] periods after the one
+    /// before, since the start.
+    pub late: u64,
+    /// The period between ticks' starts (s): median, 99th percentile,
+    /// greatest.
+    pub period_s: Percentiles,
+    /// The device exchange's time (s), the same three.
+    pub io_s: Percentiles,
+}
+
+/// A sample's median, 99th percentile and greatest value.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Percentiles {
+    /// The median.
+    pub p50: f64,
+    /// The 99th percentile.
+    pub p99: f64,
+    /// The greatest.
+    pub max: f64,
+}
+
+impl Percentiles {
+    fn of(ring: &[f64]) -> Self {
+        if ring.is_empty() {
+            return Percentiles::default();
+        }
+        let mut v = ring.to_vec();
+        v.sort_by(f64::total_cmp);
+        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+        Percentiles {
+            p50: at(0.5),
+            p99: at(0.99),
+            max: v[v.len() - 1],
+        }
+    }
+}
+
+/// What the loop's thread and the application share.
+#[derive(Default)]
+struct Shared {
+    link: ByteQueues,
+    periods: Vec<f64>,
+    ios: Vec<f64>,
+    ticks: u64,
+    late: u64,
+    /// Why the loop stopped, once it has.
+    failed: Option<String>,
+    stop: bool,
+}
+
+/// The board support the image's loop runs against on the PC: the device
+/// through [`DeviceIo`], the link through the shared queues.
+struct PcSupport<Io, const N: usize> {
+    io: Io,
+    shared: Arc<(Mutex<Shared>, Condvar)>,
+    duty: [i16; N],
+    on: bool,
+    last: RawSensors<N>,
+    failed: Option<String>,
+    io_s: f64,
+    start: Instant,
+    period_ns: u32,
+}
+
+impl<Io, const N: usize> PcSupport<Io, N> {
+    fn shared(&self) -> MutexGuard<'_, Shared> {
+        lock(&self.shared.0)
+    }
+}
+
+/// The lock, whoever held it last: the shared state stays consistent
+/// through a panic, as every write to it is one assignment.
+fn lock(m: &Mutex<Shared>) -> MutexGuard<'_, Shared> {
+    m.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+impl<Io: DeviceIo<N>, const N: usize> BoardSupport<N> for PcSupport<Io, N> {
+    fn sample(&mut self) -> RawSensors<N> {
+        let t = Instant::now();
+        match self.io.exchange(self.duty, self.on) {
+            Ok(raw) => self.last = raw,
+            Err(e) => {
+                // The hand is taken off: the loop commands no force on
+                // this tick, and stops after it.
+                self.failed.get_or_insert(e);
+                self.last.dead_man_closed = false;
+            }
+        }
+        self.io_s = t.elapsed().as_secs_f64();
+        self.last
+    }
+    fn set_duty(&mut self, duty: [i16; N]) {
+        self.duty = duty;
+    }
+    fn set_outputs(&mut self, on: bool) {
+        self.on = on;
+    }
+    fn feed_watchdog(&mut self) {}
+    fn read_byte(&mut self) -> Option<u8> {
+        self.shared().link.host_byte()
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        let (m, c) = &*self.shared;
+        lock(m).link.board_write(bytes);
+        c.notify_all();
+    }
+    fn cycles(&mut self) -> u32 {
+        // Nanoseconds, wrapping every 4.3 s: the board's timing takes
+        // differences within a tick.
+        self.start.elapsed().as_nanos() as u32
+    }
+    fn cycles_per_tick(&self) -> u32 {
+        self.period_ns
+    }
+}
+
+/// A board image's loop on the PC against the device `Io`: the image's
+/// board `Board<W, R, N, L, D>` ticking every period in its own thread.
+pub struct PcBoard {
+    shared: Arc<(Mutex<Shared>, Condvar)>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl PcBoard {
+    /// Start `board` ticking every `period_s` (s) against `io`.
+    pub fn start<Io, W, L, D, const N: usize, const R: usize>(
+        board: Board<W, R, N, L, D>,
+        io: Io,
+        period_s: f64,
+    ) -> Result<Self, LinkError>
+    where
+        Io: DeviceIo<N> + 'static,
+        W: World<f32, N> + Send + 'static,
+        L: PortLayer + Send + 'static,
+        D: Drive<N, World = W, Layer = L> + Send + 'static,
+    {
+        if !(period_s.is_finite() && period_s > 1e-6 && period_s < 1.0) {
+            return Err(LinkError::Device(format!(
+                "period_s {period_s}: the loop's period must be between 1 µs and 1 s"
+            )));
+        }
+        let shared = Arc::new((Mutex::new(Shared::default()), Condvar::new()));
+        let support = PcSupport {
+            io,
+            shared: Arc::clone(&shared),
+            duty: [0; N],
+            on: false,
+            last: RawSensors::default(),
+            failed: None,
+            io_s: 0.0,
+            start: Instant::now(),
+            period_ns: (period_s * 1e9).round() as u32,
+        };
+        let period = Duration::from_secs_f64(period_s);
+        let thread = std::thread::Builder::new()
+            .name("twoport-pc-loop".into())
+            .spawn(move || run(board, support, period))
+            .map_err(|e| LinkError::Device(format!("the loop's thread would not start: {e}")))?;
+        Ok(PcBoard {
+            shared,
+            thread: Some(thread),
+        })
+    }
+
+    /// The loop's timing so far.
+    pub fn timing(&self) -> LoopTiming {
+        let s = lock(&self.shared.0);
+        LoopTiming {
+            ticks: s.ticks,
+            late: s.late,
+            period_s: Percentiles::of(&s.periods),
+            io_s: Percentiles::of(&s.ios),
+        }
+    }
+
+    /// Why the loop stopped, once a device exchange has failed.
+    pub fn failure(&self) -> Option<String> {
+        lock(&self.shared.0).failed.clone()
+    }
+}
+
+/// The loop's thread: a tick every `period` until told to stop or the
+/// device fails, then zero force with the outputs off.
+fn run<Io, W, L, D, const N: usize, const R: usize>(
+    mut board: Board<W, R, N, L, D>,
+    mut io: PcSupport<Io, N>,
+    period: Duration,
+) where
+    Io: DeviceIo<N>,
+    W: World<f32, N>,
+    L: PortLayer,
+    D: Drive<N, World = W, Layer = L>,
+{
+    let mut next = Instant::now();
+    let mut last_start: Option<Instant> = None;
+    let mut slot = 0;
+    loop {
+        let now = Instant::now();
+        if next > now {
+            std::thread::sleep(next - now);
+        }
+        let start = Instant::now();
+        // (Behind by more than a period, the loop keeps its phase from now
+        // rather than run the missed ticks back to back.)
+        next = if start > next + period { start } else { next } + period;
+        board.poll_link(&mut io);
+        board.control_tick(&mut io);
+        board.flush(&mut io);
+        let failed = io.failed.take();
+        let (m, c) = &*io.shared;
+        let mut s = lock(m);
+        let since = last_start.map(|l| start.duration_since(l).as_secs_f64());
+        last_start = Some(start);
+        s.ticks += 1;
+        if let Some(p) = since {
+            s.late += u64::from(p > LATE_PERIODS * period.as_secs_f64());
+            record(&mut s.periods, slot, p);
+        }
+        record(&mut s.ios, slot, io.io_s);
+        slot = (slot + 1) % TIMING_WINDOW;
+        if let Some(e) = failed {
+            s.failed = Some(e);
+        }
+        let stop = s.stop || s.failed.is_some();
+        drop(s);
+        c.notify_all();
+        if stop {
+            break;
+        }
+    }
+    // Zero force, outputs off, whatever the device says to it now.
+    let _ = io.io.exchange([0; N], false);
+}
+
+/// Put `v` in the ring at `slot`, growing it to its window first.
+fn record(ring: &mut Vec<f64>, slot: usize, v: f64) {
+    if ring.len() < TIMING_WINDOW {
+        ring.push(v);
+    } else {
+        ring[slot] = v;
+    }
+}
+
+impl BoardPort for PcBoard {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        let mut s = lock(&self.shared.0);
+        if let Some(e) = &s.failed {
+            return Err(LinkError::Device(e.clone()));
+        }
+        s.link.send(bytes);
+        Ok(())
+    }
+
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError> {
+        let (m, c) = &*self.shared;
+        let deadline = Instant::now() + timeout;
+        let mut s = lock(m);
+        loop {
+            let n = s.link.take(buf);
+            if n > 0 {
+                return Ok(n);
+            }
+            if let Some(e) = &s.failed {
+                return Err(LinkError::Device(e.clone()));
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return Ok(0);
+            }
+            s = c
+                .wait_timeout(s, deadline - now)
+                .map(|(g, _)| g)
+                .unwrap_or_else(|p| p.into_inner().0);
+        }
+    }
+}
+
+impl Drop for PcBoard {
+    /// Stop the loop: its last act is zero force with the outputs off.
+    fn drop(&mut self) {
+        lock(&self.shared.0).stop = true;
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
