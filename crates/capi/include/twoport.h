@@ -129,9 +129,9 @@ typedef enum TpMode {
 } TpMode;
 
 /**
- * A board, opened by `tp_board_open_serial` or `tp_board_open_simulated`
- * and freed by `tp_board_close`. Use it from one thread at a time (any
- * thread).
+ * A board, opened by `tp_board_open_serial`, `tp_board_open_simulated`
+ * or `tp_board_open_pc_simulated` and freed by `tp_board_close`. Use it
+ * from one thread at a time (any thread).
  */
 typedef struct TpBoard TpBoard;
 
@@ -324,6 +324,17 @@ enum TpResult tp_board_open_serial(const char *path, uint8_t axes, struct TpBoar
  * `out` points to a writable pointer.
  */
 enum TpResult tp_board_open_simulated(float hand_n, struct TpBoard **out);
+
+/**
+ * Open the shipped Excalibur image's loop on the PC, in a thread of its
+ * own, against a simulated device exchanged with as a USB device is (the
+ * path a Falcon or a Haply board takes), the hand pushing `hand_n` (N)
+ * along +x while the outputs are on.
+ *
+ * # Safety
+ * `out` points to a writable pointer.
+ */
+enum TpResult tp_board_open_pc_simulated(float hand_n, struct TpBoard **out);
 
 /**
  * Disarm the board and free it. NULL is ignored. The board must not be

@@ -11,7 +11,7 @@ use std::ffi::{c_char, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::Duration;
 use twoport_host::{
-    BoardPort, Contact, Gains, HostBoard, LinkError, Pace, SerialBoard, SimulatedBoard,
+    BoardPort, Contact, Gains, HostBoard, LinkError, Pace, PcBoard, SerialBoard, SimulatedBoard,
 };
 pub use types::{
     TpAxisSpec, TpAxisState, TpDisplay, TpMode, TpResult, TpSpec, TpState, TP_CONTACT_ABOVE,
@@ -19,9 +19,9 @@ pub use types::{
     TP_VE_STIFFNESS, TP_VE_SURFACE,
 };
 
-/// A board, opened by `tp_board_open_serial` or `tp_board_open_simulated`
-/// and freed by `tp_board_close`. Use it from one thread at a time (any
-/// thread).
+/// A board, opened by `tp_board_open_serial`, `tp_board_open_simulated`
+/// or `tp_board_open_pc_simulated` and freed by `tp_board_close`. Use it
+/// from one thread at a time (any thread).
 pub struct TpBoard(HostBoard<Box<dyn BoardPort + Send>>);
 
 thread_local! {
@@ -151,6 +151,25 @@ pub unsafe extern "C" fn tp_board_open_simulated(hand_n: f32, out: *mut *mut TpB
     guard(|| {
         let port = SimulatedBoard::excalibur(hand_n, Pace::RealTime)
             .map(|p| Box::new(p) as Box<dyn BoardPort + Send>);
+        opened(port.and_then(|p| HostBoard::open(p, 1)), out)
+    })
+}
+
+/// Open the shipped Excalibur image's loop on the PC, in a thread of its
+/// own, against a simulated device exchanged with as a USB device is (the
+/// path a Falcon or a Haply board takes), the hand pushing `hand_n` (N)
+/// along +x while the outputs are on.
+///
+/// # Safety
+/// `out` points to a writable pointer.
+#[no_mangle]
+pub unsafe extern "C" fn tp_board_open_pc_simulated(
+    hand_n: f32,
+    out: *mut *mut TpBoard,
+) -> TpResult {
+    guard(|| {
+        let port =
+            PcBoard::excalibur_simulated(hand_n).map(|p| Box::new(p) as Box<dyn BoardPort + Send>);
         opened(port.and_then(|p| HostBoard::open(p, 1)), out)
     })
 }

@@ -57,3 +57,23 @@ fn the_spec_and_the_boards_own_ve_through_the_c_abi() {
         TpResult::Argument
     );
 }
+
+/// The PC's loop opens through the C ABI as a board does, and says what
+/// it is: the Excalibur image at 1 ms on one axis.
+#[test]
+fn the_pc_loop_opens_through_the_c_abi() {
+    let mut b: *mut TpBoard = null_mut();
+    // SAFETY: `b` is a valid place for the board's pointer.
+    assert_eq!(
+        unsafe { tp_board_open_pc_simulated(2.0, &mut b) },
+        TpResult::Ok
+    );
+    let mut spec = std::mem::MaybeUninit::<TpSpec>::uninit();
+    // SAFETY: `b` is open and `spec` is a writable TpSpec.
+    assert_eq!(unsafe { tp_board_spec(b, spec.as_mut_ptr()) }, TpResult::Ok);
+    // SAFETY: tp_board_spec wrote it.
+    let spec = unsafe { spec.assume_init() };
+    assert_eq!((spec.period_s, spec.axes), (1e-3, 1));
+    // SAFETY: `b` is open; closing frees it (and stops the loop).
+    assert_eq!(unsafe { tp_board_close(b) }, TpResult::Ok);
+}

@@ -4,7 +4,7 @@
 //! what the device object's tests drive.
 
 use crate::in_process::ByteQueues;
-use crate::{BoardPort, DeviceIo, LinkError};
+use crate::{BoardPort, DeviceIo, LinkError, PcBoard};
 use std::time::{Duration, Instant};
 use twoport_board::excalibur::{self, REGION_POINTS};
 use twoport_board::{Board, BoardSupport, IoScale, RawSensors, SimAxis, Simulated};
@@ -139,5 +139,20 @@ impl<const N: usize> DeviceIo<N> for SimulatedDevice<N> {
         self.sim.set_outputs(on);
         self.sim.set_duty(duty);
         Ok(self.sim.sample())
+    }
+}
+
+impl PcBoard {
+    /// The shipped Excalibur image's loop on the PC, at its 1 kHz, against
+    /// [`SimulatedDevice::excalibur`] with the hand pushing `hand_n` (N):
+    /// the PC's loop tried without a device.
+    pub fn excalibur_simulated(hand_n: f32) -> Result<Self, LinkError> {
+        let board = excalibur::stiff_wall_board()
+            .map_err(|e| LinkError::Image(format!("the Excalibur board image: {e:?}")))?;
+        PcBoard::start(
+            board,
+            SimulatedDevice::excalibur(hand_n),
+            f64::from(excalibur::PERIOD_S),
+        )
     }
 }

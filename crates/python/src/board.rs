@@ -7,7 +7,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::time::Duration;
 use twoport_host::{
-    BoardPort, Contact, HostBoard, LinkError, Pace, SerialBoard, SimulatedBoard, State,
+    BoardPort, Contact, HostBoard, LinkError, Pace, PcBoard, SerialBoard, SimulatedBoard, State,
 };
 
 /// A board: a real one over a serial port, the firmware in QEMU through
@@ -91,6 +91,20 @@ impl Board {
     fn simulated(hand_n: f32) -> PyResult<Board> {
         let port: Box<dyn BoardPort + Send> =
             Box::new(SimulatedBoard::excalibur(hand_n, Pace::RealTime).map_err(link)?);
+        Ok(Board {
+            inner: Some(HostBoard::open(port, 1).map_err(link)?),
+        })
+    }
+
+    /// The shipped Excalibur image's loop on the PC, in a thread of its
+    /// own, against a simulated device exchanged with as a USB device is
+    /// (the path a Falcon or a Haply board takes), the hand pushing
+    /// `hand_n` (N) along +x while the outputs are on.
+    #[staticmethod]
+    #[pyo3(signature = (hand_n=2.0))]
+    fn pc_simulated(hand_n: f32) -> PyResult<Board> {
+        let port: Box<dyn BoardPort + Send> =
+            Box::new(PcBoard::excalibur_simulated(hand_n).map_err(link)?);
         Ok(Board {
             inner: Some(HostBoard::open(port, 1).map_err(link)?),
         })

@@ -118,3 +118,25 @@ def test_the_boards_own_wall_is_set_from_python():
     with pytest.raises(RuntimeError, match="NotDisarmed"):
         b.set_ve_param(0, "damping", 1.0)
     b.close()
+
+
+def test_the_pc_loop_holds_the_images_wall_from_python():
+    # The image's loop on the PC against a device exchanged with over USB:
+    # the same calls as a board's, the hand's 2 N resting on the wall.
+    b = twoport.Board.pc_simulated(2.0)
+    assert b.spec()["period_s"] == 1e-3
+    b.calibrate([0.0])
+    b.set_ve_param(0, "surface", 0.005)
+    b.stream(1)
+    b.arm()
+    b.run_for(0.01)
+    armed_at = b.latest()["tick"]
+    # A thousand ticks armed, however the machine schedules the loop.
+    for _ in range(600):
+        if b.latest()["tick"] >= armed_at + 1000:
+            break
+        b.run_for(0.1)
+    s = b.latest()
+    assert s["mode"] == "armed" and s["faults"] == 0
+    assert abs(s["position_m"][0] - 0.005 - 2.0 / 51000.0) < 10e-6
+    b.close()
