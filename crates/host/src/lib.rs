@@ -14,7 +14,9 @@ mod simulated;
 pub use device::{AxisState, HostBoard, State, HEARTBEAT_PERIOD, HEARTBEAT_POLLS, STATE_BUFFER};
 pub use error::LinkError;
 pub use local::{LocalBoard, LocalDelta, LocalFast, LocalSerialArm};
-pub use pc_loop::{DeviceIo, LoopTiming, PcBoard, Percentiles, LATE_PERIODS, TIMING_WINDOW};
+pub use pc_loop::{
+    DeviceIo, LoopTiming, PcBoard, Percentiles, Priority, LATE_PERIODS, TIMING_WINDOW,
+};
 pub use port::{BoardPort, SerialBoard};
 pub use session::{LinkFaults, Session, ANSWER_TIMEOUT, HEARTBEAT_EVERY};
 pub use simulated::{Pace, SimulatedBoard, SimulatedDevice};

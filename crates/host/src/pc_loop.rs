@@ -81,9 +81,44 @@ impl Percentiles {
     }
 }
 
+/// The priority the loop's thread runs at.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Priority {
+    /// Real-time (first-in first-out, the highest the system gives): no
+    /// ordinary thread delays a tick.
+    RealTime,
+    /// The system's normal priority, and why no higher: other work on the
+    /// machine may delay a tick (see [`LoopTiming::late`]).
+    Normal(String),
+}
+
+/// Raise the calling thread to real-time priority where the system allows
+/// it, and say what it got.
+fn raise_priority() -> Priority {
+    use thread_priority::*;
+    #[cfg(unix)]
+    let raised = set_thread_priority_and_policy(
+        thread_native_id(),
+        ThreadPriority::Max,
+        ThreadSchedulePolicy::Realtime(RealtimeThreadSchedulePolicy::Fifo),
+    );
+    #[cfg(not(unix))]
+    let raised = set_current_thread_priority(ThreadPriority::Max);
+    match raised {
+        Ok(()) => Priority::RealTime,
+        Err(e) => Priority::Normal(format!(
+            "the system refused real-time scheduling ({e:?}): on Linux allow it \
+             with a line `@YOURGROUP - rtprio 99` in /etc/security/limits.conf \
+             (then log in again), or give the program CAP_SYS_NICE"
+        )),
+    }
+}
+
 /// What the loop's thread and the application share.
 #[derive(Default)]
 struct Shared {
+    /// The loop thread's priority, once it has asked for one.
+    priority: Option<Priority>,
     link: ByteQueues,
     periods: Vec<f64>,
     ios: Vec<f64>,
@@ -223,6 +258,19 @@ impl PcBoard {
     pub fn failure(&self) -> Option<String> {
         lock(&self.shared.0).failed.clone()
     }
+
+    /// The priority the loop's thread runs at (it asks before its first
+    /// tick: this waits for that).
+    pub fn priority(&self) -> Priority {
+        let (m, c) = &*self.shared;
+        let mut s = lock(m);
+        loop {
+            if let Some(p) = &s.priority {
+                return p.clone();
+            }
+            s = c.wait(s).unwrap_or_else(|p| p.into_inner());
+        }
+    }
 }
 
 /// The loop's thread: a tick every `period` until told to stop or the
@@ -237,6 +285,12 @@ fn run<Io, W, L, D, const N: usize, const R: usize>(
     L: PortLayer,
     D: Drive<N, World = W, Layer = L>,
 {
+    let priority = raise_priority();
+    {
+        let (m, c) = &*io.shared;
+        lock(m).priority = Some(priority);
+        c.notify_all();
+    }
     let mut next = Instant::now();
     let mut last_start: Option<Instant> = None;
     let mut slot = 0;

@@ -9,7 +9,9 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use twoport_board::excalibur;
 use twoport_board::RawSensors;
-use twoport_host::{BoardMode, DeviceIo, HostBoard, LinkError, PcBoard, SimulatedDevice, VeParam};
+use twoport_host::{
+    BoardMode, DeviceIo, HostBoard, LinkError, PcBoard, Priority, SimulatedDevice, VeParam,
+};
 
 /// The wall the board's own VE is moved to (m): solid above.
 const WALL_M: f64 = 0.005;
@@ -140,4 +142,11 @@ fn the_loop_keeps_its_period_and_reports_its_timing() {
     }
     assert!(timing.period_s.max > 0.0);
     assert_eq!(pc.failure(), None);
+    // Real-time where the system allows it, and otherwise how to allow it.
+    if let Priority::Normal(why) = pc.priority() {
+        assert!(
+            why.contains("rtprio") && why.contains("CAP_SYS_NICE"),
+            "{why}"
+        );
+    }
 }
