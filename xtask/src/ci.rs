@@ -264,8 +264,9 @@ const NEEDS_QEMU: [&str; 3] = [
     "an_application_drives_the_free_running_board_in_qemu",
 ];
 
-/// Every test, in one release build of the workspace (the profile the
-/// `pil` and `python` steps build too, so nothing is compiled twice): the
+/// Every test, in one release build of the workspace (the build the
+/// `pil`, `scope-board`, `device` and `watchdog` steps make first and run
+/// from, so none compiles the workspace again with other features): the
 /// ignored long cases (24 h of ticks, 2 x 10^4 random terminations, an
 /// hour of scope buffers, the scope under Xvfb) included, but for those
 /// that need QEMU. It closes on the total so that CI reads the whole count

@@ -40,6 +40,18 @@ pub(crate) fn qemu_netduino(elf: &Path) -> Command {
     c
 }
 
+/// The workspace's one release build, as the tests step makes it (its
+/// tests' features unified over every member), and where its programs
+/// are: every step that runs a host program or test uses this build, so
+/// none of them compiles the workspace again with other features.
+pub(crate) fn workspace_release_build() -> Result<std::path::PathBuf, String> {
+    run(
+        "build the workspace (release, as its tests)",
+        cargo().args(["test", "--release", "--workspace", "--no-run", "-q"]),
+    )?;
+    Ok(crate::target_dir().join("release"))
+}
+
 /// Processor-in-the-loop: start a board image in QEMU with its link on a
 /// pty, point `host-sim pil` at it, and fail if either side fails. The
 /// an386 image by default (`--passivity`: its passivity build); with
@@ -56,17 +68,11 @@ pub(crate) fn pil(extra: &[String]) -> Result<(), String> {
         Some(_) => return Err("pil: --board needs a name (an386 or stm32f405)".into()),
         None => "an386".into(),
     };
-    run(
-        "build host-sim",
-        cargo().args(["build", "--release", "-q", "-p", "host-sim"]),
-    )?;
+    let exe = workspace_release_build()?.join("host-sim");
     let host = |pty: &str| {
         run(
             "host-sim pil",
-            cargo()
-                .args(["run", "--release", "-q", "-p", "host-sim", "--"])
-                .args(["pil", "--port", pty])
-                .args(&args),
+            Command::new(&exe).args(["pil", "--port", pty]).args(&args),
         )
     };
     let xyz = args.iter().any(|a| declares_three_axes(a));
@@ -275,7 +281,7 @@ pub(crate) fn host_test_against_an386(
             what,
             cargo()
                 .env("TWOPORT_PTY", pty)
-                .args(["test", "--release", "-p", "host-sim", "--test", file])
+                .args(["test", "--release", "--workspace", "--test", file])
                 .args(["--", "--ignored", "--exact", name]),
         )
     })
@@ -318,7 +324,7 @@ pub(crate) fn device(args: &[String]) -> Result<(), String> {
             "the device object against the free-running board",
             cargo()
                 .env("TWOPORT_PTY", pty)
-                .args(["test", "--release", "-p", "twoport-host", "--test", "qemu"])
+                .args(["test", "--release", "--workspace", "--test", "qemu"])
                 .args(["--", "--ignored"]),
         )?;
         run(
