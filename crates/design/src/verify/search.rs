@@ -285,6 +285,12 @@ pub fn verify_near(
     })
 }
 
+/// `f` (Hz) and the frequencies the sample rate `fs` folds onto it, up to
+/// twice the rate: where a hand's resonance meets the loop's at `f`.
+fn aliases(f: f64, fs: f64) -> [f64; 4] {
+    [f, fs - f, fs + f, 2.0 * fs - f]
+}
+
 /// 24 frequencies log-spaced from 1 Hz to twice the sample rate (Hz).
 fn band(period_s: f64) -> Vec<f64> {
     let nyq_hz = 0.5 / period_s;
@@ -314,7 +320,7 @@ fn hand_starts(
     // inertia there as at Nyquist's multiples.
     let fs = 2.0 * nyq_hz;
     for f in binding_hz.iter().filter(|f| f.is_finite() && **f > 0.0) {
-        for alias in [*f, fs - f, fs + f, 2.0 * fs - f] {
+        for alias in aliases(*f, fs) {
             if alias > 0.0 {
                 tuned.push((alias, true));
                 tuned.push((alias, false));
@@ -386,7 +392,7 @@ fn two_resonances(
     let fs = 1.0 / period_s;
     let mut starts: Vec<(f64, VeKind, Vec<f64>)> = Vec::new();
     for (_, kind, p, f) in finals.iter().take(3) {
-        for f2 in [*f, fs - f, fs + f, 2.0 * fs - f] {
+        for f2 in aliases(*f, fs) {
             let w2 = (2.0 * PI * f2.max(0.1)).powi(2);
             for m in [-3.0, -2.0, -1.0] {
                 let k = (10f64.powf(m) * w2).log10();
