@@ -115,7 +115,7 @@ fn verify(c: &mut Criterion) {
     let mut group = c.benchmark_group("verify");
     group.sample_size(10);
     group.bench_function("verify, Excalibur impedance display at the design", |b| {
-        b.iter(|| black_box(verify(&m, 1e-3, &g, Some(HumanBound::PAPER), 0).unwrap()))
+        b.iter(|| black_box(verify(&m, 1e-3, &g, Some(HumanBound::PAPER)).unwrap()))
     });
     group.finish();
 }

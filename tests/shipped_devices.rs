@@ -49,10 +49,9 @@ fn every_device_design_survives_verify_and_breaks_past_it() {
         for human in [Some(HumanBound::PAPER), None] {
             let (k, b) = best_impedance(&a, &a.impedance_bound(human)).unwrap();
             let g = |k_npm| Gains::from(ImpedanceGains::new(k_npm as f32, b as f32));
-            let d = m.delay_samples as usize;
-            let at = verify(&m, T, &g(k), human, d).unwrap();
+            let at = verify(&m, T, &g(k), human).unwrap();
             assert!(!at.unstable, "{model} {human:?}: ({k}, {b}) broken: {at:?}");
-            let past = verify(&m, T, &g(1.01 * k), human, d).unwrap();
+            let past = verify(&m, T, &g(1.01 * k), human).unwrap();
             assert!(
                 past.unstable,
                 "{model} {human:?}: 1.01 x ({k}, {b}): {past:?}"

@@ -97,7 +97,7 @@ fn verifys_counterexample_grows_in_the_simulator_at_its_rate() {
     let human = Some(HumanBound::PAPER);
     let k_max = max_stiffness(&a, &a.impedance_bound(human), 90.0).unwrap();
     let past = Gains::from(ImpedanceGains::new((1.2 * k_max) as f32, 90.0));
-    let v = verify(&model, T, &past, human, 0).unwrap();
+    let v = verify(&model, T, &past, human).unwrap();
     assert!(v.unstable, "{v:?}");
     let (hand, ve) = (v.termination.hand, v.termination.ve);
     // Growth between two windows a second apart, against rho^(1 s / T).
@@ -112,7 +112,7 @@ fn verifys_counterexample_grows_in_the_simulator_at_its_rate() {
     );
     // The same termination at 90% of the designed stiffness decays.
     let below = Gains::from(ImpedanceGains::new((0.9 * k_max) as f32, 90.0));
-    let r = radius(&model, T, &below, &v.termination, 0).unwrap();
+    let r = radius(&model, T, &below, &v.termination).unwrap();
     assert!(r.spectral_radius < 1.0, "{r:?}");
     let p = peaks(scene(0.9 * k_max, 90.0, &hand, &ve), &w);
     assert!(p[1] < p[0], "decays at 0.9 k_max: {p:?}");
@@ -144,7 +144,7 @@ fn a_declared_delay_enters_the_simulator() {
     let k_max = max_stiffness(&a, &a.impedance_bound(None), 0.0).unwrap();
     assert!((k_max - 10_000.0).abs() < 50.0, "{k_max}");
     let past = Gains::from(ImpedanceGains::new(13_000.0, 0.0));
-    let v = verify(&m, T, &past, None, 1).unwrap();
+    let v = verify(&m, T, &past, None).unwrap();
     assert!(v.unstable, "{v:?}");
     // The simulator's hand is a grasp plus an arm, so it replays the worst
     // hands-off termination among verify's VE families (a hand that is a
@@ -169,7 +169,7 @@ fn a_declared_delay_enters_the_simulator() {
                 hand: hands_off,
                 ve,
             };
-            (radius(&m, T, &past, &t, 1).unwrap(), ve)
+            (radius(&m, T, &past, &t).unwrap(), ve)
         })
         .max_by(|a, b| a.0.spectral_radius.total_cmp(&b.0.spectral_radius))
         .unwrap();

@@ -20,12 +20,58 @@ pub(crate) struct Common {
     /// Sample period (s); the model's by default.
     #[arg(long, allow_negative_numbers = true)]
     pub(crate) period: Option<f64>,
+    /// Latency from sampling the sensors to the force's change, in place of
+    /// the model's `latency_s`: seconds (`50e-6`) or a fraction of the
+    /// period (`0.25T`). The proof holds the force that much later.
+    #[arg(long, allow_hyphen_values = true)]
+    pub(crate) latency: Option<Latency>,
     /// Leave out the human bound Z_max = 300 + 1000/s (any passive human).
     #[arg(long)]
     pub(crate) no_human: bool,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub(crate) json: bool,
+}
+
+/// A latency as the command line gives it: seconds, or periods.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Latency {
+    /// Seconds.
+    Seconds(f64),
+    /// A number of sample periods.
+    Periods(f64),
+}
+
+impl Latency {
+    /// The latency (s) at sample period `period_s`.
+    pub(crate) fn seconds(self, period_s: f64) -> f64 {
+        match self {
+            Latency::Seconds(s) => s,
+            Latency::Periods(p) => p * period_s,
+        }
+    }
+}
+
+impl std::str::FromStr for Latency {
+    type Err = String;
+    fn from_str(text: &str) -> Result<Self, String> {
+        let t = text.trim();
+        let (number, periods) = match t.strip_suffix('T') {
+            Some(n) => (n, true),
+            None => (t, false),
+        };
+        let v: f64 = number.trim().parse().map_err(|_| {
+            format!("{text:?}: a latency is seconds (50e-6) or a fraction of the period (0.25T)")
+        })?;
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(format!("{text:?}: a latency must be finite and >= 0"));
+        }
+        Ok(if periods {
+            Latency::Periods(v)
+        } else {
+            Latency::Seconds(v)
+        })
+    }
 }
 
 #[derive(Args, Clone)]

@@ -19,7 +19,7 @@ pub(crate) fn designer(c: &Common, axis: Option<&DeviceAxis>) -> Result<Designer
             "--period {t}: must be a positive number of seconds"
         ));
     }
-    let models = match axis {
+    let mut models = match axis {
         Some(a) => a.models.clone(),
         None => c
             .model
@@ -27,6 +27,18 @@ pub(crate) fn designer(c: &Common, axis: Option<&DeviceAxis>) -> Result<Designer
             .map(|path| DeviceModel::load_or_excalibur(path).map_err(|e| e.to_string()))
             .collect::<Result<Vec<_>, _>>()?,
     };
+    if let Some(l) = c.latency {
+        for m in &mut models {
+            let s = l.seconds(c.period.unwrap_or(m.period_s));
+            if s > twoport_design::model::MAX_LATENCY_S {
+                return Err(format!(
+                    "--latency {s} s: at most {} s",
+                    twoport_design::model::MAX_LATENCY_S
+                ));
+            }
+            m.latency_s = s;
+        }
+    }
     let human = (!c.no_human).then_some(HumanBound::PAPER);
     Designer::new(models, c.period, human).map_err(|e| e.to_string())
 }
@@ -34,6 +46,13 @@ pub(crate) fn designer(c: &Common, axis: Option<&DeviceAxis>) -> Result<Designer
 /// The linkage file of `--device`, at `--period` where one is given.
 pub(crate) fn linkage_file(c: &Common) -> Result<twoport_design::linkage::LinkageFile, String> {
     let path = c.device.as_ref().ok_or("--device: a linkage file")?;
+    if c.latency.is_some() {
+        return Err(
+            "--latency: a linkage's workspace proof does not take a latency yet \
+             (prove one pose's model with --model and --latency)"
+                .into(),
+        );
+    }
     let mut file = twoport_design::linkage::LinkageFile::load(path).map_err(|e| e.to_string())?;
     if let Some(t) = c.period {
         if !(t.is_finite() && t > 0.0) {

@@ -36,6 +36,31 @@ fn design_impedance_json() {
     assert_eq!(v["b_c_nspm"], 90.0);
 }
 
+/// `--latency` in seconds or periods holds the force later: the same
+/// latency either way gives the same design, below the one without; a
+/// latency that is not a time is named.
+#[test]
+fn a_latency_lowers_the_design_the_same_in_seconds_and_periods() {
+    let k = |extra: &[&str]| {
+        let mut a = vec!["design", "impedance", "--b", "90", "--json"];
+        a.extend(extra);
+        TWOPORT.json(&a)["k_c_npm"].as_f64().unwrap()
+    };
+    let (none, periods, seconds) = (
+        k(&[]),
+        k(&["--latency", "0.25T"]),
+        k(&["--latency", "250e-6"]),
+    );
+    assert_eq!(periods, seconds);
+    assert!(periods < 0.9 * none, "{periods} vs {none}");
+    for bad in ["-1e-4", "fast", "0.1TT"] {
+        let e = TWOPORT.failure(&["design", "impedance", "--latency", bad]);
+        assert!(e.contains("latency"), "{bad}: {e}");
+    }
+    let e = TWOPORT.failure(&["design", "impedance", "--latency", "2"]);
+    assert!(e.contains("--latency 2 s: at most 1 s"), "{e}");
+}
+
 #[test]
 fn design_admittance_json_and_infeasible_without_human() {
     let paper = |human: &[&str]| {

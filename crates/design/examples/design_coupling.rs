@@ -25,13 +25,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         c.min_margin, c.worst_frequency_hz
     );
     let gains = Gains::from(ImpedanceGains::new(k as f32, b as f32));
-    let v = verify(
-        &model,
-        model.period_s,
-        &gains,
-        human,
-        model.delay_samples as usize,
-    )?;
+    let v = verify(&model, model.period_s, &gains, human)?;
     println!(
         "  verify: worst spectral radius {:.7} ({} loops), unstable: {}",
         v.spectral_radius, v.evaluations, v.unstable

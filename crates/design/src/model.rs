@@ -41,6 +41,11 @@ pub struct DeviceModel {
     /// Measurement-to-actuation delay in whole ticks (0: the force is held
     /// from the tick that sampled the sensors).
     pub delay_samples: u32,
+    /// Latency from sampling the sensors to the force's change (s), on top
+    /// of `delay_samples`: the servo's own computation, a bus transfer.
+    /// The force changes at `τ` after each tick's sample, inside the tick
+    /// or later ([`lag`](Self::lag) splits it at a period).
+    pub latency_s: f64,
     /// The actuator encoder's quantum `Δ` (m at the actuator), if known.
     pub encoder_quantum_m: Option<f64>,
     /// The Coulomb friction at the actuator `f_c` (N), if known.
@@ -86,6 +91,7 @@ struct RawModel {
     #[serde(rename = "C_f")]
     c_f: Option<Vec<Vec<f64>>>,
     delay_samples: Option<u32>,
+    latency_s: Option<f64>,
     encoder_quantum_m: Option<f64>,
     coulomb_friction_n: Option<f64>,
 }
@@ -127,6 +133,34 @@ pub const DEFAULT_LOAD_CELL_POLE_RAD_S: f64 = 235.0;
 
 /// The longest measurement-to-actuation delay a model may declare (ticks).
 pub const MAX_DELAY_SAMPLES: u32 = 64;
+
+/// The longest latency a model may declare (s).
+pub const MAX_LATENCY_S: f64 = 1.0;
+
+/// The measurement-to-actuation delay of a model at one sample period:
+/// `ticks` whole ticks and a `fraction` of one more, `0 <= fraction < 1`.
+/// The force a tick computes is applied from `(ticks + fraction) T` after
+/// its sample, and held one period.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lag {
+    /// Whole ticks.
+    pub ticks: u32,
+    /// The part of a tick on top, `α` in `[0, 1)`.
+    pub fraction: f64,
+}
+
+impl Lag {
+    /// No delay at all.
+    pub const NONE: Lag = Lag {
+        ticks: 0,
+        fraction: 0.0,
+    };
+
+    /// `ticks + fraction` ticks of `period_s` (s): the total delay (s).
+    pub fn seconds(&self, period_s: f64) -> f64 {
+        (self.ticks as f64 + self.fraction) * period_s
+    }
+}
 
 /// Where the paper's Excalibur model lives in this repository.
 pub const EXCALIBUR_PATH: &str = "models/excalibur.toml";
@@ -219,6 +253,15 @@ impl DeviceModel {
                 }
                 d => d.unwrap_or(0),
             },
+            latency_s: match raw.latency_s {
+                None => 0.0,
+                Some(l) if l.is_finite() && (0.0..=MAX_LATENCY_S).contains(&l) => l,
+                Some(l) => {
+                    return Err(err(format!(
+                        "latency_s = {l}: must be a time from 0 to {MAX_LATENCY_S} s"
+                    )))
+                }
+            },
             encoder_quantum_m: raw
                 .encoder_quantum_m
                 .map(|v| scalar("encoder_quantum_m", v))
@@ -273,6 +316,9 @@ impl DeviceModel {
         if self.delay_samples > 0 {
             let _ = writeln!(out, "delay_samples = {}", self.delay_samples);
         }
+        if self.latency_s > 0.0 {
+            let _ = writeln!(out, "latency_s = {:?}", self.latency_s);
+        }
         if let Some(q) = self.encoder_quantum_m {
             let _ = writeln!(out, "encoder_quantum_m = {q:?}");
         }
@@ -325,6 +371,25 @@ impl DeviceModel {
         Ok(loaded)
     }
 
+    /// The delay at sample period `period_s` (s): `delay_samples` and the
+    /// latency's whole ticks, and what is left of it as a fraction of a
+    /// tick. A latency within a part in 1e9 of a whole number of ticks is
+    /// that number (a period's rounding must not make a tick of `0.999...`).
+    pub fn lag(&self, period_s: f64) -> Lag {
+        let ticks = self.latency_s / period_s;
+        let mut whole = ticks.floor();
+        let mut fraction = ticks - whole;
+        if fraction > 1.0 - 1e-9 {
+            (whole, fraction) = (whole + 1.0, 0.0);
+        } else if fraction < 1e-9 {
+            fraction = 0.0;
+        }
+        Lag {
+            ticks: self.delay_samples + whole as u32,
+            fraction,
+        }
+    }
+
     /// Number of coordinates `n`.
     pub fn dof(&self) -> usize {
         self.m.nrows()
@@ -333,7 +398,8 @@ impl DeviceModel {
     /// The encoder quantum and Coulomb friction, where the model gives
     /// both (a missing friction is none).
     pub fn friction(&self) -> Option<crate::limit_cycle::Friction> {
-        let rigid = self.dof() == 1 && self.k[(0, 0)] == 0.0 && self.delay_samples == 0;
+        let rigid =
+            self.dof() == 1 && self.k[(0, 0)] == 0.0 && self.lag(self.period_s) == Lag::NONE;
         self.encoder_quantum_m
             .map(|q| crate::limit_cycle::Friction {
                 encoder_quantum_m: q,
@@ -569,6 +635,51 @@ mod tests {
         assert!(broken("C_f = [", "delay_samples = 65\nC_f = [").contains("at most 64"));
         let e = broken("load_cell_pole_rad_s = 235.0\n", "");
         assert!(e.contains("needs its filter pole"), "{e}");
+    }
+
+    /// `latency_s` is read, checked, written back, and split at a period
+    /// into whole ticks (on top of `delay_samples`) and a fraction, a
+    /// period's rounding never leaving `0.999...` of a tick.
+    #[test]
+    fn a_latency_is_read_and_split_at_a_period() {
+        let rigid = "period_s = 0.001\npeak_force_n = 5.0\ncontinuous_force_n = 2.0\n\
+                     M = [[0.01]]\nD = [[0.5]]\nK = [[0.0]]\nG = [[1.0, -1.0]]\n\
+                     C_v = [[1.0], [-1.0]]\n";
+        let with = |l: &str| DeviceModel::from_toml(&format!("{rigid}latency_s = {l}\n"), "r");
+        let m = with("2.5e-4").unwrap();
+        assert_eq!(m.latency_s, 2.5e-4);
+        assert_eq!(
+            m.lag(1e-3),
+            Lag {
+                ticks: 0,
+                fraction: 0.25
+            }
+        );
+        assert_eq!(m.lag(1e-4).ticks, 2);
+        assert!((m.lag(1e-4).fraction - 0.5).abs() < 1e-12);
+        let back = DeviceModel::from_toml(&m.to_toml(""), "r").unwrap();
+        assert_eq!(back, m);
+        // 3e-4 / 1e-4 is 2.9999999999999996 in f64: three whole ticks.
+        let d = DeviceModel::from_toml(
+            &format!("{rigid}latency_s = 3e-4\ndelay_samples = 1\n"),
+            "r",
+        )
+        .unwrap();
+        assert_eq!(
+            d.lag(1e-4),
+            Lag {
+                ticks: 4,
+                fraction: 0.0
+            }
+        );
+        for bad in ["-1e-4", "nan", "2.0"] {
+            let e = with(bad).unwrap_err().to_string();
+            assert!(e.contains("latency_s"), "{bad}: {e}");
+        }
+        assert_eq!(
+            DeviceModel::from_toml(rigid, "r").unwrap().lag(1e-3),
+            Lag::NONE
+        );
     }
 
     /// A model without `C_f` has no force sensor; `delay_samples` defaults

@@ -37,10 +37,12 @@ fn y_hh(p: &PlantPoint, human: Option<HumanBound>) -> Complex64 {
 
 /// The impedance display's hybrid form without the coupling (section 3):
 /// `[[Y_hh, Y_hc], [Y_ch*, Y_cc*]]`. A measurement-to-actuation delay
-/// `z^-d` delays everything the coupling force drives (the second column).
+/// `z^-d` delays everything the coupling force drives (the second column);
+/// a latency inside the tick delays the held force (`Y_cc*`'s sampled
+/// term includes it).
 pub fn impedance_display(p: &PlantPoint, human: Option<HumanBound>) -> Matrix2 {
     [
-        [y_hh(p, human), p.y[0][1] * p.hold * p.delay],
+        [y_hh(p, human), p.y[0][1] * p.hold * p.latency() * p.delay],
         [
             p.hold * p.y[1][0],
             p.delay * (Complex64::new(1.0, 0.0) - p.z.inv()) / p.period_s * p.xaa_d,
@@ -58,10 +60,12 @@ pub fn admittance_display(p: &PlantPoint, kp: &ZTransfer, human: Option<HumanBou
     let den = one + p.xaa_d * k;
     let x_ah = p.y[1][0] / p.s;
     let integ = p.period_s / (one - p.z.inv());
+    // The held force's way to the handle, the latency inside the tick on it.
+    let held = p.y[0][1] * p.hold * p.latency();
     [
         [
-            y_hh(p, human) - p.y[0][1] * p.hold * k * x_ah / den,
-            p.y[0][1] * p.hold * k / den * integ,
+            y_hh(p, human) - held * k * x_ah / den,
+            held * k / den * integ,
         ],
         [p.f[0] - p.fma_d * k * x_ah / den, p.fma_d * k / den * integ],
     ]

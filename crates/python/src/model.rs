@@ -126,7 +126,7 @@ impl Model {
     #[allow(clippy::too_many_arguments)]
     #[pyo3(signature = (M, D, K, G, C_v, *, period_s, peak_force_n, continuous_force_n,
                         C_f=None, load_cell_pole_rad_s=None, delay_samples=None,
-                        name="a model from arrays".to_string()))]
+                        latency_s=None, name="a model from arrays".to_string()))]
     #[allow(non_snake_case)]
     fn from_arrays(
         M: Vec<Vec<f64>>,
@@ -140,6 +140,7 @@ impl Model {
         C_f: Option<Vec<Vec<f64>>>,
         load_cell_pole_rad_s: Option<f64>,
         delay_samples: Option<u32>,
+        latency_s: Option<f64>,
         name: String,
     ) -> PyResult<Model> {
         // TOML has no NaN of its own: name a number that is not one here.
@@ -148,6 +149,7 @@ impl Model {
             ("peak_force_n", Some(peak_force_n)),
             ("continuous_force_n", Some(continuous_force_n)),
             ("load_cell_pole_rad_s", load_cell_pole_rad_s),
+            ("latency_s", latency_s),
         ];
         for (n, v) in scalars {
             if let Some(v) = v.filter(|v| !v.is_finite()) {
@@ -179,6 +181,9 @@ impl Model {
         if let Some(d) = delay_samples {
             let _ = writeln!(t, "delay_samples = {d}");
         }
+        if let Some(l) = latency_s {
+            let _ = writeln!(t, "latency_s = {l:?}");
+        }
         for (n, m) in matrices {
             t += &matrix(n, m);
         }
@@ -203,6 +208,13 @@ impl Model {
     }
 
     /// Its degrees of freedom.
+    /// Latency from sampling to the force's change (s), beyond
+    /// `delay_samples` whole ticks.
+    #[getter]
+    fn latency_s(&self) -> f64 {
+        self.inner.latency_s
+    }
+
     #[getter]
     fn dof(&self) -> usize {
         self.inner.dof()

@@ -36,6 +36,27 @@ def test_a_model_from_arrays_meets_colgates_closed_form():
     assert twoport.verify(k=1.5 * d.k_c_npm, b=5.0, model=m, human=False).unstable
 
 
+def test_a_latency_inside_the_tick_lowers_the_proven_stiffness():
+    # Half a tick from sample to force on the rigid device: the proof is
+    # below the exact loop's boundary 2 b / ((1 + 0.5)^2 T), and verify,
+    # on the loop with the force held half a tick late, agrees on both sides.
+    m = twoport.Model.from_arrays(
+        [[1.0]], [[20.0]], [[0.0]], [[1.0, -1.0]], [[1.0], [-1.0]],
+        period_s=1e-3, peak_force_n=50.0, continuous_force_n=20.0,
+        latency_s=0.5e-3, name="late")
+    assert m.latency_s == 0.5e-3
+    exact = 2 * 20.0 / (1.5 ** 2 * 1e-3)
+    d = twoport.design_impedance(m, b=0.0, human=False)
+    assert 0.88 * exact <= d.k_c_npm <= exact, d
+    assert twoport.design_impedance(rigid(), b=0.0, human=False).k_c_npm > 2 * d.k_c_npm
+    assert not twoport.verify(k=d.k_c_npm, b=0.0, model=m, human=False).unstable
+    assert twoport.verify(k=1.05 * exact, b=0.0, model=m, human=False).unstable
+    with pytest.raises(ValueError, match="latency_s"):
+        twoport.Model.from_arrays([[1.0]], [[1.0]], [[0.0]], [[1.0, -1.0]],
+                                  [[1.0], [-1.0]], period_s=1e-3, latency_s=-1.0,
+                                  peak_force_n=1.0, continuous_force_n=1.0)
+
+
 def test_bad_arrays_and_arguments_are_named():
     with pytest.raises(ValueError, match="M"):
         twoport.Model.from_arrays([[1.0, 0.0]], [[1.0]], [[0.0]], [[1.0, -1.0]],

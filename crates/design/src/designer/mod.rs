@@ -582,7 +582,6 @@ impl Designer {
                 self.period_s(),
                 gains,
                 self.human,
-                p.model.delay_samples as usize,
                 &self.binding_hz(p, gains),
             )?;
             evaluations += v.evaluations;

@@ -602,7 +602,7 @@ mod tests {
                 assert!((d.k_c_npm - 2.0 * b / l.period_s).abs() <= 1e-9 * d.k_c_npm);
                 let axis = crate::model::rigid_for_tests(d.binding.mass_kg, b);
                 let g = |k: f64| Gains::from(ImpedanceGains::new(k as f32, 0.0));
-                let v = |k: f64| crate::verify::verify(&axis, l.period_s, &g(k), None, 0).unwrap();
+                let v = |k: f64| crate::verify::verify(&axis, l.period_s, &g(k), None).unwrap();
                 let at = v(d.k_c_npm * 0.999);
                 assert!(!at.unstable, "{name}, grasp {grasp}: {at:?}");
                 let past = v(d.k_c_npm * 1.2);

@@ -12,8 +12,9 @@ use modal::Modal;
 use precise::Precise;
 
 use crate::linalg::{balance, expm_balanced, hessenberg_shift_solve, lu_solve};
+use crate::model::Lag;
 use crate::DeviceModel;
-use nalgebra::{Cholesky, DMatrix};
+use nalgebra::{Cholesky, DMatrix, DVector};
 use num_complex::Complex64;
 
 /// Everything the two-port analysis needs about the device at one frequency.
@@ -37,8 +38,26 @@ pub struct PlantPoint {
     pub xaa_d: Complex64,
     /// ZOH-exact held actuator force to sampled `f_m`, `F_ma^d(z)` (N/N).
     pub fma_d: Complex64,
-    /// The device's measurement-to-actuation delay `z^-d` (1 without one).
+    /// The device's measurement-to-actuation delay in whole ticks, `z^-d`
+    /// (1 without one).
     pub delay: Complex64,
+    /// The rest of the delay inside the tick, `τ = αT` (s): the held force
+    /// changes `τ` after the tick's sample. `xaa_d` and `fma_d` include it
+    /// (the modified z-transform); the held force's path to the handle
+    /// takes [`latency`](Self::latency).
+    pub latency_s: f64,
+}
+
+impl PlantPoint {
+    /// `e^{-jωτ}`: the latency inside the tick on the held force's way to
+    /// the handle (1 without one).
+    pub fn latency(&self) -> Complex64 {
+        if self.latency_s == 0.0 {
+            Complex64::new(1.0, 0.0)
+        } else {
+            Complex64::from_polar(1.0, -self.omega * self.latency_s)
+        }
+    }
 }
 
 /// A single-input single-output discrete system `c (zI - H)^-1 b` with `H`
@@ -135,7 +154,7 @@ pub struct Plant {
     modes: Vec<Mode>,
     discrete_angles: Vec<f64>,
     features: Vec<Feature>,
-    delay_samples: u32,
+    lag: Lag,
 }
 
 /// The device's state space on `x = [q, q', w]`, `w` the load cell's
@@ -186,6 +205,83 @@ pub(crate) fn zoh(
     ))
 }
 
+/// The zero-order hold of one input delayed inside the tick: the force a
+/// tick computes acts from `τ` after its sample, the previous tick's force
+/// before it, so `x[k+1] = A_d x[k] + b_now u[k] + b_prev u[k-1]`.
+#[derive(Clone, Debug)]
+pub(crate) struct DelayedHold {
+    /// `e^{AT}`.
+    pub(crate) ad: DMatrix<f64>,
+    /// `∫_0^{T-τ} e^{As} ds b`.
+    pub(crate) b_now: DVector<f64>,
+    /// `e^{A(T-τ)} ∫_0^τ e^{As} ds b`; zero without a latency.
+    pub(crate) b_prev: DVector<f64>,
+}
+
+impl DelayedHold {
+    /// The hold of the input `b` at period `t` (s), delayed by `fraction`
+    /// of it. At `fraction = 0` it is [`zoh`]'s, with `b_prev = 0`.
+    pub(crate) fn new(
+        a: &DMatrix<f64>,
+        b: &DVector<f64>,
+        t: f64,
+        fraction: f64,
+    ) -> Result<Self, String> {
+        let b = DMatrix::from_column_slice(b.len(), 1, b.as_slice());
+        if fraction == 0.0 {
+            let (ad, bd) = zoh(a, &b, t)?;
+            return Ok(DelayedHold {
+                ad,
+                b_now: bd.column(0).into_owned(),
+                b_prev: DVector::zeros(a.nrows()),
+            });
+        }
+        let tau = fraction * t;
+        let (e_rest, b_rest) = zoh(a, &b, t - tau)?;
+        let (e_tau, b_tau) = zoh(a, &b, tau)?;
+        Ok(DelayedHold {
+            ad: &e_rest * e_tau,
+            b_now: b_rest.column(0).into_owned(),
+            b_prev: (&e_rest * b_tau).column(0).into_owned(),
+        })
+    }
+
+    /// The first `n` states alone (where the rest do not feed them).
+    pub(crate) fn leading(&self, n: usize) -> DelayedHold {
+        DelayedHold {
+            ad: self.ad.view((0, 0), (n, n)).into_owned(),
+            b_now: self.b_now.rows(0, n).into_owned(),
+            b_prev: self.b_prev.rows(0, n).into_owned(),
+        }
+    }
+
+    /// As one discrete system: the state gains the previous tick's force,
+    /// `[x; u[k-1]]`, with `[[A_d, b_prev], [0, 0]]` and input `[b_now;
+    /// 1]` (an output row gains a zero: [`padded`]). Without a latency the
+    /// system is `(A_d, b_now)` as it is.
+    pub(crate) fn latched(&self) -> (DMatrix<f64>, Vec<f64>) {
+        let mut b = self.b_now.as_slice().to_vec();
+        if self.b_prev.iter().all(|v| *v == 0.0) {
+            return (self.ad.clone(), b);
+        }
+        let n = self.ad.nrows();
+        let mut a = DMatrix::<f64>::zeros(n + 1, n + 1);
+        a.view_mut((0, 0), (n, n)).copy_from(&self.ad);
+        for (i, v) in self.b_prev.iter().enumerate() {
+            a[(i, n)] = *v;
+        }
+        b.push(1.0);
+        (a, b)
+    }
+}
+
+/// `c` with zeros up to `n` entries: an output row of a [`latched`] system.
+pub(crate) fn padded(c: &[f64], n: usize) -> Vec<f64> {
+    let mut c = c.to_vec();
+    c.resize(n, 0.0);
+    c
+}
+
 fn row_major(a: &DMatrix<f64>) -> Vec<f64> {
     let mut v = Vec::with_capacity(a.len());
     for r in 0..a.nrows() {
@@ -228,8 +324,8 @@ impl Plant {
         let p = model.load_cell_pole_rad_s;
         let na = 2 * n + 1;
         let (a, b) = augmented(&minv_k, &minv_d, &minv_g, &model.c_f, p);
-        let (ad, bd) = zoh(&a, &b, period_s)?;
-        let bd_act: Vec<f64> = bd.column(1).iter().copied().collect();
+        let lag = model.lag(period_s);
+        let hold = DelayedHold::new(&a, &b.column(1).into_owned(), period_s, lag.fraction)?;
         // -x_a is C_v's second row applied to positions.
         let mut c_xa = vec![0.0; na];
         for (j, c) in c_xa.iter_mut().take(n).enumerate() {
@@ -237,16 +333,20 @@ impl Plant {
         }
         let mut c_fm = vec![0.0; na];
         c_fm[2 * n] = 1.0;
-        let ad_q = ad.view((0, 0), (2 * n, 2 * n)).into_owned();
-        let xaa = Siso::new(ad_q, bd_act[..2 * n].to_vec(), c_xa[..2 * n].to_vec());
+        // (The filter's state does not feed the mechanics: -x_a needs only
+        // the mechanical states.)
+        let (aq, bq) = hold.leading(2 * n).latched();
+        let xaa = Siso::new(aq.clone(), bq, padded(&c_xa[..2 * n], aq.nrows()));
+        let (al, bl) = hold.latched();
+        let nl = al.nrows();
         let zoh = (
-            na,
-            row_major(&ad),
-            bd_act.clone(),
-            c_xa.clone(),
-            c_fm.clone(),
+            nl,
+            row_major(&al),
+            bl.clone(),
+            padded(&c_xa, nl),
+            padded(&c_fm, nl),
         );
-        let fma = Siso::new(ad.clone(), bd_act, c_fm.clone());
+        let fma = Siso::new(al, bl, padded(&c_fm, nl));
 
         let a_q = a.view((0, 0), (2 * n, 2 * n)).into_owned();
         let unsettled = "the device's poles could not be found (a number is not finite, or the eigenvalue iteration did not settle)";
@@ -260,7 +360,7 @@ impl Plant {
             })
             .collect();
         modes.sort_by(|x, y| x.omega_n.total_cmp(&y.omega_n));
-        let discrete_poles = crate::linalg::eigenvalues(&ad).ok_or(unsettled)?;
+        let discrete_poles = crate::linalg::eigenvalues(&hold.ad).ok_or(unsettled)?;
         let discrete_angles = discrete_poles
             .iter()
             .map(|l| l.im.atan2(l.re).abs())
@@ -279,7 +379,7 @@ impl Plant {
         }
         c_out[(2, 2 * n)] = 1.0;
         let modal = Modal::new(&a, &b, &c_out);
-        let precise = Precise::new(model, period_s, &c_xa, &c_fm);
+        let precise = Precise::new(model, period_s, lag.fraction, &c_xa, &c_fm);
         let mut plant = Plant {
             n,
             period_s,
@@ -298,7 +398,7 @@ impl Plant {
             modes,
             discrete_angles,
             features,
-            delay_samples: model.delay_samples,
+            lag,
         };
         plant.keep_modal_if_exact();
         Ok(plant)
@@ -335,9 +435,9 @@ impl Plant {
         self.modal.is_some()
     }
 
-    /// The device's measurement-to-actuation delay (ticks).
-    pub fn delay_samples(&self) -> u32 {
-        self.delay_samples
+    /// The device's measurement-to-actuation delay at this period.
+    pub fn lag(&self) -> Lag {
+        self.lag
     }
 
     /// The sample period (s).
@@ -374,7 +474,8 @@ impl Plant {
 
     /// Buffers sized for this plant.
     pub fn scratch(&self) -> Scratch {
-        let na = 2 * self.n + 1;
+        // (One more state for the previous tick's force, with a latency.)
+        let na = 2 * self.n + 2;
         Scratch {
             mat: vec![Complex64::new(0.0, 0.0); na * na],
             vec: vec![Complex64::new(0.0, 0.0); na * 2],
@@ -467,7 +568,8 @@ impl Plant {
             f,
             xaa_d: self.xaa.eval(z, work),
             fma_d: self.fma.eval(z, work),
-            delay: z.powi(-(self.delay_samples as i32)),
+            delay: z.powi(-(self.lag.ticks as i32)),
+            latency_s: self.lag.fraction * t,
         }
     }
 
@@ -522,7 +624,7 @@ impl Plant {
         let n = self.xaa.n;
         // K_p z^-d in transposed direct form II.
         let (num, den) = from_tf(kp);
-        let k = realise(&delayed(&num, self.delay_samples as usize), &den).ok()?;
+        let k = realise(&delayed(&num, self.lag.ticks as usize), &den).ok()?;
         let nk = k.b.len();
         let h = &self.xaa;
         let mut a = DMatrix::<f64>::zeros(n + nk, n + nk);

@@ -372,9 +372,17 @@ pub(super) struct Precise {
 }
 
 impl Precise {
-    /// The device at period `t` (s); `None` where `M` is singular or the
-    /// exponential is not finite.
-    pub(super) fn new(model: &DeviceModel, t: f64, c_xa: &[f64], c_fm: &[f64]) -> Option<Self> {
+    /// The device at period `t` (s), its force delayed by `fraction` of
+    /// the period inside the tick (the state then gains the previous
+    /// tick's force, as `super::latched` builds it); `None` where `M` is
+    /// singular or the exponential is not finite.
+    pub(super) fn new(
+        model: &DeviceModel,
+        t: f64,
+        fraction: f64,
+        c_xa: &[f64],
+        c_fm: &[f64],
+    ) -> Option<Self> {
         let n = model.dof();
         let rm = |m: &nalgebra::DMatrix<f64>| -> Vec<f64> {
             (0..m.nrows())
@@ -386,39 +394,68 @@ impl Precise {
         let minv_d = solve_real(&m, &rm(&model.d), n, n)?;
         let gcols = model.g.ncols();
         let minv_g = solve_real(&m, &rm(&model.g), n, gcols)?;
-        // [[A T, b T], [0, 0]] for the augmented state and the actuator's
+        // [[A t, b t], [0, 0]] for the augmented state and the actuator's
         // column, as the f64 path builds them.
         let na = 2 * n + 1;
         let nb = na + 1;
         let p = model.load_cell_pole_rad_s;
-        let tt = Dd::of(t);
-        let mut x = vec![Dd::ZERO; nb * nb];
-        for i in 0..n {
-            x[i * nb + n + i] = tt;
-            for j in 0..n {
-                x[(n + i) * nb + j] = -minv_k[i * n + j] * tt;
-                x[(n + i) * nb + n + j] = -minv_d[i * n + j] * tt;
+        let block = |t: f64| {
+            let tt = Dd::of(t);
+            let mut x = vec![Dd::ZERO; nb * nb];
+            for i in 0..n {
+                x[i * nb + n + i] = tt;
+                for j in 0..n {
+                    x[(n + i) * nb + j] = -minv_k[i * n + j] * tt;
+                    x[(n + i) * nb + n + j] = -minv_d[i * n + j] * tt;
+                }
+                x[(n + i) * nb + na] = minv_g[i * gcols + 1] * tt;
+                x[2 * n * nb + i] = Dd::of(p * model.c_f[(0, i)]) * tt;
             }
-            x[(n + i) * nb + na] = minv_g[i * gcols + 1] * tt;
-            x[2 * n * nb + i] = Dd::of(p * model.c_f[(0, i)]) * tt;
-        }
-        x[2 * n * nb + 2 * n] = Dd::of(-p) * tt;
-        let e = expm(&x, nb)?;
-        let mut h: Mat = (0..na * na)
+            x[2 * n * nb + 2 * n] = Dd::of(-p) * tt;
+            expm(&x, nb)
+        };
+        // `e^{A t}` and the held input's column, or with a latency `τ`
+        // their product over `t - τ` and `τ` and the previous force's column.
+        let (ad, b_now, b_prev): (Mat, Vec<Dd>, Option<Vec<Dd>>) = if fraction == 0.0 {
+            let e = block(t)?;
+            let ad = (0..na * na).map(|i| e[(i / na) * nb + i % na]).collect();
+            (ad, (0..na).map(|r| e[r * nb + na]).collect(), None)
+        } else {
+            let rest = block(t - fraction * t)?;
+            let tau = block(fraction * t)?;
+            let prod = matmul(&rest, &tau, nb);
+            let ad = (0..na * na).map(|i| prod[(i / na) * nb + i % na]).collect();
+            let b_now = (0..na).map(|r| rest[r * nb + na]).collect();
+            let b_prev = (0..na)
+                .map(|r| (0..na).fold(Dd::ZERO, |acc, k| acc + rest[r * nb + k] * tau[k * nb + na]))
+                .collect();
+            (ad, b_now, Some(b_prev))
+        };
+        let size = na + usize::from(b_prev.is_some());
+        let mut h: Mat = (0..size * size)
             .map(|i| {
-                let (r, c) = (i / na, i % na);
-                e[r * nb + c] - Dd::of(if r == c { 1.0 } else { 0.0 })
+                let (r, c) = (i / size, i % size);
+                let a = match (&b_prev, r < na, c < na) {
+                    (_, true, true) => ad[r * na + c],
+                    (Some(bp), true, false) => bp[r],
+                    _ => Dd::ZERO,
+                };
+                a - Dd::of(if r == c { 1.0 } else { 0.0 })
             })
             .collect();
-        let mut b: Vec<Dd> = (0..na).map(|r| e[r * nb + na]).collect();
+        let mut b = b_now;
+        if b_prev.is_some() {
+            b.push(Dd::of(1.0));
+        }
         // (The filter's state does not feed the mechanics: `-x_a` over
         // every state is `-x_a` over the mechanical ones.)
-        let mut c = [
-            (0..na)
-                .map(|j| Dd::of(c_xa.get(j).copied().unwrap_or(0.0)))
-                .collect(),
-            c_fm.iter().map(|&v| Dd::of(v)).collect(),
-        ];
+        let row = |c: &[f64]| {
+            (0..size)
+                .map(|j| Dd::of(c.get(j).copied().unwrap_or(0.0)))
+                .collect()
+        };
+        let mut c = [row(c_xa), row(c_fm)];
+        let na = size;
         hessenberg(&mut h, &mut b, &mut c, na);
         Some(Precise {
             n,

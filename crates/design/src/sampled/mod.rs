@@ -175,6 +175,13 @@ fn each_alias_pair(
     true
 }
 
+/// The latency's phase at alias frequency `omega` (rad/s): the held force
+/// reaches the handle `e^{-jωτ}` later at each alias, a different turn at
+/// each when `τ` is not a whole tick.
+fn latency(p: &PlantPoint, omega: f64) -> Complex64 {
+    PlantPoint { omega, ..*p }.latency()
+}
+
 /// `Σ_{|k|>N} 1/(θ + 2πk)²` is at most this (for `0 <= θ <= π`).
 fn tail_sum(n: usize) -> f64 {
     2.0 / (4.0 * PI * PI * (n as f64 - 0.5))
@@ -193,14 +200,16 @@ fn impedance_alias_terms(
     let t = p.period_s;
     let th = p.omega * t;
     let s2 = 4.0 * (0.5 * th).sin().powi(2);
-    // e^{-jθ} from the hold and the first difference, times the delay.
+    // e^{-jθ} from the hold and the first difference, times the delay (and
+    // the latency, at each alias's own frequency).
     let rot = Complex64::from_polar(1.0, -th) * p.delay;
     let (mut sum, mut tail) = (0.0, 0.0);
     let bounded = each_alias_pair(plant, (i, p), human, cache, |pair, n| {
         let mut ratio = 0.0f64;
         for a in pair {
             let wt = a.omega * t;
-            sum += s2 / (wt * wt) * (a.p_abs + (rot * a.p).re) / (2.0 * a.re_yhh);
+            let re = (rot * latency(p, a.omega) * a.p).re;
+            sum += s2 / (wt * wt) * (a.p_abs + re) / (2.0 * a.re_yhh);
             ratio = ratio.max(a.p_abs / a.re_yhh);
         }
         tail = ratio * s2 * tail_sum(n);

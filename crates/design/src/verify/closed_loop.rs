@@ -5,7 +5,7 @@
 use super::{Gains, Hand, Radius, Termination, Ve, OSCILLATING_MARGIN, UNSTABLE_MARGIN};
 use crate::analysis::{admittance_coupling_tf, impedance_coupling_tf, regulator_tf};
 use crate::linalg::balance;
-use crate::plant::{augmented, zoh};
+use crate::plant::{augmented, padded, DelayedHold};
 use crate::rational::{add, delayed, from_tf, mul, realise, reduced, scale, Rational};
 use crate::DeviceModel;
 use nalgebra::DMatrix;
@@ -53,7 +53,8 @@ impl Ve {
 
 /// The device with the hand, discretised under the ZOH from the actuator
 /// force: `(A_d, b_d, c_xa, c_fm)` with outputs the actuator position `x_a`
-/// (m) and the measured force `f_m` (N).
+/// (m) and the measured force `f_m` (N). With a latency inside the tick the
+/// hold is delayed by it, and the last state is the previous tick's force.
 pub(super) struct Sampled {
     pub(super) ad: DMatrix<f64>,
     pub(super) bd: Vec<f64>,
@@ -131,9 +132,10 @@ pub(super) fn sampled(model: &DeviceModel, hand: &Hand, t: f64) -> Result<Sample
         &c_f,
         model.load_cell_pole_rad_s,
     );
-    let (ad, bd) = zoh(&a, &b, t)?;
-    let na = ad.nrows();
-    let bd = bd.column(0).iter().copied().collect();
+    // The force held from `τ` after the sample, the previous tick's before
+    // it: the state gains that force where the model has a latency.
+    let hold = DelayedHold::new(&a, &b.column(0).into_owned(), t, model.lag(t).fraction)?;
+    let na = hold.ad.nrows();
     let mut c_xa = vec![0.0; na];
     for (j, c) in c_xa.iter_mut().take(n).enumerate() {
         // C_v's second row gives -v_a.
@@ -141,6 +143,8 @@ pub(super) fn sampled(model: &DeviceModel, hand: &Hand, t: f64) -> Result<Sample
     }
     let mut c_fm = vec![0.0; na];
     c_fm[2 * nq] = 1.0;
+    let (ad, bd) = hold.latched();
+    let (c_xa, c_fm) = (padded(&c_xa, ad.nrows()), padded(&c_fm, ad.nrows()));
     Ok(Sampled { ad, bd, c_xa, c_fm })
 }
 
@@ -213,10 +217,10 @@ pub(super) fn closed_loop(
     period_s: f64,
     gains: &Gains,
     term: &Termination,
-    delay_samples: usize,
 ) -> Result<DMatrix<f64>, String> {
     let plant = sampled(model, &term.hand, period_s)?;
-    let ((nx, dx), (nf, df)) = controller(gains, &term.ve, period_s, delay_samples)?;
+    let delay = model.lag(period_s).ticks as usize;
+    let ((nx, dx), (nf, df)) = controller(gains, &term.ve, period_s, delay)?;
     let realised = |n: &[f64], d: &[f64]| realise(n, d).map_err(|e| e.to_string());
     let (hx, hf) = (realised(&nx, &dx)?, realised(&nf, &df)?);
     let np = plant.ad.nrows();

@@ -49,6 +49,8 @@ struct Setting<'a> {
     t: f64,
     gains: Gains,
     grasp: Option<HumanBound>,
+    /// The whole ticks of the model's delay (the latency inside the tick
+    /// is in the sampled device).
     delay: usize,
 }
 
@@ -138,7 +140,6 @@ pub fn construct(
     period_s: f64,
     gains: Gains,
     human: Option<HumanBound>,
-    delay_samples: usize,
     frequencies_hz: &[f64],
     seeds: &[Hand],
 ) -> Option<Constructed> {
@@ -152,7 +153,7 @@ pub fn construct(
         t: period_s,
         gains,
         grasp: human,
-        delay: delay_samples,
+        delay: model.lag(period_s).ticks as usize,
     };
     let mut candidates: Vec<(f64, (f64, f64), f64)> = frequencies_hz
         .iter()
@@ -206,7 +207,7 @@ impl Setting<'_> {
             }
         };
         let termination = Termination { hand, ve };
-        let r: Radius = radius(self.model, period_s, &self.gains, &termination, self.delay).ok()?;
+        let r: Radius = radius(self.model, period_s, &self.gains, &termination).ok()?;
         Some(Constructed {
             frequency_hz: w / (2.0 * PI),
             termination,

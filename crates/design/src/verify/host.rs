@@ -56,7 +56,7 @@ pub fn monodromy(
     let n_ve = host.ve_period_ticks as usize;
     let d = host.delay_ticks as usize;
     let held = d + n_ve - 1;
-    let late = model.delay_samples as usize;
+    let late = model.lag(period_s).ticks as usize;
     let np = plant.ad.nrows();
     let nl = law.a.nrows();
     // [plant | law | body x, v | held positions τ[k-1..] | forces f[k-1..]]

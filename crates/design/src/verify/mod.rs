@@ -179,13 +179,10 @@ pub fn radius(
     period_s: f64,
     gains: &Gains,
     term: &Termination,
-    delay_samples: usize,
 ) -> Result<Radius, crate::Error> {
-    let a = closed_loop(model, period_s, gains, term, delay_samples).map_err(|why| {
-        crate::Error::Verify {
-            model: model.name.clone(),
-            why,
-        }
+    let a = closed_loop(model, period_s, gains, term).map_err(|why| crate::Error::Verify {
+        model: model.name.clone(),
+        why,
     })?;
     Ok(judge(&a, period_s))
 }
@@ -229,7 +226,7 @@ mod tests {
         let x = b * t / m;
         let k_star = (b * b / m) * (1.0 - (-x).exp()) / (1.0 - (1.0 + x) * (-x).exp());
         let rho = |k: f64| {
-            radius(&rigid(), t, &imp(k, 0.0), &hands_off(Ve::Constraint), 0)
+            radius(&rigid(), t, &imp(k, 0.0), &hands_off(Ve::Constraint))
                 .unwrap()
                 .spectral_radius
         };
@@ -269,7 +266,7 @@ mod tests {
                     ve,
                 };
                 let g = imp(k, 20.0);
-                let a = closed_loop(&model, 1e-3, &g, &term, 0).unwrap();
+                let a = closed_loop(&model, 1e-3, &g, &term).unwrap();
                 let osc = |m: &DMatrix<f64>| {
                     crate::linalg::eigenvalues(m)
                         .unwrap()
@@ -305,7 +302,6 @@ mod tests {
                     1e-3,
                     &imp(40_000.0, 20.0),
                     &Termination { hand, ve },
-                    0,
                 );
                 r.unwrap().spectral_radius
             };
@@ -339,16 +335,15 @@ mod tests {
     #[test]
     fn construct_puts_a_pole_on_the_circle() {
         let g = twoport_control::ImpedanceGains::new(40_000.0, 10.0);
-        let v = verify(&rigid(), 1e-3, &g.into(), None, 0).unwrap();
+        let v = verify(&rigid(), 1e-3, &g.into(), None).unwrap();
         let seeds = [v.termination.hand];
         let freqs = [v.frequency_hz, 499.0, 450.0];
-        let c =
-            construct(&rigid(), 1e-3, g.into(), None, 0, &freqs, &seeds).expect("a termination");
+        let c = construct(&rigid(), 1e-3, g.into(), None, &freqs, &seeds).expect("a termination");
         assert!((c.spectral_radius - 1.0).abs() < 1e-6, "{c:?}");
         assert_eq!(c.termination.hand.damping_nspm, 0.0);
         let at = twoport_control::ImpedanceGains::new(19_900.0, 10.0);
         assert_eq!(
-            construct(&rigid(), 1e-3, at.into(), None, 0, &freqs, &seeds),
+            construct(&rigid(), 1e-3, at.into(), None, &freqs, &seeds),
             None
         );
     }
@@ -358,7 +353,7 @@ mod tests {
     /// rigid device unstable, though the paper's bound calls it proven.
     #[test]
     fn finds_the_rigid_counterexample() {
-        let v = verify(&rigid(), 1e-3, &imp(40_000.0, 10.0), None, 0).unwrap();
+        let v = verify(&rigid(), 1e-3, &imp(40_000.0, 10.0), None).unwrap();
         assert!(v.unstable, "{v:?}");
         assert!(v.frequency_hz > 300.0, "{v:?}");
     }

@@ -61,7 +61,6 @@ struct Search<'a> {
     t: f64,
     gains: Gains,
     grasp: Option<HumanBound>,
-    delay: usize,
     evaluations: usize,
     /// Whether the hand has a second resonance (three more parameters
     /// after the first's).
@@ -106,7 +105,7 @@ impl Search<'_> {
         }
         self.evaluations += 1;
         let term = self.termination(kind, p);
-        radius(self.model, self.t, &self.gains, &term, self.delay).unwrap_or(Radius {
+        radius(self.model, self.t, &self.gains, &term).unwrap_or(Radius {
             spectral_radius: 0.0,
             frequency_hz: 0.0,
             score: 0.0,
@@ -167,9 +166,8 @@ pub fn verify(
     period_s: f64,
     gains: &Gains,
     human: Option<HumanBound>,
-    delay_samples: usize,
 ) -> Result<Verdict, crate::Error> {
-    verify_near(model, period_s, gains, human, delay_samples, &[])
+    verify_near(model, period_s, gains, human, &[])
 }
 
 /// [`verify`], first at `binding_hz`: the frequencies where the proof
@@ -183,7 +181,6 @@ pub fn verify_near(
     period_s: f64,
     gains: &Gains,
     human: Option<HumanBound>,
-    delay_samples: usize,
     binding_hz: &[f64],
 ) -> Result<Verdict, crate::Error> {
     if !(period_s.is_finite() && period_s > 0.0) {
@@ -197,7 +194,6 @@ pub fn verify_near(
         t: period_s,
         gains: *gains,
         grasp: human,
-        delay: delay_samples,
         evaluations: 0,
         two: false,
     };
@@ -207,7 +203,6 @@ pub fn verify_near(
         period_s,
         gains,
         &s.termination(VeKind::Constraint, &HELD_OFF),
-        delay_samples,
     )?;
     let freqs = band(period_s);
     let hands = hand_starts(model, period_s, human, &freqs, binding_hz);
@@ -265,15 +260,7 @@ pub fn verify_near(
     let mut freqs: Vec<f64> = binding_hz.to_vec();
     freqs.extend(finals.iter().take(5).map(|f| f.3));
     freqs.push(r.frequency_hz);
-    let constructed = construct(
-        model,
-        period_s,
-        *gains,
-        human,
-        delay_samples,
-        &freqs,
-        &seeds,
-    );
+    let constructed = construct(model, period_s, *gains, human, &freqs, &seeds);
     Ok(Verdict {
         constructed,
         unstable: r.unstable,

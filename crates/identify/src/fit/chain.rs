@@ -132,6 +132,7 @@ impl Chain {
             c_f,
             force_sensor: sensor.is_some(),
             delay_samples: 0,
+            latency_s: 0.0,
             encoder_quantum_m: None,
             coulomb_friction_n: None,
         })

@@ -265,6 +265,7 @@ impl Modal {
             c_f,
             force_sensor: true,
             delay_samples: 0,
+            latency_s: 0.0,
             encoder_quantum_m: None,
             coulomb_friction_n: None,
         })
