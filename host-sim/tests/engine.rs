@@ -234,6 +234,27 @@ fn bad_scene_files_name_the_line_and_field() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("coupling.m is required"), "{e}");
+    for (sets, want) in [
+        (
+            &["effects.latency.seconds=-1e-4"][..],
+            "effects.latency = -0.0001 s",
+        ),
+        (
+            &["effects.latency.periods=2000"][..],
+            "from 0 to 1000 periods",
+        ),
+        (
+            &[
+                "effects.latency.periods=0.5",
+                "effects.latency.seconds=1e-4",
+            ][..],
+            "give one of seconds or periods",
+        ),
+    ] {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let e = Scene::parse(&text, "w", &sets).unwrap_err().to_string();
+        assert!(e.contains(want), "{sets:?}: {e}");
+    }
     // A coupling is one display's: its keys say which, and a mix, or too
     // few, is refused with the line and what is wrong.
     for (set, want) in [
@@ -305,4 +326,113 @@ fn bad_scene_files_name_the_line_and_field() {
             .to_string();
         assert!(e.contains(want), "{set}: {e}");
     }
+}
+
+/// The rigid 3.9 kg, 20 N s/m device behind a wall `k` (N/m, `b = 0`)
+/// with the force held `alpha` of a tick late: the design crate's exact
+/// discrete loop's spectral radius (hands off, the bilateral constraint).
+fn exact_wall_radius(alpha: f64, k: f64) -> f64 {
+    use twoport_control::{Gains, ImpedanceGains};
+    use twoport_design::verify::{radius, Hand, Termination, Ve};
+    let model = twoport_design::DeviceModel::from_toml(
+        &format!(
+            "period_s = 0.001\npeak_force_n = 50.0\ncontinuous_force_n = 20.0\n\
+             latency_s = {:e}\nM = [[3.9]]\nD = [[20.0]]\nK = [[0.0]]\n\
+             G = [[1.0, -1.0]]\nC_v = [[1.0], [-1.0]]\n",
+            alpha * 1e-3
+        ),
+        "rigid",
+    )
+    .unwrap();
+    let term = Termination {
+        hand: Hand {
+            mass_kg: 0.0,
+            stiffness_npm: 0.0,
+            damping_nspm: 0.0,
+            grasp: None,
+            second: None,
+        },
+        ve: Ve::Constraint,
+    };
+    let g: Gains = ImpedanceGains::new(k as f32, 0.0).into();
+    radius(&model, 1e-3, &g, &term).unwrap().spectral_radius
+}
+
+/// The wall's boundary stiffness (N/m) there, by bisection.
+fn exact_wall_boundary(alpha: f64) -> f64 {
+    let (mut lo, mut hi) = (1e3f64, 1e6f64);
+    for _ in 0..50 {
+        let mid = (lo * hi).sqrt();
+        if exact_wall_radius(alpha, mid) < 1.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// The simulator holds the force `effects.latency` after the sample (the
+/// hold switches inside the tick). On the rigid device behind a wall, 5%
+/// either side of the exact loop's boundary with that latency, the
+/// handle's swing grows or decays a tick at the exact loop's rate (its
+/// spectral radius), to a tenth of the rate, at half a tick and at 0.9 of
+/// one, in periods or in seconds; and a hair under a tick runs as a whole
+/// tick's delay does.
+#[test]
+fn a_latency_moves_the_simulators_boundary_to_the_exact_loops() {
+    let rel = "scenes/table1/impedance_bilateral_hands_off.toml";
+    for (alpha, latency) in [
+        (0.5, "effects.latency.periods=0.5"),
+        (0.9, "effects.latency.seconds=0.0009"),
+    ] {
+        let k = exact_wall_boundary(alpha);
+        let none = exact_wall_boundary(0.0);
+        assert!(k < 0.8 * none, "α {alpha}: {k} vs {none} without");
+        for f in [0.95, 1.05] {
+            let kc = format!("coupling.k={}", f * k);
+            let sets = ["effects.flexibility=false", "coupling.b=0", latency, &kc];
+            let mut sim = Simulation::new(scene(rel, &sets)).unwrap();
+            let x: Vec<f64> = (0..5000).map(|_| sim.step().handle_m[0]).collect();
+            let swing = |from: usize| {
+                x[from..from + 1000]
+                    .iter()
+                    .fold(0.0f64, |m, v| m.max(v.abs()))
+            };
+            // A second after the last push (at 2 s), and a second later.
+            let rate = (swing(4000) / swing(3000)).ln() / 1000.0;
+            let want = exact_wall_radius(alpha, f * k).ln();
+            assert!(
+                (rate - want).abs() < 0.1 * want.abs(),
+                "α {alpha}, {f} x {k}: the swing grows {rate:e} a tick, the exact loop {want:e}"
+            );
+        }
+    }
+    let r = run(
+        rel,
+        &["effects.flexibility=false", "effects.latency.periods=0.25"],
+    );
+    let names: Vec<&str> = r.effects.iter().map(|e| e.name.as_str()).collect();
+    assert_eq!(names, ["latency"]);
+    // Within a thousandth of a tick of a whole tick's delay, the handle
+    // moves as it does with the delay.
+    let path = |sets: &[&str]| {
+        let mut s = Simulation::new(scene(rel, sets)).unwrap();
+        (0..3000)
+            .map(|_| s.step().handle_m[0])
+            .collect::<Vec<f64>>()
+    };
+    let base = [
+        "effects.flexibility=false",
+        "coupling.k=5000",
+        "coupling.b=0",
+    ];
+    let late = path(&[&base[..], &["effects.latency.periods=0.999"]].concat());
+    let delayed = path(&[&base[..], &["effects.delay.ticks=1"]].concat());
+    let peak = delayed.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let off = late
+        .iter()
+        .zip(&delayed)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(peak > 0.0 && off < 0.01 * peak, "{off} of {peak}");
 }

@@ -156,6 +156,25 @@ impl Lag {
         fraction: 0.0,
     };
 
+    /// A latency of `latency_s` (s) at sample period `period_s` (s), split
+    /// into whole ticks and a fraction. A latency within a part in 1e9 of a
+    /// whole number of ticks is that number (a period's rounding must not
+    /// make a tick of `0.999...`).
+    pub fn of(latency_s: f64, period_s: f64) -> Lag {
+        let ticks = latency_s / period_s;
+        let mut whole = ticks.floor();
+        let mut fraction = ticks - whole;
+        if fraction > 1.0 - 1e-9 {
+            (whole, fraction) = (whole + 1.0, 0.0);
+        } else if fraction < 1e-9 {
+            fraction = 0.0;
+        }
+        Lag {
+            ticks: whole as u32,
+            fraction,
+        }
+    }
+
     /// `ticks + fraction` ticks of `period_s` (s): the total delay (s).
     pub fn seconds(&self, period_s: f64) -> f64 {
         (self.ticks as f64 + self.fraction) * period_s
@@ -373,20 +392,12 @@ impl DeviceModel {
 
     /// The delay at sample period `period_s` (s): `delay_samples` and the
     /// latency's whole ticks, and what is left of it as a fraction of a
-    /// tick. A latency within a part in 1e9 of a whole number of ticks is
-    /// that number (a period's rounding must not make a tick of `0.999...`).
+    /// tick ([`Lag::of`]).
     pub fn lag(&self, period_s: f64) -> Lag {
-        let ticks = self.latency_s / period_s;
-        let mut whole = ticks.floor();
-        let mut fraction = ticks - whole;
-        if fraction > 1.0 - 1e-9 {
-            (whole, fraction) = (whole + 1.0, 0.0);
-        } else if fraction < 1e-9 {
-            fraction = 0.0;
-        }
+        let l = Lag::of(self.latency_s, period_s);
         Lag {
-            ticks: self.delay_samples + whole as u32,
-            fraction,
+            ticks: self.delay_samples + l.ticks,
+            ..l
         }
     }
 

@@ -29,13 +29,15 @@ pub enum Effect {
     CableSlack,
     /// Measurement-to-actuation delay.
     Delay,
+    /// The force applied inside the tick, a time after the sample.
+    Latency,
     /// A hard stop at the end of travel.
     HardStop,
 }
 
 impl Effect {
     /// Every effect.
-    pub const ALL: [Effect; 10] = [
+    pub const ALL: [Effect; 11] = [
         Effect::Flexibility,
         Effect::LoadCell,
         Effect::Encoder,
@@ -45,6 +47,7 @@ impl Effect {
         Effect::Cogging,
         Effect::CableSlack,
         Effect::Delay,
+        Effect::Latency,
         Effect::HardStop,
     ];
 
@@ -60,6 +63,7 @@ impl Effect {
             Effect::Cogging => "cogging",
             Effect::CableSlack => "cable_slack",
             Effect::Delay => "delay",
+            Effect::Latency => "latency",
             Effect::HardStop => "hard_stop",
         }
     }
@@ -75,6 +79,7 @@ impl Effect {
             Effect::Cogging => e.cogging.is_some(),
             Effect::CableSlack => e.cable_slack.is_some(),
             Effect::Delay => e.delay.is_some(),
+            Effect::Latency => e.latency.is_some(),
             Effect::HardStop => e.hard_stop.is_some(),
         }
     }
@@ -328,6 +333,11 @@ impl<const N: usize> Pipeline<N> {
         let f = f_n.clamp(-limit, limit);
         self.costs.charge(&[Effect::Saturation], t0);
         f
+    }
+
+    /// The nonlinear forces, if the scene has any, and the costs.
+    pub fn parts(&mut self) -> (Option<&Forces>, &mut Costs) {
+        (self.forces.as_ref(), &mut self.costs)
     }
 
     /// The nonlinear forces, if the scene has any, and the costs to charge

@@ -230,6 +230,23 @@ impl Scene {
                 ));
             }
         }
+        if let Some(x) = e.latency {
+            let v = match (x.seconds, x.periods) {
+                (Some(v), None) => v,
+                (None, Some(v)) => v * self.period(),
+                _ => {
+                    return Err(
+                        "effects.latency: give one of seconds or periods (the time from sampling to the force)"
+                            .into(),
+                    )
+                }
+            };
+            if !(v.is_finite() && v >= 0.0 && v <= 1000.0 * self.period()) {
+                return Err(sim_err!(
+                    "effects.latency = {v} s: must be a time from 0 to 1000 periods"
+                ));
+            }
+        }
         if let Some(x) = e.element_delay {
             if x.ticks > 1000 {
                 return Err(sim_err!(
@@ -377,6 +394,7 @@ impl Scene {
             ("cogging", e.cogging.is_some()),
             ("cable_slack", e.cable_slack.is_some()),
             ("delay", e.delay.is_some()),
+            ("latency", e.latency.is_some()),
             ("hard_stop", e.hard_stop.is_some()),
             ("element_delay", e.element_delay.is_some()),
         ];

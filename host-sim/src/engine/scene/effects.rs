@@ -26,6 +26,9 @@ pub struct Effects {
     pub cable_slack: Option<SlackEffect>,
     /// Sensor delay.
     pub delay: Option<DelayEffect>,
+    /// The time from sampling the sensors to the force's change: the
+    /// hold switches inside the tick (its whole ticks join `delay`).
+    pub latency: Option<LatencyEffect>,
     /// A hard stop at the end of the actuator's travel (what homing finds).
     pub hard_stop: Option<HardStopEffect>,
     /// The coupling and VE see the device's position this many ticks late
@@ -149,4 +152,26 @@ pub enum StopSide {
 pub struct DelayEffect {
     /// Ticks of delay.
     pub ticks: u32,
+}
+
+/// The time from sampling the sensors to the force's change: one of the
+/// two, in seconds or in periods.
+#[derive(Clone, Copy, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LatencyEffect {
+    /// Seconds.
+    #[serde(default)]
+    pub seconds: Option<f64>,
+    /// Sample periods.
+    #[serde(default)]
+    pub periods: Option<f64>,
+}
+
+impl LatencyEffect {
+    /// The latency (s) at sample period `period_s`.
+    pub fn seconds_at(&self, period_s: f64) -> f64 {
+        self.seconds
+            .or(self.periods.map(|p| p * period_s))
+            .unwrap_or(0.0)
+    }
 }

@@ -176,6 +176,42 @@ struct Axis {
     /// Ticks the passivity layer acted, and the lowest energy it saw.
     layer_active: u64,
     layer_lowest: f64,
+    /// The force the amplifier holds from the last tick until this one's
+    /// latency has passed (N).
+    held_n: f64,
+}
+
+/// One grasp's steppers: over the whole tick, and with a latency inside
+/// the tick over its two parts (before and after the hold switches).
+#[derive(Clone, Debug)]
+pub(super) struct Steppers {
+    pub(super) tick: Stepper,
+    pub(super) split: Option<[Stepper; 2]>,
+}
+
+impl Steppers {
+    /// `sys`'s steppers by `method`, `substeps` a tick of `period` (s),
+    /// the hold switching `inside_s` (s) into the tick.
+    fn new(
+        sys: &System,
+        method: Method,
+        (period, substeps): (f64, u32),
+        inside_s: f64,
+    ) -> Result<Self, Error> {
+        let n = f64::from(substeps);
+        let split = if inside_s > 0.0 {
+            Some([
+                Stepper::new(sys, method, inside_s / n)?,
+                Stepper::new(sys, method, (period - inside_s) / n)?,
+            ])
+        } else {
+            None
+        };
+        Ok(Steppers {
+            tick: Stepper::new(sys, method, period / n)?,
+            split,
+        })
+    }
 }
 
 /// A simulation in progress of a device of `N` axes (1 by default): one
@@ -188,9 +224,12 @@ pub struct Simulation<const N: usize = 1> {
     load_cell: bool,
     /// A stepper per grasp the hands take, shared by the axes (each has
     /// its own state).
-    steppers: Vec<(GraspKind, Stepper)>,
+    steppers: Vec<(GraspKind, Steppers)>,
     method: Method,
     substeps: u32,
+    /// The latency inside the tick (s): the hold switches this long after
+    /// the sample (0: at it).
+    inside_s: f64,
     axes: [Axis; N],
     servo: SceneServo<N>,
     tick: u64,
@@ -286,7 +325,36 @@ fn device_of(scene: &mut Scene) -> Result<Device, Error> {
             ticks: extra + model.delay_samples,
         });
     }
+    // Its latency, likewise, adds to the scene's.
+    if model.latency_s > 0.0 {
+        let extra = scene
+            .effects
+            .latency
+            .map_or(0.0, |l| l.seconds_at(scene.period()));
+        scene.effects.latency = Some(crate::engine::scene::LatencyEffect {
+            seconds: Some(extra + model.latency_s),
+            periods: None,
+        });
+    }
     Device::flexible(&model)
+}
+
+/// The scene's latency split at its period: the whole ticks join the
+/// delay effect (a delay is a delay, whichever side of the controller it
+/// sits), and the rest (s) is where the hold switches inside the tick.
+fn split_latency(scene: &mut Scene) -> f64 {
+    let period = scene.period();
+    let Some(l) = scene.effects.latency else {
+        return 0.0;
+    };
+    let lag = twoport_design::model::Lag::of(l.seconds_at(period), period);
+    if lag.ticks > 0 {
+        let before = scene.effects.delay.map_or(0, |d| d.ticks);
+        scene.effects.delay = Some(crate::engine::scene::DelayEffect {
+            ticks: before + lag.ticks,
+        });
+    }
+    lag.fraction * period
 }
 
 /// The integrator and its sub-steps a tick: the exact hold on a linear
@@ -337,8 +405,9 @@ impl<const N: usize> Simulation<N> {
             ));
         }
         let device = device_of(&mut scene)?;
-        let e = scene.effects.clone();
         let period = scene.period();
+        let inside_s = split_latency(&mut scene);
+        let e = scene.effects.clone();
         let humans = scene.humans()?;
         let nonlinear = scene.nonlinear();
         let (method, substeps) = integrator_of(&scene, nonlinear);
@@ -353,7 +422,10 @@ impl<const N: usize> Simulation<N> {
                 warning = warning
                     .take()
                     .or_else(|| integrator_warning(&sys, method, h));
-                Ok((g, Stepper::new(&sys, method, h)?))
+                Ok((
+                    g,
+                    Steppers::new(&sys, method, (period, substeps), inside_s)?,
+                ))
             })
             .collect::<Result<_, Error>>()?;
         let (encoder, mask, pm_per_count) = encoder_of(&e)?;
@@ -391,6 +463,7 @@ impl<const N: usize> Simulation<N> {
                 offset_m: 0.0,
                 layer_active: 0,
                 layer_lowest: 0.0,
+                held_n: 0.0,
             })
             .collect();
         let actuator_dir = device.actuator.clone();
@@ -407,6 +480,7 @@ impl<const N: usize> Simulation<N> {
             steppers,
             method,
             substeps,
+            inside_s,
             axes: axes
                 .try_into()
                 .map_err(|_| "one hand per axis".to_string())?,
@@ -458,8 +532,9 @@ impl<const N: usize> Simulation<N> {
             if !self.steppers.iter().any(|(k, _)| *k == g) {
                 let grasp = self.axes[0].human.grasp_of(g);
                 let sys = self.device.system(grasp, self.load_cell);
-                let h = self.period / self.substeps as f64;
-                self.steppers.push((g, Stepper::new(&sys, self.method, h)?));
+                let tick = (self.period, self.substeps);
+                let steppers = Steppers::new(&sys, self.method, tick, self.inside_s)?;
+                self.steppers.push((g, steppers));
             }
         }
         self.grasp_override = grasp;

@@ -3,6 +3,7 @@
 use super::{round_counts, EffectCost, PassivityReport, Report, Sample, Simulation};
 use crate::engine::effects::Effect;
 use crate::engine::human::HandState;
+use crate::engine::plant::Stepper;
 use crate::engine::servo::{frame_f32, output_f64};
 use crate::engine::stability::Verdict;
 use std::time::Instant;
@@ -87,7 +88,7 @@ impl<const N: usize> Simulation<N> {
         let t0 = timing.then(Instant::now);
         for i in 0..N {
             let hand = self.hand_of(i, t);
-            self.integrate(i, &hand, applied[i]);
+            self.integrate(i, &hand, applied[i], timing);
             let (x_h, v_h, f_h) = self.at_handle(i, &hand);
             self.account(i, (x_h, v_h, f_h), delivered[i]);
             let axis = &self.axes[i];
@@ -146,7 +147,7 @@ impl<const N: usize> Simulation<N> {
 
     /// Axis `i`'s plant through one tick, pushed by `hand` and the
     /// actuator's `force_n`, on the stepper of the hand's grasp.
-    fn integrate(&mut self, i: usize, hand: &HandState, force_n: f64) {
+    fn integrate(&mut self, i: usize, hand: &HandState, force_n: f64, timing: bool) {
         let n = self.device.n;
         let axis = &mut self.axes[i];
         // Behind an arm the hand is still: only pushes reach the handle.
@@ -170,20 +171,36 @@ impl<const N: usize> Simulation<N> {
                 at
             }
         };
-        let stepper = &mut self.steppers[at].1;
+        let steppers = &mut self.steppers[at].1;
         let dir = &self.actuator_dir;
-        match self.effects.forces() {
-            Some((forces, _)) => {
+        let substeps = self.substeps;
+        let held = std::mem::replace(&mut axis.held_n, force_n);
+        let (forces, costs) = self.effects.parts();
+        let x = &mut axis.x;
+        let mut run = |stepper: &mut Stepper, f: f64| match forces {
+            Some(forces) => {
                 let mut nl = |x: &[f64], f: &mut [f64]| forces.add(n, dir, x, f);
-                for _ in 0..self.substeps {
-                    stepper.step(&mut axis.x, u, Some(&mut nl));
+                for _ in 0..substeps {
+                    stepper.step(x, [u[0], f], Some(&mut nl));
                 }
             }
             None => {
-                for _ in 0..self.substeps {
-                    stepper.step(&mut axis.x, u, None);
+                for _ in 0..substeps {
+                    stepper.step(x, [u[0], f], None);
                 }
             }
+        };
+        match &mut steppers.split {
+            // With a latency the amplifier holds the last tick's force until
+            // the hold switches, then this tick's; the first part is the
+            // latency's cost.
+            Some([before, after]) => {
+                let t0 = timing.then(Instant::now);
+                run(before, held);
+                costs.charge(&[Effect::Latency], t0);
+                run(after, force_n);
+            }
+            None => run(&mut steppers.tick, force_n),
         }
     }
 
