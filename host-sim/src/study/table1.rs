@@ -53,21 +53,21 @@ pub fn case_files(folder: &Path) -> Result<Vec<PathBuf>, Error> {
     Ok(files)
 }
 
-/// Run the table over the scenes in `folder`; `step` is called after each
-/// case.
-pub fn table1(folder: &Path, step: &mut dyn FnMut()) -> Result<Table1, Error> {
+/// Run the table over the scenes in `folder`, each with the overrides
+/// `sets`; `step` is called after each case.
+pub fn table1(folder: &Path, sets: &[String], step: &mut dyn FnMut()) -> Result<Table1, Error> {
     let mut cases = Vec::new();
     let (mut k_bound, mut m_bound) = (f64::INFINITY, 0.0f64);
     for f in case_files(folder)? {
-        let scene = Scene::load(&f, &[])?;
+        let scene = Scene::load(&f, sets)?;
         let display = scene.display;
         let report = Simulation::new(scene)?.run(|_| {});
         let m = match display {
             Display::Impedance => {
-                marginal(&f, &[], "coupling.k", (51_000.0, 2.0e6), 0.005, &mut || {}).ok()
+                marginal(&f, sets, "coupling.k", (51_000.0, 2.0e6), 0.005, &mut || {}).ok()
             }
             Display::Admittance => {
-                marginal(&f, &[], "coupling.m", (5.0, 0.01), 0.005, &mut || {}).ok()
+                marginal(&f, sets, "coupling.m", (5.0, 0.01), 0.005, &mut || {}).ok()
             }
         };
         match (display, m) {

@@ -45,7 +45,8 @@ use run::{run, RunArgs};
 use scope::{scope, ScopeArgs};
 use std::process::ExitCode;
 use study::{
-    accuracy, passivity, sweep, table1, AccuracyArgs, PassivityArgs, SweepArgs, Table1Args,
+    accuracy, latency_fit, passivity, sweep, table1, AccuracyArgs, LatencyFitArgs, PassivityArgs,
+    SweepArgs, Table1Args,
 };
 
 /// Simulate a haptic device around the board's own control code.
@@ -68,6 +69,9 @@ enum Cmd {
     Sweep(SweepArgs),
     /// Run the paper's Table I matrix and sweep its boundaries.
     Table1(Table1Args),
+    /// Find the latency inside the tick at which a scene's swept boundary
+    /// meets a measured one.
+    LatencyFit(LatencyFitArgs),
     /// Measure what accuracy costs: every integrator x sub-step count.
     Accuracy(AccuracyArgs),
     /// The passivity layer's scenes: off, on, and at passive settings.
@@ -101,6 +105,7 @@ fn subcommand(c: &Cmd) -> Result<(), Error> {
         Cmd::Sweep(a) => sweep(a),
         Cmd::Passivity(a) => passivity(a),
         Cmd::Table1(a) => table1(a),
+        Cmd::LatencyFit(a) => latency_fit(a),
         Cmd::Accuracy(a) => accuracy(a),
         Cmd::Pil(a) => pil(a),
     }

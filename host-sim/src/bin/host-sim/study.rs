@@ -1,9 +1,10 @@
 //! The studies: a sweep to a stability boundary, the paper's Table I,
-//! the passivity layer's scenes and what accuracy costs.
+//! the latency that explains a boundary, the passivity layer's scenes and
+//! what accuracy costs.
 
 use crate::run::SceneArgs;
 use clap::Args;
-use host_sim::study::{passivity, sweep, table1};
+use host_sim::study::{latency, passivity, sweep, table1};
 use host_sim::Error;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
@@ -49,9 +50,23 @@ pub(crate) struct Table1Args {
     /// The folder of the Table I scenes.
     #[arg(long, default_value = "scenes/table1")]
     pub(crate) scenes: PathBuf,
+    /// Override a value in every case, e.g. `--set
+    /// effects.latency.periods=0.5` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub(crate) sets: Vec<String>,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub(crate) json: bool,
+}
+
+#[derive(Args)]
+pub(crate) struct LatencyFitArgs {
+    #[command(flatten)]
+    pub(crate) sweep: SweepArgs,
+    /// The measured boundary the latency should explain (the parameter's
+    /// unit).
+    #[arg(long)]
+    pub(crate) target: f64,
 }
 
 pub(crate) fn bar(len: u64, msg: String) -> ProgressBar {
@@ -106,6 +121,44 @@ pub(crate) fn sweep(a: &SweepArgs) -> Result<(), Error> {
     Ok(())
 }
 
+/// The latency that explains a measured boundary.
+pub(crate) fn latency_fit(a: &LatencyFitArgs) -> Result<(), Error> {
+    let s = &a.sweep;
+    let b = bar(
+        30,
+        format!("fitting the latency to {} = {}", s.param, a.target),
+    );
+    let fit = latency::fit(
+        &s.scene.scene,
+        &s.scene.sets,
+        (&s.param, (s.from, s.to), s.tol),
+        a.target,
+        &mut || b.inc(1),
+    )?;
+    b.finish_and_clear();
+    match (fit, s.scene.json) {
+        (latency::Fit::Found { alpha, marginal }, true) => {
+            say!("{}", json!({"param": s.param, "target": a.target, "latency_periods": alpha, "marginal": marginal}));
+        }
+        (latency::Fit::Found { alpha, marginal }, false) => say!(
+            "{}: {marginal:.6} at a latency of {alpha:.3} T (the target {})",
+            s.param,
+            a.target
+        ),
+        (latency::Fit::NotReached { at_zero, last, at_last }, true) => {
+            say!("{}", json!({"param": s.param, "target": a.target, "latency_periods": null,
+                "at_zero": at_zero, "last_periods": last, "at_last": at_last}));
+        }
+        (latency::Fit::NotReached { at_zero, last, at_last }, false) => say!(
+            "{}: no latency in [0, 1) gives {}: {at_zero:.6} with none, {at_last:.6} at {last:.3} T, \
+             and past it no boundary in the range",
+            s.param,
+            a.target
+        ),
+    }
+    Ok(())
+}
+
 /// The passivity layer's table: each scene off, on, and at its passive
 /// reference.
 pub(crate) fn passivity(a: &PassivityArgs) -> Result<(), Error> {
@@ -121,7 +174,9 @@ pub(crate) fn passivity(a: &PassivityArgs) -> Result<(), Error> {
 /// Table I: every VE state x grasp at the theoretical gains, then the
 /// boundaries swept as the paper did.
 pub(crate) fn table1(a: &Table1Args) -> Result<(), Error> {
-    let t = over_cases(&a.scenes, "Table I", table1::table1)?;
+    let t = over_cases(&a.scenes, "Table I", |dir, step| {
+        table1::table1(dir, &a.sets, step)
+    })?;
     let rows: Vec<serde_json::Value> = t
         .cases
         .iter()
@@ -145,6 +200,9 @@ pub(crate) fn table1(a: &Table1Args) -> Result<(), Error> {
         return Ok(());
     }
     say!("Table I  Theoretical versus experimental (paper) and simulated (linear model) stability boundary gains");
+    if !a.sets.is_empty() {
+        say!("(every case with {})", a.sets.join(", "));
+    }
     say!(
         "{:<26} {:>10} {:>6}   {:>8} {:>6}",
         "",
