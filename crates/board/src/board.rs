@@ -87,6 +87,8 @@ pub struct Board<W, const R: usize, const N: usize = 1, L = Direct, D = Servo<W,
     /// and what the link carries (bytes/s): stated in the spec.
     workspace: [Option<(Position, Position)>; N],
     link_bytes_per_s: Option<u32>,
+    /// The rate of the count `cycles` gives (Hz), where the image knows it.
+    count_hz: Option<u32>,
     /// The dead-man switch at the last tick (open before the first).
     dead_man_closed: bool,
     /// Whether the amplifier's outputs are on (as last commanded).
@@ -112,17 +114,21 @@ struct Timing {
     last_start: Option<u32>,
     deadline_misses: u32,
     worst_jitter: u32,
+    /// The longest from the sample to the amplifiers' command since boot.
+    worst_latency: u32,
 }
 
 impl Timing {
-    /// A tick that started at `start` and ran its stages through the
-    /// instants `t`, against a period of `period` (0: unchecked).
-    fn record(&mut self, start: u32, t: [u32; 3], period: u32) {
+    /// A tick that started (sampled) at `start`, ran its stages through
+    /// the instants `t` and wrote the amplifiers' command at `written`,
+    /// against a period of `period` (0: unchecked).
+    fn record(&mut self, start: u32, t: [u32; 3], written: u32, period: u32) {
         self.stages = [
             t[0].wrapping_sub(start),
             t[1].wrapping_sub(t[0]),
             t[2].wrapping_sub(t[1]),
         ];
+        self.worst_latency = self.worst_latency.max(written.wrapping_sub(start));
         if period > 0 {
             let took = t[2].wrapping_sub(start);
             let late = self.last_start.is_some_and(|s0| {
@@ -185,6 +191,7 @@ where
             host: None,
             workspace: [None; N],
             link_bytes_per_s: None,
+            count_hz: None,
             dead_man_closed: false,
             outputs_on: false,
             config_source: None,
@@ -215,6 +222,15 @@ where
     /// baud over ten) in its spec.
     pub fn with_link_rate(mut self, bytes_per_s: u32) -> Self {
         self.link_bytes_per_s = Some(bytes_per_s);
+        self
+    }
+
+    /// The same board stating the rate of its support's
+    /// [`cycles`](BoardSupport::cycles) count (Hz: its core clock; in an
+    /// emulator that counts instructions, the core clock at one cycle per
+    /// instruction), so that its spec gives its latency in seconds.
+    pub fn with_count_rate(mut self, hz: u32) -> Self {
+        self.count_hz = Some(hz);
         self
     }
 
@@ -513,11 +529,15 @@ where
             (frame, start)
         };
         let sensed = io.cycles();
-        let out = self.tick(&frame);
+        let (out, identifying) = self.law(&frame);
         self.index = [None; N];
         let ruled = io.cycles();
         let duty = self.duty();
         io.set_duty(duty);
+        let written = io.cycles();
+        // What the tick reports is encoded after the command is written:
+        // the latency from the sample to the force is the law's alone.
+        self.report(&frame, &out, identifying);
         io.feed_watchdog();
         if self.pil {
             self.queue(Message::Actuator(ActuatorFrame {
@@ -529,13 +549,23 @@ where
         let end = io.cycles();
         self.loop_cycles = end.wrapping_sub(start);
         let period = io.cycles_per_tick();
-        self.timing.record(start, [sensed, ruled, end], period);
+        self.timing
+            .record(start, [sensed, ruled, end], written, period);
         out
     }
 
     /// One control tick: the law, a fault report when new faults latch,
     /// telemetry on schedule. Returns the held actuator command.
     pub fn tick(&mut self, frame: &SensorFrame<f32, N>) -> ServoOutput<f32, N> {
+        let (out, identifying) = self.law(frame);
+        self.report(frame, &out, identifying);
+        out
+    }
+
+    /// The tick's law: the held actuator command, and whether the tick was
+    /// an experiment's (its telemetry goes out in that mode, even on the
+    /// tick that ends it).
+    fn law(&mut self, frame: &SensorFrame<f32, N>) -> (ServoOutput<f32, N>, bool) {
         self.dead_man_closed = frame.dead_man_closed;
         self.host_ve_tick();
         let driven = match (self.homing.as_mut(), self.experiment.as_ref()) {
@@ -554,11 +584,20 @@ where
         let out = driven.cartesian;
         self.last = out;
         self.motor = driven.motor;
-        // (Telemetry of this tick goes out in the experiment's mode, even
-        // on the tick that ends it.)
         let identifying = self.mode == BoardMode::Identifying;
         self.after_experiment_tick();
         self.after_tick(&out);
+        (out, identifying)
+    }
+
+    /// What a tick reports: a fault report when new faults latch, and
+    /// telemetry on schedule.
+    fn report(
+        &mut self,
+        frame: &SensorFrame<f32, N>,
+        out: &ServoOutput<f32, N>,
+        identifying: bool,
+    ) {
         if !out.faults.is_empty() && out.faults != self.reported {
             self.reported = out.faults;
             self.queue(Message::FaultReport {
@@ -596,11 +635,11 @@ where
                     stage_cycles: self.timing.stages,
                     deadline_misses: self.timing.deadline_misses,
                     worst_jitter_cycles: self.timing.worst_jitter,
+                    worst_latency_cycles: self.timing.worst_latency,
                     session: self.session,
                     ve_seq,
                 }));
             }
         }
-        out
     }
 }

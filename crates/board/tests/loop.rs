@@ -527,10 +527,12 @@ fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
     assert!(telemetry
         .iter()
         .all(|t| (t.axes[0].load_cell_n - 1.5).abs() < 1e-6));
-    // Three stages (sensors, law, drive), one step of the clock each.
-    assert!(telemetry
-        .iter()
-        .all(|t| t.loop_cycles == 21 && t.stage_cycles == [7, 7, 7]));
+    // Three stages (sensors, law, drive), one step of the clock each and
+    // the drive two (it looks once more when the command is written): the
+    // latency from the sample to the command is three.
+    assert!(telemetry.iter().all(|t| t.loop_cycles == 28
+        && t.stage_cycles == [7, 7, 14]
+        && t.worst_latency_cycles == 21));
     // Without a period, nothing is checked.
     assert!(telemetry
         .iter()
@@ -541,16 +543,17 @@ fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
     assert_eq!(*io.duties.last().unwrap(), 0, "{out:?}");
 }
 
-/// Loop timing against a period of 30 counts: ticks of 21 that start 28
-/// apart are on time with 2 of jitter; a tick of 33 overruns its period,
-/// and a tick that starts 78 after the last (a late interrupt) is a miss
-/// too. Each telemetry frame, sent from inside a tick, carries the timing
-/// of the ticks before it.
+/// Loop timing against a period of 37 counts: ticks of 28 that start 35
+/// apart are on time with 2 of jitter; a tick of 44 overruns its period,
+/// and a tick that starts 85 after the last (a late interrupt) is a miss
+/// too. The longest from a sample to its command (three looks of the
+/// clock) is kept since boot. Each telemetry frame, sent from inside a
+/// tick, carries the timing of the ticks before it.
 #[test]
-fn deadline_misses_and_the_worst_jitter_are_counted_and_reported() {
+fn deadline_misses_the_worst_jitter_and_latency_are_counted_and_reported() {
     let mut b = common::board(51_000.0, safety(), 1);
     let mut io = Io {
-        period: 30,
+        period: 37,
         ..Io::default()
     };
     // One tick, and the telemetry it sent.
@@ -570,19 +573,35 @@ fn deadline_misses_and_the_worst_jitter_are_counted_and_reported() {
         t = tick(&mut b, &mut io);
     }
     assert_eq!((t.deadline_misses, t.worst_jitter_cycles), (0, 2));
-    // One slow tick: 11 a look, 33 in all.
+    assert_eq!(t.worst_latency_cycles, 21);
+    // One slow tick: 11 a look, 44 in all, 33 from sample to command.
     io.step = 11;
     tick(&mut b, &mut io);
     io.step = 7;
     let t = tick(&mut b, &mut io);
-    assert_eq!((t.deadline_misses, t.stage_cycles), (1, [11, 11, 11]));
-    // The tick after it started 33 + 7 = 40 after it: 10 of jitter, but
+    assert_eq!((t.deadline_misses, t.stage_cycles), (1, [11, 11, 22]));
+    assert_eq!(t.worst_latency_cycles, 33);
+    // The tick after it started 44 + 7 = 51 after it: 14 of jitter, but
     // less than half a period late.
     let t = tick(&mut b, &mut io);
-    assert_eq!((t.deadline_misses, t.worst_jitter_cycles), (1, 10));
-    // An interrupt 50 counts late: 78 from start to start.
+    assert_eq!((t.deadline_misses, t.worst_jitter_cycles), (1, 14));
+    // An interrupt 50 counts late: 85 from start to start. The latency
+    // stays the worst since boot.
     io.clock = io.clock.wrapping_add(50);
     tick(&mut b, &mut io);
     let t = tick(&mut b, &mut io);
     assert_eq!((t.deadline_misses, t.worst_jitter_cycles), (2, 48));
+    assert_eq!(t.worst_latency_cycles, 33);
+    // The spec gives it in seconds where the board knows its count's rate.
+    let mut b = common::board(51_000.0, safety(), 1).with_count_rate(7_000_000);
+    b.control_tick(&mut io);
+    let spec = b.spec();
+    assert_eq!(spec.worst_latency_cycles, 21);
+    assert!((spec.worst_latency_s().unwrap() - 3e-6).abs() < 1e-15);
+    assert_eq!(
+        common::board(51_000.0, safety(), 1)
+            .spec()
+            .worst_latency_s(),
+        None
+    );
 }

@@ -216,6 +216,12 @@ typedef struct TpSpec {
    */
   uint32_t link_bytes_per_s;
   /**
+   * The longest time since boot from sampling the sensors to writing
+   * the amplifiers' command (s), when the spec was read: the latency
+   * inside the tick. NaN where the board does not give its count's rate.
+   */
+  double worst_latency_s;
+  /**
    * The board's axes (1 to `TP_MAX_AXES`).
    */
   uint8_t axes;
@@ -284,6 +290,11 @@ typedef struct TpState {
    * The loop's last tick, in the board's cycle count.
    */
   uint32_t loop_cycles;
+  /**
+   * The longest from sampling to the amplifiers' command since boot,
+   * in the same count.
+   */
+  uint32_t worst_latency_cycles;
   /**
    * The board's axes.
    */

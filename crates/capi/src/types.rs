@@ -128,6 +128,10 @@ pub struct TpSpec {
     /// What the link carries (bytes/s; 0 where the board does not say):
     /// a stream faster than that loses frames.
     pub link_bytes_per_s: u32,
+    /// The longest time since boot from sampling the sensors to writing
+    /// the amplifiers' command (s), when the spec was read: the latency
+    /// inside the tick. NaN where the board does not give its count's rate.
+    pub worst_latency_s: f64,
     /// The board's axes (1 to `TP_MAX_AXES`).
     pub axes: u8,
     /// Each axis's, the first `axes` of them.
@@ -169,6 +173,9 @@ pub struct TpState {
     pub deadline_misses: u32,
     /// The loop's last tick, in the board's cycle count.
     pub loop_cycles: u32,
+    /// The longest from sampling to the amplifiers' command since boot,
+    /// in the same count.
+    pub worst_latency_cycles: u32,
     /// The board's axes.
     pub axes: u8,
     /// Each axis's, the first `axes` of them.
@@ -231,6 +238,7 @@ impl From<&Spec> for TpSpec {
             stream_every: s.stream_every,
             linkage: s.linkage,
             link_bytes_per_s: s.link_bytes_per_s.unwrap_or(0),
+            worst_latency_s: s.worst_latency_s().unwrap_or(f64::NAN),
             axes: s.axes.len() as u8,
             axis,
         }
@@ -262,6 +270,7 @@ impl From<&State> for TpState {
             ve_seq: s.ve_seq,
             deadline_misses: s.deadline_misses,
             loop_cycles: s.loop_cycles,
+            worst_latency_cycles: s.worst_latency_cycles,
             axes: s.axes.len() as u8,
             axis,
         }

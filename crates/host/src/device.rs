@@ -61,6 +61,10 @@ pub struct State {
     /// The largest difference since boot between a tick's start-to-start
     /// time and the period, in the same count.
     pub worst_jitter_cycles: u32,
+    /// The longest time since boot from sampling the sensors to writing
+    /// the amplifiers' command, in the same count: the latency inside the
+    /// tick (the spec's `count_hz` gives it in seconds).
+    pub worst_latency_cycles: u32,
 }
 
 impl From<&Telemetry> for State {
@@ -81,6 +85,7 @@ impl From<&Telemetry> for State {
             deadline_misses: t.deadline_misses,
             loop_cycles: t.loop_cycles,
             worst_jitter_cycles: t.worst_jitter_cycles,
+            worst_latency_cycles: t.worst_latency_cycles,
         }
     }
 }

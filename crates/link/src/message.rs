@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 /// experiments ([`Message::Identify`]); version 8 tells a host what the
 /// board can do ([`Message::GetSpec`]) and lets it set the telemetry rate
 /// ([`Message::SetStream`]).
-pub const PROTOCOL_VERSION: u16 = 10;
+pub const PROTOCOL_VERSION: u16 = 11;
 
 /// The session number of a board no host has shaken hands with since it
 /// booted. A host opens a session with any other number, and a board
@@ -74,6 +74,10 @@ pub struct Telemetry {
     /// time and the period, in the same count (protocol 3; 0 where the
     /// host paces the ticks).
     pub worst_jitter_cycles: u32,
+    /// The longest time since boot from sampling the sensors to writing
+    /// the amplifiers' command, in the same count: the latency inside the
+    /// tick a proof must allow for (protocol 11).
+    pub worst_latency_cycles: u32,
     /// The session the board is in ([`NO_SESSION`] after a reset;
     /// protocol 5).
     pub session: u16,

@@ -25,8 +25,25 @@ pub struct Spec {
     /// baud rate over ten): a stream faster than that loses frames
     /// (protocol 9).
     pub link_bytes_per_s: Option<u32>,
+    /// The rate of the count the board times its loop in (Hz: core cycles
+    /// on hardware; in an emulator that counts instructions, the core
+    /// clock at one cycle per instruction), where it knows it (protocol 11).
+    pub count_hz: Option<u32>,
+    /// The longest time since boot from sampling the sensors to writing
+    /// the amplifiers' command, in that count (protocol 11).
+    pub worst_latency_cycles: u32,
     /// Each Cartesian axis's.
     pub axes: Axes<AxisSpec>,
+}
+
+impl Spec {
+    /// [`worst_latency_cycles`](Self::worst_latency_cycles) in seconds,
+    /// where the board gives its count's rate.
+    pub fn worst_latency_s(&self) -> Option<f64> {
+        self.count_hz
+            .filter(|hz| *hz > 0)
+            .map(|hz| f64::from(self.worst_latency_cycles) / f64::from(hz))
+    }
 }
 
 /// One Cartesian axis's limits and proven region.

@@ -43,6 +43,7 @@ fn all_messages() -> Vec<Message> {
             stage_cycles: [u32::MAX; 3],
             deadline_misses: u32::MAX,
             worst_jitter_cycles: u32::MAX,
+            worst_latency_cycles: u32::MAX,
             session: u16::MAX,
             ve_seq: u32::MAX,
         }),
@@ -132,6 +133,8 @@ fn spec_and_ve_messages() -> Vec<Message> {
                 deadline_ticks: u32::MAX,
             },
             link_bytes_per_s: Some(u32::MAX),
+            count_hz: Some(u32::MAX),
+            worst_latency_cycles: u32::MAX,
             axes: Axes::new([f32::MAX, 1.0, -0.0].map(|x| AxisSpec {
                 peak_force_n: x,
                 continuous_force_n: x,
@@ -154,6 +157,8 @@ fn spec_and_ve_messages() -> Vec<Message> {
             linkage: false,
             ve: VeSource::Board,
             link_bytes_per_s: None,
+            count_hz: None,
+            worst_latency_cycles: 0,
             axes: Axes::one(AxisSpec {
                 peak_force_n: 200.0,
                 continuous_force_n: 100.0,

@@ -118,6 +118,8 @@ impl Board {
         d.set_item("period_s", s.period_s())?;
         d.set_item("linkage", s.linkage)?;
         d.set_item("link_bytes_per_s", s.link_bytes_per_s)?;
+        d.set_item("count_hz", s.count_hz)?;
+        d.set_item("worst_latency_s", s.worst_latency_s())?;
         let axes = pyo3::types::PyList::empty(py);
         for a in s.axes.iter() {
             let x = PyDict::new(py);

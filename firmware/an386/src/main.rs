@@ -55,7 +55,13 @@ fn main() -> ! {
     let board = twoport_board::linkage::delta_board().map_err(|_| ());
     #[cfg(feature = "sim-device")]
     let board = twoport_board::excalibur::stiff_wall_board().map_err(|_| ());
-    let Ok(mut board) = board.map(|b| b.with_pil(!cfg!(feature = "sim-device"))) else {
+    // SysTick runs at the 25 MHz core clock; under -icount QEMU advances it
+    // 1.6 counts an instruction, its model of the core's cycles.
+    let board = board.map(|b| {
+        b.with_pil(!cfg!(feature = "sim-device"))
+            .with_count_rate(watchdog::CLOCK_HZ)
+    });
+    let Ok(mut board) = board else {
         hprintln!("the board image would not build");
         exit(false)
     };

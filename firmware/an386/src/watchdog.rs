@@ -20,7 +20,7 @@ const LOCK: usize = BASE + 0xC00;
 const UNLOCK_KEY: u32 = 0x1ACC_E551;
 const CTRL_INTEN_RESEN: u32 = 0b11;
 /// Its clock (Hz).
-const CLOCK_HZ: u32 = 25_000_000;
+pub(crate) const CLOCK_HZ: u32 = 25_000_000;
 
 /// The word that outlives a reset ("TPWD" while the loop runs).
 #[link_section = ".uninit.twoport_watchdog"]

@@ -166,7 +166,10 @@ fn main() -> ! {
     let Ok(board) = board else { halt() };
     let mut board = board
         .with_pil(cfg!(feature = "qemu"))
-        .with_link_rate(init::LINK_BYTES_PER_S);
+        .with_link_rate(init::LINK_BYTES_PER_S)
+        // The DWT counts the 168 MHz core's cycles; in QEMU, TIM5 counts
+        // instructions, at one cycle each.
+        .with_count_rate(168_000_000);
     if init::reset_by_watchdog(&dp.RCC) {
         board.trip(twoport_control::Faults::WATCHDOG_RESET);
         log::watchdog_reset();

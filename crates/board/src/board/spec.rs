@@ -31,6 +31,8 @@ where
             linkage: !D::HOMES,
             ve: self.ve_source(),
             link_bytes_per_s: self.link_bytes_per_s,
+            count_hz: self.count_hz,
+            worst_latency_cycles: self.timing.worst_latency,
             axes: Self::axes(axes),
         }
     }

@@ -341,6 +341,7 @@ pub(crate) fn pil_report<const N: usize>(
         "peak_force_n": peak,
         "last_loop_cycles": loop_cycles,
         "last_stage_cycles": run.telemetry.last().map(|t| t.stage_cycles),
+        "worst_latency_cycles": run.telemetry.last().map(|t| t.worst_latency_cycles),
         "start": run.start,
         "config_booted": run.config.map(|c| format!("{:?}", c.0)),
         "config_saved": run.config.map(|c| format!("{:?}", c.1)),
