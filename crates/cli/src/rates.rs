@@ -10,7 +10,7 @@
 //! device's row also gives the stiffest coupling proven against it (see
 //! docs/host.md).
 
-use crate::args::{HostArgs, RatesArgs};
+use crate::args::{HostArgs, Latency, RatesArgs};
 use serde::Serialize;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -56,12 +56,20 @@ fn host_pair(
     host_best_pair(&plant, Some(HumanBound::PAPER), &l, b_max).map_err(|e| e.to_string())
 }
 
-fn model_row(path: &Path, rates: &[f64], host: Option<&HostArgs>) -> Result<Row, String> {
-    let model = DeviceModel::load(path).map_err(|e| format!("{}: {e}", path.display()))?;
+fn model_row(
+    path: &Path,
+    rates: &[f64],
+    host: Option<&HostArgs>,
+    latency: Option<Latency>,
+) -> Result<Row, String> {
+    let mut model = DeviceModel::load(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut at = Vec::new();
     let mut first_b = None;
     let mut with_host = host.map(|_| Vec::new());
     for r in rates {
+        if let Some(l) = latency {
+            model.latency_s = l.seconds(1.0 / r);
+        }
         let best = pair(&model, 1.0 / r, None)?;
         let b0 = *first_b.get_or_insert(best.1);
         let (k_same, _) = pair(&model, 1.0 / r, Some(b0))?;
@@ -104,17 +112,36 @@ pub(crate) fn rates(a: &RatesArgs) -> Result<RatesReport, String> {
             h.ticks(*r)?;
         }
     }
+    if let Some(l) = a.latency {
+        let s = l.seconds(1.0 / rates[0]);
+        if s > twoport_design::model::MAX_LATENCY_S {
+            return Err(format!(
+                "--latency {s} s: at most {} s",
+                twoport_design::model::MAX_LATENCY_S
+            ));
+        }
+    }
     let mut rows = Vec::new();
     for m in &a.model {
-        rows.push(model_row(m, &rates, host.as_ref())?);
+        rows.push(model_row(m, &rates, host.as_ref(), a.latency)?);
     }
-    for l in &a.linkage {
+    // (A linkage's workspace proof takes no latency yet.)
+    let linkages: &[PathBuf] = if a.latency.is_some() { &[] } else { &a.linkage };
+    for l in linkages {
         rows.push(linkage_row(l, &rates, grasp)?);
     }
     if let Some(out) = &a.plot {
         plot::render(&figure(&rows, &rates), out).map_err(|e| e.to_string())?;
     }
     Ok(RatesReport {
+        latency_s: a
+            .latency
+            .map(|l| rates.iter().map(|r| l.seconds(1.0 / r)).collect()),
+        linkages_left_out: if a.latency.is_some() {
+            a.linkage.clone()
+        } else {
+            Vec::new()
+        },
         host: host.map(|h| HostBody {
             mass_kg: h.body.0,
             damping_nspm: h.body.1,
@@ -144,6 +171,12 @@ pub(crate) fn rates(a: &RatesArgs) -> Result<RatesReport, String> {
 #[derive(Serialize)]
 pub(crate) struct RatesReport {
     rates_hz: Vec<f64>,
+    /// The latency from sampling to the force each rate is proven with (s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    latency_s: Option<Vec<f64>>,
+    /// Linkages not in the table: their workspace proof takes no latency.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    linkages_left_out: Vec<PathBuf>,
     /// The body the host moves, where one is given.
     #[serde(skip_serializing_if = "Option::is_none")]
     host: Option<HostBody>,
@@ -190,6 +223,14 @@ impl fmt::Display for RatesReport {
             f,
             "proven impedance coupling k (N/m) at b (N s/m), per servo rate"
         )?;
+        if let Some(l) = &self.latency_s {
+            let us: Vec<String> = l.iter().map(|s| format!("{:.3}", s * 1e6)).collect();
+            write!(
+                f,
+                "\nwith a latency from sampling to the force of {} us (the rates in order)",
+                us.join(", ")
+            )?;
+        }
         if let Some(h) = &self.host {
             write!(
                 f,
@@ -215,6 +256,17 @@ impl fmt::Display for RatesReport {
                     None => {}
                 }
             }
+        }
+        if !self.linkages_left_out.is_empty() {
+            write!(
+                f,
+                "\n\nleft out (a linkage's workspace proof takes no latency yet): {}",
+                self.linkages_left_out
+                    .iter()
+                    .map(|p| p.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )?;
         }
         if let Some(out) = &self.figure {
             write!(f, "\n\nwrote {}", out.display())?;

@@ -75,3 +75,42 @@ fn bad_rates_and_grasps_are_named() {
     let e = TWOPORT.failure(&["rates", "--model", "no/such.toml"]);
     assert!(e.contains("no/such.toml"), "{e}");
 }
+
+/// With the board's latency (a computation's time, the same at every
+/// rate) each rate's coupling is proven with it: lower than without, and
+/// by a larger share the faster the tick. A latency in periods is the
+/// same share of every tick. The linkages, whose workspace proof takes no
+/// latency yet, are named as left out.
+#[test]
+fn a_boards_latency_costs_a_faster_rate_more() {
+    let k = |extra: &[&str]| {
+        let mut a = vec![
+            "rates",
+            "--model",
+            "models/capstan.toml",
+            "--linkage",
+            "models/linkages/hapkit.toml",
+            "--rates",
+            "1000,10000",
+            "--json",
+        ];
+        a.extend(extra);
+        TWOPORT.json(&a)
+    };
+    let (none, late) = (k(&[]), k(&["--latency", "18e-6"]));
+    let (k0, k1) = (
+        numbers(&none["devices"][0]["k_npm"]),
+        numbers(&late["devices"][0]["k_npm"]),
+    );
+    assert!(k1[0] < k0[0] && k1[1] < k0[1], "{k0:?} {k1:?}");
+    assert!(k1[1] / k0[1] < k1[0] / k0[0], "{k0:?} {k1:?}");
+    assert_eq!(numbers(&late["latency_s"]), [18e-6, 18e-6]);
+    assert_eq!(late["devices"].as_array().unwrap().len(), 1);
+    assert_eq!(late["linkages_left_out"][0], "models/linkages/hapkit.toml");
+    let share = k(&["--latency", "0.1T"]);
+    let s = numbers(&share["latency_s"]);
+    assert!(
+        (s[0] - 1e-4).abs() < 1e-15 && (s[1] - 1e-5).abs() < 1e-15,
+        "{s:?}"
+    );
+}

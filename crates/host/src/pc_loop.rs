@@ -52,6 +52,13 @@ pub struct LoopTiming {
     pub period_s: Percentiles,
     /// The device exchange's time (s), the same three.
     pub io_s: Percentiles,
+    /// The latency from a sample to its force (s), the same three: from
+    /// the start of the exchange that read a tick's sensors to the end of
+    /// the one that wrote the force computed from them, the next tick's.
+    /// The device sampled no earlier and applied no later, so this bounds
+    /// what the proof must allow (a whole tick and the part of one past
+    /// it: `twoport spec`'s latency).
+    pub latency_s: Percentiles,
 }
 
 /// A sample's median, 99th percentile and greatest value.
@@ -122,6 +129,7 @@ struct Shared {
     link: ByteQueues,
     periods: Vec<f64>,
     ios: Vec<f64>,
+    latencies: Vec<f64>,
     ticks: u64,
     late: u64,
     /// Why the loop stopped, once it has.
@@ -139,6 +147,10 @@ struct PcSupport<Io, const N: usize> {
     last: RawSensors<N>,
     failed: Option<String>,
     io_s: f64,
+    /// When the last exchange began, and the latency its sensors' force
+    /// had by the end of this one (s; 0 before the second).
+    exchanged: Option<Instant>,
+    latency_s: f64,
     start: Instant,
     period_ns: u32,
 }
@@ -168,6 +180,9 @@ impl<Io: DeviceIo<N>, const N: usize> BoardSupport<N> for PcSupport<Io, N> {
             }
         }
         self.io_s = t.elapsed().as_secs_f64();
+        if let Some(before) = self.exchanged.replace(t) {
+            self.latency_s = before.elapsed().as_secs_f64();
+        }
         self.last
     }
     fn set_duty(&mut self, duty: [i16; N]) {
@@ -229,6 +244,8 @@ impl PcBoard {
             last: RawSensors::default(),
             failed: None,
             io_s: 0.0,
+            exchanged: None,
+            latency_s: 0.0,
             start: Instant::now(),
             period_ns: (period_s * 1e9).round() as u32,
         };
@@ -251,6 +268,7 @@ impl PcBoard {
             late: s.late,
             period_s: Percentiles::of(&s.periods),
             io_s: Percentiles::of(&s.ios),
+            latency_s: Percentiles::of(&s.latencies),
         }
     }
 
@@ -317,6 +335,9 @@ fn run<Io, W, L, D, const N: usize, const R: usize>(
             record(&mut s.periods, slot, p);
         }
         record(&mut s.ios, slot, io.io_s);
+        if io.latency_s > 0.0 {
+            record(&mut s.latencies, slot, io.latency_s);
+        }
         slot = (slot + 1) % TIMING_WINDOW;
         if let Some(e) = failed {
             s.failed = Some(e);
