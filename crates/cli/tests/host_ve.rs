@@ -72,3 +72,29 @@ fn bad_host_arguments_are_named() {
     let e = TWOPORT.failure(&["host-ve", "--host-body", "1,10", "--k", "-5", "--b", "10"]);
     assert!(e.contains("--k"), "{e}");
 }
+
+/// The two-rate proof takes the board's latency inside the tick through
+/// the device's sampled terms: at half a tick the stiffest coupling proven
+/// against the host's body is softer than with none, and the exact
+/// two-rate loop, with the force held half a tick late, finds no hand
+/// that breaks it.
+#[test]
+fn the_two_rate_proof_takes_a_latency() {
+    let k = |extra: &[&str]| {
+        let mut a = vec!["host-ve", "--host-body", "1,10", "--json"];
+        a.extend(extra);
+        TWOPORT.json(&a)
+    };
+    let (none, late) = (k(&[]), k(&["--latency", "0.5T", "--verify"]));
+    assert_eq!(
+        (none["proven"].as_bool(), late["proven"].as_bool()),
+        (Some(true), Some(true))
+    );
+    let (k0, k1) = (
+        none["k_npm"].as_f64().unwrap(),
+        late["k_npm"].as_f64().unwrap(),
+    );
+    assert!(k1 < 0.8 * k0, "{k1} vs {k0}");
+    let v = &late["poses"][0]["verify"];
+    assert_eq!(v["unstable"], false, "{v}");
+}
