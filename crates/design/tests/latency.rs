@@ -191,3 +191,38 @@ fn a_heavy_devices_wall_boundary_is_the_delayed_passivity_bound() {
         );
     }
 }
+
+/// The admittance display with half a tick of latency, on the Excalibur
+/// with the human bound: the design (its own regulator, the impedance
+/// design's gains) holds against `verify`'s exact loop with the force held
+/// half a tick late, and 2.5% lighter it breaks; the latency costs mass
+/// (and softens the regulator the impedance design gives).
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn an_admittance_design_with_a_latency_holds_and_breaks_just_past() {
+    use twoport_control::AdmittanceGains;
+    use twoport_design::network::HumanBound;
+    use twoport_design::Designer;
+    let mut m = DeviceModel::excalibur().unwrap();
+    let none = Designer::new(vec![m.clone()], None, Some(HumanBound::PAPER)).unwrap();
+    let m0 = none
+        .design_admittance(None, None, 0.0)
+        .unwrap()
+        .coupling
+        .unwrap()
+        .0;
+    m.latency_s = 0.5 * T;
+    let d = Designer::new(vec![m], None, Some(HumanBound::PAPER)).unwrap();
+    let design = d.design_admittance(None, None, 0.0).unwrap();
+    let (mass, b) = design.coupling.unwrap();
+    let r = design.regulator.unwrap();
+    assert!(mass > 1.2 * m0, "{mass} kg against {m0} kg with none");
+    let g = |mass: f64| -> Gains {
+        AdmittanceGains::new(r.kp as f32, r.bp as f32, mass as f32, b as f32).into()
+    };
+    // (The board's gains are f32: a hair heavier than the boundary.)
+    let at = d.verify(&g(mass * (1.0 + 1e-6))).unwrap().verdict;
+    assert!(!at.unstable, "{at:?}");
+    let past = d.verify(&g(0.975 * mass)).unwrap().verdict;
+    assert!(past.unstable, "{past:?}");
+}
