@@ -345,13 +345,7 @@ fn exact_wall_radius(alpha: f64, k: f64) -> f64 {
     )
     .unwrap();
     let term = Termination {
-        hand: Hand {
-            mass_kg: 0.0,
-            stiffness_npm: 0.0,
-            damping_nspm: 0.0,
-            grasp: None,
-            second: None,
-        },
+        hand: Hand::OFF,
         ve: Ve::Constraint,
     };
     let g: Gains = ImpedanceGains::new(k as f32, 0.0).into();

@@ -141,27 +141,29 @@ fn pil_runs_fail_for_any_difference_and_a_late_zero() {
 )]
 fn a_latency_explains_table_ones_impedance_boundary_and_not_its_admittance_one() {
     use host_sim::study::latency::{fit, Fit};
-    let k = fit(
-        Path::new("../scenes/table1/impedance_bilateral_hands_off.toml"),
-        &[],
-        ("coupling.k", (1e4, 2e6), 0.005),
+    let to = |case: &str, param: &str, range: (f64, f64), target: f64| {
+        let path = format!("../scenes/table1/{case}.toml");
+        fit(
+            Path::new(&path),
+            &[],
+            (param, range, 0.005),
+            target,
+            &mut || {},
+        )
+        .unwrap()
+    };
+    let k = to(
+        "impedance_bilateral_hands_off",
+        "coupling.k",
+        (1e4, 2e6),
         75_000.0,
-        &mut || {},
-    )
-    .unwrap();
+    );
     let Fit::Found { alpha, marginal } = k else {
         panic!("{k:?}")
     };
     assert!((alpha - 0.5).abs() < 0.02, "{alpha}");
     assert!((marginal / 75_000.0 - 1.0).abs() < 0.02, "{marginal}");
-    let m = fit(
-        Path::new("../scenes/table1/admittance_free_maximum.toml"),
-        &[],
-        ("coupling.m", (50.0, 0.01), 0.005),
-        4.3,
-        &mut || {},
-    )
-    .unwrap();
+    let m = to("admittance_free_maximum", "coupling.m", (50.0, 0.01), 4.3);
     let Fit::NotReached {
         at_zero,
         last,
@@ -173,13 +175,11 @@ fn a_latency_explains_table_ones_impedance_boundary_and_not_its_admittance_one()
     assert!((at_zero - 2.66).abs() < 0.05, "{at_zero}");
     assert!(at_last > at_zero && at_last < 3.2 && last < 0.9, "{m:?}");
     // A target the boundary never meets, for a stiffness that only falls.
-    let up = fit(
-        Path::new("../scenes/table1/impedance_bilateral_hands_off.toml"),
-        &[],
-        ("coupling.k", (1e4, 2e6), 0.005),
+    let up = to(
+        "impedance_bilateral_hands_off",
+        "coupling.k",
+        (1e4, 2e6),
         400_000.0,
-        &mut || {},
-    )
-    .unwrap();
+    );
     assert!(matches!(up, Fit::NotReached { .. }), "{up:?}");
 }

@@ -84,16 +84,9 @@ fn bad_rates_and_grasps_are_named() {
 #[test]
 fn a_boards_latency_costs_a_faster_rate_more() {
     let k = |extra: &[&str]| {
-        let mut a = vec![
-            "rates",
-            "--model",
-            "models/capstan.toml",
-            "--linkage",
-            "models/linkages/hapkit.toml",
-            "--rates",
-            "1000,10000",
-            "--json",
-        ];
+        let words = "rates --model models/capstan.toml --linkage models/linkages/hapkit.toml \
+                     --rates 1000,10000 --json";
+        let mut a: Vec<&str> = words.split_whitespace().collect();
         a.extend(extra);
         TWOPORT.json(&a)
     };

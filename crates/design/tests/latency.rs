@@ -43,14 +43,6 @@ fn imp(k: f64, b: f64) -> Gains {
     ImpedanceGains::new(k as f32, b as f32).into()
 }
 
-const HANDS_OFF: Hand = Hand {
-    mass_kg: 0.0,
-    stiffness_npm: 0.0,
-    damping_nspm: 0.0,
-    grasp: None,
-    second: None,
-};
-
 /// The virtual wall `f = K x + B (x - x_prev)/T` on the rigid device `m x''
 /// + b x' = -f`, its force applied `τ` after the sample, stepped over one
 /// tick in closed form (the velocity and position of a mass-damper under a
@@ -98,7 +90,7 @@ fn the_delayed_hold_is_the_rigid_device_stepped_in_closed_form() {
         let model = rigid(m, b, alpha * T);
         for (k, bw) in [(5_000.0, 0.0), (20_000.0, 2.0), (60_000.0, 5.0)] {
             let term = Termination {
-                hand: HANDS_OFF,
+                hand: Hand::OFF,
                 ve: Ve::Constraint,
             };
             let r = radius(&model, T, &imp(k, bw), &term)
@@ -165,7 +157,7 @@ fn the_rigid_proof_with_a_latency_is_sound_and_close() {
 fn a_heavy_devices_wall_boundary_is_the_delayed_passivity_bound() {
     let (m, b) = (200.0, 20.0);
     let wall = Termination {
-        hand: HANDS_OFF,
+        hand: Hand::OFF,
         ve: Ve::Constraint,
     };
     for alpha in [0.0, 0.25, 0.5, 0.75, 1.5] {

@@ -74,6 +74,17 @@ pub struct Hand {
     pub second: Option<Resonator>,
 }
 
+impl Hand {
+    /// No hand on the handle.
+    pub const OFF: Hand = Hand {
+        mass_kg: 0.0,
+        stiffness_npm: 0.0,
+        damping_nspm: 0.0,
+        grasp: None,
+        second: None,
+    };
+}
+
 /// A mass on a spring and a damper in parallel.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Resonator {
@@ -205,13 +216,7 @@ mod tests {
 
     fn hands_off(ve: Ve) -> Termination {
         Termination {
-            hand: Hand {
-                mass_kg: 0.0,
-                stiffness_npm: 0.0,
-                damping_nspm: 0.0,
-                grasp: None,
-                second: None,
-            },
+            hand: Hand::OFF,
             ve,
         }
     }
