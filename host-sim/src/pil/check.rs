@@ -42,9 +42,13 @@ pub fn compare<const N: usize>(a: &Run<N>, b: &Run<N>) -> Comparison {
     }
     c.start_differs = (a.armed_at_tick, a.homing.map(|h| h.0), a.experiment)
         != (b.armed_at_tick, b.homing.map(|h| h.0), b.experiment);
+    // (The link's rate, the count's rate and the latency measured are the
+    // hardware's, not the image's.)
     let image = |s: Option<twoport_link::Spec>| {
         s.map(|s| twoport_link::Spec {
             link_bytes_per_s: None,
+            count_hz: None,
+            worst_latency_cycles: 0,
             ..s
         })
     };
