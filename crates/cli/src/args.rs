@@ -437,9 +437,8 @@ pub(crate) struct RatesArgs {
     pub(crate) host: HostOpts,
     /// The board's latency from sampling to the force (`2e-6`, s: a
     /// computation takes the same time at every rate, a larger share of a
-    /// faster tick; or `0.1T`, the same share of each). The lumped devices
-    /// are proven with it; the linkages' workspace proof takes none yet,
-    /// so they are left out.
+    /// faster tick; or `0.1T`, the same share of each). Every device is
+    /// proven with it.
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) latency: Option<Latency>,
     /// Draw the table as a log-log figure (.png or .svg).

@@ -85,13 +85,21 @@ fn model_row(
     })
 }
 
-fn linkage_row(path: &Path, rates: &[f64], grasp: f64) -> Result<Row, String> {
+fn linkage_row(
+    path: &Path,
+    rates: &[f64],
+    grasp: f64,
+    latency: Option<Latency>,
+) -> Result<Row, String> {
     let mut file = LinkageFile::load(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut at = Vec::new();
     // (The workspace's least damping does not depend on the rate.)
     let damping = least_damping(&file).map_err(|e| format!("{}: {e}", path.display()))?;
     for r in rates {
         file.period_s = 1.0 / r;
+        if let Some(l) = latency {
+            file.latency_s = l.seconds(1.0 / r);
+        }
         let d =
             certified_design_from(&file, &damping, 0.0, grasp, None).map_err(|e| e.to_string())?;
         at.push(((d.k_c_npm, 0.0), d.k_c_npm));
@@ -125,10 +133,8 @@ pub(crate) fn rates(a: &RatesArgs) -> Result<RatesReport, String> {
     for m in &a.model {
         rows.push(model_row(m, &rates, host.as_ref(), a.latency)?);
     }
-    // (A linkage's workspace proof takes no latency yet.)
-    let linkages: &[PathBuf] = if a.latency.is_some() { &[] } else { &a.linkage };
-    for l in linkages {
-        rows.push(linkage_row(l, &rates, grasp)?);
+    for l in &a.linkage {
+        rows.push(linkage_row(l, &rates, grasp, a.latency)?);
     }
     if let Some(out) = &a.plot {
         plot::render(&figure(&rows, &rates), out).map_err(|e| e.to_string())?;
@@ -137,11 +143,6 @@ pub(crate) fn rates(a: &RatesArgs) -> Result<RatesReport, String> {
         latency_s: a
             .latency
             .map(|l| rates.iter().map(|r| l.seconds(1.0 / r)).collect()),
-        linkages_left_out: if a.latency.is_some() {
-            a.linkage.clone()
-        } else {
-            Vec::new()
-        },
         host: host.map(|h| HostBody {
             mass_kg: h.body.0,
             damping_nspm: h.body.1,
@@ -174,9 +175,7 @@ pub(crate) struct RatesReport {
     /// The latency from sampling to the force each rate is proven with (s).
     #[serde(skip_serializing_if = "Option::is_none")]
     latency_s: Option<Vec<f64>>,
-    /// Linkages not in the table: their workspace proof takes no latency.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    linkages_left_out: Vec<PathBuf>,
+
     /// The body the host moves, where one is given.
     #[serde(skip_serializing_if = "Option::is_none")]
     host: Option<HostBody>,
@@ -256,17 +255,6 @@ impl fmt::Display for RatesReport {
                     None => {}
                 }
             }
-        }
-        if !self.linkages_left_out.is_empty() {
-            write!(
-                f,
-                "\n\nleft out (a linkage's workspace proof takes no latency yet): {}",
-                self.linkages_left_out
-                    .iter()
-                    .map(|p| p.display().to_string())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )?;
         }
         if let Some(out) = &self.figure {
             write!(f, "\n\nwrote {}", out.display())?;

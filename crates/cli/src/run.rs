@@ -46,19 +46,22 @@ pub(crate) fn designer(c: &Common, axis: Option<&DeviceAxis>) -> Result<Designer
 /// The linkage file of `--device`, at `--period` where one is given.
 pub(crate) fn linkage_file(c: &Common) -> Result<twoport_design::linkage::LinkageFile, String> {
     let path = c.device.as_ref().ok_or("--device: a linkage file")?;
-    if c.latency.is_some() {
-        return Err(
-            "--latency: a linkage's workspace proof does not take a latency yet \
-             (prove one pose's model with --model and --latency)"
-                .into(),
-        );
-    }
     let mut file = twoport_design::linkage::LinkageFile::load(path).map_err(|e| e.to_string())?;
     if let Some(t) = c.period {
         if !(t.is_finite() && t > 0.0) {
             return Err(format!("--period {t}: must be finite and > 0"));
         }
         file.period_s = t;
+    }
+    if let Some(l) = c.latency {
+        let s = l.seconds(file.period_s);
+        if s > twoport_design::model::MAX_LATENCY_S {
+            return Err(format!(
+                "--latency {s} s: at most {} s",
+                twoport_design::model::MAX_LATENCY_S
+            ));
+        }
+        file.latency_s = s;
     }
     Ok(file)
 }

@@ -54,6 +54,13 @@ pub(crate) fn verify_linkage(a: &ImpedanceGains) -> Reported {
     };
     use twoport_design::network::HumanBound;
     let file = linkage_file(&a.common)?;
+    if file.latency_s > 0.0 {
+        return Err(
+            "--latency: verify's loops of a linkage hold the torques at the sample \
+             (no latency) yet; verify one pose's model with --model and --latency"
+                .into(),
+        );
+    }
     let (k, b) = (gain("k", a.k)?, gain("b", a.b)?);
     let grasp = match a.min_grasp {
         Some(g) if !(g.is_finite() && g >= 0.0) => {

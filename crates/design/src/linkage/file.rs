@@ -19,6 +19,11 @@ pub struct LinkageFile {
     pub source: String,
     /// The servo's period (s).
     pub period_s: f64,
+    /// Latency from sampling the joints to the torques' change (s): the
+    /// servo's computation, a bus's round trip; whole ticks and a part of
+    /// one at the period (0 by default).
+    #[serde(default)]
+    pub latency_s: f64,
     /// The linkage's kind and dimensions.
     pub geometry: Geometry,
     /// Every motor's drive, the same for each joint.
@@ -227,6 +232,12 @@ impl Geometry {
 }
 
 impl LinkageFile {
+    /// The delay from sampling to the torques at the file's period: whole
+    /// ticks and a fraction of one.
+    pub fn lag(&self) -> crate::model::Lag {
+        crate::model::Lag::of(self.latency_s, self.period_s)
+    }
+
     /// Parse and check a linkage file's text; `source` names it in errors.
     ///
     /// # Examples
@@ -298,6 +309,14 @@ impl LinkageFile {
             }
         };
         positive("period_s", self.period_s)?;
+        at_least_zero("latency_s", self.latency_s)?;
+        if self.latency_s > crate::model::MAX_LATENCY_S {
+            return Err(format!(
+                "latency_s = {}: at most {} s",
+                self.latency_s,
+                crate::model::MAX_LATENCY_S
+            ));
+        }
         self.geometry.check()?;
         let m = &self.motors;
         positive("motors.torque_constant_nmpa", m.torque_constant_nmpa)?;
