@@ -232,6 +232,53 @@ typedef struct TpSpec {
 } TpSpec;
 
 /**
+ * A sample's median, 99th percentile and greatest value.
+ */
+typedef struct TpPercentiles {
+  /**
+   * The median.
+   */
+  double p50;
+  /**
+   * The 99th percentile.
+   */
+  double p99;
+  /**
+   * The greatest.
+   */
+  double max;
+} TpPercentiles;
+
+/**
+ * The servo loop's timing where it runs on this computer (over the last
+ * ticks of a window): every tick's period and device exchange, and the
+ * latency from a sample to its force (s).
+ */
+typedef struct TpLoopTiming {
+  /**
+   * Ticks run.
+   */
+  uint64_t ticks;
+  /**
+   * Ticks that started more than 1.5 periods after the one before.
+   */
+  uint64_t late;
+  /**
+   * The period between ticks' starts (s).
+   */
+  struct TpPercentiles period_s;
+  /**
+   * The device exchange's time (s).
+   */
+  struct TpPercentiles io_s;
+  /**
+   * From the start of the exchange that read a tick's sensors to the
+   * end of the one that wrote its force (s).
+   */
+  struct TpPercentiles latency_s;
+} TpLoopTiming;
+
+/**
  * One axis at one tick.
  */
 typedef struct TpAxisState {
@@ -363,6 +410,17 @@ enum TpResult tp_board_close(struct TpBoard *b);
  * `b` is an open board; `out` points to a writable `TpSpec`.
  */
 enum TpResult tp_board_spec(struct TpBoard *b, struct TpSpec *out);
+
+/**
+ * The servo loop's timing, where it runs on this computer (a board
+ * opened with `tp_board_open_pc_simulated`, or a device's driver); a
+ * board that runs its own loop reports its timing in its state instead,
+ * and this answers `TP_ARGUMENT`.
+ *
+ * # Safety
+ * `b` is an open board; `out` points to a writable `TpLoopTiming`.
+ */
+enum TpResult tp_board_loop_timing(struct TpBoard *b, struct TpLoopTiming *out);
 
 /**
  * Tell a disarmed board where each of its `n` axes stands (m).

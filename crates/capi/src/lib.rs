@@ -14,9 +14,9 @@ use twoport_host::{
     BoardPort, Contact, Gains, HostBoard, LinkError, Pace, PcBoard, SerialBoard, SimulatedBoard,
 };
 pub use types::{
-    TpAxisSpec, TpAxisState, TpDisplay, TpMode, TpResult, TpSpec, TpState, TP_CONTACT_ABOVE,
-    TP_CONTACT_BELOW, TP_CONTACT_FREE, TP_CONTACT_HELD, TP_MAX_AXES, TP_VE_DAMPING,
-    TP_VE_STIFFNESS, TP_VE_SURFACE,
+    TpAxisSpec, TpAxisState, TpDisplay, TpLoopTiming, TpMode, TpPercentiles, TpResult, TpSpec,
+    TpState, TP_CONTACT_ABOVE, TP_CONTACT_BELOW, TP_CONTACT_FREE, TP_CONTACT_HELD, TP_MAX_AXES,
+    TP_VE_DAMPING, TP_VE_STIFFNESS, TP_VE_SURFACE,
 };
 
 /// A board, opened by `tp_board_open_serial`, `tp_board_open_simulated`
@@ -209,6 +209,30 @@ pub unsafe extern "C" fn tp_board_spec(b: *mut TpBoard, out: *mut TpSpec) -> TpR
                 TpResult::Ok
             }
             None => bad("out is NULL"),
+        }
+    })
+}
+
+/// The servo loop's timing, where it runs on this computer (a board
+/// opened with `tp_board_open_pc_simulated`, or a device's driver); a
+/// board that runs its own loop reports its timing in its state instead,
+/// and this answers `TP_ARGUMENT`.
+///
+/// # Safety
+/// `b` is an open board; `out` points to a writable `TpLoopTiming`.
+#[no_mangle]
+pub unsafe extern "C" fn tp_board_loop_timing(b: *mut TpBoard, out: *mut TpLoopTiming) -> TpResult {
+    with_board(b, |b| {
+        // SAFETY: `out`, if non-null, points to a writable TpLoopTiming.
+        let Some(out) = (unsafe { out.as_mut() }) else {
+            return bad("out is NULL");
+        };
+        match b.0.port().loop_timing() {
+            Some(t) => {
+                *out = TpLoopTiming::from(&t);
+                TpResult::Ok
+            }
+            None => bad("the board runs its own loop: its state has its timing"),
         }
     })
 }

@@ -276,3 +276,56 @@ impl From<&State> for TpState {
         }
     }
 }
+
+/// A sample's median, 99th percentile and greatest value.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TpPercentiles {
+    /// The median.
+    pub p50: f64,
+    /// The 99th percentile.
+    pub p99: f64,
+    /// The greatest.
+    pub max: f64,
+}
+
+impl From<twoport_host::Percentiles> for TpPercentiles {
+    fn from(p: twoport_host::Percentiles) -> Self {
+        TpPercentiles {
+            p50: p.p50,
+            p99: p.p99,
+            max: p.max,
+        }
+    }
+}
+
+/// The servo loop's timing where it runs on this computer (over the last
+/// ticks of a window): every tick's period and device exchange, and the
+/// latency from a sample to its force (s).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TpLoopTiming {
+    /// Ticks run.
+    pub ticks: u64,
+    /// Ticks that started more than 1.5 periods after the one before.
+    pub late: u64,
+    /// The period between ticks' starts (s).
+    pub period_s: TpPercentiles,
+    /// The device exchange's time (s).
+    pub io_s: TpPercentiles,
+    /// From the start of the exchange that read a tick's sensors to the
+    /// end of the one that wrote its force (s).
+    pub latency_s: TpPercentiles,
+}
+
+impl From<&twoport_host::LoopTiming> for TpLoopTiming {
+    fn from(t: &twoport_host::LoopTiming) -> Self {
+        TpLoopTiming {
+            ticks: t.ticks,
+            late: t.late,
+            period_s: t.period_s.into(),
+            io_s: t.io_s.into(),
+            latency_s: t.latency_s.into(),
+        }
+    }
+}

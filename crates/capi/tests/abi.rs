@@ -59,7 +59,8 @@ fn the_spec_and_the_boards_own_ve_through_the_c_abi() {
 }
 
 /// The PC's loop opens through the C ABI as a board does, and says what
-/// it is: the Excalibur image at 1 ms on one axis.
+/// it is: the Excalibur image at 1 ms on one axis; its loop's timing is
+/// read through the C ABI too, ordered, once it has ticked.
 #[test]
 fn the_pc_loop_opens_through_the_c_abi() {
     let mut b: *mut TpBoard = null_mut();
@@ -74,6 +75,34 @@ fn the_pc_loop_opens_through_the_c_abi() {
     // SAFETY: tp_board_spec wrote it.
     let spec = unsafe { spec.assume_init() };
     assert_eq!((spec.period_s, spec.axes), (1e-3, 1));
+    let mut t = TpLoopTiming::default();
+    while t.ticks < 3 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+        // SAFETY: `b` is open and `t` is a writable TpLoopTiming.
+        assert_eq!(unsafe { tp_board_loop_timing(b, &mut t) }, TpResult::Ok);
+    }
+    for p in [t.period_s, t.io_s, t.latency_s] {
+        assert!(0.0 <= p.p50 && p.p50 <= p.p99 && p.p99 <= p.max, "{t:?}");
+    }
+    // SAFETY: a NULL `out` is refused, not written.
+    assert_eq!(
+        unsafe { tp_board_loop_timing(b, null_mut()) },
+        TpResult::Argument
+    );
     // SAFETY: `b` is open; closing frees it (and stops the loop).
+    assert_eq!(unsafe { tp_board_close(b) }, TpResult::Ok);
+    // A board that runs its own loop has no PC loop to time.
+    let mut b: *mut TpBoard = null_mut();
+    // SAFETY: `b` is a valid place for the board's pointer.
+    assert_eq!(
+        unsafe { tp_board_open_simulated(2.0, &mut b) },
+        TpResult::Ok
+    );
+    // SAFETY: `b` is open and `t` is a writable TpLoopTiming.
+    assert_eq!(
+        unsafe { tp_board_loop_timing(b, &mut t) },
+        TpResult::Argument
+    );
+    // SAFETY: `b` is open; closing frees it.
     assert_eq!(unsafe { tp_board_close(b) }, TpResult::Ok);
 }

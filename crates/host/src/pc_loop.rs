@@ -394,6 +394,9 @@ impl BoardPort for PcBoard {
                 .unwrap_or_else(|p| p.into_inner().0);
         }
     }
+    fn loop_timing(&self) -> Option<LoopTiming> {
+        Some(self.timing())
+    }
 }
 
 impl Drop for PcBoard {

@@ -10,6 +10,11 @@ pub trait BoardPort {
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError>;
     /// Bytes from the board: waits up to `timeout` for at least one.
     fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError>;
+    /// The servo loop's timing, where it runs on this computer
+    /// ([`PcBoard`](crate::PcBoard)); `None` where a board runs it.
+    fn loop_timing(&self) -> Option<crate::LoopTiming> {
+        None
+    }
 }
 
 /// Any port, chosen at run time (the scope's: a serial port, or a board
@@ -21,6 +26,9 @@ impl BoardPort for Box<dyn BoardPort> {
     fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError> {
         (**self).recv(buf, timeout)
     }
+    fn loop_timing(&self) -> Option<crate::LoopTiming> {
+        (**self).loop_timing()
+    }
 }
 
 /// Any port that may move to another thread, chosen at run time (the C
@@ -31,6 +39,9 @@ impl BoardPort for Box<dyn BoardPort + Send> {
     }
     fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError> {
         (**self).recv(buf, timeout)
+    }
+    fn loop_timing(&self) -> Option<crate::LoopTiming> {
+        (**self).loop_timing()
     }
 }
 

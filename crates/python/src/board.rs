@@ -110,6 +110,31 @@ impl Board {
         })
     }
 
+    /// The servo loop's timing where it runs on this computer
+    /// (`pc_simulated`, a device's driver): ticks, late ticks, and the
+    /// period's, the device exchange's and the latency's p50/p99/max (s);
+    /// `None` where the board runs its own loop.
+    fn loop_timing<'py>(&mut self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(t) = self.open()?.port().loop_timing() else {
+            return Ok(None);
+        };
+        let d = PyDict::new(py);
+        d.set_item("ticks", t.ticks)?;
+        d.set_item("late", t.late)?;
+        for (name, p) in [
+            ("period_s", t.period_s),
+            ("io_s", t.io_s),
+            ("latency_s", t.latency_s),
+        ] {
+            let q = PyDict::new(py);
+            q.set_item("p50", p.p50)?;
+            q.set_item("p99", p.p99)?;
+            q.set_item("max", p.max)?;
+            d.set_item(name, q)?;
+        }
+        Ok(Some(d))
+    }
+
     /// What the board can do: its period (s), and per axis its force
     /// limits and its proven region's envelope.
     fn spec<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {

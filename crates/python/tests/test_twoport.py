@@ -35,6 +35,8 @@ def test_bad_inputs_are_named():
         b.send_ve([0.0], ["sideways"])
     with pytest.raises(RuntimeError, match="values for a board of 1 axes"):
         b.calibrate([0.0, 0.0])
+    # A board that runs its own loop has no PC loop to time.
+    assert b.loop_timing() is None
     b.close()
     with pytest.raises(RuntimeError, match="closed"):
         b.arm()
@@ -139,4 +141,10 @@ def test_the_pc_loop_holds_the_images_wall_from_python():
     s = b.latest()
     assert s["mode"] == "armed" and s["faults"] == 0
     assert abs(s["position_m"][0] - 0.005 - 2.0 / 51000.0) < 10e-6
+    # The loop's timing, ordered, every statistic of a tick it ran.
+    t = b.loop_timing()
+    assert t["ticks"] >= 1000 and 0 <= t["late"] <= t["ticks"]
+    for name in ("period_s", "io_s", "latency_s"):
+        p = t[name]
+        assert 0.0 <= p["p50"] <= p["p99"] <= p["max"], (name, p)
     b.close()
