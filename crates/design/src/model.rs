@@ -6,6 +6,10 @@ use serde::Deserialize;
 use std::fmt;
 use std::path::Path;
 
+mod lag;
+
+pub use lag::Lag;
+
 /// A linear device model `M q'' + D q' + K q = G [f_h, f_a]^T`, with
 /// `[v_h, -v_a]^T = C_v q'`, strain gauge `f_s = C_f q` and load-cell filter
 /// `a(s) = p/(s + p)`. SI units: kg, N s/m, N/m, N, m/s, rad/s, s.
@@ -136,50 +140,6 @@ pub const MAX_DELAY_SAMPLES: u32 = 64;
 
 /// The longest latency a model may declare (s).
 pub const MAX_LATENCY_S: f64 = 1.0;
-
-/// The measurement-to-actuation delay of a model at one sample period:
-/// `ticks` whole ticks and a `fraction` of one more, `0 <= fraction < 1`.
-/// The force a tick computes is applied from `(ticks + fraction) T` after
-/// its sample, and held one period.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Lag {
-    /// Whole ticks.
-    pub ticks: u32,
-    /// The part of a tick on top, `α` in `[0, 1)`.
-    pub fraction: f64,
-}
-
-impl Lag {
-    /// No delay at all.
-    pub const NONE: Lag = Lag {
-        ticks: 0,
-        fraction: 0.0,
-    };
-
-    /// A latency of `latency_s` (s) at sample period `period_s` (s), split
-    /// into whole ticks and a fraction. A latency within a part in 1e9 of a
-    /// whole number of ticks is that number (a period's rounding must not
-    /// make a tick of `0.999...`).
-    pub fn of(latency_s: f64, period_s: f64) -> Lag {
-        let ticks = latency_s / period_s;
-        let mut whole = ticks.floor();
-        let mut fraction = ticks - whole;
-        if fraction > 1.0 - 1e-9 {
-            (whole, fraction) = (whole + 1.0, 0.0);
-        } else if fraction < 1e-9 {
-            fraction = 0.0;
-        }
-        Lag {
-            ticks: whole as u32,
-            fraction,
-        }
-    }
-
-    /// `ticks + fraction` ticks of `period_s` (s): the total delay (s).
-    pub fn seconds(&self, period_s: f64) -> f64 {
-        (self.ticks as f64 + self.fraction) * period_s
-    }
-}
 
 /// Where the paper's Excalibur model lives in this repository.
 pub const EXCALIBUR_PATH: &str = "models/excalibur.toml";

@@ -10,6 +10,7 @@ mod interval;
 mod pose;
 mod proof;
 mod report;
+mod rigid;
 mod search;
 mod symmetry;
 mod taylor;

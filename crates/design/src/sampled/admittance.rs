@@ -19,7 +19,7 @@
 //! bound, where the base-band hand can bring the regulated device to the
 //! edge of resonance (`w` near `w_p`) and the first grows as `1/ω²`.
 
-use super::{alias_count, each_alias_pair, latency, tail_sum, AliasCache, Flow, TAIL_SHARE};
+use super::{alias_count, each_alias_pair, tail_sum, AliasCache, Flow, TAIL_SHARE};
 use crate::network::{admittance_display, design_bound, HumanBound};
 use crate::{Plant, PlantPoint};
 use num_complex::Complex64;
@@ -81,7 +81,7 @@ impl Base {
     fn at(p: &PlantPoint, human: Option<HumanBound>) -> Option<Base> {
         let y0 = p.y[0][0] + human.map_or(Complex64::new(0.0, 0.0), |h| h.admittance(p.s));
         // (The held force, delayed by the latency, drives the handle.)
-        let lag = latency(p, p.omega);
+        let lag = p.latency();
         let a0 = -(p.y[1][0] * p.y[0][1]) / (p.omega * p.omega) * lag;
         (y0.re > 0.0 && a0.norm() > 0.0).then(|| Base {
             a0,
@@ -167,7 +167,7 @@ fn alias_disks(
         for a in pair {
             // a_k = P/(jω)² and f_k = F_mh Y_ha/(jω), without a division.
             let inv = 1.0 / a.omega;
-            let lag = latency(p, a.omega);
+            let lag = p.latency_at(a.omega);
             let ak = a.p * -(inv * inv) * lag;
             let fk = Complex64::new(a.fy.im * inv, -a.fy.re * inv) * lag;
             let bk = fk - rho * ak;

@@ -175,13 +175,6 @@ fn each_alias_pair(
     true
 }
 
-/// The latency's phase at alias frequency `omega` (rad/s): the held force
-/// reaches the handle `e^{-jωτ}` later at each alias, a different turn at
-/// each when `τ` is not a whole tick.
-fn latency(p: &PlantPoint, omega: f64) -> Complex64 {
-    PlantPoint { omega, ..*p }.latency()
-}
-
 /// `Σ_{|k|>N} 1/(θ + 2πk)²` is at most this (for `0 <= θ <= π`).
 fn tail_sum(n: usize) -> f64 {
     2.0 / (4.0 * PI * PI * (n as f64 - 0.5))
@@ -208,7 +201,7 @@ fn impedance_alias_terms(
         let mut ratio = 0.0f64;
         for a in pair {
             let wt = a.omega * t;
-            let re = (rot * latency(p, a.omega) * a.p).re;
+            let re = (rot * p.latency_at(a.omega) * a.p).re;
             sum += s2 / (wt * wt) * (a.p_abs + re) / (2.0 * a.re_yhh);
             ratio = ratio.max(a.p_abs / a.re_yhh);
         }
