@@ -27,6 +27,7 @@ use twoport_design::linkage::{
     bounded_workspace_design, verify_linkage, HandAssumption, PoseDynamics,
 };
 use twoport_design::network::HumanBound;
+use twoport_design::Lag;
 use twoport_identify::log::Log;
 use twoport_identify::pose::fit::{fit, POSE_DOUBT};
 use twoport_identify::pose::PoseMeasured;
@@ -135,7 +136,7 @@ fn closes(device: Device, ident: &PoseDynamics, set: &[PoseDynamics], heavy_tol:
         human: Some(HumanBound::PAPER),
     };
     let period = device.file().unwrap().period_s;
-    let v = verify_linkage(&[&truth], &hands, (k_robust, 0.0), period).unwrap();
+    let v = verify_linkage(&[&truth], &hands, (k_robust, 0.0), (period, Lag::NONE)).unwrap();
     assert!(!v.unstable, "{device:?}: {v}");
     Closed {
         k_true,

@@ -54,13 +54,6 @@ pub(crate) fn verify_linkage(a: &ImpedanceGains) -> Reported {
     };
     use twoport_design::network::HumanBound;
     let file = linkage_file(&a.common)?;
-    if file.latency_s > 0.0 {
-        return Err(
-            "--latency: verify's loops of a linkage hold the torques at the sample \
-             (no latency) yet; verify one pose's model with --model and --latency"
-                .into(),
-        );
-    }
     let (k, b) = (gain("k", a.k)?, gain("b", a.b)?);
     let grasp = match a.min_grasp {
         Some(g) if !(g.is_finite() && g >= 0.0) => {
@@ -92,7 +85,7 @@ pub(crate) fn verify_linkage(a: &ImpedanceGains) -> Reported {
         min_grasp_nspm: grasp,
         human,
     };
-    let v = verify_linkage(&sample, &assumption, (k, b), file.period_s)
+    let v = verify_linkage(&sample, &assumption, (k, b), (file.period_s, file.lag()))
         .ok_or("no pose could be searched")?;
     reported(v)
 }

@@ -27,5 +27,5 @@ pub mod verify;
 pub use designer::Designer;
 pub use device::{Device, DeviceAxis};
 pub use error::Error;
-pub use model::{DeviceModel, ModelError};
+pub use model::{DeviceModel, Lag, ModelError};
 pub use plant::{Plant, PlantPoint};

@@ -606,7 +606,8 @@ mod tests {
     /// holding hand leaves at the binding pose, with the force held half a
     /// tick late in `verify`'s exact loop, holds at the certificate and
     /// breaks 20% past `2b/((1 + α)² T)` (as the hands-off test does: the
-    /// PHANToM's 0.004 N s/m rings too slowly to break 2% past).
+    /// PHANToM's 0.004 N s/m rings too slowly to break 2% past); so does
+    /// the whole linkage at that pose in `verify --device`'s loop.
     #[test]
     #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
     fn a_latency_scales_each_linkages_certificate_as_a_rigid_devices() {
@@ -634,6 +635,25 @@ mod tests {
             assert!(!at.unstable, "{name}: {at:?}");
             let exact = 2.0 * d.binding.damping_nspm / (1.5 * 1.5 * l.period_s);
             let past = v(exact * 1.2);
+            assert!(past.unstable, "{name}: {past:?}");
+            // The whole linkage at the binding pose, every hand's direction
+            // searched, the torques held half a tick late: the same.
+            let hands = crate::linkage::verify::HandAssumption {
+                min_grasp_nspm: 0.0,
+                human: None,
+            };
+            let linkage = |k: f64| {
+                crate::linkage::verify::verify_linkage(
+                    &[&d.binding.pose],
+                    &hands,
+                    (k, 0.0),
+                    (l.period_s, l.lag()),
+                )
+                .unwrap()
+            };
+            let at = linkage(d.k_c_npm * 0.999);
+            assert!(!at.unstable, "{name}: {at:?}");
+            let past = linkage(exact * 1.2);
             assert!(past.unstable, "{name}: {past:?}");
         }
     }

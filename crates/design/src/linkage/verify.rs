@@ -5,8 +5,9 @@
 //! With a hand of mass, damping and stiffness matrices on it (held at the
 //! handle, or behind the paper's `Z_max` spring and damper when the grasp
 //! is bounded), device and hand are discretised together exactly under the
-//! zero-order hold, and the coupling `k_c + b_c (1 - z^-1)/T` to a rigid VE
-//! closes the loop. It is stable iff the one-tick transition matrix has
+//! zero-order hold (delayed by the file's latency: whole ticks, and a
+//! fraction of one inside which the previous force still acts), and the
+//! coupling `k_c + b_c (1 - z^-1)/T` to a rigid VE closes the loop. It is stable iff the one-tick transition matrix has
 //! spectral radius below 1. The search maximises that radius over hands
 //! that act along a direction `u` (mass `m u u^T`, damping `d u u^T`,
 //! stiffness `k u u^T`) and hold every other direction with a stiffness
@@ -17,6 +18,7 @@
 
 use super::pose::PoseDynamics;
 use crate::linalg::expm_balanced;
+use crate::model::Lag;
 use crate::network::HumanBound;
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -98,13 +100,13 @@ pub struct HandAssumption {
 }
 
 /// The spectral radius of the loop at `pose` with `hand`, coupling
-/// `(k_c, b_c)` and period `t`.
+/// `(k_c, b_c)`, period `t` (s) and the force held back by `lag`.
 pub fn loop_radius(
     pose: &PoseDynamics,
     hand: &LinkageHand,
     assumption: &HandAssumption,
     (kc, bc): (f64, f64),
-    t: f64,
+    (t, lag): (f64, Lag),
 ) -> Option<f64> {
     let n = pose.q_rad.len();
     let i = DMatrix::<f64>::identity(n, n);
@@ -151,20 +153,59 @@ pub fn loop_radius(
             put(3, 3, &(-&mpinv * (&d_h + &i * bz)));
         }
     }
-    let e = expm_balanced(&(big * t)).ok()?;
-    let ad = e.view((0, 0), (s, s)).into_owned();
-    let bd = e.view((0, s), (s, n)).into_owned();
-    // f_n = -k_c x_n - b_c (x_n - x_{n-1})/T; the state gains x_prev.
-    let mut gain = DMatrix::zeros(n, s + n);
+    // Over a tick the force computed `d` ticks ago acts after `α T`, the
+    // one before it until then: x' = A_d x + B_now f[n-d] + B_prev f[n-d-1].
+    let hold = |span: f64| -> Option<(DMatrix<f64>, DMatrix<f64>)> {
+        let e = expm_balanced(&(&big * span)).ok()?;
+        Some((
+            e.view((0, 0), (s, s)).into_owned(),
+            e.view((0, s), (s, n)).into_owned(),
+        ))
+    };
+    let (ad, b_now, b_prev) = if lag.fraction > 0.0 {
+        let (a_rest, b_rest) = hold((1.0 - lag.fraction) * t)?;
+        let (a_tau, b_tau) = hold(lag.fraction * t)?;
+        (&a_rest * a_tau, b_rest, Some(&a_rest * b_tau))
+    } else {
+        let (ad, bd) = hold(t)?;
+        (ad, bd, None)
+    };
+    // The state: [x (s), x_prev (n), f[n-1], ..., f[n-L]] with L forces
+    // held back, so that f[n-d] and f[n-d-1] are at hand.
+    let d = lag.ticks as usize;
+    let held = d + usize::from(b_prev.is_some());
+    let size = s + n + held * n;
+    // f_n = -k_c x_n - b_c (x_n - x_{n-1})/T.
+    let mut gain = DMatrix::zeros(n, size);
     for j in 0..n {
         gain[(j, j)] = -(kc + bc / t);
         gain[(j, s + j)] = bc / t;
     }
-    let mut cl = DMatrix::zeros(s + n, s + n);
-    let top = &ad * DMatrix::identity(s, s + n) + &bd * gain;
-    cl.view_mut((0, 0), (s, s + n)).copy_from(&top);
+    // The force `ago` ticks back, as a map of the state.
+    let force = |ago: usize| -> DMatrix<f64> {
+        if ago == 0 {
+            return gain.clone();
+        }
+        let mut m = DMatrix::zeros(n, size);
+        m.view_mut((0, s + n + (ago - 1) * n), (n, n))
+            .copy_from(&DMatrix::identity(n, n));
+        m
+    };
+    let mut cl = DMatrix::zeros(size, size);
+    let mut top = &ad * DMatrix::identity(s, size) + &b_now * force(d);
+    if let Some(b_prev) = &b_prev {
+        top += b_prev * force(d + 1);
+    }
+    cl.view_mut((0, 0), (s, size)).copy_from(&top);
     for j in 0..n {
         cl[(s + j, j)] = 1.0;
+    }
+    if held > 0 {
+        cl.view_mut((s + n, 0), (n, size)).copy_from(&gain);
+        for k in 1..held {
+            cl.view_mut((s + n + k * n, s + n + (k - 1) * n), (n, n))
+                .copy_from(&DMatrix::identity(n, n));
+        }
     }
     let r = crate::linalg::eigenvalues(&cl)?
         .iter()
@@ -211,12 +252,13 @@ fn hand_at(n: usize, p: &[f64]) -> LinkageHand {
 }
 
 /// Search `poses` (the first is the binding pose) for a hand that makes
-/// the loop at coupling `(k_c, b_c)` grow.
+/// the loop at coupling `(k_c, b_c)` grow, at `timing`'s period (s) and
+/// latency.
 pub fn verify_linkage(
     poses: &[&PoseDynamics],
     assumption: &HandAssumption,
     (kc, bc): (f64, f64),
-    t: f64,
+    timing: (f64, Lag),
 ) -> Option<LinkageVerdict> {
     let mut best: Option<(f64, usize, Vec<f64>)> = None;
     let mut evaluations = 0;
@@ -228,7 +270,7 @@ pub fn verify_linkage(
                 *x = x.clamp(lo, hi);
             }
             evaluations += 1;
-            loop_radius(pose, &hand_at(n, p), assumption, (kc, bc), t).unwrap_or(0.0)
+            loop_radius(pose, &hand_at(n, p), assumption, (kc, bc), timing).unwrap_or(0.0)
         };
         // Directions: the least damped, the other eigenvectors of D_x, and
         // of M_x.
@@ -297,10 +339,21 @@ mod tests {
                 let sample: Vec<&PoseDynamics> = std::iter::once(&d.binding.pose)
                     .chain(poses.iter().step_by(25))
                     .collect();
-                let at = verify_linkage(&sample, &a, (0.999 * d.k_c_npm, 0.0), l.period_s).unwrap();
+                let at = verify_linkage(
+                    &sample,
+                    &a,
+                    (0.999 * d.k_c_npm, 0.0),
+                    (l.period_s, Lag::NONE),
+                )
+                .unwrap();
                 assert!(!at.unstable, "{name}, {a:?}: {at:?}");
-                let past =
-                    verify_linkage(&sample[..1], &a, (1.2 * d.k_c_npm, 0.0), l.period_s).unwrap();
+                let past = verify_linkage(
+                    &sample[..1],
+                    &a,
+                    (1.2 * d.k_c_npm, 0.0),
+                    (l.period_s, Lag::NONE),
+                )
+                .unwrap();
                 assert!(past.unstable, "{name}, {a:?}: 20 % past: {past:?}");
             }
         }
@@ -318,7 +371,13 @@ mod tests {
             min_grasp_nspm: 0.0,
             human: None,
         };
-        let v = verify_linkage(&[&d.binding.pose], &a, (7.5634, 0.0), l.period_s).unwrap();
+        let v = verify_linkage(
+            &[&d.binding.pose],
+            &a,
+            (7.5634, 0.0),
+            (l.period_s, Lag::NONE),
+        )
+        .unwrap();
         assert!(v.unstable, "{v:?}");
     }
 }
