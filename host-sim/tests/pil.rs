@@ -389,8 +389,10 @@ fn the_board_states_its_spec_and_a_scene_at_another_period_is_refused() {
     let twoport_link::ProvenRegion::MaxStiffness { k_max_npm, .. } = axis.region else {
         panic!("{:?}", axis.region)
     };
-    // The paper's coupling is inside it.
-    assert!(k_max_npm >= 51_000.0, "{k_max_npm}");
+    // The image's coupling is inside it, and the spec states the latency
+    // the region is proven for.
+    assert!(k_max_npm >= excalibur::COUPLING.k_npm, "{k_max_npm}");
+    assert_eq!(spec.latency_budget_s, excalibur::region::LATENCY_S);
 
     let e = refusal("period_s=0.0005");
     assert!(e.to_string().contains("period_s"), "{e}");

@@ -136,7 +136,7 @@ fn a_linkage_board_refuses_homing_and_a_pose_it_cannot_serve() {
 #[test]
 fn the_images_are_their_device_files_and_their_proof() {
     use twoport_board::linkage::{region, GRASP_NSPM, PERIOD_S};
-    use twoport_design::linkage::{certified_design_from, least_damping, Geometry};
+    use twoport_design::linkage::{certified_design_from, least_damping, Geometry, LinkageFile};
     for device in [Device::SerialArm, Device::Delta] {
         let file = device.file().unwrap();
         let spec = device.spec();
@@ -197,8 +197,18 @@ fn the_images_are_their_device_files_and_their_proof() {
             least.bound
         );
         let r = region(spec).unwrap();
-        // On its grid the region is the proof; between grid points, the
-        // stiffer neighbour's less 1 %, never more than the proof.
+        // Proven for the image's latency, which the file leaves out.
+        assert_eq!(r.latency_s(), twoport_board::linkage::LATENCY_S);
+        let file = LinkageFile {
+            latency_s: f64::from(twoport_board::linkage::LATENCY_S),
+            ..file
+        };
+        // On its grid the region is Colgate's bound over `1 + 3α` for the
+        // latency: never more than the proof. With no coupling damping it
+        // is within 1.5 % of it (at α = 0.1 the proof's denominator is
+        // 1.285); with some, the proof gives more (the latency turns the
+        // coupling's damper less than the device's own). Between grid
+        // points, the stiffer neighbour's less 1 %.
         let total = spec.least_damping_nspm + GRASP_NSPM;
         let grid = (0..5).map(|i| 0.01 + 0.24 * total * i as f32);
         for (b_c, on_grid) in grid.map(|b| (b, true)).chain([(0.5, false), (1.3, false)]) {
@@ -206,11 +216,8 @@ fn the_images_are_their_device_files_and_their_proof() {
                 certified_design_from(&file, &least, f64::from(b_c), f64::from(GRASP_NSPM), None)
                     .unwrap();
             let kmax = f64::from(r.limit_at(b_c).unwrap());
-            let ok = if on_grid {
-                (kmax - d.k_c_npm).abs() <= 1e-4 * d.k_c_npm
-            } else {
-                kmax <= d.k_c_npm
-            };
+            let tight = on_grid && b_c < 0.1;
+            let ok = kmax <= d.k_c_npm && (!tight || kmax >= 0.985 * d.k_c_npm);
             assert!(
                 ok,
                 "{device:?} at b_c {b_c}: the region allows {kmax}, the proof {}",

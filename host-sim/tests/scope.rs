@@ -38,7 +38,7 @@ fn imp(k_npm: f32, b_nspm: f32) -> Gains {
 #[test]
 fn the_stiffness_slider_changes_the_running_simulations_gain() {
     let mut h = harness();
-    assert_eq!(h.state().0.running_gains(), imp(51_000.0, 90.0));
+    assert_eq!(h.state().0.running_gains(), imp(43_500.0, 90.0));
     h.get_by_role_and_label(Role::Slider, "k_c (N/m)")
         .set_value_accesskit(30_000.0);
     h.run();

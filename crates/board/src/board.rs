@@ -89,6 +89,8 @@ pub struct Board<W, const R: usize, const N: usize = 1, L = Direct, D = Servo<W,
     link_bytes_per_s: Option<u32>,
     /// The rate of the count `cycles` gives (Hz), where the image knows it.
     count_hz: Option<u32>,
+    /// The greatest latency, in that count, the regions are proven for.
+    late_after: Option<u32>,
     /// The dead-man switch at the last tick (open before the first).
     dead_man_closed: bool,
     /// Whether the amplifier's outputs are on (as last commanded).
@@ -120,15 +122,15 @@ struct Timing {
 
 impl Timing {
     /// A tick that started (sampled) at `start`, ran its stages through
-    /// the instants `t` and wrote the amplifiers' command at `written`,
-    /// against a period of `period` (0: unchecked).
-    fn record(&mut self, start: u32, t: [u32; 3], written: u32, period: u32) {
+    /// the instants `t` and whose force reached the device `latency` after
+    /// its sample, against a period of `period` (0: unchecked).
+    fn record(&mut self, start: u32, t: [u32; 3], latency: u32, period: u32) {
         self.stages = [
             t[0].wrapping_sub(start),
             t[1].wrapping_sub(t[0]),
             t[2].wrapping_sub(t[1]),
         ];
-        self.worst_latency = self.worst_latency.max(written.wrapping_sub(start));
+        self.worst_latency = self.worst_latency.max(latency);
         if period > 0 {
             let took = t[2].wrapping_sub(start);
             let late = self.last_start.is_some_and(|s0| {
@@ -192,6 +194,7 @@ where
             workspace: [None; N],
             link_bytes_per_s: None,
             count_hz: None,
+            late_after: None,
             dead_man_closed: false,
             outputs_on: false,
             config_source: None,
@@ -229,9 +232,29 @@ where
     /// [`cycles`](BoardSupport::cycles) count (Hz: its core clock; in an
     /// emulator that counts instructions, the core clock at one cycle per
     /// instruction), so that its spec gives its latency in seconds.
+    ///
+    /// Knowing it, the board holds its latency to what its regions are
+    /// proven for: a force that reaches the device later latches
+    /// [`Faults::LATE_FORCE`], and from the next tick on the force is zero.
     pub fn with_count_rate(mut self, hz: u32) -> Self {
         self.count_hz = Some(hz);
+        // (f64: a budget of microseconds at a GHz count is exact.)
+        let counts = f64::from(self.latency_budget_s()) * f64::from(hz);
+        self.late_after = Some(if counts < f64::from(u32::MAX) {
+            counts as u32
+        } else {
+            u32::MAX
+        });
         self
+    }
+
+    /// The latency from sampling to the force (s) every axis's region is
+    /// proven for.
+    pub fn latency_budget_s(&self) -> f32 {
+        self.regions
+            .iter()
+            .map(|r| r.latency_s())
+            .fold(f32::INFINITY, f32::min)
     }
 
     /// The same board driven by sensor frames from the link (processor in
@@ -549,8 +572,14 @@ where
         let end = io.cycles();
         self.loop_cycles = end.wrapping_sub(start);
         let period = io.cycles_per_tick();
+        let latency = io
+            .force_latency()
+            .unwrap_or_else(|| written.wrapping_sub(start));
         self.timing
-            .record(start, [sensed, ruled, end], written, period);
+            .record(start, [sensed, ruled, end], latency, period);
+        if self.outputs_on && self.late_after.is_some_and(|budget| latency > budget) {
+            self.servo.servo_mut().trip(Faults::LATE_FORCE);
+        }
         out
     }
 

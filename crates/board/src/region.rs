@@ -29,6 +29,9 @@ pub struct Region<const N: usize> {
     regulator: Option<(f32, f32)>,
     /// Relative margin taken off (or added to) interpolated limits.
     margin: f32,
+    /// The latency from sampling to the force (s) the limits are proven
+    /// for: a board whose force comes later than this is outside them.
+    latency_s: f32,
 }
 
 /// Why a region could not be built.
@@ -39,6 +42,8 @@ pub enum RegionError {
     Grid,
     /// A limit is not finite and positive.
     Limit,
+    /// The latency is not finite and at least zero.
+    Latency,
 }
 
 impl<const N: usize> Region<N> {
@@ -65,7 +70,24 @@ impl<const N: usize> Region<N> {
             limit,
             regulator,
             margin: 0.01,
+            latency_s: 0.0,
         })
+    }
+
+    /// The same region, its limits proven for a latency of `latency_s`
+    /// (s) from sampling to the force (default: none).
+    pub fn with_latency(mut self, latency_s: f32) -> Result<Self, RegionError> {
+        if !(latency_s.is_finite() && latency_s >= 0.0) {
+            return Err(RegionError::Latency);
+        }
+        self.latency_s = latency_s;
+        Ok(self)
+    }
+
+    /// The latency from sampling to the force (s) its limits are proven
+    /// for.
+    pub fn latency_s(&self) -> f32 {
+        self.latency_s
     }
 
     /// What it bounds.
@@ -273,5 +295,10 @@ mod tests {
             Region::new(Bound::MinMass, [1.0, 2.0], [1.0, f32::NAN], None),
             Err(RegionError::Limit)
         );
+        assert_eq!(r.latency_s(), 0.0);
+        assert_eq!(r.with_latency(25e-6).map(|r| r.latency_s()), Ok(25e-6));
+        for bad in [-1e-6, f32::NAN, f32::INFINITY] {
+            assert_eq!(r.with_latency(bad), Err(RegionError::Latency));
+        }
     }
 }

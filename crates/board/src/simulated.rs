@@ -63,6 +63,10 @@ pub struct Simulated<S, const N: usize> {
     v_mps: [f32; N],
     duty: [i16; N],
     outputs_on: bool,
+    /// When the last sample's sensors were latched, and when the force
+    /// computed from them was applied, in the inner support's count.
+    latched: u32,
+    applied: Option<u32>,
 }
 
 impl<S, const N: usize> Simulated<S, N> {
@@ -85,6 +89,8 @@ impl<S, const N: usize> Simulated<S, N> {
             v_mps: [0.0; N],
             duty: [0; N],
             outputs_on: false,
+            latched: 0,
+            applied: None,
         }
     }
 
@@ -142,7 +148,7 @@ impl<S: BoardSupport<N>, const N: usize> BoardSupport<N> for Simulated<S, N> {
                 }
             }
         }
-        RawSensors {
+        let raw = RawSensors {
             encoder_raw: core::array::from_fn(|i| self.count(self.x_m[i])),
             load_cell_counts: core::array::from_fn(|i| {
                 let hand = if self.outputs_on {
@@ -154,12 +160,22 @@ impl<S: BoardSupport<N>, const N: usize> BoardSupport<N> for Simulated<S, N> {
             }),
             dead_man_closed: true,
             index_raw: [None; N],
-        }
+        };
+        // The simulated sensors are latched once the device's step is
+        // done: the step is the device's time, not the loop's latency.
+        self.latched = self.inner.cycles();
+        self.applied = None;
+        raw
     }
 
     fn set_duty(&mut self, duty: [i16; N]) {
+        self.applied = Some(self.inner.cycles());
         self.duty = duty;
         self.inner.set_duty(duty);
+    }
+
+    fn force_latency(&self) -> Option<u32> {
+        self.applied.map(|a| a.wrapping_sub(self.latched))
     }
 
     fn set_outputs(&mut self, on: bool) {

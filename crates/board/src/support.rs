@@ -65,4 +65,13 @@ pub trait BoardSupport<const N: usize = 1> {
     /// deadline and jitter checks; 0 where the host paces the ticks
     /// (processor in the loop) or there is no count.
     fn cycles_per_tick(&self) -> u32;
+    /// The latency, in [`cycles`](Self::cycles)' count, of the force the
+    /// device applied at this tick's [`sample`](Self::sample), where the
+    /// device applies a command later than [`set_duty`](Self::set_duty)
+    /// (a device on a bus takes the command with its next exchange). `None`
+    /// (the default): the amplifiers take it at `set_duty`, and the loop
+    /// times the latency itself.
+    fn force_latency(&self) -> Option<u32> {
+        None
+    }
 }

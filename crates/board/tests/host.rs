@@ -79,6 +79,7 @@ fn the_spec_names_the_limits_and_the_region_and_the_stream_follows_the_host() {
         link_bytes_per_s: None,
         count_hz: None,
         worst_latency_cycles: 0,
+        latency_budget_s: 0.0,
         axes: Axes::one(AxisSpec {
             peak_force_n: s.peak_force_n,
             continuous_force_n: s.continuous_force_n,

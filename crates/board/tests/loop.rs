@@ -413,6 +413,73 @@ impl Io {
     }
 }
 
+/// A board that knows its count's rate holds its latency to its region's:
+/// at 7 MHz a region proven for 3 µs allows 21 counts, what a tick of
+/// three 7-count looks takes. Disarmed, a slower tick latches nothing (no
+/// force goes out); armed, the first tick whose force comes 24 counts
+/// after its sample latches "force late", and the next tick's force is
+/// zero. A board that does not know its count's rate checks nothing.
+#[test]
+fn a_force_later_than_the_region_allows_faults_to_zero() {
+    let region = common::region().with_latency(3e-6).unwrap();
+    let run = |rate: Option<u32>| {
+        let b = common::board_in(region, 51_000.0, safety(), 0);
+        let mut b = match rate {
+            Some(hz) => b.with_count_rate(hz),
+            None => b,
+        };
+        assert_eq!(b.spec().latency_budget_s, 3e-6);
+        let mut io = Io {
+            sensors: RawSensors {
+                encoder_raw: [0],
+                load_cell_counts: [0],
+                dead_man_closed: true,
+                index_raw: [None],
+            },
+            ..Io::default()
+        };
+        io.queue(
+            0,
+            Message::Calibrate {
+                position_pm: Axes::one(0),
+            },
+        );
+        let tick = |b: &mut common::TestBoard, io: &mut Io, k: u16| {
+            io.queue(1 + k, Message::Heartbeat);
+            b.poll_link(io);
+            let out = b.control_tick(io);
+            b.flush(io);
+            out
+        };
+        // Disarmed and slow: no force, nothing latched.
+        io.step = 8;
+        assert!(tick(&mut b, &mut io, 0).faults.is_empty());
+        io.step = 7;
+        io.queue(100, Message::Arm);
+        let mut outs = vec![tick(&mut b, &mut io, 1)];
+        // Armed at rest, then the handle moves 30 µm off the constraint.
+        io.sensors.encoder_raw = [30];
+        outs.extend((2..200).map(|k| tick(&mut b, &mut io, k)));
+        assert!(outs.iter().all(|o| o.faults.is_empty()), "on time");
+        assert!(outs.last().unwrap().actuator_force_n[0].abs() > 1.0);
+        io.step = 8;
+        outs.push(tick(&mut b, &mut io, 200));
+        io.step = 7;
+        outs.push(tick(&mut b, &mut io, 201));
+        (outs, *io.duties.last().unwrap(), b.spec())
+    };
+    let (outs, duty, spec) = run(Some(7_000_000));
+    let [late, after] = [&outs[outs.len() - 2], &outs[outs.len() - 1]];
+    // The late tick's force is out when it is measured; the next is zero.
+    assert!(late.actuator_force_n[0].abs() > 1.0);
+    assert!(after.faults.contains(Faults::LATE_FORCE), "{after:?}");
+    assert_eq!((after.actuator_force_n[0], duty), (0.0, 0));
+    assert_eq!(spec.worst_latency_cycles, 24);
+    let (outs, duty, _) = run(None);
+    assert!(outs.iter().all(|o| o.faults.is_empty()));
+    assert_ne!(duty, 0);
+}
+
 #[test]
 fn a_pil_board_ticks_once_per_sensor_frame_and_answers_with_the_duty() {
     let mut b = board().with_pil(true);

@@ -231,9 +231,9 @@ fn calibration_and_gains_are_refused_per_axis_by_name() {
     };
     let before = b.config();
     io.say(Message::SetGains(
-        Axes::new([g(40_000.0), g(90_000.0), g(40_000.0)]).unwrap(),
+        Axes::new([g(25_000.0), g(90_000.0), g(25_000.0)]).unwrap(),
     ));
-    io.say(Message::SetGains(Axes::one(g(40_000.0))));
+    io.say(Message::SetGains(Axes::one(g(25_000.0))));
     tick(&mut b, &mut io);
     let replies: Vec<_> = io
         .heard()
@@ -254,9 +254,9 @@ fn calibration_and_gains_are_refused_per_axis_by_name() {
         }
     );
     assert_eq!(b.config(), before, "a refused change changes no axis");
-    io.say(Message::SetGains(Axes::new([g(40_000.0); 3]).unwrap()));
+    io.say(Message::SetGains(Axes::new([g(25_000.0); 3]).unwrap()));
     tick(&mut b, &mut io);
-    assert!(b.config().iter().all(|c| c.gains == g(40_000.0)));
+    assert!(b.config().iter().all(|c| c.gains == g(25_000.0)));
 }
 
 /// Armed, with the hand pressing the cursor into the cube's face along x

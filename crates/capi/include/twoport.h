@@ -222,6 +222,11 @@ typedef struct TpSpec {
    */
   double worst_latency_s;
   /**
+   * The latency from sampling to the force (s) the proven regions
+   * allow: a board that times its loop faults past it ("force late").
+   */
+  double latency_budget_s;
+  /**
    * The board's axes (1 to `TP_MAX_AXES`).
    */
   uint8_t axes;

@@ -155,8 +155,8 @@ pub unsafe extern "C" fn tp_board_open_simulated(hand_n: f32, out: *mut *mut TpB
     })
 }
 
-/// Open the shipped Excalibur image's loop on the PC, in a thread of its
-/// own, against a simulated device exchanged with as a USB device is (the
+/// Open the Excalibur's PC image (its region proven for up to 5 ms from
+/// sample to force) on the PC's loop, in a thread of its own, against a simulated device exchanged with as a USB device is (the
 /// path a Falcon or a Haply board takes), the hand pushing `hand_n` (N)
 /// along +x while the outputs are on.
 ///

@@ -132,6 +132,9 @@ pub struct TpSpec {
     /// the amplifiers' command (s), when the spec was read: the latency
     /// inside the tick. NaN where the board does not give its count's rate.
     pub worst_latency_s: f64,
+    /// The latency from sampling to the force (s) the proven regions
+    /// allow: a board that times its loop faults past it ("force late").
+    pub latency_budget_s: f64,
     /// The board's axes (1 to `TP_MAX_AXES`).
     pub axes: u8,
     /// Each axis's, the first `axes` of them.
@@ -239,6 +242,7 @@ impl From<&Spec> for TpSpec {
             linkage: s.linkage,
             link_bytes_per_s: s.link_bytes_per_s.unwrap_or(0),
             worst_latency_s: s.worst_latency_s().unwrap_or(f64::NAN),
+            latency_budget_s: f64::from(s.latency_budget_s),
             axes: s.axes.len() as u8,
             axis,
         }

@@ -35,6 +35,7 @@ pub(crate) fn region(
         &r.rows,
         r.bound == RegionBound::MaxStiffness,
         r.regulator,
+        r.context.latency_s,
         &format!("twoport {how}"),
     );
     Ok(Box::new(RustSource(match axis {

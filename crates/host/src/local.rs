@@ -98,7 +98,11 @@ impl LocalFast {
     }
 }
 
-impl LocalBoard<xyz::XyzWorld, 3> {
+/// The three-axis image's loop.
+pub type LocalXyz =
+    LocalBoard<xyz::XyzWorld, 3, Direct, Servo<xyz::XyzWorld, f32, 3>, { xyz::REGION_POINTS }>;
+
+impl LocalXyz {
     /// The three-axis image ([`xyz::board`]).
     pub fn excalibur_xyz() -> Result<Self, LinkError> {
         xyz::board()

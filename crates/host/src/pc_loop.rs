@@ -151,6 +151,8 @@ struct PcSupport<Io, const N: usize> {
     /// had by the end of this one (s; 0 before the second).
     exchanged: Option<Instant>,
     latency_s: f64,
+    /// The same latency in the board's count (ns), once there is one.
+    latency_ns: Option<u32>,
     start: Instant,
     period_ns: u32,
 }
@@ -181,7 +183,9 @@ impl<Io: DeviceIo<N>, const N: usize> BoardSupport<N> for PcSupport<Io, N> {
         }
         self.io_s = t.elapsed().as_secs_f64();
         if let Some(before) = self.exchanged.replace(t) {
-            self.latency_s = before.elapsed().as_secs_f64();
+            let latency = before.elapsed();
+            self.latency_s = latency.as_secs_f64();
+            self.latency_ns = Some(u32::try_from(latency.as_nanos()).unwrap_or(u32::MAX));
         }
         self.last
     }
@@ -208,6 +212,11 @@ impl<Io: DeviceIo<N>, const N: usize> BoardSupport<N> for PcSupport<Io, N> {
     fn cycles_per_tick(&self) -> u32 {
         self.period_ns
     }
+    fn force_latency(&self) -> Option<u32> {
+        // The force the device took at this exchange was computed from
+        // the last exchange's sensors.
+        self.latency_ns
+    }
 }
 
 /// A board image's loop on the PC against the device `Io`: the image's
@@ -219,6 +228,12 @@ pub struct PcBoard {
 
 impl PcBoard {
     /// Start `board` ticking every `period_s` (s) against `io`.
+    ///
+    /// The force a tick computes reaches the device at the next tick's
+    /// exchange, so the latency is a period and more: `board`'s regions
+    /// must be proven for it (the Excalibur's for the PC are
+    /// `excalibur::pc`'s, for up to 5 ms). A force later than they allow
+    /// faults the board to zero force ("force late").
     pub fn start<Io, W, L, D, const N: usize, const R: usize>(
         board: Board<W, R, N, L, D>,
         io: Io,
@@ -246,10 +261,14 @@ impl PcBoard {
             io_s: 0.0,
             exchanged: None,
             latency_s: 0.0,
+            latency_ns: None,
             start: Instant::now(),
             period_ns: (period_s * 1e9).round() as u32,
         };
         let period = Duration::from_secs_f64(period_s);
+        // The loop's count is nanoseconds: the board holds the latency it
+        // measures in them to what its regions are proven for.
+        let board = board.with_count_rate(1_000_000_000);
         let thread = std::thread::Builder::new()
             .name("twoport-pc-loop".into())
             .spawn(move || run(board, support, period))

@@ -143,11 +143,12 @@ impl<const N: usize> DeviceIo<N> for SimulatedDevice<N> {
 }
 
 impl PcBoard {
-    /// The shipped Excalibur image's loop on the PC, at its 1 kHz, against
-    /// [`SimulatedDevice::excalibur`] with the hand pushing `hand_n` (N):
-    /// the PC's loop tried without a device.
+    /// The Excalibur's image for the PC (`excalibur::pc`: its region
+    /// proven for up to 5 ms from sample to force) on the PC's loop at
+    /// 1 kHz, against [`SimulatedDevice::excalibur`] with the hand pushing
+    /// `hand_n` (N): the PC's loop tried without a device.
     pub fn excalibur_simulated(hand_n: f32) -> Result<Self, LinkError> {
-        let board = excalibur::stiff_wall_board()
+        let board = excalibur::pc::board()
             .map_err(|e| LinkError::Image(format!("the Excalibur board image: {e:?}")))?;
         PcBoard::start(
             board,

@@ -2,12 +2,18 @@
 //! simulated device, one tick per read: the same run on every machine.
 
 use std::time::Duration;
+use twoport_board::excalibur;
 use twoport_control::Faults;
 use twoport_host::{HostBoard, LinkError, Pace, SimulatedBoard};
 use twoport_link::{BoardMode, Contact, Gains, ProvenRegion, Refusal, VeSource};
 
 /// The wall the host's VE renders (m): solid above.
 const WALL_M: f64 = 0.005;
+
+/// The image's coupling stiffness (N/m).
+fn k_c() -> f64 {
+    f64::from(excalibur::COUPLING.k_npm)
+}
 
 fn open(hand_n: f32) -> HostBoard<SimulatedBoard> {
     HostBoard::open(
@@ -20,7 +26,7 @@ fn open(hand_n: f32) -> HostBoard<SimulatedBoard> {
 /// An application opens the board, reads what it can prove, calibrates,
 /// hands the VE to the host, arms, and sends a wall at 5 mm (solid above)
 /// at 1 kHz against a hand pushing 2 N: the handle stops at the wall,
-/// pressed in by the coupling's spring (2 N / 51,000 N/m = 39 um), and
+/// pressed in by the coupling's spring (2 N / 43,500 N/m = 46 um), and
 /// the board holds every update it was sent.
 #[test]
 fn an_application_renders_a_wall_from_the_host_and_lets_go() {
@@ -33,7 +39,8 @@ fn an_application_renders_a_wall_from_the_host_and_lets_go() {
     let ProvenRegion::MaxStiffness { k_max_npm, .. } = spec.axes[0].region else {
         panic!("{spec:?}")
     };
-    assert!(k_max_npm > 51_000.0);
+    assert!(f64::from(k_max_npm) > k_c());
+    assert_eq!(spec.latency_budget_s, excalibur::region::LATENCY_S);
     b.calibrate(&[0.0]).unwrap();
     b.stream(1).unwrap();
     b.host_ve(1, 20).unwrap();
@@ -55,11 +62,11 @@ fn an_application_renders_a_wall_from_the_host_and_lets_go() {
         .iter()
         .find(|s| s.axes[0].position_m > WALL_M)
         .unwrap();
-    let reach = hit.axes[0].velocity_mps * (0.93f64 / 51_000.0).sqrt();
+    let reach = hit.axes[0].velocity_mps * (0.93 / k_c()).sqrt();
     let last = states.last().unwrap();
     assert_eq!((last.mode, last.faults), (BoardMode::Armed, 0));
     let x = last.axes[0].position_m;
-    let press = 2.0 / 51_000.0;
+    let press = 2.0 / k_c();
     assert!((x - WALL_M - press).abs() < 10e-6, "at {x} m");
     assert!(
         deepest < WALL_M + press + reach,
@@ -188,7 +195,7 @@ fn the_boards_own_wall_is_set_from_the_host() {
         b.poll().unwrap();
     }
     let x = b.latest().unwrap().axes[0].position_m;
-    assert!((x - WALL_M - 2.0 / 51_000.0).abs() < 10e-6, "at {x} m");
+    assert!((x - WALL_M - 2.0 / k_c()).abs() < 10e-6, "at {x} m");
     let e = b.set_ve_param(0, VeParam::Damping(1.0)).unwrap_err();
     assert!(e.to_string().contains("NotDisarmed"), "{e}");
 }

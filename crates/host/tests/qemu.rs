@@ -5,6 +5,7 @@
 //! nothing here counts on how many ticks a second of the host's brings.
 
 use std::time::{Duration, Instant};
+use twoport_board::excalibur;
 use twoport_host::HostBoard;
 use twoport_link::{BoardMode, Contact, ProvenRegion, VeSource};
 
@@ -16,7 +17,8 @@ const WALL_M: f64 = 0.005;
 /// hands the VE to the host, arms, sends a wall at 5 mm (solid above) with
 /// every state it reads for two seconds against the simulated hand, and
 /// disarms: the handle rests on the wall, pressed in by the coupling's
-/// spring, and no fault latched.
+/// spring, no fault latched, and the latency the board measured is inside
+/// the budget its region is proven for.
 #[test]
 #[ignore = "needs the sim-device image in QEMU (cargo xtask device --check)"]
 fn an_application_drives_the_free_running_board_in_qemu() {
@@ -29,8 +31,9 @@ fn an_application_drives_the_free_running_board_in_qemu() {
     );
     assert!(matches!(
         spec.axes[0].region,
-        ProvenRegion::MaxStiffness { k_max_npm, .. } if k_max_npm > 51_000.0
+        ProvenRegion::MaxStiffness { k_max_npm, .. } if k_max_npm > excalibur::COUPLING.k_npm
     ));
+    assert_eq!(spec.latency_budget_s, excalibur::region::LATENCY_S);
     b.calibrate(&[0.0]).unwrap();
     b.stream(1).unwrap();
     // A ramp of one tick, and up to half a second on one update, as the
@@ -49,7 +52,7 @@ fn an_application_drives_the_free_running_board_in_qemu() {
     let last = states.last().copied().unwrap();
     assert_eq!((last.mode, last.faults), (BoardMode::Armed, 0), "{last:?}");
     let x = last.axes[0].position_m;
-    let press = 2.0 / 51_000.0;
+    let press = 2.0 / f64::from(excalibur::COUPLING.k_npm);
     assert!(
         (x - WALL_M - press).abs() < 20e-6,
         "at {x} m after {} states",
@@ -57,5 +60,14 @@ fn an_application_drives_the_free_running_board_in_qemu() {
     );
     assert!(last.ve_seq > 0 && last.ve_seq <= last_seq);
     assert_eq!(b.disarm().unwrap().mode, BoardMode::Disarmed);
+    let spec = b.session().spec().unwrap();
+    let worst = spec
+        .worst_latency_s()
+        .expect("the image states its count's rate");
+    assert!(
+        worst > 0.0 && worst <= f64::from(spec.latency_budget_s),
+        "{worst} s late, {} s allowed",
+        spec.latency_budget_s
+    );
     b.close().unwrap();
 }

@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 /// experiments ([`Message::Identify`]); version 8 tells a host what the
 /// board can do ([`Message::GetSpec`]) and lets it set the telemetry rate
 /// ([`Message::SetStream`]).
-pub const PROTOCOL_VERSION: u16 = 11;
+pub const PROTOCOL_VERSION: u16 = 12;
 
 /// The session number of a board no host has shaken hands with since it
 /// booted. A host opens a session with any other number, and a board

@@ -32,6 +32,10 @@ pub struct Spec {
     /// The longest time since boot from sampling the sensors to writing
     /// the amplifiers' command, in that count (protocol 11).
     pub worst_latency_cycles: u32,
+    /// The latency from sampling to the force (s) the proven regions
+    /// allow: a board that knows its count's rate faults past it, to zero
+    /// force (protocol 12).
+    pub latency_budget_s: f32,
     /// Each Cartesian axis's.
     pub axes: Axes<AxisSpec>,
 }

@@ -135,6 +135,7 @@ fn spec_and_ve_messages() -> Vec<Message> {
             link_bytes_per_s: Some(u32::MAX),
             count_hz: Some(u32::MAX),
             worst_latency_cycles: u32::MAX,
+            latency_budget_s: f32::MAX,
             axes: Axes::new([f32::MAX, 1.0, -0.0].map(|x| AxisSpec {
                 peak_force_n: x,
                 continuous_force_n: x,
@@ -159,6 +160,7 @@ fn spec_and_ve_messages() -> Vec<Message> {
             link_bytes_per_s: None,
             count_hz: None,
             worst_latency_cycles: 0,
+            latency_budget_s: 25e-6,
             axes: Axes::one(AxisSpec {
                 peak_force_n: 200.0,
                 continuous_force_n: 100.0,

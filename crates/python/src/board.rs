@@ -96,8 +96,8 @@ impl Board {
         })
     }
 
-    /// The shipped Excalibur image's loop on the PC, in a thread of its
-    /// own, against a simulated device exchanged with as a USB device is
+    /// The Excalibur's PC image (its region proven for up to 5 ms from
+    /// sample to force) on the PC's loop, in a thread of its own, against a simulated device exchanged with as a USB device is
     /// (the path a Falcon or a Haply board takes), the hand pushing
     /// `hand_n` (N) along +x while the outputs are on.
     #[staticmethod]
@@ -145,6 +145,7 @@ impl Board {
         d.set_item("link_bytes_per_s", s.link_bytes_per_s)?;
         d.set_item("count_hz", s.count_hz)?;
         d.set_item("worst_latency_s", s.worst_latency_s())?;
+        d.set_item("latency_budget_s", s.latency_budget_s)?;
         let axes = pyo3::types::PyList::empty(py);
         for a in s.axes.iter() {
             let x = PyDict::new(py);

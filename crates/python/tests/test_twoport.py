@@ -45,7 +45,7 @@ def test_bad_inputs_are_named():
 def test_a_host_wall_from_python_holds_the_simulated_hand():
     b = twoport.Board.simulated(hand_n=2.0)
     axis = b.spec()["axes"][0]
-    assert axis["display"] == "impedance" and axis["k_max_npm"] > 51_000.0
+    assert axis["display"] == "impedance" and axis["k_max_npm"] > 43_500.0
     lo, hi = axis["b_range_nspm"]
     assert lo == 10.0 and abs(hi - 155.885) < 1e-3
     b.calibrate([0.0])
@@ -61,8 +61,8 @@ def test_a_host_wall_from_python_holds_the_simulated_hand():
     assert x.shape == (len(s["tick"]), 1) and x.dtype == np.float64
     assert len(s["tick"]) > 100
     assert np.all(s["faults"] == 0)
-    # At rest on the wall, 2 N into the 51,000 N/m coupling.
-    assert abs(x[-1, 0] - (0.005 + 2.0 / 51_000.0)) < 10e-6
+    # At rest on the wall, 2 N into the image's 43,500 N/m coupling.
+    assert abs(x[-1, 0] - (0.005 + 2.0 / 43_500.0)) < 10e-6
     b.close()
 
 
@@ -116,7 +116,7 @@ def test_the_boards_own_wall_is_set_from_python():
     b.arm()
     b.run_for(1.0)
     x = b.latest()["position_m"][0]
-    assert abs(x - 0.005 - 2.0 / 51000.0) < 10e-6, x
+    assert abs(x - 0.005 - 2.0 / 43500.0) < 10e-6, x
     with pytest.raises(RuntimeError, match="NotDisarmed"):
         b.set_ve_param(0, "damping", 1.0)
     b.close()
@@ -139,10 +139,17 @@ def test_the_pc_loop_holds_the_images_wall_from_python():
             break
         b.run_for(0.1)
     s = b.latest()
-    assert s["mode"] == "armed" and s["faults"] == 0
-    assert abs(s["position_m"][0] - 0.005 - 2.0 / 51000.0) < 10e-6
-    # The loop's timing, ordered, every statistic of a tick it ran.
     t = b.loop_timing()
+    assert b.spec()["latency_budget_s"] == 5e-3
+    if s["faults"] == 1 << 12:
+        # The machine held a tick back past the 5 ms the PC image's region
+        # is proven for: the board faulted "force late", and said why.
+        assert t["latency_s"]["max"] > 5e-3, t
+    else:
+        # At rest on the wall, 2 N into the PC image's 3,000 N/m coupling.
+        assert s["mode"] == "armed" and s["faults"] == 0
+        assert abs(s["position_m"][0] - 0.005 - 2.0 / 3000.0) < 10e-6
+    # The loop's timing, ordered, every statistic of a tick it ran.
     assert t["ticks"] >= 1000 and 0 <= t["late"] <= t["ticks"]
     for name in ("period_s", "io_s", "latency_s"):
         p = t[name]

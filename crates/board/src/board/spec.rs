@@ -33,6 +33,7 @@ where
             link_bytes_per_s: self.link_bytes_per_s,
             count_hz: self.count_hz,
             worst_latency_cycles: self.timing.worst_latency,
+            latency_budget_s: self.latency_budget_s(),
             axes: Self::axes(axes),
         }
     }

@@ -12,7 +12,8 @@ use twoport_control::homing::HomingConfig;
 use twoport_control::ve::UnilateralWall;
 use twoport_control::{ImpedanceGains, Position, SafetyConfig, Servo};
 
-/// The proven region (impedance display, paper human bound, T = 0.25 ms).
+/// The proven region (impedance display, paper human bound, T = 0.25 ms,
+/// latency 25 µs).
 pub mod region {
     use super::Bound;
     include!("../excalibur_fast_region.rs");
@@ -20,9 +21,9 @@ pub mod region {
 
 /// Control period (s): 4 kHz.
 pub const PERIOD_S: f32 = 2.5e-4;
-/// The coupling: 90% of the stiffest proven at 1,066 N s/m, the region's
-/// point nearest the best pair (627,082 N/m at 1,009 N s/m).
-pub const COUPLING: ImpedanceGains = ImpedanceGains::new(563_000.0, 1_066.019_9);
+/// The coupling: 90% of the stiffest proven at 810 N s/m, the region's
+/// point nearest the best pair (529,763 N/m at 863 N s/m).
+pub const COUPLING: ImpedanceGains = ImpedanceGains::new(476_000.0, 810.0);
 /// Ticks without a host heartbeat before the board forces zero (50 ms, as
 /// the 1 kHz image).
 pub const HEARTBEAT_TIMEOUT_TICKS: u32 = 200;
@@ -45,7 +46,8 @@ pub fn proven_region() -> Result<Region<REGION_POINTS>, RegionError> {
         region::DAMPING_NSPM,
         region::LIMIT,
         region::REGULATOR,
-    )
+    )?
+    .with_latency(region::LATENCY_S)
 }
 
 /// The 4 kHz servo on the wall.

@@ -24,6 +24,16 @@ pub fn region() -> Region<3> {
 /// encoder, with `safety`'s limits and telemetry every `telemetry_every`
 /// ticks (0: none).
 pub fn board(k_npm: f32, safety: SafetyConfig, telemetry_every: u32) -> TestBoard {
+    board_in(region(), k_npm, safety, telemetry_every)
+}
+
+/// [`board`] accepting the gains of `region`.
+pub fn board_in(
+    region: Region<3>,
+    k_npm: f32,
+    safety: SafetyConfig,
+    telemetry_every: u32,
+) -> TestBoard {
     let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
     let s = Servo::new(
         [ImpedanceGains::new(k_npm, 90.0).into()],
@@ -32,5 +42,5 @@ pub fn board(k_npm: f32, safety: SafetyConfig, telemetry_every: u32) -> TestBoar
         BilateralConstraint::new(Position::ZERO),
     )
     .unwrap();
-    Board::new(s, [region()], telemetry_every)
+    Board::new(s, [region], telemetry_every)
 }

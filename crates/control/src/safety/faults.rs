@@ -34,8 +34,11 @@ impl Faults {
     pub const KINEMATICS: Faults = Faults(1 << 10);
     /// The host's VE sent no update within its deadline.
     pub const VE_STALE: Faults = Faults(1 << 11);
+    /// A force reached the device later after its sample than the proven
+    /// gains allow.
+    pub const LATE_FORCE: Faults = Faults(1 << 12);
 
-    const NAMES: [(Faults, &'static str); 12] = [
+    const NAMES: [(Faults, &'static str); 13] = [
         (Faults::SENSOR_NOT_FINITE, "sensor reading not finite"),
         (Faults::SENSOR_OUT_OF_RANGE, "sensor reading out of range"),
         (Faults::ENCODER_INVALID, "encoder value invalid"),
@@ -53,6 +56,10 @@ impl Faults {
         (
             Faults::VE_STALE,
             "host VE late: no update within its deadline",
+        ),
+        (
+            Faults::LATE_FORCE,
+            "force late: the latency passed what the gains are proven for",
         ),
     ];
 

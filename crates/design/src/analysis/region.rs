@@ -31,12 +31,15 @@ fn region(
 /// A proven region as Rust source for a board image (`twoport-board`'s
 /// `Region`): the damping grid, the limits (rounded *toward safety*: a
 /// stiffness down, a mass up, so that the f32 copy never proves more than
-/// the f64 analysis did), and the regulator for an admittance region.
-/// `how` is the command that made it, quoted in the header.
+/// the f64 analysis did), the regulator for an admittance region, and the
+/// latency from sampling to the force the proofs allow (`latency_s`, s:
+/// rounded down, the board's budget). `how` is the command that made it,
+/// quoted in the header.
 pub fn region_rust_source(
     rows: &[(f64, f64)],
     max_stiffness: bool,
     regulator: Option<(f64, f64)>,
+    latency_s: f64,
     how: &str,
 ) -> String {
     use std::fmt::Write;
@@ -95,5 +98,14 @@ pub fn region_rust_source(
             let _ = writeln!(s, "pub const REGULATOR: Option<(f32, f32)> = None;");
         }
     }
+    let budget = match latency_s as f32 {
+        l if f64::from(l) > latency_s => l.next_down(),
+        l => l,
+    };
+    let _ = writeln!(
+        s,
+        "/// The latency from sampling to the force (s) the limits are proven for."
+    );
+    let _ = writeln!(s, "pub const LATENCY_S: f32 = {budget:?};");
     s
 }

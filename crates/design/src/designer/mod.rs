@@ -152,6 +152,11 @@ impl Designer {
             device: self.name(),
             period_s: self.period_s(),
             human_model: self.human.is_some(),
+            latency_s: self
+                .poses
+                .iter()
+                .map(|p| p.model.latency_s)
+                .fold(f64::INFINITY, f64::min),
         }
     }
 

@@ -51,6 +51,9 @@ pub struct Context {
     pub period_s: f64,
     /// Whether the proofs assume the human bound `Z_max = 300 + 1000/s`.
     pub human_model: bool,
+    /// The latency from sampling to the force (s) every proof allows: the
+    /// least of the poses'.
+    pub latency_s: f64,
 }
 
 impl Context {
@@ -65,7 +68,8 @@ impl Context {
     fn entries<M: SerializeMap>(&self, m: &mut M) -> Result<(), M::Error> {
         m.serialize_entry("display", &self.display)?;
         m.serialize_entry("period_s", &self.period_s)?;
-        m.serialize_entry("human_model", &self.human_model)
+        m.serialize_entry("human_model", &self.human_model)?;
+        m.serialize_entry("latency_s", &self.latency_s)
     }
 }
 
@@ -78,7 +82,11 @@ impl fmt::Display for Context {
             self.device,
             self.period_s * 1e3,
             self.human_text()
-        )
+        )?;
+        if self.latency_s > 0.0 {
+            write!(f, ", latency {:.4} ms", self.latency_s * 1e3)?;
+        }
+        Ok(())
     }
 }
 

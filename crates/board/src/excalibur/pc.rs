@@ -1,0 +1,51 @@
+//! The Excalibur driven from the PC: the same device, wall, encoder and
+//! limits as the shipped image, its loop run by `twoport-host`'s PC servo
+//! loop against the device over a bus. The force a tick computes reaches
+//! the device at the next tick's exchange, a period and more after its
+//! sample, so the region is the designer's for a latency of up to 5 ms,
+//! and the coupling is far softer than a board's.
+
+use super::{safety, wall_servo, BuildError, HOMING, TELEMETRY_EVERY};
+use crate::io::IoScale;
+use crate::region::{Bound, Region, RegionError};
+use crate::Board;
+use twoport_control::ve::UnilateralWall;
+use twoport_control::{ImpedanceGains, Servo};
+
+/// The proven region (impedance display, paper human bound, T = 1 ms,
+/// latency 5 ms).
+// (Its log grid steps by √2: a damping, not the constant.)
+#[allow(clippy::approx_constant)]
+pub mod region {
+    use super::Bound;
+    include!("../excalibur_pc_region.rs");
+}
+
+/// The coupling: 88% of the stiffest proven at 4 N s/m, the region's
+/// point nearest the best pair.
+pub const COUPLING: ImpedanceGains = ImpedanceGains::new(3_000.0, 4.0);
+/// Grid points of [`region`].
+pub const REGION_POINTS: usize = region::DAMPING_NSPM.len();
+
+/// The region as a `Region`.
+pub fn proven_region() -> Result<Region<REGION_POINTS>, RegionError> {
+    Region::new(
+        region::BOUND,
+        region::DAMPING_NSPM,
+        region::LIMIT,
+        region::REGULATOR,
+    )?
+    .with_latency(region::LATENCY_S)
+}
+
+/// The servo on the wall, at the PC's coupling.
+pub fn servo() -> Result<Servo<UnilateralWall>, BuildError> {
+    wall_servo(COUPLING, safety())
+}
+
+/// The whole board, for the PC's loop.
+pub fn board() -> Result<Board<UnilateralWall, REGION_POINTS>, BuildError> {
+    Ok(Board::new(servo()?, [proven_region()?], TELEMETRY_EVERY)
+        .with_io([IoScale::EXCALIBUR])
+        .with_homing([HOMING]))
+}

@@ -1,0 +1,12 @@
+// Made by the designer: `twoport region impedance --latency 200e-6 --b-from 10 --b-to 810 --points 17 --rust`. Do not edit;
+// tests/shipped_region.rs checks it against the designer.
+/// What the region bounds.
+pub const BOUND: Bound = Bound::MaxStiffness;
+/// Coupling damping grid (N s/m).
+pub const DAMPING_NSPM: [f32; 10] = [10.0, 13.16074, 17.320509, 22.79507, 30.0, 39.48222, 51.961525, 68.38521, 90.0, 118.44666];
+/// The proven limit at each damping (N/m).
+pub const LIMIT: [f32; 10] = [27702.104, 29427.965, 31269.264, 33144.19, 34908.01, 36311.047, 36919.33, 35950.254, 31847.553, 20574.857];
+/// The regulator (k_p N/m, b_p N s/m) an admittance region holds for.
+pub const REGULATOR: Option<(f32, f32)> = None;
+/// The latency from sampling to the force (s) the limits are proven for.
+pub const LATENCY_S: f32 = 0.0002;
