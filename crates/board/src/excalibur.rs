@@ -6,7 +6,6 @@
 //! up to 25 µs from sampling to the force.
 
 use crate::io::{EncoderScale, IoScale};
-use crate::region::{Bound, Region, RegionError};
 use crate::Board;
 use crate::BuildError;
 use twoport_control::homing::HomingConfig;
@@ -18,12 +17,11 @@ pub mod fast;
 pub mod pc;
 pub mod xyz;
 
-/// The proven region (impedance display, paper human bound, T = 1 ms,
-/// latency 25 µs).
-pub mod region {
-    use super::Bound;
-    include!("excalibur_region.rs");
-}
+crate::region::shipped_region!(
+    /// The proven region (impedance display, paper human bound, T = 1 ms,
+    /// latency 25 µs).
+    "excalibur_region.rs"
+);
 
 /// Control period (s).
 pub const PERIOD_S: f32 = 1.0e-3;
@@ -62,9 +60,6 @@ pub const HOMING: HomingConfig = HomingConfig::gentle(Position::from_nm(-20_000_
 /// Telemetry every this many ticks (100 Hz).
 pub const TELEMETRY_EVERY: u32 = 10;
 
-/// Grid points of [`region`].
-pub const REGION_POINTS: usize = region::DAMPING_NSPM.len();
-
 /// The axis limits: Excalibur's, with the link watchdog and the dead-man
 /// switch on.
 pub const fn safety() -> SafetyConfig {
@@ -80,17 +75,6 @@ pub(crate) const fn safety_at(period_s: f32, heartbeat_ticks: u32) -> SafetyConf
         require_dead_man: true,
         ..SafetyConfig::excalibur()
     }
-}
-
-/// The shipped region as a `Region`.
-pub fn proven_region() -> Result<Region<REGION_POINTS>, RegionError> {
-    Region::new(
-        region::BOUND,
-        region::DAMPING_NSPM,
-        region::LIMIT,
-        region::REGULATOR,
-    )?
-    .with_latency(region::LATENCY_S)
 }
 
 /// The board's servo: the impedance display on the wall, disabled until the

@@ -3,6 +3,37 @@
 //! per axis of a board of several ([`check_axes`]).
 
 use twoport_control::servo::{Display, Gains};
+
+/// A region file the designer wrote (`twoport region ... --rust`) as the
+/// invoking module's `region`, with its `REGION_POINTS` and its
+/// `proven_region()`: one image's region, declared in one line.
+macro_rules! shipped_region {
+    ($(#[$doc:meta])* $file:literal) => {
+        $(#[$doc])*
+        // (A log grid may step by √2: a damping, not the constant.)
+        #[allow(clippy::approx_constant)]
+        pub mod region {
+            use $crate::region::Bound;
+            include!($file);
+        }
+
+        /// Grid points of [`region`].
+        pub const REGION_POINTS: usize = region::DAMPING_NSPM.len();
+
+        /// The region as a `Region`, proven for its latency.
+        pub fn proven_region(
+        ) -> Result<$crate::region::Region<REGION_POINTS>, $crate::region::RegionError> {
+            $crate::region::Region::new(
+                region::BOUND,
+                region::DAMPING_NSPM,
+                region::LIMIT,
+                region::REGULATOR,
+            )?
+            .with_latency(region::LATENCY_S)
+        }
+    };
+}
+pub(crate) use shipped_region;
 use twoport_link::{AxisRefusal, ProvenRegion, Refusal};
 
 /// What a region bounds.

@@ -6,18 +6,16 @@
 
 use super::{safety_at, wall_servo, BuildError};
 use crate::io::IoScale;
-use crate::region::{Bound, Region, RegionError};
 use crate::Board;
 use twoport_control::homing::HomingConfig;
 use twoport_control::ve::UnilateralWall;
 use twoport_control::{ImpedanceGains, Position, SafetyConfig, Servo};
 
-/// The proven region (impedance display, paper human bound, T = 0.25 ms,
-/// latency 25 µs).
-pub mod region {
-    use super::Bound;
-    include!("../excalibur_fast_region.rs");
-}
+crate::region::shipped_region!(
+    /// The proven region (impedance display, paper human bound,
+    /// T = 0.25 ms, latency 25 µs).
+    "../excalibur_fast_region.rs"
+);
 
 /// Control period (s): 4 kHz.
 pub const PERIOD_S: f32 = 2.5e-4;
@@ -31,23 +29,10 @@ pub const HEARTBEAT_TIMEOUT_TICKS: u32 = 200;
 pub const TELEMETRY_EVERY: u32 = 40;
 /// Homing onto the stop 20 mm below the origin, as the 1 kHz image.
 pub const HOMING: HomingConfig = HomingConfig::gentle(Position::from_nm(-20_000_000), PERIOD_S);
-/// Grid points of [`region`].
-pub const REGION_POINTS: usize = region::DAMPING_NSPM.len();
 
 /// The axis limits at 4 kHz.
 pub const fn safety() -> SafetyConfig {
     safety_at(PERIOD_S, HEARTBEAT_TIMEOUT_TICKS)
-}
-
-/// The region as a `Region`.
-pub fn proven_region() -> Result<Region<REGION_POINTS>, RegionError> {
-    Region::new(
-        region::BOUND,
-        region::DAMPING_NSPM,
-        region::LIMIT,
-        region::REGULATOR,
-    )?
-    .with_latency(region::LATENCY_S)
 }
 
 /// The 4 kHz servo on the wall.

@@ -7,36 +7,19 @@
 
 use super::{safety, wall_servo, BuildError, HOMING, TELEMETRY_EVERY};
 use crate::io::IoScale;
-use crate::region::{Bound, Region, RegionError};
 use crate::Board;
 use twoport_control::ve::UnilateralWall;
 use twoport_control::{ImpedanceGains, Servo};
 
-/// The proven region (impedance display, paper human bound, T = 1 ms,
-/// latency 5 ms).
-// (Its log grid steps by √2: a damping, not the constant.)
-#[allow(clippy::approx_constant)]
-pub mod region {
-    use super::Bound;
-    include!("../excalibur_pc_region.rs");
-}
+crate::region::shipped_region!(
+    /// The proven region (impedance display, paper human bound, T = 1 ms,
+    /// latency 5 ms).
+    "../excalibur_pc_region.rs"
+);
 
 /// The coupling: 88% of the stiffest proven at 4 N s/m, the region's
 /// point nearest the best pair.
 pub const COUPLING: ImpedanceGains = ImpedanceGains::new(3_000.0, 4.0);
-/// Grid points of [`region`].
-pub const REGION_POINTS: usize = region::DAMPING_NSPM.len();
-
-/// The region as a `Region`.
-pub fn proven_region() -> Result<Region<REGION_POINTS>, RegionError> {
-    Region::new(
-        region::BOUND,
-        region::DAMPING_NSPM,
-        region::LIMIT,
-        region::REGULATOR,
-    )?
-    .with_latency(region::LATENCY_S)
-}
 
 /// The servo on the wall, at the PC's coupling.
 pub fn servo() -> Result<Servo<UnilateralWall>, BuildError> {

@@ -9,37 +9,21 @@
 
 use super::{safety, BuildError, ENCODER, PERIOD_S, TELEMETRY_EVERY};
 use crate::io::IoScale;
-use crate::region::{Bound, Region, RegionError};
 use crate::Board;
 use twoport_control::homing::HomingConfig;
 use twoport_control::servo::Servo;
 use twoport_control::world::vbb::{Block, Vbb, VbbConfig};
 use twoport_control::{Encoder, ImpedanceGains, ParamError, Position};
 
-/// The x axis's proven region (impedance display, paper human bound,
-/// T = 1 ms, latency 200 µs).
-pub mod region {
-    use super::Bound;
-    include!("../excalibur_xyz_region.rs");
-}
-
-/// Grid points of [`region`].
-pub const REGION_POINTS: usize = region::DAMPING_NSPM.len();
+crate::region::shipped_region!(
+    /// The x axis's proven region (impedance display, paper human bound,
+    /// T = 1 ms, latency 200 µs).
+    "../excalibur_xyz_region.rs"
+);
 
 /// The coupling on every axis: 90% of the stiffest the region proves at
 /// the paper's damping (31,847 N/m at 90 N s/m).
 pub const COUPLING: ImpedanceGains = ImpedanceGains::new(28_500.0, 90.0);
-
-/// The region as a `Region`.
-pub fn proven_region() -> Result<Region<REGION_POINTS>, RegionError> {
-    Region::new(
-        region::BOUND,
-        region::DAMPING_NSPM,
-        region::LIMIT,
-        region::REGULATOR,
-    )?
-    .with_latency(region::LATENCY_S)
-}
 
 /// The blocks the image's world starts with: lowest corner (m), size (m),
 /// mass (kg). A 30 mm cube in reach of the start, a 20 mm one beside it,
