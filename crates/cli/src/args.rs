@@ -612,3 +612,25 @@ pub(crate) struct IdentifyPoseArgs {
     #[arg(long)]
     pub(crate) json: bool,
 }
+
+/// Only `--json`.
+#[derive(Args)]
+pub(crate) struct JsonArg {
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub(crate) json: bool,
+}
+
+/// `twoport spec`'s arguments.
+#[derive(Args)]
+pub(crate) struct SpecArgs {
+    /// The device (`twoport devices` lists them).
+    pub(crate) device: String,
+    /// The least grasp damping the second proof assumes (N s/m): a
+    /// dead-man switch keeps force off without it.
+    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
+    pub(crate) min_grasp: f64,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub(crate) json: bool,
+}

@@ -30,6 +30,7 @@ mod plots;
 mod rates;
 mod region;
 mod run;
+mod spec;
 mod synthesis;
 mod verify;
 
@@ -83,6 +84,11 @@ pub(crate) enum Cmd {
     /// moves with the handle, at its VE rate and the link's delay (or find
     /// the stiffest such coupling).
     HostVe(HostVeArgs),
+    /// The devices whose servo loop runs on the PC, which `spec` knows.
+    Devices(JsonArg),
+    /// A device's coupling proven over its workspace at its loop's rate
+    /// and latency, beside the stiffness CHAI3D sets for it by hand.
+    Spec(SpecArgs),
 }
 
 fn main() -> ExitCode {
@@ -113,6 +119,8 @@ fn main() -> ExitCode {
         Cmd::IdentifyPose(a) => identify_pose::identify_pose(a).and_then(|r| print(a.json, &r)),
         Cmd::Rates(a) => rates::rates(a).and_then(|r| print(a.json, &r)),
         Cmd::HostVe(a) => one_axis(a, host::host_ve),
+        Cmd::Devices(a) => print(a.json, &spec::devices()),
+        Cmd::Spec(a) => spec::spec(&a.device, a.min_grasp).and_then(|r| print(a.json, &r)),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,

@@ -203,6 +203,8 @@ fn every_subcommand_has_help() {
         vec!["verify", "impedance", "--help"],
         vec!["identify", "--help"],
         vec!["rates", "--help"],
+        vec!["devices", "--help"],
+        vec!["spec", "--help"],
     ] {
         let out = TWOPORT.run(&args);
         assert!(out.status.success(), "{args:?}");
@@ -566,4 +568,48 @@ fn linkages_are_proven_over_their_workspace() {
 #[test]
 fn a_closed_pipe_ends_the_command_quietly() {
     TWOPORT.closes_quietly(&["design", "impedance", "--b", "90"]);
+}
+
+/// `spec` proves each PC-driven device at its rate and its protocol's
+/// latency. Two whole ticks, no fraction: the workspace certificate is the
+/// rigid bound `2b/((d + 1)² T)` of the handle's least damping `b`, hands
+/// off and with the grasp added, which the report's own damping bound
+/// gives back; and CHAI3D's hand-set Falcon stiffness is past it.
+/// `devices` lists them; a device with no model, or unknown, is named.
+#[test]
+fn spec_proves_a_pc_driven_device_at_its_rate_and_latency() {
+    let v = TWOPORT.json(&["devices", "--json"]);
+    let names: Vec<&str> = v["devices"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["falcon", "haply-2diy", "touch"]);
+    for name in ["falcon", "haply-2diy"] {
+        let v = TWOPORT.json(&["spec", name, "--min-grasp", "2", "--json"]);
+        let t = 1.0 / v["rate_hz"].as_f64().unwrap();
+        assert_eq!(v["latency_s"].as_f64().unwrap(), 2.0 * t);
+        let b = v["grasp_b_max_nspm"].as_f64().unwrap();
+        let rigid = |b: f64| 2.0 * b / (9.0 * t);
+        let k = v["grasp_k_npm"].as_f64().unwrap();
+        assert!(
+            (k - rigid(b)).abs() < 1e-3 * k,
+            "{name}: {k} vs {}",
+            rigid(b)
+        );
+        let off = v["hands_off_k_npm"].as_f64().unwrap();
+        assert!((off - rigid(b - 2.0)).abs() < 1e-3 * off, "{name}: {off}");
+    }
+    let v = TWOPORT.json(&["spec", "falcon", "--json"]);
+    assert!(v["chai3d_k_npm"].as_f64().unwrap() > 5.0 * v["grasp_k_npm"].as_f64().unwrap());
+    let e = TWOPORT.failure(&["spec", "touch"]);
+    assert!(e.contains("no model") && e.contains("identify-pose"), "{e}");
+    let e = TWOPORT.failure(&["spec", "omni"]);
+    assert!(
+        e.contains("omni") && e.contains("falcon, haply-2diy, touch"),
+        "{e}"
+    );
+    let e = TWOPORT.failure(&["spec", "falcon", "--min-grasp", "nan"]);
+    assert!(e.contains("--min-grasp"), "{e}");
 }
