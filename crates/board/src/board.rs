@@ -234,7 +234,7 @@ where
     /// instruction), so that its spec gives its latency in seconds.
     ///
     /// Knowing it, the board holds its latency to what its regions are
-    /// proven for: a force that reaches the device later latches
+    /// proven for: armed, a force that reaches the device later latches
     /// [`Faults::LATE_FORCE`], and from the next tick on the force is zero.
     pub fn with_count_rate(mut self, hz: u32) -> Self {
         self.count_hz = Some(hz);
@@ -577,7 +577,11 @@ where
             .unwrap_or_else(|| written.wrapping_sub(start));
         self.timing
             .record(start, [sensed, ruled, end], latency, period);
-        if self.outputs_on && self.late_after.is_some_and(|budget| latency > budget) {
+        // The regions prove the coupling: its force is what must not come
+        // late (homing's and an experiment's laws are not the coupling,
+        // and a tick that ends them may run long).
+        let coupled = self.mode == BoardMode::Armed && self.outputs_on;
+        if coupled && self.late_after.is_some_and(|budget| latency > budget) {
             self.servo.servo_mut().trip(Faults::LATE_FORCE);
         }
         out
