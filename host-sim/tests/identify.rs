@@ -60,6 +60,12 @@ fn admittance_m(models: Vec<DeviceModel>, a: Admittance) -> f64 {
 /// none), run on the Excalibur's board image against the scene's plant,
 /// through its CSV record to what it measured.
 fn measured(scene: &str, model: &str, truth: &DeviceModel, handle_kg: f64) -> Measured {
+    // (Two periods skipped while the hold's mode settles.)
+    Measured::from_log(&record(scene, model, truth, handle_kg), 2).unwrap()
+}
+
+/// [`measured`]'s CSV record, read back.
+fn record(scene: &str, model: &str, truth: &DeviceModel, handle_kg: f64) -> Log {
     // (Paths in scenes are the repository root's; tests run in host-sim.)
     let sets = [
         format!("plant.model=\"../{model}\""),
@@ -82,8 +88,37 @@ fn measured(scene: &str, model: &str, truth: &DeviceModel, handle_kg: f64) -> Me
     let log = Log::from_csv(&csv, "record.csv").unwrap();
     // A 30 s experiment: thirty 1 s periods.
     assert_eq!(log.force_n.len(), 30_000);
-    // (Two periods skipped while the hold's mode settles.)
-    Measured::from_log(&log, 2).unwrap()
+    log
+}
+
+/// The Excalibur's record with its force's sign turned (the commonest
+/// mistake with an amplifier) or its encoder's: named as a reversed sign
+/// before any fit, so no model is made from it.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn a_record_with_a_reversed_sign_is_named_not_fitted() {
+    let truth = DeviceModel::load(Path::new("../models/excalibur.toml")).unwrap();
+    let log = record(
+        "../scenes/identify/excalibur.toml",
+        "models/excalibur.toml",
+        &truth,
+        0.0,
+    );
+    let force = Log {
+        force_n: log.force_n.iter().map(|f| -f).collect(),
+        ..log.clone()
+    };
+    let encoder = Log {
+        position_m: log.position_m.iter().map(|x| -x).collect(),
+        ..log
+    };
+    for turned in [force, encoder] {
+        let e = Measured::from_log(&turned, 2).unwrap_err();
+        assert!(
+            matches!(e, twoport_identify::IdentifyError::ReversedSign { .. }),
+            "{e}"
+        );
+    }
 }
 
 /// The scene's experiment through to the chosen fit; with `loaded`, the

@@ -74,6 +74,19 @@ pub enum IdentifyError {
         /// Where the first run of them starts (s).
         at_s: f64,
     },
+    /// The record's response gives out power: no passive device does, so
+    /// the force's sign or the encoder's is reversed.
+    #[error("the response gives out power where a passive device absorbs it: the actuator's mobility v/F has a negative real part at {negative} of {harmonics} harmonics below a fifth of Nyquist (their weighted mean -{share:.3} of its size, {sigmas:.0} standard deviations): the force's sign or the encoder's is reversed. The force must push the actuator toward +x, the way its encoder counts up: turn the sign of one of them (the amplifier's, the motor's leads, or the encoder's direction) and record again")]
+    ReversedSign {
+        /// Harmonics with a negative real part.
+        negative: usize,
+        /// Harmonics weighed.
+        harmonics: usize,
+        /// The weighted mean of `-Re Y/|Y|`.
+        share: f64,
+        /// How many standard deviations below zero its evidence is.
+        sigmas: f64,
+    },
     /// The pose's records are not what a linear body gives: its fit
     /// leaves residuals far past their noise.
     #[error("the records are not what a linear body at one pose gives: the fit leaves {misfit:.1} times their noise (at most {most} is taken); friction that sticks, or a push that moves the handle far enough to change the pose, does this: push harder against friction, softer against the pose, or hold the handle stiffer")]

@@ -80,6 +80,7 @@ impl Measured {
             (f, q)
         };
         let (position, encoder) = floored(at(&log.position_m)?, &log.position_m);
+        passive(&position, log.period_s)?;
         let load_cell = match log.load_cell_n.as_deref() {
             Some(lc) => Some(floored(at(lc)?, lc).0),
             None => None,
@@ -204,6 +205,55 @@ pub(crate) fn clipped(force_n: &[f64], period_s: f64) -> Result<(), crate::Ident
             at_s: i as f64 * period_s,
         }),
     }
+}
+
+/// Refuse a response that gives out power. The actuator's force and its
+/// encoder meet at one point, so the device's mobility there, `Y = jω H`,
+/// is positive real: `Re Y >= 0` at every frequency, for any passive
+/// device (free, on springs to ground, with any modes). With the sign of
+/// the force or of the encoder turned, `Re Y <= 0`. The sampled response
+/// lags the continuous one by the hold's half sample (exactly so for a
+/// rigid body), which is put back; only harmonics below a fifth of Nyquist
+/// are weighed, where what is left of the hold is small. The evidence is
+/// each harmonic's `Re Y` over its standard deviation, summed; the sign is
+/// named reversed only when that sum is 8 standard deviations below zero
+/// and the weighted mean of `Re Y/|Y|` below -0.02, so that noise, or a
+/// device with next to no damping, is never taken for it.
+pub(crate) fn passive(h: &Frf, period_s: f64) -> Result<(), crate::IdentifyError> {
+    let nyquist = 0.5 / period_s;
+    let (mut z, mut n, mut negative, mut share, mut weight) = (0.0, 0usize, 0usize, 0.0, 0.0);
+    for ((f, r), v) in h.freq_hz.iter().zip(&h.response).zip(&h.variance) {
+        if *f <= 0.0 || *f > 0.2 * nyquist {
+            continue;
+        }
+        let w = 2.0 * std::f64::consts::PI * f;
+        let advance = num_complex::Complex64::from_polar(1.0, 0.5 * w * period_s);
+        let y = num_complex::Complex64::new(0.0, w) * r * advance;
+        let sd = w * v.sqrt();
+        if !(sd > 0.0 && y.norm() > 0.0) {
+            continue;
+        }
+        z += y.re / sd;
+        n += 1;
+        negative += usize::from(y.re < 0.0);
+        // Weighted by how well each harmonic is known.
+        let snr = y.norm() / sd;
+        share += snr * y.re / y.norm();
+        weight += snr;
+    }
+    if n == 0 || weight == 0.0 {
+        return Ok(());
+    }
+    let (sigmas, share) = (z / (n as f64).sqrt(), share / weight);
+    if sigmas < -8.0 && share < -0.02 {
+        return Err(crate::IdentifyError::ReversedSign {
+            negative,
+            harmonics: n,
+            share: -share,
+            sigmas: -sigmas,
+        });
+    }
+    Ok(())
 }
 
 /// The least step between the values a quantised signal took, if it
