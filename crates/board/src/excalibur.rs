@@ -6,10 +6,12 @@
 //! up to 25 µs from sampling to the force.
 
 use crate::io::{EncoderScale, IoScale};
+use crate::region::Region;
 use crate::Board;
 use crate::BuildError;
 use twoport_control::homing::HomingConfig;
 use twoport_control::passivity::{PassivityLimits, SeriesDamper};
+use twoport_control::servo::PortLayer;
 use twoport_control::ve::{Solid, UnilateralWall};
 use twoport_control::{Encoder, ImpedanceGains, Position, SafetyConfig, Servo};
 
@@ -132,21 +134,35 @@ pub fn stiff_wall_servo_with_passivity(
 /// damper between the actuator's port and the coupling.
 pub fn stiff_wall_board_with_passivity(
 ) -> Result<Board<UnilateralWall, REGION_POINTS, 1, SeriesDamper>, BuildError> {
-    Ok(Board::new(
+    Ok(wall_board(
         stiff_wall_servo_with_passivity()?,
-        [proven_region()?],
+        proven_region()?,
         TELEMETRY_EVERY,
-    )
-    .with_io([IoScale::EXCALIBUR])
-    .with_homing([HOMING]))
+        HOMING,
+    ))
 }
 
 /// The whole board: servo, region, telemetry rate, I/O scaling. It reads its
 /// own sensors; the processor-in-the-loop images add `.with_pil(true)`.
 pub fn stiff_wall_board() -> Result<Board<UnilateralWall, REGION_POINTS>, BuildError> {
-    Ok(
-        Board::new(stiff_wall_servo()?, [proven_region()?], TELEMETRY_EVERY)
-            .with_io([IoScale::EXCALIBUR])
-            .with_homing([HOMING]),
-    )
+    Ok(wall_board(
+        stiff_wall_servo()?,
+        proven_region()?,
+        TELEMETRY_EVERY,
+        HOMING,
+    ))
+}
+
+/// A one-axis Excalibur board: `servo` on the wall, accepting gains inside
+/// `region`, telemetry every `telemetry_every` ticks, the Excalibur's I/O
+/// scaling, homing with `homing`.
+pub(crate) fn wall_board<L: PortLayer, const R: usize>(
+    servo: Servo<UnilateralWall, f32, 1, L>,
+    region: Region<R>,
+    telemetry_every: u32,
+    homing: HomingConfig,
+) -> Board<UnilateralWall, R, 1, L> {
+    Board::new(servo, [region], telemetry_every)
+        .with_io([IoScale::EXCALIBUR])
+        .with_homing([homing])
 }

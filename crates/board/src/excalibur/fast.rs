@@ -5,11 +5,10 @@
 //! `scenes/pil/fast_host_ve.toml`, its surfaces sent every 4 ticks.
 
 use super::{safety_at, wall_servo, BuildError};
-use crate::io::IoScale;
 use crate::Board;
 use twoport_control::homing::HomingConfig;
 use twoport_control::ve::UnilateralWall;
-use twoport_control::{ImpedanceGains, Position, SafetyConfig, Servo};
+use twoport_control::{ImpedanceGains, Position, SafetyConfig};
 
 crate::region::shipped_region!(
     /// The proven region (impedance display, paper human bound,
@@ -35,14 +34,12 @@ pub const fn safety() -> SafetyConfig {
     safety_at(PERIOD_S, HEARTBEAT_TIMEOUT_TICKS)
 }
 
-/// The 4 kHz servo on the wall.
-pub fn servo() -> Result<Servo<UnilateralWall>, BuildError> {
-    wall_servo(COUPLING, safety())
-}
-
 /// The whole 4 kHz board.
 pub fn board() -> Result<Board<UnilateralWall, REGION_POINTS>, BuildError> {
-    Ok(Board::new(servo()?, [proven_region()?], TELEMETRY_EVERY)
-        .with_io([IoScale::EXCALIBUR])
-        .with_homing([HOMING]))
+    Ok(super::wall_board(
+        wall_servo(COUPLING, safety())?,
+        proven_region()?,
+        TELEMETRY_EVERY,
+        HOMING,
+    ))
 }

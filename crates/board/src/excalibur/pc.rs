@@ -6,10 +6,9 @@
 //! and the coupling is far softer than a board's.
 
 use super::{safety, wall_servo, BuildError, HOMING, TELEMETRY_EVERY};
-use crate::io::IoScale;
 use crate::Board;
 use twoport_control::ve::UnilateralWall;
-use twoport_control::{ImpedanceGains, Servo};
+use twoport_control::ImpedanceGains;
 
 crate::region::shipped_region!(
     /// The proven region (impedance display, paper human bound, T = 1 ms,
@@ -21,14 +20,12 @@ crate::region::shipped_region!(
 /// point nearest the best pair.
 pub const COUPLING: ImpedanceGains = ImpedanceGains::new(3_000.0, 4.0);
 
-/// The servo on the wall, at the PC's coupling.
-pub fn servo() -> Result<Servo<UnilateralWall>, BuildError> {
-    wall_servo(COUPLING, safety())
-}
-
 /// The whole board, for the PC's loop.
 pub fn board() -> Result<Board<UnilateralWall, REGION_POINTS>, BuildError> {
-    Ok(Board::new(servo()?, [proven_region()?], TELEMETRY_EVERY)
-        .with_io([IoScale::EXCALIBUR])
-        .with_homing([HOMING]))
+    Ok(super::wall_board(
+        wall_servo(COUPLING, safety())?,
+        proven_region()?,
+        TELEMETRY_EVERY,
+        HOMING,
+    ))
 }
