@@ -389,15 +389,16 @@ enum TpResult tp_board_open_serial(const char *path, uint8_t axes, struct TpBoar
 enum TpResult tp_board_open_simulated(float hand_n, struct TpBoard **out);
 
 /**
- * Open the shipped Excalibur image's loop on the PC, in a thread of its
- * own, against a simulated device exchanged with as a USB device is (the
+ * Open the Excalibur's PC image (its region proven for up to 5 ms from
+ * sample to force) on the PC's loop, in a thread of its own, against a simulated device exchanged with as a USB device is (the
  * path a Falcon or a Haply board takes), the hand pushing `hand_n` (N)
  * along +x while the outputs are on.
  *
  * # Safety
  * `out` points to a writable pointer.
  */
-enum TpResult tp_board_open_pc_simulated(float hand_n, struct TpBoard **out);
+enum TpResult tp_board_open_pc_simulated(float hand_n,
+                                         struct TpBoard **out);
 
 /**
  * Disarm the board and free it. NULL is ignored. The board must not be
