@@ -140,7 +140,7 @@ def test_the_pc_loop_holds_the_images_wall_from_python():
         b.run_for(0.1)
     s = b.latest()
     t = b.loop_timing()
-    assert b.spec()["latency_budget_s"] == 5e-3
+    assert abs(b.spec()["latency_budget_s"] - 5e-3) < 1e-9  # an f32 on the wire
     if s["faults"] == 1 << 12:
         # The machine held a tick back past the 5 ms the PC image's region
         # is proven for: the board faulted "force late", and said why.
