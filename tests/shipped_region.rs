@@ -46,8 +46,8 @@ fn is_the_designers(
 fn the_shipped_regions_are_the_designers() {
     is_the_designers(
         include_str!("../crates/board/src/excalibur_region.rs"),
-        "twoport region impedance --latency 25e-6 --b-from 10 --b-to 810 --points 17 --rust",
-        (1e-3, 25e-6),
+        "twoport region impedance --latency 50e-6 --b-from 10 --b-to 810 --points 17 --rust",
+        (1e-3, 50e-6),
         (10.0, 810.0),
         17,
         &excalibur::region::LIMIT,
@@ -88,7 +88,7 @@ fn the_images_gains_are_proven_for_their_latency() {
             excalibur::COUPLING,
             excalibur::proven_region()
                 .map(|r| (r.limit_at(excalibur::COUPLING.b_nspm), r.latency_s())),
-            25e-6,
+            50e-6,
         ),
         (
             fast::COUPLING,

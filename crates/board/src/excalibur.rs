@@ -3,7 +3,7 @@
 //! impedance display at 90 N s/m, the paper's coupling damping, holding
 //! the stiff wall of the default scene (`scenes/stiff_wall.toml`), and the
 //! region of gains the designer proved absolutely stable for a latency of
-//! up to 25 µs from sampling to the force.
+//! up to 50 µs from sampling to the force.
 
 use crate::io::{EncoderScale, IoScale};
 use crate::region::Region;
@@ -21,7 +21,7 @@ pub mod xyz;
 
 crate::region::shipped_region!(
     /// The proven region (impedance display, paper human bound, T = 1 ms,
-    /// latency 25 µs).
+    /// latency 50 µs).
     "excalibur_region.rs"
 );
 
@@ -32,8 +32,8 @@ pub const ENCODER: EncoderScale = EncoderScale {
     bits: 16,
     pm_per_count: 1_000_000,
 };
-/// The coupling: 90% of the stiffest the region proves at the paper's
-/// damping (48,369 N/m at 90 N s/m). The paper's 51,000 N/m sits on the
+/// The coupling: 95% of the stiffest the region proves at the paper's
+/// damping (45,770 N/m at 90 N s/m). The paper's 51,000 N/m sits on the
 /// boundary proven with no latency, and any latency moves it inside.
 pub const COUPLING: ImpedanceGains = ImpedanceGains::new(43_500.0, 90.0);
 /// The image's wall, solid above its surface.

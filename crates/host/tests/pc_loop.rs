@@ -60,7 +60,7 @@ fn the_pc_loop_holds_the_images_wall_as_a_board_does() {
     b.close().unwrap();
 }
 
-/// The shipped 1 kHz image, its region proven for a board's 25 µs, on the
+/// The shipped 1 kHz image, its region proven for a board's 50 µs, on the
 /// PC's loop: a force a period late is outside its proof, so the first
 /// armed tick faults it to zero force.
 #[test]

@@ -133,9 +133,10 @@ def test_the_pc_loop_holds_the_images_wall_from_python():
     b.arm()
     b.run_for(0.01)
     armed_at = b.latest()["tick"]
-    # A thousand ticks armed, however the machine schedules the loop.
-    for _ in range(600):
-        if b.latest()["tick"] >= armed_at + 1000:
+    # Three thousand ticks armed (the soft coupling's ring, 9 Hz and 8%
+    # damped, settles in that), however the machine schedules the loop.
+    for _ in range(900):
+        if b.latest()["tick"] >= armed_at + 3000:
             break
         b.run_for(0.1)
     s = b.latest()
@@ -150,7 +151,7 @@ def test_the_pc_loop_holds_the_images_wall_from_python():
         assert s["mode"] == "armed" and s["faults"] == 0
         assert abs(s["position_m"][0] - 0.005 - 2.0 / 3000.0) < 10e-6
     # The loop's timing, ordered, every statistic of a tick it ran.
-    assert t["ticks"] >= 1000 and 0 <= t["late"] <= t["ticks"]
+    assert t["ticks"] >= 3000 and 0 <= t["late"] <= t["ticks"]
     for name in ("period_s", "io_s", "latency_s"):
         p = t[name]
         assert 0.0 <= p["p50"] <= p["p99"] <= p["max"], (name, p)
