@@ -34,7 +34,7 @@ pub const ENCODER: EncoderScale = EncoderScale {
 };
 /// The coupling: 95% of the stiffest the region proves at the paper's
 /// damping (45,770 N/m at 90 N s/m). The paper's 51,000 N/m sits on the
-/// boundary proven with no latency, and any latency moves it inside.
+/// boundary proven with no latency, and any latency leaves it outside.
 pub const COUPLING: ImpedanceGains = ImpedanceGains::new(43_500.0, 90.0);
 /// The image's wall, solid above its surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
