@@ -148,11 +148,9 @@ struct PcSupport<Io, const N: usize> {
     failed: Option<String>,
     io_s: f64,
     /// When the last exchange began, and the latency its sensors' force
-    /// had by the end of this one (s; 0 before the second).
+    /// had by the end of this one (none before the second).
     exchanged: Option<Instant>,
-    latency_s: f64,
-    /// The same latency in the board's count (ns), once there is one.
-    latency_ns: Option<u32>,
+    latency: Option<Duration>,
     start: Instant,
     period_ns: u32,
 }
@@ -183,9 +181,7 @@ impl<Io: DeviceIo<N>, const N: usize> BoardSupport<N> for PcSupport<Io, N> {
         }
         self.io_s = t.elapsed().as_secs_f64();
         if let Some(before) = self.exchanged.replace(t) {
-            let latency = before.elapsed();
-            self.latency_s = latency.as_secs_f64();
-            self.latency_ns = Some(u32::try_from(latency.as_nanos()).unwrap_or(u32::MAX));
+            self.latency = Some(before.elapsed());
         }
         self.last
     }
@@ -215,7 +211,8 @@ impl<Io: DeviceIo<N>, const N: usize> BoardSupport<N> for PcSupport<Io, N> {
     fn force_latency(&self) -> Option<u32> {
         // The force the device took at this exchange was computed from
         // the last exchange's sensors.
-        self.latency_ns
+        self.latency
+            .map(|l| u32::try_from(l.as_nanos()).unwrap_or(u32::MAX))
     }
 }
 
@@ -260,8 +257,7 @@ impl PcBoard {
             failed: None,
             io_s: 0.0,
             exchanged: None,
-            latency_s: 0.0,
-            latency_ns: None,
+            latency: None,
             start: Instant::now(),
             period_ns: (period_s * 1e9).round() as u32,
         };
@@ -354,8 +350,8 @@ fn run<Io, W, L, D, const N: usize, const R: usize>(
             record(&mut s.periods, slot, p);
         }
         record(&mut s.ios, slot, io.io_s);
-        if io.latency_s > 0.0 {
-            record(&mut s.latencies, slot, io.latency_s);
+        if let Some(l) = io.latency {
+            record(&mut s.latencies, slot, l.as_secs_f64());
         }
         slot = (slot + 1) % TIMING_WINDOW;
         if let Some(e) = failed {
