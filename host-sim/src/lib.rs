@@ -16,6 +16,7 @@ macro_rules! sim_err {
     };
 }
 
+pub mod emulate;
 pub mod engine;
 mod error;
 pub mod link;

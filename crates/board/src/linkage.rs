@@ -10,6 +10,8 @@
 //! A linkage board is calibrated, not homed: the host puts the arm at a
 //! known pose and sends its joint angles (`Calibrate`, in 1e-12 rad).
 
+pub mod haply;
+
 use crate::io::IoScale;
 use crate::region::{Bound, Region};
 use crate::{Board, BuildError};
@@ -17,7 +19,7 @@ use twoport_control::kinematics::{Delta, Kinematics, SerialArm};
 use twoport_control::linkage::{Gravity, Hardware, LinkageServo};
 use twoport_control::servo::ImpedanceGains;
 use twoport_control::ve::{Solid, UnilateralWall};
-use twoport_control::world::PerAxis;
+use twoport_control::world::{PerAxis, World};
 use twoport_control::{Position, SafetyConfig};
 
 /// Control period (s): both devices' 1 kHz loop.
@@ -56,17 +58,17 @@ pub const REGION_POINTS: usize = 5;
 /// The encoder counters' width (bits).
 pub const COUNTER_BITS: u8 = 32;
 
-/// What an image needs of its device file.
+/// What an image needs of its device file, for a linkage of `N` joints.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ImageSpec {
+pub struct ImageSpec<const N: usize = 3> {
     /// The encoders, transmissions, joint limits and motors.
-    pub hardware: Hardware<3>,
+    pub hardware: Hardware<N>,
     /// The least damping the handle has anywhere in the workspace, in its
     /// least damped direction (N s/m): the designer's certified lower
     /// bound on `λ_min(D_x)`, rounded down.
     pub least_damping_nspm: f32,
     /// The calibration pose (rad): where the host puts the arm.
-    pub rest_rad: [f32; 3],
+    pub rest_rad: [f32; N],
     /// The moving masses the motors hold up (g = 9.81 m/s² along `-z`).
     pub gravity: Gravity,
 }
@@ -141,16 +143,21 @@ pub const FALCON_DELTA: DeltaLengths = DeltaLengths {
     lower_m: 0.1025,
 };
 
-/// The images' world: a wall on each Cartesian axis, only the floor (z)
-/// within reach.
-pub type LinkageWorld = PerAxis<UnilateralWall, 3>;
+/// The images' world: a wall on each Cartesian axis, only the floor (the
+/// last axis) within reach.
+pub type LinkageWorld<const N: usize = 3> = PerAxis<UnilateralWall, N>;
 
 /// A linkage image's servo.
-pub type LinkageImageServo<K> = LinkageServo<K, LinkageWorld, f32, 3>;
+pub type LinkageImageServo<K, const N: usize = 3> = LinkageServo<K, LinkageWorld<N>, f32, N>;
 
 /// A linkage image's board.
-pub type LinkageBoard<K> =
-    Board<LinkageWorld, REGION_POINTS, 3, twoport_control::servo::Direct, LinkageImageServo<K>>;
+pub type LinkageBoard<K, const N: usize = 3> = Board<
+    LinkageWorld<N>,
+    REGION_POINTS,
+    N,
+    twoport_control::servo::Direct,
+    LinkageImageServo<K, N>,
+>;
 
 /// The serial-arm image's board.
 pub type SerialArmBoard = LinkageBoard<SerialArm>;
@@ -175,7 +182,9 @@ pub fn safety() -> SafetyConfig {
 /// [`GRASP_NSPM`]: Colgate's bound with the rigid device's cost of a
 /// latency, at or below the designer's workspace proof at each grid
 /// point (a host test holds it there).
-pub fn region(spec: &ImageSpec) -> Result<Region<REGION_POINTS>, crate::RegionError> {
+pub fn region<const N: usize>(
+    spec: &ImageSpec<N>,
+) -> Result<Region<REGION_POINTS>, crate::RegionError> {
     let total = spec.least_damping_nspm + GRASP_NSPM;
     let b: [f32; REGION_POINTS] = core::array::from_fn(|i| 0.01 + 0.24 * total * i as f32);
     let alpha = LATENCY_S / PERIOD_S;
@@ -184,7 +193,7 @@ pub fn region(spec: &ImageSpec) -> Result<Region<REGION_POINTS>, crate::RegionEr
 }
 
 /// Each motor's duty scale: full scale at its peak torque at the joint.
-pub fn io(spec: &ImageSpec) -> [IoScale; 3] {
+pub fn io<const N: usize>(spec: &ImageSpec<N>) -> [IoScale; N] {
     spec.hardware.ratios.map(|n| IoScale {
         force_full_scale_n: spec.hardware.peak_torque_nm * n,
         ..IoScale::EXCALIBUR
@@ -192,11 +201,29 @@ pub fn io(spec: &ImageSpec) -> [IoScale; 3] {
 }
 
 /// The board for `spec` on `kinematics`, disarmed and uncalibrated, its
-/// joints reading the rest pose until the host calibrates them.
+/// joints reading the rest pose until the host calibrates them: the
+/// coupling and the region the board runs under, proven [`region`] at the
+/// board's own latency.
 pub fn board<K: Kinematics<f32, 3>>(
     spec: &ImageSpec,
     kinematics: K,
 ) -> Result<LinkageBoard<K>, BuildError> {
+    let r = region(spec).map_err(BuildError::Region)?;
+    board_with(spec, kinematics, COUPLING, r)
+}
+
+/// The board for `spec` on `kinematics` running `coupling` under
+/// `region` on every axis: the world [`FLOOR`] under the rest pose along
+/// the last axis, far walls along the others.
+pub fn board_with<K: Kinematics<f32, N>, const N: usize>(
+    spec: &ImageSpec<N>,
+    kinematics: K,
+    coupling: ImpedanceGains,
+    region: Region<REGION_POINTS>,
+) -> Result<LinkageBoard<K, N>, BuildError>
+where
+    LinkageWorld<N>: World<f32, N>,
+{
     let at = kinematics
         .forward(&spec.rest_rad)
         .map_err(|_| BuildError::RestPose)?
@@ -211,25 +238,26 @@ pub fn board<K: Kinematics<f32, 3>>(
     let wall = |surface, solid, probe| {
         UnilateralWall::new(k, b, surface, solid, PERIOD_S, probe).map_err(BuildError::Param)
     };
-    let world = PerAxis([
-        wall(far, Solid::Above, p(at[0])?)?,
-        wall(far, Solid::Above, p(at[1])?)?,
-        wall(p(at[2] - below)?, Solid::Below, p(at[2])?)?,
-    ]);
+    let last = N.checked_sub(1).ok_or(BuildError::RestPose)?;
+    let floor = wall(p(at[last] - below)?, Solid::Below, p(at[last])?)?;
+    let mut walls = [floor; N];
+    for (i, w) in walls.iter_mut().enumerate().take(last) {
+        *w = wall(far, Solid::Above, p(at[i])?)?;
+    }
+    let world = PerAxis(walls);
     let servo = LinkageServo::on(
         kinematics,
         &spec.hardware,
         COUNTER_BITS,
         spec.rest_rad,
-        [COUPLING.into(); 3],
-        [safety(); 3],
+        [coupling.into(); N],
+        [safety(); N],
         world,
     )
     .map_err(BuildError::Linkage)?
     .with_gravity(spec.gravity)
     .map_err(BuildError::Param)?;
-    let r = region(spec).map_err(BuildError::Region)?;
-    Ok(Board::new(servo, [r; 3], TELEMETRY_EVERY).with_io(io(spec)))
+    Ok(Board::new(servo, [region; N], TELEMETRY_EVERY).with_io(io(spec)))
 }
 
 /// The serial-arm image: the PHANToM Premium 1.5.

@@ -4,6 +4,7 @@
 
 mod device;
 mod error;
+pub mod haply;
 mod in_process;
 mod local;
 mod pc_loop;
