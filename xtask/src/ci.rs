@@ -83,8 +83,8 @@ const STEPS: [Step; 14] = [
     },
     Step {
         name: "fuzz",
-        what: "each fuzz target for 25 s",
-        run: || fuzz(25),
+        what: "each fuzz target for 20 s",
+        run: || fuzz(20),
     },
     Step {
         name: "tests",

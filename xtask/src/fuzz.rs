@@ -4,11 +4,12 @@ use crate::{cargo, cross_target_dir, root, run};
 use std::process::Command;
 
 /// The cargo-fuzz targets in fuzz/.
-pub(crate) const FUZZ_TARGETS: [&str; 4] = [
+pub(crate) const FUZZ_TARGETS: [&str; 5] = [
     "link_decoder",
     "config_record",
     "model_parser",
     "scene_parser",
+    "device_packets",
 ];
 
 /// Run each fuzz target for `secs` seconds on a scratch copy of its seed
