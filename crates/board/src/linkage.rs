@@ -10,7 +10,9 @@
 //! A linkage board is calibrated, not homed: the host puts the arm at a
 //! known pose and sends its joint angles (`Calibrate`, in 1e-12 rad).
 
+pub mod falcon_pc;
 pub mod haply;
+pub mod pc;
 
 use crate::io::IoScale;
 use crate::region::{Bound, Region};
@@ -297,5 +299,27 @@ mod tests {
             let past = Gains::from(ImpedanceGains::new(1.2 * kmax, COUPLING.b_nspm));
             assert!(r.check(Display::Impedance, &past).is_err());
         }
+    }
+
+    /// The PC images build; each coupling is inside its region, 20 %
+    /// stiffer than its boundary is not, and the region states the PC's
+    /// latency.
+    #[test]
+    fn the_pc_images_build_inside_their_regions() {
+        assert!(haply::board().is_ok());
+        assert!(falcon_pc::board().is_ok());
+        let check = |r: Region<REGION_POINTS>, c: ImpedanceGains, at: f32| {
+            assert_eq!(r.latency_s(), pc::LATENCY_S);
+            assert!(r.check(Display::Impedance, &Gains::from(c)).is_ok());
+            let past = ImpedanceGains::new(1.2 * at, c.b_nspm);
+            assert!(r.check(Display::Impedance, &Gains::from(past)).is_err());
+        };
+        check(
+            haply::IMAGE.region().unwrap(),
+            haply::IMAGE.coupling,
+            haply::IMAGE.limit_npm[2],
+        );
+        let f = falcon_pc::IMAGE;
+        check(f.region().unwrap(), f.coupling, f.limit_npm[2]);
     }
 }

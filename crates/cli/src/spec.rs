@@ -64,10 +64,26 @@ const KNOWN: [Known; 3] = [
     },
 ];
 
-/// `twoport devices`: what `twoport spec` knows.
+/// `twoport devices`: what `twoport spec` knows, and what is plugged in.
 #[derive(Serialize)]
 pub(crate) struct Devices {
     devices: Vec<DeviceLine>,
+    /// This computer's serial ports.
+    ports: Vec<PortLine>,
+    /// Falcons plugged in that the kernel has given no port.
+    falcons_without_a_port: usize,
+    /// OpenHaptics' HD library, where installed.
+    hd_library: Option<String>,
+}
+
+#[derive(Serialize)]
+struct PortLine {
+    path: String,
+    usb_id: Option<String>,
+    product: Option<String>,
+    device: Option<&'static str>,
+    /// Why this program cannot open it, where it cannot.
+    cannot_open: Option<String>,
 }
 
 #[derive(Serialize)]
@@ -91,6 +107,18 @@ pub(crate) fn devices() -> Devices {
                 model: k.file.map(|f| f.0),
             })
             .collect(),
+        ports: twoport_host::attached::ports()
+            .into_iter()
+            .map(|p| PortLine {
+                path: p.path,
+                usb_id: p.usb.map(|(v, d)| format!("{v:04x}:{d:04x}")),
+                product: p.product,
+                device: p.device,
+                cannot_open: p.open.err(),
+            })
+            .collect(),
+        falcons_without_a_port: twoport_host::attached::falcons_without_a_port(),
+        hd_library: twoport_host::attached::hd_library().map(|p| p.display().to_string()),
     }
 }
 
@@ -113,6 +141,43 @@ impl fmt::Display for Devices {
                 Some(m) => writeln!(f, " ({m})")?,
                 None => writeln!(f, " (no published model)")?,
             }
+        }
+        writeln!(f, "Serial ports on this computer:")?;
+        if self.ports.is_empty() {
+            writeln!(f, "  none")?;
+        }
+        for p in &self.ports {
+            write!(f, "  {}", p.path)?;
+            if let Some(id) = &p.usb_id {
+                write!(
+                    f,
+                    " (USB {id}{})",
+                    p.product
+                        .as_deref()
+                        .map(|s| format!(", {s}"))
+                        .unwrap_or_default()
+                )?;
+            }
+            match (p.device, &p.cannot_open) {
+                (Some(d), None) => writeln!(f, ": a {d}? twoport can open it")?,
+                (Some(d), Some(why)) => writeln!(f, ": a {d}? {why}")?,
+                (None, _) => writeln!(f)?,
+            }
+        }
+        if self.falcons_without_a_port > 0 {
+            writeln!(
+                f,
+                "  {} Falcon(s) plugged in with no serial port: install twoport's udev rule \
+                 (udev/60-twoport.rules), then unplug and plug it",
+                self.falcons_without_a_port
+            )?;
+        }
+        match &self.hd_library {
+            Some(p) => writeln!(
+                f,
+                "OpenHaptics' HD library (for a Touch): {p}; twoport does not drive the Touch yet"
+            )?,
+            None => writeln!(f, "OpenHaptics' HD library (for a Touch): not found")?,
         }
         Ok(())
     }

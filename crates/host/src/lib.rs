@@ -2,8 +2,11 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod attached;
 mod device;
+pub mod device_port;
 mod error;
+pub mod falcon;
 pub mod haply;
 mod in_process;
 mod local;

@@ -5,9 +5,14 @@
 mod io;
 pub mod protocol;
 
-pub use io::{Grip, HaplyIo, REPLY_TIMEOUT};
+pub use crate::device_port::Grip;
+pub use io::HaplyIo;
 
+use crate::device_port::DevicePort;
 use crate::{DeviceIo, LinkError, PcBoard};
+
+/// The device's name in messages.
+const NAME: &str = "2DIY";
 use protocol::{Direction, Joint, Setup};
 use twoport_board::linkage::haply::{self as image, HAPLY};
 use twoport_board::linkage::{io as io_scale, PERIOD_S};
@@ -51,72 +56,23 @@ impl HaplyConfig {
             joints: self.joints,
             sensor_pins: match self.grip {
                 Grip::Pin { pin, .. } => vec![pin],
-                Grip::Assumed => vec![],
+                Grip::Assumed | Grip::Button { .. } => vec![],
             },
         }
-    }
-}
-
-/// Why a port would not open, and what to do about it.
-pub fn open_error(path: &str, kind: std::io::ErrorKind, what: &str) -> LinkError {
-    use std::io::ErrorKind as K;
-    let why = match kind {
-        K::NotFound => format!(
-            "{what}: no such port; is the 2DIY plugged in? `twoport devices` lists the \
-             serial ports this computer has"
-        ),
-        K::PermissionDenied => format!(
-            "{what}: permission denied; on Linux add yourself to the port's group \
-             (`sudo usermod -aG dialout $USER`, then log in again), or install \
-             twoport's udev rule (docs/devices.md)"
-        ),
-        K::ResourceBusy | K::WouldBlock => format!(
-            "{what}: the port is held by another program (a Processing sketch, Haply's \
-             own software, another twoport); close it and open the port again"
-        ),
-        _ => format!("{what}: {kind}"),
-    };
-    LinkError::Open {
-        path: path.to_string(),
-        why,
     }
 }
 
 /// Open the 2DIY's board on `path`, reset and set it up as `config` says,
 /// and hear it answer: the [`HaplyIo`] the PC's loop runs against.
 pub fn open(path: &str, config: &HaplyConfig) -> Result<impl DeviceIo<2> + 'static, LinkError> {
-    // (The port is opened in its exclusive mode, under an advisory lock:
-    // a second driver, twoport's or another, is refused.)
-    let port = serialport::new(path, 115_200)
-        .timeout(REPLY_TIMEOUT)
-        .open()
-        .map_err(|e| {
-            let there = std::path::Path::new(path).exists();
-            let kind = match e.kind {
-                serialport::ErrorKind::NoDevice if !there => std::io::ErrorKind::NotFound,
-                serialport::ErrorKind::NoDevice if e.description.contains("lock") => {
-                    std::io::ErrorKind::ResourceBusy
-                }
-                serialport::ErrorKind::Io(k) => k,
-                _ => std::io::ErrorKind::Other,
-            };
-            match kind {
-                std::io::ErrorKind::Other => LinkError::Open {
-                    path: path.to_string(),
-                    why: e.to_string(),
-                },
-                k => open_error(path, k, "open"),
-            }
-        })?;
-    // What the board sent before this program opened the port is stale.
-    let _ = port.clear(serialport::ClearBuffer::All);
-    if matches!(config.grip, Grip::Assumed) {
-        eprintln!(
-            "twoport: {path}: the 2DIY's grip is assumed (Grip::Assumed): force is on \
-             whenever the loop is armed, hands on the handle or not; its region is \
-             proven only for a grasp of at least 2 N s/m"
-        );
+    let port = DevicePort::open(path, 115_200, NAME)?;
+    if let Grip::Button { .. } = config.grip {
+        return Err(LinkError::Open {
+            path: path.to_string(),
+            why: "the 2DIY has no buttons: wire a switch to an analog pin (Grip::Pin)".into(),
+        });
     }
+    config.grip.warn_if_assumed(path, NAME);
     let mut io =
         HaplyIo::open(port, config.setup(), io_scale(&HAPLY), config.grip).map_err(|why| {
             LinkError::Open {
@@ -138,7 +94,8 @@ pub fn open(path: &str, config: &HaplyConfig) -> Result<impl DeviceIo<2> + 'stat
 
 impl PcBoard {
     /// The 2DIY on `path`: its image ([`image::board`], its region proven
-    /// for [`image::LATENCY_S`]) ticking at 1 kHz in the PC's loop.
+    /// for [`LATENCY_S`](twoport_board::linkage::pc::LATENCY_S)) ticking at
+    /// 1 kHz in the PC's loop.
     pub fn haply(path: &str, config: &HaplyConfig) -> Result<Self, LinkError> {
         let io = open(path, config)?;
         let board =

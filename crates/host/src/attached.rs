@@ -1,0 +1,113 @@
+//! What is plugged into this computer that twoport can drive: its serial
+//! ports with their USB ids, a Falcon the kernel has not given a port,
+//! and OpenHaptics' library for a Touch.
+
+use std::path::{Path, PathBuf};
+
+/// A serial port, and what twoport makes of it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Port {
+    /// Its path (`/dev/ttyUSB0`).
+    pub path: String,
+    /// Its USB vendor and product ids, where it is a USB device.
+    pub usb: Option<(u16, u16)>,
+    /// What the device calls itself.
+    pub product: Option<String>,
+    /// The device twoport takes it for (`twoport spec`'s name), if any.
+    pub device: Option<&'static str>,
+    /// Whether this program may open it, or why not and what to do.
+    pub open: Result<(), String>,
+}
+
+/// The device a USB id is: the Falcon's FTDI chip, or an Arduino-class
+/// CDC board as Haply's are.
+fn device(usb: (u16, u16)) -> Option<&'static str> {
+    match usb {
+        crate::falcon::protocol::USB_ID => Some("falcon"),
+        // Arduino's and Adafruit's vendor ids: the hAPI boards' Due and
+        // SAMD21 kin.
+        (0x2341 | 0x2a03 | 0x239a, _) => Some("haply-2diy"),
+        _ => None,
+    }
+}
+
+/// Every serial port this computer has.
+pub fn ports() -> Vec<Port> {
+    let mut out = Vec::new();
+    for p in serialport::available_ports().unwrap_or_default() {
+        let (usb, product) = match &p.port_type {
+            serialport::SerialPortType::UsbPort(u) => (Some((u.vid, u.pid)), u.product.clone()),
+            _ => (None, None),
+        };
+        let device = usb.and_then(device);
+        // (Opened only where twoport would drive it: opening a port
+        // resets some boards.)
+        let open = match device {
+            Some(name) => std::fs::File::options()
+                .read(true)
+                .write(true)
+                .open(&p.port_name)
+                .map(drop)
+                .map_err(|e| {
+                    crate::device_port::open_error(&p.port_name, e.kind(), name).to_string()
+                }),
+            None => Ok(()),
+        };
+        out.push(Port {
+            path: p.port_name,
+            usb,
+            product,
+            device,
+            open,
+        });
+    }
+    out
+}
+
+/// Falcons plugged in with no serial port: the kernel's `ftdi_sio` does
+/// not know their id until twoport's udev rule adds it.
+pub fn falcons_without_a_port() -> usize {
+    let Ok(dir) = std::fs::read_dir("/sys/bus/usb/devices") else {
+        return 0;
+    };
+    let id = |d: &Path, f: &str| {
+        std::fs::read_to_string(d.join(f))
+            .ok()
+            .and_then(|s| u16::from_str_radix(s.trim(), 16).ok())
+    };
+    let with_port: Vec<_> = ports()
+        .into_iter()
+        .filter(|p| p.device == Some("falcon"))
+        .collect();
+    let plugged = dir
+        .flatten()
+        .filter(|e| {
+            let d = e.path();
+            (id(&d, "idVendor"), id(&d, "idProduct"))
+                == (
+                    Some(crate::falcon::protocol::USB_ID.0),
+                    Some(crate::falcon::protocol::USB_ID.1),
+                )
+        })
+        .count();
+    plugged.saturating_sub(with_port.len())
+}
+
+/// OpenHaptics' HD library, where it is installed (for a Touch).
+pub fn hd_library() -> Option<PathBuf> {
+    let mut dirs: Vec<PathBuf> = std::env::var_os("LD_LIBRARY_PATH")
+        .map(|v| std::env::split_paths(&v).collect())
+        .unwrap_or_default();
+    dirs.extend(
+        [
+            "/usr/lib",
+            "/usr/lib64",
+            "/usr/local/lib",
+            "/usr/lib/x86_64-linux-gnu",
+        ]
+        .map(PathBuf::from),
+    );
+    dirs.into_iter()
+        .map(|d| d.join("libHD.so"))
+        .find(|p| p.exists())
+}

@@ -1,0 +1,133 @@
+//! What the drivers' tests against their emulators share: the hand, the
+//! turns, the wall run and the faults mid-run. The emulators' plants
+//! advance one period per command, so what is asserted does not depend on
+//! the machine's speed (a tick later than the region allows is its own,
+//! named, fault, checked against the latency the loop measured).
+
+use host_sim::emulate::{Emulator, Fault, Hand};
+use std::sync::{Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+use twoport_board::linkage::pc;
+use twoport_control::servo::ImpedanceGains;
+use twoport_control::Faults;
+use twoport_host::{HostBoard, LinkError, PcBoard};
+
+/// The hand of the wall runs: a 2 N s/m grasp (the regions' least) and a
+/// 100 N/m spring pressing 10 mm past the rest pose, 5 mm past the wall.
+pub const HAND: Hand = Hand {
+    grasp_nspm: 2.0,
+    stiffness_npm: 100.0,
+    push_m: 0.010,
+};
+
+/// The tests take turns: a loop's thread and the emulator's are the
+/// machine's to schedule, and another test at once on two cores would
+/// hold their ticks back.
+static LOOP: Mutex<()> = Mutex::new(());
+
+pub fn turn() -> MutexGuard<'static, ()> {
+    LOOP.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// Wait up to `limit` for `done`, polling the board.
+pub fn wait(
+    b: &mut HostBoard<PcBoard>,
+    limit: Duration,
+    mut done: impl FnMut(&mut HostBoard<PcBoard>) -> bool,
+) {
+    let until = Instant::now() + limit;
+    while !done(b) && Instant::now() < until {
+        let _ = b.poll();
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
+/// The hand presses through the wall 5 mm under the rest pose along the
+/// last axis and rests on it for 10 s (10,000 periods of the device):
+/// where its spring meets the coupling in series with the wall's
+/// 100 kN/m, to within `quantum_m` (the encoders' at the handle), moving
+/// less than it in the last second, the motors holding it. Unless the
+/// machine held a tick past the region's latency: then the board faulted
+/// "force late", the loop measured the latency past it, and the motors
+/// were sent zero.
+pub fn rests_on_the_wall<const N: usize>(
+    emu: &Emulator<N>,
+    b: &mut HostBoard<PcBoard>,
+    coupling: ImpedanceGains,
+    quantum_m: f64,
+) {
+    emu.press();
+    let from = emu.ticks();
+    let mut faults = 0;
+    wait(b, Duration::from_secs(120), |b| {
+        faults = b.latest().map_or(0, |s| s.faults);
+        faults != 0 || emu.ticks() >= from + 10_000
+    });
+    let worst = b.port().timing().latency_s.max;
+    if faults == Faults::LATE_FORCE.0 {
+        assert!(
+            worst > f64::from(pc::LATENCY_S),
+            "faulted late at {worst} s"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+        assert_eq!(emu.trace().torque_nm.last(), Some(&[0.0; N]));
+        return;
+    }
+    assert_eq!(faults, 0);
+    let t = emu.trace();
+    assert!(t.ticks >= from + 10_000, "{} periods", t.ticks - from);
+    let up = |x: &[f64; N]| x[N - 1];
+    let y0 = up(&t.handle_m[0]);
+    let last = &t.handle_m[t.handle_m.len() - 1000..];
+    let (lo, hi) = last.iter().fold((f64::MAX, f64::MIN), |(lo, hi), x| {
+        (lo.min(up(x)), hi.max(up(x)))
+    });
+    let k = f64::from(coupling.k_npm);
+    let press = 0.005 * HAND.stiffness_npm / (HAND.stiffness_npm + k * 100e3 / (100e3 + k));
+    let mid = 0.5 * (lo + hi);
+    let want = y0 - 0.005 - press;
+    assert!(
+        (want - mid).abs() < quantum_m,
+        "at {} mm, not {} mm",
+        (mid - y0) * 1e3,
+        (want - y0) * 1e3
+    );
+    assert!(
+        hi - lo < quantum_m,
+        "moved {} mm in the last second",
+        (hi - lo) * 1e3
+    );
+    let tau = t.torque_nm.last().unwrap();
+    assert!(tau.iter().any(|t| t.abs() > 1e-3), "{tau:?}");
+}
+
+/// Each fault of the device mid-run stops the loop with a message saying
+/// what happened and what to do (`says`), and the motors' last command is
+/// zero.
+pub fn each_fault_stops_at_zero<const N: usize>(
+    says: [(Fault, &str); 4],
+    start: impl Fn(Fault) -> Emulator<N>,
+    arm: impl Fn(&Emulator<N>) -> HostBoard<PcBoard>,
+) {
+    for (fault, says) in says {
+        let emu = start(fault);
+        let mut b = arm(&emu);
+        emu.press();
+        let mut err = None;
+        wait(&mut b, Duration::from_secs(60), |b| {
+            if let Err(e) = b.poll() {
+                err = Some(e);
+            }
+            err.is_some()
+        });
+        match err {
+            Some(LinkError::Device(why)) => assert!(why.contains(says), "{fault:?}: {why}"),
+            e => panic!("{fault:?}: {e:?}"),
+        }
+        if fault != Fault::Unplug {
+            std::thread::sleep(Duration::from_millis(50));
+            let t = emu.trace();
+            assert_eq!(t.torque_nm.last(), Some(&[0.0; N]), "{fault:?}");
+        }
+    }
+}
