@@ -1,9 +1,11 @@
 //! Any bytes into the device protocols' decoders, on both sides: no panic;
-//! a setup that decodes re-encodes to its own bytes; a reply that decodes
-//! holds finite readings and re-encodes to counts it reads back.
+//! a Haply setup that decodes re-encodes to its own bytes, a reply holds
+//! finite readings and re-encodes to counts it reads back; a Falcon packet
+//! that decodes re-encodes to what it means.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
+use twoport_host::falcon::protocol::{Command, Status, PACKET};
 use twoport_host::haply::protocol::{Direction, Joint, Setup};
 
 fuzz_target!(|data: &[u8]| {
@@ -35,5 +37,15 @@ fuzz_target!(|data: &[u8]| {
     }
     if let Ok(t) = s.decode_torques(data) {
         assert_eq!(s.torques(t)[..], data[..Setup::<2>::torques_len()]);
+    }
+    // The Falcon's packets, each way: what decodes re-encodes to what it
+    // means (its spare byte and unused bits aside).
+    if let Ok(p) = <[u8; PACKET]>::try_from(data.get(..PACKET).unwrap_or_default()) {
+        if let Ok(c) = Command::decode(&p) {
+            assert_eq!(Command::decode(&c.encode()), Ok(c));
+        }
+        if let Ok(st) = Status::decode(&p) {
+            assert_eq!(Status::decode(&st.encode()), Ok(st));
+        }
     }
 });

@@ -246,6 +246,12 @@ impl<const N: usize> Setup<N> {
         let float = |at: usize| {
             f32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]])
         };
+        let pwm = bytes[pins_at + 1 + pins];
+        if pwm != 0 {
+            return Err(PacketError::Setup(format!(
+                "{pwm} PWM pins: twoport's devices drive none"
+            )));
+        }
         let floats_at = pins_at + 1 + pins + 1;
         let mut joints = [Joint {
             port: 0,
