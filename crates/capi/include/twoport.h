@@ -401,6 +401,22 @@ enum TpResult tp_board_open_pc_simulated(float hand_n,
                                          struct TpBoard **out);
 
 /**
+ * Open the device `name` (`"haply-2diy"` or `"falcon"`, as `twoport
+ * devices` lists them) on its serial port `path`, its image running in
+ * this computer's servo loop; `firmware` is the Falcon's firmware file
+ * (Novint's, not shipped; NULL for a Haply). Each failure says what to do
+ * (`tp_last_error`).
+ *
+ * # Safety
+ * `name` and `path` are NUL-terminated strings, `firmware` one or NULL;
+ * `out` points to a writable pointer.
+ */
+enum TpResult tp_board_open_device(const char *name,
+                                   const char *path,
+                                   const char *firmware,
+                                   struct TpBoard **out);
+
+/**
  * Disarm the board and free it. NULL is ignored. The board must not be
  * used after.
  *

@@ -174,6 +174,40 @@ pub unsafe extern "C" fn tp_board_open_pc_simulated(
     })
 }
 
+/// Open the device `name` (`"haply-2diy"` or `"falcon"`, as `twoport
+/// devices` lists them) on its serial port `path`, its image running in
+/// this computer's servo loop; `firmware` is the Falcon's firmware file
+/// (Novint's, not shipped; NULL for a Haply). Each failure says what to do
+/// (`tp_last_error`).
+///
+/// # Safety
+/// `name` and `path` are NUL-terminated strings, `firmware` one or NULL;
+/// `out` points to a writable pointer.
+#[no_mangle]
+pub unsafe extern "C" fn tp_board_open_device(
+    name: *const c_char,
+    path: *const c_char,
+    firmware: *const c_char,
+    out: *mut *mut TpBoard,
+) -> TpResult {
+    guard(|| {
+        let text = |p: *const c_char| {
+            // SAFETY: `p` is non-null and NUL-terminated (the contract).
+            (!p.is_null()).then(|| unsafe { CStr::from_ptr(p) })
+        };
+        let (Some(name), Some(path)) = (text(name), text(path)) else {
+            return bad("name and path must not be NULL");
+        };
+        let (Ok(name), Ok(path)) = (name.to_str(), path.to_str()) else {
+            return bad("name and path must be UTF-8");
+        };
+        let firmware = text(firmware).map(|f| std::path::PathBuf::from(&*f.to_string_lossy()));
+        let port = twoport_host::attached::open(name, path, firmware.as_deref())
+            .map(|(p, n)| (Box::new(p) as Box<dyn BoardPort + Send>, n));
+        opened(port.and_then(|(p, n)| HostBoard::open(p, n)), out)
+    })
+}
+
 /// Disarm the board and free it. NULL is ignored. The board must not be
 /// used after.
 ///

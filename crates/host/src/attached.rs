@@ -111,3 +111,51 @@ pub fn hd_library() -> Option<PathBuf> {
         .map(|d| d.join("libHD.so"))
         .find(|p| p.exists())
 }
+
+/// The device `name` (`twoport spec`'s: `haply-2diy` or `falcon`) on its
+/// port `path`, wired and held as its driver does by default (a Haply
+/// v3 with a grip switch on analog pin 2; a Falcon's center button),
+/// its image running in the PC's loop; with its axes. A Falcon needs
+/// Novint's `firmware` file.
+pub fn open(
+    name: &str,
+    path: &str,
+    firmware: Option<&Path>,
+) -> Result<(crate::PcBoard, u8), crate::LinkError> {
+    use crate::device_port::Grip;
+    let bad = |why: String| crate::LinkError::Open {
+        path: path.to_string(),
+        why,
+    };
+    match name {
+        "haply-2diy" => {
+            let grip = Grip::Pin {
+                pin: 2,
+                closed_above: 0.5,
+            };
+            Ok((
+                crate::PcBoard::haply(path, &crate::haply::HaplyConfig::v3(grip))?,
+                2,
+            ))
+        }
+        "falcon" => {
+            let firmware = firmware.ok_or_else(|| {
+                bad(
+                    "the Falcon needs Novint's firmware file, which twoport does not ship: \
+                     name it"
+                        .into(),
+                )
+            })?;
+            Ok((
+                crate::PcBoard::falcon(path, &crate::falcon::FalconConfig::new(firmware))?,
+                3,
+            ))
+        }
+        "touch" => Err(bad(
+            "twoport does not drive the Touch yet (it needs OpenHaptics' HD library)".into(),
+        )),
+        other => Err(bad(format!(
+            "{other}: not a device twoport drives (haply-2diy, falcon)"
+        ))),
+    }
+}

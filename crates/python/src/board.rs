@@ -110,6 +110,21 @@ impl Board {
         })
     }
 
+    /// The device `name` (`"haply-2diy"` or `"falcon"`, as `twoport
+    /// devices` lists them) on its serial port `path`, its image running in
+    /// this computer's servo loop; `firmware` is the Falcon's firmware file
+    /// (Novint's, not shipped). Each failure says what to do.
+    #[staticmethod]
+    #[pyo3(signature = (name, path, firmware=None))]
+    fn device(name: &str, path: &str, firmware: Option<std::path::PathBuf>) -> PyResult<Board> {
+        let (pc, axes) =
+            twoport_host::attached::open(name, path, firmware.as_deref()).map_err(link)?;
+        let port: Box<dyn BoardPort + Send> = Box::new(pc);
+        Ok(Board {
+            inner: Some(HostBoard::open(port, axes).map_err(link)?),
+        })
+    }
+
     /// The servo loop's timing where it runs on this computer
     /// (`pc_simulated`, a device's driver): ticks, late ticks, and the
     /// period's, the device exchange's and the latency's p50/p99/max (s);
