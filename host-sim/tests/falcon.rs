@@ -15,7 +15,7 @@ use host_sim::emulate::{Emulator, Fault};
 use std::path::PathBuf;
 use twoport_board::linkage::{falcon_pc, pc, FALCON};
 use twoport_host::falcon::FalconConfig;
-use twoport_host::{BoardMode, HostBoard, PcBoard};
+use twoport_host::{BoardMode, HostBoard, PcBoard, SteppedPc};
 
 /// A stand-in firmware file of 1,000 bytes, and its bytes.
 fn firmware(name: &str) -> (PathBuf, Vec<u8>) {
@@ -74,6 +74,23 @@ fn the_driver_loads_the_firmware_and_holds_the_floor_for_ten_seconds() {
     let b = HostBoard::open(PcBoard::falcon(emu.path(), &config).unwrap(), 3).unwrap();
     assert_eq!(emu.trace().events.len(), 3);
     b.close().unwrap();
+}
+
+/// The same floor with the loop stepped tick by tick (no thread, no
+/// clock, no latency gate): what the image, the driver's bytes and the
+/// plant do at the certified coupling, whatever the machine's load.
+#[test]
+fn the_floor_holds_tick_by_tick() {
+    let _turn = turn();
+    let (path, image) = firmware("stepped.bin");
+    let emu = falcon::start(loader(image), Some(HAND), None).unwrap();
+    let io = twoport_host::falcon::open(emu.path(), &FalconConfig::new(&path)).unwrap();
+    let stepped = SteppedPc::new(falcon_pc::board().unwrap(), io);
+    let mut b = HostBoard::open(stepped, 3).unwrap();
+    b.calibrate(&FALCON.rest_rad.map(f64::from)).unwrap();
+    b.stream(10).unwrap();
+    assert_eq!(b.arm().unwrap().mode, BoardMode::Armed);
+    rests_on_the_wall(&emu, &mut b, falcon_pc::IMAGE.coupling, 0.1e-3);
 }
 
 #[test]

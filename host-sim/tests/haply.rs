@@ -11,7 +11,7 @@ use twoport_board::linkage::haply::{self as image, HAPLY};
 use twoport_board::linkage::pc;
 use twoport_host::device_port::open_error;
 use twoport_host::haply::{Grip, HaplyConfig};
-use twoport_host::{BoardMode, HostBoard, PcBoard};
+use twoport_host::{BoardMode, HostBoard, PcBoard, SteppedPc};
 
 /// A switch on analog pin 2, as the emulator's hand closes it.
 fn config() -> HaplyConfig {
@@ -49,6 +49,22 @@ fn the_driver_holds_the_wall_for_ten_seconds() {
     let mut b = armed(&emu);
     rests_on_the_wall(&emu, &mut b, image::IMAGE.coupling, 0.05e-3);
     b.disarm().unwrap();
+}
+
+/// The same wall with the loop stepped tick by tick (no thread, no
+/// clock, no latency gate): what the image, the driver's bytes and the
+/// plant do at the certified coupling, whatever the machine's load.
+#[test]
+fn the_wall_holds_tick_by_tick() {
+    let _turn = turn();
+    let emu = haply::start(Some(HAND), None).unwrap();
+    let io = twoport_host::haply::open(emu.path(), &config()).unwrap();
+    let stepped = SteppedPc::new(image::board().unwrap(), io);
+    let mut b = HostBoard::open(stepped, 2).unwrap();
+    b.calibrate(&HAPLY.rest_rad.map(f64::from)).unwrap();
+    b.stream(10).unwrap();
+    assert_eq!(b.arm().unwrap().mode, BoardMode::Armed);
+    rests_on_the_wall(&emu, &mut b, image::IMAGE.coupling, 0.05e-3);
 }
 
 #[test]

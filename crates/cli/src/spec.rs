@@ -22,6 +22,8 @@ struct Known {
     latency_why: &'static str,
     /// CHAI3D's hand-set (force N, stiffness N/m, damping N s/m).
     chai3d: Option<(f64, f64, f64)>,
+    /// The coupling twoport's driver runs, where it drives the device.
+    driven: Option<twoport_control::ImpedanceGains>,
 }
 
 const KNOWN: [Known; 3] = [
@@ -37,6 +39,7 @@ const KNOWN: [Known; 3] = [
         latency_why: "the PC hands a tick's torques to the next exchange (one tick), and the \
                       FTDI chip's 1 ms latency timer can hold the encoders' packet a tick more",
         chai3d: Some((8.0, 3000.0, 20.0)),
+        driven: Some(twoport_board::linkage::falcon_pc::IMAGE.coupling),
     },
     Known {
         name: "haply-2diy",
@@ -51,6 +54,7 @@ const KNOWN: [Known; 3] = [
                       board answers a torque packet with its encoders within the next 1 ms USB \
                       frame",
         chai3d: None,
+        driven: Some(twoport_board::linkage::haply::IMAGE.coupling),
     },
     Known {
         name: "touch",
@@ -61,6 +65,7 @@ const KNOWN: [Known; 3] = [
         latency_why: "OpenHaptics' servo callback sends the force at the end of the frame that \
                       read the position, which the device applies at the next (one tick)",
         chai3d: Some((3.3, 400.0, 4.0)),
+        driven: None,
     },
 ];
 
@@ -205,6 +210,11 @@ pub(crate) struct DeviceSpec {
     /// CHAI3D's hand-set stiffness and damping, where it has one.
     chai3d_k_npm: Option<f64>,
     chai3d_b_nspm: Option<f64>,
+    /// The coupling twoport's driver runs (N/m, N s/m), and the latency
+    /// (s) its region is proven for, where twoport drives the device.
+    driven_k_npm: Option<f64>,
+    driven_b_nspm: Option<f64>,
+    driven_latency_s: Option<f64>,
 }
 
 pub(crate) fn spec(name: &str, min_grasp_nspm: f64) -> Result<DeviceSpec, String> {
@@ -247,6 +257,11 @@ pub(crate) fn spec(name: &str, min_grasp_nspm: f64) -> Result<DeviceSpec, String
         grasp_b_max_nspm: least.bound + min_grasp_nspm,
         chai3d_k_npm: k.chai3d.map(|c| c.1),
         chai3d_b_nspm: k.chai3d.map(|c| c.2),
+        driven_k_npm: k.driven.map(|c| f64::from(c.k_npm)),
+        driven_b_nspm: k.driven.map(|c| f64::from(c.b_nspm)),
+        driven_latency_s: k
+            .driven
+            .map(|_| f64::from(twoport_board::linkage::pc::LATENCY_S)),
     })
 }
 
@@ -269,6 +284,15 @@ impl fmt::Display for DeviceSpec {
             self.min_grasp_nspm,
             self.grasp_b_max_nspm
         )?;
+        match (self.driven_k_npm, self.driven_b_nspm, self.driven_latency_s) {
+            (Some(k), Some(b), Some(l)) => writeln!(
+                f,
+                "  twoport's driver runs {k:.0} N/m at {b} N s/m, proven over the workspace for \
+                 a grasp of at least 2 N s/m at {:.0} ms (the protocol's and the PC's scheduling): docs/devices.md",
+                l * 1e3
+            )?,
+            _ => writeln!(f, "  twoport does not drive this device yet")?,
+        }
         match (self.chai3d_k_npm, self.chai3d_b_nspm) {
             (Some(k), Some(b)) => write!(
                 f,

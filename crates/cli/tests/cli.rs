@@ -603,6 +603,21 @@ fn spec_proves_a_pc_driven_device_at_its_rate_and_latency() {
     }
     let v = TWOPORT.json(&["spec", "falcon", "--json"]);
     assert!(v["chai3d_k_npm"].as_f64().unwrap() > 5.0 * v["grasp_k_npm"].as_f64().unwrap());
+    // The driver's coupling, and the latency its region is proven for:
+    // the board image's.
+    let image = twoport_board::linkage::falcon_pc::IMAGE.coupling;
+    assert_eq!(v["driven_k_npm"].as_f64(), Some(f64::from(image.k_npm)));
+    assert_eq!(
+        v["driven_latency_s"].as_f64(),
+        Some(f64::from(twoport_board::linkage::pc::LATENCY_S))
+    );
+    // What is plugged in: every serial port, each with its path.
+    let ports = TWOPORT.json(&["devices", "--json"]);
+    assert!(ports["ports"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|p| p["path"].is_string()));
     let e = TWOPORT.failure(&["spec", "touch"]);
     assert!(e.contains("no model") && e.contains("identify-pose"), "{e}");
     let e = TWOPORT.failure(&["spec", "omni"]);

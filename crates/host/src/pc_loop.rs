@@ -377,6 +377,90 @@ fn record(ring: &mut Vec<f64>, slot: usize, v: f64) {
     }
 }
 
+/// A board image's loop on the PC stepped by its caller, with no thread
+/// and no clock: each read of the link that finds nothing runs one tick
+/// (one exchange with the device). Its count's rate is not set, so the
+/// latency gate is off: what it shows is the image, the driver and the
+/// device, tick by tick, whatever the machine's load. For tests and
+/// studies of a driver; a device is run by [`PcBoard`].
+pub struct SteppedPc<Io, W, L, D, const N: usize, const R: usize> {
+    board: Board<W, R, N, L, D>,
+    support: PcSupport<Io, N>,
+}
+
+impl<Io, W, L, D, const N: usize, const R: usize> SteppedPc<Io, W, L, D, N, R>
+where
+    Io: DeviceIo<N>,
+    W: World<f32, N>,
+    L: PortLayer,
+    D: Drive<N, World = W, Layer = L>,
+{
+    /// `board` against `io`, stepped by reads of its link.
+    pub fn new(board: Board<W, R, N, L, D>, io: Io) -> Self {
+        SteppedPc {
+            board,
+            support: PcSupport {
+                io,
+                shared: Arc::new((Mutex::new(Shared::default()), Condvar::new())),
+                duty: [0; N],
+                on: false,
+                last: RawSensors::default(),
+                failed: None,
+                io_s: 0.0,
+                exchanged: None,
+                latency: None,
+                start: Instant::now(),
+                period_ns: 1,
+            },
+        }
+    }
+
+    /// Why the loop stopped, once a device exchange has failed.
+    pub fn failure(&self) -> Option<String> {
+        self.support.shared().failed.clone()
+    }
+}
+
+impl<Io, W, L, D, const N: usize, const R: usize> BoardPort for SteppedPc<Io, W, L, D, N, R>
+where
+    Io: DeviceIo<N>,
+    W: World<f32, N>,
+    L: PortLayer,
+    D: Drive<N, World = W, Layer = L>,
+{
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        let mut s = self.support.shared();
+        if let Some(e) = &s.failed {
+            return Err(LinkError::Device(e.clone()));
+        }
+        s.link.send(bytes);
+        Ok(())
+    }
+
+    fn recv(&mut self, buf: &mut [u8], _: Duration) -> Result<usize, LinkError> {
+        {
+            let mut s = self.support.shared();
+            let n = s.link.take(buf);
+            if n > 0 {
+                return Ok(n);
+            }
+            if let Some(e) = &s.failed {
+                return Err(LinkError::Device(e.clone()));
+            }
+        }
+        let io = &mut self.support;
+        self.board.poll_link(io);
+        self.board.control_tick(io);
+        self.board.flush(io);
+        if let Some(e) = io.failed.take() {
+            // Zero force with the outputs off, as the thread's loop ends.
+            let _ = io.io.exchange([0; N], false);
+            io.shared().failed = Some(e);
+        }
+        Ok(self.support.shared().link.take(buf))
+    }
+}
+
 impl BoardPort for PcBoard {
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
         let mut s = lock(&self.shared.0);

@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use twoport_board::linkage::pc;
 use twoport_control::servo::ImpedanceGains;
 use twoport_control::Faults;
-use twoport_host::{HostBoard, LinkError, PcBoard};
+use twoport_host::{BoardPort, HostBoard, LinkError, PcBoard};
 
 /// The hand of the wall runs: a 2 N s/m grasp (the regions' least) and a
 /// 100 N/m spring pressing 10 mm past the rest pose, 5 mm past the wall.
@@ -29,30 +29,39 @@ pub fn turn() -> MutexGuard<'static, ()> {
     LOOP.lock().unwrap_or_else(|p| p.into_inner())
 }
 
-/// Wait up to `limit` for `done`, polling the board.
-pub fn wait(
-    b: &mut HostBoard<PcBoard>,
+/// Wait up to `limit` for `done`, polling the board (with a pause
+/// between polls where a thread runs its loop; none where each poll steps
+/// it).
+pub fn wait<P: BoardPort>(
+    b: &mut HostBoard<P>,
     limit: Duration,
-    mut done: impl FnMut(&mut HostBoard<PcBoard>) -> bool,
+    mut done: impl FnMut(&mut HostBoard<P>) -> bool,
 ) {
     let until = Instant::now() + limit;
+    let pause = if b.port().loop_timing().is_some() {
+        2
+    } else {
+        0
+    };
     while !done(b) && Instant::now() < until {
         let _ = b.poll();
-        std::thread::sleep(Duration::from_millis(2));
+        std::thread::sleep(Duration::from_millis(pause));
     }
 }
 
 /// The hand presses through the wall 5 mm under the rest pose along the
-/// last axis and rests on it for 10 s (10,000 periods of the device):
+/// last axis and rests on it for 10 s (10,000 periods of the device),
+/// the loop in its thread ([`PcBoard`]) or stepped by the polls
+/// ([`twoport_host::SteppedPc`], no latency gate):
 /// where its spring meets the coupling in series with the wall's
 /// 100 kN/m, to within `quantum_m` (the encoders' at the handle), moving
 /// less than it in the last second, the motors holding it. Unless the
 /// machine held a tick past the region's latency: then the board faulted
 /// "force late", the loop measured the latency past it, and the motors
 /// were sent zero.
-pub fn rests_on_the_wall<const N: usize>(
+pub fn rests_on_the_wall<const N: usize, P: BoardPort>(
     emu: &Emulator<N>,
-    b: &mut HostBoard<PcBoard>,
+    b: &mut HostBoard<P>,
     coupling: ImpedanceGains,
     quantum_m: f64,
 ) {
@@ -63,7 +72,7 @@ pub fn rests_on_the_wall<const N: usize>(
         faults = b.latest().map_or(0, |s| s.faults);
         faults != 0 || emu.ticks() >= from + 10_000
     });
-    let worst = b.port().timing().latency_s.max;
+    let worst = b.port().loop_timing().map_or(0.0, |t| t.latency_s.max);
     if faults == Faults::LATE_FORCE.0 {
         assert!(
             worst > f64::from(pc::LATENCY_S),

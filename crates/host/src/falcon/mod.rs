@@ -67,28 +67,40 @@ impl FalconIo {
 
 impl DeviceIo<3> for FalconIo {
     fn exchange(&mut self, duty: [i16; 3], on: bool) -> Result<RawSensors<3>, String> {
-        // The image's torque resists the joint's motion, as libnifalcon's
-        // motor value does (the negative of J^T f).
-        let motor = core::array::from_fn(|i| {
-            let tau = if on { self.io[i].force_n(duty[i]) } else { 0.0 };
-            (tau * protocol::MOTOR_PER_NM)
-                .round()
-                .clamp(-32_767.0, 32_767.0) as i16
-        });
-        let s = self.send(&Command {
-            motor,
-            leds: self.leds,
-            homing: false,
-        })?;
-        Ok(RawSensors {
-            encoder_raw: s.encoder.map(|c| i32::from(c) as u32),
-            dead_man_closed: match self.grip {
-                Grip::Button { mask } => s.buttons & mask != 0,
-                Grip::Assumed => true,
-                Grip::Pin { .. } => false,
-            },
-            ..RawSensors::default()
-        })
+        let s = self.send(&command(duty, on, &self.io, self.leds))?;
+        Ok(sensors(&s, self.grip))
+    }
+}
+
+/// The packet that commands the board image's `duty` (outputs `on`, or
+/// zero), each joint's scaled by `io`: the image's torque resists the
+/// joint's motion, as libnifalcon's motor value does (the negative of
+/// `J^T f`).
+pub fn command(duty: [i16; 3], on: bool, io: &[IoScale; 3], leds: u8) -> Command {
+    let motor = core::array::from_fn(|i| {
+        let tau = if on { io[i].force_n(duty[i]) } else { 0.0 };
+        (tau * protocol::MOTOR_PER_NM)
+            .round()
+            .clamp(-32_767.0, 32_767.0) as i16
+    });
+    Command {
+        motor,
+        leds,
+        homing: false,
+    }
+}
+
+/// What the board image reads from the Falcon's `status`, its dead-man
+/// switch from `grip`.
+pub fn sensors(status: &Status, grip: Grip) -> RawSensors<3> {
+    RawSensors {
+        encoder_raw: status.encoder.map(|c| i32::from(c) as u32),
+        dead_man_closed: match grip {
+            Grip::Button { mask } => status.buttons & mask != 0,
+            Grip::Assumed => true,
+            Grip::Pin { .. } => false,
+        },
+        ..RawSensors::default()
     }
 }
 
