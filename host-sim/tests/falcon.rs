@@ -9,13 +9,13 @@
 
 mod emulated;
 
-use emulated::{each_fault_stops_at_zero, rests_on_the_wall, turn, HAND};
+use emulated::{armed_at, each_fault_stops_at_zero, rests_on_the_wall, turn, HAND};
 use host_sim::emulate::falcon::{self, Loader};
 use host_sim::emulate::{Emulator, Fault};
 use std::path::PathBuf;
-use twoport_board::linkage::{falcon_pc, pc, FALCON};
+use twoport_board::linkage::{falcon_pc, FALCON};
 use twoport_host::falcon::FalconConfig;
-use twoport_host::{BoardMode, HostBoard, PcBoard, SteppedPc};
+use twoport_host::{HostBoard, PcBoard, SteppedPc};
 
 /// A stand-in firmware file of 1,000 bytes, and its bytes.
 fn firmware(name: &str) -> (PathBuf, Vec<u8>) {
@@ -39,13 +39,11 @@ fn loader(image: Vec<u8>) -> Loader {
 
 /// Open, calibrate at the rest pose, stream and arm.
 fn armed(emu: &Emulator<3>, config: &FalconConfig) -> HostBoard<PcBoard> {
-    let pc = PcBoard::falcon(emu.path(), config).unwrap();
-    let mut b = HostBoard::open(pc, 3).unwrap();
-    assert_eq!(b.spec().latency_budget_s, pc::LATENCY_S);
-    b.calibrate(&FALCON.rest_rad.map(f64::from)).unwrap();
-    b.stream(10).unwrap();
-    assert_eq!(b.arm().unwrap().mode, BoardMode::Armed);
-    b
+    armed_at(
+        PcBoard::falcon(emu.path(), config).unwrap(),
+        3,
+        &FALCON.rest_rad,
+    )
 }
 
 /// The firmware goes up once: the loader's two handshakes, its 1,000
@@ -86,10 +84,7 @@ fn the_floor_holds_tick_by_tick() {
     let emu = falcon::start(loader(image), Some(HAND), None).unwrap();
     let io = twoport_host::falcon::open(emu.path(), &FalconConfig::new(&path)).unwrap();
     let stepped = SteppedPc::new(falcon_pc::board().unwrap(), io);
-    let mut b = HostBoard::open(stepped, 3).unwrap();
-    b.calibrate(&FALCON.rest_rad.map(f64::from)).unwrap();
-    b.stream(10).unwrap();
-    assert_eq!(b.arm().unwrap().mode, BoardMode::Armed);
+    let mut b = armed_at(stepped, 3, &FALCON.rest_rad);
     rests_on_the_wall(&emu, &mut b, falcon_pc::IMAGE.coupling, 0.1e-3);
 }
 

@@ -5,13 +5,12 @@
 
 mod emulated;
 
-use emulated::{each_fault_stops_at_zero, rests_on_the_wall, turn, HAND};
+use emulated::{armed_at, each_fault_stops_at_zero, rests_on_the_wall, turn, HAND};
 use host_sim::emulate::{haply, Emulator, Fault};
 use twoport_board::linkage::haply::{self as image, HAPLY};
-use twoport_board::linkage::pc;
 use twoport_host::device_port::open_error;
 use twoport_host::haply::{Grip, HaplyConfig};
-use twoport_host::{BoardMode, HostBoard, PcBoard, SteppedPc};
+use twoport_host::{HostBoard, PcBoard, SteppedPc};
 
 /// A switch on analog pin 2, as the emulator's hand closes it.
 fn config() -> HaplyConfig {
@@ -24,12 +23,11 @@ fn config() -> HaplyConfig {
 /// Open, calibrate at the rest pose, stream and arm: the setup the board
 /// read is the one the driver meant.
 fn armed(emu: &Emulator<2>) -> HostBoard<PcBoard> {
-    let pc = PcBoard::haply(emu.path(), &config()).unwrap();
-    let mut b = HostBoard::open(pc, 2).unwrap();
-    assert_eq!(b.spec().latency_budget_s, pc::LATENCY_S);
-    b.calibrate(&HAPLY.rest_rad.map(f64::from)).unwrap();
-    b.stream(10).unwrap();
-    assert_eq!(b.arm().unwrap().mode, BoardMode::Armed);
+    let b = armed_at(
+        PcBoard::haply(emu.path(), &config()).unwrap(),
+        2,
+        &HAPLY.rest_rad,
+    );
     let mut sent = config().setup();
     sent.joints.sort_by_key(|j| j.port);
     assert_eq!(
@@ -60,10 +58,7 @@ fn the_wall_holds_tick_by_tick() {
     let emu = haply::start(Some(HAND), None).unwrap();
     let io = twoport_host::haply::open(emu.path(), &config()).unwrap();
     let stepped = SteppedPc::new(image::board().unwrap(), io);
-    let mut b = HostBoard::open(stepped, 2).unwrap();
-    b.calibrate(&HAPLY.rest_rad.map(f64::from)).unwrap();
-    b.stream(10).unwrap();
-    assert_eq!(b.arm().unwrap().mode, BoardMode::Armed);
+    let mut b = armed_at(stepped, 2, &HAPLY.rest_rad);
     rests_on_the_wall(&emu, &mut b, image::IMAGE.coupling, 0.05e-3);
 }
 

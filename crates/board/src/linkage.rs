@@ -268,15 +268,20 @@ pub fn serial_arm_board() -> Result<SerialArmBoard, BuildError> {
     board(&PHANTOM, arm)
 }
 
-/// The delta image: the Falcon-like delta.
-pub fn delta_board() -> Result<DeltaBoard, BuildError> {
+/// The Falcon-like delta's kinematics.
+pub fn falcon_delta() -> Result<Delta, BuildError> {
     let DeltaLengths {
         base_m: r,
         effector_m: e,
         upper_m: a,
         lower_m: b,
     } = FALCON_DELTA;
-    board(&FALCON, Delta::new(r, e, a, b).map_err(BuildError::Param)?)
+    Delta::new(r, e, a, b).map_err(BuildError::Param)
+}
+
+/// The delta image: the Falcon-like delta.
+pub fn delta_board() -> Result<DeltaBoard, BuildError> {
+    board(&FALCON, falcon_delta()?)
 }
 
 #[cfg(test)]

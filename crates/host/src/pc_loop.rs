@@ -156,6 +156,23 @@ struct PcSupport<Io, const N: usize> {
 }
 
 impl<Io, const N: usize> PcSupport<Io, N> {
+    /// `io`, nothing exchanged yet, its tick `period_ns` long.
+    fn new(io: Io, period_ns: u32) -> Self {
+        PcSupport {
+            io,
+            shared: Arc::new((Mutex::new(Shared::default()), Condvar::new())),
+            duty: [0; N],
+            on: false,
+            last: RawSensors::default(),
+            failed: None,
+            io_s: 0.0,
+            exchanged: None,
+            latency: None,
+            start: Instant::now(),
+            period_ns,
+        }
+    }
+
     fn shared(&self) -> MutexGuard<'_, Shared> {
         lock(&self.shared.0)
     }
@@ -247,20 +264,8 @@ impl PcBoard {
                 "period_s {period_s}: the loop's period must be between 1 µs and 1 s"
             )));
         }
-        let shared = Arc::new((Mutex::new(Shared::default()), Condvar::new()));
-        let support = PcSupport {
-            io,
-            shared: Arc::clone(&shared),
-            duty: [0; N],
-            on: false,
-            last: RawSensors::default(),
-            failed: None,
-            io_s: 0.0,
-            exchanged: None,
-            latency: None,
-            start: Instant::now(),
-            period_ns: (period_s * 1e9).round() as u32,
-        };
+        let support = PcSupport::new(io, (period_s * 1e9).round() as u32);
+        let shared = Arc::clone(&support.shared);
         let period = Duration::from_secs_f64(period_s);
         // The loop's count is nanoseconds: the board holds the latency it
         // measures in them to what its regions are proven for.
@@ -399,19 +404,7 @@ where
     pub fn new(board: Board<W, R, N, L, D>, io: Io) -> Self {
         SteppedPc {
             board,
-            support: PcSupport {
-                io,
-                shared: Arc::new((Mutex::new(Shared::default()), Condvar::new())),
-                duty: [0; N],
-                on: false,
-                last: RawSensors::default(),
-                failed: None,
-                io_s: 0.0,
-                exchanged: None,
-                latency: None,
-                start: Instant::now(),
-                period_ns: 1,
-            },
+            support: PcSupport::new(io, 1),
         }
     }
 

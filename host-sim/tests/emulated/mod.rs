@@ -29,6 +29,18 @@ pub fn turn() -> MutexGuard<'static, ()> {
     LOOP.lock().unwrap_or_else(|p| p.into_inner())
 }
 
+/// Open the board on `port` (its `axes`), calibrate it at the image's
+/// `rest_rad`, stream and arm: its region states the PC's latency.
+pub fn armed_at<P: BoardPort>(port: P, axes: u8, rest_rad: &[f32]) -> HostBoard<P> {
+    let mut b = HostBoard::open(port, axes).unwrap();
+    assert_eq!(b.spec().latency_budget_s, pc::LATENCY_S);
+    let rest: Vec<f64> = rest_rad.iter().map(|q| f64::from(*q)).collect();
+    b.calibrate(&rest).unwrap();
+    b.stream(10).unwrap();
+    assert_eq!(b.arm().unwrap().mode, twoport_host::BoardMode::Armed);
+    b
+}
+
 /// Wait up to `limit` for `done`, polling the board (with a pause
 /// between polls where a thread runs its loop; none where each poll steps
 /// it).
@@ -68,7 +80,7 @@ pub fn rests_on_the_wall<const N: usize, P: BoardPort>(
     emu.press();
     let from = emu.ticks();
     let mut faults = 0;
-    wait(b, Duration::from_secs(120), |b| {
+    wait(b, Duration::from_secs(600), |b| {
         faults = b.latest().map_or(0, |s| s.faults);
         faults != 0 || emu.ticks() >= from + 10_000
     });

@@ -7,9 +7,8 @@
 //! --min-grasp 2 --latency 0.005 --b B`).
 
 use super::pc::PcImage;
-use super::{DeltaBoard, DeltaLengths, FALCON, FALCON_DELTA};
+use super::{falcon_delta, DeltaBoard, FALCON};
 use crate::BuildError;
-use twoport_control::kinematics::Delta;
 use twoport_control::servo::ImpedanceGains;
 
 /// The image: 400 N/m at 1 N s/m (18 % under its boundary).
@@ -22,11 +21,5 @@ pub const IMAGE: PcImage<3> = PcImage {
 
 /// The image's board.
 pub fn board() -> Result<DeltaBoard, BuildError> {
-    let DeltaLengths {
-        base_m: r,
-        effector_m: e,
-        upper_m: a,
-        lower_m: b,
-    } = FALCON_DELTA;
-    IMAGE.board(Delta::new(r, e, a, b).map_err(BuildError::Param)?)
+    IMAGE.board(falcon_delta()?)
 }

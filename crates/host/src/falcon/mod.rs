@@ -194,26 +194,28 @@ fn load(port: &mut DevicePort, path: &str, image: &[u8]) -> Result<(), String> {
              program's: see docs/devices.md)"
         )
     };
-    port.send(&protocol::CHECK_1)?;
-    let mut a = [0; 4];
-    port.receive(&mut a)
-        .map_err(|_| not_loader("its first handshake"))?;
-    if a != protocol::CHECK_1_ANSWER {
-        return Err(not_loader(&format!(
-            "its first handshake as expected ({a:02x?})"
-        )));
-    }
+    // Each handshake: what the host sends, and what the loader answers.
+    let shake = |port: &mut DevicePort, send: &[u8], answer: &[u8], which: &str| {
+        port.send(send)?;
+        let mut got = vec![0; answer.len()];
+        port.receive(&mut got)
+            .map_err(|_| not_loader(&format!("its {which} handshake")))?;
+        if got != answer {
+            return Err(not_loader(&format!(
+                "its {which} handshake as expected ({got:02x?})"
+            )));
+        }
+        Ok(())
+    };
+    shake(port, &protocol::CHECK_1, &protocol::CHECK_1_ANSWER, "first")?;
     let _ = port.port_mut().write_data_terminal_ready(false);
     rate(port, protocol::LOAD_BAUD)?;
-    port.send(&protocol::CHECK_2)?;
-    let mut b = [0; 2];
-    port.receive(&mut b)
-        .map_err(|_| not_loader("its second handshake"))?;
-    if b != protocol::CHECK_2_ANSWER {
-        return Err(not_loader(&format!(
-            "its second handshake as expected ({b:02x?})"
-        )));
-    }
+    shake(
+        port,
+        &protocol::CHECK_2,
+        &protocol::CHECK_2_ANSWER,
+        "second",
+    )?;
     let mut echo = [0; CHUNK];
     for (k, chunk) in image.chunks(CHUNK).enumerate() {
         port.send(chunk)?;
