@@ -43,12 +43,12 @@ pub fn armed_at<P: BoardPort>(port: P, axes: u8, rest_rad: &[f32]) -> HostBoard<
 
 /// Wait up to `limit` for `done`, polling the board (with a pause
 /// between polls where a thread runs its loop; none where each poll steps
-/// it).
+/// it); the first error a poll meets ends the wait.
 pub fn wait<P: BoardPort>(
     b: &mut HostBoard<P>,
     limit: Duration,
     mut done: impl FnMut(&mut HostBoard<P>) -> bool,
-) {
+) -> Result<(), LinkError> {
     let until = Instant::now() + limit;
     let pause = if b.port().loop_timing().is_some() {
         2
@@ -56,9 +56,10 @@ pub fn wait<P: BoardPort>(
         0
     };
     while !done(b) && Instant::now() < until {
-        let _ = b.poll();
+        b.poll()?;
         std::thread::sleep(Duration::from_millis(pause));
     }
+    Ok(())
 }
 
 /// The hand presses through the wall 5 mm under the rest pose along the
@@ -83,7 +84,8 @@ pub fn rests_on_the_wall<const N: usize, P: BoardPort>(
     wait(b, Duration::from_secs(600), |b| {
         faults = b.latest().map_or(0, |s| s.faults);
         faults != 0 || emu.ticks() >= from + 10_000
-    });
+    })
+    .unwrap();
     let worst = b.port().loop_timing().map_or(0.0, |t| t.latency_s.max);
     if faults == Faults::LATE_FORCE.0 {
         assert!(
@@ -134,15 +136,8 @@ pub fn each_fault_stops_at_zero<const N: usize>(
         let emu = start(fault);
         let mut b = arm(&emu);
         emu.press();
-        let mut err = None;
-        wait(&mut b, Duration::from_secs(60), |b| {
-            if let Err(e) = b.poll() {
-                err = Some(e);
-            }
-            err.is_some()
-        });
-        match err {
-            Some(LinkError::Device(why)) => assert!(why.contains(says), "{fault:?}: {why}"),
+        match wait(&mut b, Duration::from_secs(60), |_| false) {
+            Err(LinkError::Device(why)) => assert!(why.contains(says), "{fault:?}: {why}"),
             e => panic!("{fault:?}: {e:?}"),
         }
         if fault != Fault::Unplug {
