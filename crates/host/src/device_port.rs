@@ -34,14 +34,48 @@ pub enum Grip {
 }
 
 impl Grip {
-    /// Say, once, that the grip is assumed.
-    pub fn warn_if_assumed(&self, path: &str, name: &str) {
-        if matches!(self, Grip::Assumed) {
-            eprintln!(
-                "twoport: {path}: the {name}'s grip is assumed (Grip::Assumed): force is on \
-                 whenever the loop is armed, hands on the handle or not; its region is \
-                 proven only for a grasp of at least 2 N s/m"
-            );
+    /// Whether the hand is on the handle, given the device's analog
+    /// readings by pin and its buttons held (a bit each).
+    pub fn closed(&self, reading: impl Fn(u8) -> Option<f32>, buttons: u8) -> bool {
+        match *self {
+            Grip::Pin { pin, closed_above } => reading(pin).is_some_and(|v| v > closed_above),
+            Grip::Button { mask } => buttons & mask != 0,
+            Grip::Assumed => true,
+        }
+    }
+
+    /// Refuse a switch the device `name` has no way to read (it has analog
+    /// pins where `pins`, buttons where `buttons`); say, once, that the
+    /// grip is assumed.
+    pub fn check(
+        &self,
+        path: &str,
+        name: &str,
+        pins: bool,
+        buttons: bool,
+    ) -> Result<(), LinkError> {
+        let refuse = |why: String| {
+            Err(LinkError::Open {
+                path: path.to_string(),
+                why,
+            })
+        };
+        match self {
+            Grip::Pin { .. } if !pins => refuse(format!(
+                "the {name} has no analog pins: use its grip buttons (Grip::Button)"
+            )),
+            Grip::Button { .. } if !buttons => refuse(format!(
+                "the {name} has no buttons: wire a switch to an analog pin (Grip::Pin)"
+            )),
+            Grip::Assumed => {
+                eprintln!(
+                    "twoport: {path}: the {name}'s grip is assumed (Grip::Assumed): force is \
+                     on whenever the loop is armed, hands on the handle or not; its region is \
+                     proven only for a grasp of at least 2 N s/m"
+                );
+                Ok(())
+            }
+            _ => Ok(()),
         }
     }
 }
@@ -180,5 +214,36 @@ pub fn open_error(path: &str, kind: ErrorKind, name: &str) -> LinkError {
     LinkError::Open {
         path: path.to_string(),
         why,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each switch reads what it is wired to; a switch the device cannot
+    /// read is refused at open, by name.
+    #[test]
+    fn a_grip_reads_its_own_switch_and_no_other() {
+        let pin = Grip::Pin {
+            pin: 2,
+            closed_above: 0.5,
+        };
+        let reading = |p| (p == 2).then_some(0.7);
+        assert!(pin.closed(reading, 0));
+        assert!(!pin.closed(|_| Some(0.3), 0xff));
+        assert!(!pin.closed(|_| None, 0xff));
+        let button = Grip::Button { mask: 0b0010 };
+        assert!(button.closed(|_| Some(1.0), 0b0010));
+        assert!(!button.closed(|_| Some(1.0), 0b0001));
+        assert!(Grip::Assumed.closed(|_| None, 0));
+        let e = button.check("/dev/x", "2DIY", true, false).unwrap_err();
+        assert!(e.to_string().contains("the 2DIY has no buttons"), "{e}");
+        let e = pin.check("/dev/x", "Falcon", false, true).unwrap_err();
+        assert!(
+            e.to_string().contains("the Falcon has no analog pins"),
+            "{e}"
+        );
+        assert!(pin.check("/dev/x", "2DIY", true, false).is_ok());
     }
 }

@@ -121,7 +121,7 @@ fn raise_priority() -> Priority {
     }
 }
 
-/// What the loop's thread and the application share.
+/// What the loop and the application share.
 #[derive(Default)]
 struct Shared {
     /// The loop thread's priority, once it has asked for one.
@@ -135,6 +135,17 @@ struct Shared {
     /// Why the loop stopped, once it has.
     failed: Option<String>,
     stop: bool,
+}
+
+impl Shared {
+    /// The application's bytes for the board, unless the loop has stopped.
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        if let Some(e) = &self.failed {
+            return Err(LinkError::Device(e.clone()));
+        }
+        self.link.send(bytes);
+        Ok(())
+    }
 }
 
 /// The board support the image's loop runs against on the PC: the device
@@ -407,11 +418,6 @@ where
             support: PcSupport::new(io, 1),
         }
     }
-
-    /// Why the loop stopped, once a device exchange has failed.
-    pub fn failure(&self) -> Option<String> {
-        self.support.shared().failed.clone()
-    }
 }
 
 impl<Io, W, L, D, const N: usize, const R: usize> BoardPort for SteppedPc<Io, W, L, D, N, R>
@@ -422,12 +428,7 @@ where
     D: Drive<N, World = W, Layer = L>,
 {
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
-        let mut s = self.support.shared();
-        if let Some(e) = &s.failed {
-            return Err(LinkError::Device(e.clone()));
-        }
-        s.link.send(bytes);
-        Ok(())
+        self.support.shared().send(bytes)
     }
 
     fn recv(&mut self, buf: &mut [u8], _: Duration) -> Result<usize, LinkError> {
@@ -456,12 +457,7 @@ where
 
 impl BoardPort for PcBoard {
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
-        let mut s = lock(&self.shared.0);
-        if let Some(e) = &s.failed {
-            return Err(LinkError::Device(e.clone()));
-        }
-        s.link.send(bytes);
-        Ok(())
+        lock(&self.shared.0).send(bytes)
     }
 
     fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError> {

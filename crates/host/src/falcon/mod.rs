@@ -95,11 +95,7 @@ pub fn command(duty: [i16; 3], on: bool, io: &[IoScale; 3], leds: u8) -> Command
 pub fn sensors(status: &Status, grip: Grip) -> RawSensors<3> {
     RawSensors {
         encoder_raw: status.encoder.map(|c| i32::from(c) as u32),
-        dead_man_closed: match grip {
-            Grip::Button { mask } => status.buttons & mask != 0,
-            Grip::Assumed => true,
-            Grip::Pin { .. } => false,
-        },
+        dead_man_closed: grip.closed(|_| None, status.buttons),
         ..RawSensors::default()
     }
 }
@@ -241,11 +237,7 @@ pub fn open(path: &str, config: &FalconConfig) -> Result<impl DeviceIo<3> + 'sta
         path: path.to_string(),
         why,
     };
-    if let Grip::Pin { .. } = config.grip {
-        return Err(open_err(
-            "the Falcon has no analog pins: use a grip button (Grip::Button)".into(),
-        ));
-    }
+    config.grip.check(path, NAME, false, true)?;
     let image = firmware(&config.firmware).map_err(open_err)?;
     let mut port = DevicePort::open(path, protocol::CHECK_BAUD, NAME)?;
     if !running(&mut port, path).map_err(open_err)? {
@@ -258,7 +250,6 @@ pub fn open(path: &str, config: &FalconConfig) -> Result<impl DeviceIo<3> + 'sta
         std::thread::sleep(Duration::from_millis(20));
         let _ = port.port_mut().clear(serialport::ClearBuffer::All);
     }
-    config.grip.warn_if_assumed(path, NAME);
     let mut io = FalconIo {
         port,
         io: io_scale(&FALCON),

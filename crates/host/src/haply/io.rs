@@ -59,16 +59,12 @@ impl DeviceIo<2> for HaplyIo {
             .setup
             .decode_reply(&self.buf)
             .map_err(|e| format!("the 2DIY's reply: {e}"))?;
-        let dead_man_closed = match self.grip {
-            Grip::Assumed => true,
-            Grip::Pin { pin, closed_above } => {
-                let at = self.setup.sensor_pins.iter().position(|p| *p == pin);
-                at.and_then(|k| reply.sensors.get(k))
-                    .is_some_and(|v| *v > closed_above)
-            }
-            // (Refused at open: the 2DIY has no buttons of its own.)
-            Grip::Button { .. } => false,
+        let pins = &self.setup.sensor_pins;
+        let reading = |pin| {
+            let k = pins.iter().position(|p| *p == pin)?;
+            reply.sensors.get(k).copied()
         };
+        let dead_man_closed = self.grip.closed(reading, 0);
         Ok(RawSensors {
             encoder_raw: reply.counts.map(|c| c as u32),
             dead_man_closed,

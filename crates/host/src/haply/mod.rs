@@ -10,12 +10,12 @@ pub use io::HaplyIo;
 
 use crate::device_port::DevicePort;
 use crate::{DeviceIo, LinkError, PcBoard};
-
-/// The device's name in messages.
-const NAME: &str = "2DIY";
 use protocol::{Direction, Joint, Setup};
 use twoport_board::linkage::haply::{self as image, HAPLY};
 use twoport_board::linkage::{io as io_scale, PERIOD_S};
+
+/// The device's name in messages.
+const NAME: &str = "2DIY";
 
 /// How the 2DIY is wired and held.
 #[derive(Clone, Debug, PartialEq)]
@@ -65,14 +65,8 @@ impl HaplyConfig {
 /// Open the 2DIY's board on `path`, reset and set it up as `config` says,
 /// and hear it answer: the [`HaplyIo`] the PC's loop runs against.
 pub fn open(path: &str, config: &HaplyConfig) -> Result<impl DeviceIo<2> + 'static, LinkError> {
+    config.grip.check(path, NAME, true, false)?;
     let port = DevicePort::open(path, 115_200, NAME)?;
-    if let Grip::Button { .. } = config.grip {
-        return Err(LinkError::Open {
-            path: path.to_string(),
-            why: "the 2DIY has no buttons: wire a switch to an analog pin (Grip::Pin)".into(),
-        });
-    }
-    config.grip.warn_if_assumed(path, NAME);
     let mut io =
         HaplyIo::open(port, config.setup(), io_scale(&HAPLY), config.grip).map_err(|why| {
             LinkError::Open {
