@@ -97,6 +97,9 @@ pub enum Priority {
     /// The system's normal priority, and why no higher: other work on the
     /// machine may delay a tick (see [`LoopTiming::late`]).
     Normal(String),
+    /// The device's library runs the loop in its own thread, at the
+    /// priority it sets (what it is, and what it says of it).
+    Library(String),
 }
 
 /// Raise the calling thread to real-time priority where the system allows
@@ -135,6 +138,10 @@ struct Shared {
     /// Why the loop stopped, once it has.
     failed: Option<String>,
     stop: bool,
+    /// The loop has sent its last zero force and runs no more ticks.
+    ended: bool,
+    /// When the latest tick ran (the loop's start, before the first).
+    last_tick: Option<Instant>,
 }
 
 impl Shared {
@@ -244,15 +251,86 @@ impl<Io: DeviceIo<N>, const N: usize> BoardSupport<N> for PcSupport<Io, N> {
     }
 }
 
-/// A board image's loop on the PC against the device `Io`: the image's
-/// board `Board<W, R, N, L, D>` ticking every period in its own thread.
-pub struct PcBoard {
-    shared: Arc<(Mutex<Shared>, Condvar)>,
+/// What runs the loop's ticks, once a period: a thread of the loop's own
+/// ([`PcBoard::start`]), or a device library's scheduler (the Touch's
+/// OpenHaptics). Dropping it stops the calls.
+pub trait Ticker: Send + 'static {
+    /// Call `tick` once every `period_s` (s) until it returns `false`;
+    /// say at what priority the calls run.
+    fn start(
+        &mut self,
+        period_s: f64,
+        tick: Box<dyn FnMut() -> bool + Send>,
+    ) -> Result<Priority, String>;
+}
+
+/// A thread of the loop's own, at real-time priority where the system
+/// allows it, sleeping to each tick's start.
+#[derive(Default)]
+pub struct LoopThread {
     thread: Option<JoinHandle<()>>,
 }
 
+impl Ticker for LoopThread {
+    fn start(
+        &mut self,
+        period_s: f64,
+        mut tick: Box<dyn FnMut() -> bool + Send>,
+    ) -> Result<Priority, String> {
+        let period = Duration::from_secs_f64(period_s);
+        let (tx, rx) = std::sync::mpsc::channel();
+        let thread = std::thread::Builder::new()
+            .name("twoport-pc-loop".into())
+            .spawn(move || {
+                let _ = tx.send(raise_priority());
+                let mut next = Instant::now();
+                loop {
+                    let now = Instant::now();
+                    if next > now {
+                        std::thread::sleep(next - now);
+                    }
+                    let start = Instant::now();
+                    // (Behind by more than a period, the loop keeps its
+                    // phase from now rather than run the missed ticks
+                    // back to back.)
+                    next = if start > next + period { start } else { next } + period;
+                    if !tick() {
+                        break;
+                    }
+                }
+            })
+            .map_err(|e| format!("the loop's thread would not start: {e}"))?;
+        self.thread = Some(thread);
+        rx.recv()
+            .map_err(|_| "the loop's thread ended before its first tick".to_string())
+    }
+}
+
+impl Drop for LoopThread {
+    fn drop(&mut self) {
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// A board image's loop on the PC against the device `Io`: the image's
+/// board `Board<W, R, N, L, D>` ticking every period.
+pub struct PcBoard {
+    shared: Arc<(Mutex<Shared>, Condvar)>,
+    ticker: Option<Box<dyn Ticker>>,
+}
+
+/// How long dropping a [`PcBoard`] waits for its loop's last tick (s).
+const END_WAIT: Duration = Duration::from_secs(1);
+
+/// A loop that has run no tick for this long has stopped: its ticker (a
+/// device library's scheduler) no longer calls it.
+pub const STALL: Duration = Duration::from_millis(500);
+
 impl PcBoard {
-    /// Start `board` ticking every `period_s` (s) against `io`.
+    /// Start `board` ticking every `period_s` (s) against `io`, in a
+    /// thread of its own ([`LoopThread`]).
     ///
     /// The force a tick computes reaches the device at the next tick's
     /// exchange, so the latency is a period and more: `board`'s regions
@@ -270,6 +348,23 @@ impl PcBoard {
         L: PortLayer + Send + 'static,
         D: Drive<N, World = W, Layer = L> + Send + 'static,
     {
+        Self::start_on(board, io, period_s, LoopThread::default())
+    }
+
+    /// Start `board` ticking every `period_s` (s) against `io`, its ticks
+    /// run by `ticker`.
+    pub fn start_on<Io, W, L, D, const N: usize, const R: usize>(
+        board: Board<W, R, N, L, D>,
+        io: Io,
+        period_s: f64,
+        mut ticker: impl Ticker,
+    ) -> Result<Self, LinkError>
+    where
+        Io: DeviceIo<N> + 'static,
+        W: World<f32, N> + Send + 'static,
+        L: PortLayer + Send + 'static,
+        D: Drive<N, World = W, Layer = L> + Send + 'static,
+    {
         if !(period_s.is_finite() && period_s > 1e-6 && period_s < 1.0) {
             return Err(LinkError::Device(format!(
                 "period_s {period_s}: the loop's period must be between 1 µs and 1 s"
@@ -277,17 +372,26 @@ impl PcBoard {
         }
         let support = PcSupport::new(io, (period_s * 1e9).round() as u32);
         let shared = Arc::clone(&support.shared);
-        let period = Duration::from_secs_f64(period_s);
         // The loop's count is nanoseconds: the board holds the latency it
         // measures in them to what its regions are proven for.
-        let board = board.with_count_rate(1_000_000_000);
-        let thread = std::thread::Builder::new()
-            .name("twoport-pc-loop".into())
-            .spawn(move || run(board, support, period))
-            .map_err(|e| LinkError::Device(format!("the loop's thread would not start: {e}")))?;
+        let mut looped = Looped {
+            board: board.with_count_rate(1_000_000_000),
+            support,
+            period_s,
+            last_start: None,
+            slot: 0,
+        };
+        let priority = ticker
+            .start(period_s, Box::new(move || looped.tick()))
+            .map_err(LinkError::Device)?;
+        {
+            let mut s = lock(&shared.0);
+            s.priority = Some(priority);
+            s.last_tick.get_or_insert_with(Instant::now);
+        }
         Ok(PcBoard {
             shared,
-            thread: Some(thread),
+            ticker: Some(Box::new(ticker)),
         })
     }
 
@@ -308,80 +412,70 @@ impl PcBoard {
         lock(&self.shared.0).failed.clone()
     }
 
-    /// The priority the loop's thread runs at (it asks before its first
-    /// tick: this waits for that).
+    /// The priority the loop's ticks run at.
     pub fn priority(&self) -> Priority {
-        let (m, c) = &*self.shared;
-        let mut s = lock(m);
-        loop {
-            if let Some(p) = &s.priority {
-                return p.clone();
-            }
-            s = c.wait(s).unwrap_or_else(|p| p.into_inner());
-        }
+        lock(&self.shared.0)
+            .priority
+            .clone()
+            .unwrap_or(Priority::Normal("not started".into()))
     }
 }
 
-/// The loop's thread: a tick every `period` until told to stop or the
-/// device fails, then zero force with the outputs off.
-fn run<Io, W, L, D, const N: usize, const R: usize>(
-    mut board: Board<W, R, N, L, D>,
-    mut io: PcSupport<Io, N>,
-    period: Duration,
-) where
+/// The loop: the image's board against the device, one tick a call.
+struct Looped<Io, W, L, D, const N: usize, const R: usize> {
+    board: Board<W, R, N, L, D>,
+    support: PcSupport<Io, N>,
+    period_s: f64,
+    last_start: Option<Instant>,
+    slot: usize,
+}
+
+impl<Io, W, L, D, const N: usize, const R: usize> Looped<Io, W, L, D, N, R>
+where
     Io: DeviceIo<N>,
     W: World<f32, N>,
     L: PortLayer,
     D: Drive<N, World = W, Layer = L>,
 {
-    let priority = raise_priority();
-    {
-        let (m, c) = &*io.shared;
-        lock(m).priority = Some(priority);
-        c.notify_all();
-    }
-    let mut next = Instant::now();
-    let mut last_start: Option<Instant> = None;
-    let mut slot = 0;
-    loop {
-        let now = Instant::now();
-        if next > now {
-            std::thread::sleep(next - now);
-        }
+    /// One tick, its timing recorded; `false` once told to stop or the
+    /// device has failed, after zero force with the outputs off.
+    fn tick(&mut self) -> bool {
         let start = Instant::now();
-        // (Behind by more than a period, the loop keeps its phase from now
-        // rather than run the missed ticks back to back.)
-        next = if start > next + period { start } else { next } + period;
-        board.poll_link(&mut io);
-        board.control_tick(&mut io);
-        board.flush(&mut io);
+        let io = &mut self.support;
+        self.board.poll_link(io);
+        self.board.control_tick(io);
+        self.board.flush(io);
         let failed = io.failed.take();
         let (m, c) = &*io.shared;
         let mut s = lock(m);
-        let since = last_start.map(|l| start.duration_since(l).as_secs_f64());
-        last_start = Some(start);
+        let since = self
+            .last_start
+            .replace(start)
+            .map(|l| start.duration_since(l).as_secs_f64());
         s.ticks += 1;
+        s.last_tick = Some(start);
         if let Some(p) = since {
-            s.late += u64::from(p > LATE_PERIODS * period.as_secs_f64());
-            record(&mut s.periods, slot, p);
+            s.late += u64::from(p > LATE_PERIODS * self.period_s);
+            record(&mut s.periods, self.slot, p);
         }
-        record(&mut s.ios, slot, io.io_s);
+        record(&mut s.ios, self.slot, io.io_s);
         if let Some(l) = io.latency {
-            record(&mut s.latencies, slot, l.as_secs_f64());
+            record(&mut s.latencies, self.slot, l.as_secs_f64());
         }
-        slot = (slot + 1) % TIMING_WINDOW;
+        self.slot = (self.slot + 1) % TIMING_WINDOW;
         if let Some(e) = failed {
             s.failed = Some(e);
         }
         let stop = s.stop || s.failed.is_some();
         drop(s);
-        c.notify_all();
         if stop {
-            break;
+            // Zero force, outputs off, whatever the device says to it now.
+            let _ = io.io.exchange([0; N], false);
+            lock(m).ended = true;
         }
+        c.notify_all();
+        !stop
     }
-    // Zero force, outputs off, whatever the device says to it now.
-    let _ = io.io.exchange([0; N], false);
 }
 
 /// Put `v` in the ring at `slot`, growing it to its window first.
@@ -473,6 +567,22 @@ impl BoardPort for PcBoard {
                 return Err(LinkError::Device(e.clone()));
             }
             let now = Instant::now();
+            if let Some(idle) = s.last_tick.map(|t| now.saturating_duration_since(t)) {
+                if idle > STALL && !s.ended {
+                    let e = format!(
+                        "the loop has run no tick for {:.1} s: what runs it ({}) has stopped \
+                         calling it, so the device has stopped answering or the machine has \
+                         stalled; reopen the device",
+                        idle.as_secs_f64(),
+                        match &s.priority {
+                            Some(Priority::Library(_)) => "the device library's scheduler",
+                            _ => "the loop's thread",
+                        }
+                    );
+                    s.failed = Some(e.clone());
+                    return Err(LinkError::Device(e));
+                }
+            }
             if now >= deadline {
                 return Ok(0);
             }
@@ -490,9 +600,18 @@ impl BoardPort for PcBoard {
 impl Drop for PcBoard {
     /// Stop the loop: its last act is zero force with the outputs off.
     fn drop(&mut self) {
-        lock(&self.shared.0).stop = true;
-        if let Some(t) = self.thread.take() {
-            let _ = t.join();
+        let (m, c) = &*self.shared;
+        let deadline = Instant::now() + END_WAIT;
+        let mut s = lock(m);
+        s.stop = true;
+        // (A ticker that has stopped calling leaves nothing to wait for.)
+        while !s.ended && Instant::now() < deadline {
+            s = c
+                .wait_timeout(s, deadline - Instant::now())
+                .map(|(g, _)| g)
+                .unwrap_or_else(|p| p.into_inner().0);
         }
+        drop(s);
+        self.ticker.take();
     }
 }
