@@ -3,7 +3,7 @@
 //! rounded down by less than 0.01 %.
 
 use twoport_board::linkage::pc::{PcImage, LATENCY_S};
-use twoport_board::linkage::{falcon_pc, haply, GRASP_NSPM};
+use twoport_board::linkage::{falcon_pc, haply, touch, GRASP_NSPM};
 use twoport_design::linkage::{certified_design_from, least_damping, LinkageFile};
 
 fn file(name: &str) -> LinkageFile {
@@ -56,4 +56,14 @@ fn the_pc_images_are_their_files_and_the_designers() {
     is_the_designers(&haply::IMAGE, h);
     // (The delta's geometry is held to its file with the delta image's.)
     is_the_designers(&falcon_pc::IMAGE, file("falcon_like.toml"));
+    let t = file("touch.toml");
+    match t.geometry {
+        twoport_design::linkage::Geometry::SerialArm { l1_m, l2_m } => {
+            let arm = touch::TOUCH_ARM;
+            let close = |a: f32, b: f64| (f64::from(a) - b).abs() < 1e-6 * b;
+            assert!(close(arm.l1_m, l1_m) && close(arm.l2_m, l2_m));
+        }
+        ref g => panic!("the Touch's file is {g:?}"),
+    }
+    is_the_designers(&touch::IMAGE, t);
 }

@@ -13,6 +13,7 @@
 pub mod falcon_pc;
 pub mod haply;
 pub mod pc;
+pub mod touch;
 
 use crate::io::IoScale;
 use crate::region::{Bound, Region};
