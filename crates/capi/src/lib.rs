@@ -174,10 +174,12 @@ pub unsafe extern "C" fn tp_board_open_pc_simulated(
     })
 }
 
-/// Open the device `name` (`"haply-2diy"` or `"falcon"`, as `twoport
-/// devices` lists them) on its serial port `path`, its image running in
-/// this computer's servo loop; `firmware` is the Falcon's firmware file
-/// (Novint's, not shipped; NULL for a Haply). Each failure says what to do
+/// Open the device `name` (`"haply-2diy"`, `"falcon"` or `"touch"`, as
+/// `twoport devices` lists them) at `path` (a serial port; a Touch's name
+/// in Touch Setup, "" for the default one), its image running in this
+/// computer's servo loop; `firmware` is the Falcon's firmware file
+/// (Novint's, not shipped), or a Touch's HD library where it is not the
+/// system's (NULL otherwise). Each failure says what to do
 /// (`tp_last_error`).
 ///
 /// # Safety

@@ -59,13 +59,17 @@ const KNOWN: [Known; 3] = [
     Known {
         name: "touch",
         title: "3D Systems Touch (serial arm, USB through OpenHaptics)",
-        file: None,
+        file: Some((
+            "models/linkages/touch.toml",
+            include_str!("../../../models/linkages/touch.toml"),
+        )),
         rate_hz: 1000.0,
-        latency_ticks: 1.0,
-        latency_why: "OpenHaptics' servo callback sends the force at the end of the frame that \
-                      read the position, which the device applies at the next (one tick)",
+        latency_ticks: 2.0,
+        latency_why: "the PC hands a tick's torques to the next servo frame of OpenHaptics' \
+                      scheduler (one tick), and the frame that applies them reads the joints \
+                      again (the device's own transfer, up to a tick more)",
         chai3d: Some((3.3, 400.0, 4.0)),
-        driven: None,
+        driven: Some(twoport_board::linkage::touch::IMAGE.coupling),
     },
 ];
 
@@ -180,9 +184,14 @@ impl fmt::Display for Devices {
         match &self.hd_library {
             Some(p) => writeln!(
                 f,
-                "OpenHaptics' HD library (for a Touch): {p}; twoport does not drive the Touch yet"
+                "OpenHaptics' HD library (for a Touch): {p}; open the Touch by its Touch Setup \
+                 name (twoport_host::attached::open(\"touch\", NAME, None))"
             )?,
-            None => writeln!(f, "OpenHaptics' HD library (for a Touch): not found")?,
+            None => writeln!(
+                f,
+                "OpenHaptics' HD library (for a Touch): not found (install 3D Systems' Touch \
+                 drivers and OpenHaptics, or name the library's path when opening)"
+            )?,
         }
         Ok(())
     }

@@ -575,7 +575,7 @@ fn a_closed_pipe_ends_the_command_quietly() {
 /// rigid bound `2b/((d + 1)² T)` of the handle's least damping `b`, hands
 /// off and with the grasp added, which the report's own damping bound
 /// gives back; and CHAI3D's hand-set Falcon stiffness is past it.
-/// `devices` lists them; a device with no model, or unknown, is named.
+/// `devices` lists them; an unknown device is named.
 #[test]
 fn spec_proves_a_pc_driven_device_at_its_rate_and_latency() {
     let v = TWOPORT.json(&["devices", "--json"]);
@@ -586,7 +586,7 @@ fn spec_proves_a_pc_driven_device_at_its_rate_and_latency() {
         .map(|d| d["name"].as_str().unwrap())
         .collect();
     assert_eq!(names, ["falcon", "haply-2diy", "touch"]);
-    for name in ["falcon", "haply-2diy"] {
+    for name in ["falcon", "haply-2diy", "touch"] {
         let v = TWOPORT.json(&["spec", name, "--min-grasp", "2", "--json"]);
         let t = 1.0 / v["rate_hz"].as_f64().unwrap();
         assert_eq!(v["latency_s"].as_f64().unwrap(), 2.0 * t);
@@ -618,8 +618,10 @@ fn spec_proves_a_pc_driven_device_at_its_rate_and_latency() {
         .unwrap()
         .iter()
         .all(|p| p["path"].is_string()));
-    let e = TWOPORT.failure(&["spec", "touch"]);
-    assert!(e.contains("no model") && e.contains("identify-pose"), "{e}");
+    let v = TWOPORT.json(&["spec", "touch", "--json"]);
+    assert_eq!(v["chai3d_k_npm"].as_f64(), Some(400.0));
+    let touch = twoport_board::linkage::touch::IMAGE.coupling;
+    assert_eq!(v["driven_k_npm"].as_f64(), Some(f64::from(touch.k_npm)));
     let e = TWOPORT.failure(&["spec", "omni"]);
     assert!(
         e.contains("omni") && e.contains("falcon, haply-2diy, touch"),

@@ -112,11 +112,14 @@ pub fn hd_library() -> Option<PathBuf> {
         .find(|p| p.exists())
 }
 
-/// The device `name` (`twoport spec`'s: `haply-2diy` or `falcon`) on its
-/// port `path`, wired and held as its driver does by default (a Haply
-/// v3 with a grip switch on analog pin 2; a Falcon's center button),
-/// its image running in the PC's loop; with its axes. A Falcon needs
-/// Novint's `firmware` file.
+/// The device `name` (`twoport spec`'s: `haply-2diy`, `falcon` or
+/// `touch`) at `path`, wired and held as its driver does by default (a
+/// Haply v3 with a grip switch on analog pin 2; a Falcon's center button;
+/// a Touch's first stylus button), its image running in the PC's loop;
+/// with its axes. A Falcon needs Novint's `firmware` file. A Touch's
+/// `path` is its name in Touch Setup (empty: the default device), and
+/// `firmware`, where given, the HD library's path (by default the
+/// system's `libHD.so`).
 pub fn open(
     name: &str,
     path: &str,
@@ -151,11 +154,16 @@ pub fn open(
                 3,
             ))
         }
-        "touch" => Err(bad(
-            "twoport does not drive the Touch yet (it needs OpenHaptics' HD library)".into(),
-        )),
+        "touch" => {
+            let config = crate::touch::TouchConfig {
+                library: firmware.map(Path::to_path_buf),
+                device: (!path.is_empty()).then(|| path.to_string()),
+                ..crate::touch::TouchConfig::stylus_button()
+            };
+            Ok((crate::PcBoard::touch(&config)?, 3))
+        }
         other => Err(bad(format!(
-            "{other}: not a device twoport drives (haply-2diy, falcon)"
+            "{other}: not a device twoport drives (haply-2diy, falcon, touch)"
         ))),
     }
 }

@@ -14,6 +14,7 @@ mod pc_loop;
 mod port;
 mod session;
 mod simulated;
+pub mod touch;
 
 pub use device::{AxisState, HostBoard, State, HEARTBEAT_PERIOD, HEARTBEAT_POLLS, STATE_BUFFER};
 pub use error::LinkError;

@@ -110,10 +110,12 @@ impl Board {
         })
     }
 
-    /// The device `name` (`"haply-2diy"` or `"falcon"`, as `twoport
-    /// devices` lists them) on its serial port `path`, its image running in
+    /// The device `name` (`"haply-2diy"`, `"falcon"` or `"touch"`, as
+    /// `twoport devices` lists them) at `path` (a serial port; a Touch's
+    /// name in Touch Setup, "" for the default one), its image running in
     /// this computer's servo loop; `firmware` is the Falcon's firmware file
-    /// (Novint's, not shipped). Each failure says what to do.
+    /// (Novint's, not shipped), or a Touch's HD library where it is not the
+    /// system's. Each failure says what to do.
     #[staticmethod]
     #[pyo3(signature = (name, path, firmware=None))]
     fn device(name: &str, path: &str, firmware: Option<std::path::PathBuf>) -> PyResult<Board> {

@@ -57,6 +57,15 @@ pub struct Hand {
     pub push_m: f64,
 }
 
+/// The hand of the drivers' wall runs: a 2 N s/m grasp (the PC images'
+/// least) and a 100 N/m spring pressing 10 mm past the rest pose, 5 mm
+/// past the images' wall.
+pub const PRESSING: Hand = Hand {
+    grasp_nspm: 2.0,
+    stiffness_npm: 100.0,
+    push_m: 0.010,
+};
+
 /// The hand's hold at the rest pose before it presses (N/m): a 60 g
 /// handle sags 0.3 mm on it under gravity.
 pub const HOLD_NPM: f64 = 2_000.0;
@@ -76,6 +85,53 @@ pub struct Trace<const N: usize> {
     pub events: Vec<String>,
     /// Why the emulator stopped reading, if it has.
     pub stopped: Option<String>,
+    /// The period after which the hand began to press, once it has.
+    pub pressed_at: Option<u64>,
+}
+
+/// A trace as a file holds it (JSON): the joints' arrays as lists.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct TraceFile {
+    ticks: u64,
+    handle_m: Vec<Vec<f64>>,
+    torque_nm: Vec<Vec<f32>>,
+    events: Vec<String>,
+    stopped: Option<String>,
+    pressed_at: Option<u64>,
+}
+
+impl<const N: usize> Trace<N> {
+    /// The trace as JSON, for an emulator in another library (the HD
+    /// stand-in's) to hand to its test.
+    pub fn to_json(&self) -> String {
+        let file = TraceFile {
+            ticks: self.ticks,
+            handle_m: self.handle_m.iter().map(|x| x.to_vec()).collect(),
+            torque_nm: self.torque_nm.iter().map(|t| t.to_vec()).collect(),
+            events: self.events.clone(),
+            stopped: self.stopped.clone(),
+            pressed_at: self.pressed_at,
+        };
+        serde_json::to_string(&file).unwrap_or_default()
+    }
+
+    /// The trace [`Trace::to_json`] wrote.
+    pub fn from_json(text: &str) -> Result<Self, Error> {
+        let bad = |what: &str| Error::Sim(format!("a trace file: {what}"));
+        let f: TraceFile = serde_json::from_str(text).map_err(|e| bad(&e.to_string()))?;
+        let fixed =
+            |v: &Vec<f64>| <[f64; N]>::try_from(v.as_slice()).map_err(|_| bad("a pose's length"));
+        let fixed32 =
+            |v: &Vec<f32>| <[f32; N]>::try_from(v.as_slice()).map_err(|_| bad("a torque's length"));
+        Ok(Trace {
+            ticks: f.ticks,
+            handle_m: f.handle_m.iter().map(fixed).collect::<Result<_, _>>()?,
+            torque_nm: f.torque_nm.iter().map(fixed32).collect::<Result<_, _>>()?,
+            events: f.events,
+            stopped: f.stopped,
+            pressed_at: f.pressed_at,
+        })
+    }
 }
 
 /// A device's firmware: what it does with the bytes the host sends.
@@ -115,6 +171,13 @@ impl<const N: usize> Shared<N> {
     fn trace(&self) -> MutexGuard<'_, Trace<N>> {
         self.trace.lock().unwrap_or_else(|p| p.into_inner())
     }
+
+    fn press(&self) {
+        let mut t = self.trace();
+        if !self.press.swap(true, Ordering::Relaxed) {
+            t.pressed_at = Some(t.ticks);
+        }
+    }
 }
 
 /// What a period leaves the firmware to answer with.
@@ -127,6 +190,55 @@ pub struct Period<const N: usize> {
 }
 
 impl<const N: usize> Device<N> {
+    /// The linkage `file` (its image `spec`) at rest at the image's rest
+    /// pose under `hand`, with gravity along `-z` where `gravity`, going
+    /// wrong as `fault` says from that command on.
+    pub fn new(
+        file: &LinkageFile,
+        spec: ImageSpec<N>,
+        gravity: bool,
+        hand: Option<Hand>,
+        fault: Option<(u64, Fault)>,
+    ) -> Result<Self, Error> {
+        let plant = |e| Error::Sim(format!("the emulated device's plant: {e:?}"));
+        let mut arm =
+            LinkageArm::<N>::at_rest(file, spec.rest_rad.map(f64::from)).map_err(plant)?;
+        if gravity {
+            arm.plant.gravity_mps2 = crate::pil::linkage::GRAVITY_MPS2;
+        }
+        let (rest_m, _) = arm.handle().map_err(plant)?;
+        Ok(Device {
+            arm,
+            spec,
+            hand,
+            rest_m,
+            fault,
+            shared: Arc::new(Shared {
+                trace: Mutex::new(Trace::default()),
+                stop: AtomicBool::new(false),
+                press: AtomicBool::new(false),
+            }),
+            unplugged: false,
+        })
+    }
+
+    /// The hand presses from now on.
+    pub fn press(&self) {
+        self.shared.press();
+    }
+
+    /// What it has seen and done so far.
+    pub fn trace(&self) -> Trace<N> {
+        self.shared.trace().clone()
+    }
+
+    /// Periods run so far, and the one after which the hand began to
+    /// press, once it has.
+    pub fn ticks(&self) -> (u64, Option<u64>) {
+        let t = self.shared.trace();
+        (t.ticks, t.pressed_at)
+    }
+
     /// One period with the motors holding `torque_nm` (N m, toward larger
     /// angles; clamped at the device's peak, a non-finite one held at
     /// zero).
@@ -226,32 +338,13 @@ impl<const N: usize> Emulator<N> {
         hand: Option<Hand>,
         fault: Option<(u64, Fault)>,
     ) -> Result<Self, Error> {
-        let plant = |e| Error::Sim(format!("the emulated device's plant: {e:?}"));
-        let mut arm =
-            LinkageArm::<N>::at_rest(file, spec.rest_rad.map(f64::from)).map_err(plant)?;
-        if gravity {
-            arm.plant.gravity_mps2 = crate::pil::linkage::GRAVITY_MPS2;
-        }
-        let (rest_m, _) = arm.handle().map_err(plant)?;
+        let device = Device::new(file, spec, gravity, hand, fault)?;
+        let shared = Arc::clone(&device.shared);
         let (master, slave) =
             TTYPort::pair().map_err(|e| Error::Sim(format!("a pseudo-terminal: {e}")))?;
         let path = slave
             .name()
             .ok_or_else(|| Error::Sim("the pseudo-terminal has no name".into()))?;
-        let shared = Arc::new(Shared {
-            trace: Mutex::new(Trace::default()),
-            stop: AtomicBool::new(false),
-            press: AtomicBool::new(false),
-        });
-        let device = Device {
-            arm,
-            spec,
-            hand,
-            rest_m,
-            fault,
-            shared: Arc::clone(&shared),
-            unplugged: false,
-        };
         let thread = std::thread::Builder::new()
             .name("device-emulator".into())
             .spawn(move || run(master, firmware, device))
@@ -271,7 +364,7 @@ impl<const N: usize> Emulator<N> {
 
     /// The hand presses from now on.
     pub fn press(&self) {
-        self.shared.press.store(true, Ordering::Relaxed);
+        self.shared.press();
     }
 
     /// Commands answered so far.
