@@ -11,7 +11,8 @@ use std::collections::VecDeque;
 use std::hint::black_box;
 use std::rc::Rc;
 use std::time::Duration;
-use twoport_board::linkage::{falcon_pc, DeltaBoard, FALCON};
+use twoport_board::linkage::falcon_pc::{self, FalconBoard};
+use twoport_board::linkage::FALCON;
 use twoport_board::{BoardSupport, RawSensors};
 use twoport_host::device_port::Grip;
 use twoport_host::falcon::protocol::{Status, PACKET};
@@ -65,7 +66,7 @@ impl BoardSupport<3> for Memory {
 
 /// The board and its memory, ticked as the host's calls arrive.
 struct Lockstep {
-    board: DeltaBoard,
+    board: FalconBoard,
     io: Memory,
 }
 

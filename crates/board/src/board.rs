@@ -30,6 +30,11 @@ pub type Frame = Vec<u8, MAX_FRAME>;
 /// telemetry in the other, so a telemetry flood never crowds out an answer.
 pub const TX_FRAMES: usize = 8;
 
+/// Ticks on time after its last late one that a board's passivity layer
+/// stays engaged for: a second at 1 kHz, so that a run of late ticks with
+/// a few on time between them is guarded throughout.
+pub const GUARD_TICKS: u32 = 1000;
+
 /// The portable firmware loop around a [`Servo`] of `N` axes (one by
 /// default) on the world `W`, with the port layer `L` ([`Direct`]: none),
 /// or around the [`Drive`] `D` that holds such a servo (a linkage's: its
@@ -91,6 +96,11 @@ pub struct Board<W, const R: usize, const N: usize = 1, L = Direct, D = Servo<W,
     count_hz: Option<u32>,
     /// The greatest latency, in that count, the regions are proven for.
     late_after: Option<u32>,
+    /// Armed ticks whose force came later than the regions allow, run on
+    /// under the passivity layer.
+    late_guarded: u32,
+    /// Ticks the passivity layer stays engaged for (none: idle).
+    guarding: u32,
     /// The dead-man switch at the last tick (open before the first).
     dead_man_closed: bool,
     /// Whether the amplifier's outputs are on (as last commanded).
@@ -195,6 +205,8 @@ where
             link_bytes_per_s: None,
             count_hz: None,
             late_after: None,
+            late_guarded: 0,
+            guarding: 0,
             dead_man_closed: false,
             outputs_on: false,
             config_source: None,
@@ -235,7 +247,11 @@ where
     ///
     /// Knowing it, the board holds its latency to what its regions are
     /// proven for: armed, a force that reaches the device later latches
-    /// [`Faults::LATE_FORCE`], and from the next tick on the force is zero.
+    /// [`Faults::LATE_FORCE`], and from the next tick on the force is zero;
+    /// unless a passivity layer guards the port
+    /// ([`PortLayer::GUARDS_LATENCY`]): then the board engages it, runs on,
+    /// and lets it go idle again [`GUARD_TICKS`] ticks after the last late
+    /// one ([`late_guarded`](Self::late_guarded) counts them).
     pub fn with_count_rate(mut self, hz: u32) -> Self {
         self.count_hz = Some(hz);
         // (f64: a budget of microseconds at a GHz count is exact.)
@@ -246,6 +262,17 @@ where
             u32::MAX
         });
         self
+    }
+
+    /// Whether the passivity layer is engaged after a late force.
+    pub fn guarding(&self) -> bool {
+        self.guarding > 0
+    }
+
+    /// Armed ticks whose force came later than the regions allow, run on
+    /// with the passivity layer engaged.
+    pub fn late_guarded(&self) -> u32 {
+        self.late_guarded
     }
 
     /// The latency from sampling to the force (s) every axis's region is
@@ -582,7 +609,23 @@ where
         // and a tick that ends them may run long).
         let coupled = self.mode == BoardMode::Armed && self.outputs_on;
         if coupled && self.late_after.is_some_and(|budget| latency > budget) {
-            self.servo.servo_mut().trip(Faults::LATE_FORCE);
+            if L::GUARDS_LATENCY {
+                // Past the proof, the passivity layer keeps the port
+                // passive: the loop runs on with it engaged, until it has
+                // been on time for a while.
+                self.late_guarded = self.late_guarded.saturating_add(1);
+                if self.guarding == 0 {
+                    self.servo.servo_mut().engage_layers();
+                }
+                self.guarding = GUARD_TICKS;
+            } else {
+                self.servo.servo_mut().trip(Faults::LATE_FORCE);
+            }
+        } else if self.guarding > 0 {
+            self.guarding -= 1;
+            if self.guarding == 0 {
+                self.servo.servo_mut().disengage_layers();
+            }
         }
         out
     }

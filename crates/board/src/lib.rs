@@ -12,7 +12,7 @@ mod region;
 mod simulated;
 mod support;
 
-pub use board::{Board, Frame, TX_FRAMES};
+pub use board::{Board, Frame, GUARD_TICKS, TX_FRAMES};
 pub use build_error::BuildError;
 pub use io::{EncoderScale, IoScale, DUTY_FULL_SCALE};
 pub use region::{check_axes, Bound, Region, RegionError};

@@ -227,6 +227,19 @@ pub fn board_with<K: Kinematics<f32, N>, const N: usize>(
 where
     LinkageWorld<N>: World<f32, N>,
 {
+    let servo = image_servo(spec, kinematics, coupling)?;
+    Ok(Board::new(servo, [region; N], TELEMETRY_EVERY).with_io(io(spec)))
+}
+
+/// The servo of [`board_with`]'s board.
+pub fn image_servo<K: Kinematics<f32, N>, const N: usize>(
+    spec: &ImageSpec<N>,
+    kinematics: K,
+    coupling: ImpedanceGains,
+) -> Result<LinkageImageServo<K, N>, BuildError>
+where
+    LinkageWorld<N>: World<f32, N>,
+{
     let at = kinematics
         .forward(&spec.rest_rad)
         .map_err(|_| BuildError::RestPose)?
@@ -248,7 +261,7 @@ where
         *w = wall(far, Solid::Above, p(at[i])?)?;
     }
     let world = PerAxis(walls);
-    let servo = LinkageServo::on(
+    LinkageServo::on(
         kinematics,
         &spec.hardware,
         COUNTER_BITS,
@@ -259,8 +272,7 @@ where
     )
     .map_err(BuildError::Linkage)?
     .with_gravity(spec.gravity)
-    .map_err(BuildError::Param)?;
-    Ok(Board::new(servo, [region; N], TELEMETRY_EVERY).with_io(io(spec)))
+    .map_err(BuildError::Param)
 }
 
 /// The serial-arm image: the PHANToM Premium 1.5.

@@ -1,6 +1,8 @@
 //! The portable firmware loop driven over the wire, as a host drives it.
 
-use twoport_board::{Board, BoardSupport, Bound, RawSensors, Region};
+use twoport_board::{Board, BoardSupport, Bound, RawSensors, Region, GUARD_TICKS};
+use twoport_control::passivity::{PassivityLimits, SeriesDamper};
+use twoport_control::servo::{ImpedanceGains, PortLayer, ServoOutput};
 use twoport_control::ve::BilateralConstraint;
 use twoport_control::{AdmittanceGains, Encoder, Faults, Position, SafetyConfig, Servo};
 use twoport_link::{
@@ -413,6 +415,61 @@ impl Io {
     }
 }
 
+/// What [`late_run`] saw: each tick's output, the last duty, the spec,
+/// the board's count of guarded late ticks, and whether it guards still.
+type LateRun = (Vec<ServoOutput<f32, 1>>, i16, twoport_link::Spec, u32, bool);
+
+/// Calibrate and tick `b` disarmed once with a slow tick, arm it, move the
+/// handle off the constraint for 199 ticks, then one tick whose force
+/// comes 24 counts after its sample and `after` on time.
+fn late_run<L: PortLayer>(b: Board<BilateralConstraint, 3, 1, L>, after: u16) -> LateRun {
+    let mut b = b;
+    assert_eq!(b.spec().latency_budget_s, 3e-6);
+    let mut io = Io {
+        sensors: RawSensors {
+            encoder_raw: [0],
+            load_cell_counts: [0],
+            dead_man_closed: true,
+            index_raw: [None],
+        },
+        ..Io::default()
+    };
+    io.queue(
+        0,
+        Message::Calibrate {
+            position_pm: Axes::one(0),
+        },
+    );
+    let tick = |b: &mut Board<BilateralConstraint, 3, 1, L>, io: &mut Io, k: u16| {
+        io.queue(1 + k, Message::Heartbeat);
+        b.poll_link(io);
+        let out = b.control_tick(io);
+        b.flush(io);
+        out
+    };
+    // Disarmed and slow: no force, nothing latched.
+    io.step = 8;
+    assert!(tick(&mut b, &mut io, 0).faults.is_empty());
+    io.step = 7;
+    io.queue(100, Message::Arm);
+    let mut outs = vec![tick(&mut b, &mut io, 1)];
+    // Armed at rest, then the handle moves 30 µm off the constraint.
+    io.sensors.encoder_raw = [30];
+    outs.extend((2..200).map(|k| tick(&mut b, &mut io, k)));
+    assert!(outs.iter().all(|o| o.faults.is_empty()), "on time");
+    assert!(outs.last().unwrap().actuator_force_n[0].abs() > 1.0);
+    io.step = 8;
+    outs.push(tick(&mut b, &mut io, 200));
+    io.step = 7;
+    outs.extend((0..after).map(|k| tick(&mut b, &mut io, 201 + k)));
+    let duty = *io.duties.last().unwrap();
+    (outs, duty, b.spec(), b.late_guarded(), b.guarding())
+}
+
+fn late_region() -> Region<3> {
+    common::region().with_latency(3e-6).unwrap()
+}
+
 /// A board that knows its count's rate holds its latency to its region's:
 /// at 7 MHz a region proven for 3 µs allows 21 counts, what a tick of
 /// three 7-count looks takes. Disarmed, a slower tick latches nothing (no
@@ -421,63 +478,60 @@ impl Io {
 /// zero. A board that does not know its count's rate checks nothing.
 #[test]
 fn a_force_later_than_the_region_allows_faults_to_zero() {
-    let region = common::region().with_latency(3e-6).unwrap();
-    let run = |rate: Option<u32>| {
-        let b = common::board_in(region, 51_000.0, safety(), 0);
-        let mut b = match rate {
-            Some(hz) => b.with_count_rate(hz),
-            None => b,
-        };
-        assert_eq!(b.spec().latency_budget_s, 3e-6);
-        let mut io = Io {
-            sensors: RawSensors {
-                encoder_raw: [0],
-                load_cell_counts: [0],
-                dead_man_closed: true,
-                index_raw: [None],
-            },
-            ..Io::default()
-        };
-        io.queue(
-            0,
-            Message::Calibrate {
-                position_pm: Axes::one(0),
-            },
-        );
-        let tick = |b: &mut common::TestBoard, io: &mut Io, k: u16| {
-            io.queue(1 + k, Message::Heartbeat);
-            b.poll_link(io);
-            let out = b.control_tick(io);
-            b.flush(io);
-            out
-        };
-        // Disarmed and slow: no force, nothing latched.
-        io.step = 8;
-        assert!(tick(&mut b, &mut io, 0).faults.is_empty());
-        io.step = 7;
-        io.queue(100, Message::Arm);
-        let mut outs = vec![tick(&mut b, &mut io, 1)];
-        // Armed at rest, then the handle moves 30 µm off the constraint.
-        io.sensors.encoder_raw = [30];
-        outs.extend((2..200).map(|k| tick(&mut b, &mut io, k)));
-        assert!(outs.iter().all(|o| o.faults.is_empty()), "on time");
-        assert!(outs.last().unwrap().actuator_force_n[0].abs() > 1.0);
-        io.step = 8;
-        outs.push(tick(&mut b, &mut io, 200));
-        io.step = 7;
-        outs.push(tick(&mut b, &mut io, 201));
-        (outs, *io.duties.last().unwrap(), b.spec())
-    };
-    let (outs, duty, spec) = run(Some(7_000_000));
+    let board = || common::board_in(late_region(), 51_000.0, safety(), 0);
+    let (outs, duty, spec, guarded, _) = late_run(board().with_count_rate(7_000_000), 1);
     let [late, after] = [&outs[outs.len() - 2], &outs[outs.len() - 1]];
     // The late tick's force is out when it is measured; the next is zero.
     assert!(late.actuator_force_n[0].abs() > 1.0);
     assert!(after.faults.contains(Faults::LATE_FORCE), "{after:?}");
-    assert_eq!((after.actuator_force_n[0], duty), (0.0, 0));
+    assert_eq!((after.actuator_force_n[0], duty, guarded), (0.0, 0, 0));
     assert_eq!(spec.worst_latency_cycles, 24);
-    let (outs, duty, _) = run(None);
+    let (outs, duty, _, _, _) = late_run(board(), 1);
     assert!(outs.iter().all(|o| o.faults.is_empty()));
     assert_ne!(duty, 0);
+}
+
+/// With a passivity layer on demand at the port, the same late tick
+/// faults nothing: the board engages the layer and runs on, counting the
+/// tick, and lets it go idle [`GUARD_TICKS`] ticks on time later. Until
+/// the late tick the forces are the unlayered board's, bit for bit.
+#[test]
+fn a_late_force_engages_the_passivity_layer() {
+    let layered = || {
+        let enc = Encoder::new(16, 1_000_000, 0, Position::ZERO).unwrap();
+        let servo = Servo::new(
+            [ImpedanceGains::new(51_000.0, 90.0).into()],
+            [enc],
+            [safety()],
+            BilateralConstraint::new(Position::ZERO),
+        )
+        .unwrap();
+        let limits = PassivityLimits::for_device(0.93, 1e-3, safety().peak_force_n).unwrap();
+        let damper = SeriesDamper::new(limits).unwrap().on_demand();
+        Board::new(servo.with_layers([damper]).unwrap(), [late_region()], 0)
+    };
+    let rate = 7_000_000;
+    let (outs, duty, spec, guarded, guarding) = late_run(layered().with_count_rate(rate), 1);
+    assert!(outs.iter().all(|o| o.faults.is_empty()));
+    assert_eq!(
+        (guarded, spec.worst_latency_cycles, guarding),
+        (1, 24, true)
+    );
+    assert_ne!(duty, 0);
+    let plain = common::board_in(late_region(), 51_000.0, safety(), 0);
+    let (direct, ..) = late_run(plain, 1);
+    let force =
+        |o: &[ServoOutput<f32, 1>]| o.iter().map(|o| o.actuator_force_n[0]).collect::<Vec<_>>();
+    assert_eq!(
+        force(&outs[..outs.len() - 1]),
+        force(&direct[..direct.len() - 1])
+    );
+    // Idle again a second of ticks on time later, not before.
+    let ticks = GUARD_TICKS as u16;
+    let (.., guarding) = late_run(layered().with_count_rate(rate), ticks - 1);
+    assert!(guarding);
+    let (outs, .., guarding) = late_run(layered().with_count_rate(rate), ticks);
+    assert!(!guarding && outs.iter().all(|o| o.faults.is_empty()));
 }
 
 #[test]

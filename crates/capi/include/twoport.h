@@ -223,7 +223,8 @@ typedef struct TpSpec {
   double worst_latency_s;
   /**
    * The latency from sampling to the force (s) the proven regions
-   * allow: a board that times its loop faults past it ("force late").
+   * allow: a board that times its loop faults past it ("force late"),
+   * or engages its passivity layer where it has one.
    */
   double latency_budget_s;
   /**

@@ -133,7 +133,8 @@ pub struct TpSpec {
     /// inside the tick. NaN where the board does not give its count's rate.
     pub worst_latency_s: f64,
     /// The latency from sampling to the force (s) the proven regions
-    /// allow: a board that times its loop faults past it ("force late").
+    /// allow: a board that times its loop faults past it ("force late"),
+    /// or engages its passivity layer where it has one.
     pub latency_budget_s: f64,
     /// The board's axes (1 to `TP_MAX_AXES`).
     pub axes: u8,

@@ -6,7 +6,7 @@
 
 use crate::kinematics::Kinematics;
 use crate::linkage::LinkageServo;
-use crate::servo::{Direct, PortLayer, SensorFrame, Servo, ServoOutput};
+use crate::servo::{PortLayer, SensorFrame, Servo, ServoOutput};
 use crate::world::World;
 use crate::Position;
 
@@ -113,16 +113,16 @@ impl<W: World<f32, N>, L: PortLayer, const N: usize> Drive<N> for Servo<W, f32, 
     }
 }
 
-impl<K: Kinematics<f32, N>, W: World<f32, N>, const N: usize> Drive<N>
-    for LinkageServo<K, W, f32, N>
+impl<K: Kinematics<f32, N>, W: World<f32, N>, L: PortLayer, const N: usize> Drive<N>
+    for LinkageServo<K, W, f32, N, L>
 {
     type World = W;
-    type Layer = Direct;
+    type Layer = L;
     const HOMES: bool = false;
-    fn servo(&self) -> &Servo<W, f32, N> {
+    fn servo(&self) -> &Servo<W, f32, N, L> {
         self.cartesian()
     }
-    fn servo_mut(&mut self) -> &mut Servo<W, f32, N> {
+    fn servo_mut(&mut self) -> &mut Servo<W, f32, N, L> {
         self.cartesian_mut()
     }
     fn tick(&mut self, frame: &SensorFrame<f32, N>) -> Driven<N> {

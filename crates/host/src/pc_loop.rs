@@ -336,7 +336,8 @@ impl PcBoard {
     /// exchange, so the latency is a period and more: `board`'s regions
     /// must be proven for it (the Excalibur's for the PC are
     /// `excalibur::pc`'s, for up to 5 ms). A force later than they allow
-    /// faults the board to zero force ("force late").
+    /// faults the board to zero force ("force late"), unless a passivity
+    /// layer guards its port, as on every image for the PC's loop.
     pub fn start<Io, W, L, D, const N: usize, const R: usize>(
         board: Board<W, R, N, L, D>,
         io: Io,

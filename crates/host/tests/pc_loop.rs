@@ -27,9 +27,9 @@ fn start(io: impl DeviceIo<1> + 'static) -> PcBoard {
 
 /// An application opens the loop as it opens a board, moves the image's
 /// wall, arms and polls: the simulated hand's 2 N rest on the wall,
-/// 0.67 mm in (2 N / 3,000 N/m), as on the board in-process. Unless the
-/// machine held a tick back past the 5 ms the region is proven for: then
-/// the board faulted "force late", and the loop measured a latency past it.
+/// 0.67 mm in (2 N / 3,000 N/m), as on the board in-process. A tick the
+/// machine held back past the 5 ms the region is proven for faults
+/// nothing: the image's passivity layer takes it.
 #[test]
 fn the_pc_loop_holds_the_images_wall_as_a_board_does() {
     let pc = start(SimulatedDevice::excalibur(2.0));
@@ -48,15 +48,10 @@ fn the_pc_loop_holds_the_images_wall_as_a_board_does() {
         std::thread::sleep(Duration::from_millis(1));
     }
     let last = b.latest().unwrap();
-    let worst = b.port().timing().latency_s.max;
-    if last.faults == Faults::LATE_FORCE.0 {
-        assert!(worst > 5e-3, "faulted late at {worst} s");
-    } else {
-        assert_eq!((last.mode, last.faults), (BoardMode::Armed, 0));
-        let x = last.axes[0].position_m;
-        let press = 2.0 / f64::from(pc::COUPLING.k_npm);
-        assert!((x - WALL_M - press).abs() < 10e-6, "at {x} m");
-    }
+    assert_eq!((last.mode, last.faults), (BoardMode::Armed, 0));
+    let x = last.axes[0].position_m;
+    let press = 2.0 / f64::from(pc::COUPLING.k_npm);
+    assert!((x - WALL_M - press).abs() < 10e-6, "at {x} m");
     b.close().unwrap();
 }
 

@@ -3,10 +3,13 @@
 //! loop against the device over a bus. The force a tick computes reaches
 //! the device at the next tick's exchange, a period and more after its
 //! sample, so the region is the designer's for a latency of up to 5 ms,
-//! and the coupling is far softer than a board's.
+//! and the coupling is far softer than a board's. A force later still
+//! engages the passivity layer (the series damper at the actuator's
+//! port), as on every image for the PC's loop.
 
-use super::{safety, wall_servo, BuildError, HOMING, TELEMETRY_EVERY};
+use super::{safety, wall_servo, BuildError, ACTUATOR_PORT, HOMING, PERIOD_S, TELEMETRY_EVERY};
 use crate::Board;
+use twoport_control::passivity::{PassivityLimits, SeriesDamper};
 use twoport_control::ve::UnilateralWall;
 use twoport_control::ImpedanceGains;
 
@@ -21,9 +24,13 @@ crate::region::shipped_region!(
 pub const COUPLING: ImpedanceGains = ImpedanceGains::new(3_000.0, 4.0);
 
 /// The whole board, for the PC's loop.
-pub fn board() -> Result<Board<UnilateralWall, REGION_POINTS>, BuildError> {
+pub fn board() -> Result<Board<UnilateralWall, REGION_POINTS, 1, SeriesDamper>, BuildError> {
+    let port = ACTUATOR_PORT;
+    let mut limits = PassivityLimits::for_device(port.mass_kg, PERIOD_S, safety().peak_force_n)?;
+    limits.device_damping_nspm = port.damping_nspm;
+    let layer = SeriesDamper::new(limits)?.on_demand();
     Ok(super::wall_board(
-        wall_servo(COUPLING, safety())?,
+        wall_servo(COUPLING, safety())?.with_layers([layer])?,
         proven_region()?,
         TELEMETRY_EVERY,
         HOMING,

@@ -6,9 +6,10 @@
 //! (`twoport design impedance --device models/linkages/falcon_like.toml
 //! --min-grasp 2 --latency 0.005 --b B`).
 
-use super::pc::PcImage;
-use super::{falcon_delta, DeltaBoard, FALCON};
+use super::pc::{PcImage, PcLinkageBoard};
+use super::{falcon_delta, FALCON};
 use crate::BuildError;
+use twoport_control::kinematics::Delta;
 use twoport_control::servo::ImpedanceGains;
 
 /// The image: 400 N/m at 1 N s/m (18 % under its boundary).
@@ -16,10 +17,14 @@ pub const IMAGE: PcImage<3> = PcImage {
     spec: FALCON,
     coupling: ImpedanceGains::new(400.0, 1.0),
     damping_nspm: [0.01, 0.5, 1.0, 1.5, 1.9],
+    port_mass_kg: 0.06,
     limit_npm: [133.36, 403.44, 486.24, 412.93, 213.92],
 };
 
 /// The image's board.
-pub fn board() -> Result<DeltaBoard, BuildError> {
+pub type FalconBoard = PcLinkageBoard<Delta, 3>;
+
+/// The image's board.
+pub fn board() -> Result<FalconBoard, BuildError> {
     IMAGE.board(falcon_delta()?)
 }

@@ -6,8 +6,8 @@
 //! (`twoport design impedance --device models/linkages/haply_2diy.toml
 //! --min-grasp 2 --latency 0.005 --b B`).
 
-use super::pc::PcImage;
-use super::{ImageSpec, LinkageBoard};
+use super::pc::{PcImage, PcLinkageBoard};
+use super::ImageSpec;
 use crate::BuildError;
 use twoport_control::kinematics::Pantograph;
 use twoport_control::linkage::{Gravity, Hardware};
@@ -55,11 +55,12 @@ pub const IMAGE: PcImage<2> = PcImage {
     spec: HAPLY,
     coupling: ImpedanceGains::new(400.0, 1.0),
     damping_nspm: [0.01, 0.5, 1.0, 1.5, 1.9],
+    port_mass_kg: 0.02,
     limit_npm: [128.66, 393.99, 466.56, 376.68, 139.71],
 };
 
 /// The image's board.
-pub type HaplyBoard = LinkageBoard<Pantograph, 2>;
+pub type HaplyBoard = PcLinkageBoard<Pantograph, 2>;
 
 /// The image's board on the v3 geometry.
 pub fn board() -> Result<HaplyBoard, BuildError> {

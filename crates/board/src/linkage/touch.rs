@@ -6,8 +6,8 @@
 //! designer's workspace proof (`twoport design impedance --device
 //! models/linkages/touch.toml --min-grasp 2 --latency 0.005 --b B`).
 
-use super::pc::PcImage;
-use super::{ArmLengths, ImageSpec, SerialArmBoard};
+use super::pc::{PcImage, PcLinkageBoard};
+use super::{ArmLengths, ImageSpec};
 use crate::BuildError;
 use twoport_control::kinematics::SerialArm;
 use twoport_control::linkage::{Gravity, Hardware};
@@ -42,11 +42,15 @@ pub const IMAGE: PcImage<3> = PcImage {
     spec: TOUCH,
     coupling: ImpedanceGains::new(400.0, 1.0),
     damping_nspm: [0.01, 0.5, 1.0, 1.5, 1.9],
+    port_mass_kg: 0.045,
     limit_npm: [128.82, 394.31, 467.24, 377.95, 142.52],
 };
 
 /// The image's board.
-pub fn board() -> Result<SerialArmBoard, BuildError> {
+pub type TouchBoard = PcLinkageBoard<SerialArm, 3>;
+
+/// The image's board.
+pub fn board() -> Result<TouchBoard, BuildError> {
     let ArmLengths { l1_m, l2_m } = TOUCH_ARM;
     IMAGE.board(SerialArm::new(l1_m, l2_m).map_err(BuildError::Param)?)
 }

@@ -27,7 +27,7 @@ pub use motors::{LimitedTorques, MotorConfig, MotorLimits};
 
 use crate::kinematics::{Jointed, Kinematics, KinematicsFault};
 use crate::safety::AxisError;
-use crate::servo::{Gains, GainsError, SensorFrame, Servo, ServoOutput};
+use crate::servo::{Direct, Gains, GainsError, PortLayer, SensorFrame, Servo, ServoOutput};
 use crate::world::World;
 use crate::{Encoder, Faults, ParamError, Position, Real, SafetyConfig};
 
@@ -120,11 +120,11 @@ impl core::error::Error for LinkageError {}
 /// # Ok::<(), twoport_control::linkage::LinkageError>(())
 /// ```
 #[derive(Clone, Copy, Debug)]
-pub struct LinkageServo<K, W, R = f32, const N: usize = 3> {
+pub struct LinkageServo<K, W, R = f32, const N: usize = 3, L = Direct> {
     joints: [JointEncoder; N],
     limits: JointLimits<N>,
     kinematics: K,
-    cartesian: Servo<W, R, N>,
+    cartesian: Servo<W, R, N, L>,
     motors: MotorLimits<R, N>,
     /// The last pose the kinematics served.
     pose: Jointed<R, N>,
@@ -220,6 +220,32 @@ impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<
             s.latch(f);
         }
         Ok(s)
+    }
+}
+
+impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize, L: PortLayer<R>>
+    LinkageServo<K, W, R, N, L>
+{
+    /// This servo with `layers[i]` between Cartesian axis `i`'s port and
+    /// its laws (a passivity layer: see [`Servo::with_layers`]).
+    pub fn with_layers<M: PortLayer<R>>(
+        self,
+        layers: [M; N],
+    ) -> Result<LinkageServo<K, W, R, N, M>, LinkageError> {
+        Ok(LinkageServo {
+            joints: self.joints,
+            limits: self.limits,
+            kinematics: self.kinematics,
+            cartesian: self
+                .cartesian
+                .with_layers(layers)
+                .map_err(LinkageError::Cartesian)?,
+            motors: self.motors,
+            pose: self.pose,
+            handle: self.handle,
+            fault: self.fault,
+            gravity: self.gravity,
+        })
     }
 
     fn latch(&mut self, f: KinematicsFault) {
@@ -380,14 +406,14 @@ impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<
     }
 
     /// The Cartesian servo: gains, world, safety layer, laws.
-    pub fn cartesian(&self) -> &Servo<W, R, N> {
+    pub fn cartesian(&self) -> &Servo<W, R, N, L> {
         &self.cartesian
     }
 
     /// The Cartesian servo, to change its gains, limits or world between
     /// ticks (its calibration follows the joints': see
     /// [`calibrate_joints`](Self::calibrate_joints)).
-    pub fn cartesian_mut(&mut self) -> &mut Servo<W, R, N> {
+    pub fn cartesian_mut(&mut self) -> &mut Servo<W, R, N, L> {
         &mut self.cartesian
     }
 

@@ -15,6 +15,23 @@ use crate::{Position, Real};
 /// motion (the paper's `f_a`), except the admittance display's measured
 /// force, which is the load cell's (on the handle along `+x`).
 pub trait PortLayer<R: Real = f32> {
+    /// Whether the layer dissipates whatever energy the element puts out
+    /// at the port, as its observer books it, however late the force (a
+    /// passivity controller): a board whose force comes later than its
+    /// proof allows then runs on with the layer engaged rather than fault.
+    const GUARDS_LATENCY: bool = false;
+
+    /// Engage the layer, the port at `x` (a layer on demand: see
+    /// [`SeriesDamper::on_demand`]); a layer always on is left as it is.
+    #[inline(always)]
+    fn engage(&mut self, x: Position) {
+        let _ = x;
+    }
+
+    /// Let a layer on demand go idle again.
+    #[inline(always)]
+    fn disengage(&mut self) {}
+
     /// The display this layer serves; `None` for either.
     fn display(&self) -> Option<Display> {
         None
@@ -68,6 +85,8 @@ impl<R: Real> PortLayer<R> for Direct {}
 /// watches the element (coupling and VE) take the device's motion and put
 /// out a force.
 impl<R: Real> PortLayer<R> for SeriesDamper<R> {
+    const GUARDS_LATENCY: bool = true;
+
     fn display(&self) -> Option<Display> {
         Some(Display::Impedance)
     }
@@ -86,6 +105,14 @@ impl<R: Real> PortLayer<R> for SeriesDamper<R> {
 
     fn reset(&mut self, x: Position) {
         SeriesDamper::reset(self, x);
+    }
+
+    fn engage(&mut self, x: Position) {
+        SeriesDamper::engage(self, x);
+    }
+
+    fn disengage(&mut self) {
+        SeriesDamper::disengage(self);
     }
 }
 

@@ -191,6 +191,22 @@ impl<W: World<R, N>, R: Real, const N: usize, L: PortLayer<R>> Servo<W, R, N, L>
         &self.layers
     }
 
+    /// Engage every axis's layer at the port's position now (a layer on
+    /// demand; see [`PortLayer::engage`]).
+    pub fn engage_layers(&mut self) {
+        let x = self.position();
+        for (l, x) in self.layers.iter_mut().zip(x) {
+            l.engage(x);
+        }
+    }
+
+    /// Let every axis's layer on demand go idle again.
+    pub fn disengage_layers(&mut self) {
+        for l in &mut self.layers {
+            l.disengage();
+        }
+    }
+
     /// Enable force output on every axis (ramping in), re-aligning the laws
     /// to the device if it was disabled. Refused while a fault is latched.
     pub fn enable(&mut self) -> Result<(), Faults> {
