@@ -292,8 +292,10 @@ pub(crate) fn host_test_against_an386(
 /// sleeps when the board runs ahead), its link's pty printed. With
 /// `--check`, two applications drive it in turn: the host's device-object
 /// test, and the C example built with the system C compiler against the
-/// library and its committed header (itself checked against the crate).
-/// Without, it runs until interrupted, for trying an application on it.
+/// library and its committed header (itself checked against the crate);
+/// then the C and Rust examples open a Touch by name, through the
+/// stand-in HD library. Without, it runs until interrupted, for trying an
+/// application on it.
 pub(crate) fn device(args: &[String]) -> Result<(), String> {
     let check = match args {
         [] => false,
@@ -331,7 +333,41 @@ pub(crate) fn device(args: &[String]) -> Result<(), String> {
             "the C example against the free-running board",
             Command::new(exe).arg(pty).env("LD_LIBRARY_PATH", lib),
         )
-    })
+    })?;
+    if let Some((exe, lib)) = &example {
+        let (release, standin) = touch_standin()?;
+        run(
+            "the C example opening a Touch by name (the stand-in HD library)",
+            Command::new(exe)
+                .args(["--device", "touch", ""])
+                .arg(&standin)
+                .env("LD_LIBRARY_PATH", lib),
+        )?;
+        run(
+            "the Rust example opening a Touch by name (the stand-in HD library)",
+            Command::new(release.join("examples").join("device"))
+                .args(["touch", ""])
+                .arg(&standin),
+        )?;
+    }
+    Ok(())
+}
+
+/// The workspace's release build, and in it the stand-in for OpenHaptics'
+/// HD library (`host-sim/hd-standin`): a Touch the examples open by name.
+pub(crate) fn touch_standin() -> Result<(std::path::PathBuf, std::path::PathBuf), String> {
+    let release = workspace_release_build()?;
+    let name = format!(
+        "{}twoport_hd_standin{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    );
+    let standin = release.join("deps").join(&name);
+    if standin.exists() {
+        Ok((release, standin))
+    } else {
+        Err(format!("{}: not built", standin.display()))
+    }
 }
 
 /// The `sim-device` image `elf` free-running

@@ -13,7 +13,8 @@ const TOOLS: [&str; 4] = ["maturin>=1.5,<2", "pytest", "numpy", "dask"];
 
 /// Build the wheel, install it, run `crates/python/tests`, then the wall
 /// example (`crates/python/examples/wall.py`) against the free-running
-/// board in QEMU: home, arm, a wall from Python at 1 kHz, disarm.
+/// board in QEMU (home, arm, a wall from Python at 1 kHz, disarm) and
+/// against a Touch opened by name through the stand-in HD library.
 pub(crate) fn python() -> Result<(), String> {
     let bin = wheel()?;
     run(
@@ -26,14 +27,21 @@ pub(crate) fn python() -> Result<(), String> {
         ]),
     )?;
     let elf = crate::firmware::an386_image_with("sim-device")?;
+    let wall = root().join("crates/python/examples/wall.py");
     crate::emulate::with_device(&elf, |pty| {
         run(
             "the Python example against the free-running board",
-            Command::new(bin.join("python"))
-                .arg(root().join("crates/python/examples/wall.py"))
-                .arg(pty),
+            Command::new(bin.join("python")).arg(&wall).arg(pty),
         )
-    })
+    })?;
+    let (_, standin) = crate::emulate::touch_standin()?;
+    run(
+        "the Python example opening a Touch by name (the stand-in HD library)",
+        Command::new(bin.join("python"))
+            .arg(&wall)
+            .args(["--device", "touch", ""])
+            .arg(&standin),
+    )
 }
 
 /// The environment with the package's wheel built and installed; its

@@ -420,6 +420,18 @@ enum TpResult tp_board_open_device(const char *name,
                                    struct TpBoard **out);
 
 /**
+ * Where the device `name`'s image calibrates (rad, a joint each): write
+ * it to `rest_rad`, which has room for `n` (at least the device's axes),
+ * and its axes to `axes`. Hold the handle there and calibrate there
+ * (`tp_board_calibrate`) after `tp_board_open_device`.
+ *
+ * # Safety
+ * `name` is a NUL-terminated string; `rest_rad` points to `n` writable
+ * doubles and `axes` to a writable `size_t`.
+ */
+enum TpResult tp_device_rest_pose(const char *name, double *rest_rad, size_t n, size_t *axes);
+
+/**
  * Disarm the board and free it. NULL is ignored. The board must not be
  * used after.
  *

@@ -210,6 +210,51 @@ pub unsafe extern "C" fn tp_board_open_device(
     })
 }
 
+/// Where the device `name`'s image calibrates (rad, a joint each): write
+/// it to `rest_rad`, which has room for `n` (at least the device's axes),
+/// and its axes to `axes`. Hold the handle there and calibrate there
+/// (`tp_board_calibrate`) after `tp_board_open_device`.
+///
+/// # Safety
+/// `name` is a NUL-terminated string; `rest_rad` points to `n` writable
+/// doubles and `axes` to a writable `size_t`.
+#[no_mangle]
+pub unsafe extern "C" fn tp_device_rest_pose(
+    name: *const c_char,
+    rest_rad: *mut f64,
+    n: usize,
+    axes: *mut usize,
+) -> TpResult {
+    guard(|| {
+        if name.is_null() || rest_rad.is_null() || axes.is_null() {
+            return bad("name, rest_rad and axes must not be NULL");
+        }
+        // SAFETY: `name` is non-null and NUL-terminated (the contract).
+        let Ok(name) = unsafe { CStr::from_ptr(name) }.to_str() else {
+            return bad("name must be UTF-8");
+        };
+        let rest = match twoport_host::attached::rest_pose(name) {
+            Ok(r) => r,
+            Err(e) => return fail(&e),
+        };
+        if rest.len() > n {
+            return bad(&format!(
+                "{name} has {} axes: rest_rad holds {n}",
+                rest.len()
+            ));
+        }
+        // SAFETY: `rest_rad` has room for `n` doubles and `axes` for one
+        // `size_t` (the contract); `rest.len() <= n`.
+        unsafe {
+            for (i, q) in rest.iter().enumerate() {
+                rest_rad.add(i).write(*q);
+            }
+            axes.write(rest.len());
+        }
+        TpResult::Ok
+    })
+}
+
 /// Disarm the board and free it. NULL is ignored. The board must not be
 /// used after.
 ///

@@ -112,6 +112,23 @@ pub fn hd_library() -> Option<PathBuf> {
         .find(|p| p.exists())
 }
 
+/// Where the device `name`'s image calibrates (rad, a joint each): hold
+/// the handle there and calibrate the board there after
+/// [`open`]ing it.
+pub fn rest_pose(name: &str) -> Result<Vec<f64>, crate::LinkError> {
+    let rest: &[f32] = match name {
+        "haply-2diy" => &twoport_board::linkage::haply::HAPLY.rest_rad,
+        "falcon" => &twoport_board::linkage::FALCON.rest_rad,
+        "touch" => &twoport_board::linkage::touch::TOUCH.rest_rad,
+        other => {
+            return Err(crate::LinkError::Image(format!(
+                "{other}: not a device twoport drives (haply-2diy, falcon, touch)"
+            )))
+        }
+    };
+    Ok(rest.iter().map(|q| f64::from(*q)).collect())
+}
+
 /// The device `name` (`twoport spec`'s: `haply-2diy`, `falcon` or
 /// `touch`) at `path`, wired and held as its driver does by default (a
 /// Haply v3 with a grip switch on analog pin 2; a Falcon's center button;

@@ -127,6 +127,13 @@ impl Board {
         })
     }
 
+    /// Where the device `name`'s image calibrates (rad, a joint each):
+    /// hold the handle there and `calibrate` there after `device`.
+    #[staticmethod]
+    fn rest_pose(name: &str) -> PyResult<Vec<f64>> {
+        twoport_host::attached::rest_pose(name).map_err(link)
+    }
+
     /// The servo loop's timing where it runs on this computer
     /// (`pc_simulated`, a device's driver): ticks, late ticks, and the
     /// period's, the device exchange's and the latency's p50/p99/max (s);
