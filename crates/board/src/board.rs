@@ -101,6 +101,11 @@ pub struct Board<W, const R: usize, const N: usize = 1, L = Direct, D = Servo<W,
     late_guarded: u32,
     /// Ticks the passivity layer stays engaged for (none: idle).
     guarding: u32,
+    /// Gains outside the proven regions are accepted: the user's explicit
+    /// choice ([`Board::accepting_unproven_gains`]).
+    unproven_allowed: bool,
+    /// Sets of gains accepted outside the proven regions.
+    unproven_sets: u32,
     /// The dead-man switch at the last tick (open before the first).
     dead_man_closed: bool,
     /// Whether the amplifier's outputs are on (as last commanded).
@@ -207,6 +212,8 @@ where
             late_after: None,
             late_guarded: 0,
             guarding: 0,
+            unproven_allowed: false,
+            unproven_sets: 0,
             dead_man_closed: false,
             outputs_on: false,
             config_source: None,
@@ -262,6 +269,21 @@ where
             u32::MAX
         });
         self
+    }
+
+    /// The same board accepting gains outside its proven regions (each
+    /// still inside what the laws take): the user's explicit choice, for
+    /// an experiment past the proof. No image ships with it; the host
+    /// that makes the choice logs it, and every such set
+    /// ([`unproven_sets`](Self::unproven_sets)).
+    pub fn accepting_unproven_gains(mut self) -> Self {
+        self.unproven_allowed = true;
+        self
+    }
+
+    /// Sets of gains accepted outside the proven regions.
+    pub fn unproven_sets(&self) -> u32 {
+        self.unproven_sets
     }
 
     /// Whether the passivity layer is engaged after a late force.
@@ -411,6 +433,13 @@ where
                         let g = g.map(Gains::from);
                         match self.check(&g) {
                             Ok(()) => self.apply(g),
+                            Err(_) if self.unproven_allowed => {
+                                let reply = self.apply(g);
+                                if matches!(reply, GainsReply::Accepted(_)) {
+                                    self.unproven_sets = self.unproven_sets.saturating_add(1);
+                                }
+                                reply
+                            }
                             Err(why) => GainsReply::Refused(why),
                         }
                     }

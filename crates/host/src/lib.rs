@@ -20,8 +20,8 @@ pub use device::{AxisState, HostBoard, State, HEARTBEAT_PERIOD, HEARTBEAT_POLLS,
 pub use error::LinkError;
 pub use local::{LocalBoard, LocalDelta, LocalFast, LocalSerialArm};
 pub use pc_loop::{
-    DeviceIo, LoopThread, LoopTiming, PcBoard, Percentiles, Priority, SteppedPc, Ticker,
-    LATE_PERIODS, STALL, TIMING_WINDOW,
+    accept_unproven_gains, DeviceIo, LoopThread, LoopTiming, PcBoard, Percentiles, Priority,
+    SteppedPc, Ticker, LATE_PERIODS, STALL, TIMING_WINDOW,
 };
 pub use port::{BoardPort, SerialBoard};
 pub use session::{LinkFaults, Session, ANSWER_TIMEOUT, HEARTBEAT_EVERY};

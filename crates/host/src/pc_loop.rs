@@ -142,6 +142,10 @@ struct Shared {
     ended: bool,
     /// When the latest tick ran (the loop's start, before the first).
     last_tick: Option<Instant>,
+    /// Sets of gains the board accepted outside its proven region, and
+    /// how many of them have been logged.
+    unproven_sets: u32,
+    unproven_logged: u32,
 }
 
 impl Shared {
@@ -248,6 +252,30 @@ impl<Io: DeviceIo<N>, const N: usize> BoardSupport<N> for PcSupport<Io, N> {
         // the last exchange's sensors.
         self.latency
             .map(|l| u32::try_from(l.as_nanos()).unwrap_or(u32::MAX))
+    }
+}
+
+/// `board`, accepting gains outside its proven region where the user
+/// chose so (`why`), the choice logged for the device at `path`.
+pub fn accept_unproven_gains<W, L, D, const N: usize, const R: usize>(
+    board: Board<W, R, N, L, D>,
+    why: Option<&str>,
+    path: &str,
+) -> Board<W, R, N, L, D>
+where
+    W: World<f32, N>,
+    L: PortLayer,
+    D: Drive<N, World = W, Layer = L>,
+{
+    match why {
+        Some(why) => {
+            eprintln!(
+                "twoport: {path}: gains outside the proven region will be accepted, by the \
+                 user's choice ({why}): stability is not proven for them"
+            );
+            board.accepting_unproven_gains()
+        }
+        None => board,
     }
 }
 
@@ -455,6 +483,7 @@ where
             .map(|l| start.duration_since(l).as_secs_f64());
         s.ticks += 1;
         s.last_tick = Some(start);
+        s.unproven_sets = self.board.unproven_sets();
         if let Some(p) = since {
             s.late += u64::from(p > LATE_PERIODS * self.period_s);
             record(&mut s.periods, self.slot, p);
@@ -559,6 +588,14 @@ impl BoardPort for PcBoard {
         let (m, c) = &*self.shared;
         let deadline = Instant::now() + timeout;
         let mut s = lock(m);
+        if s.unproven_sets > s.unproven_logged {
+            s.unproven_logged = s.unproven_sets;
+            eprintln!(
+                "twoport: gains outside the proven region set ({} so far), by the user's \
+                 choice: stability is not proven for them",
+                s.unproven_sets
+            );
+        }
         loop {
             let n = s.link.take(buf);
             if n > 0 {

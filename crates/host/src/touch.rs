@@ -31,6 +31,11 @@ pub struct TouchConfig {
     pub directions: [f32; 3],
     /// The dead-man switch: the stylus's buttons, or assumed.
     pub grip: Grip,
+    /// Gains outside the image's proven region accepted, and why: the
+    /// user's explicit choice, logged when the loop starts and at every
+    /// such set ([`accept_unproven_gains`](crate::accept_unproven_gains)).
+    /// `None`: refused.
+    pub unproven_gains: Option<String>,
 }
 
 impl TouchConfig {
@@ -43,6 +48,7 @@ impl TouchConfig {
             device: None,
             directions: [1.0; 3],
             grip,
+            unproven_gains: None,
         }
     }
 
@@ -182,6 +188,8 @@ impl PcBoard {
         let (io, scheduler) = open(config)?;
         let board =
             image::board().map_err(|e| LinkError::Image(format!("the {NAME}'s image: {e:?}")))?;
+        let board =
+            crate::accept_unproven_gains(board, config.unproven_gains.as_deref(), &shown(config));
         PcBoard::start_on(board, io, f64::from(PERIOD_S), scheduler)
     }
 }

@@ -14,8 +14,9 @@ use host_sim::emulate::Trace;
 use std::path::PathBuf;
 use std::time::Duration;
 use twoport_board::linkage::touch::{self as image, TOUCH};
+use twoport_control::servo::ImpedanceGains;
 use twoport_host::touch::TouchConfig;
-use twoport_host::{BoardPort, HostBoard, LinkError, PcBoard, SteppedPc};
+use twoport_host::{BoardPort, Gains, HostBoard, LinkError, PcBoard, SteppedPc};
 
 /// The stand-in library, built beside this test.
 fn standin() -> PathBuf {
@@ -143,6 +144,28 @@ fn a_failing_device_gets_zero_force_and_a_named_error() {
             assert_eq!(t.torque_nm.last(), Some(&[0.0; 3]));
         }
     }
+}
+
+/// Gains past the proven region are refused, naming the limit, unless the
+/// user chose to accept them (an explicit, logged choice).
+#[test]
+fn gains_past_the_region_need_the_users_choice() {
+    let _turn = turn();
+    let stiff: [Gains; 3] =
+        [twoport_control::Gains::from(ImpedanceGains::new(800.0, 1.0)).into(); 3];
+    let mut b = HostBoard::open(PcBoard::touch(&config("")).unwrap(), 3).unwrap();
+    match b.set_gains(&stiff) {
+        Err(LinkError::GainsRefused(why)) => assert_eq!(why.axis, 0, "{why:?}"),
+        e => panic!("{e:?}"),
+    }
+    drop(b);
+    let chosen = TouchConfig {
+        unproven_gains: Some("a stiffness study on a clamped handle".into()),
+        ..config("")
+    };
+    let mut b = HostBoard::open(PcBoard::touch(&chosen).unwrap(), 3).unwrap();
+    let g = b.set_gains(&stiff).unwrap();
+    assert_eq!(g.as_slice(), &stiff);
 }
 
 /// A library that is not there, a port the user may not open, a device

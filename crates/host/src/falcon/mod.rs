@@ -33,6 +33,11 @@ pub struct FalconConfig {
     pub grip: Grip,
     /// The LEDs while it runs.
     pub leds: u8,
+    /// Gains outside the image's proven region accepted, and why: the
+    /// user's explicit choice, logged when the loop starts and at every
+    /// such set ([`accept_unproven_gains`](crate::accept_unproven_gains)).
+    /// `None`: refused.
+    pub unproven_gains: Option<String>,
 }
 
 impl FalconConfig {
@@ -43,6 +48,7 @@ impl FalconConfig {
             firmware: firmware.into(),
             grip: Grip::Button { mask: 0b0001 },
             leds: protocol::LED_BLUE,
+            unproven_gains: None,
         }
     }
 }
@@ -273,6 +279,7 @@ impl PcBoard {
         let io = open(path, config)?;
         let board = falcon_pc::board()
             .map_err(|e| LinkError::Image(format!("the Falcon's image: {e:?}")))?;
+        let board = crate::accept_unproven_gains(board, config.unproven_gains.as_deref(), path);
         PcBoard::start(board, io, f64::from(PERIOD_S))
     }
 }

@@ -27,6 +27,11 @@ pub struct HaplyConfig {
     pub joints: [Joint; 2],
     /// Its dead-man switch.
     pub grip: Grip,
+    /// Gains outside the image's proven region accepted, and why: the
+    /// user's explicit choice, logged when the loop starts and at every
+    /// such set ([`accept_unproven_gains`](crate::accept_unproven_gains)).
+    /// `None`: refused.
+    pub unproven_gains: Option<String>,
 }
 
 impl HaplyConfig {
@@ -46,6 +51,7 @@ impl HaplyConfig {
             device_id: 1,
             joints: [joint(2, HAPLY.rest_rad[0]), joint(1, HAPLY.rest_rad[1])],
             grip,
+            unproven_gains: None,
         }
     }
 
@@ -94,6 +100,7 @@ impl PcBoard {
         let io = open(path, config)?;
         let board =
             image::board().map_err(|e| LinkError::Image(format!("the 2DIY's image: {e:?}")))?;
+        let board = crate::accept_unproven_gains(board, config.unproven_gains.as_deref(), path);
         PcBoard::start(board, io, f64::from(PERIOD_S))
     }
 }
