@@ -2,7 +2,7 @@
 
 use twoport_board::{Board, BoardSupport, Bound, RawSensors, Region, GUARD_TICKS};
 use twoport_control::passivity::{PassivityLimits, SeriesDamper};
-use twoport_control::servo::{ImpedanceGains, PortLayer, ServoOutput};
+use twoport_control::servo::{ImpedanceGains, OnDemand, PortLayer, ServoOutput};
 use twoport_control::ve::BilateralConstraint;
 use twoport_control::{AdmittanceGains, Encoder, Faults, Position, SafetyConfig, Servo};
 use twoport_link::{
@@ -507,7 +507,7 @@ fn a_late_force_engages_the_passivity_layer() {
         )
         .unwrap();
         let limits = PassivityLimits::for_device(0.93, 1e-3, safety().peak_force_n).unwrap();
-        let damper = SeriesDamper::new(limits).unwrap().on_demand();
+        let damper = OnDemand::new(SeriesDamper::new(limits).unwrap());
         Board::new(servo.with_layers([damper]).unwrap(), [late_region()], 0)
     };
     let rate = 7_000_000;

@@ -10,6 +10,7 @@
 use super::{safety, wall_servo, BuildError, ACTUATOR_PORT, HOMING, PERIOD_S, TELEMETRY_EVERY};
 use crate::Board;
 use twoport_control::passivity::{PassivityLimits, SeriesDamper};
+use twoport_control::servo::OnDemand;
 use twoport_control::ve::UnilateralWall;
 use twoport_control::ImpedanceGains;
 
@@ -24,11 +25,12 @@ crate::region::shipped_region!(
 pub const COUPLING: ImpedanceGains = ImpedanceGains::new(3_000.0, 4.0);
 
 /// The whole board, for the PC's loop.
-pub fn board() -> Result<Board<UnilateralWall, REGION_POINTS, 1, SeriesDamper>, BuildError> {
+pub fn board() -> Result<Board<UnilateralWall, REGION_POINTS, 1, OnDemand<SeriesDamper>>, BuildError>
+{
     let port = ACTUATOR_PORT;
     let mut limits = PassivityLimits::for_device(port.mass_kg, PERIOD_S, safety().peak_force_n)?;
     limits.device_damping_nspm = port.damping_nspm;
-    let layer = SeriesDamper::new(limits)?.on_demand();
+    let layer = OnDemand::new(SeriesDamper::new(limits)?);
     Ok(super::wall_board(
         wall_servo(COUPLING, safety())?.with_layers([layer])?,
         proven_region()?,

@@ -10,7 +10,7 @@ use crate::{Board, BuildError};
 use twoport_control::kinematics::Kinematics;
 use twoport_control::linkage::LinkageServo;
 use twoport_control::passivity::{PassivityLimits, SeriesDamper};
-use twoport_control::servo::ImpedanceGains;
+use twoport_control::servo::{ImpedanceGains, OnDemand};
 use twoport_control::world::World;
 
 /// The latency from a sample to its force (s) the PC images are proven
@@ -40,13 +40,16 @@ pub struct PcImage<const N: usize> {
     pub port_mass_kg: f32,
 }
 
-/// A PC image's servo: the linkage's, with a series damper (the
-/// passivity layer) at each Cartesian axis's port.
-pub type PcServo<K, const N: usize> = LinkageServo<K, LinkageWorld<N>, f32, N, SeriesDamper>;
+/// The passivity layer of the PC images: a series damper at each
+/// Cartesian axis's port, engaged on demand.
+pub type PcLayer = OnDemand<SeriesDamper>;
+
+/// A PC image's servo: the linkage's, with [`PcLayer`].
+pub type PcServo<K, const N: usize> = LinkageServo<K, LinkageWorld<N>, f32, N, PcLayer>;
 
 /// A PC image's board.
 pub type PcLinkageBoard<K, const N: usize> =
-    Board<LinkageWorld<N>, REGION_POINTS, N, SeriesDamper, PcServo<K, N>>;
+    Board<LinkageWorld<N>, REGION_POINTS, N, PcLayer, PcServo<K, N>>;
 
 impl<const N: usize> PcImage<N> {
     /// Its region, stating its latency.
@@ -73,7 +76,7 @@ impl<const N: usize> PcImage<N> {
         let mut limits =
             PassivityLimits::for_device(self.port_mass_kg, PERIOD_S, safety().peak_force_n)?;
         limits.device_damping_nspm = self.spec.least_damping_nspm;
-        let layer = SeriesDamper::new(limits)?.on_demand();
+        let layer = OnDemand::new(SeriesDamper::new(limits)?);
         let servo = image_servo(&self.spec, kinematics, self.coupling)?
             .with_layers([layer; N])
             .map_err(BuildError::Linkage)?;

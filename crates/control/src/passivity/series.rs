@@ -129,10 +129,6 @@ pub struct SeriesDamper<R = f32> {
     force_limit_n: R,
     max_reserve_nj: R,
     damping_nspm: R,
-    /// Whether it books and corrects: always, unless made
-    /// [`on_demand`](Self::on_demand) and not engaged.
-    engaged: bool,
-    on_demand: bool,
 }
 
 impl<R: Real> SeriesDamper<R> {
@@ -148,41 +144,7 @@ impl<R: Real> SeriesDamper<R> {
             force_limit_n: R::of(l.force_limit_n),
             max_reserve_nj: R::of(l.max_reserve_j) * R::NM_PER_M,
             damping_nspm: R::ZERO,
-            engaged: true,
-            on_demand: false,
         })
-    }
-
-    /// The same controller, idle (the element's force passes through, and
-    /// nothing is booked) until [`engage`](Self::engage)d: for a loop
-    /// whose proof covers it but for the ticks that come late.
-    pub fn on_demand(mut self) -> Self {
-        self.on_demand = true;
-        self.engaged = false;
-        self
-    }
-
-    /// Start booking and correcting, the element at rest and the port at
-    /// `x` from now (an on-demand controller not engaged; any other is
-    /// left as it is).
-    pub fn engage(&mut self, x: Position) {
-        if self.on_demand && !self.engaged {
-            self.engaged = true;
-            self.reset(x);
-        }
-    }
-
-    /// Go idle again (an on-demand controller only).
-    pub fn disengage(&mut self) {
-        if self.on_demand {
-            self.engaged = false;
-            self.damping_nspm = R::ZERO;
-        }
-    }
-
-    /// Whether it books and corrects now.
-    pub fn engaged(&self) -> bool {
-        self.engaged
     }
 
     /// One tick: `x` the port's position now, `v` its velocity estimate
@@ -213,9 +175,6 @@ impl<R: Real> SeriesDamper<R> {
     /// [`hold`](Self::hold) (the servo's tick).
     #[inline(always)]
     pub(crate) fn correct(&mut self, x: Position, v: R, force_n: R) -> R {
-        if !self.engaged {
-            return force_n;
-        }
         self.observer.book(x, force_n);
         let e = self.observer.energy_in_nj();
         if e > self.max_reserve_nj {
@@ -249,9 +208,7 @@ impl<R: Real> SeriesDamper<R> {
     /// returned: what a safety layer downstream finally let through.
     #[inline]
     pub fn hold(&mut self, force_n: R) {
-        if self.engaged {
-            self.observer.hold(force_n);
-        }
+        self.observer.hold(force_n);
     }
 
     /// Forget everything booked: the element starts again at rest, the

@@ -15,20 +15,19 @@ use crate::{Position, Real};
 /// motion (the paper's `f_a`), except the admittance display's measured
 /// force, which is the load cell's (on the handle along `+x`).
 pub trait PortLayer<R: Real = f32> {
-    /// Whether the layer dissipates whatever energy the element puts out
-    /// at the port, as its observer books it, however late the force (a
-    /// passivity controller): a board whose force comes later than its
-    /// proof allows then runs on with the layer engaged rather than fault.
+    /// Whether a board whose force comes later than its proof allows
+    /// runs on with this layer [`engage`](Self::engage)d rather than
+    /// fault: a passivity controller [`OnDemand`].
     const GUARDS_LATENCY: bool = false;
 
-    /// Engage the layer, the port at `x` (a layer on demand: see
-    /// [`SeriesDamper::on_demand`]); a layer always on is left as it is.
+    /// Engage the layer, the port at `x` ([`OnDemand`]'s); any other is
+    /// always on.
     #[inline(always)]
     fn engage(&mut self, x: Position) {
         let _ = x;
     }
 
-    /// Let a layer on demand go idle again.
+    /// Let a layer [`OnDemand`] go idle again.
     #[inline(always)]
     fn disengage(&mut self) {}
 
@@ -85,8 +84,6 @@ impl<R: Real> PortLayer<R> for Direct {}
 /// watches the element (coupling and VE) take the device's motion and put
 /// out a force.
 impl<R: Real> PortLayer<R> for SeriesDamper<R> {
-    const GUARDS_LATENCY: bool = true;
-
     fn display(&self) -> Option<Display> {
         Some(Display::Impedance)
     }
@@ -106,14 +103,6 @@ impl<R: Real> PortLayer<R> for SeriesDamper<R> {
     fn reset(&mut self, x: Position) {
         SeriesDamper::reset(self, x);
     }
-
-    fn engage(&mut self, x: Position) {
-        SeriesDamper::engage(self, x);
-    }
-
-    fn disengage(&mut self) {
-        SeriesDamper::disengage(self);
-    }
 }
 
 /// The admittance display's passivity controller at the load cell: it
@@ -131,5 +120,93 @@ impl<R: Real> PortLayer<R> for ParallelDamper<R> {
 
     fn reset(&mut self, _: Position) {
         ParallelDamper::reset(self);
+    }
+}
+
+/// A passivity controller `L` engaged on demand: idle (the element's
+/// output passes through, bit for bit, and nothing is booked) until its
+/// board engages it, on a force later than the board's proof allows;
+/// then `L`, its element taken at rest from the port's position there,
+/// until the board lets it go idle again.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OnDemand<L> {
+    layer: L,
+    engaged: bool,
+}
+
+impl<L> OnDemand<L> {
+    /// `layer`, idle.
+    pub fn new(layer: L) -> Self {
+        OnDemand {
+            layer,
+            engaged: false,
+        }
+    }
+
+    /// Whether it is engaged.
+    pub fn engaged(&self) -> bool {
+        self.engaged
+    }
+
+    /// The controller.
+    pub fn layer(&self) -> &L {
+        &self.layer
+    }
+}
+
+impl<R: Real, L: PortLayer<R>> PortLayer<R> for OnDemand<L> {
+    const GUARDS_LATENCY: bool = true;
+
+    fn display(&self) -> Option<Display> {
+        self.layer.display()
+    }
+
+    #[inline(always)]
+    fn element_motion(&mut self, x: Position, v_mps: R) -> (Position, R) {
+        if self.engaged {
+            self.layer.element_motion(x, v_mps)
+        } else {
+            (x, v_mps)
+        }
+    }
+
+    #[inline(always)]
+    fn impedance_force(&mut self, x: Position, v_mps: R, force_n: R) -> R {
+        if self.engaged {
+            self.layer.impedance_force(x, v_mps, force_n)
+        } else {
+            force_n
+        }
+    }
+
+    #[inline(always)]
+    fn admittance_velocity(&mut self, force_n: R, velocity_mps: R) -> R {
+        if self.engaged {
+            self.layer.admittance_velocity(force_n, velocity_mps)
+        } else {
+            velocity_mps
+        }
+    }
+
+    #[inline(always)]
+    fn held(&mut self, force_n: R) {
+        if self.engaged {
+            self.layer.held(force_n);
+        }
+    }
+
+    fn reset(&mut self, x: Position) {
+        self.layer.reset(x);
+    }
+
+    fn engage(&mut self, x: Position) {
+        if !self.engaged {
+            self.engaged = true;
+            self.layer.reset(x);
+        }
+    }
+
+    fn disengage(&mut self) {
+        self.engaged = false;
     }
 }

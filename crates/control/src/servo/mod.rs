@@ -11,7 +11,7 @@ mod tick;
 pub use frame::{SensorFrame, ServoOutput};
 pub use gains::{AdmittanceGains, Display, Gains, GainsError, ImpedanceGains};
 pub use laws::LawsRef;
-pub use layer::{Direct, PortLayer};
+pub use layer::{Direct, OnDemand, PortLayer};
 
 use crate::safety::{AxisError, Faults, SafetyConfig, SafetyLayer};
 use crate::world::World;
