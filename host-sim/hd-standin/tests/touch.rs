@@ -146,6 +146,47 @@ fn a_failing_device_gets_zero_force_and_a_named_error() {
     }
 }
 
+/// The scope watches a device as it watches a board: opened by name on a
+/// scene of its axes, calibrated at its image's rest pose, armed; its
+/// telemetry streams in, armed, with the hand's press on the last axis.
+#[test]
+fn the_scope_runs_the_touch_live() {
+    use host_sim::scope::board::WithBoard;
+    use host_sim::scope::world::WorldState;
+    let _turn = turn();
+    // (A scene names its files from the workspace's root; this test alone
+    // reads any by a relative path.)
+    std::env::set_current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).unwrap();
+    let scene = std::path::Path::new("scenes/linkages/phantom_wall.toml");
+    let mut s = WorldState::<3>::open(scene).unwrap();
+    let lib = standin();
+    s.connect_device("touch", "", Some(&lib));
+    assert_eq!(s.message, None);
+    assert_eq!(
+        s.board.as_ref().and_then(|b| b.device.as_deref()),
+        Some("touch")
+    );
+    let run = |s: &mut WorldState<3>, seconds: f64| {
+        let until = std::time::Instant::now() + Duration::from_secs_f64(seconds);
+        while std::time::Instant::now() < until {
+            s.advance(0.002);
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    };
+    run(&mut s, 0.1);
+    s.calibrate_device();
+    run(&mut s, 0.1);
+    s.tell_board(twoport_link::Message::Arm);
+    run(&mut s, 1.0);
+    assert_eq!(s.message, None);
+    let b = s.board.as_ref().unwrap();
+    let t = b.telemetry.expect("telemetry streamed");
+    assert_eq!((t.mode, t.faults), (twoport_link::BoardMode::Armed, 0));
+    assert!(b.status.is_some_and(|st| st.calibrated));
+    let pressed = s.board_forces[2].iter().last().map_or(0.0, |(_, f)| *f);
+    assert!(pressed.abs() > 0.1, "{pressed} N on z");
+}
+
 /// Gains past the proven region are refused, naming the limit, unless the
 /// user chose to accept them (an explicit, logged choice).
 #[test]

@@ -28,6 +28,9 @@ pub struct BoardLink {
     pub status: Option<Status>,
     /// Its last refusal of a mode change.
     pub refusal: Option<String>,
+    /// The device the PC drives, by name, where it is one
+    /// ([`WithBoard::connect_device`]).
+    pub device: Option<String>,
 }
 
 impl BoardLink {
@@ -55,6 +58,7 @@ impl BoardLink {
             faults: None,
             status: None,
             refusal: None,
+            device: None,
         })
     }
 
@@ -143,6 +147,43 @@ pub trait WithBoard {
         }
     }
 
+    /// Board mode on a device the PC drives, by `name` (`twoport
+    /// devices`' names) at `path` (a Touch: its Touch Setup name), with
+    /// the `file` it needs (a Falcon's firmware, a Touch's HD library): its
+    /// image in this computer's loop, free running, the scope watching.
+    fn connect_device(&mut self, name: &str, path: &str, file: Option<&std::path::Path>) {
+        match twoport_host::attached::open(name, path, file) {
+            Ok((pc, _)) => {
+                let label = format!("{name} at {path:?}");
+                self.connect_port(Box::new(pc), &label, false);
+                if let Some(b) = self.board_parts().0.as_mut() {
+                    b.device = Some(name.to_string());
+                }
+            }
+            Err(e) => *self.board_parts().1 = Some(format!("{name} at {path:?}: {e}")),
+        }
+    }
+
+    /// Calibrate a device at its image's rest pose, the handle held there
+    /// (a board not a device's: nothing to do, and said so).
+    fn calibrate_device(&mut self) {
+        let (board, message, _) = self.board_parts();
+        let Some(name) = board.as_ref().and_then(|b| b.device.clone()) else {
+            *message = Some("not a device the PC drives: calibrate it as its board".into());
+            return;
+        };
+        match twoport_host::attached::rest_pose(&name) {
+            Ok(rest) => {
+                let pm: Vec<i64> = rest.iter().map(|q| (q * 1e12).round() as i64).collect();
+                match twoport_link::Axes::from_slice(&pm) {
+                    Some(position_pm) => self.tell_board(Message::Calibrate { position_pm }),
+                    None => *message = Some(format!("{name}: {} axes", pm.len())),
+                }
+            }
+            Err(e) => *message = Some(e.to_string()),
+        }
+    }
+
     /// Leave board mode, disarming the board.
     fn disconnect(&mut self) {
         if let Some(b) = self.board_parts().0.take() {
@@ -167,6 +208,11 @@ pub struct BoardChoice {
     pub port: String,
     /// Lockstep (processor in the loop) or free running.
     pub lockstep: bool,
+    /// A device the PC drives, by name (empty: a board on the port).
+    pub device: String,
+    /// The file that device needs (a Falcon's firmware, a Touch's HD
+    /// library; empty: none).
+    pub file: String,
 }
 
 impl Default for BoardChoice {
@@ -174,6 +220,8 @@ impl Default for BoardChoice {
         BoardChoice {
             port: String::new(),
             lockstep: true,
+            device: String::new(),
+            file: String::new(),
         }
     }
 }

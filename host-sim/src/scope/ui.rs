@@ -475,6 +475,34 @@ pub fn board_choice(ui: &mut Ui, link: &mut BoardChoice) -> Option<(String, bool
         .then(|| (link.port.clone(), link.lockstep))
 }
 
+/// The controls for a device the PC drives (`twoport devices`): its
+/// name, where it is (a serial port; a Touch: its Touch Setup name) and
+/// the file it needs; what to open when the button is pressed.
+pub fn device_choice(ui: &mut Ui, link: &mut BoardChoice) -> Option<(String, String, String)> {
+    ui.horizontal(|ui| {
+        egui::ComboBox::from_label("device")
+            .selected_text(if link.device.is_empty() {
+                "a device the PC drives"
+            } else {
+                link.device.as_str()
+            })
+            .show_ui(ui, |ui| {
+                for d in ["haply-2diy", "falcon", "touch"] {
+                    ui.selectable_value(&mut link.device, d.to_string(), d);
+                }
+            });
+        ui.label("at");
+        ui.text_edit_singleline(&mut link.port).on_hover_text(
+            "its serial port; a Touch: its name in Touch Setup (empty: the default)",
+        );
+        ui.label("file");
+        ui.text_edit_singleline(&mut link.file)
+            .on_hover_text("a Falcon's firmware; a Touch's HD library where not the system's");
+    });
+    (ui.button("open device").clicked() && !link.device.is_empty())
+        .then(|| (link.device.clone(), link.port.clone(), link.file.clone()))
+}
+
 /// The board's state machine: its mode, calibration and latched faults by
 /// name, and the buttons that move it; what a button asks the board.
 pub fn board_state(ui: &mut Ui, b: &BoardLink) -> Option<twoport_link::Message> {

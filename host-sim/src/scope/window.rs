@@ -17,6 +17,9 @@ pub struct Script {
     pub screenshot: Option<PathBuf>,
     /// Close after this many seconds of wall time.
     pub exit_after_s: Option<f64>,
+    /// A device the PC drives to open at the start, free running: its
+    /// name, where it is, the file it needs.
+    pub device: Option<(String, String, Option<PathBuf>)>,
 }
 
 /// The first screenshot's path: `out.png` -> `out.first.png`.
@@ -137,6 +140,16 @@ pub fn display_available() -> bool {
         .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()))
 }
 
+/// Open the scripted device, if any, on `state`.
+fn open_device(
+    state: &mut impl crate::scope::board::WithBoard,
+    device: Option<(String, String, Option<PathBuf>)>,
+) {
+    if let Some((name, path, file)) = device {
+        state.connect_device(&name, &path, file.as_deref());
+    }
+}
+
 /// Open the scope on `scene` (the world view for a scene of two or three
 /// axes);
 /// returns the screenshots saved.
@@ -144,16 +157,21 @@ pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, Error> {
     let shots = Shots::new(script);
     let saved = shots.saved.clone();
     let parsed = crate::Scene::load(scene, &[])?;
+    let device = shots.script.device.clone();
+    if device.is_some() && parsed.axes < 2 {
+        return Err(Error::Sim(format!(
+            "{}: a device the PC drives needs a scene of its axes (scenes/linkages/)",
+            scene.display()
+        )));
+    }
     let app: Box<dyn eframe::App> = if parsed.axes == 3 {
-        Box::new(WorldApp::<3> {
-            state: crate::scope::world::WorldState::new(parsed)?,
-            shots,
-        })
+        let mut state = crate::scope::world::WorldState::<3>::new(parsed)?;
+        open_device(&mut state, device);
+        Box::new(WorldApp::<3> { state, shots })
     } else if parsed.axes == 2 {
-        Box::new(WorldApp::<2> {
-            state: crate::scope::world::WorldState::new(parsed)?,
-            shots,
-        })
+        let mut state = crate::scope::world::WorldState::<2>::new(parsed)?;
+        open_device(&mut state, device);
+        Box::new(WorldApp::<2> { state, shots })
     } else {
         Box::new(ScopeApp {
             state: ScopeState::open(scene)?,

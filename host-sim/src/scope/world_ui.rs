@@ -51,14 +51,19 @@ fn status<const N: usize>(ui: &mut Ui, s: &mut WorldState<N>) {
     });
 }
 
-/// Board mode: connect a three-axis board, its state and buttons
-/// (calibrate where the world's cursor starts, then arm), disconnect.
+/// Board mode: connect a board of the scene's axes, or open a device the
+/// PC drives; its state and buttons (calibrate where the world's cursor
+/// starts, a device at its image's rest pose, then arm), disconnect.
 fn board<const N: usize>(ui: &mut Ui, s: &mut WorldState<N>) {
     ui.horizontal(|ui| {
         let Some(b) = &s.board else {
             ui.label("board:");
             if let Some((port, lockstep)) = ui::board_choice(ui, &mut s.link) {
                 s.connect(&port, lockstep);
+            }
+            if let Some((name, path, file)) = ui::device_choice(ui, &mut s.link) {
+                let file = (!file.is_empty()).then(|| std::path::PathBuf::from(file));
+                s.connect_device(&name, &path, file.as_deref());
             }
             return;
         };
@@ -69,14 +74,20 @@ fn board<const N: usize>(ui: &mut Ui, s: &mut WorldState<N>) {
         };
         ui.label(format!("board: {} ({how})", b.port));
         let mut say = ui::board_state(ui, b);
-        if ui
-            .button("calibrate")
-            .on_hover_text("the device stands where the world's cursor starts")
-            .clicked()
-        {
-            match s.at_rest_pm() {
-                Ok(position_pm) => say = Some(Message::Calibrate { position_pm }),
-                Err(e) => s.message = Some(e.to_string()),
+        let device = b.device.is_some();
+        let hint = if device {
+            "the handle held at the device's rest pose (its image's)"
+        } else {
+            "the device stands where the world's cursor starts"
+        };
+        if ui.button("calibrate").on_hover_text(hint).clicked() {
+            if device {
+                s.calibrate_device();
+            } else {
+                match s.at_rest_pm() {
+                    Ok(position_pm) => say = Some(Message::Calibrate { position_pm }),
+                    Err(e) => s.message = Some(e.to_string()),
+                }
             }
         }
         if let Some(m) = say {

@@ -22,6 +22,19 @@ pub(crate) struct ScopeArgs {
     /// Run the scene headless even where a display exists.
     #[arg(long)]
     pub(crate) headless: bool,
+    /// Open a device the PC drives, by name (haply-2diy, falcon, touch),
+    /// and watch it in board mode (the scene must have its axes, e.g.
+    /// scenes/linkages/falcon_wall.toml).
+    #[arg(long)]
+    pub(crate) device: Option<String>,
+    /// Where the device is: its serial port (a Touch: its name in Touch
+    /// Setup, empty for the default one).
+    #[arg(long, requires = "device", default_value = "")]
+    pub(crate) device_path: String,
+    /// The file the device needs: a Falcon's firmware, a Touch's HD
+    /// library where it is not the system's.
+    #[arg(long, requires = "device")]
+    pub(crate) device_file: Option<PathBuf>,
 }
 
 /// The scope, or where no window can open, a headless run of its scene.
@@ -43,6 +56,11 @@ pub(crate) fn scope(a: &ScopeArgs) -> Result<(), Error> {
     };
     if a.screenshot.is_some() {
         return Err(err!("--screenshot needs a window: {why_headless}"));
+    }
+    if let Some(d) = &a.device {
+        return Err(err!(
+            "--device {d}: the scope watches a device in its window: {why_headless}"
+        ));
     }
     eprintln!(
         "host-sim: {why_headless}; running {} headless instead",
@@ -71,6 +89,10 @@ pub(crate) fn open_window(a: &ScopeArgs) -> Result<Option<String>, Error> {
     let script = host_sim::scope::window::Script {
         screenshot: a.screenshot.clone(),
         exit_after_s: a.exit_after,
+        device: a
+            .device
+            .clone()
+            .map(|d| (d, a.device_path.clone(), a.device_file.clone())),
     };
     match host_sim::scope::window::run(&a.scene, script) {
         Ok(shots) => {
