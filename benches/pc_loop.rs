@@ -1,9 +1,12 @@
 //! The PC loop's own work in a tick, for a 3-DOF linkage (goal: at most
-//! 3 µs): the Falcon's status packet decoded and turned into the board's
-//! sensors, the delta image's whole control tick armed (the linkage
-//! servo: kinematics, Jacobian, the three-axis coupling and VE, safety,
-//! the latency gate), a host heartbeat read, and the command packet
-//! encoded. The device's own exchange (USB) is not the PC's work.
+//! 3 µs): the device's answer turned into the board's sensors, the
+//! image's whole control tick armed (the linkage servo: kinematics,
+//! Jacobian, the three-axis coupling and VE, safety, the latency gate), a
+//! host heartbeat read, and the command made. For the Falcon that is its
+//! status packet decoded and its command packet encoded; for the Touch,
+//! OpenHaptics' joint angles read and its joint torques written. The
+//! device's own exchange (USB, the HD library's frame) is not the PC's
+//! work.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::cell::RefCell;
@@ -11,21 +14,78 @@ use std::collections::VecDeque;
 use std::hint::black_box;
 use std::rc::Rc;
 use std::time::Duration;
-use twoport_board::linkage::falcon_pc::{self, FalconBoard};
-use twoport_board::linkage::FALCON;
+use twoport_board::linkage::pc::PcLinkageBoard;
+use twoport_board::linkage::touch::{self, TOUCH};
+use twoport_board::linkage::{falcon_pc, ImageSpec, FALCON};
 use twoport_board::{BoardSupport, RawSensors};
+use twoport_control::kinematics::Kinematics;
+use twoport_hd::Frame;
 use twoport_host::device_port::Grip;
 use twoport_host::falcon::protocol::{Status, PACKET};
 use twoport_host::falcon::{command, sensors};
 use twoport_host::{BoardMode, BoardPort, HostBoard, LinkError};
 use twoport_link::{encode, Message, MAX_FRAME};
 
-/// The board's peripherals in memory: the Falcon's last status packet
-/// in, the command packet out, the link's bytes both ways.
+/// A device's side of the exchange, in memory: the command out, the
+/// sensors in, its encoders at `c` counts off the rest pose.
+trait Exchange {
+    fn exchange(&mut self, duty: [i16; 3], on: bool) -> RawSensors<3>;
+    fn sweep(&mut self, c: i16);
+}
+
+/// The Falcon's packets.
 #[derive(Default)]
-struct Memory {
+struct FalconPackets {
     status: [u8; PACKET],
     command: [u8; PACKET],
+}
+
+impl Exchange for FalconPackets {
+    fn exchange(&mut self, duty: [i16; 3], on: bool) -> RawSensors<3> {
+        let io = twoport_board::linkage::io(&FALCON);
+        self.command = command(duty, on, &io, 0).encode();
+        black_box(self.command);
+        let s = Status::decode(&self.status).unwrap_or_default();
+        sensors(&s, Grip::Button { mask: 1 })
+    }
+    fn sweep(&mut self, c: i16) {
+        let s = Status {
+            encoder: [c, -c, c / 2],
+            buttons: 1,
+            homed: 7,
+        };
+        self.status = s.encode();
+    }
+}
+
+/// The Touch's frame: angles in, joint torques out.
+struct TouchFrame {
+    frame: Frame,
+    torque_mnm: [f64; 3],
+}
+
+impl Exchange for TouchFrame {
+    fn exchange(&mut self, duty: [i16; 3], on: bool) -> RawSensors<3> {
+        let io = twoport_board::linkage::io(&TOUCH);
+        self.torque_mnm = twoport_host::touch::torques_mnm(duty, on, &io, [1.0; 3]);
+        black_box(self.torque_mnm);
+        twoport_host::touch::sensors(&self.frame, [1.0; 3], Grip::Button { mask: 1 })
+    }
+    fn sweep(&mut self, c: i16) {
+        let per_count = core::f64::consts::TAU / f64::from(TOUCH.hardware.counts_per_rev);
+        let c = f64::from(c) * per_count;
+        let rest = TOUCH.rest_rad.map(f64::from);
+        self.frame = Frame {
+            joint_rad: [rest[0] + c, rest[1] - c, rest[2] + c / 2.0],
+            buttons: 1,
+        };
+    }
+}
+
+/// The board's peripherals in memory: the device's exchange, the link's
+/// bytes both ways.
+struct Memory<E> {
+    device: E,
     rx: VecDeque<u8>,
     tx: Vec<u8>,
     duty: [i16; 3],
@@ -33,14 +93,11 @@ struct Memory {
     cycles: u32,
 }
 
-impl BoardSupport<3> for Memory {
+impl<E: Exchange> BoardSupport<3> for Memory<E> {
     /// The exchange, as the driver's: last tick's command out, the
-    /// status in.
+    /// sensors in.
     fn sample(&mut self) -> RawSensors<3> {
-        let io = twoport_board::linkage::io(&FALCON);
-        self.command = command(self.duty, self.on, &io, 0).encode();
-        let s = Status::decode(&self.status).unwrap_or_default();
-        sensors(&s, Grip::Button { mask: 1 })
+        self.device.exchange(self.duty, self.on)
     }
     fn set_duty(&mut self, duty: [i16; 3]) {
         self.duty = duty;
@@ -65,15 +122,14 @@ impl BoardSupport<3> for Memory {
 }
 
 /// The board and its memory, ticked as the host's calls arrive.
-struct Lockstep {
-    board: FalconBoard,
-    io: Memory,
+struct Lockstep<K: Kinematics<f32, 3>, E> {
+    board: PcLinkageBoard<K, 3>,
+    io: Memory<E>,
 }
 
-#[derive(Clone)]
-struct Port(Rc<RefCell<Lockstep>>);
+struct Port<K: Kinematics<f32, 3>, E>(Rc<RefCell<Lockstep<K, E>>>);
 
-impl BoardPort for Port {
+impl<K: Kinematics<f32, 3>, E: Exchange> BoardPort for Port<K, E> {
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
         let mut l = self.0.borrow_mut();
         let Lockstep { board, io } = &mut *l;
@@ -96,53 +152,73 @@ impl BoardPort for Port {
     }
 }
 
-fn pc_tick(c: &mut Criterion) {
-    // The grip's button held, the handle at the rest pose.
-    let status = Status {
-        buttons: 1,
-        ..Status::default()
-    };
+/// Arm `board` (the device at rest, its grip held) and time its ticks
+/// with the encoders sweeping 0 to 40 counts and back, a count a tick.
+fn bench_device<K: Kinematics<f32, 3>, E: Exchange>(
+    c: &mut Criterion,
+    name: &str,
+    board: PcLinkageBoard<K, 3>,
+    mut device: E,
+    spec: &ImageSpec,
+) {
+    device.sweep(0);
     let lock = Rc::new(RefCell::new(Lockstep {
-        board: falcon_pc::board().unwrap(),
+        board,
         io: Memory {
-            status: status.encode(),
-            ..Memory::default()
+            device,
+            rx: VecDeque::new(),
+            tx: Vec::new(),
+            duty: [0; 3],
+            on: false,
+            cycles: 0,
         },
     }));
     let mut b = HostBoard::open(Port(Rc::clone(&lock)), 3).unwrap();
-    b.calibrate(&FALCON.rest_rad.map(f64::from)).unwrap();
+    b.calibrate(&spec.rest_rad.map(f64::from)).unwrap();
     assert_eq!(b.arm().unwrap().mode, BoardMode::Armed);
     let mut heartbeat = [0u8; MAX_FRAME];
     let n = encode(0, &Message::Heartbeat, &mut heartbeat).unwrap();
     let heartbeat = heartbeat[..n].to_vec();
     let mut l = lock.borrow_mut();
     let mut k = 0i16;
-    let mut tick = |l: &mut Lockstep| {
+    let mut tick = |l: &mut Lockstep<K, E>| {
         k = k.wrapping_add(1);
-        // The encoders sweep 0 to 40 counts and back, a count a tick.
-        let c = (k % 80 - 40).abs();
-        let s = Status {
-            encoder: [c, -c, c / 2],
-            buttons: 1,
-            homed: 7,
-        };
-        l.io.status = s.encode();
+        l.io.device.sweep(40 - (k % 80 - 40).abs());
         l.io.rx.extend(&heartbeat);
         let Lockstep { board, io } = l;
         board.poll_link(io);
         black_box(board.control_tick(io));
         board.flush(io);
         io.tx.clear();
-        black_box(io.command);
     };
     for _ in 0..1000 {
         tick(&mut l);
     }
     let out = *l.board.last_output();
-    assert!(l.io.on, "the board is still armed, its outputs on: {out:?}");
-    c.bench_function(
+    assert!(
+        l.io.on,
+        "{name}: the board is still armed, its outputs on: {out:?}"
+    );
+    c.bench_function(name, |bench| bench.iter(|| tick(&mut l)));
+}
+
+fn pc_tick(c: &mut Criterion) {
+    bench_device(
+        c,
         "PC loop: a Falcon tick's work (decode, delta image armed, encode)",
-        |bench| bench.iter(|| tick(&mut l)),
+        falcon_pc::board().unwrap(),
+        FalconPackets::default(),
+        &FALCON,
+    );
+    bench_device(
+        c,
+        "PC loop: a Touch tick's work (HD's angles, serial-arm image armed, torques)",
+        touch::board().unwrap(),
+        TouchFrame {
+            frame: Frame::default(),
+            torque_mnm: [0.0; 3],
+        },
+        &TOUCH,
     );
 }
 

@@ -12,7 +12,7 @@ use std::sync::Arc;
 use twoport_board::linkage::touch::{self as image, TOUCH};
 use twoport_board::linkage::{io as io_scale, PERIOD_S};
 use twoport_board::{IoScale, RawSensors};
-use twoport_hd::{Device, HdError, HdLibrary, Scheduled, HD_DEVICE_BUTTON_1};
+use twoport_hd::{Device, Frame, HdError, HdLibrary, Scheduled, HD_DEVICE_BUTTON_1};
 
 /// The device's name in messages.
 const NAME: &str = "Touch";
@@ -79,6 +79,39 @@ pub struct TouchIo {
     on: bool,
 }
 
+/// The joints' torques HD takes (mN m, toward larger angles) for the
+/// image's `duty`, its outputs `on`, each joint scaled by `io` and turned
+/// by `directions`.
+pub fn torques_mnm(duty: [i16; 3], on: bool, io: &[IoScale; 3], directions: [f32; 3]) -> [f64; 3] {
+    // The board image's torque resists the joint's motion.
+    core::array::from_fn(|i| {
+        if on {
+            f64::from(-io[i].force_n(duty[i]) * directions[i]) * 1e3
+        } else {
+            0.0
+        }
+    })
+}
+
+/// The image's sensors for a frame HD gave: each joint's angle counted
+/// from the image's rest pose (as the image's joints read until the host
+/// calibrates them) at its quantum, turned by `directions`; the grip from
+/// the buttons.
+pub fn sensors(frame: &Frame, directions: [f32; 3], grip: Grip) -> RawSensors<3> {
+    let counts = core::array::from_fn(|i| {
+        let rad = frame.joint_rad[i] * f64::from(directions[i]) - f64::from(TOUCH.rest_rad[i]);
+        let c = (rad * f64::from(TOUCH.hardware.counts_per_rev) / core::f64::consts::TAU).round();
+        // (Two's complement: the counter wraps as an encoder's does.)
+        (c as i64) as u32
+    });
+    let buttons = u8::try_from(frame.buttons & 0xff).unwrap_or(0);
+    RawSensors {
+        encoder_raw: counts,
+        dead_man_closed: grip.closed(|_| None, buttons),
+        ..RawSensors::default()
+    }
+}
+
 impl DeviceIo<3> for TouchIo {
     fn exchange(&mut self, duty: [i16; 3], on: bool) -> Result<RawSensors<3>, String> {
         let said = |e: HdError| format!("the {NAME}: {e}");
@@ -86,32 +119,9 @@ impl DeviceIo<3> for TouchIo {
             self.device.force_output(on).map_err(said)?;
             self.on = on;
         }
-        // The board image's torque resists the joint's motion; HD's turns
-        // the joint toward larger angles, in mN m.
-        let torque_mnm = core::array::from_fn(|i| {
-            if on {
-                f64::from(-self.io[i].force_n(duty[i]) * self.directions[i]) * 1e3
-            } else {
-                0.0
-            }
-        });
-        let frame = self.device.frame(torque_mnm).map_err(said)?;
-        // Counted from the image's rest pose, as the image's joints read
-        // until the host calibrates them.
-        let counts = core::array::from_fn(|i| {
-            let rad =
-                frame.joint_rad[i] * f64::from(self.directions[i]) - f64::from(TOUCH.rest_rad[i]);
-            let c =
-                (rad * f64::from(TOUCH.hardware.counts_per_rev) / core::f64::consts::TAU).round();
-            // (Two's complement: the counter wraps as an encoder's does.)
-            (c as i64) as u32
-        });
-        let buttons = u8::try_from(frame.buttons & 0xff).unwrap_or(0);
-        Ok(RawSensors {
-            encoder_raw: counts,
-            dead_man_closed: self.grip.closed(|_| None, buttons),
-            ..RawSensors::default()
-        })
+        let torque = torques_mnm(duty, on, &self.io, self.directions);
+        let frame = self.device.frame(torque).map_err(said)?;
+        Ok(sensors(&frame, self.directions, self.grip))
     }
 }
 
