@@ -403,6 +403,27 @@ impl BoardSupport for Io {
 }
 
 impl Io {
+    /// At rest with the dead-man closed and `load_cell` counts on the load
+    /// cell, a calibration at 0 queued.
+    fn calibrating(load_cell: i32) -> Self {
+        let mut io = Io {
+            sensors: RawSensors {
+                encoder_raw: [0],
+                load_cell_counts: [load_cell],
+                dead_man_closed: true,
+                index_raw: [None],
+            },
+            ..Io::default()
+        };
+        io.queue(
+            0,
+            Message::Calibrate {
+                position_pm: Axes::one(0),
+            },
+        );
+        io
+    }
+
     fn queue(&mut self, seq: u16, m: Message) {
         let mut buf = [0u8; MAX_FRAME];
         let n = encode(seq, &m, &mut buf).unwrap();
@@ -425,21 +446,7 @@ type LateRun = (Vec<ServoOutput<f32, 1>>, i16, twoport_link::Spec, u32, bool);
 fn late_run<L: PortLayer>(b: Board<BilateralConstraint, 3, 1, L>, after: u16) -> LateRun {
     let mut b = b;
     assert_eq!(b.spec().latency_budget_s, 3e-6);
-    let mut io = Io {
-        sensors: RawSensors {
-            encoder_raw: [0],
-            load_cell_counts: [0],
-            dead_man_closed: true,
-            index_raw: [None],
-        },
-        ..Io::default()
-    };
-    io.queue(
-        0,
-        Message::Calibrate {
-            position_pm: Axes::one(0),
-        },
-    );
+    let mut io = Io::calibrating(0);
     let tick = |b: &mut Board<BilateralConstraint, 3, 1, L>, io: &mut Io, k: u16| {
         io.queue(1 + k, Message::Heartbeat);
         b.poll_link(io);
@@ -586,21 +593,7 @@ fn a_pil_board_ticks_once_per_sensor_frame_and_answers_with_the_duty() {
 #[test]
 fn a_board_with_real_sensors_ticks_from_its_support_and_counts_its_ticks() {
     let mut b = board();
-    let mut io = Io {
-        sensors: RawSensors {
-            encoder_raw: [0],
-            load_cell_counts: [1_500],
-            dead_man_closed: true,
-            index_raw: [None],
-        },
-        ..Io::default()
-    };
-    io.queue(
-        0,
-        Message::Calibrate {
-            position_pm: Axes::one(0),
-        },
-    );
+    let mut io = Io::calibrating(1_500);
     // Not a PIL board: nothing the link says makes a tick wait.
     assert!(!b.poll_link(&mut io));
     let mut outs = Vec::new();

@@ -420,6 +420,21 @@ enum TpResult tp_board_open_device(const char *name,
                                    struct TpBoard **out);
 
 /**
+ * `tp_board_open_device`, its image accepting gains outside its proven
+ * region where `unproven_gains` (NULL: refused) says why: the user's
+ * explicit choice, which the loop logs.
+ *
+ * # Safety
+ * As `tp_board_open_device`'s; `unproven_gains` is a NUL-terminated
+ * string or NULL.
+ */
+enum TpResult tp_board_open_device_unproven(const char *name,
+                                            const char *path,
+                                            const char *firmware,
+                                            const char *unproven_gains,
+                                            struct TpBoard **out);
+
+/**
  * Where the device `name`'s image calibrates (rad, a joint each): write
  * it to `rest_rad`, which has room for `n` (at least the device's axes),
  * and its axes to `axes`. Hold the handle there and calibrate there

@@ -192,6 +192,25 @@ pub unsafe extern "C" fn tp_board_open_device(
     firmware: *const c_char,
     out: *mut *mut TpBoard,
 ) -> TpResult {
+    // SAFETY: the same contract, with no reason given.
+    unsafe { tp_board_open_device_unproven(name, path, firmware, core::ptr::null(), out) }
+}
+
+/// `tp_board_open_device`, its image accepting gains outside its proven
+/// region where `unproven_gains` (NULL: refused) says why: the user's
+/// explicit choice, which the loop logs.
+///
+/// # Safety
+/// As `tp_board_open_device`'s; `unproven_gains` is a NUL-terminated
+/// string or NULL.
+#[no_mangle]
+pub unsafe extern "C" fn tp_board_open_device_unproven(
+    name: *const c_char,
+    path: *const c_char,
+    firmware: *const c_char,
+    unproven_gains: *const c_char,
+    out: *mut *mut TpBoard,
+) -> TpResult {
     guard(|| {
         let text = |p: *const c_char| {
             // SAFETY: `p` is non-null and NUL-terminated (the contract).
@@ -204,8 +223,10 @@ pub unsafe extern "C" fn tp_board_open_device(
             return bad("name and path must be UTF-8");
         };
         let firmware = text(firmware).map(|f| std::path::PathBuf::from(&*f.to_string_lossy()));
-        let port = twoport_host::attached::open(name, path, firmware.as_deref())
-            .map(|(p, n)| (Box::new(p) as Box<dyn BoardPort + Send>, n));
+        let why = text(unproven_gains).map(|w| w.to_string_lossy().into_owned());
+        let port =
+            twoport_host::attached::open_with(name, path, firmware.as_deref(), why.as_deref())
+                .map(|(p, n)| (Box::new(p) as Box<dyn BoardPort + Send>, n));
         opened(port.and_then(|(p, n)| HostBoard::open(p, n)), out)
     })
 }

@@ -106,3 +106,45 @@ fn the_pc_loop_opens_through_the_c_abi() {
     // SAFETY: `b` is open; closing frees it.
     assert_eq!(unsafe { tp_board_close(b) }, TpResult::Ok);
 }
+
+/// A device's rest pose by name: written where there is room for it,
+/// refused, naming the room, where there is not; an unknown device, and
+/// one opened with a reason for unproven gains but not there, are named.
+#[test]
+fn a_devices_rest_pose_and_open_by_name_through_the_c_abi() {
+    let mut rest = [0.0f64; TP_MAX_AXES];
+    let mut axes = 0usize;
+    // SAFETY: NUL-terminated names; `rest` holds `TP_MAX_AXES` doubles.
+    let r =
+        unsafe { tp_device_rest_pose(c"touch".as_ptr(), rest.as_mut_ptr(), rest.len(), &mut axes) };
+    assert_eq!((r, axes), (TpResult::Ok, 3));
+    let want = twoport_board::linkage::touch::TOUCH.rest_rad.map(f64::from);
+    assert_eq!(rest, want);
+    // SAFETY: as above, with room for one.
+    let r = unsafe { tp_device_rest_pose(c"falcon".as_ptr(), rest.as_mut_ptr(), 1, &mut axes) };
+    assert_eq!(r, TpResult::Argument);
+    assert!(last_error().contains("3 axes"), "{}", last_error());
+    // SAFETY: as above.
+    let r =
+        unsafe { tp_device_rest_pose(c"omni".as_ptr(), rest.as_mut_ptr(), rest.len(), &mut axes) };
+    assert_ne!(r, TpResult::Ok);
+    assert!(
+        last_error().contains("haply-2diy, falcon, touch"),
+        "{}",
+        last_error()
+    );
+    let mut b = null_mut();
+    // SAFETY: NUL-terminated strings; `b` is a writable pointer.
+    let r = unsafe {
+        tp_board_open_device_unproven(
+            c"haply-2diy".as_ptr(),
+            c"/dev/twoport-no-such-port".as_ptr(),
+            std::ptr::null(),
+            c"a study".as_ptr(),
+            &mut b,
+        )
+    };
+    assert_ne!(r, TpResult::Ok);
+    assert!(b.is_null());
+    assert!(last_error().contains("no such port"), "{}", last_error());
+}

@@ -142,21 +142,35 @@ pub fn open(
     path: &str,
     firmware: Option<&Path>,
 ) -> Result<(crate::PcBoard, u8), crate::LinkError> {
+    open_with(name, path, firmware, None)
+}
+
+/// [`open`], its image accepting gains outside its proven region where
+/// `unproven_gains` says why: the user's explicit choice, logged
+/// ([`accept_unproven_gains`](crate::accept_unproven_gains)).
+pub fn open_with(
+    name: &str,
+    path: &str,
+    firmware: Option<&Path>,
+    unproven_gains: Option<&str>,
+) -> Result<(crate::PcBoard, u8), crate::LinkError> {
     use crate::device_port::Grip;
     let bad = |why: String| crate::LinkError::Open {
         path: path.to_string(),
         why,
     };
+    let why = || unproven_gains.map(str::to_string);
     match name {
         "haply-2diy" => {
             let grip = Grip::Pin {
                 pin: 2,
                 closed_above: 0.5,
             };
-            Ok((
-                crate::PcBoard::haply(path, &crate::haply::HaplyConfig::v3(grip))?,
-                2,
-            ))
+            let config = crate::haply::HaplyConfig {
+                unproven_gains: why(),
+                ..crate::haply::HaplyConfig::v3(grip)
+            };
+            Ok((crate::PcBoard::haply(path, &config)?, 2))
         }
         "falcon" => {
             let firmware = firmware.ok_or_else(|| {
@@ -166,15 +180,17 @@ pub fn open(
                         .into(),
                 )
             })?;
-            Ok((
-                crate::PcBoard::falcon(path, &crate::falcon::FalconConfig::new(firmware))?,
-                3,
-            ))
+            let config = crate::falcon::FalconConfig {
+                unproven_gains: why(),
+                ..crate::falcon::FalconConfig::new(firmware)
+            };
+            Ok((crate::PcBoard::falcon(path, &config)?, 3))
         }
         "touch" => {
             let config = crate::touch::TouchConfig {
                 library: firmware.map(Path::to_path_buf),
                 device: (!path.is_empty()).then(|| path.to_string()),
+                unproven_gains: why(),
                 ..crate::touch::TouchConfig::stylus_button()
             };
             Ok((crate::PcBoard::touch(&config)?, 3))

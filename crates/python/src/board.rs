@@ -116,11 +116,20 @@ impl Board {
     /// this computer's servo loop; `firmware` is the Falcon's firmware file
     /// (Novint's, not shipped), or a Touch's HD library where it is not the
     /// system's. Each failure says what to do.
+    /// `unproven_gains`, where given, says why its image should accept
+    /// gains outside its proven region: the user's explicit choice, which
+    /// the loop logs.
     #[staticmethod]
-    #[pyo3(signature = (name, path, firmware=None))]
-    fn device(name: &str, path: &str, firmware: Option<std::path::PathBuf>) -> PyResult<Board> {
+    #[pyo3(signature = (name, path, firmware=None, unproven_gains=None))]
+    fn device(
+        name: &str,
+        path: &str,
+        firmware: Option<std::path::PathBuf>,
+        unproven_gains: Option<&str>,
+    ) -> PyResult<Board> {
         let (pc, axes) =
-            twoport_host::attached::open(name, path, firmware.as_deref()).map_err(link)?;
+            twoport_host::attached::open_with(name, path, firmware.as_deref(), unproven_gains)
+                .map_err(link)?;
         let port: Box<dyn BoardPort + Send> = Box::new(pc);
         Ok(Board {
             inner: Some(HostBoard::open(port, axes).map_err(link)?),
