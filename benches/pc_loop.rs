@@ -3,7 +3,8 @@
 //! image's whole control tick armed (the linkage servo: kinematics,
 //! Jacobian, the three-axis coupling and VE, safety, the latency gate), a
 //! host heartbeat read, and the command made. For the Falcon that is its
-//! status packet decoded and its command packet encoded; for the Touch,
+//! status packet decoded and its command packet encoded; for the 2DIY (two
+//! joints), its reply decoded and its torques packet encoded; for the Touch,
 //! OpenHaptics' joint angles read and its joint torques written. The
 //! device's own exchange (USB, the HD library's frame) is not the PC's
 //! work.
@@ -14,22 +15,26 @@ use std::collections::VecDeque;
 use std::hint::black_box;
 use std::rc::Rc;
 use std::time::Duration;
+use twoport_board::linkage::haply::{self as haply_image, HAPLY};
 use twoport_board::linkage::pc::PcLinkageBoard;
 use twoport_board::linkage::touch::{self, TOUCH};
+use twoport_board::linkage::LinkageWorld;
 use twoport_board::linkage::{falcon_pc, ImageSpec, FALCON};
 use twoport_board::{BoardSupport, RawSensors};
 use twoport_control::kinematics::Kinematics;
+use twoport_control::world::World;
 use twoport_hd::Frame;
 use twoport_host::device_port::Grip;
 use twoport_host::falcon::protocol::{Status, PACKET};
 use twoport_host::falcon::{command, sensors};
+use twoport_host::haply::{self, protocol::Setup, HaplyConfig};
 use twoport_host::{BoardMode, BoardPort, HostBoard, LinkError};
 use twoport_link::{encode, Message, MAX_FRAME};
 
 /// A device's side of the exchange, in memory: the command out, the
 /// sensors in, its encoders at `c` counts off the rest pose.
-trait Exchange {
-    fn exchange(&mut self, duty: [i16; 3], on: bool) -> RawSensors<3>;
+trait Exchange<const N: usize> {
+    fn exchange(&mut self, duty: [i16; N], on: bool) -> RawSensors<N>;
     fn sweep(&mut self, c: i16);
 }
 
@@ -40,7 +45,7 @@ struct FalconPackets {
     command: [u8; PACKET],
 }
 
-impl Exchange for FalconPackets {
+impl Exchange<3> for FalconPackets {
     fn exchange(&mut self, duty: [i16; 3], on: bool) -> RawSensors<3> {
         let io = twoport_board::linkage::io(&FALCON);
         self.command = command(duty, on, &io, 0).encode();
@@ -64,7 +69,7 @@ struct TouchFrame {
     torque_mnm: [f64; 3],
 }
 
-impl Exchange for TouchFrame {
+impl Exchange<3> for TouchFrame {
     fn exchange(&mut self, duty: [i16; 3], on: bool) -> RawSensors<3> {
         let io = twoport_board::linkage::io(&TOUCH);
         self.torque_mnm = twoport_host::touch::torques_mnm(duty, on, &io, [1.0; 3]);
@@ -82,24 +87,54 @@ impl Exchange for TouchFrame {
     }
 }
 
+/// The 2DIY's packets: torques out, the reply in.
+struct HaplyPackets {
+    setup: Setup<2>,
+    reply: Vec<u8>,
+    torques: Vec<u8>,
+}
+
+impl Exchange<2> for HaplyPackets {
+    fn exchange(&mut self, duty: [i16; 2], on: bool) -> RawSensors<2> {
+        let io = twoport_board::linkage::io(&HAPLY);
+        self.torques = self.setup.torques(haply::torques_nm(duty, on, &io));
+        black_box(&self.torques);
+        let reply = self.setup.decode_reply(&self.reply).unwrap();
+        haply::sensors(&self.setup, &reply, Self::grip())
+    }
+    fn sweep(&mut self, c: i16) {
+        self.reply = self.setup.reply(&[1.0], [i32::from(c), -i32::from(c)]);
+    }
+}
+
+impl HaplyPackets {
+    /// A switch on analog pin 2, read closed.
+    fn grip() -> Grip {
+        Grip::Pin {
+            pin: 2,
+            closed_above: 0.5,
+        }
+    }
+}
+
 /// The board's peripherals in memory: the device's exchange, the link's
 /// bytes both ways.
-struct Memory<E> {
+struct Memory<E, const N: usize> {
     device: E,
     rx: VecDeque<u8>,
     tx: Vec<u8>,
-    duty: [i16; 3],
+    duty: [i16; N],
     on: bool,
     cycles: u32,
 }
 
-impl<E: Exchange> BoardSupport<3> for Memory<E> {
+impl<E: Exchange<N>, const N: usize> BoardSupport<N> for Memory<E, N> {
     /// The exchange, as the driver's: last tick's command out, the
     /// sensors in.
-    fn sample(&mut self) -> RawSensors<3> {
+    fn sample(&mut self) -> RawSensors<N> {
         self.device.exchange(self.duty, self.on)
     }
-    fn set_duty(&mut self, duty: [i16; 3]) {
+    fn set_duty(&mut self, duty: [i16; N]) {
         self.duty = duty;
     }
     fn set_outputs(&mut self, on: bool) {
@@ -122,14 +157,17 @@ impl<E: Exchange> BoardSupport<3> for Memory<E> {
 }
 
 /// The board and its memory, ticked as the host's calls arrive.
-struct Lockstep<K: Kinematics<f32, 3>, E> {
-    board: PcLinkageBoard<K, 3>,
-    io: Memory<E>,
+struct Lockstep<K: Kinematics<f32, N>, E, const N: usize> {
+    board: PcLinkageBoard<K, N>,
+    io: Memory<E, N>,
 }
 
-struct Port<K: Kinematics<f32, 3>, E>(Rc<RefCell<Lockstep<K, E>>>);
+struct Port<K: Kinematics<f32, N>, E, const N: usize>(Rc<RefCell<Lockstep<K, E, N>>>);
 
-impl<K: Kinematics<f32, 3>, E: Exchange> BoardPort for Port<K, E> {
+impl<K: Kinematics<f32, N>, E: Exchange<N>, const N: usize> BoardPort for Port<K, E, N>
+where
+    LinkageWorld<N>: World<f32, N>,
+{
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
         let mut l = self.0.borrow_mut();
         let Lockstep { board, io } = &mut *l;
@@ -154,13 +192,15 @@ impl<K: Kinematics<f32, 3>, E: Exchange> BoardPort for Port<K, E> {
 
 /// Arm `board` (the device at rest, its grip held) and time its ticks
 /// with the encoders sweeping 0 to 40 counts and back, a count a tick.
-fn bench_device<K: Kinematics<f32, 3>, E: Exchange>(
+fn bench_device<K: Kinematics<f32, N>, E: Exchange<N>, const N: usize>(
     c: &mut Criterion,
     name: &str,
-    board: PcLinkageBoard<K, 3>,
+    board: PcLinkageBoard<K, N>,
     mut device: E,
-    spec: &ImageSpec,
-) {
+    spec: &ImageSpec<N>,
+) where
+    LinkageWorld<N>: World<f32, N>,
+{
     device.sweep(0);
     let lock = Rc::new(RefCell::new(Lockstep {
         board,
@@ -168,12 +208,12 @@ fn bench_device<K: Kinematics<f32, 3>, E: Exchange>(
             device,
             rx: VecDeque::new(),
             tx: Vec::new(),
-            duty: [0; 3],
+            duty: [0; N],
             on: false,
             cycles: 0,
         },
     }));
-    let mut b = HostBoard::open(Port(Rc::clone(&lock)), 3).unwrap();
+    let mut b = HostBoard::open(Port(Rc::clone(&lock)), N as u8).unwrap();
     b.calibrate(&spec.rest_rad.map(f64::from)).unwrap();
     assert_eq!(b.arm().unwrap().mode, BoardMode::Armed);
     let mut heartbeat = [0u8; MAX_FRAME];
@@ -181,7 +221,7 @@ fn bench_device<K: Kinematics<f32, 3>, E: Exchange>(
     let heartbeat = heartbeat[..n].to_vec();
     let mut l = lock.borrow_mut();
     let mut k = 0i16;
-    let mut tick = |l: &mut Lockstep<K, E>| {
+    let mut tick = |l: &mut Lockstep<K, E, N>| {
         k = k.wrapping_add(1);
         l.io.device.sweep(40 - (k % 80 - 40).abs());
         l.io.rx.extend(&heartbeat);
@@ -203,6 +243,18 @@ fn bench_device<K: Kinematics<f32, 3>, E: Exchange>(
 }
 
 fn pc_tick(c: &mut Criterion) {
+    let setup = HaplyConfig::v3(HaplyPackets::grip()).setup();
+    bench_device(
+        c,
+        "PC loop: a 2DIY tick's work (reply decoded, pantograph image armed, torques)",
+        haply_image::board().unwrap(),
+        HaplyPackets {
+            setup,
+            reply: Vec::new(),
+            torques: Vec::new(),
+        },
+        &HAPLY,
+    );
     bench_device(
         c,
         "PC loop: a Falcon tick's work (decode, delta image armed, encode)",

@@ -1,7 +1,7 @@
 //! The 2DIY over its serial port: one torque packet out and one reply in
 //! a tick, as the PC's loop asks through [`DeviceIo`].
 
-use super::protocol::Setup;
+use super::protocol::{Reply, Setup};
 use crate::device_port::{DevicePort, Grip};
 use crate::DeviceIo;
 use twoport_board::IoScale;
@@ -42,33 +42,36 @@ impl HaplyIo {
     }
 }
 
+/// The torques the board takes (N m, toward larger angles) for the
+/// image's `duty`, its outputs `on`, each joint scaled by `io`.
+pub fn torques_nm(duty: [i16; 2], on: bool, io: &[IoScale; 2]) -> [f32; 2] {
+    // The board image's torque resists the joint's motion.
+    core::array::from_fn(|i| if on { -io[i].force_n(duty[i]) } else { 0.0 })
+}
+
+/// The image's sensors for the board's `reply` to `setup`: the encoders'
+/// counts, and the grip from its pin.
+pub fn sensors(setup: &Setup<2>, reply: &Reply<2>, grip: Grip) -> RawSensors<2> {
+    let reading = |pin| {
+        let k = setup.sensor_pins.iter().position(|p| *p == pin)?;
+        reply.sensors.get(k).copied()
+    };
+    RawSensors {
+        encoder_raw: reply.counts.map(|c| c as u32),
+        dead_man_closed: grip.closed(reading, 0),
+        ..RawSensors::default()
+    }
+}
+
 impl DeviceIo<2> for HaplyIo {
     fn exchange(&mut self, duty: [i16; 2], on: bool) -> Result<RawSensors<2>, String> {
-        // The board image's torque resists the joint's motion; the
-        // protocol's turns it toward larger angles.
-        let torque = core::array::from_fn(|i| {
-            if on {
-                -self.io[i].force_n(duty[i])
-            } else {
-                0.0
-            }
-        });
+        let torque = torques_nm(duty, on, &self.io);
         self.port.send(&self.setup.torques(torque))?;
         self.port.receive(&mut self.buf)?;
         let reply = self
             .setup
             .decode_reply(&self.buf)
             .map_err(|e| format!("the 2DIY's reply: {e}"))?;
-        let pins = &self.setup.sensor_pins;
-        let reading = |pin| {
-            let k = pins.iter().position(|p| *p == pin)?;
-            reply.sensors.get(k).copied()
-        };
-        let dead_man_closed = self.grip.closed(reading, 0);
-        Ok(RawSensors {
-            encoder_raw: reply.counts.map(|c| c as u32),
-            dead_man_closed,
-            ..RawSensors::default()
-        })
+        Ok(sensors(&self.setup, &reply, self.grip))
     }
 }

@@ -6,7 +6,7 @@ mod io;
 pub mod protocol;
 
 pub use crate::device_port::Grip;
-pub use io::HaplyIo;
+pub use io::{sensors, torques_nm, HaplyIo};
 
 use crate::device_port::DevicePort;
 use crate::{DeviceIo, LinkError, PcBoard};
