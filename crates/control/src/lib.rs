@@ -24,6 +24,7 @@ mod regulator;
 mod root;
 pub mod safety;
 pub mod servo;
+pub mod teleop;
 mod tf;
 mod trig;
 pub mod ve;

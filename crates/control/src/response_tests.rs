@@ -399,3 +399,35 @@ fn f64_laws_match_their_z_forms_to_double_precision() {
     assert!(zci32 > 100.0 * zci64 && d32 > 100.0 * d64);
     assert!(zci32 < 1e-4 && d32 < 1e-4);
 }
+
+/// The position-position teleoperator, each device driven in turn with
+/// the other at rest, with no delay and with three ticks each way: every
+/// term of its impedance matrix, the channel's delay included, is its
+/// z-domain form.
+#[test]
+fn position_position_teleoperator() {
+    use crate::teleop::PositionPosition;
+    for d in [0, 3] {
+        for p in BINS {
+            for (row, col) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let mut t =
+                    PositionPosition::<f32, 8>::new(1_000.0, 5.0, T, d, Position::ZERO).unwrap();
+                let mut est = FirstDifference::new(T, Position::ZERO).unwrap();
+                let rest = (Position::ZERO, 0.0);
+                let got = measure(p, |u| {
+                    let x = pos(1e-3 * u);
+                    let v = est.step(x);
+                    let f = if col == 0 {
+                        t.step((x, v), rest)
+                    } else {
+                        t.step(rest, (x, v))
+                    };
+                    let out = if row == 0 { f.master_n } else { f.slave_n };
+                    (f64::from(v), f64::from(out))
+                });
+                let want = t.tf().eval(z_of(p))[row][col];
+                assert_close(&std::format!("Z[{row}][{col}], {d} ticks"), p, got, want);
+            }
+        }
+    }
+}
