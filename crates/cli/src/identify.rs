@@ -274,9 +274,7 @@ fn axis(
         load_cell_pole_rad_s: pole,
     };
     let (fits, best) = fit::fit_orders(&data, &base);
-    let chosen = best
-        .map(|i| &fits[i])
-        .ok_or_else(|| format!("{source}: no model of 0 to {} modes fits", fit::MAX_MODES))?;
+    let chosen = fit::chosen(&fits, best).map_err(|e| format!("{source}: {e}"))?;
     let doubt = uncertainty::Doubt {
         sigmas: a.sigmas,
         damping: a.damping_doubt,

@@ -96,6 +96,24 @@ pub enum IdentifyError {
         /// The most taken.
         most: f64,
     },
+    /// An axis's best fit leaves a misfit far past the record's noise: the
+    /// device is not one the fit's class holds, or the record is too poor
+    /// to tell.
+    #[error("the best fit ({modes} modes) leaves {misfit:.1} times the record's noise (at most {most} is taken): no model of the fit's class explains this device, so none is written. A spring to ground (a centring spring, a flexure, a cable), friction that sticks under the excitation, or a sensor's sign or scale wrong does this; so does too little excitation where the coherence is low. Check the device against docs/identification.md, record again with a larger excitation or more periods, or with the load cell")]
+    Misfit {
+        /// Modes of the best fit.
+        modes: usize,
+        /// Its `χ²/ν`.
+        misfit: f64,
+        /// The most taken.
+        most: f64,
+    },
+    /// No fit of any order converged.
+    #[error("no model of 0 to {most} modes fits the record")]
+    NoFit {
+        /// The most modes tried.
+        most: usize,
+    },
     /// No body with a positive definite mass fits the records.
     #[error("no body with a positive mass in every direction fits the records")]
     NoBody,

@@ -46,9 +46,7 @@ pub fn identify(scene: &Scene) -> Result<Identification, String> {
         load_cell_pole_rad_s: model.force_sensor.then_some(model.load_cell_pole_rad_s),
     };
     let (fits, best) = fit::fit_orders(&data, &base);
-    let f = best
-        .map(|i| &fits[i])
-        .ok_or_else(|| format!("no model of 0 to {} modes fits", fit::MAX_MODES))?;
+    let f = fit::chosen(&fits, best).map_err(|e| e.to_string())?;
     let figures = twoport_identify::figures::figures(&data, f)
         .ok_or("the fitted model has no finite response")?;
     let form = match f.form {

@@ -443,6 +443,35 @@ fn finish(
     })
 }
 
+/// The most `χ²/ν` an axis's fit is taken at. A record its model
+/// explains leaves 1 or less (0.1 to 0.4 on the simulated Excalibur,
+/// capstan and two-mass device, whose noise the periods' spread
+/// overestimates); a clean record that stops short of a mode, about 9
+/// (the Excalibur to 200 Hz at 0.5% noise). Up to this bound a fit is
+/// taken, the set around it widened by its misfit. A record the fit's
+/// class cannot hold leaves far more (the Excalibur's 4 ms late, 39,000;
+/// a reversed sign, tens of thousands), or no order converges (a handle
+/// on a spring to ground): past 25, the misfit's RMS five times the
+/// noise's, a model would claim what the device does not have.
+pub const MOST_AXIS_MISFIT: f64 = 25.0;
+
+/// The fit [`fit_orders`] chose, or why none is taken: no order
+/// converged, or the best leaves more than [`MOST_AXIS_MISFIT`] times the
+/// record's noise.
+pub fn chosen(fits: &[Fit], best: Option<usize>) -> Result<&Fit, crate::IdentifyError> {
+    let f = best
+        .and_then(|i| fits.get(i))
+        .ok_or(crate::IdentifyError::NoFit { most: MAX_MODES })?;
+    if f.reduced_chi2() > MOST_AXIS_MISFIT {
+        return Err(crate::IdentifyError::Misfit {
+            modes: f.form.modes(),
+            misfit: f.reduced_chi2(),
+            most: MOST_AXIS_MISFIT,
+        });
+    }
+    Ok(f)
+}
+
 /// Every order from a rigid body to [`MAX_MODES`] that could be fitted,
 /// in the form the measurement calls for, and the index of the one the
 /// criterion chooses.
