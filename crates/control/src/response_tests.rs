@@ -431,3 +431,42 @@ fn position_position_teleoperator() {
         }
     }
 }
+
+/// Force reflection, each input driven in turn with the others at rest
+/// (the master's motion, the slave's, the environment's sensed force), with
+/// no delay and with three ticks each way: every term of its matrix is its
+/// z-domain form.
+#[test]
+fn position_force_teleoperator() {
+    use crate::teleop::PositionForce;
+    for d in [0, 3] {
+        for p in BINS {
+            for (row, col) in [(0, 0), (1, 0), (1, 1), (0, 2)] {
+                let mut t =
+                    PositionForce::<f32, 8>::new(1_000.0, 5.0, 0.5, 2.0, T, d, Position::ZERO)
+                        .unwrap();
+                let mut est = FirstDifference::new(T, Position::ZERO).unwrap();
+                let rest = (Position::ZERO, 0.0);
+                let got = measure(p, |u| {
+                    let (input, f) = match col {
+                        2 => (u, t.step(rest, rest, u as f32)),
+                        _ => {
+                            let x = pos(1e-3 * u);
+                            let v = est.step(x);
+                            let f = if col == 0 {
+                                t.step((x, v), rest, 0.0)
+                            } else {
+                                t.step(rest, (x, v), 0.0)
+                            };
+                            (f64::from(v), f)
+                        }
+                    };
+                    let out = if row == 0 { f.master_n } else { f.slave_n };
+                    (input, f64::from(out))
+                });
+                let want = t.tf().eval(z_of(p))[row][col];
+                assert_close(&std::format!("[{row}][{col}], {d} ticks"), p, got, want);
+            }
+        }
+    }
+}

@@ -4,19 +4,23 @@
 //!
 //! A teleoperator's law takes each device's motion and gives each its
 //! force; across a channel that delays what each side sends by `d` ticks.
-//! Each law exposes its z-domain form as the two-port's impedance matrix
-//! `F = Z(z) V` ([`TeleopTransfer`]): forces (N) on the master and the
-//! slave, positive resisting each device's positive motion (the paper's
-//! actuator force), per the devices' velocities (m/s).
+//! Each law exposes its z-domain form ([`TeleopTransfer`]): forces (N) on
+//! the master and the slave, positive resisting each device's positive
+//! motion (the paper's actuator force), per the devices' velocities (m/s)
+//! (the two-port's impedance matrix `F = Z(z) V`) and per the force the
+//! slave's sensor reads.
 //!
 //! [`Channel`] is the delay; [`PositionPosition`] the symmetric
 //! position-position architecture (each side a virtual coupling to the
-//! other side's delayed motion).
+//! other side's delayed motion); [`PositionForce`] force reflection (the
+//! slave tracks the master, the master feels the slave's sensed force).
 
 mod channel;
+mod force;
 mod position;
 mod transfer;
 
 pub use channel::Channel;
-pub use position::{PositionPosition, TeleopStep};
+pub use force::PositionForce;
+pub use position::{Motion, PositionPosition, TeleopStep};
 pub use transfer::{Delayed, TeleopTransfer};

@@ -5,7 +5,7 @@ use super::{Channel, Delayed, TeleopTransfer};
 use crate::{ImpedanceCoupling, ParamError, Position, Real, ZTransfer};
 
 /// What a device's side sends: its position and velocity estimate (m/s).
-type Motion<R> = (Position, R);
+pub type Motion<R> = (Position, R);
 
 /// The symmetric position-position teleoperator: the master is held to
 /// the slave's motion and the slave to the master's, each by the spring
@@ -127,17 +127,16 @@ impl<R: Real, const D: usize> PositionPosition<R, D> {
             num: zci.num.map(|c| -c),
             den: zci.den,
         };
-        let d = self.to_slave.delay_ticks() as u32;
-        let local = Delayed {
-            tf: zci,
-            delay_ticks: 0,
-        };
         let remote = Delayed {
             tf: neg,
-            delay_ticks: d,
+            delay_ticks: self.to_slave.delay_ticks() as u32,
         };
+        let local = Delayed::now(zci);
         TeleopTransfer {
-            z: [[local, remote], [remote, local]],
+            z: [
+                [local, remote, Delayed::ZERO],
+                [remote, local, Delayed::ZERO],
+            ],
         }
     }
 }
