@@ -470,3 +470,33 @@ fn position_force_teleoperator() {
         }
     }
 }
+
+/// The wave-variable channel, each device driven in turn with the other
+/// held, at one, two and five ticks each way: every term is its z-domain
+/// form. The channel is lossless, so the start's echo rings on at the
+/// round trip's harmonics (bins that are multiples of `WINDOW/2d`, the
+/// poles), and `Z_mm` vanishes half-way between them (the zeros); the
+/// bins measured are off both (Nyquist, a multiple of each, is left out).
+#[test]
+fn wave_variable_teleoperator() {
+    use crate::teleop::WaveVariables;
+    for d in [1, 2, 5] {
+        for p in BINS.into_iter().filter(|p| p % (WINDOW / (4 * d)) != 0) {
+            for (row, col) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let mut w = WaveVariables::<f32, 8>::new(25.0, d).unwrap();
+                let got = measure(p, |u| {
+                    let v = (0.1 * u) as f32;
+                    let f = if col == 0 {
+                        w.step(v, 0.0)
+                    } else {
+                        w.step(0.0, v)
+                    };
+                    let out = if row == 0 { f.master_n } else { f.slave_n };
+                    (f64::from(v), f64::from(out))
+                });
+                let want = w.tf().eval(z_of(p))[row][col];
+                assert_close(&std::format!("[{row}][{col}], {d} ticks"), p, got, want);
+            }
+        }
+    }
+}

@@ -33,10 +33,26 @@ impl<T: Copy, const D: usize> Channel<T, D> {
         if self.delay == 0 {
             return value;
         }
-        let out = self.ring[self.next];
-        self.ring[self.next] = value;
-        self.next = (self.next + 1) % self.delay;
+        let out = self.arriving();
+        self.send(value);
         out
+    }
+
+    /// What arrives this tick, sent `delay` ticks ago (a channel of at
+    /// least one tick: what is sent this tick is not yet there).
+    #[inline]
+    pub fn arriving(&self) -> T {
+        self.ring[self.next]
+    }
+
+    /// Send `value` this tick, after reading what arrives (a channel of
+    /// at least one tick).
+    #[inline]
+    pub fn send(&mut self, value: T) {
+        if self.delay > 0 {
+            self.ring[self.next] = value;
+            self.next = (self.next + 1) % self.delay;
+        }
     }
 
     /// Empty it: it holds `value` again until what is sent next arrives.

@@ -115,7 +115,7 @@ impl<R: Real, const D: usize> PositionForce<R, D> {
     pub fn tf(&self) -> TeleopTransfer {
         let zci = self.coupling.tf();
         let d = self.to_slave.delay_ticks() as u32;
-        let delayed = |tf| Delayed { tf, delay_ticks: d };
+        let delayed = |tf| Delayed::after(tf, d);
         let neg = ZTransfer {
             num: zci.num.map(|c| -c),
             den: zci.den,

@@ -13,14 +13,17 @@
 //! [`Channel`] is the delay; [`PositionPosition`] the symmetric
 //! position-position architecture (each side a virtual coupling to the
 //! other side's delayed motion); [`PositionForce`] force reflection (the
-//! slave tracks the master, the master feels the slave's sensed force).
+//! slave tracks the master, the master feels the slave's sensed force);
+//! [`WaveVariables`] a channel passive whatever its delay.
 
 mod channel;
 mod force;
 mod position;
 mod transfer;
+mod wave;
 
 pub use channel::Channel;
 pub use force::PositionForce;
 pub use position::{Motion, PositionPosition, TeleopStep};
 pub use transfer::{Delayed, TeleopTransfer};
+pub use wave::WaveVariables;

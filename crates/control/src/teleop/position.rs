@@ -127,10 +127,7 @@ impl<R: Real, const D: usize> PositionPosition<R, D> {
             num: zci.num.map(|c| -c),
             den: zci.den,
         };
-        let remote = Delayed {
-            tf: neg,
-            delay_ticks: self.to_slave.delay_ticks() as u32,
-        };
+        let remote = Delayed::after(neg, self.to_slave.delay_ticks() as u32);
         let local = Delayed::now(zci);
         TeleopTransfer {
             z: [

@@ -2,30 +2,39 @@
 
 use crate::{Complex64, ZTransfer};
 
-/// A term `tf(z) z^-delay`: a law's part and the channel's delay.
+/// A term `tf(z^s) z^-delay`: a law's part, in steps of `s` ticks (a
+/// channel's round trip is one), and the channel's delay.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Delayed {
-    /// The law's part.
+    /// The law's part, in powers of `z^-s`.
     pub tf: ZTransfer,
+    /// Its step `s` (ticks; 1 for a law's own).
+    pub stride_ticks: u32,
     /// The channel's delay (ticks).
     pub delay_ticks: u32,
 }
 
 impl Delayed {
     /// No term.
-    pub const ZERO: Delayed = Delayed {
-        tf: ZTransfer::gain(0.0),
-        delay_ticks: 0,
-    };
+    pub const ZERO: Delayed = Delayed::now(ZTransfer::gain(0.0));
 
     /// `tf` with no delay.
     pub const fn now(tf: ZTransfer) -> Self {
-        Delayed { tf, delay_ticks: 0 }
+        Delayed::after(tf, 0)
+    }
+
+    /// `tf` after `delay_ticks`.
+    pub const fn after(tf: ZTransfer, delay_ticks: u32) -> Self {
+        Delayed {
+            tf,
+            stride_ticks: 1,
+            delay_ticks,
+        }
     }
 
     /// Its value at `z`.
     pub fn eval(&self, z: Complex64) -> Complex64 {
-        self.tf.eval(z) * z.powi(-(self.delay_ticks as i32))
+        self.tf.eval(z.powi(self.stride_ticks as i32)) * z.powi(-(self.delay_ticks as i32))
     }
 }
 
