@@ -27,7 +27,7 @@ pub struct PositionForce<R = f32, const D: usize = 64> {
     to_master: Channel<R, D>,
 }
 
-impl<const D: usize> PositionForce<f32, D> {
+impl<R: Real, const D: usize> PositionForce<R, D> {
     /// The slave's coupling `k_npm` (N/m) and `b_nspm` (N s/m), the force
     /// scale `k_f` (the master's force per the environment's) and the
     /// master's damping `b_m_nspm` (N s/m), at `period_s` (s), the
@@ -48,21 +48,6 @@ impl<const D: usize> PositionForce<f32, D> {
     /// # Ok::<(), twoport_control::ParamError>(())
     /// ```
     pub fn new(
-        k_npm: f32,
-        b_nspm: f32,
-        k_f: f32,
-        b_m_nspm: f32,
-        period_s: f32,
-        delay_ticks: usize,
-        at: Position,
-    ) -> Result<Self, ParamError> {
-        Self::new_in(k_npm, b_nspm, k_f, b_m_nspm, period_s, delay_ticks, at)
-    }
-}
-
-impl<R: Real, const D: usize> PositionForce<R, D> {
-    /// [`PositionForce::new`] computing in `R`.
-    pub fn new_in(
         k_npm: f32,
         b_nspm: f32,
         k_f: f32,

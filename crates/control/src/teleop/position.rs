@@ -38,7 +38,7 @@ pub struct TeleopStep<R = f32> {
     pub slave_n: R,
 }
 
-impl<const D: usize> PositionPosition<f32, D> {
+impl<R: Real, const D: usize> PositionPosition<R, D> {
     /// The teleoperator of stiffness `k_npm` (N/m) and damping `b_nspm`
     /// (N s/m) at `period_s` (s), its channel `delay_ticks` long each way
     /// (at most `D`), both devices at `at` until their motion arrives.
@@ -58,19 +58,6 @@ impl<const D: usize> PositionPosition<f32, D> {
     /// # Ok::<(), twoport_control::ParamError>(())
     /// ```
     pub fn new(
-        k_npm: f32,
-        b_nspm: f32,
-        period_s: f32,
-        delay_ticks: usize,
-        at: Position,
-    ) -> Result<Self, ParamError> {
-        Self::new_in(k_npm, b_nspm, period_s, delay_ticks, at)
-    }
-}
-
-impl<R: Real, const D: usize> PositionPosition<R, D> {
-    /// [`PositionPosition::new`] computing in `R`.
-    pub fn new_in(
         k_npm: f32,
         b_nspm: f32,
         period_s: f32,

@@ -24,7 +24,7 @@ pub struct WaveVariables<R = f32, const D: usize = 64> {
     to_master: Channel<R, D>,
 }
 
-impl<const D: usize> WaveVariables<f32, D> {
+impl<R: Real, const D: usize> WaveVariables<R, D> {
     /// Wave impedance `b_nspm` (N s/m, > 0), the channel `delay_ticks`
     /// long each way (1 to `D`), empty.
     ///
@@ -44,13 +44,6 @@ impl<const D: usize> WaveVariables<f32, D> {
     /// # Ok::<(), twoport_control::ParamError>(())
     /// ```
     pub fn new(b_nspm: f32, delay_ticks: usize) -> Result<Self, ParamError> {
-        Self::new_in(b_nspm, delay_ticks)
-    }
-}
-
-impl<R: Real, const D: usize> WaveVariables<R, D> {
-    /// [`WaveVariables::new`] computing in `R`.
-    pub fn new_in(b_nspm: f32, delay_ticks: usize) -> Result<Self, ParamError> {
         let b = param::positive("b (N s/m)", b_nspm)?;
         let bad = ParamError {
             name: "delay (ticks)",
@@ -126,7 +119,7 @@ mod tests {
             (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
         };
         for d in 1..=7 {
-            let mut w = WaveVariables::<f64, 8>::new_in(25.0, d).unwrap();
+            let mut w = WaveVariables::<f64, 8>::new(25.0, d).unwrap();
             let mut taken = 0.0;
             for k in 0..20_000 {
                 let (v_m, v_s) = (rng(), if k % 3 == 0 { 0.0 } else { rng() });
