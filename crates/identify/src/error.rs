@@ -108,6 +108,15 @@ pub enum IdentifyError {
         /// The most taken.
         most: f64,
     },
+    /// The record gives no more values than the chosen fit has
+    /// parameters.
+    #[error("the record gives {values} values (two a harmonic, and the load cell's) for a fit of {parameters} parameters: nothing is left to tell the model from the noise; excite more harmonics (a multisine over the band the design needs, up to a fifth of the sampling rate)")]
+    TooFewHarmonics {
+        /// Values the record gives.
+        values: usize,
+        /// Parameters of the fit.
+        parameters: usize,
+    },
     /// No fit of any order converged.
     #[error("no model of 0 to {most} modes fits the record")]
     NoFit {

@@ -142,7 +142,7 @@ impl Fit {
 
     /// Degrees of freedom `ν`: residuals less parameters (at least one).
     fn dof(&self) -> f64 {
-        (self.residuals - self.parameters).max(1) as f64
+        self.residuals.saturating_sub(self.parameters).max(1) as f64
     }
 
     /// `χ²` per degree of freedom.
@@ -423,7 +423,7 @@ fn finish(
     });
     let residuals = sol.jacobian.nrows();
     let parameters = sol.p.len();
-    let nu = (residuals - parameters).max(1) as f64;
+    let nu = residuals.saturating_sub(parameters).max(1) as f64;
     let inflate = (sol.cost / nu).max(1.0);
     let jtj = sol.jacobian.transpose() * &sol.jacobian;
     let eps = 1e-12 * jtj.norm();
@@ -456,12 +456,19 @@ fn finish(
 pub const MOST_AXIS_MISFIT: f64 = 25.0;
 
 /// The fit [`fit_orders`] chose, or why none is taken: no order
-/// converged, or the best leaves more than [`MOST_AXIS_MISFIT`] times the
-/// record's noise.
+/// converged, the record gives no more values than the fit has
+/// parameters (nothing is left to tell the fit from the noise), or the
+/// best leaves more than [`MOST_AXIS_MISFIT`] times the record's noise.
 pub fn chosen(fits: &[Fit], best: Option<usize>) -> Result<&Fit, crate::IdentifyError> {
     let f = best
         .and_then(|i| fits.get(i))
         .ok_or(crate::IdentifyError::NoFit { most: MAX_MODES })?;
+    if f.residuals <= f.parameters {
+        return Err(crate::IdentifyError::TooFewHarmonics {
+            values: f.residuals,
+            parameters: f.parameters,
+        });
+    }
     if f.reduced_chi2() > MOST_AXIS_MISFIT {
         return Err(crate::IdentifyError::Misfit {
             modes: f.form.modes(),

@@ -447,3 +447,19 @@ fn a_device_outside_the_class_is_refused_not_fitted() {
         );
     }
 }
+
+/// A record of one harmonic gives two values, no more than a rigid body's
+/// mass and damping: the fit is refused, naming the count, not taken as
+/// one that explains the record to its noise.
+#[test]
+fn a_record_of_too_few_harmonics_is_refused() {
+    let truth = shipped("capstan");
+    let (fits, best) = fit_orders(&measure(&truth, 0.5, 0.005), &base(&truth));
+    match super::chosen(&fits, best) {
+        Err(crate::IdentifyError::TooFewHarmonics { values, parameters }) => {
+            assert!(values <= parameters, "{values} for {parameters}")
+        }
+        Err(crate::IdentifyError::NoFit { .. }) => {}
+        other => panic!("{:?}", other.map(|f| (f.residuals, f.parameters))),
+    }
+}
