@@ -5,6 +5,18 @@ use twoport_board::{Board, Bound, Region};
 use twoport_control::ve::BilateralConstraint;
 use twoport_control::{Encoder, ImpedanceGains, Position, SafetyConfig, Servo};
 
+/// The Excalibur's limits with a 50-tick link watchdog and the dead-man
+/// switch required.
+// (Each test file builds `common` anew; not every one uses this.)
+#[allow(dead_code)]
+pub fn safety() -> SafetyConfig {
+    SafetyConfig {
+        heartbeat_timeout_ticks: 50,
+        require_dead_man: true,
+        ..SafetyConfig::excalibur()
+    }
+}
+
 /// The board every test drives.
 pub type TestBoard = Board<BilateralConstraint, 3>;
 
@@ -43,4 +55,18 @@ pub fn board_in(
     )
     .unwrap();
     Board::new(s, [region], telemetry_every)
+}
+
+/// The host's sensor frame for tick `tick`: the encoder at `raw`, the
+/// dead-man closed.
+// (Not every test file sends one.)
+#[allow(dead_code)]
+pub fn sensors(tick: u32, raw: u32) -> twoport_link::Message {
+    twoport_link::Message::Sensors(twoport_link::PilSensors {
+        tick,
+        encoder_raw: twoport_link::Axes::one(raw),
+        load_cell_raw: twoport_link::Axes::one(0),
+        dead_man_closed: true,
+        index_raw: twoport_link::Axes::one(None),
+    })
 }
