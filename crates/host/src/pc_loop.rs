@@ -524,8 +524,7 @@ fn record(ring: &mut Vec<f64>, slot: usize, v: f64) {
 /// device, tick by tick, whatever the machine's load. For tests and
 /// studies of a driver; a device is run by [`PcBoard`].
 pub struct SteppedPc<Io, W, L, D, const N: usize, const R: usize> {
-    board: Board<W, R, N, L, D>,
-    support: PcSupport<Io, N>,
+    looped: Looped<Io, W, L, D, N, R>,
 }
 
 impl<Io, W, L, D, const N: usize, const R: usize> SteppedPc<Io, W, L, D, N, R>
@@ -538,8 +537,14 @@ where
     /// `board` against `io`, stepped by reads of its link.
     pub fn new(board: Board<W, R, N, L, D>, io: Io) -> Self {
         SteppedPc {
-            board,
-            support: PcSupport::new(io, 1),
+            looped: Looped {
+                board,
+                support: PcSupport::new(io, 1),
+                // (No period: no tick is late.)
+                period_s: f64::INFINITY,
+                last_start: None,
+                slot: 0,
+            },
         }
     }
 }
@@ -552,12 +557,12 @@ where
     D: Drive<N, World = W, Layer = L>,
 {
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
-        self.support.shared().send(bytes)
+        self.looped.support.shared().send(bytes)
     }
 
     fn recv(&mut self, buf: &mut [u8], _: Duration) -> Result<usize, LinkError> {
         {
-            let mut s = self.support.shared();
+            let mut s = self.looped.support.shared();
             let n = s.link.take(buf);
             if n > 0 {
                 return Ok(n);
@@ -566,16 +571,10 @@ where
                 return Err(LinkError::Device(e.clone()));
             }
         }
-        let io = &mut self.support;
-        self.board.poll_link(io);
-        self.board.control_tick(io);
-        self.board.flush(io);
-        if let Some(e) = io.failed.take() {
-            // Zero force with the outputs off, as the thread's loop ends.
-            let _ = io.io.exchange([0; N], false);
-            io.shared().failed = Some(e);
-        }
-        Ok(self.support.shared().link.take(buf))
+        // One tick of the loop a thread would run: a failing device is
+        // sent zero force with its outputs off, and the next read says why.
+        self.looped.tick();
+        Ok(self.looped.support.shared().link.take(buf))
     }
 }
 
