@@ -9,4 +9,4 @@ mod library;
 pub use consts::*;
 pub use device::{Device, Frame, Scheduled};
 pub use error::HdError;
-pub use library::HdLibrary;
+pub use library::{HdLibrary, DEFAULT_NAME};

@@ -108,7 +108,7 @@ pub fn hd_library() -> Option<PathBuf> {
         .map(PathBuf::from),
     );
     dirs.into_iter()
-        .map(|d| d.join("libHD.so"))
+        .map(|d| d.join(twoport_hd::DEFAULT_NAME))
         .find(|p| p.exists())
 }
 
