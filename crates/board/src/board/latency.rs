@@ -58,7 +58,7 @@ where
     D: Drive<N, World = W, Layer = L>,
 {
     /// The same board stating the rate of its support's
-    /// [`cycles`](BoardSupport::cycles) count (Hz: its core clock; in an
+    /// [`cycles`](crate::BoardSupport::cycles) count (Hz: its core clock; in an
     /// emulator that counts instructions, the core clock at one cycle per
     /// instruction), so that its spec gives its latency in seconds.
     ///
