@@ -315,6 +315,7 @@ fn axis(
 /// The header of every model file written: where it came from.
 fn provenance(source: &str, f: &Fit) -> String {
     let form = match &f.form {
+        Form::Chain(c) if c.ground.is_some() => "a chain of masses held to the frame by a spring",
         Form::Chain(_) => "a chain of masses",
         Form::Modal(m) if m.bypass_npm.is_some() => {
             "modes, the handle on its load cell and a bypass spring"
@@ -380,6 +381,10 @@ struct Chosen {
     handle_kg: Option<f64>,
     /// The spring that holds the handle beside the load cell, if any.
     bypass_npm: Option<f64>,
+    /// A chain's spring to the frame: the mass it holds (0 the
+    /// actuator's), and its stiffness.
+    ground_at: Option<usize>,
+    ground_npm: Option<f64>,
 }
 
 impl AxisReport {
@@ -406,6 +411,10 @@ impl AxisReport {
         let handle = match &f.form {
             Form::Modal(m) => Some((m.handle_kg, m.bypass_npm)),
             Form::Chain(_) => None,
+        };
+        let ground = match &f.form {
+            Form::Chain(c) => c.ground,
+            Form::Modal(_) => None,
         };
         AxisReport {
             axis: axis.to_string(),
@@ -438,6 +447,8 @@ impl AxisReport {
                 chi2_per_dof: f.reduced_chi2(),
                 handle_kg: handle.map(|h| h.0),
                 bypass_npm: handle.and_then(|h| h.1),
+                ground_at: ground.map(|g| g.at),
+                ground_npm: ground.map(|g| g.npm),
             },
             coulomb_friction_n: f.model.coulomb_friction_n,
             cogging_n: f.cogging.map(|c| c.amplitude_n),
@@ -490,6 +501,12 @@ impl fmt::Display for AxisReport {
         writeln!(f, "  model ({}), resonances below Nyquist:", c.form)?;
         for (hz, zeta) in c.resonances_hz.iter().zip(&c.damping_ratios) {
             writeln!(f, "    {hz:9.3} Hz  damping ratio {zeta:.4}")?;
+        }
+        if let (Some(at), Some(k)) = (c.ground_at, c.ground_npm) {
+            writeln!(
+                f,
+                "  held to the frame by {k:.1} N/m at mass {at} of the chain (0 the actuator's)"
+            )?;
         }
         if let Some(kg) = c.handle_kg {
             write!(f, "  handle past the load cell {kg:.4} kg")?;

@@ -1,7 +1,8 @@
 //! The physical model a fit adjusts: a chain of masses from the actuator
 //! (the encoder's) to the handle, springs and dampers between neighbours,
-//! a damper to ground at each end, and the load cell, if any, in the last
-//! spring. Written in the model-file form (`M`, `D`, `K`, `G`, `C_v`,
+//! a damper to ground at each end, at most one spring to ground (a return
+//! spring, a flexure to the frame) at any mass, and the load cell, if any,
+//! in the last spring. Written in the model-file form (`M`, `D`, `K`, `G`, `C_v`,
 //! `C_f`) that `twoport design` reads.
 
 use nalgebra::{DMatrix, DVector};
@@ -23,6 +24,19 @@ pub struct Chain {
     pub handle_nspm: f64,
     /// The load cell's sign: `+1` reads `k (q_handle - q_before)`.
     pub load_cell_sign: f64,
+    /// A spring from one mass to the frame, if the device has one.
+    pub ground: Option<Ground>,
+}
+
+/// A spring from a mass of the chain to the frame: a centring or return
+/// spring, a flexure or cable anchored to the frame, gravity on an arm
+/// about its pose. Units are SI.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ground {
+    /// The mass it holds, counted from the actuator's (0).
+    pub at: usize,
+    /// Its stiffness (N/m).
+    pub npm: f64,
 }
 
 /// What a model needs beside its dynamics: the board's and the
@@ -48,7 +62,8 @@ impl Chain {
     }
 
     /// The parameters a fit moves: the logarithms of every mass, spring
-    /// and damper, so that each stays positive.
+    /// and damper, so that each stays positive; the spring to ground, if
+    /// any, last.
     pub fn to_log(&self) -> DVector<f64> {
         let mut v: Vec<f64> = Vec::new();
         v.extend(&self.masses_kg);
@@ -58,14 +73,25 @@ impl Chain {
         if self.modes() > 0 {
             v.push(self.handle_nspm);
         }
+        v.extend(self.ground.map(|g| g.npm));
         DVector::from_iterator(v.len(), v.iter().map(|x| x.max(1e-300).ln()))
     }
 
-    /// The chain of `masses` masses from [`to_log`](Self::to_log)'s form.
-    pub fn from_log(masses: usize, p: &DVector<f64>, load_cell_sign: f64) -> Chain {
+    /// The chain of `masses` masses, held to the frame at mass
+    /// `ground_at` if given, from [`to_log`](Self::to_log)'s form.
+    pub fn from_log(
+        masses: usize,
+        ground_at: Option<usize>,
+        p: &DVector<f64>,
+        load_cell_sign: f64,
+    ) -> Chain {
         let e: Vec<f64> = p.iter().map(|x| x.exp()).collect();
         let n = masses;
         Chain {
+            ground: ground_at.map(|at| Ground {
+                at,
+                npm: e[e.len() - 1],
+            }),
             masses_kg: e[..n].to_vec(),
             springs_npm: e[n..2 * n - 1].to_vec(),
             links_nspm: e[2 * n - 1..3 * n - 2].to_vec(),
@@ -93,6 +119,12 @@ impl Chain {
         d[(0, 0)] += self.actuator_nspm;
         if n > 1 {
             d[(n - 1, n - 1)] += self.handle_nspm;
+        }
+        if let Some(gr) = self.ground {
+            if gr.at >= n || !gr.npm.is_finite() {
+                return None;
+            }
+            k[(gr.at, gr.at)] += gr.npm;
         }
         let mut g = DMatrix::zeros(n, 2);
         g[(n - 1, 0)] = 1.0;

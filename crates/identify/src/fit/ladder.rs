@@ -40,6 +40,44 @@ pub fn synthesise(m_t: f64, anti_rad_s: &[f64], res_rad_s: &[f64]) -> Option<Lad
     for w in res_rad_s {
         p = times_linear(&p, scale / (w * w));
     }
+    let (ladder, _) = expand(p, anti_rad_s, scale)?;
+    Some(ladder)
+}
+
+/// The chain held to the frame at its far end (the handle) whose
+/// driving-point stiffness is `k_0` (N/m) at DC, with resonances
+/// `res_rad_s` (one more than the antiresonances `anti_rad_s`, rad/s,
+/// interlacing from a resonance): `F/X(λ) = k_0 Π(1 + λ/ω_r²) / Π(1 +
+/// λ/ω_a²)`, whose continued fraction at `λ → ∞` ends in the spring to
+/// the frame. The ladder and that spring (N/m), or `None` if the
+/// frequencies do not interlace or a step leaves a value that is not
+/// positive.
+pub fn synthesise_held(k_0: f64, anti_rad_s: &[f64], res_rad_s: &[f64]) -> Option<(Ladder, f64)> {
+    let n = anti_rad_s.len();
+    if res_rad_s.len() != n + 1 || k_0.is_nan() || k_0 <= 0.0 {
+        return None;
+    }
+    for i in 0..n {
+        if !(res_rad_s[i] > 0.0 && res_rad_s[i] < anti_rad_s[i] && anti_rad_s[i] < res_rad_s[i + 1])
+        {
+            return None;
+        }
+    }
+    let scale = res_rad_s.iter().fold(1.0f64, |a, w| a.max(w * w));
+    let mut p = vec![k_0];
+    for w in res_rad_s {
+        p = times_linear(&p, scale / (w * w));
+    }
+    let (ladder, end) = expand(p, anti_rad_s, scale)?;
+    (end > 0.0 && end.is_finite()).then_some((ladder, end))
+}
+
+/// The continued fraction of `P(u)/Q(u)` at `u → ∞` (`λ = scale u`,
+/// `Q = Π(1 + u scale/ω_a²)`, `P` one degree higher): the masses and
+/// springs from the pushed end, and the constant left at the far end (a
+/// spring to the frame there; zero for a free chain).
+fn expand(mut p: Vec<f64>, anti_rad_s: &[f64], scale: f64) -> Option<(Ladder, f64)> {
+    let n = anti_rad_s.len();
     let mut q = vec![1.0];
     for w in anti_rad_s {
         q = times_linear(&q, scale / (w * w));
@@ -62,7 +100,7 @@ pub fn synthesise(m_t: f64, anti_rad_s: &[f64], res_rad_s: &[f64]) -> Option<Lad
             r[i + 1] -= lead * qi;
         }
         if dq == 0 {
-            return Some(ladder);
+            return Some((ladder, r[0] / q[0]));
         }
         let k = r[dq] / q[dq];
         if !(k > 0.0 && k.is_finite()) {
@@ -150,6 +188,31 @@ mod tests {
             assert!((a / b - 1.0).abs() < 1e-4, "{a} {b}");
         }
         assert!(synthesise(1.0, &[100.0, 50.0], &[80.0, 120.0]).is_none());
+        assert!(synthesise_held(1.0, &[100.0], &[120.0, 150.0]).is_none());
+    }
+
+    /// A motor's 0.2 kg pulling, through a 3e4 N/m cable, a 0.05 kg
+    /// handle held to the frame by 1,500 N/m: its DC stiffness, two
+    /// resonances and one antiresonance give it back, the spring to the
+    /// frame last.
+    #[test]
+    fn a_chain_held_at_its_far_end_round_trips() {
+        let (m1, m2, k1, kg): (f64, f64, f64, f64) = (0.2, 0.05, 3e4, 1500.0);
+        let k_0 = k1 * kg / (k1 + kg);
+        let anti = ((k1 + kg) / m2).sqrt();
+        // m1 m2 λ² + (m1 (k1 + kg) + k1 m2) λ + k1 kg = 0.
+        let (a, b, c) = (m1 * m2, m1 * (k1 + kg) + k1 * m2, k1 * kg);
+        let root = (b * b - 4.0 * a * c).sqrt();
+        let res = [
+            ((b - root) / (2.0 * a)).sqrt(),
+            ((b + root) / (2.0 * a)).sqrt(),
+        ];
+        let (l, end) = synthesise_held(k_0, &[anti], &res).unwrap();
+        for (got, want) in l.masses_kg.iter().zip([m1, m2]) {
+            assert!((got / want - 1.0).abs() < 1e-9, "{l:?}");
+        }
+        assert!((l.springs_npm[0] / k1 - 1.0).abs() < 1e-9, "{l:?}");
+        assert!((end / kg - 1.0).abs() < 1e-9, "{end}");
         assert!(synthesise(1.0, &[100.0], &[90.0]).is_none());
     }
 }

@@ -36,12 +36,13 @@ pub(super) fn refit_loaded(bare: &Fit, data: &Measured, loaded: &Loaded) -> Opti
     let m = match &bare.form {
         Form::Chain(c) => {
             let (masses, sign) = (c.masses_kg.len(), c.load_cell_sign);
+            let at = c.ground.map(|g| g.at);
             return finish(
                 data,
                 base,
                 bare.params.clone(),
-                |p| Chain::from_log(masses, p, sign).model(base),
-                |p| Form::Chain(Chain::from_log(masses, p, sign)),
+                |p| Chain::from_log(masses, at, p, sign).model(base),
+                |p| Form::Chain(Chain::from_log(masses, at, p, sign)),
             );
         }
         Form::Modal(m) => m,
