@@ -150,18 +150,18 @@ fn identified(scene: &str, model: &str, truth: &DeviceModel, loaded: Option<f64>
 /// robust one no lighter, and `verify` silent on the true model there.
 /// `loaded` is the mass (kg) on the handle of a second, loaded record.
 fn closes(
-    device: &str,
+    model: &str,
     modes: usize,
     b: f64,
     friction: (f64, f64),
-    cogging_n: f64,
+    cogging_n: Option<f64>,
     admittance: Option<Admittance>,
     loaded: Option<f64>,
 ) {
-    let model = format!("models/{device}.toml");
+    let device = Path::new(model).file_stem().unwrap().to_str().unwrap();
     let truth = DeviceModel::load(Path::new(&format!("../{model}"))).unwrap();
     let scene = format!("../scenes/identify/{device}.toml");
-    let f = identified(&scene, &model, &truth, loaded);
+    let f = identified(&scene, model, &truth, loaded);
     assert_eq!(f.loaded, loaded.is_some());
     assert_eq!(f.form.modes(), modes, "{:?}", f.form);
     let (want, got) = (resonances_hz(&truth), resonances_hz(&f.model));
@@ -218,10 +218,27 @@ fn closes(
     }
     let coulomb = f.model.coulomb_friction_n.unwrap();
     assert!((friction.0..friction.1).contains(&coulomb), "{coulomb} N");
-    // Each scene's cogging: 2 mm of travel a period.
-    let c = f.cogging.expect("no cogging found");
-    assert!((c.amplitude_n / cogging_n - 1.0).abs() < 0.15, "{c:?}");
-    assert!((c.period_m / 2e-3 - 1.0).abs() < 0.05, "{c:?}");
+    // Each scene's cogging: 2 mm of travel a period. Where the scene has
+    // none, the search may still take up a little of what the band's
+    // smooth terms leave (the belt drive: 0.008 N), never a fifth of the
+    // friction.
+    let none = twoport_identify::fit::cogging::Found {
+        amplitude_n: 0.0,
+        period_m: 0.0,
+    };
+    let c = match (cogging_n, f.cogging) {
+        (Some(n), Some(c)) => {
+            assert!((c.amplitude_n / n - 1.0).abs() < 0.15, "{c:?}");
+            assert!((c.period_m / 2e-3 - 1.0).abs() < 0.05, "{c:?}");
+            c
+        }
+        (None, None) => none,
+        (None, Some(c)) => {
+            assert!(c.amplitude_n < 0.2 * coulomb, "{c:?} beside {coulomb} N");
+            c
+        }
+        (want, got) => panic!("cogging {want:?} N, found {got:?}"),
+    };
     let q = f.model.encoder_quantum_m.unwrap();
     assert!((q / 1e-6 - 1.0).abs() < 1e-6, "{q} m");
     eprintln!(
@@ -245,11 +262,11 @@ fn the_excalibur_is_identified_from_its_experiment() {
         b: 500.0,
     };
     closes(
-        "excalibur",
+        "models/excalibur.toml",
         3,
         90.0,
         (0.1, 0.3),
-        0.05,
+        Some(0.05),
         Some(paper),
         Some(0.5),
     );
@@ -260,7 +277,15 @@ fn the_excalibur_is_identified_from_its_experiment() {
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
 fn the_capstan_is_identified_from_its_experiment() {
-    closes("capstan", 0, 147.9, (0.03, 0.06), 0.01, None, None);
+    closes(
+        "models/capstan.toml",
+        0,
+        147.9,
+        (0.03, 0.06),
+        Some(0.01),
+        None,
+        None,
+    );
 }
 
 /// The two-mass device, whose load cell is its one flexure: one mode, at
@@ -272,5 +297,60 @@ fn the_two_mass_device_is_identified_from_its_experiment() {
         regulator: (109_054.0, 302.5),
         b: 5_000.0,
     };
-    closes("two_mass", 1, 302.5, (0.07, 0.12), 0.02, Some(a), None);
+    closes(
+        "models/two_mass.toml",
+        1,
+        302.5,
+        (0.07, 0.12),
+        Some(0.02),
+        Some(a),
+        None,
+    );
+}
+
+/// A voice-coil handle on a centring spring (a free chain could not hold
+/// it): held to the frame in the fit, its flexure's mode found, at 2 N s/m.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn a_handle_on_a_centring_spring_is_identified_from_its_experiment() {
+    closes(
+        "models/bench/centring.toml",
+        1,
+        2.0,
+        (0.01, 0.03),
+        None,
+        None,
+        None,
+    );
+}
+
+/// A handle on a flexure to the frame, past a cable from the motor.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn a_handle_on_a_flexure_to_the_frame_is_identified_from_its_experiment() {
+    closes(
+        "models/bench/grounded_flexure.toml",
+        1,
+        2.0,
+        (0.02, 0.04),
+        None,
+        None,
+        None,
+    );
+}
+
+/// A belt drive with its load cell past the belt's mode: the device's
+/// modes as the two sensors see them.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn a_belt_drive_with_its_load_cell_past_the_belt_is_identified_from_its_experiment() {
+    closes(
+        "models/bench/noncollocated.toml",
+        1,
+        2.0,
+        (0.035, 0.065),
+        None,
+        None,
+        None,
+    );
 }

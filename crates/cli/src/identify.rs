@@ -250,6 +250,8 @@ fn axis(
         (lc, p) => p.filter(|_| lc.is_some()),
     };
     let mut data = Measured::from_log(&log, a.skip).map_err(|e| format!("{source}: {e}"))?;
+    data.band_reaches(log.period_s)
+        .map_err(|e| format!("{source}: {e}"))?;
     let mut sources = source.clone();
     if let Some((path, kg)) = loaded {
         let (l, src) = read_record(path, amp)?;

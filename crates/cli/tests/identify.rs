@@ -15,26 +15,27 @@ const TWOPORT: support::Tool = support::Tool {
 };
 
 /// A bench record of the capstan handle (0.25 kg, 2 N s/m): a multisine
-/// of 1 to 100 Hz at 1 kHz, the exact sampled motion, and 1 nm of noise
+/// of 1 to 300 Hz at 1 kHz, the exact sampled motion, and 1 nm of noise
 /// on the encoder. `tweak` edits the samples before they are written.
 fn capstan_record(
     dir: &std::path::Path,
     name: &str,
     tweak: impl Fn(&mut twoport_identify::log::Log),
 ) -> PathBuf {
-    record_of(dir, name, 0.25, tweak)
+    record_of(dir, name, 0.25, 300, tweak)
 }
 
-/// [`capstan_record`] of a handle of `m` kg.
+/// [`capstan_record`] of a handle of `m` kg, played up to `top_hz`.
 fn record_of(
     dir: &std::path::Path,
     name: &str,
     m: f64,
+    top_hz: u32,
     tweak: impl Fn(&mut twoport_identify::log::Log),
 ) -> PathBuf {
     use twoport_control::multisine::Multisine;
     let (b, t, period, periods) = (2.0_f64, 1e-3_f64, 1000u32, 8u32);
-    let ms = Multisine::new(period, 1, 100, 2.0).unwrap();
+    let ms = Multisine::new(period, 1, top_hz, 2.0).unwrap();
     let a = (-b * t / m).exp();
     let (mut x, mut v) = (0.0_f64, 0.0_f64);
     let mut seed = 0x2545_f491_u64;
@@ -59,7 +60,7 @@ fn record_of(
         excitation: Some(twoport_identify::log::Excitation {
             period_ticks: period as usize,
             first: 1,
-            last: 100,
+            last: top_hz as usize,
         }),
     };
     tweak(&mut log);
@@ -142,7 +143,7 @@ fn identify_writes_each_axis_and_the_device_files() {
 fn identify_fits_a_loaded_record_with_the_bare_one() {
     let dir = scratch("identify-loaded");
     let x = capstan_record(&dir, "x", |_| {});
-    let loaded = record_of(&dir, "x-loaded", 0.35, |_| {});
+    let loaded = record_of(&dir, "x-loaded", 0.35, 300, |_| {});
     let out = dir.join("out");
     let v = TWOPORT.json(&[
         "identify",
@@ -243,6 +244,14 @@ fn identify_refuses_bad_records_and_arguments() {
         let e = fail(&capstan_record(&dir, "capstan", tweak), &[]);
         assert!(e.contains(want) && e.contains("capstan.csv"), "{want}: {e}");
     }
+    // Played to 50 Hz at 1 kHz: short of the fifth of the sampling rate
+    // a design needs.
+    let narrow = record_of(&dir, "narrow", 0.25, 50, |_| {});
+    let e = fail(&narrow, &[]);
+    assert!(
+        e.contains("narrow.csv") && e.contains("stops at 50.0 Hz") && e.contains("200.0 Hz"),
+        "{e}"
+    );
     let e = fail(&dir.join("missing.csv"), &[]);
     assert!(e.contains("missing.csv"), "{e}");
     // Two records of one name would be one axis twice.

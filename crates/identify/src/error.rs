@@ -99,7 +99,7 @@ pub enum IdentifyError {
     /// An axis's best fit leaves a misfit far past the record's noise: the
     /// device is not one the fit's class holds, or the record is too poor
     /// to tell.
-    #[error("the best fit ({modes} modes) leaves {misfit:.1} times the record's noise (at most {most} is taken): no model of the fit's class explains this device, so none is written. A spring to ground (a centring spring, a flexure, a cable), friction that sticks under the excitation, or a sensor's sign or scale wrong does this; so does too little excitation where the coherence is low. Check the device against docs/identification.md, record again with a larger excitation or more periods, or with the load cell")]
+    #[error("the best fit ({modes} modes) leaves {misfit:.1} times the record's noise (at most {most} is taken): no model of the fit's class explains this device, so none is written. A delay the record does not show elsewhere, friction that sticks under the excitation, more than one spring to the frame, a structure with branches the load cell does not sit on, or a sensor's scale wrong does this; so does too little excitation where the coherence is low. Check the device against docs/identification.md, record again with a larger excitation or more periods, or with the load cell")]
     Misfit {
         /// Modes of the best fit.
         modes: usize,
@@ -116,6 +116,14 @@ pub enum IdentifyError {
         values: usize,
         /// Parameters of the fit.
         parameters: usize,
+    },
+    /// The played band stops short of what a design needs to see.
+    #[error("the excitation stops at {top_hz:.1} Hz: a fit sees only the band played, and a design needs the device's response to at least a fifth of the sampling rate ({needed_hz:.1} Hz), where a coupling's proof often binds and where the modes that limit it sit. Play the multisine up to {needed_hz:.1} Hz or higher")]
+    NarrowBand {
+        /// The highest harmonic played (Hz).
+        top_hz: f64,
+        /// The least top a record must reach (Hz).
+        needed_hz: f64,
     },
     /// No fit of any order converged.
     #[error("no model of 0 to {most} modes fits the record")]

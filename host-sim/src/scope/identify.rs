@@ -36,6 +36,7 @@ pub fn identify(scene: &Scene) -> Result<Identification, String> {
         .ok_or("the board played no experiment (did it arm?)")?
         .map_err(|e| e.to_string())?;
     let data = Measured::from_log(&log, SKIP).map_err(|e| e.to_string())?;
+    data.band_reaches(log.period_s).map_err(|e| e.to_string())?;
     // What no experiment measures comes from the scene's own model: the
     // amplifier and the load cell's filter, as a lab knows its own.
     let base = ModelBase {

@@ -151,16 +151,21 @@ pub fn rigid_with(
     let p = a.clone().svd(true, true).solve(b, 1e-12).ok()?;
     let cost = (a * &p - b).norm_squared();
     let ok = p[0] > 0.0 && p.iter().all(|v| v.is_finite());
-    ok.then(|| (p[0], p[1], p.as_slice()[2 + bend..].to_vec(), cost))
+    ok.then(|| (p[0], p[1], p.as_slice()[rows.body + bend..].to_vec(), cost))
 }
 
 /// The weighted least-squares rows of [`rigid_with`]: two a harmonic
 /// below the band's top (the real and imaginary parts of `F/X`), each
 /// harmonic weighted as a relative error of `F/X` by its measured
-/// variance with the model floor.
+/// variance with the model floor. Where the record shows a spring to the
+/// frame ([`ground_shown`](super::ground_shown)), the body is held by
+/// one: its stiffness is a column too.
 pub(crate) struct RigidRows {
-    /// The columns: mass, damping, the `bend` terms, then each shape.
+    /// The columns: mass, damping, the spring to the frame if shown, the
+    /// `bend` terms, then each shape.
     pub a: DMatrix<f64>,
+    /// The body's columns before the `bend` terms: 2, or 3 held.
+    pub body: usize,
     /// `F/X`.
     pub b: DVector<f64>,
     /// Each harmonic's `F/X` times its weight: a shape per force times it
@@ -188,7 +193,9 @@ impl RigidRows {
             .map(|r| r.per_force.as_slice())
             .chain(more.iter().copied())
             .collect();
-        let n = 2 + bend + shapes.len();
+        let held = super::ground_shown(x, period_s).is_some();
+        let body = 2 + usize::from(held);
+        let n = body + bend + shapes.len();
         let used = x.freq_hz.iter().take_while(|f| **f < below_hz).count();
         if 2 * used < n + spare {
             return None;
@@ -204,6 +211,9 @@ impl RigidRows {
             let rel = x.variance[i] / x.response[i].norm_sqr() + super::MODEL_FLOOR.powi(2);
             let wt = 1.0 / (fx.norm() * rel.sqrt());
             let mut cols = vec![-w * w * hold, Complex64::new(0.0, w) * hold];
+            if held {
+                cols.push(hold);
+            }
             cols.extend((0..bend).map(|k| Complex64::new(0.0, w).powi(3 + k as i32) * hold));
             cols.extend(shapes.iter().map(|s| s[i] * fx));
             for (j, c) in cols.iter().enumerate() {
@@ -214,7 +224,13 @@ impl RigidRows {
             b[2 * i + 1] = fx.im * wt;
             scale.push(fx * wt);
         }
-        Some(RigidRows { a, b, scale, used })
+        Some(RigidRows {
+            a,
+            body,
+            b,
+            scale,
+            used,
+        })
     }
 }
 

@@ -39,7 +39,27 @@ pub struct Loaded {
     pub data: Measured,
 }
 
+/// The least top of a record's band a fit is made from, as a share of
+/// the sampling rate: a fifth (two fifths of Nyquist).
+pub const LEAST_BAND_SHARE: f64 = 0.2;
+
 impl Measured {
+    /// Whether the played band reaches [`LEAST_BAND_SHARE`] of the
+    /// sampling rate (`1/period_s`): what a design is made from must show
+    /// the device where a coupling's proof binds, and a mode above the
+    /// band is not in the record. A record stopped short of a mode but
+    /// past this (the Excalibur to 200 Hz at 1 kHz) is fitted, its misfit
+    /// widening its set.
+    pub fn band_reaches(&self, period_s: f64) -> Result<(), crate::IdentifyError> {
+        let top_hz = self.position.freq_hz.last().copied().unwrap_or(0.0);
+        let needed_hz = LEAST_BAND_SHARE / period_s;
+        // (A hundredth of a harmonic's rounding is not short.)
+        if top_hz < needed_hz * (1.0 - 1e-9) {
+            return Err(crate::IdentifyError::NarrowBand { top_hz, needed_hz });
+        }
+        Ok(())
+    }
+
     /// The responses an experiment's record shows at the harmonics it
     /// played, averaged over its whole periods after the first `skip` (the
     /// transient). Refused, with the reason: a record that does not name
@@ -109,7 +129,7 @@ impl Measured {
         };
         if let (Some(motion), false) = (&data.motion, forces.is_empty()) {
             data.forces = forces.clone();
-            let below = super::features::rigid_band_hz(&data.position);
+            let below = super::body_band_hz(&data.position, log.period_s);
             if let Some(c) = cogging::find(&data, motion, log.period_s, below) {
                 forces.extend(c);
             }

@@ -51,7 +51,7 @@ use std::f64::consts::TAU;
 use twoport_design::{DeviceModel, Plant};
 
 use features::{features, rigid_band_hz};
-pub use measured::{Loaded, Measured};
+pub use measured::{Loaded, Measured, LEAST_BAND_SHARE};
 
 /// The physical form of a fitted model.
 #[derive(Clone, Debug, PartialEq)]
@@ -306,13 +306,30 @@ fn grounded_estimate(data: &Frf, period_s: f64) -> Option<(f64, f64, f64, f64)> 
 
 /// A spring to the frame the record shows (its stiffness, N/m; the mass,
 /// kg, and damping, N s/m, beside it): the low harmonics' stiffness, if it
-/// is five of its standard deviations above zero and at least 2% of the
-/// inertia at the lowest harmonic. A free body's is zero within its
-/// noise.
+/// is five of its standard deviations above zero and at least half the
+/// inertia at the lowest harmonic (the body's resonance on it at least
+/// 0.7 of that harmonic). Friction and cogging left in a free body's
+/// record read as a stiffness too, a few per cent to a third of that
+/// inertia on the simulated devices (cogging is a spring over each of its
+/// periods): a spring weaker than this is not told from them.
 pub(super) fn ground_shown(data: &Frf, period_s: f64) -> Option<(f64, f64, f64)> {
     let (k, sigma_k, m, d) = grounded_estimate(data, period_s)?;
     let w = TAU * data.freq_hz.first()?;
-    (k > 5.0 * sigma_k && k > 0.02 * m * w * w).then_some((k, m, d))
+    (k > 5.0 * sigma_k && k > 0.5 * m * w * w).then_some((k, m, d))
+}
+
+/// Below where the device moves as one body (Hz): a quarter of the way to
+/// its lowest resonance (see [`rigid_band_hz`]); for a device held to the
+/// frame, the lowest of its chain's, the spring taken out, not the body's
+/// own on the spring.
+pub(super) fn body_band_hz(x: &Frf, period_s: f64) -> f64 {
+    match ground_shown(x, period_s) {
+        Some((k, ..)) => rigid_band_hz(&Frf {
+            response: x.response.iter().map(|h| 1.0 / (1.0 / h - k)).collect(),
+            ..x.clone()
+        }),
+        None => rigid_band_hz(x),
+    }
 }
 
 /// Fit a chain of `modes` modes, held to the frame at mass `ground_at`
@@ -615,7 +632,7 @@ pub fn fit_orders(data: &Measured, base: &ModelBase) -> (Vec<Fit>, Option<usize>
     let data = if data.forces.is_empty() {
         data
     } else {
-        let below = rigid_band_hz(&data.position);
+        let below = body_band_hz(&data.position, base.period_s);
         let mut amounts = friction::rigid_with(data, &[], 0, base.period_s, below)
             .map_or(vec![0.0; data.forces.len()], |r| r.2);
         // Friction opposes the motion: an estimate below zero is none.

@@ -452,3 +452,29 @@ fn a_record_of_too_few_harmonics_is_refused() {
         other => panic!("{:?}", other.map(|f| (f.residuals, f.parameters))),
     }
 }
+
+/// A record with no excitation above 50 Hz at 1 kHz is refused, naming
+/// where it stops and where it must reach (200 Hz); one to 200 Hz is not.
+#[test]
+fn a_record_that_stops_short_of_the_band_a_design_needs_is_refused() {
+    let truth = shipped("excalibur");
+    let e = measure(&truth, 50.0, 0.005)
+        .band_reaches(truth.period_s)
+        .unwrap_err();
+    let text = e.to_string();
+    assert!(
+        text.contains("50.0 Hz") && text.contains("200.0 Hz"),
+        "{text}"
+    );
+    match e {
+        crate::IdentifyError::NarrowBand { top_hz, needed_hz } => {
+            assert_eq!(top_hz, 50.0);
+            assert!((needed_hz - 200.0).abs() < 1e-9, "{needed_hz}");
+        }
+        other => panic!("{other}"),
+    }
+    assert_eq!(
+        measure(&truth, 200.0, 0.005).band_reaches(truth.period_s),
+        Ok(())
+    );
+}
