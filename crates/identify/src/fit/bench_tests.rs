@@ -81,3 +81,12 @@ fn a_handle_on_a_flexure_to_the_frame_is_held() {
 fn a_load_cell_past_the_belts_mode_is_fitted_as_modes() {
     comes_back(&bench("noncollocated"), 2.0);
 }
+
+/// Two modes 5% apart (150.0 and 157.5 Hz), the antiresonance between
+/// them: both found, as a chain of three masses.
+#[test]
+fn two_modes_five_percent_apart_come_back_as_two() {
+    let truth = bench("close_modes");
+    let f = comes_back(&truth, 1.0);
+    assert_eq!(f.form.modes(), 2, "{:?}", f.form);
+}
