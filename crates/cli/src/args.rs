@@ -374,9 +374,18 @@ pub(crate) struct IdentifyArgs {
     /// load cell.
     #[arg(long, allow_negative_numbers = true)]
     pub(crate) load_cell_pole: Option<f64>,
-    /// Whole periods skipped at the start, while the transient settles.
+    /// Whole periods (or a stepped sine's steps) skipped at the start,
+    /// while the transient settles.
     #[arg(long, default_value_t = 2)]
     pub(crate) skip: usize,
+    /// What the records played, for records without a `# twoport
+    /// experiment:` line (made by another program), in its words: a
+    /// periodic force, "period_ticks = 4096, first = 2, last = 1843" (the
+    /// harmonics of that period it holds: a multisine, random phases, a
+    /// chirp swept once a period); or a stepped sine, "stepped, step_ticks
+    /// = 3000" (one frequency held for each 3000 samples).
+    #[arg(long, value_name = "WORDS")]
+    pub(crate) excitation: Option<String>,
     /// A second record of an axis's experiment, played with a known mass
     /// clamped on the handle (--added-mass), fitted with the bare record:
     /// it shows the handle's side of the device (what the handle weighs

@@ -10,7 +10,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use twoport_design::plot;
 use twoport_identify::fit::{self, chain::ModelBase, uncertainty, Fit, Form, Measured};
-use twoport_identify::log::Log;
+use twoport_identify::log::{Excitation, Log};
 
 pub(crate) fn identify(a: &IdentifyArgs) -> Result<IdentifyReport, String> {
     let positive = |name: &str, v: f64| {
@@ -24,6 +24,11 @@ pub(crate) fn identify(a: &IdentifyArgs) -> Result<IdentifyReport, String> {
         pole: a
             .load_cell_pole
             .map(|p| positive("load-cell-pole", p))
+            .transpose()?,
+        excitation: a
+            .excitation
+            .as_deref()
+            .map(|w| Excitation::parse(w).map_err(|e| format!("--excitation \"{w}\": {e}")))
             .transpose()?,
     };
     if !(a.sigmas.is_finite() && a.sigmas >= 0.0) {
@@ -154,6 +159,8 @@ struct Amplifier {
     peak: f64,
     continuous: f64,
     pole: Option<f64>,
+    /// What the records played, where `--excitation` says it.
+    excitation: Option<Excitation>,
 }
 
 /// One axis identified: its report, and its set's files (relative to the
@@ -213,7 +220,18 @@ fn loaded_records(
 fn read_record(record: &Path, amp: &Amplifier) -> Result<(Log, String), String> {
     let text = std::fs::read_to_string(record).map_err(|e| format!("{}: {e}", record.display()))?;
     let source = record.display().to_string();
-    let log = Log::from_csv(&text, &source).map_err(|e| e.to_string())?;
+    let mut log = Log::from_csv(&text, &source).map_err(|e| e.to_string())?;
+    match (log.excitation, amp.excitation) {
+        (Some(own), Some(given)) if own != given => {
+            return Err(format!(
+                "{source}: the record says it played \"{}\", --excitation \"{}\"; give one",
+                own.words(),
+                given.words()
+            ))
+        }
+        (None, Some(given)) => log.excitation = Some(given),
+        _ => {}
+    }
     let most = log.force_n.iter().fold(0.0_f64, |m, f| m.max(f.abs()));
     if most > amp.peak {
         return Err(format!(
@@ -345,6 +363,10 @@ struct AxisReport {
     /// The encoder's least coherence over the harmonics, and where.
     coherence_min: f64,
     coherence_min_hz: Option<f64>,
+    /// Harmonics whose coherence is below a half: the noise, or the
+    /// encoder's quantum, as large as the response there. Each counts by
+    /// its variance, so they weigh little; they are not dropped.
+    weak_harmonics: usize,
     orders: Vec<Order>,
     chosen: Chosen,
     coulomb_friction_n: Option<f64>,
@@ -427,6 +449,7 @@ impl AxisReport {
             periods_averaged: x.periods,
             coherence_min: worst,
             coherence_min_hz: x.freq_hz.get(worst_at).copied(),
+            weak_harmonics: x.coherence().iter().filter(|c| **c < 0.5).count(),
             orders: fits
                 .iter()
                 .enumerate()
@@ -473,7 +496,7 @@ impl fmt::Display for AxisReport {
         let [lo, hi] = self.harmonics_hz.map(|h| h.unwrap_or(0.0));
         writeln!(
             f,
-            "  record {}: {} samples at {:.0} Hz, harmonics {lo:.3} to {hi:.3} Hz, {} periods averaged",
+            "  record {}: {} samples at {:.0} Hz, harmonics {lo:.3} to {hi:.3} Hz, {} periods (or blocks of a step) averaged",
             self.record,
             self.samples,
             1.0 / self.period_s,
@@ -485,6 +508,13 @@ impl fmt::Display for AxisReport {
             self.coherence_min,
             self.coherence_min_hz.unwrap_or(0.0)
         )?;
+        if self.weak_harmonics > 0 {
+            writeln!(
+                f,
+                "  {} harmonics have a coherence below 0.5 (the noise or the encoder's quantum as large as the response): each is weighed by its variance, so they count for little",
+                self.weak_harmonics
+            )?;
+        }
         writeln!(f, "  orders fitted (modes: chi2/nu, BIC):")?;
         for g in &self.orders {
             let mark = if g.chosen { "  <- chosen" } else { "" };

@@ -57,7 +57,7 @@ fn record_of(
         force_n: force,
         position_m: position,
         load_cell_n: None,
-        excitation: Some(twoport_identify::log::Excitation {
+        excitation: Some(twoport_identify::log::Excitation::Periodic {
             period_ticks: period as usize,
             first: 1,
             last: top_hz as usize,
@@ -243,6 +243,45 @@ fn identify_refuses_bad_records_and_arguments() {
     for (tweak, want) in cases {
         let e = fail(&capstan_record(&dir, "capstan", tweak), &[]);
         assert!(e.contains(want) && e.contains("capstan.csv"), "{want}: {e}");
+    }
+    // A record another program wrote has no experiment line: without
+    // --excitation it is refused, saying how to name one; with it, read.
+    let bare = dir.join("elsewhere.csv");
+    let text = std::fs::read_to_string(capstan_record(&dir, "made", |_| {})).unwrap();
+    std::fs::write(&bare, text.lines().skip(1).collect::<Vec<_>>().join("\n")).unwrap();
+    let e = fail(&bare, &[]);
+    assert!(
+        e.contains("--excitation") && e.contains("elsewhere.csv"),
+        "{e}"
+    );
+    let said = "period_ticks = 1000, first = 1, last = 300";
+    let read = TWOPORT.json(&[
+        "identify",
+        bare.to_str().unwrap(),
+        "--out",
+        &o,
+        "--peak-force",
+        "10",
+        "--continuous-force",
+        "4",
+        "--excitation",
+        said,
+        "--json",
+    ]);
+    let axis = &read["axes"][0];
+    assert_eq!(axis["chosen"]["modes"], 0, "{axis}");
+    for (words, want) in [
+        ("period_ticks = 1000, first = 1, last = 200", "give one"),
+        (
+            "stepped, step_ticks = -3",
+            "--excitation \"stepped, step_ticks = -3\"",
+        ),
+    ] {
+        let e = fail(
+            &capstan_record(&dir, "made", |_| {}),
+            &["--excitation", words],
+        );
+        assert!(e.contains(want), "{words}: {e}");
     }
     // Played to 50 Hz at 1 kHz: short of the fifth of the sampling rate
     // a design needs.

@@ -44,7 +44,7 @@ fn level(dir: &Path, peak: f64) -> PathBuf {
         force_n: force,
         position_m: position,
         load_cell_n: None,
-        excitation: Some(Excitation {
+        excitation: Some(Excitation::Periodic {
             period_ticks: period,
             first: 1,
             last: 1,

@@ -142,6 +142,32 @@ pub(crate) fn whole_periods(
     Ok(periods)
 }
 
+/// The ratio of the means of `x` and `f`, one value a period (or a
+/// block), and its variance from their spread; `None` where the force's
+/// mean is not above what its spread allows (the excitation does not
+/// reach it).
+pub(crate) fn ratio(f: &[Complex64], x: &[Complex64]) -> Option<(Complex64, f64)> {
+    let p = f.len() as f64;
+    let fm: Complex64 = f.iter().sum::<Complex64>() / p;
+    let xm: Complex64 = x.iter().sum::<Complex64>() / p;
+    // The force's harmonic against what the periods' spread allows.
+    let var_f = f.iter().map(|v| (v - fm).norm_sqr()).sum::<f64>() / (p - 1.0);
+    if fm.norm() <= 1e-12 || fm.norm_sqr() <= var_f / p {
+        return None;
+    }
+    let var_x = x.iter().map(|v| (v - xm).norm_sqr()).sum::<f64>() / (p - 1.0);
+    let cov: Complex64 = f
+        .iter()
+        .zip(x)
+        .map(|(f, x)| (x - xm) * (f - fm).conj())
+        .sum::<Complex64>()
+        / (p - 1.0);
+    let hh = xm / fm;
+    let rel = var_x / xm.norm_sqr().max(f64::MIN_POSITIVE) + var_f / fm.norm_sqr()
+        - 2.0 * (cov / (xm * fm.conj())).re;
+    Some((hh, hh.norm_sqr() * rel.max(0.0) / p))
+}
+
 /// The response from `force_n` to `position_m`, sampled every `period_s`,
 /// at `harmonics` of a period of `period` samples, over the whole periods
 /// after the first `skip`.
@@ -169,30 +195,17 @@ pub fn periodic(
     for (i, &h) in harmonics.iter().enumerate() {
         let f: Vec<Complex64> = fs.iter().map(|s| s[i]).collect();
         let x: Vec<Complex64> = xs.iter().map(|s| s[i]).collect();
-        let fm: Complex64 = f.iter().sum::<Complex64>() / p;
-        let xm: Complex64 = x.iter().sum::<Complex64>() / p;
-        // The force's harmonic against what the periods' spread allows.
-        let var_f = f.iter().map(|v| (v - fm).norm_sqr()).sum::<f64>() / (p - 1.0);
-        if fm.norm() <= 1e-12 || fm.norm_sqr() <= var_f / p {
+        let Some((hh, variance)) = ratio(&f, &x) else {
+            let fm = f.iter().sum::<Complex64>() / p;
             return Err(IdentifyError::NoExcitation {
                 harmonic: h,
                 hz: hz(h),
                 force: 2.0 * fm.norm() / period as f64,
             });
-        }
-        let var_x = x.iter().map(|v| (v - xm).norm_sqr()).sum::<f64>() / (p - 1.0);
-        let cov: Complex64 = f
-            .iter()
-            .zip(&x)
-            .map(|(f, x)| (x - xm) * (f - fm).conj())
-            .sum::<Complex64>()
-            / (p - 1.0);
-        let hh = xm / fm;
-        let rel = var_x / xm.norm_sqr().max(f64::MIN_POSITIVE) + var_f / fm.norm_sqr()
-            - 2.0 * (cov / (xm * fm.conj())).re;
+        };
         out.freq_hz.push(hz(h));
         out.response.push(hh);
-        out.variance.push(hh.norm_sqr() * rel.max(0.0) / p);
+        out.variance.push(variance);
     }
     Ok(out)
 }

@@ -9,5 +9,6 @@ pub mod fit;
 pub mod frf;
 pub mod log;
 pub mod pose;
+pub mod stepped;
 
 pub use error::IdentifyError;

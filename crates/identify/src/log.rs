@@ -14,23 +14,118 @@
 //! - `position_m`: the encoder's reading (m).
 //! - `load_cell_n` (optional): the load cell's reading (N).
 //!
-//! A comment line `# twoport experiment: ...` names the multisine's
-//! period and band, so that the record says which harmonics were played.
-//! One file holds one axis's experiment.
+//! A comment line `# twoport experiment: ...` names the excitation, so
+//! that the record says what was played:
+//!
+//! - a periodic one (twoport's multisine, another program's with random
+//!   phases, a chirp repeated every period): `period_ticks = P, first = a,
+//!   last = b`, the harmonics `a..=b` of a period of `P` samples;
+//! - a stepped sine: `stepped, step_ticks = L`, one frequency held for
+//!   each `L` samples, in any order.
+//!
+//! A record made elsewhere can say the same with `twoport identify
+//! --excitation`, in the same words. One file holds one axis's
+//! experiment.
 
 use crate::IdentifyError;
 use std::fmt::Write as _;
 
-/// The multisine an experiment played: harmonics `first..=last` of a
-/// period of `period_ticks`.
+/// What an experiment played.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Excitation {
-    /// The period (samples).
-    pub period_ticks: usize,
-    /// The lowest harmonic.
-    pub first: usize,
-    /// The highest.
-    pub last: usize,
+pub enum Excitation {
+    /// A force that repeats every `period_ticks` samples (a multisine, a
+    /// chirp swept once a period, random phases), with the harmonics
+    /// `first..=last` of that period in it.
+    Periodic {
+        /// The period (samples).
+        period_ticks: usize,
+        /// The lowest harmonic.
+        first: usize,
+        /// The highest.
+        last: usize,
+    },
+    /// A stepped sine: one frequency held for each `step_ticks` samples,
+    /// the steps in any order, each read from its own force.
+    Stepped {
+        /// Samples a step.
+        step_ticks: usize,
+    },
+}
+
+impl Excitation {
+    /// A periodic excitation's period (samples) and its first and last
+    /// harmonics; `None` for a stepped sine.
+    pub fn periodic(&self) -> Option<(usize, usize, usize)> {
+        match *self {
+            Excitation::Periodic {
+                period_ticks,
+                first,
+                last,
+            } => Some((period_ticks, first, last)),
+            Excitation::Stepped { .. } => None,
+        }
+    }
+
+    /// The words of the record's comment line after its mark, as
+    /// [`Excitation::parse`] reads them.
+    pub fn words(&self) -> String {
+        match self {
+            Excitation::Periodic {
+                period_ticks,
+                first,
+                last,
+            } => format!("period_ticks = {period_ticks}, first = {first}, last = {last}"),
+            Excitation::Stepped { step_ticks } => format!("stepped, step_ticks = {step_ticks}"),
+        }
+    }
+
+    /// Read `period_ticks = P, first = a, last = b` or `stepped,
+    /// step_ticks = L`; the error says what is wrong.
+    pub fn parse(words: &str) -> Result<Excitation, String> {
+        let mut parts: Vec<&str> = words.split(',').map(str::trim).collect();
+        let stepped = parts.first() == Some(&"stepped");
+        if stepped {
+            parts.remove(0);
+        }
+        let mut v = [None; 4];
+        for part in parts {
+            let (k, x) = part
+                .split_once('=')
+                .ok_or_else(|| format!("`{part}` is not `name = value`"))?;
+            let x: usize = x
+                .trim()
+                .parse()
+                .map_err(|_| format!("{} = `{}` is not a whole number", k.trim(), x.trim()))?;
+            let slot = match (stepped, k.trim()) {
+                (false, "period_ticks") => 0,
+                (false, "first") => 1,
+                (false, "last") => 2,
+                (true, "step_ticks") => 3,
+                (_, other) => {
+                    return Err(format!(
+                        "`{other}`: the excitation names period_ticks, first and last, or is `stepped, step_ticks = L`"
+                    ))
+                }
+            };
+            v[slot] = Some(x);
+        }
+        match v {
+            [Some(period_ticks), Some(first), Some(last), None] if period_ticks > 0 => {
+                Ok(Excitation::Periodic {
+                    period_ticks,
+                    first,
+                    last,
+                })
+            }
+            [None, None, None, Some(step_ticks)] if step_ticks > 0 => {
+                Ok(Excitation::Stepped { step_ticks })
+            }
+            _ => Err(
+                "the excitation must name period_ticks, first and last (a period above zero), or be `stepped, step_ticks = L` (L above zero)"
+                    .into(),
+            ),
+        }
+    }
 }
 
 /// An experiment's record.
@@ -56,11 +151,7 @@ impl Log {
     pub fn to_csv(&self) -> String {
         let mut s = String::new();
         if let Some(e) = self.excitation {
-            let _ = writeln!(
-                s,
-                "{MARK} period_ticks = {}, first = {}, last = {}",
-                e.period_ticks, e.first, e.last
-            );
+            let _ = writeln!(s, "{MARK} {}", e.words());
         }
         let cols = if self.load_cell_n.is_some() { 4 } else { 3 };
         let _ = writeln!(s, "{}", COLUMNS[..cols].join(","));
@@ -99,7 +190,7 @@ impl Log {
             let line = i + 1;
             let l = raw.trim();
             if let Some(rest) = l.strip_prefix(MARK) {
-                excitation = Some(parse_excitation(rest).map_err(|w| bad(line, w))?);
+                excitation = Some(Excitation::parse(rest).map_err(|w| bad(line, w))?);
                 continue;
             }
             if l.is_empty() || l.starts_with('#') {
@@ -193,38 +284,6 @@ impl Log {
     }
 }
 
-/// `period_ticks = P, first = a, last = b`.
-fn parse_excitation(rest: &str) -> Result<Excitation, String> {
-    let mut v = [None; 3];
-    for part in rest.split(',') {
-        let (k, x) = part
-            .split_once('=')
-            .ok_or_else(|| format!("`{}` is not `name = value`", part.trim()))?;
-        let x: usize = x
-            .trim()
-            .parse()
-            .map_err(|_| format!("{} = `{}` is not a whole number", k.trim(), x.trim()))?;
-        match k.trim() {
-            "period_ticks" => v[0] = Some(x),
-            "first" => v[1] = Some(x),
-            "last" => v[2] = Some(x),
-            other => {
-                return Err(format!(
-                    "`{other}`: the experiment line names period_ticks, first and last"
-                ))
-            }
-        }
-    }
-    match v {
-        [Some(period_ticks), Some(first), Some(last)] => Ok(Excitation {
-            period_ticks,
-            first,
-            last,
-        }),
-        _ => Err("the experiment line must name period_ticks, first and last".into()),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -235,7 +294,7 @@ mod tests {
             force_n: vec![0.5, -1.25, 2.0, 0.0, 3.5],
             position_m: vec![1e-6, 2e-6, -3e-6, 0.0, 1.5e-5],
             load_cell_n: Some(vec![0.1, 0.2, 0.3, 0.4, 0.5]),
-            excitation: Some(Excitation {
+            excitation: Some(Excitation::Periodic {
                 period_ticks: 5,
                 first: 1,
                 last: 2,
@@ -307,6 +366,31 @@ mod tests {
                 e.contains("bench.csv") && e.contains(want),
                 "{e}\nwanted: {want}\n{text}"
             );
+        }
+    }
+
+    /// A stepped sine's line round-trips; lines that mix the two kinds,
+    /// or leave one out, are refused with the reason.
+    #[test]
+    fn a_stepped_sine_is_named_and_read_back() {
+        let stepped = Excitation::Stepped { step_ticks: 2000 };
+        assert_eq!(stepped.words(), "stepped, step_ticks = 2000");
+        assert_eq!(Excitation::parse(&stepped.words()), Ok(stepped));
+        let l = Log {
+            excitation: Some(stepped),
+            ..log()
+        };
+        let back = Log::from_csv(&l.to_csv(), "t.csv").unwrap();
+        assert_eq!(back.excitation, Some(stepped));
+        for (words, want) in [
+            ("stepped, period_ticks = 5", "`period_ticks`"),
+            ("period_ticks = 5, first = 1", "must name period_ticks"),
+            ("stepped", "must name period_ticks"),
+            ("stepped, step_ticks = 0", "above zero"),
+            ("period_ticks = 0, first = 1, last = 2", "above zero"),
+        ] {
+            let e = Excitation::parse(words).unwrap_err();
+            assert!(e.contains(want), "{words}: {e}");
         }
     }
 }

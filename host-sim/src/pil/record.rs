@@ -130,7 +130,7 @@ fn axis_log(
         force_n: get(&|a| -f64::from(a.actuator_n)),
         position_m: get(&|a| a.position_pm as f64 * 1e-12),
         load_cell_n: with_load_cell.then(|| get(&|a| f64::from(a.load_cell_n))),
-        excitation: Some(twoport_identify::log::Excitation {
+        excitation: Some(twoport_identify::log::Excitation::Periodic {
             period_ticks: x.period_ticks as usize,
             first: x.first as usize,
             last: x.last as usize,

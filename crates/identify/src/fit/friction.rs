@@ -334,7 +334,7 @@ pub(crate) mod tests {
                 force_n: force,
                 position_m: pos,
                 load_cell_n: None,
-                excitation: Some(Excitation {
+                excitation: Some(Excitation::Periodic {
                     period_ticks: 1000,
                     first: 1,
                     last: self.top as usize,

@@ -68,21 +68,79 @@ impl Measured {
     pub fn from_log(log: &crate::log::Log, skip: usize) -> Result<Measured, crate::IdentifyError> {
         let e = log.excitation.ok_or(crate::IdentifyError::Log {
             place: "the record".into(),
-            why: "it does not name its excitation (the `# twoport experiment:` line)".into(),
+            why: "it does not name its excitation (the `# twoport experiment:` line, or `identify --excitation`)".into(),
         })?;
         clipped(&log.force_n, log.period_s)?;
-        let harmonics: Vec<usize> = (e.first..=e.last).collect();
+        match e {
+            crate::log::Excitation::Periodic {
+                period_ticks,
+                first,
+                last,
+            } => Self::periodic(log, skip, period_ticks, first, last),
+            crate::log::Excitation::Stepped { step_ticks } => Self::stepped(log, skip, step_ticks),
+        }
+    }
+
+    /// A stepped sine's responses ([`stepped`](crate::stepped)), `skip`
+    /// whole steps first left out. Friction under a sine is, to first
+    /// order, damping, and cogging's shapes need a motion that repeats:
+    /// neither is estimated beside the model. A quantised reading's error
+    /// repeats each cycle, so a cycle's samples bound its variance.
+    fn stepped(
+        log: &crate::log::Log,
+        skip: usize,
+        step_ticks: usize,
+    ) -> Result<Measured, crate::IdentifyError> {
+        let mut signals: Vec<&[f64]> = vec![&log.position_m];
+        signals.extend(log.load_cell_n.as_deref());
+        let steps =
+            crate::stepped::stepped(&log.force_n, &signals, log.period_s, step_ticks, skip)?;
+        let mut frfs = steps.responses.clone();
+        for (f, signal) in frfs.iter_mut().zip(&signals) {
+            // A quantised reading's error repeats each cycle, so it does
+            // not average over a step: its share of a cycle's amplitude,
+            // `q²/(3 N)` for `N` samples a cycle, over the force's.
+            if let Some(q) = quantum(signal) {
+                for (i, v) in f.variance.iter_mut().enumerate() {
+                    let a = steps.force_n[i];
+                    *v += q * q / (3.0 * steps.cycle_ticks[i] * (a * a).max(f64::MIN_POSITIVE));
+                }
+            }
+        }
+        let load_cell = (frfs.len() > 1).then(|| frfs.remove(1));
+        let position = frfs.remove(0);
+        let encoder = quantum(&log.position_m);
+        passive(&position, log.period_s)?;
+        Ok(Measured {
+            position,
+            load_cell,
+            forces: Vec::new(),
+            encoder_quantum_m: encoder,
+            motion: None,
+            loaded: None,
+        })
+    }
+
+    /// A periodic record's responses at its harmonics `first..=last`.
+    fn periodic(
+        log: &crate::log::Log,
+        skip: usize,
+        period_ticks: usize,
+        first: usize,
+        last: usize,
+    ) -> Result<Measured, crate::IdentifyError> {
+        let harmonics: Vec<usize> = (first..=last).collect();
         let at = |signal: &[f64]| {
             crate::frf::periodic(
                 &log.force_n,
                 signal,
                 log.period_s,
-                e.period_ticks,
+                period_ticks,
                 &harmonics,
                 skip,
             )
         };
-        let spectrum = |x: &[f64]| crate::frf::mean_spectrum(x, e.period_ticks, &harmonics, skip);
+        let spectrum = |x: &[f64]| crate::frf::mean_spectrum(x, period_ticks, &harmonics, skip);
         let force = spectrum(&log.force_n);
         // A quantised reading's error repeats with the motion, period after
         // period, so no averaging removes it: its share of each harmonic,
@@ -92,7 +150,7 @@ impl Measured {
         let floored = |mut f: Frf, signal: &[f64]| {
             let q = quantum(signal);
             if let Some(q) = q {
-                let floor = e.period_ticks as f64 * q * q / 12.0;
+                let floor = period_ticks as f64 * q * q / 12.0;
                 for (v, fm) in f.variance.iter_mut().zip(&force) {
                     *v += floor / fm.norm_sqr().max(f64::MIN_POSITIVE);
                 }
@@ -105,11 +163,11 @@ impl Measured {
             Some(lc) => Some(floored(at(lc)?, lc).0),
             None => None,
         };
-        let sign = friction::tick_sign(&log.position_m, e.period_ticks, e.last, skip);
+        let sign = friction::tick_sign(&log.position_m, period_ticks, last, skip);
         let mut forces: Vec<friction::Regressor> = sign
             .map(|sign| friction::Regressor {
                 shape: friction::Shape::Coulomb,
-                per_force: crate::frf::mean_spectrum(&sign, e.period_ticks, &harmonics, 0)
+                per_force: crate::frf::mean_spectrum(&sign, period_ticks, &harmonics, 0)
                     .iter()
                     .zip(&force)
                     .map(|(s, f)| s / f)
@@ -118,7 +176,7 @@ impl Measured {
             })
             .into_iter()
             .collect();
-        let motion = cogging::Motion::new(&log.position_m, e.period_ticks, &harmonics, force, skip);
+        let motion = cogging::Motion::new(&log.position_m, period_ticks, &harmonics, force, skip);
         let mut data = Measured {
             position,
             load_cell,

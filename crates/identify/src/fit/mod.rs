@@ -735,4 +735,6 @@ fn climb(data: &Measured, base: &ModelBase) -> (Vec<Fit>, Option<usize>) {
 #[cfg(test)]
 mod bench_tests;
 #[cfg(test)]
+mod elsewhere_tests;
+#[cfg(test)]
 pub(crate) mod tests;

@@ -252,7 +252,7 @@ fn pushed_mass(scale: f64, limit_n: f64) -> crate::log::Log {
         force_n: force,
         position_m: position,
         load_cell_n: None,
-        excitation: Some(crate::log::Excitation {
+        excitation: Some(crate::log::Excitation::Periodic {
             period_ticks: n,
             first: 1,
             last: 3,
@@ -273,7 +273,9 @@ fn clipped_or_unexcited_records_are_refused() {
     );
     assert!(e.to_string().contains("lower the excitation's peak"), "{e}");
     let mut log = pushed_mass(1.0, 10.0);
-    log.excitation.as_mut().unwrap().last = 5;
+    if let Some(crate::log::Excitation::Periodic { last, .. }) = log.excitation.as_mut() {
+        *last = 5;
+    }
     let e = Measured::from_log(&log, 1).unwrap_err().to_string();
     assert!(e.contains("harmonic 4"), "{e}");
 }

@@ -97,12 +97,17 @@ pub fn dissipation(
             "it does not name its excitation (the `# twoport experiment:` line)".into(),
         )
     })?;
-    let period = e.period_ticks;
+    let (period, first, last) = e.periodic().ok_or_else(|| {
+        bad(
+            format!("{place}, axis 0"),
+            "a stepped sine: the losses are read from a sine repeated every period".into(),
+        )
+    })?;
     let max = period.saturating_sub(1) / 2;
-    let top = e.last.saturating_mul(RATE_HARMONICS).min(max);
-    if e.first == 0 || e.last > max {
+    let top = last.saturating_mul(RATE_HARMONICS).min(max);
+    if first == 0 || last > max {
         return Err(IdentifyError::Harmonic {
-            harmonic: e.last.max(e.first),
+            harmonic: last.max(first),
             period,
             max,
         });
@@ -378,7 +383,7 @@ mod tests {
             force_n: force,
             position_m: position,
             load_cell_n: None,
-            excitation: Some(Excitation {
+            excitation: Some(Excitation::Periodic {
                 period_ticks: period,
                 first: 1,
                 last: 1,

@@ -49,16 +49,21 @@ impl PoseMeasured {
                 "it does not name its excitation (the `# twoport experiment:` line)".into(),
             )
         })?;
-        let period = e.period_ticks;
+        let (period, first_h, last_h) = e.periodic().ok_or_else(|| {
+            bad(
+                "experiment 0, axis 0".into(),
+                "a stepped sine: a pose's response matrix is read from periodic records".into(),
+            )
+        })?;
         let max = period.saturating_sub(1) / 2;
-        if e.first > e.last {
+        if first_h > last_h {
             return Err(IdentifyError::Harmonic {
-                harmonic: e.last,
+                harmonic: last_h,
                 period,
                 max,
             });
         }
-        let harmonics: Vec<usize> = (e.first..=e.last).collect();
+        let harmonics: Vec<usize> = (first_h..=last_h).collect();
         let periods = checked(experiments, first, e, &harmonics, skip)?;
         let spec = |x: &[f64]| spectra(x, period, &harmonics, skip, periods);
         // The harmonics the multisine leaves out, past its band: what the
@@ -67,7 +72,7 @@ impl PoseMeasured {
         // step that is no one number), which no averaging removes. Its
         // power per harmonic in each axis's mean spectrum is a floor on
         // the excited harmonics' variance.
-        let quiet: Vec<usize> = (e.last + 1..=max).collect();
+        let quiet: Vec<usize> = (last_h + 1..=max).collect();
         let noise = repeating_noise(experiments, period, &quiet, skip);
         // [experiment][axis][period][harmonic]
         let (f, x): (Vec<Vec<_>>, Vec<Vec<_>>) = experiments
@@ -140,7 +145,8 @@ fn checked(
     harmonics: &[usize],
     skip: usize,
 ) -> Result<usize, IdentifyError> {
-    let (n, period) = (experiments.len(), e.period_ticks);
+    let n = experiments.len();
+    let period = e.periodic().map_or(0, |p| p.0);
     let mut periods = 0;
     for (j, axes) in experiments.iter().enumerate() {
         if axes.len() != n {
