@@ -3,7 +3,9 @@
 //! `identify` does with the record: the frequency responses over its
 //! periods, and the fit of every order with the choice among them. The
 //! goal is the fit of a 5-DOF model in at most 1 s. Then the refit of the
-//! chosen order with a loaded record (0.5 kg on the handle) beside it.
+//! chosen order with a loaded record (0.5 kg on the handle) beside it,
+//! and the fit of a 1-DOF device (the capstan handle's 30 s record), whose
+//! goal is 0.1 s.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use host_sim::link::{LinkFaults, LocalBoard};
@@ -13,11 +15,14 @@ use std::path::Path;
 use twoport_identify::fit::{self, chain::ModelBase, Measured};
 
 fn identify(c: &mut Criterion) {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../scenes/identify/excalibur.toml"
-    );
-    let record = |sets: &[String]| {
+    let scene_path = |device: &str| {
+        format!(
+            "{}/../scenes/identify/{device}.toml",
+            env!("CARGO_MANIFEST_DIR")
+        )
+    };
+    let path = scene_path("excalibur");
+    let record_of = |path: &str, sets: &[String], load_cell: bool| {
         let scene = Scene::load(Path::new(path), sets).unwrap();
         let ticks = (scene.duration_s / 1e-3).round() as u64;
         let run = pil::run(
@@ -27,10 +32,10 @@ fn identify(c: &mut Criterion) {
             LinkFaults::default(),
         )
         .unwrap();
-        run.experiment_log(true).unwrap().unwrap()
+        run.experiment_log(load_cell).unwrap().unwrap()
     };
-    let log = record(&[]);
-    let loaded_log = record(&["plant.handle_mass_kg=0.5".into()]);
+    let log = record_of(&path, &[], true);
+    let loaded_log = record_of(&path, &["plant.handle_mass_kg=0.5".into()], true);
     let base = ModelBase {
         name: "identified".into(),
         period_s: 1e-3,
@@ -53,6 +58,25 @@ fn identify(c: &mut Criterion) {
         "identify: fit every order, then refit with a loaded record",
         |b| b.iter(|| fit::fit_orders(black_box(&both), &base)),
     );
+    // (The scene's paths are the repository root's.)
+    let capstan = record_of(
+        &scene_path("capstan"),
+        &[format!(
+            "plant.model=\"{}/../models/capstan.toml\"",
+            env!("CARGO_MANIFEST_DIR")
+        )],
+        false,
+    );
+    let one = Measured::from_log(&capstan, 2).unwrap();
+    let encoder_only = ModelBase {
+        load_cell_pole_rad_s: None,
+        peak_force_n: 10.0,
+        continuous_force_n: 4.0,
+        ..base.clone()
+    };
+    c.bench_function("identify: fit every order, capstan (1 DOF chosen)", |b| {
+        b.iter(|| fit::fit_orders(black_box(&one), &encoder_only))
+    });
 }
 
 criterion_group! {
