@@ -47,3 +47,16 @@ pub(crate) fn non_negative(name: &'static str, value: f32) -> Result<f32, ParamE
         })
     }
 }
+
+/// `value`, if finite (either sign).
+pub(crate) fn finite(name: &'static str, value: f32) -> Result<f32, ParamError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(ParamError {
+            name,
+            value,
+            problem: "must be finite",
+        })
+    }
+}

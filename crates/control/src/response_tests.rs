@@ -14,29 +14,29 @@ use crate::ve::{
 use crate::*;
 use std::f64::consts::PI;
 
-const T: f32 = 1.0e-3;
-const WINDOW: usize = 4000;
+pub(crate) const T: f32 = 1.0e-3;
+pub(crate) const WINDOW: usize = 4000;
 const SETTLE: usize = 3000;
 /// DFT bins: p periods per window; 2000 is Nyquist.
-const BINS: [usize; 12] = [1, 3, 7, 20, 50, 130, 333, 700, 1200, 1800, 1990, 2000];
+pub(crate) const BINS: [usize; 12] = [1, 3, 7, 20, 50, 130, 333, 700, 1200, 1800, 1990, 2000];
 
 fn theta(p: usize) -> f64 {
     2.0 * PI * p as f64 / WINDOW as f64
 }
 
-fn z_of(p: usize) -> Complex64 {
+pub(crate) fn z_of(p: usize) -> Complex64 {
     let th = theta(p);
     Complex64::new(th.cos(), th.sin())
 }
 
 /// Drive `tick` with `cos(θk)` for SETTLE + WINDOW ticks; it returns the
 /// (input, output) it really had; the response is their DFT-bin ratio.
-fn measure(p: usize, tick: impl FnMut(f64) -> (f64, f64)) -> Complex64 {
+pub(crate) fn measure(p: usize, tick: impl FnMut(f64) -> (f64, f64)) -> Complex64 {
     let z = z_of(p);
     SineProbe::measure(z.re, z.im, SETTLE as u32, WINDOW as u32, tick)
 }
 
-fn assert_close(what: &str, p: usize, got: Complex64, want: Complex64) {
+pub(crate) fn assert_close(what: &str, p: usize, got: Complex64, want: Complex64) {
     let err = (got - want).norm() / want.norm();
     assert!(
         err <= 1e-4,
@@ -45,7 +45,7 @@ fn assert_close(what: &str, p: usize, got: Complex64, want: Complex64) {
     );
 }
 
-fn pos(x_m: f64) -> Position {
+pub(crate) fn pos(x_m: f64) -> Position {
     Position::from_m_f64(x_m).unwrap()
 }
 
@@ -398,105 +398,4 @@ fn f64_laws_match_their_z_forms_to_double_precision() {
     assert!(zci64 < 1e-10 && d64 < 1e-10, "{zci64:e} {d64:e}");
     assert!(zci32 > 100.0 * zci64 && d32 > 100.0 * d64);
     assert!(zci32 < 1e-4 && d32 < 1e-4);
-}
-
-/// The position-position teleoperator, each device driven in turn with
-/// the other at rest, with no delay and with three ticks each way: every
-/// term of its impedance matrix, the channel's delay included, is its
-/// z-domain form.
-#[test]
-fn position_position_teleoperator() {
-    use crate::teleop::PositionPosition;
-    for d in [0, 3] {
-        for p in BINS {
-            for (row, col) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                let mut t =
-                    PositionPosition::<f32, 8>::new(1_000.0, 5.0, T, d, Position::ZERO).unwrap();
-                let mut est = FirstDifference::new(T, Position::ZERO).unwrap();
-                let rest = (Position::ZERO, 0.0);
-                let got = measure(p, |u| {
-                    let x = pos(1e-3 * u);
-                    let v = est.step(x);
-                    let f = if col == 0 {
-                        t.step((x, v), rest)
-                    } else {
-                        t.step(rest, (x, v))
-                    };
-                    let out = if row == 0 { f.master_n } else { f.slave_n };
-                    (f64::from(v), f64::from(out))
-                });
-                let want = t.tf().eval(z_of(p))[row][col];
-                assert_close(&std::format!("Z[{row}][{col}], {d} ticks"), p, got, want);
-            }
-        }
-    }
-}
-
-/// Force reflection, each input driven in turn with the others at rest
-/// (the master's motion, the slave's, the environment's sensed force), with
-/// no delay and with three ticks each way: every term of its matrix is its
-/// z-domain form.
-#[test]
-fn position_force_teleoperator() {
-    use crate::teleop::PositionForce;
-    for d in [0, 3] {
-        for p in BINS {
-            for (row, col) in [(0, 0), (1, 0), (1, 1), (0, 2)] {
-                let mut t =
-                    PositionForce::<f32, 8>::new(1_000.0, 5.0, 0.5, 2.0, T, d, Position::ZERO)
-                        .unwrap();
-                let mut est = FirstDifference::new(T, Position::ZERO).unwrap();
-                let rest = (Position::ZERO, 0.0);
-                let got = measure(p, |u| {
-                    let (input, f) = match col {
-                        2 => (u, t.step(rest, rest, u as f32)),
-                        _ => {
-                            let x = pos(1e-3 * u);
-                            let v = est.step(x);
-                            let f = if col == 0 {
-                                t.step((x, v), rest, 0.0)
-                            } else {
-                                t.step(rest, (x, v), 0.0)
-                            };
-                            (f64::from(v), f)
-                        }
-                    };
-                    let out = if row == 0 { f.master_n } else { f.slave_n };
-                    (input, f64::from(out))
-                });
-                let want = t.tf().eval(z_of(p))[row][col];
-                assert_close(&std::format!("[{row}][{col}], {d} ticks"), p, got, want);
-            }
-        }
-    }
-}
-
-/// The wave-variable channel, each device driven in turn with the other
-/// held, at one, two and five ticks each way: every term is its z-domain
-/// form. The channel is lossless, so the start's echo rings on at the
-/// round trip's harmonics (bins that are multiples of `WINDOW/2d`, the
-/// poles), and `Z_mm` vanishes half-way between them (the zeros); the
-/// bins measured are off both (Nyquist, a multiple of each, is left out).
-#[test]
-fn wave_variable_teleoperator() {
-    use crate::teleop::WaveVariables;
-    for d in [1, 2, 5] {
-        for p in BINS.into_iter().filter(|p| p % (WINDOW / (4 * d)) != 0) {
-            for (row, col) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                let mut w = WaveVariables::<f32, 8>::new(25.0, d).unwrap();
-                let got = measure(p, |u| {
-                    let v = (0.1 * u) as f32;
-                    let f = if col == 0 {
-                        w.step(v, 0.0)
-                    } else {
-                        w.step(0.0, v)
-                    };
-                    let out = if row == 0 { f.master_n } else { f.slave_n };
-                    (f64::from(v), f64::from(out))
-                });
-                let want = w.tf().eval(z_of(p))[row][col];
-                assert_close(&std::format!("[{row}][{col}], {d} ticks"), p, got, want);
-            }
-        }
-    }
 }

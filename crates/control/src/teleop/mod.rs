@@ -10,20 +10,24 @@
 //! (the two-port's impedance matrix `F = Z(z) V`) and per the force the
 //! slave's sensor reads.
 //!
-//! [`Channel`] is the delay; [`PositionPosition`] the symmetric
-//! position-position architecture (each side a virtual coupling to the
-//! other side's delayed motion); [`PositionForce`] force reflection (the
-//! slave tracks the master, the master feels the slave's sensed force);
-//! [`WaveVariables`] a channel passive whatever its delay.
+//! [`Channel`] is the delay; [`FourChannel`] Lawrence's four-channel
+//! architecture (each side a virtual coupling to the other side's delayed
+//! motion, and each side's sensed force sent across and fed back), with
+//! its two common cases as constructors: position-position
+//! ([`FourChannel::position_position`]) and force reflection
+//! ([`FourChannel::position_force`]: the slave tracks the master, the
+//! master feels the slave's sensed force); [`WaveVariables`] a channel
+//! passive whatever its delay.
 
 mod channel;
-mod force;
-mod position;
+mod four_channel;
 mod transfer;
 mod wave;
 
 pub use channel::Channel;
-pub use force::PositionForce;
-pub use position::{Motion, PositionPosition, TeleopStep};
+pub use four_channel::{FourChannel, FourChannelGains, Motion, TeleopStep};
 pub use transfer::{Delayed, TeleopTransfer};
 pub use wave::WaveVariables;
+
+#[cfg(test)]
+mod response_tests;

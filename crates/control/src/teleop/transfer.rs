@@ -40,19 +40,20 @@ impl Delayed {
 
 /// A teleoperator's law as a matrix: row 0 the master's force, row 1 the
 /// slave's (N, positive resisting the device's positive motion), per
-/// column 0 the master's velocity, column 1 the slave's (m/s), and
-/// column 2 the force the slave's sensor reads from the environment (N,
-/// on the slave along `+x`, as a load cell reads it). Columns 0 and 1
-/// are the two-port's impedance matrix `Z(z)`.
+/// column 0 the master's velocity, column 1 the slave's (m/s), column 2
+/// the force the slave's sensor reads from the environment (N, on the
+/// slave along `+x`, as a load cell reads it), and column 3 the force the
+/// master's sensor reads from the operator (N, on the master along `+x`).
+/// Columns 0 and 1 are the two-port's impedance matrix `Z(z)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TeleopTransfer {
     /// The matrix's terms, `z[row][column]`.
-    pub z: [[Delayed; 3]; 2],
+    pub z: [[Delayed; 4]; 2],
 }
 
 impl TeleopTransfer {
     /// Its value at `z`.
-    pub fn eval(&self, z: Complex64) -> [[Complex64; 3]; 2] {
+    pub fn eval(&self, z: Complex64) -> [[Complex64; 4]; 2] {
         self.z.map(|row| row.map(|t| t.eval(z)))
     }
 }

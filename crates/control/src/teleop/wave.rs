@@ -94,8 +94,8 @@ impl<R: Real, const D: usize> WaveVariables<R, D> {
         let (local, remote) = (line([b, 0.0, b]), line([0.0, -2.0 * b, 0.0]));
         TeleopTransfer {
             z: [
-                [local, remote, Delayed::ZERO],
-                [remote, local, Delayed::ZERO],
+                [local, remote, Delayed::ZERO, Delayed::ZERO],
+                [remote, local, Delayed::ZERO, Delayed::ZERO],
             ],
         }
     }
