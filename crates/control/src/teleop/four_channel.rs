@@ -232,8 +232,28 @@ impl<R: Real, const D: usize> FourChannel<R, D> {
         hand_n: R,
         env_n: R,
     ) -> TeleopStep<R> {
-        let ((x_s, v_s), f_e) = self.to_master.pass((slave, env_n));
-        let ((x_m, v_m), f_h) = self.to_slave.pass((master, hand_n));
+        let at_master = self.to_master.pass((slave, env_n));
+        let at_slave = self.to_slave.pass((master, hand_n));
+        self.forces(master, slave, hand_n, env_n, at_master, at_slave)
+    }
+
+    /// The forces this tick given what has arrived, whatever the channel
+    /// that carried it: at the master the slave's motion and sensed force
+    /// as last received, at the slave the master's. [`step`](Self::step)
+    /// is this across the law's own channel of constant delay; a channel
+    /// whose delay varies, or that drops packets, hands over what it has.
+    #[inline]
+    pub fn forces(
+        &self,
+        master: Motion<R>,
+        slave: Motion<R>,
+        hand_n: R,
+        env_n: R,
+        at_master: (Motion<R>, R),
+        at_slave: (Motion<R>, R),
+    ) -> TeleopStep<R> {
+        let ((x_s, v_s), f_e) = at_master;
+        let ((x_m, v_m), f_h) = at_slave;
         let [c2, c3, c5, c6] = self.c;
         let spring = |k: R, x: Position, x_r: Position| k * x.nm_from::<R>(x_r) * R::M_PER_NM;
         TeleopStep {

@@ -17,15 +17,18 @@
 //! ([`FourChannel::position_position`]) and force reflection
 //! ([`FourChannel::position_force`]: the slave tracks the master, the
 //! master feels the slave's sensed force); [`WaveVariables`] a channel
-//! passive whatever its delay.
+//! passive whatever its delay; [`ChannelGuard`] the passivity layer on a
+//! channel whose delay varies or that drops packets.
 
 mod channel;
 mod four_channel;
+mod guard;
 mod transfer;
 mod wave;
 
 pub use channel::Channel;
 pub use four_channel::{FourChannel, FourChannelGains, Motion, TeleopStep};
+pub use guard::ChannelGuard;
 pub use transfer::{Delayed, TeleopTransfer};
 pub use wave::WaveVariables;
 
