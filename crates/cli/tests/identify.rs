@@ -183,20 +183,27 @@ fn identify_refuses_bad_records_and_arguments() {
     let dir = scratch("identify-bad");
     let out = dir.join("out");
     let o = out.to_str().unwrap().to_string();
-    let fail = |record: &PathBuf, extra: &[&str]| {
-        let mut args = vec![
-            "identify",
-            record.to_str().unwrap(),
-            "--out",
-            &o,
-            "--peak-force",
-            "10",
-            "--continuous-force",
-            "4",
-        ];
-        args.extend(extra);
-        TWOPORT.failure(&args)
+    // `identify RECORD` with the amplifier's numbers and `extra`.
+    let args = |record: &PathBuf, extra: &[&str]| -> Vec<String> {
+        let record = record.to_str().unwrap();
+        let base = ["identify", record, "--out", &o, "--peak-force", "10"];
+        let amp = ["--continuous-force", "4"];
+        base.iter()
+            .chain(&amp)
+            .chain(extra)
+            .map(|a| a.to_string())
+            .collect()
     };
+    let run = |record: &PathBuf, extra: &[&str], ok: bool| {
+        let a = args(record, extra);
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        if ok {
+            TWOPORT.json(&a).to_string()
+        } else {
+            TWOPORT.failure(&a)
+        }
+    };
+    let fail = |record: &PathBuf, extra: &[&str]| run(record, extra, false);
     let good = capstan_record(&dir, "capstan", |_| {});
     for (extra, want) in [
         (
@@ -255,19 +262,8 @@ fn identify_refuses_bad_records_and_arguments() {
         "{e}"
     );
     let said = "period_ticks = 1000, first = 1, last = 300";
-    let read = TWOPORT.json(&[
-        "identify",
-        bare.to_str().unwrap(),
-        "--out",
-        &o,
-        "--peak-force",
-        "10",
-        "--continuous-force",
-        "4",
-        "--excitation",
-        said,
-        "--json",
-    ]);
+    let read: serde_json::Value =
+        serde_json::from_str(&run(&bare, &["--excitation", said, "--json"], true)).unwrap();
     let axis = &read["axes"][0];
     assert_eq!(axis["chosen"]["modes"], 0, "{axis}");
     for (words, want) in [

@@ -12,7 +12,7 @@
 //! still, with the servo pushing at least [`STALL_FORCE_FRACTION`] of the
 //! limit, for `stall_s`.
 
-use crate::{param, ParamError, Position, NM_PER_M};
+use crate::{param, ParamError, Position, Real, NM_PER_M};
 
 /// Of the force limit, what the servo must push with for a stall to count:
 /// a handle that stands still under less is held by something softer than
@@ -191,13 +191,7 @@ impl Homing {
         let c = &self.cfg;
         let f = c.stiffness_npm * x.minus_m(self.set_point) + c.damping_nspm * v_mps;
         let limit = c.force_limit_n;
-        let f = if f > limit {
-            limit
-        } else if f < -limit {
-            -limit
-        } else {
-            f
-        };
+        let f = f.within(limit);
         // Pushing toward the stop is a negative force for a stop toward
         // positive positions (the force resists positive motion).
         let toward = if self.step_nm > 0 { -f } else { f };

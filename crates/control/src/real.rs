@@ -66,6 +66,29 @@ pub trait Real:
     fn sqrt(self) -> Self;
     /// The angle of `(x, self)` (rad, in `[-π, π]`).
     fn atan2(self, x: Self) -> Self;
+
+    /// `self` within `±limit` (a NaN passes through, for the safety layer
+    /// downstream to refuse).
+    #[inline(always)]
+    fn within(self, limit: Self) -> Self {
+        if self > limit {
+            limit
+        } else if self < -limit {
+            -limit
+        } else {
+            self
+        }
+    }
+
+    /// `self`, at most `cap` (a NaN gives `cap`).
+    #[inline(always)]
+    fn at_most(self, cap: Self) -> Self {
+        if self < cap {
+            self
+        } else {
+            cap
+        }
+    }
 }
 
 macro_rules! real {

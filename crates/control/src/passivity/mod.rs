@@ -34,12 +34,14 @@
 //! on the M4F that is seven `f32` additions and a comparison per tick in
 //! hardware, where an `f64` sum would call the soft-float library.
 
+mod brake;
 mod observer;
 mod parallel;
 mod series;
 mod sum;
 mod ve_port;
 
+pub(crate) use brake::Brake;
 pub use observer::EnergyObserver;
 pub use parallel::{ParallelDamper, ParallelLimits};
 pub use series::{PassivityLimits, SeriesDamper};

@@ -144,22 +144,9 @@ impl<R: Real> ParallelDamper<R> {
         let e = self.taken_in_j.value() + t * force_n * velocity_mps;
         let active = e < R::ZERO && force_n.abs() >= self.min_force_n;
         let v = if active {
-            let wanted = -e / (t * force_n * force_n);
-            let beta = if wanted < self.max_conductance_mpns {
-                wanted
-            } else {
-                self.max_conductance_mpns
-            };
+            let beta = (-e / (t * force_n * force_n)).at_most(self.max_conductance_mpns);
             self.conductance_mpns = beta;
-            let v = velocity_mps + beta * force_n;
-            let lim = self.velocity_limit_mps;
-            if v > lim {
-                lim
-            } else if v < -lim {
-                -lim
-            } else {
-                v
-            }
+            (velocity_mps + beta * force_n).within(self.velocity_limit_mps)
         } else {
             self.conductance_mpns = R::ZERO;
             velocity_mps

@@ -1,4 +1,4 @@
-use super::EnergyObserver;
+use super::{Brake, EnergyObserver};
 use crate::param::{non_negative, positive};
 use crate::{ParamError, Position, Real};
 
@@ -121,11 +121,7 @@ impl PassivityLimits {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SeriesDamper<R = f32> {
     observer: EnergyObserver<R>,
-    /// `-1e-9 / T` (J per nJ per s): the observer books in nJ.
-    neg_j_per_nj_per_s: R,
-    max_damping_nspm: R,
-    /// The velocity floor, squared (m²/s²).
-    min_velocity_sq: R,
+    brake: Brake<R>,
     force_limit_n: R,
     max_reserve_nj: R,
     damping_nspm: R,
@@ -138,9 +134,7 @@ impl<R: Real> SeriesDamper<R> {
         let l = limits.checked()?;
         Ok(SeriesDamper {
             observer: EnergyObserver::with_device_damping(l.device_damping_nspm, l.period_s),
-            neg_j_per_nj_per_s: -R::M_PER_NM / R::of(l.period_s),
-            max_damping_nspm: R::of(l.max_damping_nspm),
-            min_velocity_sq: R::of(l.min_velocity_mps) * R::of(l.min_velocity_mps),
+            brake: Brake::new(&l),
             force_limit_n: R::of(l.force_limit_n),
             max_reserve_nj: R::of(l.max_reserve_j) * R::NM_PER_M,
             damping_nspm: R::ZERO,
@@ -158,14 +152,7 @@ impl<R: Real> SeriesDamper<R> {
         }
         // (On the servo's path the safety layer limits the force and
         // books what it let through.)
-        let lim = self.force_limit_n;
-        let f = if f > lim {
-            lim
-        } else if f < -lim {
-            -lim
-        } else {
-            f
-        };
+        let f = f.within(self.force_limit_n);
         self.observer.hold(f);
         f
     }
@@ -187,18 +174,7 @@ impl<R: Real> SeriesDamper<R> {
             self.damping_nspm = R::ZERO;
             return force_n;
         }
-        let v2 = v * v;
-        let fast_enough = v2 >= self.min_velocity_sq;
-        if !fast_enough {
-            self.damping_nspm = R::ZERO;
-            return force_n;
-        }
-        let wanted = e * self.neg_j_per_nj_per_s / v2;
-        let alpha = if wanted < self.max_damping_nspm {
-            wanted
-        } else {
-            self.max_damping_nspm
-        };
+        let alpha = self.brake.damping(e, v);
         self.damping_nspm = alpha;
         force_n + alpha * v
     }

@@ -43,6 +43,21 @@ pub struct FourChannelGains {
     pub c6: f32,
 }
 
+impl FourChannelGains {
+    /// Every channel off: the start of a law that turns some on.
+    pub const OFF: FourChannelGains = FourChannelGains {
+        k_m_npm: 0.0,
+        b_m_nspm: 0.0,
+        b_local_nspm: 0.0,
+        k_s_npm: 0.0,
+        b_s_nspm: 0.0,
+        c2: 0.0,
+        c3: 0.0,
+        c5: 0.0,
+        c6: 0.0,
+    };
+}
+
 /// Lawrence's four-channel teleoperator across a channel that delays
 /// what each side sends by `d` ticks (at most `D`):
 ///
@@ -168,13 +183,9 @@ impl<R: Real, const D: usize> FourChannel<R, D> {
         let gains = FourChannelGains {
             k_m_npm: k_npm,
             b_m_nspm: b_nspm,
-            b_local_nspm: 0.0,
             k_s_npm: k_npm,
             b_s_nspm: b_nspm,
-            c2: 0.0,
-            c3: 0.0,
-            c5: 0.0,
-            c6: 0.0,
+            ..FourChannelGains::OFF
         };
         Self::new(gains, period_s, delay_ticks, at)
     }
@@ -207,15 +218,11 @@ impl<R: Real, const D: usize> FourChannel<R, D> {
         at: Position,
     ) -> Result<Self, ParamError> {
         let gains = FourChannelGains {
-            k_m_npm: 0.0,
-            b_m_nspm: 0.0,
             b_local_nspm: param::non_negative("b_m (N s/m)", b_m_nspm)?,
             k_s_npm: k_npm,
             b_s_nspm: b_nspm,
             c2: param::non_negative("k_f (force scale)", k_f)?,
-            c3: 0.0,
-            c5: 0.0,
-            c6: 0.0,
+            ..FourChannelGains::OFF
         };
         Self::new(gains, period_s, delay_ticks, at)
     }

@@ -1,7 +1,7 @@
 //! The passivity layer on a teleoperator's channel: a time-domain guard
 //! for a delay that varies, or packets that drop.
 
-use crate::passivity::{CompensatedSum, PassivityLimits};
+use crate::passivity::{Brake, CompensatedSum, PassivityLimits};
 use crate::{ParamError, Position, Real};
 
 /// One side's guard on a channel (Ryu and Artigas's time-domain
@@ -46,10 +46,7 @@ pub struct ChannelGuard<R = f32> {
     out_nj: CompensatedSum<R>,
     start: Position,
     held_n: R,
-    /// `1e-9 / T` (J per nJ per s).
-    j_per_nj_per_s: R,
-    max_damping_nspm: R,
-    min_velocity_sq: R,
+    brake: Brake<R>,
     force_limit_n: R,
     damping_nspm: R,
 }
@@ -65,9 +62,7 @@ impl<R: Real> ChannelGuard<R> {
             out_nj: CompensatedSum::new(),
             start: Position::ZERO,
             held_n: R::ZERO,
-            j_per_nj_per_s: R::M_PER_NM / R::of(l.period_s),
-            max_damping_nspm: R::of(l.max_damping_nspm),
-            min_velocity_sq: R::of(l.min_velocity_mps) * R::of(l.min_velocity_mps),
+            brake: Brake::new(&l),
             force_limit_n: R::of(l.force_limit_n),
             damping_nspm: R::ZERO,
         })
@@ -88,32 +83,23 @@ impl<R: Real> ChannelGuard<R> {
             self.out_nj.add(-e);
         }
         self.start = x;
-        let excess_nj = self.out_nj.value() - other_in_j * R::NM_PER_M;
-        let over = excess_nj > R::ZERO;
-        let v2 = v * v;
+        // What the port holds against what it may give out: below zero,
+        // it has given out more than the other side had put in.
+        let margin_nj = other_in_j * R::NM_PER_M - self.out_nj.value();
+        let in_deficit = margin_nj < R::ZERO;
         // Within what came in (or a NaN, which leaves the force to the
-        // safety layer downstream), or too slow to damp.
-        if !over || v2 < self.min_velocity_sq {
-            self.damping_nspm = R::ZERO;
+        // safety layer downstream).
+        let alpha = if in_deficit {
+            self.brake.damping(margin_nj, v)
+        } else {
+            R::ZERO
+        };
+        self.damping_nspm = alpha;
+        if alpha == R::ZERO {
             self.held_n = force_n;
             return force_n;
         }
-        let wanted = excess_nj * self.j_per_nj_per_s / v2;
-        let alpha = if wanted < self.max_damping_nspm {
-            wanted
-        } else {
-            self.max_damping_nspm
-        };
-        self.damping_nspm = alpha;
-        let f = force_n + alpha * v;
-        let lim = self.force_limit_n;
-        let f = if f > lim {
-            lim
-        } else if f < -lim {
-            -lim
-        } else {
-            f
-        };
+        let f = (force_n + alpha * v).within(self.force_limit_n);
         self.held_n = f;
         f
     }

@@ -52,9 +52,11 @@ fn simulate(model: &DeviceModel, force_n: &[f64], quantum_m: f64) -> Vec<f64> {
         .collect()
 }
 
-/// The design `model`'s record gives, at 2 N s/m, through its CSV.
-fn design_from(truth: &DeviceModel, force_n: Vec<f64>, excitation: Excitation, skip: usize) -> f64 {
-    let position_m = simulate(truth, &force_n, 1e-6);
+/// The design at 2 N s/m that the centring handle's record of `force_n`,
+/// read through its CSV, gives: within 3% of the truth's.
+fn closes(what: &str, force_n: Vec<f64>, excitation: Excitation, skip: usize) {
+    let truth = centring();
+    let position_m = simulate(&truth, &force_n, 1e-6);
     let log = Log {
         period_s: T,
         force_n,
@@ -65,24 +67,29 @@ fn design_from(truth: &DeviceModel, force_n: Vec<f64>, excitation: Excitation, s
     let log = Log::from_csv(&log.to_csv(), "elsewhere.csv").unwrap();
     let data = Measured::from_log(&log, skip).unwrap();
     data.band_reaches(T).unwrap();
-    let (fits, best) = fit_orders(&data, &base(truth));
+    let (fits, best) = fit_orders(&data, &base(&truth));
     let f = super::chosen(&fits, best).unwrap();
-    impedance_k(&f.model, 2.0)
+    let (got, want) = (impedance_k(&f.model, 2.0), impedance_k(&truth, 2.0));
+    eprintln!("{what}: {got:.1} N/m against {want:.1}");
+    assert!(
+        (got / want - 1.0).abs() < 0.03,
+        "{what}: {got} against {want}"
+    );
 }
 
-fn within_3_percent(what: &str, got: f64, truth: f64) {
-    eprintln!("{what}: {got:.1} N/m against {truth:.1}");
-    assert!(
-        (got / truth - 1.0).abs() < 0.03,
-        "{what}: {got} against {truth}"
-    );
+/// Harmonics `first..=last` of a period of `period_ticks`.
+fn periodic(period_ticks: usize, first: usize, last: usize) -> Excitation {
+    Excitation::Periodic {
+        period_ticks,
+        first,
+        last,
+    }
 }
 
 /// 4,096 samples a period, harmonics 2 to 1,843 (0.49 to 450 Hz) at 2 N
 /// rms with random phases, eight periods.
 #[test]
 fn another_programs_multisine_is_read_and_fitted() {
-    let truth = centring();
     let (period, first, last) = (4096usize, 2usize, 1843usize);
     let mut seed = 0x5eed_u64;
     let harmonics: Vec<(f64, f64)> = (first..=last)
@@ -104,24 +111,18 @@ fn another_programs_multisine_is_read_and_fitted() {
                 .sum()
         })
         .collect();
-    let k = design_from(
-        &truth,
+    closes(
+        "random-phase multisine",
         force,
-        Excitation::Periodic {
-            period_ticks: period,
-            first,
-            last,
-        },
+        periodic(period, first, last),
         2,
     );
-    within_3_percent("random-phase multisine", k, impedance_k(&truth, 2.0));
 }
 
 /// A linear chirp from 0.5 to 450 Hz swept once in each 4,096-sample
 /// period, 1 N, eight periods.
 #[test]
 fn a_chirp_swept_once_a_period_is_read_and_fitted() {
-    let truth = centring();
     let period = 4096usize;
     let duration = period as f64 * T;
     let (f0, f1) = (0.5, 450.0);
@@ -135,24 +136,13 @@ fn a_chirp_swept_once_a_period_is_read_and_fitted() {
         (f0 * duration).ceil() as usize,
         (f1 * duration).floor() as usize,
     );
-    let k = design_from(
-        &truth,
-        force,
-        Excitation::Periodic {
-            period_ticks: period,
-            first,
-            last,
-        },
-        2,
-    );
-    within_3_percent("chirp", k, impedance_k(&truth, 2.0));
+    closes("chirp", force, periodic(period, first, last), 2);
 }
 
 /// Forty frequencies from 1 to 450 Hz, log-spaced, each held for 3 s at
 /// 1 N.
 #[test]
 fn a_stepped_sine_is_read_and_fitted() {
-    let truth = centring();
     let step = 3000usize;
     let force: Vec<f64> = (0..40)
         .flat_map(|k| {
@@ -160,6 +150,10 @@ fn a_stepped_sine_is_read_and_fitted() {
             (0..step).map(move |i| (TAU * hz * i as f64 * T).sin())
         })
         .collect();
-    let k = design_from(&truth, force, Excitation::Stepped { step_ticks: step }, 0);
-    within_3_percent("stepped sine", k, impedance_k(&truth, 2.0));
+    closes(
+        "stepped sine",
+        force,
+        Excitation::Stepped { step_ticks: step },
+        0,
+    );
 }
