@@ -84,6 +84,14 @@ fn eigen(m: &DMatrix<f64>) -> Vec<f64> {
     e
 }
 
+/// The Jacobian where the handle is, from the device's kinematics near
+/// its calibration pose.
+fn along(device: Device) -> impl Fn(&[f64]) -> Option<DMatrix<f64>> + Sync {
+    let file = device.file().unwrap();
+    let rest = truth(device).q_rad;
+    move |x| twoport_design::linkage::inverse(&file.geometry, x, &rest).map(|(_, j)| j)
+}
+
 /// The device's true pose at its calibration pose.
 fn truth(device: Device) -> PoseDynamics {
     let rest: Vec<f64> = device
@@ -240,7 +248,7 @@ fn the_linkages_close_with_their_joints_friction() {
                 .iter()
                 .map(|r| mass(&PoseMeasured::from_logs(r, SKIP).unwrap()).unwrap())
                 .collect();
-            let l = losses::fit(&runs.concat(), &truth.jacobian, SKIP).unwrap();
+            let l = losses::fit(&runs.concat(), &along(device), SKIP).unwrap();
             let m = masses.last().unwrap();
             let d = l.damping_nspm(&truth.jacobian, 0.0).unwrap();
             let least = l.damping_nspm(&truth.jacobian, 3.0).unwrap();
@@ -317,8 +325,7 @@ fn host_sim_writes_the_sines_identify_pose_reads() {
             records.push(axes);
         }
     }
-    let truth = truth(Device::Delta);
-    let l = losses::fit(&records, &truth.jacobian, 8).unwrap();
+    let l = losses::fit(&records, &along(Device::Delta), 8).unwrap();
     let c = Device::Delta.file().unwrap().joints.friction_nm;
     for (got, want) in l.friction_nm.iter().zip(&c) {
         assert!((got / want - 1.0).abs() < 0.02, "{l:?}");
@@ -339,4 +346,100 @@ fn host_sim_writes_the_sines_identify_pose_reads() {
     let e = tool.failure(&["pil", "--sines", "1,2", "--log", d]);
     assert!(e.contains("--linkage"), "{e}");
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// The PHANToM's shoulder and elbow come apart with a second frequency.
+/// At 10 Hz every push turns them in nearly one proportion; at 4 Hz, the
+/// hold's own resonance along the reach, in another. The 10 Hz sines
+/// (0.5, 1 and 1.5 N) and 4 Hz ones (0.3, 0.6 and 0.9 N) together, the
+/// joints' friction acting, give each joint's damping within 25% and its
+/// standard deviation within a fifth of it (the 10 Hz sines alone leave
+/// the shoulder's at 120%), and friction within 3%. A hands-off design
+/// then rests on the fit: over the whole workspace, with each joint's
+/// damping three deviations down, it is proven no stiffer than the
+/// truth's certificate, and at the calibration pose the fit's is within
+/// 20% of the truth's and `verify` finds nothing at the set's.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
+fn the_phantoms_joints_come_apart_at_two_frequencies() {
+    use twoport_design::linkage::certified_design;
+    use twoport_identify::pose::losses;
+    const SKIP: usize = 8;
+    let device = Device::SerialArm;
+    let file = device.file().unwrap();
+    let truth = truth(device);
+    let records: Vec<Vec<Log>> = [(10.0, [0.5, 1.0, 1.5]), (4.0, [0.3, 0.6, 0.9])]
+        .into_iter()
+        .flat_map(|(hz, levels)| {
+            Sines {
+                hz,
+                periods: 24,
+                levels_n: levels.to_vec(),
+                hold: (100.0, 1.0),
+                friction: true,
+            }
+            .play(device)
+            .unwrap()
+            .concat()
+        })
+        .collect();
+    let l = losses::fit(&records, &along(device), SKIP).unwrap();
+    let want = &file.joints.damping_nmsprad;
+    for (i, (b, w)) in l.damping_nmsprad.iter().zip(want).enumerate() {
+        assert!((b / w - 1.0).abs() < 0.25, "joint {i}: {l:?}");
+        assert!(l.sd[i] < 0.2 * w, "joint {i}: {l:?}");
+    }
+    for (c, w) in l.friction_nm.iter().zip(&file.joints.friction_nm) {
+        assert!((c / w - 1.0).abs() < 0.03, "{l:?}");
+    }
+    // Hands off over the workspace, each joint's damping three deviations
+    // down.
+    let mut down = file.clone();
+    down.joints.damping_nmsprad = l
+        .damping_nmsprad
+        .iter()
+        .zip(&l.sd)
+        .map(|(b, s)| (b - 3.0 * s).max(0.0))
+        .collect();
+    let hands_off = |f: &twoport_design::linkage::LinkageFile| {
+        certified_design(f, 0.0, 0.0, Some(HumanBound::PAPER))
+            .unwrap()
+            .k_c_npm
+    };
+    let (k_file, k_down) = (hands_off(&file), hands_off(&down));
+    assert!(
+        k_down <= k_file && k_down > 0.3 * k_file,
+        "{k_down} against {k_file}"
+    );
+    // At the calibration pose.
+    let d = l.damping_nspm(&truth.jacobian, 0.0).unwrap();
+    let d_set = l.damping_nspm(&truth.jacobian, 3.0).unwrap();
+    let at = |d: &DMatrix<f64>| design(device, &[truth.with_body(&truth.mass_kg, d)], 0.0);
+    let (k_true, k_fit, k_set) = (
+        design(device, std::slice::from_ref(&truth), 0.0),
+        at(&d),
+        at(&d_set),
+    );
+    assert!(
+        (k_fit / k_true - 1.0).abs() < 0.2,
+        "{k_fit} against {k_true}"
+    );
+    assert!(k_set <= k_true, "{k_set} against {k_true}");
+    let hands = HandAssumption {
+        min_grasp_nspm: 0.0,
+        human: Some(HumanBound::PAPER),
+    };
+    let v = verify_linkage(&[&truth], &hands, (k_set, 0.0), (file.period_s, Lag::NONE)).unwrap();
+    assert!(!v.unstable, "{v}");
+    eprintln!(
+        "PHANToM at two frequencies: joints' damping {:?} ± {:?} N m s/rad (true {want:?}), \
+         friction {:?} N m, misfit {:.4}; hands off over the workspace: file {k_file:.4}, three \
+         deviations down {k_down:.4} N/m; at the pose: true {k_true:.3}, fit {k_fit:.3}, set \
+         {k_set:.3} N/m, verify on the truth at the set's: radius {}",
+        l.damping_nmsprad,
+        &l.sd[..3],
+        l.friction_nm,
+        l.misfit,
+        v.spectral_radius
+    );
 }

@@ -9,7 +9,7 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 use std::fmt;
 use std::path::{Path, PathBuf};
-use twoport_design::linkage::{bounded_workspace_design, LinkageFile, PoseDynamics};
+use twoport_design::linkage::{bounded_workspace_design, inverse, LinkageFile, PoseDynamics};
 use twoport_design::network::HumanBound;
 use twoport_identify::log::Log;
 use twoport_identify::pose::{fit::mass, losses, record_file, PoseMeasured, AXES};
@@ -61,7 +61,9 @@ pub(crate) fn identify_pose(a: &IdentifyPoseArgs) -> Result<PoseIdentified, Stri
                 .map_err(|e| format!("{}: {e}", dir.display()))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let l = losses::fit(&levels.concat(), &own.jacobian, a.skip).map_err(|e| {
+    // The joints' rates along each orbit, from the file's kinematics.
+    let along = |x: &[f64]| inverse(&file.geometry, x, &a.pose_rad).map(|(_, j)| j);
+    let l = losses::fit(&levels.concat(), &along, a.skip).map_err(|e| {
         // The experiments count level by level, each axis's in turn.
         format!("the levels {}: {e}", names(&a.level))
     })?;

@@ -21,7 +21,7 @@ pub use cell::{CellBounds, Undecided};
 pub use dynamics::SerialArmDynamics;
 pub use file::{Geometry, Inertia, Joints, LinkageFile, Motors, OnKinematics, RelativeLimit};
 pub use interval::Interval;
-pub use pose::{forward, PoseDynamics};
+pub use pose::{forward, inverse, PoseDynamics};
 pub use proof::{
     bounded_workspace_design, certified_design, certified_design_from, least_damping,
     workspace_design, workspace_poses, Binding, Certificate, WorkspaceDesign, BOUNDED_GRID,

@@ -62,6 +62,33 @@ pub fn forward(
         .map_err(|_| KinematicsFault::NotFinite)?
 }
 
+/// The joint angles (rad) that put the handle at `position_m` (m), and
+/// the Jacobian there, by Newton's steps from `q_start` (rad); `None`
+/// where they do not converge to 1 nm within 50 steps, or the Jacobian
+/// turns singular on the way.
+pub fn inverse(
+    geometry: &Geometry,
+    position_m: &[f64],
+    q_start: &[f64],
+) -> Option<(Vec<f64>, DMatrix<f64>)> {
+    let mut q = q_start.to_vec();
+    for _ in 0..50 {
+        let (x, j) = forward(geometry, &q).ok()?;
+        let miss = nalgebra::DVector::from_iterator(
+            x.len(),
+            position_m.iter().zip(&x).map(|(want, at)| want - at),
+        );
+        if miss.amax() < 1e-9 {
+            return Some((q, j));
+        }
+        let step = j.lu().solve(&miss)?;
+        for (qi, s) in q.iter_mut().zip(step.iter()) {
+            *qi += s;
+        }
+    }
+    None
+}
+
 impl LinkageFile {
     /// The joint-space mass matrix at `q` with the rotors reflected
     /// (kg m²), given the Jacobian there.
