@@ -332,6 +332,27 @@ fn axis(
     Ok(Axis { report, members })
 }
 
+/// The longest run of harmonics in a row whose coherence is below a half,
+/// from its first to its last (Hz); `None` for a run of fewer than three.
+fn weak_band(freq_hz: &[f64], coherence: &[f64]) -> Option<[f64; 2]> {
+    let mut best: Option<(usize, usize)> = None;
+    let mut start = None;
+    for (i, c) in coherence.iter().chain([&1.0]).enumerate() {
+        match (*c < 0.5, start) {
+            (true, None) => start = Some(i),
+            (false, Some(s)) => {
+                if best.is_none_or(|(a, b)| i - s > b - a) {
+                    best = Some((s, i));
+                }
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    best.filter(|(a, b)| b - a >= 3)
+        .map(|(a, b)| [freq_hz[a], freq_hz[b - 1]])
+}
+
 /// The header of every model file written: where it came from.
 fn provenance(source: &str, f: &Fit) -> String {
     let form = match &f.form {
@@ -367,6 +388,9 @@ struct AxisReport {
     /// encoder's quantum, as large as the response there. Each counts by
     /// its variance, so they weigh little; they are not dropped.
     weak_harmonics: usize,
+    /// The longest band of such harmonics in a row (Hz), if any: where the
+    /// coherence collapses.
+    weak_band_hz: Option<[f64; 2]>,
     orders: Vec<Order>,
     chosen: Chosen,
     coulomb_friction_n: Option<f64>,
@@ -450,6 +474,7 @@ impl AxisReport {
             coherence_min: worst,
             coherence_min_hz: x.freq_hz.get(worst_at).copied(),
             weak_harmonics: x.coherence().iter().filter(|c| **c < 0.5).count(),
+            weak_band_hz: weak_band(&x.freq_hz, &x.coherence()),
             orders: fits
                 .iter()
                 .enumerate()
@@ -513,6 +538,12 @@ impl fmt::Display for AxisReport {
                 f,
                 "  {} harmonics have a coherence below 0.5 (the noise or the encoder's quantum as large as the response): each is weighed by its variance, so they count for little",
                 self.weak_harmonics
+            )?;
+        }
+        if let Some([lo, hi]) = self.weak_band_hz {
+            writeln!(
+                f,
+                "  the coherence collapses from {lo:.3} to {hi:.3} Hz: a larger excitation there, or more periods, would show the device in that band"
             )?;
         }
         writeln!(f, "  orders fitted (modes: chi2/nu, BIC):")?;
@@ -588,4 +619,23 @@ fn draw(out: &Path, format: PlotFormat, data: &Measured, f: &Fit) -> Result<Vec<
         written.push(path);
     }
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::weak_band;
+
+    /// The longest run of weak harmonics is named, first to last; short
+    /// runs and a record with none are not.
+    #[test]
+    fn the_band_where_the_coherence_collapses_is_named() {
+        let f: Vec<f64> = (1..=12).map(f64::from).collect();
+        let c = [0.9, 0.4, 0.3, 0.9, 0.2, 0.1, 0.3, 0.4, 0.9, 0.1, 0.2, 0.3];
+        assert_eq!(weak_band(&f, &c), Some([5.0, 8.0]));
+        let mut tail = c;
+        tail[8] = 0.1;
+        assert_eq!(weak_band(&f, &tail), Some([5.0, 12.0]));
+        assert_eq!(weak_band(&f, &[0.9; 12]), None);
+        assert_eq!(weak_band(&f[..3], &[0.9, 0.1, 0.1]), None);
+    }
 }
