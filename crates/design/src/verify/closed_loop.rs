@@ -62,6 +62,13 @@ pub(super) struct Sampled {
     c_fm: Vec<f64>,
 }
 
+impl Sampled {
+    /// The measured force's output row.
+    pub(super) fn c_fm(&self) -> &[f64] {
+        &self.c_fm
+    }
+}
+
 pub(super) fn sampled(model: &DeviceModel, hand: &Hand, t: f64) -> Result<Sampled, String> {
     let n = model.dof();
     let grasp = hand.grasp;

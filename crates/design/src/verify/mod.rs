@@ -176,6 +176,7 @@ mod construct;
 mod host;
 mod search;
 mod simplex;
+mod teleop;
 
 pub(crate) use simplex::maximise as simplex_maximise;
 
@@ -183,6 +184,10 @@ use closed_loop::{closed_loop, judge};
 pub use construct::{construct, Constructed};
 pub use host::{host_radius, monodromy, verify_host, HostVerdict};
 pub use search::{verify, verify_near};
+pub use teleop::{
+    teleop_closed_loop, teleop_radius, verify_teleop, TeleopTermination, TeleopVerdict,
+    Teleoperator,
+};
 
 /// The closed loop's spectral radius for one termination.
 pub fn radius(
