@@ -30,7 +30,9 @@
 //! 3. **Bound** the fit: the parameters' covariance from the Jacobian,
 //!    inflated by the misfit (`χ²/ν` where above one).
 
+mod body;
 pub mod chain;
+mod chain_fit;
 pub mod cogging;
 mod features;
 pub mod friction;
@@ -42,7 +44,6 @@ pub mod modal;
 pub mod start;
 pub mod uncertainty;
 
-use crate::frf::Frf;
 use chain::{Chain, ModelBase};
 use modal::Modal;
 use nalgebra::{DMatrix, DVector};
@@ -50,7 +51,10 @@ use num_complex::Complex64;
 use std::f64::consts::TAU;
 use twoport_design::{DeviceModel, Plant};
 
-use features::{features, rigid_band_hz};
+pub(crate) use body::body_band_hz;
+use body::{ground_shown, rigid_estimate};
+pub use chain_fit::fit_chain;
+use features::features;
 pub use measured::{Loaded, Measured, LEAST_BAND_SHARE};
 
 /// The physical form of a fitted model.
@@ -243,227 +247,6 @@ fn residuals(model: &DeviceModel, data: &Measured, amounts: &[f64]) -> Option<DV
     Some(DVector::from_vec(r))
 }
 
-/// Total mass (kg) and damping (N s/m) from the lowest harmonics, where
-/// the device moves as one body: `1/H ≈ -m ω² + j ω d` once the hold's
-/// half-tick delay is taken out.
-fn rigid_estimate(data: &Frf, period_s: f64) -> Option<(f64, f64)> {
-    let take = data.freq_hz.len().clamp(1, 5);
-    let (mut mm, mut dd) = (0.0, 0.0);
-    for i in 0..take {
-        let w = TAU * data.freq_hz[i];
-        let z = 1.0 / (data.response[i] * Complex64::from_polar(1.0, w * period_s / 2.0));
-        mm += -z.re / (w * w);
-        dd += z.im / w;
-    }
-    let (m, d) = (mm / take as f64, dd / take as f64);
-    (m > 0.0).then_some((m, d.max(1e-3 * m)))
-}
-
-/// Stiffness to the frame (N/m), its standard deviation, mass (kg) and
-/// damping (N s/m) from the harmonics below where the device moves as
-/// one body: `Re 1/H ≈ k - m ω² + c ω⁴` once the hold's half-tick delay
-/// is taken out (`c` the modes above bending the band), by least squares
-/// weighted by each harmonic's deviation (with the model floor), and
-/// `Im 1/H ≈ ω d`. `None` where those harmonics cannot tell a spring from
-/// a mass (fewer than four).
-fn grounded_estimate(data: &Frf, period_s: f64) -> Option<(f64, f64, f64, f64)> {
-    let below = rigid_band_hz(data);
-    let take = data
-        .freq_hz
-        .iter()
-        .take_while(|f| **f <= below)
-        .count()
-        .max(5)
-        .min(data.freq_hz.len());
-    if take < 4 {
-        return None;
-    }
-    let (mut a, mut y) = (DMatrix::zeros(take, 3), DVector::zeros(take));
-    let mut dd = 0.0;
-    for i in 0..take {
-        let w = TAU * data.freq_hz[i];
-        let h = data.response[i];
-        let z = 1.0 / (h * Complex64::from_polar(1.0, w * period_s / 2.0));
-        // The real part's deviation: |Z| times the relative deviation,
-        // over √2.
-        let rel = (data.variance[i] / h.norm_sqr().max(f64::MIN_POSITIVE)
-            + MODEL_FLOOR * MODEL_FLOOR)
-            .sqrt();
-        let weight = std::f64::consts::SQRT_2 / (rel * z.norm()).max(f64::MIN_POSITIVE);
-        a[(i, 0)] = weight;
-        a[(i, 1)] = -w * w * weight;
-        a[(i, 2)] = w.powi(4) * weight;
-        y[i] = z.re * weight;
-        dd += z.im / w;
-    }
-    let normal = a.transpose() * &a;
-    let inverse = normal.try_inverse()?;
-    let km = &inverse * (a.transpose() * y);
-    let (k, m, d) = (km[0], km[1], dd / take as f64);
-    let sigma_k = inverse[(0, 0)].max(0.0).sqrt();
-    (k.is_finite() && m.is_finite() && m > 0.0).then_some((k, sigma_k, m, d.max(1e-3 * m)))
-}
-
-/// A spring to the frame the record shows (its stiffness, N/m; the mass,
-/// kg, and damping, N s/m, beside it): the low harmonics' stiffness, if it
-/// is five of its standard deviations above zero and at least half the
-/// inertia at the lowest harmonic (the body's resonance on it at least
-/// 0.7 of that harmonic). Friction and cogging left in a free body's
-/// record read as a stiffness too, a few per cent to a third of that
-/// inertia on the simulated devices (cogging is a spring over each of its
-/// periods): a spring weaker than this is not told from them.
-pub(super) fn ground_shown(data: &Frf, period_s: f64) -> Option<(f64, f64, f64)> {
-    let (k, sigma_k, m, d) = grounded_estimate(data, period_s)?;
-    let w = TAU * data.freq_hz.first()?;
-    (k > 5.0 * sigma_k && k > 0.5 * m * w * w).then_some((k, m, d))
-}
-
-/// Below where the device moves as one body (Hz): a quarter of the way to
-/// its lowest resonance (see [`rigid_band_hz`]); for a device held to the
-/// frame, the lowest of its chain's, the spring taken out, not the body's
-/// own on the spring.
-pub(super) fn body_band_hz(x: &Frf, period_s: f64) -> f64 {
-    match ground_shown(x, period_s) {
-        Some((k, ..)) => rigid_band_hz(&Frf {
-            response: x.response.iter().map(|h| 1.0 / (1.0 / h - k)).collect(),
-            ..x.clone()
-        }),
-        None => rigid_band_hz(x),
-    }
-}
-
-/// Fit a chain of `modes` modes, held to the frame at mass `ground_at`
-/// if given, or `None` where the measurement shows fewer resonances or
-/// the search finds no model. A load cell, if measured, is the chain's
-/// last spring: a flexure in the band.
-pub fn fit_chain(
-    data: &Measured,
-    base: &ModelBase,
-    modes: usize,
-    ground_at: Option<usize>,
-) -> Option<Fit> {
-    if ground_at.is_some_and(|at| at > modes) {
-        return None;
-    }
-    let x = &data.position;
-    let (k_g, m_t, d_t) = match ground_at {
-        None => {
-            let (m, d) = rigid_estimate(x, base.period_s)?;
-            (0.0, m, d)
-        }
-        Some(_) => ground_shown(x, base.period_s)?,
-    };
-    // At low frequency the load cell reads the force that accelerates the
-    // handle's mass, `-sign m_h/m_t` of the push (the acceleration per
-    // push has a positive real part, whatever the damping).
-    let sign = match &data.load_cell {
-        Some(lc) if lc.response.iter().take(5).map(|h| h.re).sum::<f64>() > 0.0 => -1.0,
-        _ => 1.0,
-    };
-    let ground = ground_at.map(|at| chain::Ground { at, npm: k_g });
-    let start = if modes == 0 {
-        Chain {
-            masses_kg: vec![m_t],
-            springs_npm: vec![],
-            links_nspm: vec![],
-            actuator_nspm: d_t,
-            handle_nspm: 0.0,
-            load_cell_sign: 1.0,
-            ground,
-        }
-    } else {
-        let w = |i: &usize| TAU * x.freq_hz[*i];
-        let (l, ground) = match ground_at {
-            // Held at the actuator: the free chain's features, the spring
-            // taken out of the record's dynamic stiffness.
-            None | Some(0) => {
-                let free;
-                let x = if k_g > 0.0 {
-                    free = Frf {
-                        response: x.response.iter().map(|h| 1.0 / (1.0 / h - k_g)).collect(),
-                        ..x.clone()
-                    };
-                    &free
-                } else {
-                    x
-                };
-                let (anti, res) = features(x, modes)?;
-                let anti: Vec<f64> = anti.iter().map(w).collect();
-                let res: Vec<f64> = res.iter().map(w).collect();
-                (ladder::synthesise(m_t, &anti, &res)?, ground)
-            }
-            // Held further along: the record's own resonances (one more
-            // than the modes: the chain's on the spring) give the chain
-            // held at the handle, and a spring held nearer the actuator
-            // starts there too.
-            Some(at) => {
-                let (anti, res) = features(x, modes + 1)?;
-                let anti: Vec<f64> = anti[1..].iter().map(w).collect();
-                let res: Vec<f64> = res.iter().map(w).collect();
-                let (l, end) = ladder::synthesise_held(k_g, &anti, &res)?;
-                (l, Some(chain::Ground { at, npm: end }))
-            }
-        };
-        let links = (0..l.springs_npm.len())
-            .map(|i| {
-                let (a, b) = (l.masses_kg[i], l.masses_kg[i + 1]);
-                2.0 * 0.03 * (l.springs_npm[i] * a * b / (a + b)).sqrt()
-            })
-            .collect();
-        // The damping to ground starts at the actuator: at the handle it
-        // would show in a load cell at low frequency, where the handle's
-        // mass alone does.
-        Chain {
-            masses_kg: l.masses_kg,
-            springs_npm: l.springs_npm,
-            links_nspm: links,
-            actuator_nspm: d_t,
-            handle_nspm: 1e-3 * d_t,
-            load_cell_sign: sign,
-            ground,
-        }
-    };
-    let masses = start.masses_kg.len();
-    let model = |p: &DVector<f64>| Chain::from_log(masses, ground_at, p, sign).model(base);
-    // With the encoder alone nothing shows where along the chain the
-    // damping to ground acts, and a damper started near zero stays there
-    // (its logarithm's gradient is as small): it is started also shared
-    // in proportion to the masses, and the better fit kept.
-    let mut starts = vec![start.clone()];
-    if data.load_cell.is_none() && masses > 1 {
-        let share = start.masses_kg[masses - 1] / start.masses_kg.iter().sum::<f64>();
-        starts.push(Chain {
-            actuator_nspm: d_t * (1.0 - share),
-            handle_nspm: d_t * share,
-            ..start
-        });
-    }
-    // First the dampers alone, the frequencies held where the ladder put
-    // them (a guessed damping is what a start gets most wrong), then all.
-    let fixed = masses + (masses - 1);
-    let dampers = masses.min(2) + (masses - 1);
-    starts
-        .iter()
-        .filter_map(|c| {
-            let p0 = c.to_log();
-            let damped = lm::minimise(
-                |d| {
-                    let mut p = p0.clone();
-                    p.rows_mut(fixed, d.len()).copy_from(d);
-                    model(&p).and_then(|m| residuals(&m, data, &[]))
-                },
-                p0.rows(fixed, dampers).into_owned(),
-                50,
-            )?;
-            let mut p1 = p0.clone();
-            p1.rows_mut(fixed, damped.p.len()).copy_from(&damped.p);
-            finish(data, base, p1, model, |p| {
-                Form::Chain(Chain::from_log(masses, ground_at, p, sign))
-            })
-        })
-        .min_by(|a, b| a.chi2.total_cmp(&b.chi2))
-}
-
 /// Fit `modes` modes, with the handle on its load cell, to what the
 /// encoder and the load cell measured; `None` where the measurement
 /// shows fewer resonances or the search finds no model.
@@ -591,9 +374,9 @@ fn finish(
 /// (the Excalibur to 200 Hz at 0.5% noise). Up to this bound a fit is
 /// taken, the set around it widened by its misfit. A record the fit's
 /// class cannot hold leaves far more (the Excalibur's 4 ms late, 39,000;
-/// a reversed sign, tens of thousands), or no order converges (a handle
-/// on a spring to ground): past 25, the misfit's RMS five times the
-/// noise's, a model would claim what the device does not have.
+/// a reversed sign, tens of thousands), or no order converges: past 25,
+/// the misfit's RMS five times the noise's, a model would claim what the
+/// device does not have.
 pub const MOST_AXIS_MISFIT: f64 = 25.0;
 
 /// The fit [`fit_orders`] chose, or why none is taken: no order

@@ -1,4 +1,5 @@
 use super::*;
+use crate::frf::Frf;
 use twoport_design::network::HumanBound;
 use twoport_design::Designer;
 
