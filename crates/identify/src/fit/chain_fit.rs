@@ -49,38 +49,7 @@ pub fn fit_chain(
             ground,
         }
     } else {
-        let w = |i: &usize| TAU * x.freq_hz[*i];
-        let (l, ground) = match ground_at {
-            // Held at the actuator: the free chain's features, the spring
-            // taken out of the record's dynamic stiffness.
-            None | Some(0) => {
-                let free;
-                let x = if k_g > 0.0 {
-                    free = Frf {
-                        response: x.response.iter().map(|h| 1.0 / (1.0 / h - k_g)).collect(),
-                        ..x.clone()
-                    };
-                    &free
-                } else {
-                    x
-                };
-                let (anti, res) = features(x, modes)?;
-                let anti: Vec<f64> = anti.iter().map(w).collect();
-                let res: Vec<f64> = res.iter().map(w).collect();
-                (ladder::synthesise(m_t, &anti, &res)?, ground)
-            }
-            // Held further along: the record's own resonances (one more
-            // than the modes: the chain's on the spring) give the chain
-            // held at the handle, and a spring held nearer the actuator
-            // starts there too.
-            Some(at) => {
-                let (anti, res) = features(x, modes + 1)?;
-                let anti: Vec<f64> = anti[1..].iter().map(w).collect();
-                let res: Vec<f64> = res.iter().map(w).collect();
-                let (l, end) = ladder::synthesise_held(k_g, &anti, &res)?;
-                (l, Some(chain::Ground { at, npm: end }))
-            }
-        };
+        let (l, ground) = ladder_start(x, modes, ground_at, k_g, m_t)?;
         let links = (0..l.springs_npm.len())
             .map(|i| {
                 let (a, b) = (l.masses_kg[i], l.masses_kg[i + 1]);
@@ -139,4 +108,52 @@ pub fn fit_chain(
             })
         })
         .min_by(|a, b| a.chi2.total_cmp(&b.chi2))
+}
+
+/// The chain's masses and springs from the record's features: free or
+/// held at the actuator, the free chain's ladder (the spring taken out of
+/// the record's dynamic stiffness); held further along, the ladder held at
+/// its far end, the spring moved to `ground_at`. `k_g` and `m_t` are the
+/// low harmonics' spring (N/m) and mass (kg).
+fn ladder_start(
+    x: &Frf,
+    modes: usize,
+    ground_at: Option<usize>,
+    k_g: f64,
+    m_t: f64,
+) -> Option<(ladder::Ladder, Option<chain::Ground>)> {
+    let ground = ground_at.map(|at| chain::Ground { at, npm: k_g });
+    let w = |i: &usize| TAU * x.freq_hz[*i];
+    let (l, ground) = match ground_at {
+        // Held at the actuator: the free chain's features, the spring
+        // taken out of the record's dynamic stiffness.
+        None | Some(0) => {
+            let free;
+            let x = if k_g > 0.0 {
+                free = Frf {
+                    response: x.response.iter().map(|h| 1.0 / (1.0 / h - k_g)).collect(),
+                    ..x.clone()
+                };
+                &free
+            } else {
+                x
+            };
+            let (anti, res) = features(x, modes)?;
+            let anti: Vec<f64> = anti.iter().map(w).collect();
+            let res: Vec<f64> = res.iter().map(w).collect();
+            (ladder::synthesise(m_t, &anti, &res)?, ground)
+        }
+        // Held further along: the record's own resonances (one more
+        // than the modes: the chain's on the spring) give the chain
+        // held at the handle, and a spring held nearer the actuator
+        // starts there too.
+        Some(at) => {
+            let (anti, res) = features(x, modes + 1)?;
+            let anti: Vec<f64> = anti[1..].iter().map(w).collect();
+            let res: Vec<f64> = res.iter().map(w).collect();
+            let (l, end) = ladder::synthesise_held(k_g, &anti, &res)?;
+            (l, Some(chain::Ground { at, npm: end }))
+        }
+    };
+    Some((l, ground))
 }
