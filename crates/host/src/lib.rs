@@ -10,6 +10,7 @@ pub mod falcon;
 pub mod haply;
 mod in_process;
 mod local;
+mod packet;
 mod pc_loop;
 mod port;
 mod session;
@@ -19,6 +20,7 @@ pub mod touch;
 pub use device::{AxisState, HostBoard, State, HEARTBEAT_PERIOD, HEARTBEAT_POLLS, STATE_BUFFER};
 pub use error::LinkError;
 pub use local::{LocalBoard, LocalDelta, LocalFast, LocalSerialArm};
+pub use packet::PacketError;
 pub use pc_loop::{
     accept_unproven_gains, DeviceIo, LoopThread, LoopTiming, PcBoard, Percentiles, Priority,
     SteppedPc, Ticker, LATE_PERIODS, STALL, TIMING_WINDOW,

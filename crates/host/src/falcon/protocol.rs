@@ -19,7 +19,7 @@
 //!   encoders' signed 16-bit counts the same way and a byte of grip
 //!   buttons (low nibble) and homed motors (next three bits).
 
-use std::fmt;
+pub use crate::PacketError;
 
 /// The Falcon's USB vendor and product ids.
 pub const USB_ID: (u16, u16) = (0x0403, 0xcb48);
@@ -74,26 +74,6 @@ pub struct Status {
     pub buttons: u8,
     /// The motors homed, a bit each.
     pub homed: u8,
-}
-
-/// What is wrong with a packet.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum PacketError {
-    /// Not framed by `<` and `>`.
-    Frame,
-    /// A byte that is not a nibble offset by `0x41`, at its position.
-    Nibble(usize),
-}
-
-impl fmt::Display for PacketError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            PacketError::Frame => write!(f, "a packet not framed by '<' and '>'"),
-            PacketError::Nibble(at) => {
-                write!(f, "byte {at} of a packet is not a nibble offset by 0x41")
-            }
-        }
-    }
 }
 
 /// `v` as four nibbles, the least significant first, into `four`.

@@ -20,7 +20,7 @@
 //! Direction 0 is counter-clockwise (the angle grows with the counts, a
 //! positive torque turns the joint toward larger angles), 1 clockwise.
 
-use std::fmt;
+pub use crate::PacketError;
 
 /// The packet types the host sends.
 pub const RESET: u8 = 0;
@@ -83,54 +83,6 @@ pub struct Setup<const N: usize> {
     pub joints: [Joint; N],
     /// The analog pins read, ascending.
     pub sensor_pins: Vec<u8>,
-}
-
-/// What is wrong with a packet.
-#[derive(Clone, Debug, PartialEq)]
-pub enum PacketError {
-    /// Fewer bytes than the packet needs.
-    Short {
-        /// Bytes there.
-        got: usize,
-        /// Bytes needed.
-        need: usize,
-    },
-    /// A reply or packet for another device.
-    DeviceId {
-        /// The id it carries.
-        got: u8,
-        /// The id set up.
-        expected: u8,
-    },
-    /// A type byte the protocol does not have.
-    Type(u8),
-    /// A setup the protocol cannot carry (ports, directions, pins), named.
-    Setup(String),
-    /// A value that is not a finite number, at its position in the reply.
-    NotFinite {
-        /// Which value (sensors first, then encoders).
-        index: usize,
-    },
-}
-
-impl fmt::Display for PacketError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            PacketError::Short { got, need } => {
-                write!(f, "a short packet: {got} of its {need} bytes")
-            }
-            PacketError::DeviceId { got, expected } => write!(
-                f,
-                "a packet for device id {got} where device {expected} is set up \
-                 (another program on the port, or a garbled byte)"
-            ),
-            PacketError::Type(t) => write!(f, "packet type {t}: the protocol has 0, 1 and 2"),
-            PacketError::Setup(why) => write!(f, "a setup the protocol cannot carry: {why}"),
-            PacketError::NotFinite { index } => {
-                write!(f, "value {index} of the reply is not a finite number")
-            }
-        }
-    }
 }
 
 impl<const N: usize> Setup<N> {
