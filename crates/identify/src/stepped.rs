@@ -111,10 +111,11 @@ fn no_force(step: usize, force_n: f64) -> IdentifyError {
     }
 }
 
-/// The complex amplitude `a - j b` of `x ≈ a cos(ω n) + b sin(ω n) + c`
-/// (`ω` in radians a sample, `n` counted from `start`), by least squares:
-/// the amplitude a DFT at `ω` would give, over two.
-fn amplitude(x: &[f64], w: f64, start: usize) -> Complex64 {
+/// The least squares of `x ≈ a cos(ω n) + b sin(ω n) + c` (`ω` in
+/// radians a sample, `n` counted from `start`): `(a, b, c)`, and the
+/// projection `y` of `x` on the three (whose product with them is what
+/// they explain of `x`); `None` where the three are not independent.
+fn sine_fit(x: &[f64], w: f64, start: usize) -> Option<(Vector3<f64>, Vector3<f64>)> {
     let mut a = Matrix3::zeros();
     let mut y = Vector3::zeros();
     for (i, v) in x.iter().enumerate() {
@@ -123,8 +124,14 @@ fn amplitude(x: &[f64], w: f64, start: usize) -> Complex64 {
         a += row * row.transpose();
         y += row * *v;
     }
-    match a.cholesky().map(|c| c.solve(&y)) {
-        Some(p) => Complex64::new(p[0], -p[1]),
+    a.cholesky().map(|c| (c.solve(&y), y))
+}
+
+/// The complex amplitude `a - j b` of [`sine_fit`]: the amplitude a DFT
+/// at `ω` would give, over two.
+fn amplitude(x: &[f64], w: f64, start: usize) -> Complex64 {
+    match sine_fit(x, w, start) {
+        Some((p, _)) => Complex64::new(p[0], -p[1]),
         None => Complex64::new(0.0, 0.0),
     }
 }
@@ -157,17 +164,7 @@ fn frequency(f: &[f64]) -> Option<f64> {
     // What a sine, a cosine and a constant at `w` explain of `f`, by least
     // squares: exact for a pure sine however few its cycles, where the
     // spectrum's peak leans toward its image at `-w`.
-    let power_at = |w: f64| -> f64 {
-        let mut a = Matrix3::zeros();
-        let mut y = Vector3::zeros();
-        for (i, v) in f.iter().enumerate() {
-            let t = w * i as f64;
-            let row = Vector3::new(t.cos(), t.sin(), 1.0);
-            a += row * row.transpose();
-            y += row * *v;
-        }
-        a.cholesky().map_or(0.0, |c| y.dot(&c.solve(&y)))
-    };
+    let power_at = |w: f64| -> f64 { sine_fit(f, w, 0).map_or(0.0, |(p, y)| y.dot(&p)) };
     let (mut lo, mut hi) = ((peak as f64 - 1.0) * bin, (peak as f64 + 1.0) * bin);
     let g = (5f64.sqrt() - 1.0) / 2.0;
     for _ in 0..40 {
