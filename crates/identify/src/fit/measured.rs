@@ -95,12 +95,13 @@ impl Measured {
         signals.extend(log.load_cell_n.as_deref());
         let steps =
             crate::stepped::stepped(&log.force_n, &signals, log.period_s, step_ticks, skip)?;
-        let mut frfs = steps.responses.clone();
-        for (f, signal) in frfs.iter_mut().zip(&signals) {
+        let mut quanta: Vec<Option<f64>> = signals.iter().map(|s| quantum(s)).collect();
+        let mut frfs = steps.responses;
+        for (f, q) in frfs.iter_mut().zip(&quanta) {
             // A quantised reading's error repeats each cycle, so it does
             // not average over a step: its share of a cycle's amplitude,
             // `q²/(3 N)` for `N` samples a cycle, over the force's.
-            if let Some(q) = quantum(signal) {
+            if let Some(q) = q {
                 for (i, v) in f.variance.iter_mut().enumerate() {
                     let a = steps.force_n[i];
                     *v += q * q / (3.0 * steps.cycle_ticks[i] * (a * a).max(f64::MIN_POSITIVE));
@@ -109,7 +110,7 @@ impl Measured {
         }
         let load_cell = (frfs.len() > 1).then(|| frfs.remove(1));
         let position = frfs.remove(0);
-        let encoder = quantum(&log.position_m);
+        let encoder = quanta.swap_remove(0);
         passive(&position, log.period_s)?;
         Ok(Measured {
             position,
