@@ -19,7 +19,7 @@ const T: f64 = 1e-3;
 fn scene(k: f64, b: f64, hand: &twoport_design::verify::Hand, ve: &Ve) -> Scene {
     let mut s = scene_on("models/excalibur.toml", k, b, ve);
     assert!(
-        hand.grasp.is_some() && hand.second.is_none(),
+        hand.grasp.is_some() && hand.hanging.is_empty(),
         "the simulator's hand is the grasp plus an arm of one mass"
     );
     s.human.grasp = GraspKind::Maximum;
@@ -99,7 +99,7 @@ fn verifys_counterexample_grows_in_the_simulator_at_its_rate() {
     let past = Gains::from(ImpedanceGains::new((1.2 * k_max) as f32, 90.0));
     let v = verify(&model, T, &past, human).unwrap();
     assert!(v.unstable, "{v:?}");
-    let (hand, ve) = (v.termination.hand, v.termination.ve);
+    let (hand, ve) = (v.termination.hand.clone(), v.termination.ve);
     // Growth between two windows a second apart, against rho^(1 s / T).
     let w = [(4.0, 4.5), (5.0, 5.5)];
     let p = peaks(scene(1.2 * k_max, 90.0, &hand, &ve), &w);
@@ -154,7 +154,7 @@ fn a_declared_delay_enters_the_simulator() {
         stiffness_npm: 0.1,
         damping_nspm: 1e-4,
         grasp: None,
-        second: None,
+        hanging: Vec::new(),
     };
     let worst = (0..25)
         .flat_map(|i| {
@@ -166,7 +166,7 @@ fn a_declared_delay_enters_the_simulator() {
         })
         .map(|ve| {
             let t = Termination {
-                hand: hands_off,
+                hand: hands_off.clone(),
                 ve,
             };
             (radius(&m, T, &past, &t).unwrap(), ve)

@@ -49,7 +49,7 @@ fn cross_check(m: &DeviceModel, p: &Plant, (k, b): (f64, f64), (n, d): (u32, u32
         stiffness_npm: 1e8,
         damping_nspm: 1e-3,
         grasp: None,
-        second: None,
+        hanging: Vec::new(),
     };
     {
         let (m, p) = (m, p);
@@ -164,7 +164,7 @@ fn random_rigid_devices_hold_where_the_proof_says() {
         stiffness_npm: k,
         damping_nspm: 1e-3,
         grasp: None,
-        second: None,
+        hanging: Vec::new(),
     };
     let mut checked = 0;
     for _ in 0..12 {

@@ -515,7 +515,9 @@ pub(crate) fn host_ve(
                 if verify {
                     let r = verify_host(&pose.model, t, (k, b), human, &host)
                         .map_err(|e| e.to_string())?;
-                    if v.is_none_or(|v| r.spectral_radius > v.spectral_radius) {
+                    if v.as_ref()
+                        .is_none_or(|v| r.spectral_radius > v.spectral_radius)
+                    {
                         v = Some(r);
                     }
                 }

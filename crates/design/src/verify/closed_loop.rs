@@ -73,7 +73,7 @@ pub(super) fn sampled(model: &DeviceModel, hand: &Hand, t: f64) -> Result<Sample
     let n = model.dof();
     let grasp = hand.grasp;
     let ny = n + usize::from(grasp.is_some());
-    let nq = ny + usize::from(hand.second.is_some());
+    let nq = ny + hand.hanging.len();
     let (mut m, mut d, mut k) = (
         DMatrix::<f64>::zeros(nq, nq),
         DMatrix::<f64>::zeros(nq, nq),
@@ -115,10 +115,10 @@ pub(super) fn sampled(model: &DeviceModel, hand: &Hand, t: f64) -> Result<Sample
     }
     link(&mut k, hk, (&gp, &cp), (&none, &none));
     link(&mut d, hb, (&gp, &cp), (&none, &none));
-    if let Some(r) = hand.second {
+    for (i, r) in hand.hanging.iter().enumerate() {
         let mut unit = vec![0.0; nq];
-        unit[ny] = 1.0;
-        m[(ny, ny)] = r.mass_kg;
+        unit[ny + i] = 1.0;
+        m[(ny + i, ny + i)] = r.mass_kg;
         link(&mut k, r.stiffness_npm, (&gp, &cp), (&unit, &unit));
         link(&mut d, r.damping_nspm, (&gp, &cp), (&unit, &unit));
     }

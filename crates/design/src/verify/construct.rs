@@ -33,7 +33,7 @@ use std::f64::consts::PI;
 use twoport_control::Gains;
 
 /// A termination built to put a pole on the unit circle.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Constructed {
     /// The frequency of the pole (Hz).
     pub frequency_hz: f64,
@@ -63,7 +63,7 @@ impl Setting<'_> {
             stiffness_npm: k,
             damping_nspm: 0.0,
             grasp: self.grasp,
-            second: None,
+            hanging: Vec::new(),
         }
     }
 
@@ -145,7 +145,7 @@ pub fn construct(
 ) -> Option<Constructed> {
     let seeds: Vec<(f64, f64)> = seeds
         .iter()
-        .filter(|h| h.second.is_none())
+        .filter(|h| h.hanging.is_empty())
         .map(|h| (h.mass_kg, h.stiffness_npm))
         .collect();
     let set = Setting {

@@ -24,7 +24,7 @@ use serde::Serialize;
 use std::f64::consts::PI;
 
 /// What the search of hands found against a host loop.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct HostVerdict {
     /// Whether the worst hand makes the loop grow (past the numerical
     /// margins of [`Radius::unstable`]).
@@ -154,7 +154,7 @@ pub fn verify_host(
         stiffness_npm: 10f64.powf(p[1]),
         damping_nspm: 10f64.powf(p[2]),
         grasp: human,
-        second: None,
+        hanging: Vec::new(),
     };
     let mut evaluations = 0;
     let mut eval = |p: &mut Vec<f64>| -> Radius {

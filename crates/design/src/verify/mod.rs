@@ -56,10 +56,10 @@ pub enum Ve {
 /// ground. Without a grasp the mass is held rigidly at the handle; with one
 /// (the paper's Fig. 3, when a human bound is set) it hangs from the handle
 /// through the bound's spring and damper, so the hand's impedance is the
-/// bound `Z_max` in series with the mass-spring-damper. A second mass may
-/// hang from the first on its own spring and damper: a hand with two
+/// bound `Z_max` in series with the mass-spring-damper. Further masses may
+/// hang from the first, each on its own spring and damper: a hand with several
 /// resonances.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Hand {
     /// Mass (kg).
     pub mass_kg: f64,
@@ -69,9 +69,12 @@ pub struct Hand {
     pub damping_nspm: f64,
     /// The grasp in series, `Z_max = b + k/s`, or none.
     pub grasp: Option<HumanBound>,
-    /// A second mass on a spring and damper from the first, or none.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub second: Option<Resonator>,
+    /// Masses hanging from the first, each on a spring and a damper of
+    /// its own (none: a hand with one resonance). Lossless, they give the
+    /// hand any reactance at any finite set of frequencies (Foster's
+    /// theorem), which the constructive search needs.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub hanging: Vec<Resonator>,
 }
 
 impl Hand {
@@ -81,7 +84,7 @@ impl Hand {
         stiffness_npm: 0.0,
         damping_nspm: 0.0,
         grasp: None,
-        second: None,
+        hanging: Vec::new(),
     };
 }
 
@@ -97,7 +100,7 @@ pub struct Resonator {
 }
 
 /// A hand and a VE.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Termination {
     /// At the handle.
     pub hand: Hand,
@@ -133,7 +136,7 @@ impl Radius {
 }
 
 /// What the search found.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Verdict {
     /// Whether the worst termination makes the loop unstable: a mode grows
     /// by more than its numerical error (see [`Radius::unstable`]).
@@ -271,7 +274,7 @@ mod tests {
                         stiffness_npm: 0.05 * w * w,
                         damping_nspm: 0.01,
                         grasp: Some(HumanBound::PAPER),
-                        second: None,
+                        hanging: Vec::new(),
                     },
                     ve,
                 };
@@ -298,12 +301,12 @@ mod tests {
     fn a_rigidly_held_second_mass_adds_to_the_first() {
         let model = crate::model::shipped_for_tests().remove(0);
         for grasp in [None, Some(HumanBound::PAPER)] {
-            let hand = |mass_kg, second| Hand {
+            let hand = |mass_kg, hanging: Option<Resonator>| Hand {
                 mass_kg,
                 stiffness_npm: 2e4,
                 damping_nspm: 1.0,
                 grasp,
-                second,
+                hanging: hanging.into_iter().collect(),
             };
             let ve = Ve::Cursor { mass_kg: 0.2 };
             let rho = |hand| {

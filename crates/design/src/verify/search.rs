@@ -85,11 +85,15 @@ impl Search<'_> {
                 stiffness_npm: x(1),
                 damping_nspm: x(2),
                 grasp: self.grasp,
-                second: self.two.then(|| Resonator {
-                    mass_kg: x(3),
-                    stiffness_npm: x(4),
-                    damping_nspm: x(5),
-                }),
+                hanging: if self.two {
+                    vec![Resonator {
+                        mass_kg: x(3),
+                        stiffness_npm: x(4),
+                        damping_nspm: x(5),
+                    }]
+                } else {
+                    Vec::new()
+                },
             },
             ve: kind.build(&p[self.ve_at()..]),
         }

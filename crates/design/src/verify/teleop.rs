@@ -34,7 +34,7 @@ pub struct Teleoperator<'a> {
 /// handle and a passive environment at the slave's, each a lumped mass
 /// with a spring and a damper to ground ([`Hand::OFF`]: let go, or free
 /// space).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TeleopTermination {
     /// At the master's handle.
     pub operator: Hand,
@@ -149,7 +149,7 @@ pub fn teleop_radius(t: &Teleoperator, term: &TeleopTermination) -> Result<Radiu
 }
 
 /// What the search over operators and environments found.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TeleopVerdict {
     /// Whether the worst termination makes the loop unstable.
     pub unstable: bool,
@@ -179,7 +179,7 @@ fn sweep() -> Vec<Hand> {
                     stiffness_npm: k,
                     damping_nspm: b,
                     grasp: None,
-                    second: None,
+                    hanging: Vec::new(),
                 });
             }
         }
@@ -210,14 +210,14 @@ pub fn verify_teleop(t: &Teleoperator) -> Result<TeleopVerdict, String> {
         .iter()
         .flat_map(|o| {
             environments.iter().map(move |e| TeleopTermination {
-                operator: *o,
-                environment: *e,
+                operator: o.clone(),
+                environment: e.clone(),
             })
         })
         .chain(ends.iter().flat_map(|e| {
             operators.iter().map(move |o| TeleopTermination {
-                operator: *o,
-                environment: *e,
+                operator: o.clone(),
+                environment: e.clone(),
             })
         }));
     let mut worst: Option<(Radius, TeleopTermination)> = None;
@@ -225,7 +225,7 @@ pub fn verify_teleop(t: &Teleoperator) -> Result<TeleopVerdict, String> {
     for term in pairs {
         let r = teleop_radius(t, &term)?;
         evaluations += 1;
-        if worst.is_none_or(|(w, _)| r.score > w.score) {
+        if worst.as_ref().is_none_or(|(w, _)| r.score > w.score) {
             worst = Some((r, term));
         }
     }

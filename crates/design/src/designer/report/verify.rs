@@ -19,7 +19,7 @@ pub struct VerifyReport {
 
 impl Serialize for VerifyReport {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let v = serde_json::to_value(self.verdict).map_err(serde::ser::Error::custom)?;
+        let v = serde_json::to_value(&self.verdict).map_err(serde::ser::Error::custom)?;
         let mut m = s.serialize_map(None)?;
         if let serde_json::Value::Object(fields) = v {
             for (k, v) in fields {
