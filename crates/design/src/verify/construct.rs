@@ -23,7 +23,8 @@
 //! the bound lets vary independently: the bound is conservative there.
 
 use super::closed_loop::actuator_response;
-use super::{radius, Hand, Radius, Termination, Ve};
+use super::foster::alias_hands;
+use super::{radius, Hand, Radius, Resonator, Termination, Ve};
 use crate::analysis::{admittance_coupling_tf, impedance_coupling_tf, regulator_tf};
 use crate::network::HumanBound;
 use crate::DeviceModel;
@@ -96,11 +97,13 @@ impl Setting<'_> {
     }
 
     /// The lossless hand at `w` with the greatest `Re S`, and `Re S`:
-    /// `seeds` (the search's worst hands, their damping removed), and a
-    /// sweep of masses, springs, and masses on springs resonant across the
+    /// `seeds` (the search's worst hands, their damping removed), a sweep
+    /// of masses, springs, and masses on springs resonant across the
     /// band, where their resonance folds onto `w`, and at multiples of the
-    /// sample rate (where a hand's sampled poles meet on the real axis).
-    fn worst_hand(&self, w: f64, seeds: &[(f64, f64)]) -> Option<((f64, f64), f64)> {
+    /// sample rate (where a hand's sampled poles meet on the real axis),
+    /// and on the impedance display the hands that take the proof's worst
+    /// value at the aliases of `w` that matter most ([`alias_hands`]).
+    fn worst_hand(&self, w: f64, seeds: &[(f64, f64)]) -> Option<(Hand, f64)> {
         let ws = 2.0 * PI / self.t;
         let mut resonances: Vec<f64> = (0..40)
             .map(|i| 2.0 * PI * (2.0 * ws / PI).powf(i as f64 / 39.0))
@@ -114,19 +117,46 @@ impl Setting<'_> {
                     .filter(|r| **r > 0.0),
             );
         }
-        let mut hands: Vec<(f64, f64)> = seeds.to_vec();
+        let mut pairs: Vec<(f64, f64)> = seeds.to_vec();
         for i in 0..15 {
             let m = 10f64.powf(-5.0 + i as f64 / 2.0);
-            hands.push((m, 0.0));
-            hands.extend(resonances.iter().map(|r| (m, m * r * r)));
+            pairs.push((m, 0.0));
+            pairs.extend(resonances.iter().map(|r| (m, m * r * r)));
         }
         if self.grasp.is_none() {
-            hands.extend((0..23).map(|i| (0.0, 10f64.powf(i as f64 / 2.0))));
+            pairs.extend((0..23).map(|i| (0.0, 10f64.powf(i as f64 / 2.0))));
         }
-        hands
+        let best = pairs
             .into_iter()
-            .filter_map(|h| self.s(&self.hand(h), w).map(|s| (h, s.re)))
-            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|h| self.hand(h))
+            .filter_map(|h| self.s(&h, w).map(|s| (h, s.re)))
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        if best.as_ref().is_some_and(|b| b.1 > 0.0) {
+            return best;
+        }
+        let Gains::Impedance(_) = self.gains else {
+            return best;
+        };
+        // More aliases taken, until enough are: the deficit falls about
+        // by half with each doubling where the gains' tail is long, so
+        // the ladder stops where what is left to gain cannot cover it
+        // (each rung costs a discretisation with a mass per alias).
+        let (model, t) = (self.model, self.t);
+        let counts = [1, 2, 4, 8, 16, 32, 64, 128, 256];
+        let hands = alias_hands(model, t, self.grasp, self.delay, w, &counts);
+        let mut best = best;
+        let mut last: Option<f64> = None;
+        for h in hands {
+            let Some(s) = self.s(&h, w) else { continue };
+            if best.as_ref().is_none_or(|b| s.re > b.1) {
+                best = Some((h, s.re));
+            }
+            if s.re > 0.0 || last.is_some_and(|l| -s.re > 2.0 * (s.re - l)) {
+                break;
+            }
+            last = Some(s.re);
+        }
+        best
     }
 }
 
@@ -155,7 +185,15 @@ pub fn construct(
         grasp: human,
         delay: model.lag(period_s).ticks as usize,
     };
-    let mut candidates: Vec<(f64, (f64, f64), f64)> = frequencies_hz
+    // At Nyquist a real hand's two nearest aliases are one frequency, so
+    // a frequency just below it, where a hand resonant at Nyquist parts
+    // them, is tried too.
+    let nyquist_hz = 0.5 / period_s;
+    let mut frequencies_hz = frequencies_hz.to_vec();
+    if frequencies_hz.iter().any(|f| *f > 0.999 * nyquist_hz) {
+        frequencies_hz.extend([0.998, 0.99].map(|x| x * nyquist_hz));
+    }
+    let mut candidates: Vec<(f64, Hand, f64)> = frequencies_hz
         .iter()
         .map(|f| 2.0 * PI * f)
         .filter_map(|w| set.worst_hand(w, &seeds).map(|(h, r)| (w, h, r)))
@@ -169,25 +207,34 @@ pub fn construct(
 }
 
 impl Setting<'_> {
-    /// The hand `(m, k)` scaled, or the frequency `w` moved, to the root
-    /// of `Re S`, and the lossless VE that closes a pole there.
-    fn pole_on_circle(&self, w: f64, (m, k): (f64, f64)) -> Option<Constructed> {
+    /// The hand scaled, or the frequency `w` moved, to the root of
+    /// `Re S`, and the lossless VE that closes a pole there.
+    fn pole_on_circle(&self, w: f64, hand: Hand) -> Option<Constructed> {
         let period_s = self.t;
         // A root of Re S on a path from there to where Re S < 0: the hand
         // scaled toward zero (it lets go, and the open device with its
         // coupling is stable), or, where even the free hand violates it, the
         // frequency moved off the violation with the hand kept.
-        let re = |scale: f64, w: f64| self.s(&self.hand((m * scale, k * scale)), w).map(|s| s.re);
+        let re = |scale: f64, w: f64| self.s(&scaled(&hand, scale), w).map(|s| s.re);
         let (scale, w) = if re(1e-12, w)? < 0.0 {
             let l = root(|l| re(l.exp(), w), (1e-12f64).ln(), 0.0)?;
             (l.exp(), w)
         } else {
-            let off = (1..=60)
-                .map(|i| w * (1.0 + 0.002 * f64::from(i / 2) * if i % 2 == 0 { 1.0 } else { -1.0 }))
+            // Near `w` first, then anywhere in the band, nearest first.
+            let near = (1..=60).map(|i| {
+                w * (1.0 + 0.002 * f64::from(i / 2) * if i % 2 == 0 { 1.0 } else { -1.0 })
+            });
+            let nyquist = PI / period_s;
+            let mut band: Vec<f64> = (0..=200)
+                .map(|i| nyquist * 1e-4f64.powf(f64::from(i) / 200.0))
+                .collect();
+            band.sort_by(|a, b| (a / w).ln().abs().total_cmp(&(b / w).ln().abs()));
+            let off = near
+                .chain(band)
                 .find(|&v| v > 0.0 && v * period_s <= PI && re(1.0, v).is_some_and(|r| r < 0.0))?;
             (1.0, root(|v| re(1.0, v), off, w)?)
         };
-        let hand = self.hand((m * scale, k * scale));
+        let hand = scaled(&hand, scale);
         let s = self.s(&hand, w)?;
         let half = 0.5 * w * period_s;
         // The lossless VE of immittance j Im S, as an admittance j β: a
@@ -216,17 +263,60 @@ impl Setting<'_> {
     }
 }
 
+/// `hand` with every mass and spring scaled by `scale`: its impedance
+/// scaled, its resonances kept (and its grasp, which is the bound's,
+/// with the least mass behind it that [`Setting::hand`] keeps).
+fn scaled(hand: &Hand, scale: f64) -> Hand {
+    let least = if hand.grasp.is_some() { 1e-6 } else { 0.0 };
+    Hand {
+        mass_kg: (hand.mass_kg * scale).max(least),
+        stiffness_npm: hand.stiffness_npm * scale,
+        damping_nspm: hand.damping_nspm * scale,
+        grasp: hand.grasp,
+        hanging: hand
+            .hanging
+            .iter()
+            .map(|r| Resonator {
+                mass_kg: r.mass_kg * scale,
+                stiffness_npm: r.stiffness_npm * scale,
+                damping_nspm: r.damping_nspm * scale,
+            })
+            .collect(),
+    }
+}
+
 /// The root of `f` between `neg` (where `f < 0`) and `pos` (where
-/// `f >= 0`), by bisection; `None` where `f` cannot be evaluated.
+/// `f >= 0`), by false position with the Illinois rule (a bracket kept,
+/// each end's value halved when the other end moved twice: a handful of
+/// evaluations where bisection takes fifty, and a hand with a hundred
+/// masses costs a discretisation each); `None` where `f` cannot be
+/// evaluated.
 fn root(f: impl Fn(f64) -> Option<f64>, mut neg: f64, mut pos: f64) -> Option<f64> {
+    let (mut f_neg, mut f_pos) = (f(neg)?, f(pos)?);
+    let mut side = 0i8;
     for _ in 0..200 {
-        let mid = 0.5 * (neg + pos);
-        if f(mid)? >= 0.0 {
-            pos = mid;
-        } else {
-            neg = mid;
-        }
         if (pos - neg).abs() <= 1e-15 * pos.abs().max(1.0) {
+            break;
+        }
+        let mut x = (neg * f_pos - pos * f_neg) / (f_pos - f_neg);
+        if !(x.is_finite() && x > neg.min(pos) && x < neg.max(pos)) {
+            x = 0.5 * (neg + pos);
+        }
+        let fx = f(x)?;
+        if fx >= 0.0 {
+            (pos, f_pos) = (x, fx);
+            if side == 1 {
+                f_neg *= 0.5;
+            }
+            side = 1;
+        } else {
+            (neg, f_neg) = (x, fx);
+            if side == -1 {
+                f_pos *= 0.5;
+            }
+            side = -1;
+        }
+        if fx == 0.0 {
             break;
         }
     }

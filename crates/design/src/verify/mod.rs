@@ -176,6 +176,7 @@ pub const OSCILLATING_MARGIN: f64 = 1e-10;
 
 mod closed_loop;
 mod construct;
+mod foster;
 mod host;
 mod search;
 mod simplex;
