@@ -32,6 +32,7 @@ mod region;
 mod run;
 mod spec;
 mod synthesis;
+mod teleop;
 mod verify;
 
 use crate::args::*;
@@ -89,6 +90,10 @@ pub(crate) enum Cmd {
     /// A device's coupling proven over its workspace at its loop's rate
     /// and latency, beside the stiffness CHAI3D sets for it by hand.
     Spec(SpecArgs),
+    /// Two devices through one teleoperator law: a master under the
+    /// operator's hand, a slave on the environment, a channel between.
+    #[command(subcommand)]
+    Teleop(Teleop),
 }
 
 fn main() -> ExitCode {
@@ -121,6 +126,7 @@ fn main() -> ExitCode {
         Cmd::HostVe(a) => one_axis(a, host::host_ve),
         Cmd::Devices(a) => print(a.json, &spec::devices()),
         Cmd::Spec(a) => spec::spec(&a.device, a.min_grasp).and_then(|r| print(a.json, &r)),
+        Cmd::Teleop(Teleop::Verify(a)) => show(a.json, teleop::verify(a)),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,

@@ -205,6 +205,8 @@ fn every_subcommand_has_help() {
         vec!["rates", "--help"],
         vec!["devices", "--help"],
         vec!["spec", "--help"],
+        vec!["teleop", "verify", "--help"],
+        vec!["teleop", "verify", "four-channel", "--help"],
     ] {
         let out = TWOPORT.run(&args);
         assert!(out.status.success(), "{args:?}");

@@ -21,6 +21,7 @@ pub struct TeleopStep<R = f32> {
 /// other side's delayed motion (Lawrence's local controller and position
 /// channel in one, `C_m = -C_4`, `C_s = -C_1`).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct FourChannelGains {
     /// The master's coupling to the slave's motion: stiffness (N/m).
     pub k_m_npm: f32,
@@ -56,6 +57,32 @@ impl FourChannelGains {
         c5: 0.0,
         c6: 0.0,
     };
+
+    /// Position-position: each side held to the other's motion by the
+    /// spring `k_npm` (N/m) and damper `b_nspm` (N s/m), no force sensed.
+    pub const fn position_position(k_npm: f32, b_nspm: f32) -> Self {
+        FourChannelGains {
+            k_m_npm: k_npm,
+            b_m_nspm: b_nspm,
+            k_s_npm: k_npm,
+            b_s_nspm: b_nspm,
+            ..FourChannelGains::OFF
+        }
+    }
+
+    /// Force reflection: the slave held to the master's motion by the
+    /// spring `k_npm` (N/m) and damper `b_nspm` (N s/m); the master pushed
+    /// by the slave's sensed force scaled by `k_f`, with damping
+    /// `b_m_nspm` (N s/m) of its own.
+    pub const fn position_force(k_npm: f32, b_nspm: f32, k_f: f32, b_m_nspm: f32) -> Self {
+        FourChannelGains {
+            b_local_nspm: b_m_nspm,
+            k_s_npm: k_npm,
+            b_s_nspm: b_nspm,
+            c2: k_f,
+            ..FourChannelGains::OFF
+        }
+    }
 }
 
 /// Lawrence's four-channel teleoperator across a channel that delays
@@ -180,13 +207,7 @@ impl<R: Real, const D: usize> FourChannel<R, D> {
         delay_ticks: usize,
         at: Position,
     ) -> Result<Self, ParamError> {
-        let gains = FourChannelGains {
-            k_m_npm: k_npm,
-            b_m_nspm: b_nspm,
-            k_s_npm: k_npm,
-            b_s_nspm: b_nspm,
-            ..FourChannelGains::OFF
-        };
+        let gains = FourChannelGains::position_position(k_npm, b_nspm);
         Self::new(gains, period_s, delay_ticks, at)
     }
 
@@ -217,13 +238,12 @@ impl<R: Real, const D: usize> FourChannel<R, D> {
         delay_ticks: usize,
         at: Position,
     ) -> Result<Self, ParamError> {
-        let gains = FourChannelGains {
-            b_local_nspm: param::non_negative("b_m (N s/m)", b_m_nspm)?,
-            k_s_npm: k_npm,
-            b_s_nspm: b_nspm,
-            c2: param::non_negative("k_f (force scale)", k_f)?,
-            ..FourChannelGains::OFF
-        };
+        let gains = FourChannelGains::position_force(
+            k_npm,
+            b_nspm,
+            param::non_negative("k_f (force scale)", k_f)?,
+            param::non_negative("b_m (N s/m)", b_m_nspm)?,
+        );
         Self::new(gains, period_s, delay_ticks, at)
     }
 

@@ -9,12 +9,13 @@
 
 use super::closed_loop::{judge, sampled, Sampled};
 use super::{Hand, Radius};
+use crate::designer::TeleopVerifyReport;
 use crate::linalg::balance;
 use crate::rational::{delayed, mul, realise, scale, Rational, Ss};
 use crate::DeviceModel;
 use nalgebra::DMatrix;
 use serde::Serialize;
-use twoport_control::teleop::{Delayed, TeleopTransfer};
+use twoport_control::teleop::{Delayed, FourChannel, FourChannelGains, TeleopTransfer};
 
 /// A teleoperator to check: the two devices (at their models' sample
 /// period, which must agree) and the law between them.
@@ -236,5 +237,50 @@ pub fn verify_teleop(t: &Teleoperator) -> Result<TeleopVerdict, String> {
         frequency_hz: r.frequency_hz,
         termination,
         evaluations,
+    })
+}
+
+/// The longest channel delay [`verify_four_channel`] takes (ticks).
+pub const MAX_DELAY_TICKS: usize = 1024;
+
+/// [`verify_teleop`] on Lawrence's four-channel law of `gains` across a
+/// channel `delay_ticks` long each way, between the models `master` and
+/// `slave` (which must sample at one period): the law the control crate
+/// runs, its z-form searched.
+pub fn verify_four_channel(
+    master: &DeviceModel,
+    slave: &DeviceModel,
+    gains: FourChannelGains,
+    delay_ticks: usize,
+) -> Result<TeleopVerifyReport, crate::Error> {
+    let fail = |why: String| crate::Error::Verify {
+        model: format!("{} and {}", master.name, slave.name),
+        why,
+    };
+    if delay_ticks > MAX_DELAY_TICKS {
+        return Err(fail(format!(
+            "delay {delay_ticks} ticks: at most {MAX_DELAY_TICKS}"
+        )));
+    }
+    let law = FourChannel::<f32, MAX_DELAY_TICKS>::new(
+        gains,
+        master.period_s as f32,
+        delay_ticks,
+        twoport_control::Position::ZERO,
+    )
+    .map_err(|e| fail(e.to_string()))?;
+    let t = Teleoperator {
+        master,
+        slave,
+        law: law.tf(),
+    };
+    let verdict = verify_teleop(&t).map_err(fail)?;
+    Ok(TeleopVerifyReport {
+        master: master.name.clone(),
+        slave: slave.name.clone(),
+        period_s: master.period_s,
+        delay_ticks,
+        gains,
+        verdict,
     })
 }

@@ -8,10 +8,12 @@ use std::fmt;
 
 mod check;
 mod region;
+mod teleop;
 mod verify;
 
 pub use check::CheckReport;
 pub use region::{RegionBound, RegionReport};
+pub use teleop::TeleopVerifyReport;
 pub use verify::VerifyReport;
 
 /// Which display a report is for.

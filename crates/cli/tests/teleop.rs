@@ -1,0 +1,173 @@
+//! `twoport teleop`: two devices through one law, as a lab runs it.
+
+#[path = "../../../tests/support/cli.rs"]
+mod support;
+
+const TWOPORT: support::Tool = support::Tool {
+    bin: env!("CARGO_BIN_EXE_twoport"),
+    root: concat!(env!("CARGO_MANIFEST_DIR"), "/../.."),
+};
+
+const CAPSTAN: &str = "models/capstan.toml";
+
+/// `teleop verify` of position-position at `k` (N/m), no damping, between
+/// two capstan handles, with `delay` ticks each way.
+fn pp(k: &str, delay: &str) -> serde_json::Value {
+    TWOPORT.json(&[
+        "teleop",
+        "verify",
+        "--master",
+        CAPSTAN,
+        "--slave",
+        CAPSTAN,
+        "--delay",
+        delay,
+        "--json",
+        "position-position",
+        "--k",
+        k,
+        "--b",
+        "0",
+    ])
+}
+
+/// Two rigid capstan handles (0.25 kg, 2 N s/m each): their relative
+/// motion is one mass on the sampled spring `2k` with damping `b`, whose
+/// edge is Colgate's `k < b/T` = 2,000 N/m. The search finds nothing 5%
+/// below it and growth 5% above; two ticks of delay break the gains
+/// below it.
+#[test]
+fn position_position_between_two_handles_meets_colgates_edge() {
+    let below = pp("1900", "0");
+    assert_eq!(below["unstable"], false, "{below}");
+    assert_eq!(below["gains"]["k_m_npm"], 1900.0);
+    assert_eq!(below["gains"]["k_s_npm"], 1900.0);
+    assert_eq!(below["delay_ticks"], 0);
+    let above = pp("2100", "0");
+    assert_eq!(above["unstable"], true, "{above}");
+    let delayed = pp("1900", "2");
+    assert_eq!(delayed["unstable"], true, "{delayed}");
+    assert!(delayed["termination"]["operator"].is_object(), "{delayed}");
+}
+
+/// Force reflection and the four channels take their gains by name, and
+/// say them back.
+#[test]
+fn each_law_reports_its_gains() {
+    let v = TWOPORT.json(&[
+        "teleop",
+        "verify",
+        "--master",
+        CAPSTAN,
+        "--slave",
+        CAPSTAN,
+        "--json",
+        "position-force",
+        "--k",
+        "500",
+        "--b",
+        "5",
+        "--k-f",
+        "0.5",
+        "--b-m",
+        "3",
+    ]);
+    let g = &v["gains"];
+    assert_eq!(
+        (g["k_s_npm"].as_f64(), g["c2"].as_f64()),
+        (Some(500.0), Some(0.5))
+    );
+    assert_eq!(g["b_local_nspm"], 3.0);
+    assert_eq!(g["k_m_npm"], 0.0);
+    let text = TWOPORT.run(&[
+        "teleop",
+        "verify",
+        "--master",
+        CAPSTAN,
+        "--slave",
+        CAPSTAN,
+        "four-channel",
+        "--k-m",
+        "300",
+        "--k-s",
+        "400",
+        "--c3",
+        "1",
+    ]);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        text.contains("k_m 300 N/m") && text.contains("k_s 400 N/m"),
+        "{text}"
+    );
+    assert!(text.contains("c3 1"), "{text}");
+}
+
+/// What a lab gets wrong is named: a missing file, devices at two
+/// periods, a delay past the longest channel, a negative gain.
+#[test]
+fn bad_teleoperators_are_named() {
+    let run = |extra: &[&str]| {
+        let mut a = vec!["teleop", "verify"];
+        a.extend(extra);
+        TWOPORT.failure(&a)
+    };
+    let e = run(&[
+        "--master",
+        "no/such.toml",
+        "--slave",
+        CAPSTAN,
+        "position-position",
+        "--k",
+        "1",
+        "--b",
+        "0",
+    ]);
+    assert!(e.contains("--master no/such.toml"), "{e}");
+    let dir = support::scratch("teleop");
+    let fast = dir.join("fast.toml");
+    let text = std::fs::read_to_string(format!("{}/{CAPSTAN}", TWOPORT.root)).unwrap();
+    std::fs::write(
+        &fast,
+        text.replacen("period_s = 0.001", "period_s = 0.0005", 1),
+    )
+    .unwrap();
+    let e = run(&[
+        "--master",
+        CAPSTAN,
+        "--slave",
+        fast.to_str().unwrap(),
+        "position-position",
+        "--k",
+        "1",
+        "--b",
+        "0",
+    ]);
+    assert!(e.contains("one period"), "{e}");
+    let e = run(&[
+        "--master",
+        CAPSTAN,
+        "--slave",
+        CAPSTAN,
+        "--delay",
+        "5000",
+        "position-position",
+        "--k",
+        "1",
+        "--b",
+        "0",
+    ]);
+    assert!(e.contains("delay 5000 ticks: at most 1024"), "{e}");
+    let e = run(&[
+        "--master",
+        CAPSTAN,
+        "--slave",
+        CAPSTAN,
+        "position-position",
+        "--k",
+        "-1",
+        "--b",
+        "0",
+    ]);
+    assert!(e.contains("k_m (N/m)") && e.contains("-1"), "{e}");
+    let _ = std::fs::remove_dir_all(dir);
+}
