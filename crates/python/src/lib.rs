@@ -5,6 +5,7 @@ mod board;
 mod design;
 mod model;
 mod simulate;
+mod teleop;
 
 use pyo3::prelude::*;
 
@@ -20,12 +21,14 @@ fn twoport_py(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(design::zrange, m)?)?;
     m.add_function(wrap_pyfunction!(design::region, m)?)?;
     m.add_function(wrap_pyfunction!(design::host_ve, m)?)?;
+    m.add_function(wrap_pyfunction!(teleop::verify_teleop, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(model::load_device, m)?)?;
     m.add_class::<design::Design>()?;
     m.add_class::<design::Check>()?;
     m.add_class::<design::Verdict>()?;
     m.add_class::<design::HostCheck>()?;
+    m.add_class::<teleop::TeleopVerdict>()?;
     m.add_class::<model::Model>()?;
     m.add_class::<board::Board>()?;
     Ok(())

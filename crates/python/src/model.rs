@@ -34,7 +34,7 @@ pub(crate) enum Pose {
 }
 
 impl Pose {
-    fn load(self) -> PyResult<DeviceModel> {
+    pub(crate) fn load(self) -> PyResult<DeviceModel> {
         match self {
             Pose::Model(m) => Ok(m.get().inner.clone()),
             Pose::Path(p) => load(&p),

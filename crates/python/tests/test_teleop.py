@@ -1,0 +1,36 @@
+"""Teleoperators from Python: two models, the four-channel gains and the
+channel's delay, searched on the exact sampled loop."""
+
+import numpy as np
+import pytest
+
+import twoport
+
+
+def rigid(mass=0.1, damping=1.0, period_s=1e-3):
+    return twoport.Model.from_arrays(
+        np.array([[mass]]), np.array([[damping]]), np.array([[0.0]]),
+        np.array([[1.0, -1.0]]), np.array([[1.0], [-1.0]]),
+        period_s=period_s, peak_force_n=50.0, continuous_force_n=20.0, name="rigid")
+
+
+def test_position_position_meets_colgates_edge_for_the_relative_motion():
+    # Two rigid 0.1 kg, 1 N s/m handles: their relative motion holds below
+    # k = b / T = 1,000 N/m and grows above it; a delay breaks it below.
+    m, s = rigid(), rigid()
+    below = twoport.verify_teleop(m, s, k_m=980.0, k_s=980.0)
+    above = twoport.verify_teleop(m, s, k_m=1020.0, k_s=1020.0)
+    assert not below.unstable, below
+    assert above.unstable and abs(above.frequency_hz - 22.7) < 1.0, above
+    assert above.operator == (0.0, 0.0, 0.0)
+    late = twoport.verify_teleop(m, s, k_m=980.0, k_s=980.0, delay=4)
+    assert late.unstable, late
+
+
+def test_a_bad_teleoperator_raises_naming_it():
+    with pytest.raises(ValueError, match="one period"):
+        twoport.verify_teleop(rigid(), rigid(period_s=5e-4), k_m=100.0, k_s=100.0)
+    with pytest.raises(ValueError, match="at most 1024"):
+        twoport.verify_teleop(rigid(), rigid(), k_m=100.0, k_s=100.0, delay=2000)
+    with pytest.raises(ValueError, match="k_m"):
+        twoport.verify_teleop(rigid(), rigid(), k_m=-1.0)
