@@ -10,25 +10,21 @@ const TWOPORT: support::Tool = support::Tool {
 
 const CAPSTAN: &str = "models/capstan.toml";
 
-/// `teleop verify` of position-position at `k` (N/m), no damping, between
-/// two capstan handles, with `delay` ticks each way.
+/// `teleop verify` between two capstan handles, then `law` (its words).
+fn between_handles(law: &str) -> Vec<String> {
+    format!("teleop verify --master {CAPSTAN} --slave {CAPSTAN} {law}")
+        .split_whitespace()
+        .map(String::from)
+        .collect()
+}
+
+/// `teleop verify --json` of position-position at `k` (N/m), no damping,
+/// between two capstan handles, with `delay` ticks each way.
 fn pp(k: &str, delay: &str) -> serde_json::Value {
-    TWOPORT.json(&[
-        "teleop",
-        "verify",
-        "--master",
-        CAPSTAN,
-        "--slave",
-        CAPSTAN,
-        "--delay",
-        delay,
-        "--json",
-        "position-position",
-        "--k",
-        k,
-        "--b",
-        "0",
-    ])
+    let args = between_handles(&format!(
+        "--delay {delay} --json position-position --k {k} --b 0"
+    ));
+    TWOPORT.json(&args.iter().map(String::as_str).collect::<Vec<_>>())
 }
 
 /// Two rigid capstan handles (0.25 kg, 2 N s/m each): their relative
@@ -54,24 +50,8 @@ fn position_position_between_two_handles_meets_colgates_edge() {
 /// say them back.
 #[test]
 fn each_law_reports_its_gains() {
-    let v = TWOPORT.json(&[
-        "teleop",
-        "verify",
-        "--master",
-        CAPSTAN,
-        "--slave",
-        CAPSTAN,
-        "--json",
-        "position-force",
-        "--k",
-        "500",
-        "--b",
-        "5",
-        "--k-f",
-        "0.5",
-        "--b-m",
-        "3",
-    ]);
+    let args = between_handles("--json position-force --k 500 --b 5 --k-f 0.5 --b-m 3");
+    let v = TWOPORT.json(&args.iter().map(String::as_str).collect::<Vec<_>>());
     let g = &v["gains"];
     assert_eq!(
         (g["k_s_npm"].as_f64(), g["c2"].as_f64()),
@@ -79,21 +59,8 @@ fn each_law_reports_its_gains() {
     );
     assert_eq!(g["b_local_nspm"], 3.0);
     assert_eq!(g["k_m_npm"], 0.0);
-    let text = TWOPORT.run(&[
-        "teleop",
-        "verify",
-        "--master",
-        CAPSTAN,
-        "--slave",
-        CAPSTAN,
-        "four-channel",
-        "--k-m",
-        "300",
-        "--k-s",
-        "400",
-        "--c3",
-        "1",
-    ]);
+    let args = between_handles("four-channel --k-m 300 --k-s 400 --c3 1");
+    let text = TWOPORT.run(&args.iter().map(String::as_str).collect::<Vec<_>>());
     let text = String::from_utf8_lossy(&text.stdout);
     assert!(
         text.contains("k_m 300 N/m") && text.contains("k_s 400 N/m"),
@@ -106,23 +73,6 @@ fn each_law_reports_its_gains() {
 /// periods, a delay past the longest channel, a negative gain.
 #[test]
 fn bad_teleoperators_are_named() {
-    let run = |extra: &[&str]| {
-        let mut a = vec!["teleop", "verify"];
-        a.extend(extra);
-        TWOPORT.failure(&a)
-    };
-    let e = run(&[
-        "--master",
-        "no/such.toml",
-        "--slave",
-        CAPSTAN,
-        "position-position",
-        "--k",
-        "1",
-        "--b",
-        "0",
-    ]);
-    assert!(e.contains("--master no/such.toml"), "{e}");
     let dir = support::scratch("teleop");
     let fast = dir.join("fast.toml");
     let text = std::fs::read_to_string(format!("{}/{CAPSTAN}", TWOPORT.root)).unwrap();
@@ -131,43 +81,31 @@ fn bad_teleoperators_are_named() {
         text.replacen("period_s = 0.001", "period_s = 0.0005", 1),
     )
     .unwrap();
-    let e = run(&[
-        "--master",
-        CAPSTAN,
-        "--slave",
-        fast.to_str().unwrap(),
-        "position-position",
-        "--k",
-        "1",
-        "--b",
-        "0",
-    ]);
-    assert!(e.contains("one period"), "{e}");
-    let e = run(&[
-        "--master",
-        CAPSTAN,
-        "--slave",
-        CAPSTAN,
-        "--delay",
-        "5000",
-        "position-position",
-        "--k",
-        "1",
-        "--b",
-        "0",
-    ]);
-    assert!(e.contains("delay 5000 ticks: at most 1024"), "{e}");
-    let e = run(&[
-        "--master",
-        CAPSTAN,
-        "--slave",
-        CAPSTAN,
-        "position-position",
-        "--k",
-        "-1",
-        "--b",
-        "0",
-    ]);
-    assert!(e.contains("k_m (N/m)") && e.contains("-1"), "{e}");
+    let fast = fast.to_str().unwrap();
+    for (line, says) in [
+        (
+            format!("--master no/such.toml --slave {CAPSTAN} --k 1"),
+            "--master no/such.toml",
+        ),
+        (
+            format!("--master {CAPSTAN} --slave {fast} --k 1"),
+            "one period",
+        ),
+        (
+            format!("--master {CAPSTAN} --slave {CAPSTAN} --delay 5000 --k 1"),
+            "delay 5000 ticks: at most 1024",
+        ),
+        (
+            format!("--master {CAPSTAN} --slave {CAPSTAN} --k -1"),
+            "k_m (N/m)",
+        ),
+    ] {
+        // The law's words after the devices', --b 0 for each.
+        let line = line.replace(" --k ", " position-position --b 0 --k ");
+        let mut args = vec!["teleop", "verify"];
+        args.extend(line.split_whitespace());
+        let e = TWOPORT.failure(&args);
+        assert!(e.contains(says), "{line}: {e}");
+    }
     let _ = std::fs::remove_dir_all(dir);
 }
