@@ -73,8 +73,22 @@ fn main() -> ExitCode {
                 "docs",
             ]),
         ),
+        Some("verify-study") => run(
+            "verify on random tight designs, at them and 1% past (docs/soundness.md)",
+            cargo()
+                .args([
+                    "run",
+                    "--release",
+                    "-p",
+                    "twoport-design",
+                    "--example",
+                    "verify_past",
+                    "--",
+                ])
+                .args(&args[1..]),
+        ),
         _ => Err(format!(
-            "usage: cargo xtask <ci [step...]|thumb|firmware|qemu|pil [--board an386|stm32f405] [options]|scope-board|device [--check]|header [--check]|python|overhead [rounds]|watchdog|fuzz [seconds]|accuracy>\n  got: {}",
+            "usage: cargo xtask <ci [step...]|thumb|firmware|qemu|pil [--board an386|stm32f405] [options]|scope-board|device [--check]|header [--check]|python|overhead [rounds]|watchdog|fuzz [seconds]|accuracy|verify-study [--seeds a,b] [--count n] [--out dir]>\n  got: {}",
             args.join(" ")
         )),
     };
