@@ -491,17 +491,17 @@ impl HostArgs {
     /// `(N, d)` at `servo_hz`: the VE period and the delay in ticks, or
     /// why the rate is not a whole multiple of the VE rate.
     pub(crate) fn ticks(&self, servo_hz: f64) -> Result<(u32, u32), String> {
-        use twoport_design::host_ve::{HostLoop, TicksError};
+        use twoport_design::{host_ve::HostLoop, Error};
         HostLoop::ticks_at(1.0 / servo_hz, self.ve_rate_hz, self.delay_s).map_err(|e| match e {
-            TicksError::NotMultiple => format!(
+            Error::HostRate { .. } => format!(
                 "--rates {servo_hz} Hz: not a whole multiple of --ve-rate {} Hz",
                 self.ve_rate_hz
             ),
-            TicksError::BadDelay => {
+            Error::HostDelay(_) => {
                 format!("--host-delay {}: must be a time > 0 s", self.delay_s)
             }
             other => format!(
-                "--rates {servo_hz} Hz, --ve-rate {} Hz, --host-delay {}: {other:?}",
+                "--rates {servo_hz} Hz, --ve-rate {} Hz, --host-delay {}: {other}",
                 self.ve_rate_hz, self.delay_s
             ),
         })

@@ -74,6 +74,20 @@ pub enum Error {
     /// A figure could not be drawn or written.
     #[error("{0}")]
     Plot(String),
+    /// A linkage whose workspace holds no pose the kinematics drive.
+    #[error("{0}: no pose inside the joint limits (and the relative ones) is one the kinematics drive: check joints.limits_rad, joints.relative and the geometry")]
+    NoReachablePose(String),
+    /// A host whose rate does not divide the servo's.
+    #[error("ve_rate {ve_rate_hz} Hz: the servo's rate (a period of {servo_period_s} s) is not a whole multiple of it")]
+    HostRate {
+        /// The host's VE rate (Hz).
+        ve_rate_hz: f64,
+        /// The servo's period (s).
+        servo_period_s: f64,
+    },
+    /// A host delay that is not a time above zero.
+    #[error("host_delay {0}: must be a time > 0 s")]
+    HostDelay(f64),
     /// The counterexample search could not run on a pose.
     #[error("{model}: {why}")]
     Verify {

@@ -83,16 +83,6 @@ pub struct HostLoop {
     pub body: HostBody,
 }
 
-/// Why a host's rate or delay does not fit a servo's period.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[non_exhaustive]
-pub enum TicksError {
-    /// The servo's rate is not a whole multiple of the host's.
-    NotMultiple,
-    /// The delay is not a time above zero.
-    BadDelay,
-}
-
 impl HostLoop {
     /// A host running at `ve_rate_hz` and answering `delay_s` after the
     /// force it read, in ticks of a servo at `servo_period_s`: its period
@@ -103,13 +93,16 @@ impl HostLoop {
         servo_period_s: f64,
         ve_rate_hz: f64,
         delay_s: f64,
-    ) -> Result<(u32, u32), TicksError> {
+    ) -> Result<(u32, u32), crate::Error> {
         let n = 1.0 / (servo_period_s * ve_rate_hz);
         if !(n.is_finite() && n >= 0.5 && (n - n.round()).abs() <= 1e-9 * n) {
-            return Err(TicksError::NotMultiple);
+            return Err(crate::Error::HostRate {
+                ve_rate_hz,
+                servo_period_s,
+            });
         }
         if !(delay_s.is_finite() && delay_s > 0.0) {
-            return Err(TicksError::BadDelay);
+            return Err(crate::Error::HostDelay(delay_s));
         }
         let d = (delay_s / servo_period_s - 1e-9).ceil().max(1.0);
         Ok((n.round() as u32, d as u32))
@@ -522,19 +515,17 @@ mod tests {
         assert_eq!(HostLoop::ticks_at(2.5e-4, 1000.0, 0.002), Ok((4, 8)));
         assert_eq!(HostLoop::ticks_at(1e-3, 1000.0, 0.0021), Ok((1, 3)));
         assert_eq!(HostLoop::ticks_at(1e-3, 1000.0, 1e-6), Ok((1, 1)));
-        assert_eq!(
-            HostLoop::ticks_at(1.0 / 1500.0, 1000.0, 0.002),
-            Err(TicksError::NotMultiple)
-        );
-        assert_eq!(
-            HostLoop::ticks_at(1e-3, 2000.0, 0.002),
-            Err(TicksError::NotMultiple)
-        );
+        for (t, rate) in [(1.0 / 1500.0, 1000.0), (1e-3, 2000.0)] {
+            assert!(matches!(
+                HostLoop::ticks_at(t, rate, 0.002),
+                Err(crate::Error::HostRate { .. })
+            ));
+        }
         for bad in [0.0, -1.0, f64::NAN] {
-            assert_eq!(
+            assert!(matches!(
                 HostLoop::ticks_at(1e-3, 1000.0, bad),
-                Err(TicksError::BadDelay)
-            );
+                Err(crate::Error::HostDelay(_))
+            ));
         }
     }
 

@@ -12,7 +12,7 @@ use pyo3::types::PyDict;
 use std::f64::consts::PI;
 use twoport_control::{AdmittanceGains, Gains, ImpedanceGains};
 use twoport_design::analysis::{self, Analysis};
-use twoport_design::host_ve::{check_host_ve, HostLoop, TicksError};
+use twoport_design::host_ve::{check_host_ve, HostLoop};
 use twoport_design::network::HumanBound;
 use twoport_design::verify::{verify_host, Hand};
 use twoport_design::{Designer, DeviceModel};
@@ -494,12 +494,11 @@ pub(crate) fn host_ve(
             let des = designer(m, period, human)?;
             let t = des.period_s();
             let (n, d) = HostLoop::ticks_at(t, ve_rate, host_delay).map_err(|e| match e {
-                TicksError::NotMultiple => format!(
+                twoport_design::Error::HostRate { .. } => format!(
                     "ve_rate {ve_rate} Hz: the servo's {} Hz is not a whole multiple of it",
                     1.0 / t
                 ),
-                TicksError::BadDelay => format!("host_delay {host_delay}: must be a time > 0 s"),
-                other => format!("ve_rate {ve_rate} Hz, host_delay {host_delay}: {other:?}"),
+                other => other.to_string(),
             })?;
             let host = HostLoop::new(t, n, d, (body.0, body.1, 0.0)).map_err(|e| e.to_string())?;
             let human = human.then_some(HumanBound::PAPER);

@@ -28,7 +28,7 @@ pub use proof::{
     DESIGN_GRID,
 };
 pub use report::{stiffness, LinkageDesign};
-pub use search::{least, Least, Objective, SearchError, BUDGET, TOLERANCE};
+pub use search::{least, Least, Objective, BUDGET, TOLERANCE};
 pub use taylor::Taylor;
 pub use verify::{loop_radius, verify_linkage, HandAssumption, LinkageHand, LinkageVerdict};
 

@@ -25,7 +25,7 @@ use super::cell::CellBounds;
 use super::file::LinkageFile;
 use super::pose::PoseDynamics;
 use super::rigid::{latency_unsupported, rigid_stiffness, Colgate};
-use super::search::{least, Least, Objective, SearchError};
+use super::search::{least, Least, Objective};
 use crate::model::Lag;
 use crate::network::HumanBound;
 use nalgebra::DVector;
@@ -325,13 +325,7 @@ impl Bounded<'_> {
 /// the coupling or the grasp: [`certified_design_from`] turns it into a
 /// design for each.
 pub fn least_damping(file: &LinkageFile) -> Result<Least, crate::Error> {
-    least(file, &LeastDamping).map_err(|SearchError::NoPose| {
-        crate::Error::Coupling(format!(
-            "{}: no pose inside the joint limits (and the relative ones) is one the \
-             kinematics drive: check joints.limits_rad, joints.relative and the geometry",
-            file.name
-        ))
-    })
+    least(file, &LeastDamping)
 }
 
 /// The design over the whole workspace, proven by branch and bound: at

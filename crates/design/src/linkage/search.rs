@@ -70,14 +70,6 @@ impl Ord for Open {
     }
 }
 
-/// Why the search has no answer.
-#[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
-pub enum SearchError {
-    /// No pose inside the limits where the kinematics answer.
-    NoPose,
-}
-
 /// The search's state: the open boxes and the least value found.
 struct Search<'a, O> {
     file: &'a LinkageFile,
@@ -114,7 +106,7 @@ impl<O: Objective + Sync> Search<'_, O> {
 
     /// Bound the boxes `[lo, hi]` (in parallel) and keep them open, but for
     /// those wholly outside the relative limits.
-    fn push(&mut self, boxes: Vec<(Vec<f64>, Vec<f64>)>) -> Result<(), SearchError> {
+    fn push(&mut self, boxes: Vec<(Vec<f64>, Vec<f64>)>) {
         self.boxes += boxes.len();
         let (file, objective) = (self.file, self.objective);
         let bounded = crate::par::map_from(boxes.len(), 8, |i| {
@@ -142,7 +134,6 @@ impl<O: Objective + Sync> Search<'_, O> {
                 Err(Undecided::Infeasible | Undecided::Refused) => {}
             }
         }
-        Ok(())
     }
 }
 
@@ -157,8 +148,12 @@ fn halves(cell: Open) -> [(Vec<f64>, Vec<f64>); 2] {
 }
 
 /// The least of `objective` over `file`'s workspace, to [`TOLERANCE`] or
-/// until [`BUDGET`] boxes.
-pub fn least<O: Objective + Sync>(file: &LinkageFile, objective: &O) -> Result<Least, SearchError> {
+/// until [`BUDGET`] boxes; [`Error::NoReachablePose`](crate::Error) where
+/// no pose inside the limits is one the kinematics drive.
+pub fn least<O: Objective + Sync>(
+    file: &LinkageFile,
+    objective: &O,
+) -> Result<Least, crate::Error> {
     // (A symmetric family of poses shares its eigenvalues: one of each.)
     let file = &file.fundamental_domain();
     let mut s = Search {
@@ -170,10 +165,10 @@ pub fn least<O: Objective + Sync>(file: &LinkageFile, objective: &O) -> Result<L
     };
     let lo: Vec<f64> = file.joints.limits_rad.iter().map(|l| l[0]).collect();
     let hi: Vec<f64> = file.joints.limits_rad.iter().map(|l| l[1]).collect();
-    s.push(vec![(lo, hi)])?;
+    s.push(vec![(lo, hi)]);
     loop {
         let Some(least) = s.open.peek() else {
-            return Err(SearchError::NoPose);
+            return Err(crate::Error::NoReachablePose(file.name.clone()));
         };
         if let Some((found, _)) = &s.best {
             let close = found - least.bound <= TOLERANCE * found.abs();
@@ -208,6 +203,6 @@ pub fn least<O: Objective + Sync>(file: &LinkageFile, objective: &O) -> Result<L
                 _ => break,
             }
         }
-        s.push(split)?;
+        s.push(split);
     }
 }
