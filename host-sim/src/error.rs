@@ -1,6 +1,5 @@
 //! host-sim's one error type.
 
-use crate::engine::scene::SceneError;
 use crate::link::LinkError;
 use thiserror::Error;
 
@@ -10,8 +9,8 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum Error {
     /// A scene file that is not a scene: the file and the line or field.
-    #[error(transparent)]
-    Scene(#[from] SceneError),
+    #[error("{0}")]
+    Scene(String),
     /// The designer refused the device (a model file, its dynamics).
     #[error(transparent)]
     Design(#[from] twoport_design::Error),
@@ -28,6 +27,19 @@ pub enum Error {
     /// The scope's window would not open (no display, no GPU context).
     #[error("the window would not open: {0}")]
     NoWindow(String),
+    /// A linkage reached a pose with no kinematics (singular or out of
+    /// reach): the joint angles (rad).
+    #[error("no kinematics at the joint angles {0:?} rad: a singular pose, or out of reach")]
+    Pose(Vec<f64>),
+    /// A linkage file with `file` joints where the run was built for
+    /// `run`.
+    #[error("the linkage file has {file} joints; the run was built for {run}")]
+    Joints {
+        /// The file's joints.
+        file: usize,
+        /// The run's.
+        run: usize,
+    },
     /// An output (a CSV, a plot, a window) that could not be made.
     #[error("{0}")]
     Output(String),

@@ -200,7 +200,7 @@ impl<const N: usize> Device<N> {
         hand: Option<Hand>,
         fault: Option<(u64, Fault)>,
     ) -> Result<Self, Error> {
-        let plant = |e| Error::Sim(format!("the emulated device's plant: {e:?}"));
+        let plant = |e| Error::Sim(format!("the emulated device's plant: {e}"));
         let mut arm =
             LinkageArm::<N>::at_rest(file, spec.rest_rad.map(f64::from)).map_err(plant)?;
         if gravity {

@@ -171,8 +171,8 @@ impl PilArm {
     }
 }
 
-fn plant_err(e: crate::engine::linkage::PlantError) -> Error {
-    Error::Pil(format!("the linkage plant: {e:?}"))
+fn plant_err(e: Error) -> Error {
+    Error::Pil(format!("the linkage plant: {e}"))
 }
 
 /// One tick recorded, with the telemetry the board sent.

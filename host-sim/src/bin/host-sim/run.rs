@@ -35,7 +35,7 @@ pub(crate) struct RunArgs {
 }
 
 pub(crate) fn load(path: &Path, sets: &[String]) -> Result<Scene, Error> {
-    Ok(Scene::load(path, sets)?)
+    Scene::load(path, sets)
 }
 
 /// `$body` with `N` the scene's axis count, a constant.

@@ -4,7 +4,8 @@
 //! The scenes' loop, processor-in-the-loop and the tests each stand on
 //! this one arm: they differ only in what turns its counts into torques.
 
-use super::plant::{HandForce, LinkagePlant, PlantError};
+use super::plant::{HandForce, LinkagePlant};
+use crate::Error;
 use twoport_board::linkage::COUNTER_BITS;
 use twoport_control::kinematics::Kinematics;
 use twoport_control::linkage::{Hardware, LinkageError, LinkageServo};
@@ -27,8 +28,8 @@ pub struct LinkageArm<const N: usize> {
 impl<const N: usize> LinkageArm<N> {
     /// The linkage `file` at rest at `q0_rad`, each counter reading 0
     /// there; no gravity, no friction until asked for on the plant.
-    pub fn at_rest(file: &LinkageFile, q0_rad: [f64; N]) -> Result<Self, PlantError> {
-        let hardware = file.hardware::<N>().ok_or(PlantError::Joints {
+    pub fn at_rest(file: &LinkageFile, q0_rad: [f64; N]) -> Result<Self, Error> {
+        let hardware = file.hardware::<N>().ok_or(Error::Joints {
             file: file.geometry.joints(),
             run: N,
         })?;
@@ -83,7 +84,7 @@ impl<const N: usize> LinkageArm<N> {
 
     /// The handle's position (m) and velocity (m/s), in the kinematics'
     /// frame.
-    pub fn handle(&self) -> Result<([f64; N], [f64; N]), PlantError> {
+    pub fn handle(&self) -> Result<([f64; N], [f64; N]), Error> {
         let (x, j) = self.plant.kinematics(&self.plant.q)?;
         let v = &j * &self.plant.qd;
         Ok((
@@ -101,7 +102,7 @@ impl<const N: usize> LinkageArm<N> {
         hand: &HandForce,
         dt_s: f64,
         substeps: u32,
-    ) -> Result<(), PlantError> {
+    ) -> Result<(), Error> {
         self.plant.step_with(torque_nm, hand, dt_s, substeps)
     }
 }

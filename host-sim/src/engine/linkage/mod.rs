@@ -10,4 +10,4 @@ mod tests;
 
 pub use arm::LinkageArm;
 pub use kinematics::{AnyKinematics, Shifted};
-pub use plant::{CartesianHand, LinkagePlant, PlantError};
+pub use plant::{CartesianHand, LinkagePlant};

@@ -11,6 +11,7 @@
 //! motion) and `f_h` the hand's force on the handle (N). Integrated by
 //! fourth-order Runge-Kutta at a fixed sub-step.
 
+use crate::Error;
 use nalgebra::{DMatrix, DVector};
 use twoport_design::linkage::{forward, LinkageFile};
 
@@ -63,22 +64,6 @@ impl CartesianHand {
 /// velocity (m/s).
 pub type HandForce<'a> = dyn Fn(&[f64], &[f64]) -> DVector<f64> + 'a;
 
-/// Why the plant cannot go on.
-#[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
-pub enum PlantError {
-    /// The linkage reached a pose with no kinematics (singular or out of
-    /// reach) at the joint angles given.
-    Pose(Vec<f64>),
-    /// The file has `file` joints; the run was built for `run`.
-    Joints {
-        /// The file's joints.
-        file: usize,
-        /// The run's.
-        run: usize,
-    },
-}
-
 /// A linkage's state and its dynamics.
 #[derive(Clone, Debug)]
 pub struct LinkagePlant {
@@ -115,12 +100,11 @@ impl LinkagePlant {
     }
 
     /// The handle's position (m) and the Jacobian at `q`.
-    pub fn kinematics(&self, q: &DVector<f64>) -> Result<(Vec<f64>, DMatrix<f64>), PlantError> {
-        forward(&self.file.geometry, q.as_slice())
-            .map_err(|_| PlantError::Pose(q.as_slice().to_vec()))
+    pub fn kinematics(&self, q: &DVector<f64>) -> Result<(Vec<f64>, DMatrix<f64>), Error> {
+        forward(&self.file.geometry, q.as_slice()).map_err(|_| Error::Pose(q.as_slice().to_vec()))
     }
 
-    fn mass(&self, q: &DVector<f64>) -> Result<DMatrix<f64>, PlantError> {
+    fn mass(&self, q: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
         let (_, j) = self.kinematics(q)?;
         Ok(self.file.joint_mass(q.as_slice(), &j))
     }
@@ -135,7 +119,7 @@ impl LinkagePlant {
     }
 
     /// The moving masses' potential energy under gravity (J).
-    pub fn potential_j(&self) -> Result<f64, PlantError> {
+    pub fn potential_j(&self) -> Result<f64, Error> {
         let (x, _) = self.kinematics(&self.q)?;
         let z = x.get(2).copied().unwrap_or(0.0);
         Ok(self
@@ -151,7 +135,7 @@ impl LinkagePlant {
         qd: &DVector<f64>,
         tau_a: &DVector<f64>,
         hand: &HandForce,
-    ) -> Result<DVector<f64>, PlantError> {
+    ) -> Result<DVector<f64>, Error> {
         let n = q.len();
         let (x, j) = self.kinematics(q)?;
         let m = self.file.joint_mass(q.as_slice(), &j);
@@ -181,7 +165,7 @@ impl LinkagePlant {
         let rhs = hand_torque - tau_a - coriolis - self.gravity(q, &j) - damping - friction;
         m.cholesky()
             .map(|c| c.solve(&rhs))
-            .ok_or_else(|| PlantError::Pose(q.as_slice().to_vec()))
+            .ok_or_else(|| Error::Pose(q.as_slice().to_vec()))
     }
 
     /// Advance `dt` (s) in `substeps` fourth-order Runge-Kutta steps with
@@ -192,7 +176,7 @@ impl LinkagePlant {
         hand: &CartesianHand,
         dt: f64,
         substeps: u32,
-    ) -> Result<(), PlantError> {
+    ) -> Result<(), Error> {
         self.step_with(tau_a, &|x, v| hand.force(x, v), dt, substeps)
     }
 
@@ -204,7 +188,7 @@ impl LinkagePlant {
         hand: &HandForce,
         dt: f64,
         substeps: u32,
-    ) -> Result<(), PlantError> {
+    ) -> Result<(), Error> {
         let tau = DVector::from_column_slice(tau_a);
         let h = dt / substeps as f64;
         for _ in 0..substeps {
@@ -227,7 +211,7 @@ impl LinkagePlant {
     }
 
     /// The kinetic energy `½ q'^T M q'` (J).
-    pub fn kinetic_j(&self) -> Result<f64, PlantError> {
+    pub fn kinetic_j(&self) -> Result<f64, Error> {
         Ok(0.5 * self.qd.dot(&(self.mass(&self.q)? * &self.qd)))
     }
 }

@@ -8,7 +8,7 @@ mod spec;
 
 pub use effects::*;
 pub use identify::IdentifySpec;
-pub use parse::{apply_set, checked, parse_toml, read, SceneError};
+pub use parse::{apply_set, checked, parse_toml, read};
 pub use spec::*;
 
 use crate::engine::human::Human;
@@ -83,12 +83,12 @@ impl Scene {
     }
 
     /// Read a scene file, apply `--set` overrides, and check it.
-    pub fn load(path: &Path, sets: &[String]) -> Result<Self, SceneError> {
+    pub fn load(path: &Path, sets: &[String]) -> Result<Self, crate::Error> {
         Self::parse(&read(path)?, &path.display().to_string(), sets)
     }
 
     /// Parse scene text; `source` names it in errors.
-    pub fn parse(text: &str, source: &str, sets: &[String]) -> Result<Self, SceneError> {
+    pub fn parse(text: &str, source: &str, sets: &[String]) -> Result<Self, crate::Error> {
         checked(parse_toml(text, source, sets)?, source, Self::check)
     }
 

@@ -4,22 +4,10 @@
 use crate::Error;
 use std::path::Path;
 
-/// Why a scene was refused: the file, and the line or the field.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SceneError(pub String);
-
-impl std::fmt::Display for SceneError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for SceneError {}
-
 /// Apply `key.path=value` to a TOML tree; the value is read as TOML
 /// (number, boolean, string, array) or else taken as a string.
-pub fn apply_set(root: &mut toml::Table, assignment: &str) -> Result<(), SceneError> {
-    let bad = |m: String| SceneError(format!("--set {assignment}: {m}"));
+pub fn apply_set(root: &mut toml::Table, assignment: &str) -> Result<(), Error> {
+    let bad = |m: String| Error::Scene(format!("--set {assignment}: {m}"));
     let (path, value) = assignment
         .split_once('=')
         .ok_or_else(|| bad("expected key=value".into()))?;
@@ -59,9 +47,9 @@ fn locate(text: &str, table: &str, message: &str) -> Option<(usize, String)> {
 }
 
 /// A scene file's text; the error names the file.
-pub fn read(path: &Path) -> Result<String, SceneError> {
+pub fn read(path: &Path) -> Result<String, Error> {
     std::fs::read_to_string(path)
-        .map_err(|e| SceneError(format!("{}: cannot read: {e}", path.display())))
+        .map_err(|e| Error::Scene(format!("{}: cannot read: {e}", path.display())))
 }
 
 /// `scene` if `check` passes it; the error names `source`.
@@ -69,8 +57,8 @@ pub fn checked<T>(
     scene: T,
     source: &str,
     check: impl FnOnce(&T) -> Result<(), Error>,
-) -> Result<T, SceneError> {
-    check(&scene).map_err(|m| SceneError(format!("{source}: {m}")))?;
+) -> Result<T, Error> {
+    check(&scene).map_err(|m| Error::Scene(format!("{source}: {m}")))?;
     Ok(scene)
 }
 
@@ -81,7 +69,7 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(
     text: &str,
     source: &str,
     sets: &[String],
-) -> Result<T, SceneError> {
+) -> Result<T, Error> {
     let line_of = |e: &toml::de::Error| {
         e.span()
             .map(|s| {
@@ -93,12 +81,12 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(
             .unwrap_or_default()
     };
     let mut table: toml::Table = toml::from_str(text)
-        .map_err(|e| SceneError(format!("{source}: {}{}", line_of(&e), e.message())))?;
+        .map_err(|e| Error::Scene(format!("{source}: {}{}", line_of(&e), e.message())))?;
     let value: T = if sets.is_empty() {
         // serde_path_to_error names the field; toml's span alone points
         // at the enclosing table for a bad value inside one.
         let de = toml::Deserializer::parse(text)
-            .map_err(|e| SceneError(format!("{source}: {}{}", line_of(&e), e.message())))?;
+            .map_err(|e| Error::Scene(format!("{source}: {}{}", line_of(&e), e.message())))?;
         serde_path_to_error::deserialize(de).map_err(|e| {
             let path = e.path().to_string();
             let inner = e.into_inner();
@@ -112,14 +100,14 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(
                     };
                     (line_of(&inner), field)
                 });
-            SceneError(format!("{source}: {line}{key}{}", inner.message()))
+            Error::Scene(format!("{source}: {line}{key}{}", inner.message()))
         })?
     } else {
         for s in sets {
             apply_set(&mut table, s)?;
         }
         // The overridden scene has no lines of its own: name the key.
-        let merged = toml::to_string(&table).map_err(|e| SceneError(format!("{source}: {e}")))?;
+        let merged = toml::to_string(&table).map_err(|e| Error::Scene(format!("{source}: {e}")))?;
         toml::from_str(&merged).map_err(|e| {
             let key = e
                 .span()
@@ -135,14 +123,14 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(
                 .iter()
                 .find(|s| s.split_once('=').is_some_and(|(_, v)| v.trim() == quoted))
             {
-                return SceneError(format!("{source}: --set {set}: {}", e.message()));
+                return Error::Scene(format!("{source}: --set {set}: {}", e.message()));
             }
             let near = if key.trim().is_empty() {
                 String::new()
             } else {
                 format!(" (at `{}`)", key.trim())
             };
-            SceneError(format!("{source} with --set: {}{near}", e.message()))
+            Error::Scene(format!("{source} with --set: {}{near}", e.message()))
         })?
     };
     Ok(value)

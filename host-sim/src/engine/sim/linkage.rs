@@ -35,8 +35,7 @@ impl<const N: usize> SceneArm<N> {
         let q0: [f64; N] = q[..]
             .try_into()
             .map_err(|_| sim_err!("plant.pose_rad: {} angles for {N} joints", q.len()))?;
-        let mut arm =
-            LinkageArm::at_rest(file, q0).map_err(|e| sim_err!("plant.pose_rad: {e:?}"))?;
+        let mut arm = LinkageArm::at_rest(file, q0).map_err(|e| sim_err!("plant.pose_rad: {e}"))?;
         arm.plant.gravity_mps2 = scene.plant.gravity_mps2;
         arm.plant.friction = scene.plant.friction.unwrap_or(true);
         Ok(arm)
@@ -44,9 +43,7 @@ impl<const N: usize> SceneArm<N> {
 
     /// `arm` in a scene whose world starts its point at `start_m` (m).
     pub(super) fn new(arm: LinkageArm<N>, start_m: &[f64]) -> Result<Self, Error> {
-        let (x0, _) = arm
-            .handle()
-            .map_err(|e| sim_err!("plant.pose_rad: {e:?}"))?;
+        let (x0, _) = arm.handle().map_err(|e| sim_err!("plant.pose_rad: {e}"))?;
         let origin = core::array::from_fn(|i| {
             x0.get(i).copied().unwrap_or(0.0) - start_m.get(i).copied().unwrap_or(0.0)
         });
@@ -126,13 +123,9 @@ impl<const N: usize> Simulation<N> {
                     self.peak_force = self.peak_force.max(out.actuator_force_n[i].abs());
                 }
             }
-            (Err(e), _) => {
+            (Err(e), _) | (_, Err(e)) => {
                 self.failure
-                    .get_or_insert(format!("the arm left what it can reach: {e:?}"));
-            }
-            (_, Err(e)) => {
-                self.failure
-                    .get_or_insert(format!("the arm left what it can reach: {e:?}"));
+                    .get_or_insert(format!("the arm left what it can reach: {e}"));
             }
         }
         self.tick += 1;
