@@ -17,23 +17,10 @@ pub trait BoardPort {
     }
 }
 
-/// Any port, chosen at run time (the scope's: a serial port, or a board
-/// in-process).
-impl BoardPort for Box<dyn BoardPort> {
-    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
-        (**self).send(bytes)
-    }
-    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError> {
-        (**self).recv(buf, timeout)
-    }
-    fn loop_timing(&self) -> Option<crate::LoopTiming> {
-        (**self).loop_timing()
-    }
-}
-
-/// Any port that may move to another thread, chosen at run time (the C
-/// ABI's and the Python package's).
-impl BoardPort for Box<dyn BoardPort + Send> {
+/// Any port behind a box: one chosen at run time (the scope's, a serial
+/// port or a board in-process; the C ABI's and the Python package's, which
+/// may move to another thread).
+impl<P: BoardPort + ?Sized> BoardPort for Box<P> {
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
         (**self).send(bytes)
     }
