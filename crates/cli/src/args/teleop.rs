@@ -1,0 +1,95 @@
+//! `teleop`'s arguments: two devices, a law and the channel.
+
+use clap::{Args, Subcommand};
+use std::path::PathBuf;
+
+/// `teleop`'s commands.
+#[derive(Subcommand, Clone)]
+pub(crate) enum Teleop {
+    /// Search for a passive operator and environment that make the exact
+    /// sampled teleoperator unstable at these gains (master, slave, law
+    /// and channel in one discrete loop).
+    Verify(TeleopArgs),
+}
+
+/// Two devices and the law between them.
+#[derive(Args, Clone)]
+pub(crate) struct TeleopArgs {
+    /// The master's model file (TOML): the device under the operator's
+    /// hand.
+    #[arg(long)]
+    pub(crate) master: PathBuf,
+    /// The slave's model file (TOML): the device on the environment. Both
+    /// must sample at one period.
+    #[arg(long)]
+    pub(crate) slave: PathBuf,
+    /// The channel's delay each way (ticks of the devices' period).
+    #[arg(long, default_value_t = 0)]
+    pub(crate) delay: usize,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub(crate) json: bool,
+    #[command(subcommand)]
+    pub(crate) law: TeleopLaw,
+}
+
+/// The teleoperator's law: one of Lawrence's four-channel laws.
+#[derive(Subcommand, Clone)]
+pub(crate) enum TeleopLaw {
+    /// Each side held to the other's delayed motion by one spring and
+    /// damper; no force sensed.
+    PositionPosition {
+        /// Stiffness (N/m).
+        #[arg(long, allow_negative_numbers = true)]
+        k: f32,
+        /// Damping (N s/m).
+        #[arg(long, allow_negative_numbers = true)]
+        b: f32,
+    },
+    /// Force reflection: the slave held to the master's delayed motion,
+    /// the master pushed by the slave's sensed force.
+    PositionForce {
+        /// The slave's stiffness (N/m).
+        #[arg(long, allow_negative_numbers = true)]
+        k: f32,
+        /// The slave's damping (N s/m).
+        #[arg(long, allow_negative_numbers = true)]
+        b: f32,
+        /// The force fed back to the master per the slave's sensed force.
+        #[arg(long, allow_negative_numbers = true)]
+        k_f: f32,
+        /// The master's own damping (N s/m).
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        b_m: f32,
+    },
+    /// Lawrence's four channels, each gain given (0 where left out).
+    FourChannel {
+        /// The master's coupling to the slave's motion (N/m).
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        k_m: f32,
+        /// Its damping (N s/m).
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        b_m: f32,
+        /// The master's own damping (N s/m).
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        b_local: f32,
+        /// The slave's coupling to the master's motion (N/m).
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        k_s: f32,
+        /// Its damping (N s/m).
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        b_s: f32,
+        /// C2: the environment's sensed force fed to the master.
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        c2: f32,
+        /// C3: the operator's sensed force fed to the slave.
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        c3: f32,
+        /// C5: the environment's force fed back on the slave.
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        c5: f32,
+        /// C6: the operator's force fed back on the master.
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        c6: f32,
+    },
+}
