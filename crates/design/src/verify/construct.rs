@@ -23,11 +23,11 @@
 //! the bound lets vary independently: the bound is conservative there.
 
 use super::closed_loop::actuator_response;
-use super::foster::alias_hands;
+use super::foster::WorstAliases;
 use super::{radius, Hand, Radius, Resonator, Termination, Ve};
 use crate::analysis::{admittance_coupling_tf, impedance_coupling_tf, regulator_tf};
 use crate::network::HumanBound;
-use crate::DeviceModel;
+use crate::{DeviceModel, Plant};
 use num_complex::Complex64;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -53,6 +53,9 @@ struct Setting<'a> {
     /// The whole ticks of the model's delay (the latency inside the tick
     /// is in the sampled device).
     delay: usize,
+    /// The device's continuous terms, for the proof's worst hand (the
+    /// impedance display's only).
+    plant: Option<Plant>,
 }
 
 impl Setting<'_> {
@@ -60,7 +63,7 @@ impl Setting<'_> {
     /// behind the grasp where there is one (which then needs a mass).
     fn hand(&self, (m, k): (f64, f64)) -> Hand {
         Hand {
-            mass_kg: if self.grasp.is_some() { m.max(1e-6) } else { m },
+            mass_kg: m.max(Hand::least_mass_kg(self.grasp)),
             stiffness_npm: k,
             damping_nspm: 0.0,
             grasp: self.grasp,
@@ -134,19 +137,20 @@ impl Setting<'_> {
         if best.as_ref().is_some_and(|b| b.1 > 0.0) {
             return best;
         }
-        let Gains::Impedance(_) = self.gains else {
+        let Some(plant) = &self.plant else {
             return best;
         };
         // More aliases taken, until enough are: the deficit falls about
         // by half with each doubling where the gains' tail is long, so
         // the ladder stops where what is left to gain cannot cover it
         // (each rung costs a discretisation with a mass per alias).
-        let (model, t) = (self.model, self.t);
-        let counts = [1, 2, 4, 8, 16, 32, 64, 128, 256];
-        let hands = alias_hands(model, t, self.grasp, self.delay, w, &counts);
+        let aliases = WorstAliases::at(plant, self.t, self.grasp, self.delay, w);
         let mut best = best;
         let mut last: Option<f64> = None;
-        for h in hands {
+        for count in [1, 2, 4, 8, 16, 32, 64, 128, 256] {
+            let Some(h) = aliases.hand(count) else {
+                continue;
+            };
             let Some(s) = self.s(&h, w) else { continue };
             if best.as_ref().is_none_or(|b| s.re > b.1) {
                 best = Some((h, s.re));
@@ -184,6 +188,9 @@ pub fn construct(
         gains,
         grasp: human,
         delay: model.lag(period_s).ticks as usize,
+        plant: matches!(gains, Gains::Impedance(_))
+            .then(|| Plant::new(model, period_s).ok())
+            .flatten(),
     };
     // At Nyquist a real hand's two nearest aliases are one frequency, so
     // a frequency just below it, where a hand resonant at Nyquist parts
@@ -265,11 +272,10 @@ impl Setting<'_> {
 
 /// `hand` with every mass and spring scaled by `scale`: its impedance
 /// scaled, its resonances kept (and its grasp, which is the bound's,
-/// with the least mass behind it that [`Setting::hand`] keeps).
+/// with the least mass behind it).
 fn scaled(hand: &Hand, scale: f64) -> Hand {
-    let least = if hand.grasp.is_some() { 1e-6 } else { 0.0 };
     Hand {
-        mass_kg: (hand.mass_kg * scale).max(least),
+        mass_kg: (hand.mass_kg * scale).max(Hand::least_mass_kg(hand.grasp)),
         stiffness_npm: hand.stiffness_npm * scale,
         damping_nspm: hand.damping_nspm * scale,
         grasp: hand.grasp,

@@ -19,7 +19,7 @@
 
 use super::{Hand, Resonator};
 use crate::network::HumanBound;
-use crate::{DeviceModel, Plant};
+use crate::Plant;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use std::f64::consts::PI;
@@ -92,7 +92,7 @@ fn targets(plant: &Plant, t: f64, grasp: Option<HumanBound>, w: f64, c0: Complex
 /// where the reactance must rise from the rest's, below where it must
 /// fall, and is moved to the other side where its spring came out
 /// negative.
-fn realise(targets: &[&Target], mass_kg: f64) -> Option<Vec<Resonator>> {
+fn realise(targets: &[Target], mass_kg: f64) -> Option<Vec<Resonator>> {
     let n = targets.len();
     // Each resonance within a tenth of the gap to its nearest neighbour.
     let room: Vec<f64> = targets
@@ -100,7 +100,7 @@ fn realise(targets: &[&Target], mass_kg: f64) -> Option<Vec<Resonator>> {
         .map(|a| {
             targets
                 .iter()
-                .filter(|b| !std::ptr::eq(*a, **b))
+                .filter(|b| !std::ptr::eq(a, *b))
                 .map(|b| ((a.omega - b.omega) / a.omega).abs())
                 .fold(1.0f64, f64::min)
                 .min(1.0)
@@ -137,47 +137,54 @@ fn realise(targets: &[&Target], mass_kg: f64) -> Option<Vec<Resonator>> {
     None
 }
 
-/// Lossless hands that take the impedance display's worst value at the
-/// `count`s of aliases of `w` (rad/s) that gain most, behind `grasp`
-/// where there is one: one hand per count, none where a hand cannot be
-/// realised.
-pub(super) fn alias_hands(
-    model: &DeviceModel,
-    t: f64,
+/// The impedance display's worst value at each alias of one frequency,
+/// each frequency once, the greatest gains first: what
+/// [`hand`](Self::hand) realises, as many aliases at a time as asked.
+pub(super) struct WorstAliases {
+    targets: Vec<Target>,
     grasp: Option<HumanBound>,
-    delay: usize,
-    w: f64,
-    counts: &[usize],
-) -> Vec<Hand> {
-    let Ok(plant) = Plant::new(model, t) else {
-        return Vec::new();
-    };
-    let z = Complex64::from_polar(1.0, w * t);
-    let c0 = z.powi(-(delay as i32)) * (Complex64::new(1.0, 0.0) - z.inv()) / (t * t);
-    let all = targets(&plant, t, grasp, w, c0);
-    // A frequency once: at Nyquist two aliases are one frequency.
-    let mut distinct: Vec<&Target> = Vec::new();
-    for a in &all {
-        if distinct
-            .iter()
-            .all(|b| ((a.omega - b.omega) / a.omega).abs() > 1e-9)
-        {
-            distinct.push(a);
+}
+
+impl WorstAliases {
+    /// The aliases of `w` (rad/s) on `plant` at period `t` (s), with
+    /// `delay` whole ticks and behind `grasp` where there is one.
+    pub(super) fn at(
+        plant: &Plant,
+        t: f64,
+        grasp: Option<HumanBound>,
+        delay: usize,
+        w: f64,
+    ) -> Self {
+        let z = Complex64::from_polar(1.0, w * t);
+        let c0 = z.powi(-(delay as i32)) * (Complex64::new(1.0, 0.0) - z.inv()) / (t * t);
+        // A frequency once: at Nyquist two aliases are one frequency.
+        let mut distinct: Vec<Target> = Vec::new();
+        for a in targets(plant, t, grasp, w, c0) {
+            let new = distinct
+                .iter()
+                .all(|b| ((a.omega - b.omega) / a.omega).abs() > 1e-9);
+            if new {
+                distinct.push(a);
+            }
+        }
+        WorstAliases {
+            targets: distinct,
+            grasp,
         }
     }
-    let mass_kg = if grasp.is_some() { 1e-6 } else { 0.0 };
-    counts
-        .iter()
-        .filter(|c| **c <= distinct.len())
-        .filter_map(|c| {
-            let hanging = realise(&distinct[..*c], mass_kg)?;
-            Some(Hand {
-                mass_kg,
-                stiffness_npm: 0.0,
-                damping_nspm: 0.0,
-                grasp,
-                hanging,
-            })
+
+    /// The lossless hand that takes the worst value at the `count`
+    /// aliases that gain most, behind the grasp; `None` where there are
+    /// fewer or no hand can be realised.
+    pub(super) fn hand(&self, count: usize) -> Option<Hand> {
+        let targets = self.targets.get(..count)?;
+        let mass_kg = Hand::least_mass_kg(self.grasp);
+        Some(Hand {
+            mass_kg,
+            stiffness_npm: 0.0,
+            damping_nspm: 0.0,
+            grasp: self.grasp,
+            hanging: realise(targets, mass_kg)?,
         })
-        .collect()
+    }
 }

@@ -78,6 +78,16 @@ pub struct Hand {
 }
 
 impl Hand {
+    /// The least mass behind a grasp (kg): the grasp's own coordinate
+    /// needs one for the mass matrix to be regular. None without a grasp.
+    pub(crate) fn least_mass_kg(grasp: Option<HumanBound>) -> f64 {
+        if grasp.is_some() {
+            1e-6
+        } else {
+            0.0
+        }
+    }
+
     /// No hand on the handle.
     pub const OFF: Hand = Hand {
         mass_kg: 0.0,
