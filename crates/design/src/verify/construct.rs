@@ -54,8 +54,9 @@ struct Setting<'a> {
     /// is in the sampled device).
     delay: usize,
     /// The device's continuous terms, for the proof's worst hand (the
-    /// impedance display's only).
-    plant: Option<Plant>,
+    /// impedance display's only), built the first time a sweep leaves
+    /// `Re S` short.
+    plant: std::cell::OnceCell<Option<Plant>>,
 }
 
 impl Setting<'_> {
@@ -137,7 +138,11 @@ impl Setting<'_> {
         if best.as_ref().is_some_and(|b| b.1 > 0.0) {
             return best;
         }
-        let Some(plant) = &self.plant else {
+        let impedance = matches!(self.gains, Gains::Impedance(_));
+        let plant = self
+            .plant
+            .get_or_init(|| impedance.then(|| Plant::new(self.model, self.t).ok())?);
+        let Some(plant) = plant else {
             return best;
         };
         // More aliases taken, until enough are: the deficit falls about
@@ -188,9 +193,7 @@ pub fn construct(
         gains,
         grasp: human,
         delay: model.lag(period_s).ticks as usize,
-        plant: matches!(gains, Gains::Impedance(_))
-            .then(|| Plant::new(model, period_s).ok())
-            .flatten(),
+        plant: std::cell::OnceCell::new(),
     };
     // At Nyquist a real hand's two nearest aliases are one frequency, so
     // a frequency just below it, where a hand resonant at Nyquist parts
