@@ -427,3 +427,10 @@ impl fmt::Display for Design {
         Ok(())
     }
 }
+
+/// A search's worst termination as the text reports print it: one line
+/// of its JSON.
+fn worst_termination(f: &mut fmt::Formatter<'_>, t: &impl Serialize) -> fmt::Result {
+    let json = serde_json::to_string(t).unwrap_or_default();
+    write!(f, "  worst termination: {json}")
+}

@@ -59,10 +59,6 @@ impl fmt::Display for TeleopVerifyReport {
             v.spectral_radius - 1.0,
             v.frequency_hz
         )?;
-        write!(
-            f,
-            "  worst termination: {}",
-            serde_json::to_string(&v.termination).unwrap_or_default()
-        )
+        super::worst_termination(f, &v.termination)
     }
 }

@@ -61,11 +61,7 @@ impl fmt::Display for VerifyReport {
             v.spectral_radius - 1.0,
             v.frequency_hz
         )?;
-        write!(
-            f,
-            "  worst termination: {}",
-            serde_json::to_string(&v.termination).unwrap_or_default()
-        )?;
+        super::worst_termination(f, &v.termination)?;
         if let Some(c) = &v.constructed {
             write!(
                 f,
