@@ -9,7 +9,7 @@
 
 mod emulated;
 
-use emulated::{armed_at, each_fault_stops_at_zero, rests_on_the_wall, turn, HAND};
+use emulated::{armed_at, each_fault_stops_at_zero, rests_on_the_wall, turn, HAND, PATIENCE};
 use host_sim::emulate::falcon::{self, Loader};
 use host_sim::emulate::{Emulator, Fault};
 use std::path::PathBuf;
@@ -27,6 +27,14 @@ fn firmware(name: &str) -> (PathBuf, Vec<u8>) {
     let path = dir.join(name);
     std::fs::write(&path, &bytes).unwrap();
     (path, bytes)
+}
+
+/// The driver's settings for `firmware`, patient with the emulator.
+fn config(firmware: impl Into<PathBuf>) -> FalconConfig {
+    FalconConfig {
+        reply_timeout: PATIENCE,
+        ..FalconConfig::new(firmware)
+    }
 }
 
 fn loader(image: Vec<u8>) -> Loader {
@@ -56,7 +64,7 @@ fn the_driver_loads_the_firmware_and_holds_the_floor_for_ten_seconds() {
     let _turn = turn();
     let (path, image) = firmware("wall.bin");
     let emu = falcon::start(loader(image), Some(HAND), None).unwrap();
-    let config = FalconConfig::new(&path);
+    let config = config(&path);
     let mut b = armed(&emu, &config);
     assert_eq!(
         emu.trace().events,
@@ -82,7 +90,7 @@ fn the_floor_holds_tick_by_tick() {
     let _turn = turn();
     let (path, image) = firmware("stepped.bin");
     let emu = falcon::start(loader(image), Some(HAND), None).unwrap();
-    let io = twoport_host::falcon::open(emu.path(), &FalconConfig::new(&path)).unwrap();
+    let io = twoport_host::falcon::open(emu.path(), &config(&path)).unwrap();
     let stepped = SteppedPc::new(falcon_pc::board().unwrap(), io);
     let mut b = armed_at(stepped, 3, &FALCON.rest_rad);
     rests_on_the_wall(&emu, &mut b, falcon_pc::IMAGE.coupling, 0.1e-3);
@@ -100,7 +108,7 @@ fn a_failing_falcon_gets_zero_force_and_a_named_error() {
             (Fault::Unplug, "unplugged"),
         ],
         |f| falcon::start(loader(image.clone()), Some(HAND), Some((300, f))).unwrap(),
-        |emu| armed(emu, &FalconConfig::new(&path)),
+        |emu| armed(emu, &config(&path)),
     );
 }
 
@@ -112,20 +120,17 @@ fn a_falcon_that_will_not_start_says_why() {
     let _turn = turn();
     let (path, image) = firmware("start.bin");
     let emu = falcon::start(loader(image.clone()), Some(HAND), None).unwrap();
-    let e = PcBoard::falcon(
-        emu.path(),
-        &FalconConfig::new("/nonexistent/test_firmware.bin"),
-    )
-    .err()
-    .unwrap()
-    .to_string();
+    let e = PcBoard::falcon(emu.path(), &config("/nonexistent/test_firmware.bin"))
+        .err()
+        .unwrap()
+        .to_string();
     assert!(e.contains("does not ship it"), "{e}");
     let silent = Loader {
         answers: false,
         ..loader(image.clone())
     };
     let emu = falcon::start(silent, Some(HAND), None).unwrap();
-    let e = PcBoard::falcon(emu.path(), &FalconConfig::new(&path))
+    let e = PcBoard::falcon(emu.path(), &config(&path))
         .err()
         .unwrap()
         .to_string();
@@ -138,7 +143,7 @@ fn a_falcon_that_will_not_start_says_why() {
         ..loader(image.clone())
     };
     let emu = falcon::start(garbled, Some(HAND), None).unwrap();
-    let e = PcBoard::falcon(emu.path(), &FalconConfig::new(&path))
+    let e = PcBoard::falcon(emu.path(), &config(&path))
         .err()
         .unwrap()
         .to_string();
@@ -146,7 +151,7 @@ fn a_falcon_that_will_not_start_says_why() {
     let mut other = image;
     other[500] ^= 1;
     let emu = falcon::start(loader(other), Some(HAND), None).unwrap();
-    let e = PcBoard::falcon(emu.path(), &FalconConfig::new(&path))
+    let e = PcBoard::falcon(emu.path(), &config(&path))
         .err()
         .unwrap()
         .to_string();

@@ -5,7 +5,7 @@
 
 mod emulated;
 
-use emulated::{armed_at, each_fault_stops_at_zero, rests_on_the_wall, turn, HAND};
+use emulated::{armed_at, each_fault_stops_at_zero, rests_on_the_wall, turn, HAND, PATIENCE};
 use host_sim::emulate::{haply, Emulator, Fault};
 use twoport_board::linkage::haply::{self as image, HAPLY};
 use twoport_host::device_port::open_error;
@@ -14,10 +14,13 @@ use twoport_host::{HostBoard, PcBoard, SteppedPc};
 
 /// A switch on analog pin 2, as the emulator's hand closes it.
 fn config() -> HaplyConfig {
-    HaplyConfig::v3(Grip::Pin {
-        pin: 2,
-        closed_above: 0.5,
-    })
+    HaplyConfig {
+        reply_timeout: PATIENCE,
+        ..HaplyConfig::v3(Grip::Pin {
+            pin: 2,
+            closed_above: 0.5,
+        })
+    }
 }
 
 /// Open, calibrate at the rest pose, stream and arm: the setup the board

@@ -9,7 +9,7 @@
 #[path = "../../tests/emulated/mod.rs"]
 mod emulated;
 
-use emulated::{armed_at, turn, wait, wall_holds};
+use emulated::{armed_at, turn, wait, wall_holds, Pacing};
 use host_sim::emulate::Trace;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -85,7 +85,7 @@ fn the_driver_holds_the_wall_for_ten_seconds() {
     assert_eq!(press_for_ten_seconds(&mut b), 0);
     drop(b);
     let t = read_trace(&path);
-    wall_holds(&t, image::IMAGE.coupling, QUANTUM_M);
+    wall_holds(&t, image::IMAGE.coupling, QUANTUM_M, Pacing::Threaded);
     assert_eq!(t.events[..2], ["open".to_string(), "force on".into()]);
     assert!(t.events.ends_with(&["force off".into(), "disabled".into()]));
 }
@@ -103,7 +103,12 @@ fn the_wall_holds_frame_by_frame() {
     assert_eq!(press_for_ten_seconds(&mut b), 0);
     drop(b);
     drop(_scheduler);
-    wall_holds(&read_trace(&path), image::IMAGE.coupling, QUANTUM_M);
+    wall_holds(
+        &read_trace(&path),
+        image::IMAGE.coupling,
+        QUANTUM_M,
+        Pacing::Stepped,
+    );
 }
 
 /// Each fault mid-run stops the loop with a message saying what happened

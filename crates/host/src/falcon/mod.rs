@@ -38,6 +38,11 @@ pub struct FalconConfig {
     /// such set ([`accept_unproven_gains`](crate::accept_unproven_gains)).
     /// `None`: refused.
     pub unproven_gains: Option<String>,
+    /// How long a reply may take in the loop before the Falcon counts as
+    /// silent ([`REPLY_TIMEOUT`](crate::device_port::REPLY_TIMEOUT)
+    /// unless a slow hub, or an emulator on a loaded machine, needs
+    /// longer).
+    pub reply_timeout: Duration,
 }
 
 impl FalconConfig {
@@ -49,6 +54,7 @@ impl FalconConfig {
             grip: Grip::Button { mask: 0b0001 },
             leds: protocol::LED_BLUE,
             unproven_gains: None,
+            reply_timeout: crate::device_port::REPLY_TIMEOUT,
         }
     }
 }
@@ -248,14 +254,14 @@ pub fn open(path: &str, config: &FalconConfig) -> Result<impl DeviceIo<3> + 'sta
     let mut port = DevicePort::open(path, protocol::CHECK_BAUD, NAME)?;
     if !running(&mut port, path).map_err(open_err)? {
         load(&mut port, path, &image).map_err(open_err)?;
-        port.set_timeout(crate::device_port::REPLY_TIMEOUT)
-            .map_err(open_err)?;
+        port.set_timeout(config.reply_timeout).map_err(open_err)?;
         latency_timer(path, 1).map_err(open_err)?;
         rate(&mut port, protocol::RUN_BAUD).map_err(open_err)?;
         // (The firmware takes a moment to start.)
         std::thread::sleep(Duration::from_millis(20));
         let _ = port.port_mut().clear(serialport::ClearBuffer::All);
     }
+    port.set_timeout(config.reply_timeout).map_err(open_err)?;
     let mut io = FalconIo {
         port,
         io: io_scale(&FALCON),

@@ -32,6 +32,10 @@ pub struct HaplyConfig {
     /// such set ([`accept_unproven_gains`](crate::accept_unproven_gains)).
     /// `None`: refused.
     pub unproven_gains: Option<String>,
+    /// How long a reply may take before the board counts as silent
+    /// ([`REPLY_TIMEOUT`](crate::device_port::REPLY_TIMEOUT) unless a
+    /// slow hub, or an emulator on a loaded machine, needs longer).
+    pub reply_timeout: std::time::Duration,
 }
 
 impl HaplyConfig {
@@ -52,6 +56,7 @@ impl HaplyConfig {
             joints: [joint(2, HAPLY.rest_rad[0]), joint(1, HAPLY.rest_rad[1])],
             grip,
             unproven_gains: None,
+            reply_timeout: crate::device_port::REPLY_TIMEOUT,
         }
     }
 
@@ -72,7 +77,12 @@ impl HaplyConfig {
 /// and hear it answer: the [`HaplyIo`] the PC's loop runs against.
 pub fn open(path: &str, config: &HaplyConfig) -> Result<impl DeviceIo<2> + 'static, LinkError> {
     config.grip.check(path, NAME, true, false)?;
-    let port = DevicePort::open(path, 115_200, NAME)?;
+    let mut port = DevicePort::open(path, 115_200, NAME)?;
+    port.set_timeout(config.reply_timeout)
+        .map_err(|why| LinkError::Open {
+            path: path.to_string(),
+            why,
+        })?;
     let mut io =
         HaplyIo::open(port, config.setup(), io_scale(&HAPLY), config.grip).map_err(|why| {
             LinkError::Open {
