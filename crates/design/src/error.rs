@@ -88,6 +88,10 @@ pub enum Error {
     /// A host delay that is not a time above zero.
     #[error("host_delay {0}: must be a time > 0 s")]
     HostDelay(f64),
+    /// A teleoperator that cannot be proven as asked: a law reading a
+    /// load cell a device lacks, a loop that cannot be built.
+    #[error("teleoperator: {0}")]
+    Teleop(String),
     /// The counterexample search could not run on a pose.
     #[error("{model}: {why}")]
     Verify {

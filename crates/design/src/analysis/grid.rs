@@ -243,6 +243,11 @@ impl Analysis {
         &self.plant
     }
 
+    /// The device's alias terms at each point, shared by every bound.
+    pub(crate) fn aliases(&self) -> &sampled::AliasCache {
+        &self.aliases
+    }
+
     /// The impedance-display bound on `Re(1/Z_cI)` at each grid point,
     /// sound for the sampled-data loop (aliasing at the handle port
     /// included, see [`crate::sampled`]): what designs and checks use.

@@ -12,6 +12,7 @@ mod grid;
 mod range;
 mod region;
 mod synthesis;
+mod teleop;
 
 pub use check::*;
 pub use grid::{feature_grid, grid, log_grid, Analysis, GridSpec};
@@ -19,6 +20,7 @@ use num_complex::Complex64;
 pub use range::*;
 pub use region::{region_admittance, region_impedance, region_rust_source};
 pub use synthesis::*;
+pub use teleop::{check_teleop, teleop_slack, TeleopAnalysis, TeleopCheck};
 use twoport_control::{
     AdmittanceCoupling, ImpedanceCoupling, ParamError, PositionRegulator, ZTransfer,
 };

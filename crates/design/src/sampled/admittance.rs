@@ -69,16 +69,16 @@ pub fn admittance_bound_with(
 /// The base band's hand terms, per unit `q = (1 - z^-1)/T`: `α_0 = q a_0`,
 /// `φ_0 = q f_0`, and the hand disk's radius `1/(2 R_0)`.
 #[derive(Clone, Copy, Debug)]
-struct Base {
-    a0: Complex64,
-    f0: Complex64,
-    r0: f64,
+pub(super) struct Base {
+    pub(super) a0: Complex64,
+    pub(super) f0: Complex64,
+    pub(super) r0: f64,
 }
 
 impl Base {
     /// `None` where the handle is lossless at `ω` (`R_0 <= 0`) or the
     /// actuator does not move the handle (`a_0 = 0`).
-    fn at(p: &PlantPoint, human: Option<HumanBound>) -> Option<Base> {
+    pub(super) fn at(p: &PlantPoint, human: Option<HumanBound>) -> Option<Base> {
         let y0 = p.y[0][0] + human.map_or(Complex64::new(0.0, 0.0), |h| h.admittance(p.s));
         // (The held force, delayed by the latency, drives the handle.)
         let lag = p.latency();
@@ -96,7 +96,7 @@ impl Base {
 /// radius `1/(2 R_k)`): `Σ |a_k|/R_k` and `Σ |f_k|/R_k`, the perturbation
 /// bound's reach into the encoder and the load cell, with their tails.
 #[derive(Clone, Copy, Debug, Default)]
-struct Reach {
+pub(super) struct Reach {
     x: f64,
     f: f64,
     tail_x: f64,
@@ -108,17 +108,17 @@ struct Reach {
 /// The disks the Möbius bound needs, over the same aliases as a [`Reach`]
 /// (tails included: a centre known to within a tail widens its disk by it).
 #[derive(Clone, Copy, Debug, Default)]
-struct Disks {
+pub(super) struct Disks {
     /// `Σ a_k w_k`.
-    a_centre: Complex64,
-    a_radius: f64,
+    pub(super) a_centre: Complex64,
+    pub(super) a_radius: f64,
     /// `Σ (f_k - (f_0/a_0) a_k) w_k`.
-    b_centre: Complex64,
-    b_radius: f64,
+    pub(super) b_centre: Complex64,
+    pub(super) b_radius: f64,
 }
 
 /// The aliases' [`Reach`] at point `i`, `None` where unbounded.
-fn alias_reach(
+pub(super) fn alias_reach(
     plant: &Plant,
     (i, p): (usize, &PlantPoint),
     human: Option<HumanBound>,
@@ -153,7 +153,7 @@ fn alias_reach(
 
 /// The [`Disks`] over the aliases `reach` summed (their terms come from
 /// `cache` where it holds them).
-fn alias_disks(
+pub(super) fn alias_disks(
     plant: &Plant,
     (i, p): (usize, &PlantPoint),
     human: Option<HumanBound>,

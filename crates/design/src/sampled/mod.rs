@@ -27,8 +27,10 @@
 //! handle's inertia dominates).
 
 mod admittance;
+mod forms;
 
 pub use admittance::{admittance_bound, admittance_bound_with};
+pub use forms::{hand_forms, Disk, HandForms};
 
 use crate::network::{design_bound, impedance_display, HumanBound};
 use crate::{Plant, PlantPoint};

@@ -1,0 +1,135 @@
+//! The designer's proof of a teleoperator, checked from outside it:
+//! Colgate's closed form on rigid devices, and `verify`'s exact closed
+//! loop at and past the proven gains on rigid and flexible pairs, with
+//! and without delay.
+
+use twoport_control::teleop::{FourChannel, FourChannelGains, TeleopTransfer};
+use twoport_control::Position;
+use twoport_design::analysis::{check_teleop, TeleopAnalysis};
+use twoport_design::verify::{verify_teleop, Teleoperator};
+use twoport_design::{DeviceModel, Error};
+
+const T: f64 = 1e-3;
+
+/// A rigid handle of `m` kg with `b` N s/m of its own damping.
+fn rigid(m: f64, b: f64) -> DeviceModel {
+    DeviceModel::from_toml(
+        &format!(
+            "name = \"rigid\"\nperiod_s = {T:e}\npeak_force_n = 50.0\ncontinuous_force_n = 20.0\n\
+             M = [[{m:e}]]\nD = [[{b:e}]]\nK = [[0.0]]\nG = [[1.0, -1.0]]\nC_v = [[1.0], [-1.0]]\n"
+        ),
+        "rigid",
+    )
+    .unwrap()
+}
+
+/// A 50 g actuator on a 20 kN/m flexure to a 20 g handle, the encoder on
+/// the actuator, a load cell on the flexure.
+fn flexible(name: &str) -> DeviceModel {
+    DeviceModel::from_toml(
+        &format!(
+            "name = \"{name}\"\nperiod_s = {T:e}\npeak_force_n = 50.0\ncontinuous_force_n = 20.0\n\
+             M = [[0.05, 0.0], [0.0, 0.02]]\nD = [[0.8, -0.3], [-0.3, 0.4]]\n\
+             K = [[2.0e4, -2.0e4], [-2.0e4, 2.0e4]]\nG = [[0.0, -1.0], [1.0, 0.0]]\n\
+             C_v = [[0.0, 1.0], [-1.0, 0.0]]\nload_cell_pole_rad_s = 2000.0\n\
+             C_f = [[-2.0e4, 2.0e4]]\n"
+        ),
+        name,
+    )
+    .unwrap()
+}
+
+fn pp(k: f64, b: f64, d: usize) -> TeleopTransfer {
+    FourChannel::<f64, 64>::position_position(k as f32, b as f32, T as f32, d, Position::ZERO)
+        .unwrap()
+        .tf()
+}
+
+fn proven(ta: &TeleopAnalysis, law: &TeleopTransfer) -> bool {
+    check_teleop(ta, law, None).unwrap().proven
+}
+
+/// The largest `x` in `(lo, hi)` at which `law(x)` is proven, to 0.2%,
+/// given that it is at `lo` and not at `hi`.
+fn proven_edge(ta: &TeleopAnalysis, law: impl Fn(f64) -> TeleopTransfer, lo: f64, hi: f64) -> f64 {
+    assert!(proven(ta, &law(lo)) && !proven(ta, &law(hi)));
+    let (mut lo, mut hi) = (lo, hi);
+    while hi - lo > 2e-3 * lo {
+        let mid = 0.5 * (lo + hi);
+        if proven(ta, &law(mid)) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// Two rigid 0.1 kg devices with 1 N s/m of their own, joined by
+/// position-position with damping `B` and no delay: their relative
+/// motion is one mass on the sampled wall `2k`, `2B`, and Colgate's
+/// condition for its passivity, `b > (2k) T/2 + 2B`, is `k < (1 - 2B)/T`.
+/// The proof holds 2% inside it and fails 2% outside, at `B` = 0 and 0.2.
+#[test]
+fn position_position_on_rigid_devices_is_proven_to_colgates_edge() {
+    let (master, slave) = (rigid(0.1, 1.0), rigid(0.1, 1.0));
+    let ta = TeleopAnalysis::of(&master, &slave).unwrap();
+    for b in [0.0, 0.2] {
+        let edge = (1.0 - 2.0 * b) / T;
+        let inside = check_teleop(&ta, &pp(0.98 * edge, b, 0), None).unwrap();
+        assert!(inside.proven, "B {b}: {inside:?}");
+        let outside = check_teleop(&ta, &pp(1.02 * edge, b, 0), None).unwrap();
+        assert!(!outside.proven && outside.slack < 0.0, "B {b}: {outside:?}");
+    }
+}
+
+/// At the proof's edge (found to 0.2%), `verify`'s exact loop finds no
+/// operator and environment that break the teleoperator, and past it
+/// finds one: 1% past on rigid devices with one and two ticks of delay
+/// (unequal devices), 5% past on two flexible devices.
+#[test]
+fn verify_meets_the_proof_at_its_edge() {
+    let cases: [(DeviceModel, DeviceModel, f64, usize, f64, f64); 3] = [
+        (rigid(0.1, 1.0), rigid(0.1, 1.0), 0.0, 1, 1.01, 400.0),
+        (rigid(0.25, 2.0), rigid(0.1, 1.0), 0.3, 2, 1.01, 500.0),
+        (flexible("master"), flexible("slave"), 0.5, 1, 1.05, 500.0),
+    ];
+    for (master, slave, b, d, past, lo) in cases {
+        let ta = TeleopAnalysis::of(&master, &slave).unwrap();
+        let k = proven_edge(&ta, |k| pp(k, b, d), lo, 2.0 * lo);
+        let at = |k: f64| {
+            verify_teleop(&Teleoperator {
+                master: &master,
+                slave: &slave,
+                law: pp(k, b, d),
+            })
+            .unwrap()
+        };
+        let (there, beyond) = (at(k), at(past * k));
+        assert!(!there.unstable, "{} N/m, d {d}: {there:?}", k);
+        assert!(beyond.unstable, "{} N/m, d {d}: {beyond:?}", past * k);
+    }
+}
+
+/// A law that reads a load cell a device does not have is refused by
+/// name.
+#[test]
+fn a_force_channel_needs_the_load_cell() {
+    let (master, slave) = (rigid(0.1, 1.0), rigid(0.1, 1.0));
+    let ta = TeleopAnalysis::of(&master, &slave).unwrap();
+    let law = FourChannel::<f64, 4>::new(
+        FourChannelGains {
+            c2: 0.5,
+            ..FourChannelGains::position_position(100.0, 1.0)
+        },
+        T as f32,
+        1,
+        Position::ZERO,
+    )
+    .unwrap()
+    .tf();
+    match check_teleop(&ta, &law, None) {
+        Err(Error::Teleop(why)) => assert!(why.contains("slave's load cell"), "{why}"),
+        e => panic!("{e:?}"),
+    }
+}
