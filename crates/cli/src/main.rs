@@ -127,6 +127,8 @@ fn main() -> ExitCode {
         Cmd::Devices(a) => print(a.json, &spec::devices()),
         Cmd::Spec(a) => spec::spec(&a.device, a.min_grasp).and_then(|r| print(a.json, &r)),
         Cmd::Teleop(Teleop::Verify(a)) => show(a.json, teleop::verify(a)),
+        Cmd::Teleop(Teleop::Check(a)) => show(a.json, teleop::check(a)),
+        Cmd::Teleop(Teleop::Design(a)) => show(a.json, teleop::design(a)),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,

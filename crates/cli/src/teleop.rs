@@ -3,15 +3,18 @@
 use crate::args::{TeleopArgs, TeleopLaw};
 use crate::run::{reported, Reported};
 use twoport_control::teleop::FourChannelGains;
+use twoport_design::designer::TeleopDesigner;
+use twoport_design::network::HumanBound;
 use twoport_design::verify::verify_four_channel;
 use twoport_design::DeviceModel;
 
-/// The law's gains as the control crate holds them.
-fn gains(law: &TeleopLaw) -> FourChannelGains {
-    match *law {
-        TeleopLaw::PositionPosition { k, b } => FourChannelGains::position_position(k, b),
+/// The law's gains as the control crate holds them, `free` standing in
+/// for the gain a design finds; `None` where that gain is left out.
+fn gains_with(law: &TeleopLaw, free: Option<f32>) -> Option<FourChannelGains> {
+    Some(match *law {
+        TeleopLaw::PositionPosition { k, b } => FourChannelGains::position_position(k.or(free)?, b),
         TeleopLaw::PositionForce { k, b, k_f, b_m } => {
-            FourChannelGains::position_force(k, b, k_f, b_m)
+            FourChannelGains::position_force(k, b, k_f.or(free)?, b_m)
         }
         TeleopLaw::FourChannel {
             k_m,
@@ -34,11 +37,24 @@ fn gains(law: &TeleopLaw) -> FourChannelGains {
             c5,
             c6,
         },
-    }
+    })
 }
 
-/// `teleop verify`: the exact loop's counterexample search.
-pub(crate) fn verify(a: &TeleopArgs) -> Reported {
+/// The law's gains, every one given.
+fn gains(law: &TeleopLaw) -> Result<FourChannelGains, String> {
+    gains_with(law, None).ok_or_else(|| {
+        match law {
+            TeleopLaw::PositionForce { .. } => {
+                "position-force: give --k-f (teleop design finds it)"
+            }
+            _ => "position-position: give --k (teleop design finds it)",
+        }
+        .to_string()
+    })
+}
+
+/// Both models, which must sample at one period.
+fn models(a: &TeleopArgs) -> Result<(DeviceModel, DeviceModel), String> {
     let load = |flag: &str, path: &std::path::Path| {
         DeviceModel::load(path).map_err(|e| format!("--{flag} {}: {e}", path.display()))
     };
@@ -49,7 +65,67 @@ pub(crate) fn verify(a: &TeleopArgs) -> Reported {
             master.period_s, slave.period_s
         ));
     }
+    Ok((master, slave))
+}
+
+/// `teleop verify`: the exact loop's counterexample search.
+pub(crate) fn verify(a: &TeleopArgs) -> Reported {
+    let (master, slave) = models(a)?;
     reported(
-        verify_four_channel(&master, &slave, gains(&a.law), a.delay).map_err(|e| e.to_string())?,
+        verify_four_channel(&master, &slave, gains(&a.law)?, a.delay).map_err(|e| e.to_string())?,
     )
+}
+
+fn designer(a: &TeleopArgs) -> Result<TeleopDesigner, String> {
+    let (master, slave) = models(a)?;
+    let human = a.human_bound.then_some(HumanBound::PAPER);
+    TeleopDesigner::new(&master, &slave, a.delay, human).map_err(|e| e.to_string())
+}
+
+/// `teleop check`: the proof at the given gains.
+pub(crate) fn check(a: &TeleopArgs) -> Reported {
+    let g = gains(&a.law)?;
+    reported(designer(a)?.check(g).map_err(|e| e.to_string())?)
+}
+
+/// The most a designed gain is searched up to: a stiffness (N/m), or a
+/// force scale.
+fn design_limit(law: &TeleopLaw) -> f64 {
+    match law {
+        TeleopLaw::PositionForce { .. } => 100.0,
+        _ => 1e7,
+    }
+}
+
+/// `teleop design`: the largest left-out gain the proof allows, and its
+/// proof.
+pub(crate) fn design(a: &TeleopArgs) -> Reported {
+    if gains_with(&a.law, None).is_some() {
+        let given = if matches!(a.law, TeleopLaw::PositionForce { .. }) {
+            "--k-f"
+        } else {
+            "--k"
+        };
+        return Err(match a.law {
+            TeleopLaw::FourChannel { .. } => {
+                "four-channel: design finds position-position's --k or position-force's --k-f; \
+                 check a four-channel law's given gains"
+                    .to_string()
+            }
+            _ => format!("design finds {given}: leave it out"),
+        });
+    }
+    let d = designer(a)?;
+    let at = |x: f64| gains_with(&a.law, Some(x as f32)).expect("the left-out gain is given");
+    match d
+        .largest(at, design_limit(&a.law))
+        .map_err(|e| e.to_string())?
+    {
+        Some((_, report)) => reported(report),
+        None => Err(format!(
+            "no gain is proven for these devices and this law (down to {:e}): \
+             `teleop check` with a small gain says where the proof fails",
+            design_limit(&a.law) * 1e-8
+        )),
+    }
 }

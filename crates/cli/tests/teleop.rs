@@ -109,3 +109,59 @@ fn bad_teleoperators_are_named() {
     }
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// `teleop <cmd> --json` between two capstan handles, `rest` after.
+fn handles_json(cmd: &str, rest: &str) -> serde_json::Value {
+    let line = format!("teleop {cmd} --master {CAPSTAN} --slave {CAPSTAN} --json {rest}");
+    TWOPORT.json(&line.split_whitespace().collect::<Vec<_>>())
+}
+
+/// `teleop design` finds the stiffest position-position coupling the
+/// proof allows between two capstan handles: Colgate's `k < b/T` =
+/// 2,000 N/m for their relative motion, to 0.1%; and with two ticks of
+/// delay and 0.5 N s/m in the law, a stiffness `verify` cannot break
+/// there and breaks 2% past.
+#[test]
+fn design_finds_the_stiffest_proven_coupling() {
+    let d = handles_json("design", "position-position --b 0");
+    assert_eq!(d["proven"], true, "{d}");
+    let k = d["gains"]["k_m_npm"].as_f64().unwrap();
+    assert!(k <= 2000.0 && k > 1996.0, "{d}");
+    let d = handles_json("design", "--delay 2 position-position --b 0.5");
+    let k = d["gains"]["k_m_npm"].as_f64().unwrap();
+    let verify = |k: f64| {
+        handles_json(
+            "verify",
+            &format!("--delay 2 position-position --k {k} --b 0.5"),
+        )
+    };
+    assert_eq!(verify(k)["unstable"], false, "{k}");
+    assert_eq!(verify(1.02 * k)["unstable"], true, "{k}");
+}
+
+/// `teleop check` says proven inside the edge and not past it, and why;
+/// a design asked with its gain given, or of four channels, is refused
+/// by name.
+#[test]
+fn check_proves_inside_the_edge_only() {
+    let inside = handles_json("check", "position-position --k 1960 --b 0");
+    assert_eq!(inside["proven"], true, "{inside}");
+    assert!(inside["slack"].as_f64().unwrap() > 0.0, "{inside}");
+    let past = handles_json("check", "position-position --k 2040 --b 0");
+    assert_eq!(past["proven"], false, "{past}");
+    assert!(past["slack"].as_f64().unwrap() < 0.0, "{past}");
+    for (law, says) in [
+        (
+            "position-position --k 100 --b 0",
+            "design finds --k: leave it out",
+        ),
+        ("four-channel --k-m 100", "four-channel: design finds"),
+    ] {
+        let line = format!("teleop design --master {CAPSTAN} --slave {CAPSTAN} {law}");
+        let e = TWOPORT.failure(&line.split_whitespace().collect::<Vec<_>>());
+        assert!(e.contains(says), "{law}: {e}");
+    }
+    let line = format!("teleop check --master {CAPSTAN} --slave {CAPSTAN} position-position --b 0");
+    let e = TWOPORT.failure(&line.split_whitespace().collect::<Vec<_>>());
+    assert!(e.contains("give --k"), "{e}");
+}

@@ -10,6 +10,13 @@ pub(crate) enum Teleop {
     /// sampled teleoperator unstable at these gains (master, slave, law
     /// and channel in one discrete loop).
     Verify(TeleopArgs),
+    /// Prove the teleoperator absolutely stable for every passive operator
+    /// and environment: the sampled loop's two-port, aliasing at both
+    /// handles.
+    Check(TeleopArgs),
+    /// The largest gain the proof allows: position-position's --k, or
+    /// position-force's --k-f, left out and found.
+    Design(TeleopArgs),
 }
 
 /// Two devices and the law between them.
@@ -26,6 +33,10 @@ pub(crate) struct TeleopArgs {
     /// The channel's delay each way (ticks of the devices' period).
     #[arg(long, default_value_t = 0)]
     pub(crate) delay: usize,
+    /// Hold the operator to the human bound Z_max = 300 + 1000/s (check
+    /// and design; verify searches every passive operator).
+    #[arg(long)]
+    pub(crate) human_bound: bool,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub(crate) json: bool,
@@ -39,9 +50,9 @@ pub(crate) enum TeleopLaw {
     /// Each side held to the other's delayed motion by one spring and
     /// damper; no force sensed.
     PositionPosition {
-        /// Stiffness (N/m).
+        /// Stiffness (N/m); design finds it.
         #[arg(long, allow_negative_numbers = true)]
-        k: f32,
+        k: Option<f32>,
         /// Damping (N s/m).
         #[arg(long, allow_negative_numbers = true)]
         b: f32,
@@ -55,9 +66,10 @@ pub(crate) enum TeleopLaw {
         /// The slave's damping (N s/m).
         #[arg(long, allow_negative_numbers = true)]
         b: f32,
-        /// The force fed back to the master per the slave's sensed force.
+        /// The force fed back to the master per the slave's sensed force;
+        /// design finds it.
         #[arg(long, allow_negative_numbers = true)]
-        k_f: f32,
+        k_f: Option<f32>,
         /// The master's own damping (N s/m).
         #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
         b_m: f32,

@@ -20,8 +20,10 @@
 
 mod regulated;
 mod report;
+mod teleop;
 
 pub use report::*;
+pub use teleop::TeleopDesigner;
 
 use crate::analysis::{self, Analysis, Check, GridSpec, Poses};
 use crate::limit_cycle::{Friction, LimitCycle};

@@ -199,8 +199,8 @@ pub use construct::{construct, Constructed};
 pub use host::{host_radius, monodromy, verify_host, HostVerdict};
 pub use search::{verify, verify_near};
 pub use teleop::{
-    teleop_closed_loop, teleop_radius, verify_four_channel, verify_teleop, TeleopTermination,
-    TeleopVerdict, Teleoperator, MAX_DELAY_TICKS,
+    four_channel_tf, teleop_closed_loop, teleop_radius, verify_four_channel, verify_teleop,
+    TeleopTermination, TeleopVerdict, Teleoperator, MAX_DELAY_TICKS,
 };
 
 /// The closed loop's spectral radius for one termination.

@@ -243,6 +243,29 @@ pub fn verify_teleop(t: &Teleoperator) -> Result<TeleopVerdict, String> {
 /// The longest channel delay [`verify_four_channel`] takes (ticks).
 pub const MAX_DELAY_TICKS: usize = 1024;
 
+/// The z-form of Lawrence's four-channel law of `gains` across a channel
+/// `delay_ticks` long each way, at `period_s`: the law the control crate
+/// runs (a delay of at most [`MAX_DELAY_TICKS`]).
+pub fn four_channel_tf(
+    gains: FourChannelGains,
+    period_s: f64,
+    delay_ticks: usize,
+) -> Result<TeleopTransfer, String> {
+    if delay_ticks > MAX_DELAY_TICKS {
+        return Err(format!(
+            "delay {delay_ticks} ticks: at most {MAX_DELAY_TICKS}"
+        ));
+    }
+    FourChannel::<f32, MAX_DELAY_TICKS>::new(
+        gains,
+        period_s as f32,
+        delay_ticks,
+        twoport_control::Position::ZERO,
+    )
+    .map(|law| law.tf())
+    .map_err(|e| e.to_string())
+}
+
 /// [`verify_teleop`] on Lawrence's four-channel law of `gains` across a
 /// channel `delay_ticks` long each way, between the models `master` and
 /// `slave` (which must sample at one period): the law the control crate
@@ -257,22 +280,10 @@ pub fn verify_four_channel(
         model: format!("{} and {}", master.name, slave.name),
         why,
     };
-    if delay_ticks > MAX_DELAY_TICKS {
-        return Err(fail(format!(
-            "delay {delay_ticks} ticks: at most {MAX_DELAY_TICKS}"
-        )));
-    }
-    let law = FourChannel::<f32, MAX_DELAY_TICKS>::new(
-        gains,
-        master.period_s as f32,
-        delay_ticks,
-        twoport_control::Position::ZERO,
-    )
-    .map_err(|e| fail(e.to_string()))?;
     let t = Teleoperator {
         master,
         slave,
-        law: law.tf(),
+        law: four_channel_tf(gains, master.period_s, delay_ticks).map_err(fail)?,
     };
     let verdict = verify_teleop(&t).map_err(fail)?;
     Ok(TeleopVerifyReport {

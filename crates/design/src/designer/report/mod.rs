@@ -13,7 +13,7 @@ mod verify;
 
 pub use check::CheckReport;
 pub use region::{RegionBound, RegionReport};
-pub use teleop::TeleopVerifyReport;
+pub use teleop::{TeleopCheckReport, TeleopVerifyReport};
 pub use verify::VerifyReport;
 
 /// Which display a report is for.

@@ -1,6 +1,7 @@
-//! `teleop verify`'s report: the counterexample search's verdict on a
-//! teleoperator.
+//! `teleop`'s reports: the proof's and the counterexample search's
+//! verdicts on a teleoperator.
 
+use crate::analysis::TeleopCheck;
 use crate::verify::TeleopVerdict;
 use serde::Serialize;
 use std::fmt;
@@ -26,27 +27,96 @@ pub struct TeleopVerifyReport {
     pub verdict: TeleopVerdict,
 }
 
+/// The proof's verdict on a four-channel teleoperator between two
+/// devices: the law's gains and channel, and the proof's margin.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TeleopCheckReport {
+    /// The master's model name.
+    pub master: String,
+    /// The slave's model name.
+    pub slave: String,
+    /// The sample period both run at (s).
+    pub period_s: f64,
+    /// The channel's delay each way (ticks).
+    pub delay_ticks: usize,
+    /// Whether the operator was held to the human bound (else any
+    /// passive operator).
+    pub human_bound: bool,
+    /// The law's gains.
+    pub gains: FourChannelGains,
+    /// What the proof found.
+    #[serde(flatten)]
+    pub check: TeleopCheck,
+}
+
+/// The heading both reports share: the devices, the channel and the law.
+fn heading(
+    f: &mut fmt::Formatter<'_>,
+    (master, slave): (&str, &str),
+    period_s: f64,
+    delay_ticks: usize,
+    g: &FourChannelGains,
+) -> fmt::Result {
+    writeln!(
+        f,
+        "Teleoperator: {master} (master) and {slave} (slave) at T = {} ms, {delay_ticks} ticks of delay each way",
+        period_s * 1e3,
+    )?;
+    writeln!(
+        f,
+        "  master: k_m {} N/m, b_m {} N s/m, own damping {} N s/m; slave: k_s {} N/m, b_s {} N s/m",
+        g.k_m_npm, g.b_m_nspm, g.b_local_nspm, g.k_s_npm, g.b_s_nspm
+    )?;
+    writeln!(
+        f,
+        "  force channels: c2 {}, c3 {}, c5 {}, c6 {}",
+        g.c2, g.c3, g.c5, g.c6
+    )
+}
+
+impl fmt::Display for TeleopCheckReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let names = (self.master.as_str(), self.slave.as_str());
+        heading(f, names, self.period_s, self.delay_ticks, &self.gains)?;
+        let c = &self.check;
+        let who = if self.human_bound {
+            "every operator within the human bound"
+        } else {
+            "every passive operator"
+        };
+        if c.proven {
+            writeln!(
+                f,
+                "  PROVEN: absolutely stable for {who} and every passive environment"
+            )?;
+        } else {
+            writeln!(f, "  NOT PROVEN for {who} and every passive environment")?;
+        }
+        writeln!(
+            f,
+            "  least slack {:.3e} at {:.2} Hz (positive: no termination closes a pole)",
+            c.slack, c.frequency_hz
+        )?;
+        if !c.holds_toward_dc {
+            writeln!(
+                f,
+                "  toward DC the slack falls below zero (a law reading a load cell: its aliased \
+                 share is bounded too loosely there)"
+            )?;
+        }
+        writeln!(
+            f,
+            "  both ends let go: spectral radius 1 {:+.3e}",
+            c.let_go_radius - 1.0
+        )
+    }
+}
+
 impl fmt::Display for TeleopVerifyReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let (g, v) = (&self.gains, &self.verdict);
-        writeln!(
-            f,
-            "Teleoperator: {} (master) and {} (slave) at T = {} ms, {} ticks of delay each way",
-            self.master,
-            self.slave,
-            self.period_s * 1e3,
-            self.delay_ticks
-        )?;
-        writeln!(
-            f,
-            "  master: k_m {} N/m, b_m {} N s/m, own damping {} N s/m; slave: k_s {} N/m, b_s {} N s/m",
-            g.k_m_npm, g.b_m_nspm, g.b_local_nspm, g.k_s_npm, g.b_s_nspm
-        )?;
-        writeln!(
-            f,
-            "  force channels: c2 {}, c3 {}, c5 {}, c6 {}",
-            g.c2, g.c3, g.c5, g.c6
-        )?;
+        let names = (self.master.as_str(), self.slave.as_str());
+        heading(f, names, self.period_s, self.delay_ticks, g)?;
         let verdict = if v.unstable {
             "UNSTABLE: a passive operator and environment break this teleoperator"
         } else {
