@@ -9,6 +9,7 @@ const TWOPORT: support::Tool = support::Tool {
 };
 
 const CAPSTAN: &str = "models/capstan.toml";
+const TWO_MASS: &str = "models/two_mass.toml";
 
 /// `teleop verify` between two capstan handles, then `law` (its words).
 fn between_handles(law: &str) -> Vec<String> {
@@ -47,10 +48,16 @@ fn position_position_between_two_handles_meets_colgates_edge() {
 }
 
 /// Force reflection and the four channels take their gains by name, and
-/// say them back.
+/// say them back (between two two-mass devices, which have load cells);
+/// between capstan handles, which have none, a law that reads one is
+/// refused by name.
 #[test]
 fn each_law_reports_its_gains() {
-    let args = between_handles("--json position-force --k 500 --b 5 --k-f 0.5 --b-m 3");
+    let between = |law: &str| {
+        let line = format!("teleop verify --master {TWO_MASS} --slave {TWO_MASS} {law}");
+        line.split_whitespace().map(String::from).collect::<Vec<_>>()
+    };
+    let args = between("--json position-force --k 500 --b 5 --k-f 0.5 --b-m 3");
     let v = TWOPORT.json(&args.iter().map(String::as_str).collect::<Vec<_>>());
     let g = &v["gains"];
     assert_eq!(
@@ -59,7 +66,7 @@ fn each_law_reports_its_gains() {
     );
     assert_eq!(g["b_local_nspm"], 3.0);
     assert_eq!(g["k_m_npm"], 0.0);
-    let args = between_handles("four-channel --k-m 300 --k-s 400 --c3 1");
+    let args = between("four-channel --k-m 300 --k-s 400 --c3 1");
     let text = TWOPORT.run(&args.iter().map(String::as_str).collect::<Vec<_>>());
     let text = String::from_utf8_lossy(&text.stdout);
     assert!(
@@ -67,6 +74,9 @@ fn each_law_reports_its_gains() {
         "{text}"
     );
     assert!(text.contains("c3 1"), "{text}");
+    let args = between_handles("position-force --k 500 --b 5 --k-f 0.5");
+    let e = TWOPORT.failure(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(e.contains("the slave's load cell") && e.contains("no C_f"), "{e}");
 }
 
 /// What a lab gets wrong is named: a missing file, devices at two

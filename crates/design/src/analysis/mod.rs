@@ -20,7 +20,7 @@ use num_complex::Complex64;
 pub use range::*;
 pub use region::{region_admittance, region_impedance, region_rust_source};
 pub use synthesis::*;
-pub use teleop::{check_teleop, teleop_slack, TeleopAnalysis, TeleopCheck};
+pub use teleop::{check_teleop, closing_hands, teleop_slack, TeleopAnalysis, TeleopCheck};
 use twoport_control::{
     AdmittanceCoupling, ImpedanceCoupling, ParamError, PositionRegulator, ZTransfer,
 };

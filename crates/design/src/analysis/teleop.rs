@@ -183,6 +183,65 @@ fn point_slack(m: &Share, s: &Share) -> f64 {
     }
 }
 
+/// Where the bilinear determinant vanishes over the two unit disks, if it
+/// does: the master's `ζ` that maximises `|Q/P|` (order master first),
+/// and the slave's that zeroes it. The image's far point is the centre
+/// pushed out by the radius; the Möbius map is inverted there.
+fn zeroing(m: &Share, s: &Share) -> Option<(Complex64, Complex64)> {
+    let one = Complex64::new(1.0, 0.0);
+    let (ac, a1, gc, g1) = (m.centre[0], m.zeta[0], m.centre[1], m.zeta[1]);
+    let (bc, b1, dc, d1) = (s.centre[0], s.zeta[0], s.centre[1], s.zeta[1]);
+    let a = (one - ac) * (one - dc) - bc * gc;
+    let b = -a1 * (one - dc) - bc * g1;
+    let c = -(one - ac) * d1 - b1 * gc;
+    let d = a1 * d1 - b1 * g1;
+    let den = a.norm_sqr() - b.norm_sqr();
+    if den <= 0.0 {
+        return None;
+    }
+    let centre = (c * a.conj() - d * b.conj()) / den;
+    let radius = (c * b - d * a).norm() / den;
+    let u = if centre.norm() > 0.0 {
+        centre * (1.0 + radius / centre.norm())
+    } else {
+        Complex64::new(radius, 0.0)
+    };
+    if u.norm() < 1.0 {
+        return None;
+    }
+    // u = (c + d ζ)/(a + b ζ) at ζ = (c - a u)/(b u - d); P + Q ζ_s = 0.
+    let zm = (c - a * u) / (b * u - d);
+    let zs = -one / u;
+    (zm.is_finite() && zs.is_finite()).then_some((zm, zs))
+}
+
+/// The hands' admittances (m/s per N, at `ω`) that close a pole at grid
+/// point `i`, where the proof fails there, from its own worst point: each
+/// device's `w` realised at the base band alone, `Y = 1/w - Y_hh` (its
+/// real part held at 0 or above). `None` where no termination of the
+/// disks zeroes the determinant (the load cells' share alone broke the
+/// proof), or for the human bound (a hand behind the grasp).
+pub fn closing_hands(
+    ta: &TeleopAnalysis,
+    law: &TeleopTransfer,
+    i: usize,
+) -> Option<[Complex64; 2]> {
+    let (ma, sa) = (&ta.master.1, &ta.slave.1);
+    let (pm, ps) = (ma.points.get(i)?, sa.points.get(i)?);
+    let hm = hand_forms(ma.plant(), (i, pm), None, ma.aliases())?;
+    let hs = hand_forms(sa.plant(), (i, ps), None, sa.aliases())?;
+    let l = law.eval(pm.z);
+    let q = (Complex64::new(1.0, 0.0) - pm.z.inv()) / ma.period_s;
+    let m = share(&hm, q, [l[0][0], l[1][0]], [l[0][3], l[1][3]]);
+    let s = share(&hs, q, [l[0][1], l[1][1]], [l[0][2], l[1][2]]);
+    let (zm, zs) = zeroing(&m, &s)?;
+    let hand = |h: &HandForms, z: Complex64, yhh: Complex64| {
+        let y = 1.0 / (h.w.centre + h.w.radius * z) - yhh;
+        Complex64::new(y.re.max(0.0), y.im)
+    };
+    Some([hand(&hm, zm, pm.y[0][0]), hand(&hs, zs, ps.y[0][0])])
+}
+
 /// The proof's margin at each grid point for the law `law` (its forms,
 /// channel delay included), the human bound `human` at the master's
 /// handle: positive where no passive operator and environment put a pole

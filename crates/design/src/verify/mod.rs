@@ -191,6 +191,7 @@ mod host;
 mod search;
 mod simplex;
 mod teleop;
+mod teleop_proof;
 
 pub(crate) use simplex::maximise as simplex_maximise;
 
@@ -202,6 +203,7 @@ pub use teleop::{
     four_channel_tf, teleop_closed_loop, teleop_radius, verify_four_channel, verify_teleop,
     TeleopTermination, TeleopVerdict, Teleoperator, MAX_DELAY_TICKS,
 };
+pub use teleop_proof::verify_teleop_near_proof;
 
 /// The closed loop's spectral radius for one termination.
 pub fn radius(

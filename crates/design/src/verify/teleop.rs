@@ -266,10 +266,11 @@ pub fn four_channel_tf(
     .map_err(|e| e.to_string())
 }
 
-/// [`verify_teleop`] on Lawrence's four-channel law of `gains` across a
-/// channel `delay_ticks` long each way, between the models `master` and
-/// `slave` (which must sample at one period): the law the control crate
-/// runs, its z-form searched.
+/// [`verify_teleop_near_proof`](super::verify_teleop_near_proof) on
+/// Lawrence's four-channel law of `gains` across a channel `delay_ticks`
+/// long each way, between the models `master` and `slave` (which must
+/// sample at one period): the law the control crate runs, its z-form
+/// searched, with the proof's own worst hands.
 pub fn verify_four_channel(
     master: &DeviceModel,
     slave: &DeviceModel,
@@ -280,12 +281,9 @@ pub fn verify_four_channel(
         model: format!("{} and {}", master.name, slave.name),
         why,
     };
-    let t = Teleoperator {
-        master,
-        slave,
-        law: four_channel_tf(gains, master.period_s, delay_ticks).map_err(fail)?,
-    };
-    let verdict = verify_teleop(&t).map_err(fail)?;
+    let law = four_channel_tf(gains, master.period_s, delay_ticks).map_err(fail)?;
+    let analysis = crate::analysis::TeleopAnalysis::of(master, slave)?;
+    let verdict = super::verify_teleop_near_proof(&analysis, &law).map_err(fail)?;
     Ok(TeleopVerifyReport {
         master: master.name.clone(),
         slave: slave.name.clone(),
