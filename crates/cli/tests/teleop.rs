@@ -55,7 +55,9 @@ fn position_position_between_two_handles_meets_colgates_edge() {
 fn each_law_reports_its_gains() {
     let between = |law: &str| {
         let line = format!("teleop verify --master {TWO_MASS} --slave {TWO_MASS} {law}");
-        line.split_whitespace().map(String::from).collect::<Vec<_>>()
+        line.split_whitespace()
+            .map(String::from)
+            .collect::<Vec<_>>()
     };
     let args = between("--json position-force --k 500 --b 5 --k-f 0.5 --b-m 3");
     let v = TWOPORT.json(&args.iter().map(String::as_str).collect::<Vec<_>>());
@@ -76,7 +78,10 @@ fn each_law_reports_its_gains() {
     assert!(text.contains("c3 1"), "{text}");
     let args = between_handles("position-force --k 500 --b 5 --k-f 0.5");
     let e = TWOPORT.failure(&args.iter().map(String::as_str).collect::<Vec<_>>());
-    assert!(e.contains("the slave's load cell") && e.contains("no C_f"), "{e}");
+    assert!(
+        e.contains("the slave's load cell") && e.contains("no C_f"),
+        "{e}"
+    );
 }
 
 /// What a lab gets wrong is named: a missing file, devices at two

@@ -18,9 +18,11 @@
 //! `A + B ζ_m + C ζ_s + D ζ_m ζ_s`, and it has no zero on the bidisk iff
 //! `|A| > |B|` and the Möbius image `(C + D ζ_m)/(A + B ζ_m)` of the unit
 //! disk lies inside it: exact, since a sum of disks is a disk. The `η`s
-//! (only a law that reads a load cell sees them) are a perturbation whose
-//! size `Δ` is bounded; the test becomes `max |Q/P| < 1 - Δ/(|A| - |B|)`,
-//! taken in both orders (master's or slave's `ζ` first), the better kept.
+//! (only a law that reads a load cell sees them) enter the determinant
+//! linearly, one side's with coefficients affine in the other side's
+//! `ζ`, so the test becomes `max |Q/P| + Σ ρ max |R/P| + k/min |P| < 1`,
+//! each a Möbius image's far point, taken in both orders (master's or
+//! slave's `ζ` first), the better kept.
 //! [`teleop_slack`] is that margin at each point; it is positive where no
 //! termination puts a pole at `z = e^{jωT}`.
 //!
@@ -150,32 +152,67 @@ fn max_ratio(a: Complex64, b: Complex64, c: Complex64, d: Complex64) -> f64 {
     ((c * a.conj() - d * b.conj()).norm() + (c * b - d * a).norm()) / den
 }
 
-/// The proof's margin at one point (see the module docs): positive where
-/// no termination closes a pole there.
-fn point_slack(m: &Share, s: &Share) -> f64 {
+/// The determinant without the load cells' share,
+/// `A + B ζ_m + C ζ_s + D ζ_m ζ_s`: `[A, B, C, D]`.
+fn bilinear(m: &Share, s: &Share) -> [Complex64; 4] {
     let one = Complex64::new(1.0, 0.0);
     // α = m_1, γ = m_2 (the master's); β = s_1, δ = s_2 (the slave's).
     let (ac, a1, gc, g1) = (m.centre[0], m.zeta[0], m.centre[1], m.zeta[1]);
     let (bc, b1, dc, d1) = (s.centre[0], s.zeta[0], s.centre[1], s.zeta[1]);
-    let a = (one - ac) * (one - dc) - bc * gc;
-    let b = -a1 * (one - dc) - bc * g1;
-    let c = -(one - ac) * d1 - b1 * gc;
-    let d = a1 * d1 - b1 * g1;
+    [
+        (one - ac) * (one - dc) - bc * gc,
+        -a1 * (one - dc) - bc * g1,
+        -(one - ac) * d1 - b1 * gc,
+        a1 * d1 - b1 * g1,
+    ]
+}
+
+/// The margin with one side's `ζ` first (`first`, whose `P = a + b ζ`
+/// and `Q = c + d ζ`) and the other's solved for. The load cells'
+/// share enters the determinant linearly: the other side's `ε`s with
+/// coefficients affine in this side's `ζ` (`(ρ, r_0, r_1)`: `ρ |r_0 + r_1
+/// ζ|`), this side's with coefficients in the other's `ζ`, bounded by
+/// constants (`k`). What must hold over the disk is
+/// `|P| > |Q| + Σ ρ |R| + k`; divided by `|P|`, each ratio's largest
+/// modulus is its Möbius image's far point, and a sum's largest is at
+/// most the sum of theirs.
+fn ordered_slack(
+    [a, b, c, d]: [Complex64; 4],
+    affine: &[(f64, Complex64, Complex64)],
+    k: f64,
+) -> f64 {
+    let den = a.norm_sqr() - b.norm_sqr();
+    let p_min = a.norm() - b.norm();
+    if p_min <= k || den <= 0.0 {
+        return f64::NEG_INFINITY;
+    }
+    let far = |c: Complex64, d: Complex64| max_ratio(a, b, c, d);
+    let perturbed: f64 = affine.iter().map(|(rho, r0, r1)| rho * far(*r0, *r1)).sum();
+    1.0 - k / p_min - far(c, d) - perturbed
+}
+
+/// The proof's margin at one point (see the module docs): positive where
+/// no termination closes a pole there.
+fn point_slack(m: &Share, s: &Share) -> f64 {
+    let one = Complex64::new(1.0, 0.0);
+    let [a, b, c, d] = bilinear(m, s);
+    let (ac, a1, gc, g1) = (m.centre[0], m.zeta[0], m.centre[1], m.zeta[1]);
+    let (bc, b1, dc, d1) = (s.centre[0], s.zeta[0], s.centre[1], s.zeta[1]);
     let (ra, rg, rb, rd) = (m.eps[0], m.eps[1], s.eps[0], s.eps[1]);
-    let delta = ra * ((one - dc).norm() + d1.norm())
-        + rd * ((one - ac).norm() + a1.norm())
-        + ra * rd
-        + (bc.norm() + b1.norm()) * rg
-        + (gc.norm() + g1.norm()) * rb
-        + rb * rg;
-    let order = |a: Complex64, b: Complex64, c: Complex64, d: Complex64| {
-        let p_min = a.norm() - b.norm();
-        if p_min <= delta {
-            return f64::NEG_INFINITY;
-        }
-        1.0 - delta / p_min - max_ratio(a, b, c, d)
-    };
-    let slack = order(a, b, c, d).max(order(a, c, b, d));
+    // det = (1 - α)(1 - δ) - β γ: ε_α's coefficient is -(1 - δ), ε_δ's
+    // -(1 - α), ε_β's -γ, ε_γ's -β; the products ε_α ε_δ and ε_β ε_γ.
+    let cross = ra * rd + rb * rg;
+    let master_first = ordered_slack(
+        [a, b, c, d],
+        &[(rb, gc, g1), (rd, one - ac, -a1)],
+        ra * ((one - dc).norm() + d1.norm()) + rg * (bc.norm() + b1.norm()) + cross,
+    );
+    let slave_first = ordered_slack(
+        [a, c, b, d],
+        &[(ra, one - dc, -d1), (rg, bc, b1)],
+        rb * (gc.norm() + g1.norm()) + rd * ((one - ac).norm() + a1.norm()) + cross,
+    );
+    let slack = master_first.max(slave_first);
     if slack.is_nan() {
         f64::NEG_INFINITY
     } else {
@@ -189,12 +226,7 @@ fn point_slack(m: &Share, s: &Share) -> f64 {
 /// pushed out by the radius; the Möbius map is inverted there.
 fn zeroing(m: &Share, s: &Share) -> Option<(Complex64, Complex64)> {
     let one = Complex64::new(1.0, 0.0);
-    let (ac, a1, gc, g1) = (m.centre[0], m.zeta[0], m.centre[1], m.zeta[1]);
-    let (bc, b1, dc, d1) = (s.centre[0], s.zeta[0], s.centre[1], s.zeta[1]);
-    let a = (one - ac) * (one - dc) - bc * gc;
-    let b = -a1 * (one - dc) - bc * g1;
-    let c = -(one - ac) * d1 - b1 * gc;
-    let d = a1 * d1 - b1 * g1;
+    let [a, b, c, d] = bilinear(m, s);
     let den = a.norm_sqr() - b.norm_sqr();
     if den <= 0.0 {
         return None;
