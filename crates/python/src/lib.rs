@@ -22,6 +22,8 @@ fn twoport_py(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(design::region, m)?)?;
     m.add_function(wrap_pyfunction!(design::host_ve, m)?)?;
     m.add_function(wrap_pyfunction!(teleop::verify_teleop, m)?)?;
+    m.add_function(wrap_pyfunction!(teleop::check_teleop, m)?)?;
+    m.add_function(wrap_pyfunction!(teleop::design_teleop, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(model::load_device, m)?)?;
     m.add_class::<design::Design>()?;
@@ -29,6 +31,8 @@ fn twoport_py(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<design::Verdict>()?;
     m.add_class::<design::HostCheck>()?;
     m.add_class::<teleop::TeleopVerdict>()?;
+    m.add_class::<teleop::TeleopGains>()?;
+    m.add_class::<teleop::TeleopCheck>()?;
     m.add_class::<model::Model>()?;
     m.add_class::<board::Board>()?;
     Ok(())

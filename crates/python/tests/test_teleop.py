@@ -34,3 +34,24 @@ def test_a_bad_teleoperator_raises_naming_it():
         twoport.verify_teleop(rigid(), rigid(), k_m=100.0, k_s=100.0, delay=2000)
     with pytest.raises(ValueError, match="k_m"):
         twoport.verify_teleop(rigid(), rigid(), k_m=-1.0)
+
+
+def test_the_proof_holds_inside_colgates_edge_and_design_finds_it():
+    # The same two handles: proven 2% inside k = b / T, refused 2% past;
+    # the stiffest proven coupling is within 0.5% below the edge, and
+    # verify finds nothing there.
+    m, s = rigid(), rigid()
+    inside = twoport.check_teleop(m, s, twoport.TeleopGains(k_m=980.0, k_s=980.0))
+    past = twoport.check_teleop(m, s, twoport.TeleopGains(k_m=1020.0, k_s=1020.0))
+    assert inside.proven and inside.slack > 0.0, inside
+    assert not past.proven and past.slack < 0.0, past
+    best = twoport.design_teleop(m, s, b=0.0)
+    assert best is not None and best.proven, best
+    assert 995.0 < best.gains.k_m <= 1000.0 and best.gains.k_s == best.gains.k_m, best
+    there = twoport.verify_teleop(m, s, k_m=best.gains.k_m, k_s=best.gains.k_s)
+    assert not there.unstable, there
+
+
+def test_a_force_channel_without_a_load_cell_raises():
+    with pytest.raises(ValueError, match="load cell"):
+        twoport.check_teleop(rigid(), rigid(), twoport.TeleopGains(k_s=100.0, c2=0.5))

@@ -48,8 +48,14 @@ pub fn verify_teleop_near_proof(
     };
     let mut verdict = verify_teleop(&t)?;
     let slack = teleop_slack(ta, law, None).map_err(|e| e.to_string())?;
-    let mut minima: Vec<usize> = (1..slack.len().saturating_sub(1))
-        .filter(|&i| slack[i] < 0.0 && slack[i] <= slack[i - 1] && slack[i] <= slack[i + 1])
+    // (Nyquist, the grid's last point, is a minimum where it binds.)
+    let n = slack.len();
+    let mut minima: Vec<usize> = (0..n)
+        .filter(|&i| {
+            slack[i] < 0.0
+                && (i == 0 || slack[i] <= slack[i - 1])
+                && (i + 1 == n || slack[i] <= slack[i + 1])
+        })
         .collect();
     minima.sort_by(|a, b| slack[*a].total_cmp(&slack[*b]));
     let omegas: Vec<f64> = ta.omegas().collect();
