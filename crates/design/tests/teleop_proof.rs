@@ -5,7 +5,7 @@
 
 use twoport_control::teleop::{FourChannel, FourChannelGains, TeleopTransfer};
 use twoport_control::Position;
-use twoport_design::analysis::{check_teleop, TeleopAnalysis};
+use twoport_design::analysis::{check_teleop, felt_at_low_frequency, teleop_range, TeleopAnalysis};
 use twoport_design::designer::TeleopDesigner;
 use twoport_design::verify::verify_teleop_near_proof;
 use twoport_design::{DeviceModel, Error};
@@ -176,5 +176,33 @@ fn a_force_channel_needs_the_load_cell() {
     match check_teleop(&ta, &law, None) {
         Err(Error::Teleop(why)) => assert!(why.contains("slave's load cell"), "{why}"),
         e => panic!("{e:?}"),
+    }
+}
+
+/// What the operator feels through position-position between two rigid
+/// 0.1 kg, 1 N s/m devices at 0.05 Hz: in free space both devices' mass
+/// and damping (0.2 kg, 2 N s/m), and against a rigid wall the
+/// coupling's stiffness. A delay of `d` ticks each way adds the damping
+/// `2 k d T` in free space (the slave follows `x_m e^{-2sτ}` back: `k (1 -
+/// e^{-2sτ}) ≈ 2kτ s`), and leaves the wall's stiffness.
+#[test]
+fn the_operator_feels_both_masses_and_the_coupling_s_spring() {
+    let (master, slave) = (rigid(0.1, 1.0), rigid(0.1, 1.0));
+    let ta = TeleopAnalysis::of(&master, &slave).unwrap();
+    let k = 500.0;
+    for d in [0, 2] {
+        let felt = felt_at_low_frequency(&teleop_range(&ta, &pp(k, 0.0, d))).unwrap();
+        let damping = 2.0 + 2.0 * k * d as f64 * T;
+        assert!(
+            (felt.free_damping_nspm - damping).abs() < 0.01 * damping,
+            "d {d}: {felt:?}"
+        );
+        assert!(
+            (felt.wall_stiffness_npm - k).abs() < 0.01 * k,
+            "d {d}: {felt:?}"
+        );
+        if d == 0 {
+            assert!((felt.free_mass_kg - 0.2).abs() < 2e-3, "{felt:?}");
+        }
     }
 }

@@ -157,6 +157,10 @@ pub(crate) struct TeleopCheck {
     let_go_radius: f64,
     /// The gains proven (or not).
     gains: TeleopGains,
+    /// What the operator feels at the lowest frequency: through free
+    /// space the mass (kg) and damping (N s/m), against a rigid wall the
+    /// stiffness (N/m).
+    felt: Option<(f64, f64, f64)>,
 }
 
 #[pymethods]
@@ -181,6 +185,9 @@ impl From<TeleopCheckReport> for TeleopCheck {
             holds_toward_dc: r.check.holds_toward_dc,
             let_go_radius: r.check.let_go_radius,
             gains: r.gains.into(),
+            felt: r
+                .felt
+                .map(|t| (t.free_mass_kg, t.free_damping_nspm, t.wall_stiffness_npm)),
         }
     }
 }

@@ -44,6 +44,9 @@ def test_the_proof_holds_inside_colgates_edge_and_design_finds_it():
     inside = twoport.check_teleop(m, s, twoport.TeleopGains(k_m=980.0, k_s=980.0))
     past = twoport.check_teleop(m, s, twoport.TeleopGains(k_m=1020.0, k_s=1020.0))
     assert inside.proven and inside.slack > 0.0, inside
+    mass, damping, stiffness = inside.felt
+    assert abs(mass - 0.2) < 2e-3 and abs(damping - 2.0) < 0.02, inside.felt
+    assert abs(stiffness - 980.0) < 10.0, inside.felt
     assert not past.proven and past.slack < 0.0, past
     best = twoport.design_teleop(m, s, b=0.0)
     assert best is not None and best.proven, best

@@ -13,6 +13,7 @@ mod range;
 mod region;
 mod synthesis;
 mod teleop;
+mod teleop_range;
 
 pub use check::*;
 pub use grid::{feature_grid, grid, log_grid, Analysis, GridSpec};
@@ -21,6 +22,7 @@ pub use range::*;
 pub use region::{region_admittance, region_impedance, region_rust_source};
 pub use synthesis::*;
 pub use teleop::{check_teleop, closing_hands, teleop_slack, TeleopAnalysis, TeleopCheck};
+pub use teleop_range::{felt_at_low_frequency, teleop_range, Felt};
 use twoport_control::{
     AdmittanceCoupling, ImpedanceCoupling, ParamError, PositionRegulator, ZTransfer,
 };

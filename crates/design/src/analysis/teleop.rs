@@ -86,6 +86,11 @@ impl TeleopAnalysis {
         &self.slave.0
     }
 
+    /// Both devices' responses at each grid point.
+    pub(super) fn points(&self) -> (&[crate::PlantPoint], &[crate::PlantPoint]) {
+        (&self.master.1.points, &self.slave.1.points)
+    }
+
     /// The grid's angular frequencies (rad/s).
     pub fn omegas(&self) -> impl Iterator<Item = f64> + '_ {
         self.master.1.points.iter().map(|p| p.omega)
@@ -314,8 +319,8 @@ pub struct TeleopCheck {
     pub slack: f64,
     /// Where it is least (Hz).
     pub frequency_hz: f64,
-    /// Whether the slack stays positive toward DC, below the grid (see
-    /// [`toward_dc`]).
+    /// Whether the slack stays positive toward DC, below the grid: its
+    /// limit from the two lowest points (the slack is even in `ω`).
     pub holds_toward_dc: bool,
     /// The spectral radius of the exact loop with both ends let go.
     pub let_go_radius: f64,

@@ -2,7 +2,7 @@
 //! two devices, and the largest gain it allows.
 
 use super::report::TeleopCheckReport;
-use crate::analysis::{check_teleop, TeleopAnalysis};
+use crate::analysis::{check_teleop, felt_at_low_frequency, teleop_range, TeleopAnalysis};
 use crate::network::HumanBound;
 use crate::verify::four_channel_tf;
 use crate::{DeviceModel, Error};
@@ -46,6 +46,7 @@ impl TeleopDesigner {
             human_bound: self.human.is_some(),
             gains,
             check: check_teleop(&self.analysis, &law, self.human)?,
+            felt: felt_at_low_frequency(&teleop_range(&self.analysis, &law)),
         })
     }
 

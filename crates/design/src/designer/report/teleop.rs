@@ -1,7 +1,7 @@
 //! `teleop`'s reports: the proof's and the counterexample search's
 //! verdicts on a teleoperator.
 
-use crate::analysis::TeleopCheck;
+use crate::analysis::{Felt, TeleopCheck};
 use crate::verify::TeleopVerdict;
 use serde::Serialize;
 use std::fmt;
@@ -47,6 +47,10 @@ pub struct TeleopCheckReport {
     /// What the proof found.
     #[serde(flatten)]
     pub check: TeleopCheck,
+    /// What the operator feels at the grid's lowest frequency, through
+    /// free space and against a rigid wall (the teleoperator's Z-width,
+    /// at the base band).
+    pub felt: Option<Felt>,
 }
 
 /// The heading both reports share: the devices, the channel and the law.
@@ -108,7 +112,15 @@ impl fmt::Display for TeleopCheckReport {
             f,
             "  both ends let go: spectral radius 1 {:+.3e}",
             c.let_go_radius - 1.0
-        )
+        )?;
+        if let Some(t) = &self.felt {
+            writeln!(
+                f,
+                "  the operator feels: through free space {:.4} kg and {:.3} N s/m; against a rigid wall {:.1} N/m",
+                t.free_mass_kg, t.free_damping_nspm, t.wall_stiffness_npm
+            )?;
+        }
+        Ok(())
     }
 }
 
