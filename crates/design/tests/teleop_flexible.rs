@@ -11,23 +11,11 @@ use twoport_design::verify::{
 };
 use twoport_design::DeviceModel;
 
-const T: f64 = 1e-3;
+mod common;
 
-/// A 50 g actuator on a 20 kN/m flexure to a 20 g handle, the encoder on
-/// the actuator, a load cell on the flexure (2,000 rad/s).
-fn flexible(name: &str) -> DeviceModel {
-    DeviceModel::from_toml(
-        &format!(
-            "name = \"{name}\"\nperiod_s = {T:e}\npeak_force_n = 50.0\ncontinuous_force_n = 20.0\n\
-             M = [[0.05, 0.0], [0.0, 0.02]]\nD = [[0.8, -0.3], [-0.3, 0.4]]\n\
-             K = [[2.0e4, -2.0e4], [-2.0e4, 2.0e4]]\nG = [[0.0, -1.0], [1.0, 0.0]]\n\
-             C_v = [[0.0, 1.0], [-1.0, 0.0]]\nload_cell_pole_rad_s = 2000.0\n\
-             C_f = [[-2.0e4, 2.0e4]]\n"
-        ),
-        name,
-    )
-    .unwrap()
-}
+use common::flexible;
+
+const T: f64 = 1e-3;
 
 /// Both springs 500 N/m and dampers 0.5 N s/m, each side's sensed force
 /// fed to the other at `c`.

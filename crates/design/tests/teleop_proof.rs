@@ -10,35 +10,16 @@ use twoport_design::designer::TeleopDesigner;
 use twoport_design::verify::verify_teleop_near_proof;
 use twoport_design::{DeviceModel, Error};
 
-const T: f64 = 1e-3;
+mod common;
+
+use common::flexible;
 
 /// A rigid handle of `m` kg with `b` N s/m of its own damping.
 fn rigid(m: f64, b: f64) -> DeviceModel {
-    DeviceModel::from_toml(
-        &format!(
-            "name = \"rigid\"\nperiod_s = {T:e}\npeak_force_n = 50.0\ncontinuous_force_n = 20.0\n\
-             M = [[{m:e}]]\nD = [[{b:e}]]\nK = [[0.0]]\nG = [[1.0, -1.0]]\nC_v = [[1.0], [-1.0]]\n"
-        ),
-        "rigid",
-    )
-    .unwrap()
+    common::rigid(m, b, 0)
 }
 
-/// A 50 g actuator on a 20 kN/m flexure to a 20 g handle, the encoder on
-/// the actuator, a load cell on the flexure.
-fn flexible(name: &str) -> DeviceModel {
-    DeviceModel::from_toml(
-        &format!(
-            "name = \"{name}\"\nperiod_s = {T:e}\npeak_force_n = 50.0\ncontinuous_force_n = 20.0\n\
-             M = [[0.05, 0.0], [0.0, 0.02]]\nD = [[0.8, -0.3], [-0.3, 0.4]]\n\
-             K = [[2.0e4, -2.0e4], [-2.0e4, 2.0e4]]\nG = [[0.0, -1.0], [1.0, 0.0]]\n\
-             C_v = [[0.0, 1.0], [-1.0, 0.0]]\nload_cell_pole_rad_s = 2000.0\n\
-             C_f = [[-2.0e4, 2.0e4]]\n"
-        ),
-        name,
-    )
-    .unwrap()
-}
+const T: f64 = 1e-3;
 
 fn pp(k: f64, b: f64, d: usize) -> TeleopTransfer {
     FourChannel::<f64, 64>::position_position(k as f32, b as f32, T as f32, d, Position::ZERO)

@@ -6,19 +6,14 @@ use twoport_control::Position;
 use twoport_design::verify::{teleop_radius, verify_teleop, Hand, TeleopTermination, Teleoperator};
 use twoport_design::DeviceModel;
 
-const T: f64 = 1e-3;
+mod common;
 
 /// A rigid handle of `m` kg with `b` N s/m of its own damping.
 fn rigid(m: f64, b: f64) -> DeviceModel {
-    DeviceModel::from_toml(
-        &format!(
-            "name = \"rigid\"\nperiod_s = {T:e}\npeak_force_n = 50.0\ncontinuous_force_n = 20.0\n\
-             M = [[{m:e}]]\nD = [[{b:e}]]\nK = [[0.0]]\nG = [[1.0, -1.0]]\nC_v = [[1.0], [-1.0]]\n"
-        ),
-        "rigid",
-    )
-    .unwrap()
+    common::rigid(m, b, 0)
 }
+
+const T: f64 = 1e-3;
 
 fn pp(k: f64, b: f64, d: usize) -> twoport_control::teleop::TeleopTransfer {
     FourChannel::<f64, 64>::position_position(k as f32, b as f32, T as f32, d, Position::ZERO)
