@@ -2,11 +2,12 @@
 
 use crate::args::{TeleopArgs, TeleopLaw};
 use crate::run::{reported, Reported};
+use num_complex::Complex64;
 use twoport_control::teleop::FourChannelGains;
 use twoport_design::designer::TeleopDesigner;
 use twoport_design::network::HumanBound;
 use twoport_design::verify::verify_four_channel;
-use twoport_design::DeviceModel;
+use twoport_design::{plot, DeviceModel};
 
 /// The law's gains as the control crate holds them, `free` standing in
 /// for the gain a design finds; `None` where that gain is left out.
@@ -85,7 +86,41 @@ fn designer(a: &TeleopArgs) -> Result<TeleopDesigner, String> {
 /// `teleop check`: the proof at the given gains.
 pub(crate) fn check(a: &TeleopArgs) -> Reported {
     let g = gains(&a.law)?;
-    reported(designer(a)?.check(g).map_err(|e| e.to_string())?)
+    let d = designer(a)?;
+    let report = d.check(g).map_err(|e| e.to_string())?;
+    plot_felt(a, &d, g)?;
+    reported(report)
+}
+
+/// With `--plot`, draw what the operator feels through `g`: `|Z|` (N s/m)
+/// through free space and against a rigid wall, against frequency.
+fn plot_felt(a: &TeleopArgs, d: &TeleopDesigner, g: FourChannelGains) -> Result<(), String> {
+    let Some(out) = &a.plot else {
+        return Ok(());
+    };
+    let range = d.range(g).map_err(|e| e.to_string())?;
+    let curve =
+        |label: &str, color, pick: fn(&(f64, Complex64, Complex64)) -> Complex64| plot::Curve {
+            label: label.into(),
+            width: 2,
+            dashed: false,
+            color,
+            points: range
+                .iter()
+                .map(|r| (r.0 / (2.0 * std::f64::consts::PI), pick(r).norm()))
+                .collect(),
+        };
+    let fig = plot::Figure {
+        title: "What the operator feels through the teleoperator".into(),
+        x_label: "frequency (Hz)".into(),
+        y_label: "|Z| at the master's handle (N s/m)".into(),
+        legend: plot::LegendAt::UpperLeft,
+        curves: vec![
+            curve("slave in free space", plot::BLUE, |r| r.1),
+            curve("slave against a rigid wall", plot::RED, |r| r.2),
+        ],
+    };
+    plot::render(&fig, out).map_err(|e| format!("--plot {}: {e}", out.display()))
 }
 
 /// The most a designed gain is searched up to: a stiffness (N/m), or a
@@ -121,7 +156,10 @@ pub(crate) fn design(a: &TeleopArgs) -> Reported {
         .largest(at, design_limit(&a.law))
         .map_err(|e| e.to_string())?
     {
-        Some((_, report)) => reported(report),
+        Some((_, report)) => {
+            plot_felt(a, &d, report.gains)?;
+            reported(report)
+        }
         None => Err(format!(
             "no gain is proven for these devices and this law (down to {:e}): \
              `teleop check` with a small gain says where the proof fails",

@@ -180,3 +180,24 @@ fn check_proves_inside_the_edge_only() {
     let e = TWOPORT.failure(&line.split_whitespace().collect::<Vec<_>>());
     assert!(e.contains("give --k"), "{e}");
 }
+
+/// `--plot` draws what the operator feels through the designed law, and
+/// an unwritable path is named.
+#[test]
+fn design_plots_what_the_operator_feels() {
+    let dir = support::scratch("teleop-plot");
+    let png = dir.join("felt.png");
+    let line = format!(
+        "teleop design --master {CAPSTAN} --slave {CAPSTAN} --plot {} position-position --b 0.5",
+        png.display()
+    );
+    TWOPORT.run(&line.split_whitespace().collect::<Vec<_>>());
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    let line = format!(
+        "teleop check --master {CAPSTAN} --slave {CAPSTAN} --plot /no/such/dir/felt.png position-position --k 100 --b 0"
+    );
+    let e = TWOPORT.failure(&line.split_whitespace().collect::<Vec<_>>());
+    assert!(e.contains("--plot /no/such/dir/felt.png"), "{e}");
+    let _ = std::fs::remove_dir_all(dir);
+}

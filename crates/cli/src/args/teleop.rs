@@ -37,6 +37,11 @@ pub(crate) struct TeleopArgs {
     /// and design; verify searches every passive operator).
     #[arg(long)]
     pub(crate) human_bound: bool,
+    /// Draw what the operator feels through the law (check and design),
+    /// through free space and against a rigid wall, against frequency
+    /// (.png or .svg).
+    #[arg(long)]
+    pub(crate) plot: Option<PathBuf>,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub(crate) json: bool,

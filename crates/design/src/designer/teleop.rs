@@ -50,6 +50,18 @@ impl TeleopDesigner {
         })
     }
 
+    /// What the operator feels through Lawrence's four-channel law of
+    /// `gains` at each grid frequency: `(ω, Z_free, Z_rigid)` (rad/s,
+    /// N s/m; [`teleop_range`]).
+    pub fn range(
+        &self,
+        gains: FourChannelGains,
+    ) -> Result<Vec<(f64, num_complex::Complex64, num_complex::Complex64)>, Error> {
+        let period_s = self.analysis.master().period_s;
+        let law = four_channel_tf(gains, period_s, self.delay_ticks).map_err(Error::Teleop)?;
+        Ok(teleop_range(&self.analysis, &law))
+    }
+
     /// The largest `x` up to `x_max` at which `gains_at(x)` is proven (to
     /// 0.1%), and its report: up by fours from `x_max` times 1e-8, then
     /// bisecting.
