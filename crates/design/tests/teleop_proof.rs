@@ -187,3 +187,20 @@ fn the_operator_feels_both_masses_and_the_coupling_s_spring() {
         }
     }
 }
+
+/// Unequal rigid devices (0.25 kg with 2 N s/m, 0.1 kg with 1 N s/m):
+/// the sampled position-position teleoperator's passivity bound (Colgate
+/// on the relative motion, which the two dampers resist in series, `b_eff
+/// = b_m b_s/(b_m + b_s)`): `k < 2 (b_eff - B)/T`, the masses free to be
+/// any. The proof's edge meets it within 0.5% at `B` = 0 and 0.2.
+#[test]
+fn unequal_rigid_devices_meet_the_sampled_passivity_bound() {
+    let (master, slave) = (rigid(0.25, 2.0), rigid(0.1, 1.0));
+    let ta = TeleopAnalysis::of(&master, &slave).unwrap();
+    let b_eff = 2.0 * 1.0 / (2.0 + 1.0);
+    for b in [0.0, 0.2] {
+        let bound = 2.0 * (b_eff - b) / T;
+        let k = proven_edge(&ta, |k| pp(k, b, 0), 0.5 * bound, 1.5 * bound);
+        assert!((k - bound).abs() < 5e-3 * bound, "B {b}: {k} vs {bound}");
+    }
+}
