@@ -3,7 +3,7 @@
 //! loop at and past the proven gains on rigid and flexible pairs, with
 //! and without delay.
 
-use twoport_control::teleop::{FourChannel, FourChannelGains, TeleopTransfer};
+use twoport_control::teleop::{FourChannel, FourChannelGains, TeleopTransfer, WaveVariables};
 use twoport_control::Position;
 use twoport_design::analysis::{check_teleop, felt_at_low_frequency, teleop_range, TeleopAnalysis};
 use twoport_design::designer::TeleopDesigner;
@@ -202,5 +202,41 @@ fn unequal_rigid_devices_meet_the_sampled_passivity_bound() {
         let bound = 2.0 * (b_eff - b) / T;
         let k = proven_edge(&ta, |k| pp(k, b, 0), 0.5 * bound, 1.5 * bound);
         assert!((k - bound).abs() < 5e-3 * bound, "B {b}: {k} vs {bound}");
+    }
+}
+
+/// The wave-variable channel on three pairs (two capstan-like handles,
+/// the flexible pair, the unequal rigid pair), wave impedance 0.5 N s/m.
+/// Unfiltered, its line's poles sit on the unit circle and a stiff
+/// termination resonates with them: the proof refuses it and `verify`
+/// breaks it. Each side's incoming wave low-passed (pole 0.9), it is
+/// proven with one and with four ticks of delay, and `verify` finds
+/// nothing.
+#[test]
+fn a_filtered_wave_channel_is_proven_and_a_bare_one_breaks() {
+    let pairs = [
+        (rigid(0.25, 2.0), rigid(0.25, 2.0)),
+        (flexible("master"), flexible("slave")),
+        (rigid(0.25, 2.0), rigid(0.1, 1.0)),
+    ];
+    let wave = |d: usize, pole: f32| {
+        WaveVariables::<f64, 16>::new(0.5, d)
+            .unwrap()
+            .with_wave_filter(pole)
+            .unwrap()
+            .tf()
+    };
+    for (master, slave) in pairs {
+        let ta = TeleopAnalysis::of(&master, &slave).unwrap();
+        let bare = check_teleop(&ta, &wave(1, 0.0), None).unwrap();
+        assert!(!bare.proven, "{bare:?}");
+        let broken = verify_teleop_near_proof(&ta, &wave(1, 0.0)).unwrap();
+        assert!(broken.unstable, "{broken:?}");
+        for d in [1, 4] {
+            let c = check_teleop(&ta, &wave(d, 0.9), None).unwrap();
+            assert!(c.proven, "d {d}: {c:?}");
+            let v = verify_teleop_near_proof(&ta, &wave(d, 0.9)).unwrap();
+            assert!(!v.unstable, "d {d}: {v:?}");
+        }
     }
 }

@@ -29,7 +29,7 @@ mod wave;
 pub use channel::Channel;
 pub use four_channel::{FourChannel, FourChannelGains, Motion, TeleopStep};
 pub use guard::ChannelGuard;
-pub use transfer::{Delayed, TeleopTransfer};
+pub use transfer::{Delayed, Sparse, TeleopTransfer};
 pub use wave::WaveVariables;
 
 #[cfg(test)]

@@ -2,16 +2,61 @@
 
 use crate::{Complex64, ZTransfer};
 
-/// A term `tf(z^s) z^-delay`: a law's part, in steps of `s` ticks (a
-/// channel's round trip is one), and the channel's delay.
+/// A polynomial in `z^-1` of at most four terms, `Σ c_i z^-p_i`: sparse,
+/// since a channel's delay puts a term many ticks from the others.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sparse {
+    /// The terms' coefficients (0 for an unused term).
+    pub coef: [f64; 4],
+    /// Their powers of `z^-1` (ticks).
+    pub power: [u32; 4],
+}
+
+impl Sparse {
+    /// The biquad's coefficients `c` at powers `shift + stride i`.
+    pub const fn spread(c: [f64; 3], stride: u32, shift: u32) -> Self {
+        Sparse {
+            coef: [c[0], c[1], c[2], 0.0],
+            power: [shift, shift + stride, shift + 2 * stride, 0],
+        }
+    }
+
+    /// Its value at `z^-1 = zinv`.
+    pub fn eval(&self, zinv: Complex64) -> Complex64 {
+        self.coef
+            .iter()
+            .zip(self.power)
+            .filter(|(c, _)| **c != 0.0)
+            .map(|(c, p)| zinv.powi(p as i32) * *c)
+            .fold(Complex64::new(0.0, 0.0), |a, b| a + b)
+    }
+
+    /// Whether every coefficient is zero.
+    pub fn is_zero(&self) -> bool {
+        self.coef.iter().all(|c| *c == 0.0)
+    }
+
+    /// The highest power with a coefficient (ticks).
+    pub fn degree(&self) -> u32 {
+        self.coef
+            .iter()
+            .zip(self.power)
+            .filter(|(c, _)| **c != 0.0)
+            .map(|(_, p)| p)
+            .max()
+            .unwrap_or(0)
+    }
+}
+
+/// A law's term: a ratio of two [`Sparse`] polynomials in `z^-1`. Most
+/// are a biquad `tf(z^s) z^-delay` (a law's own part in steps of `s`
+/// ticks, then the channel's delay); a filtered wave channel is not.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Delayed {
-    /// The law's part, in powers of `z^-s`.
-    pub tf: ZTransfer,
-    /// Its step `s` (ticks; 1 for a law's own).
-    pub stride_ticks: u32,
-    /// The channel's delay (ticks).
-    pub delay_ticks: u32,
+    /// The numerator.
+    pub num: Sparse,
+    /// The denominator.
+    pub den: Sparse,
 }
 
 impl Delayed {
@@ -25,16 +70,21 @@ impl Delayed {
 
     /// `tf` after `delay_ticks`.
     pub const fn after(tf: ZTransfer, delay_ticks: u32) -> Self {
+        Delayed::strided(tf, 1, delay_ticks)
+    }
+
+    /// `tf(z^stride)` after `delay_ticks`.
+    pub const fn strided(tf: ZTransfer, stride_ticks: u32, delay_ticks: u32) -> Self {
         Delayed {
-            tf,
-            stride_ticks: 1,
-            delay_ticks,
+            num: Sparse::spread(tf.num, stride_ticks, delay_ticks),
+            den: Sparse::spread(tf.den, stride_ticks, 0),
         }
     }
 
     /// Its value at `z`.
     pub fn eval(&self, z: Complex64) -> Complex64 {
-        self.tf.eval(z.powi(self.stride_ticks as i32)) * z.powi(-(self.delay_ticks as i32))
+        let zinv = z.inv();
+        self.num.eval(zinv) / self.den.eval(zinv)
     }
 }
 

@@ -98,11 +98,7 @@ impl TeleopAnalysis {
 
     /// Refuse a law that reads a load cell a device does not have.
     fn sensors_for(&self, law: &TeleopTransfer) -> Result<(), Error> {
-        let reads = |col: usize| {
-            law.z
-                .iter()
-                .any(|row| row[col].tf.num.iter().any(|c| *c != 0.0))
-        };
+        let reads = |col: usize| law.z.iter().any(|row| !row[col].num.is_zero());
         for (col, (model, side)) in [
             (3, (&self.master.0, "master")),
             (2, (&self.slave.0, "slave")),

@@ -11,11 +11,11 @@ use super::closed_loop::{judge, sampled, Sampled};
 use super::{Hand, Radius};
 use crate::designer::TeleopVerifyReport;
 use crate::linalg::balance;
-use crate::rational::{delayed, mul, realise, scale, Rational, Ss};
+use crate::rational::{mul, realise, scale, Rational, Ss};
 use crate::DeviceModel;
 use nalgebra::DMatrix;
 use serde::Serialize;
-use twoport_control::teleop::{Delayed, FourChannel, FourChannelGains, TeleopTransfer};
+use twoport_control::teleop::{Delayed, FourChannel, FourChannelGains, Sparse, TeleopTransfer};
 
 /// A teleoperator to check: the two devices (at their models' sample
 /// period, which must agree) and the law between them.
@@ -43,21 +43,18 @@ pub struct TeleopTermination {
     pub environment: Hand,
 }
 
-/// A law's term as a rational function of `z^-1`: its part in steps of
-/// its stride, then the channel's delay.
+/// A law's term as a rational function of `z^-1`, dense.
 fn rational(t: &Delayed) -> Rational {
-    let s = t.stride_ticks.max(1) as usize;
-    let spread = |c: &[f64; 3]| {
-        let mut p = vec![0.0; 2 * s + 1];
-        for (i, v) in c.iter().enumerate() {
-            p[i * s] = *v;
+    let dense = |p: &Sparse| {
+        let mut c = vec![0.0; p.degree() as usize + 1];
+        for (v, k) in p.coef.iter().zip(p.power) {
+            if *v != 0.0 {
+                c[k as usize] += v;
+            }
         }
-        p
+        c
     };
-    (
-        delayed(&spread(&t.tf.num), t.delay_ticks as usize),
-        spread(&t.tf.den),
-    )
+    (dense(&t.num), dense(&t.den))
 }
 
 /// The teleoperator's one-tick transition matrix for one termination,
@@ -96,7 +93,7 @@ pub fn teleop_closed_loop(
     let mut terms: Vec<(usize, usize, Ss)> = Vec::new();
     for (r, row) in t.law.z.iter().enumerate() {
         for (j, term) in row.iter().enumerate() {
-            if term.tf.num.iter().all(|c| *c == 0.0) {
+            if term.num.is_zero() {
                 continue;
             }
             let (mut num, den) = rational(term);
