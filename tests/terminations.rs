@@ -27,6 +27,12 @@ fn log_uniform(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
     (lo.ln()..hi.ln()).prop_map(f64::exp)
 }
 
+/// A random arm whose own ringing the criterion can tell from a
+/// sustained one: an arm decays at `b/2m` at the slowest, and one slower
+/// than the criterion's threshold (`ζω` of 0.36 rad/s, with a factor of
+/// three to spare) rings on by itself, whatever the interface does (an
+/// 8 kg arm on 1 N s/m, 0.06 rad/s, kept 71% a second against a stable
+/// interface).
 fn arm() -> impl Strategy<Value = Arm> {
     (
         log_uniform(0.01, 10.0),
@@ -37,6 +43,9 @@ fn arm() -> impl Strategy<Value = Arm> {
             mass_kg,
             damping_nspm,
             stiffness_npm,
+        })
+        .prop_filter("an arm that rings on by itself", |a| {
+            a.damping_nspm / (2.0 * a.mass_kg) > 3.0 * 0.36
         })
 }
 
@@ -160,12 +169,19 @@ fn stable(display: Display, c: &Case, set: &[(&str, f64)]) -> Result<(), String>
     }
 }
 
+/// The same draws on every run: a verdict must not depend on the day.
 fn search(display: Display, cases: u32, set: &[(&str, f64)]) -> Result<(), TestCaseError> {
-    let mut runner = TestRunner::new(Config {
+    let config = Config {
         cases,
         failure_persistence: None,
         ..Config::default()
-    });
+    };
+    let seed = [0x5eu8; 32];
+    let rng = proptest::test_runner::TestRng::from_seed(
+        proptest::test_runner::RngAlgorithm::ChaCha,
+        &seed,
+    );
+    let mut runner = TestRunner::new_with_rng(config, rng);
     runner
         .run(&case(), |c| {
             if let Err(why) = stable(display, &c, set) {
