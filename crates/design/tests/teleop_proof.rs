@@ -240,3 +240,30 @@ fn a_filtered_wave_channel_is_proven_and_a_bare_one_breaks() {
         }
     }
 }
+
+/// A delayed channel in time: the rigid pair with one tick each way,
+/// position-position at the proof's edge and 20% past it, the law
+/// stepped on the two devices integrated exactly between ticks (free
+/// ends, where `verify` finds the growth): at the edge (0.2% inside the
+/// true one) the stretch still shrinks, to 62% over 20 s; 20% past it
+/// grows.
+#[test]
+fn a_delayed_channel_holds_at_the_proven_gain_and_grows_20_percent_past() {
+    let (master, slave) = (rigid(0.1, 1.0), rigid(0.1, 1.0));
+    let ta = TeleopAnalysis::of(&master, &slave).unwrap();
+    let k = proven_edge(&ta, |k| pp(k, 0.0, 1), 400.0, 600.0);
+    let run = |k: f64| {
+        let mut law =
+            FourChannel::<f64, 4>::position_position(k as f32, 0.0, T as f32, 1, Position::ZERO)
+                .unwrap();
+        common::stepped_rigid_pair(&mut law, (0.1, 1.0), T, 1e-3, 20_000)
+    };
+    let (early, late) = run(k);
+    assert!(late < 0.9 * early, "{k} N/m: {early} then {late} m");
+    let (early, late) = run(1.2 * k);
+    assert!(
+        late > 10.0 * early,
+        "{} N/m: {early} then {late} m",
+        1.2 * k
+    );
+}

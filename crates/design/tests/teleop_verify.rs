@@ -67,38 +67,12 @@ fn the_closed_loop_matches_the_law_stepped_in_time() {
         };
         let r = teleop_radius(&t, &free).unwrap();
         // The relative coordinate's amplitude over 4,000 ticks, from a
-        // 1 mm stretch, each device exact between ticks under its held
-        // force (mass 0.1 kg, damping 1 N s/m).
+        // 1 mm stretch.
         let mut law =
             FourChannel::<f64, 4>::position_position(k as f32, 0.0, T as f32, 0, Position::ZERO)
                 .unwrap();
-        let (m, b) = (0.1f64, 1.0f64);
-        let a = (-b * T / m).exp();
-        let mut s = [(1e-3f64, 0.0f64), (0.0, 0.0)];
-        let mut prev = [Position::from_m_f64(1e-3).unwrap(), Position::ZERO];
-        let mut peaks = (0.0f64, 0.0f64);
         let ticks = 4000;
-        for n in 0..ticks {
-            let x = s.map(|(x, _)| Position::from_m_f64(x).unwrap());
-            let v = [0, 1].map(|i| x[i].nm_from::<f64>(prev[i]) * 1e-9 / T);
-            prev = x;
-            let f = law.step((x[0], v[0]), (x[1], v[1]), 0.0, 0.0);
-            for (st, force) in s.iter_mut().zip([f.master_n, f.slave_n]) {
-                // The push is the force's opposite (it resists +x).
-                let push = -force;
-                let (x0, v0) = *st;
-                *st = (
-                    x0 + m / b * (1.0 - a) * v0 + (T / b - m * (1.0 - a) / (b * b)) * push,
-                    a * v0 + (1.0 - a) / b * push,
-                );
-            }
-            let stretch = (s[0].0 - s[1].0).abs();
-            if n < 500 {
-                peaks.0 = peaks.0.max(stretch);
-            } else if n >= ticks - 500 {
-                peaks.1 = peaks.1.max(stretch);
-            }
-        }
+        let peaks = common::stepped_rigid_pair(&mut law, (0.1, 1.0), T, 1e-3, ticks);
         let per_tick = (peaks.1 / peaks.0).ln() / (ticks - 500) as f64;
         // (The oscillating mode's, not the translation's at z = 1.)
         let predicted = r.score.ln();
