@@ -6,16 +6,22 @@ use num_complex::Complex64;
 use twoport_control::teleop::FourChannelGains;
 use twoport_design::designer::TeleopDesigner;
 use twoport_design::network::HumanBound;
-use twoport_design::verify::verify_four_channel;
+use twoport_design::verify::{verify_law, TeleopLaw as Law, WaveGains};
 use twoport_design::{plot, DeviceModel};
 
-/// The law's gains as the control crate holds them, `free` standing in
-/// for the gain a design finds; `None` where that gain is left out.
-fn gains_with(law: &TeleopLaw, free: Option<f32>) -> Option<FourChannelGains> {
-    Some(match *law {
+/// The law as the designer names it, `free` standing in for the gain a
+/// design finds; `None` where that gain is left out.
+fn law_with(law: &TeleopLaw, free: Option<f32>) -> Option<Law> {
+    Some(Law::FourChannel(match *law {
         TeleopLaw::PositionPosition { k, b } => FourChannelGains::position_position(k.or(free)?, b),
         TeleopLaw::PositionForce { k, b, k_f, b_m } => {
             FourChannelGains::position_force(k, b, k_f.or(free)?, b_m)
+        }
+        TeleopLaw::Wave { b, filter_pole } => {
+            return Some(Law::Wave(WaveGains {
+                b_nspm: b,
+                filter_pole,
+            }))
         }
         TeleopLaw::FourChannel {
             k_m,
@@ -38,12 +44,12 @@ fn gains_with(law: &TeleopLaw, free: Option<f32>) -> Option<FourChannelGains> {
             c5,
             c6,
         },
-    })
+    }))
 }
 
-/// The law's gains, every one given.
-fn gains(law: &TeleopLaw) -> Result<FourChannelGains, String> {
-    gains_with(law, None).ok_or_else(|| {
+/// The law, every gain given.
+fn law(law: &TeleopLaw) -> Result<Law, String> {
+    law_with(law, None).ok_or_else(|| {
         match law {
             TeleopLaw::PositionForce { .. } => {
                 "position-force: give --k-f (teleop design finds it)"
@@ -52,6 +58,14 @@ fn gains(law: &TeleopLaw) -> Result<FourChannelGains, String> {
         }
         .to_string()
     })
+}
+
+/// The four-channel gains a design varies, with `x` for the left-out one.
+fn gains_at(law: &TeleopLaw, x: f64) -> FourChannelGains {
+    match law_with(law, Some(x as f32)) {
+        Some(Law::FourChannel(g)) => g,
+        _ => FourChannelGains::OFF,
+    }
 }
 
 /// Both models, which must sample at one period.
@@ -72,9 +86,7 @@ fn models(a: &TeleopArgs) -> Result<(DeviceModel, DeviceModel), String> {
 /// `teleop verify`: the exact loop's counterexample search.
 pub(crate) fn verify(a: &TeleopArgs) -> Reported {
     let (master, slave) = models(a)?;
-    reported(
-        verify_four_channel(&master, &slave, gains(&a.law)?, a.delay).map_err(|e| e.to_string())?,
-    )
+    reported(verify_law(&master, &slave, law(&a.law)?, a.delay).map_err(|e| e.to_string())?)
 }
 
 fn designer(a: &TeleopArgs) -> Result<TeleopDesigner, String> {
@@ -85,20 +97,20 @@ fn designer(a: &TeleopArgs) -> Result<TeleopDesigner, String> {
 
 /// `teleop check`: the proof at the given gains.
 pub(crate) fn check(a: &TeleopArgs) -> Reported {
-    let g = gains(&a.law)?;
+    let l = law(&a.law)?;
     let d = designer(a)?;
-    let report = d.check(g).map_err(|e| e.to_string())?;
-    plot_felt(a, &d, g)?;
+    let report = d.check_law(l).map_err(|e| e.to_string())?;
+    plot_felt(a, &d, l)?;
     reported(report)
 }
 
-/// With `--plot`, draw what the operator feels through `g`: `|Z|` (N s/m)
+/// With `--plot`, draw what the operator feels through `law`: `|Z|` (N s/m)
 /// through free space and against a rigid wall, against frequency.
-fn plot_felt(a: &TeleopArgs, d: &TeleopDesigner, g: FourChannelGains) -> Result<(), String> {
+fn plot_felt(a: &TeleopArgs, d: &TeleopDesigner, law: Law) -> Result<(), String> {
     let Some(out) = &a.plot else {
         return Ok(());
     };
-    let range = d.range(g).map_err(|e| e.to_string())?;
+    let range = d.range(law).map_err(|e| e.to_string())?;
     let curve =
         |label: &str, color, pick: fn(&(f64, Complex64, Complex64)) -> Complex64| plot::Curve {
             label: label.into(),
@@ -135,7 +147,14 @@ fn design_limit(law: &TeleopLaw) -> f64 {
 /// `teleop design`: the largest left-out gain the proof allows, and its
 /// proof.
 pub(crate) fn design(a: &TeleopArgs) -> Reported {
-    if gains_with(&a.law, None).is_some() {
+    if matches!(a.law, TeleopLaw::Wave { .. }) {
+        return Err(
+            "wave: design finds position-position's --k or position-force's --k-f; \
+             check a wave channel's given impedance and filter"
+                .to_string(),
+        );
+    }
+    if law_with(&a.law, None).is_some() {
         let given = if matches!(a.law, TeleopLaw::PositionForce { .. }) {
             "--k-f"
         } else {
@@ -151,13 +170,13 @@ pub(crate) fn design(a: &TeleopArgs) -> Reported {
         });
     }
     let d = designer(a)?;
-    let at = |x: f64| gains_with(&a.law, Some(x as f32)).expect("the left-out gain is given");
+    let at = |x: f64| gains_at(&a.law, x);
     match d
         .largest(at, design_limit(&a.law))
         .map_err(|e| e.to_string())?
     {
         Some((_, report)) => {
-            plot_felt(a, &d, report.gains)?;
+            plot_felt(a, &d, report.law)?;
             reported(report)
         }
         None => Err(format!(

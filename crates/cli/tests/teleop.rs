@@ -201,3 +201,32 @@ fn design_plots_what_the_operator_feels() {
     assert!(e.contains("--plot /no/such/dir/felt.png"), "{e}");
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// The wave channel by name: filtered, proven between two capstan
+/// handles with one tick of delay; bare, broken (its line resonates at
+/// Nyquist); with no delay, or asked of design, refused by name.
+#[test]
+fn the_wave_channel_is_proven_filtered_and_broken_bare() {
+    let proven = handles_json("check", "--delay 1 wave --b 0.5 --filter-pole 0.9");
+    assert_eq!(proven["proven"], true, "{proven}");
+    assert_eq!(proven["wave"]["filter_pole"], 0.9f32 as f64, "{proven}");
+    let bare = handles_json("verify", "--delay 1 wave --b 0.5");
+    assert_eq!(bare["unstable"], true, "{bare}");
+    for (cmd, law, says) in [
+        (
+            "check",
+            "wave --b 0.5",
+            "delay (ticks) = 0 must be at least 1",
+        ),
+        ("design", "--delay 1 wave --b 0.5", "wave: design finds"),
+        (
+            "check",
+            "--delay 1 wave --b 0.5 --filter-pole 1",
+            "wave filter pole",
+        ),
+    ] {
+        let line = format!("teleop {cmd} --master {CAPSTAN} --slave {CAPSTAN} {law}");
+        let e = TWOPORT.failure(&line.split_whitespace().collect::<Vec<_>>());
+        assert!(e.contains(says), "{law}: {e}");
+    }
+}

@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use twoport_control::teleop::FourChannelGains;
 use twoport_design::designer::{TeleopCheckReport, TeleopDesigner};
 use twoport_design::network::HumanBound;
-use twoport_design::verify::{verify_four_channel, Hand};
+use twoport_design::verify::{verify_four_channel, Hand, TeleopLaw};
 
 /// What `verify_teleop` found: the worst operator and environment of the
 /// exact teleoperator loop over those searched.
@@ -184,7 +184,11 @@ impl From<TeleopCheckReport> for TeleopCheck {
             frequency_hz: r.check.frequency_hz,
             holds_toward_dc: r.check.holds_toward_dc,
             let_go_radius: r.check.let_go_radius,
-            gains: r.gains.into(),
+            // (Python proves four-channel laws only.)
+            gains: match r.law {
+                TeleopLaw::FourChannel(g) => g.into(),
+                TeleopLaw::Wave(_) => FourChannelGains::OFF.into(),
+            },
             felt: r
                 .felt
                 .map(|t| (t.free_mass_kg, t.free_damping_nspm, t.wall_stiffness_npm)),

@@ -79,6 +79,18 @@ pub(crate) enum TeleopLaw {
         #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
         b_m: f32,
     },
+    /// The wave-variable channel (passive for any constant delay of at
+    /// least one tick), each side's incoming wave low-passed at
+    /// --filter-pole (0: none; a bare channel's line resonates with a
+    /// stiff termination at Nyquist).
+    Wave {
+        /// The wave impedance (N s/m).
+        #[arg(long, allow_negative_numbers = true)]
+        b: f32,
+        /// The incoming-wave filter's pole, in [0, 1).
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        filter_pole: f32,
+    },
     /// Lawrence's four channels, each gain given (0 where left out).
     FourChannel {
         /// The master's coupling to the slave's motion (N/m).

@@ -4,7 +4,7 @@
 use super::report::TeleopCheckReport;
 use crate::analysis::{check_teleop, felt_at_low_frequency, teleop_range, TeleopAnalysis};
 use crate::network::HumanBound;
-use crate::verify::four_channel_tf;
+use crate::verify::TeleopLaw;
 use crate::{DeviceModel, Error};
 use twoport_control::teleop::FourChannelGains;
 
@@ -35,31 +35,36 @@ impl TeleopDesigner {
 
     /// Prove Lawrence's four-channel law of `gains`.
     pub fn check(&self, gains: FourChannelGains) -> Result<TeleopCheckReport, Error> {
+        self.check_law(TeleopLaw::FourChannel(gains))
+    }
+
+    /// Prove `law` (four channels or waves).
+    pub fn check_law(&self, law: TeleopLaw) -> Result<TeleopCheckReport, Error> {
         let (master, slave) = (self.analysis.master(), self.analysis.slave());
-        let law =
-            four_channel_tf(gains, master.period_s, self.delay_ticks).map_err(Error::Teleop)?;
+        let tf = law
+            .tf(master.period_s, self.delay_ticks)
+            .map_err(Error::Teleop)?;
         Ok(TeleopCheckReport {
             master: master.name.clone(),
             slave: slave.name.clone(),
             period_s: master.period_s,
             delay_ticks: self.delay_ticks,
             human_bound: self.human.is_some(),
-            gains,
-            check: check_teleop(&self.analysis, &law, self.human)?,
-            felt: felt_at_low_frequency(&teleop_range(&self.analysis, &law)),
+            law,
+            check: check_teleop(&self.analysis, &tf, self.human)?,
+            felt: felt_at_low_frequency(&teleop_range(&self.analysis, &tf)),
         })
     }
 
-    /// What the operator feels through Lawrence's four-channel law of
-    /// `gains` at each grid frequency: `(ω, Z_free, Z_rigid)` (rad/s,
-    /// N s/m; [`teleop_range`]).
+    /// What the operator feels through `law` at each grid frequency:
+    /// `(ω, Z_free, Z_rigid)` (rad/s, N s/m; [`teleop_range`]).
     pub fn range(
         &self,
-        gains: FourChannelGains,
+        law: TeleopLaw,
     ) -> Result<Vec<(f64, num_complex::Complex64, num_complex::Complex64)>, Error> {
         let period_s = self.analysis.master().period_s;
-        let law = four_channel_tf(gains, period_s, self.delay_ticks).map_err(Error::Teleop)?;
-        Ok(teleop_range(&self.analysis, &law))
+        let tf = law.tf(period_s, self.delay_ticks).map_err(Error::Teleop)?;
+        Ok(teleop_range(&self.analysis, &tf))
     }
 
     /// The largest `x` up to `x_max` at which `gains_at(x)` is proven (to

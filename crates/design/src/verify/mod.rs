@@ -200,8 +200,9 @@ pub use construct::{construct, Constructed};
 pub use host::{host_radius, monodromy, verify_host, HostVerdict};
 pub use search::{verify, verify_near};
 pub use teleop::{
-    four_channel_tf, teleop_closed_loop, teleop_radius, verify_four_channel, verify_teleop,
-    TeleopTermination, TeleopVerdict, Teleoperator, MAX_DELAY_TICKS,
+    four_channel_tf, teleop_closed_loop, teleop_radius, verify_four_channel, verify_law,
+    verify_teleop, TeleopLaw, TeleopTermination, TeleopVerdict, Teleoperator, WaveGains,
+    MAX_DELAY_TICKS,
 };
 pub use teleop_proof::verify_teleop_near_proof;
 

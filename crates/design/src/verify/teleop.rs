@@ -15,7 +15,9 @@ use crate::rational::{mul, realise, scale, Rational, Ss};
 use crate::DeviceModel;
 use nalgebra::DMatrix;
 use serde::Serialize;
-use twoport_control::teleop::{Delayed, FourChannel, FourChannelGains, Sparse, TeleopTransfer};
+use twoport_control::teleop::{
+    Delayed, FourChannel, FourChannelGains, Sparse, TeleopTransfer, WaveVariables,
+};
 
 /// A teleoperator to check: the two devices (at their models' sample
 /// period, which must agree) and the law between them.
@@ -240,6 +242,49 @@ pub fn verify_teleop(t: &Teleoperator) -> Result<TeleopVerdict, String> {
 /// The longest channel delay [`verify_four_channel`] takes (ticks).
 pub const MAX_DELAY_TICKS: usize = 1024;
 
+/// A teleoperator's law as a lab names it: Lawrence's four channels (in
+/// JSON, `"gains"`), or the wave-variable channel (`"wave"`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub enum TeleopLaw {
+    /// Lawrence's four channels.
+    #[serde(rename = "gains")]
+    FourChannel(FourChannelGains),
+    /// The wave-variable channel.
+    #[serde(rename = "wave")]
+    Wave(WaveGains),
+}
+
+/// The wave-variable channel's parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct WaveGains {
+    /// The wave impedance (N s/m, > 0).
+    pub b_nspm: f32,
+    /// Each side's incoming-wave filter pole, in `[0, 1)` (0: none).
+    pub filter_pole: f32,
+}
+
+impl TeleopLaw {
+    /// Its z-form at `period_s` across a channel `delay_ticks` long each
+    /// way (at most [`MAX_DELAY_TICKS`]; at least one for waves): the law
+    /// the control crate runs.
+    pub fn tf(&self, period_s: f64, delay_ticks: usize) -> Result<TeleopTransfer, String> {
+        match *self {
+            TeleopLaw::FourChannel(g) => four_channel_tf(g, period_s, delay_ticks),
+            TeleopLaw::Wave(w) => {
+                if delay_ticks > MAX_DELAY_TICKS {
+                    return Err(format!(
+                        "delay {delay_ticks} ticks: at most {MAX_DELAY_TICKS}"
+                    ));
+                }
+                WaveVariables::<f32, MAX_DELAY_TICKS>::new(w.b_nspm, delay_ticks)
+                    .and_then(|l| l.with_wave_filter(w.filter_pole))
+                    .map(|l| l.tf())
+                    .map_err(|e| e.to_string())
+            }
+        }
+    }
+}
+
 /// The z-form of Lawrence's four-channel law of `gains` across a channel
 /// `delay_ticks` long each way, at `period_s`: the law the control crate
 /// runs (a delay of at most [`MAX_DELAY_TICKS`]).
@@ -274,19 +319,29 @@ pub fn verify_four_channel(
     gains: FourChannelGains,
     delay_ticks: usize,
 ) -> Result<TeleopVerifyReport, crate::Error> {
+    verify_law(master, slave, TeleopLaw::FourChannel(gains), delay_ticks)
+}
+
+/// [`verify_four_channel`] for any [`TeleopLaw`].
+pub fn verify_law(
+    master: &DeviceModel,
+    slave: &DeviceModel,
+    law: TeleopLaw,
+    delay_ticks: usize,
+) -> Result<TeleopVerifyReport, crate::Error> {
     let fail = |why: String| crate::Error::Verify {
         model: format!("{} and {}", master.name, slave.name),
         why,
     };
-    let law = four_channel_tf(gains, master.period_s, delay_ticks).map_err(fail)?;
+    let tf = law.tf(master.period_s, delay_ticks).map_err(fail)?;
     let analysis = crate::analysis::TeleopAnalysis::of(master, slave)?;
-    let verdict = super::verify_teleop_near_proof(&analysis, &law).map_err(fail)?;
+    let verdict = super::verify_teleop_near_proof(&analysis, &tf).map_err(fail)?;
     Ok(TeleopVerifyReport {
         master: master.name.clone(),
         slave: slave.name.clone(),
         period_s: master.period_s,
         delay_ticks,
-        gains,
+        law,
         verdict,
     })
 }

@@ -2,13 +2,13 @@
 //! verdicts on a teleoperator.
 
 use crate::analysis::{Felt, TeleopCheck};
-use crate::verify::TeleopVerdict;
+use crate::verify::{TeleopLaw, TeleopVerdict};
 use serde::Serialize;
 use std::fmt;
 use twoport_control::teleop::FourChannelGains;
 
-/// The search's verdict on a four-channel teleoperator between two
-/// devices: the law's gains and channel, and the worst operator and
+/// The search's verdict on a teleoperator between two devices: the law
+/// and its channel, and the worst operator and
 /// environment found.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TeleopVerifyReport {
@@ -20,8 +20,9 @@ pub struct TeleopVerifyReport {
     pub period_s: f64,
     /// The channel's delay each way (ticks).
     pub delay_ticks: usize,
-    /// The law's gains.
-    pub gains: FourChannelGains,
+    /// The law (JSON: `gains` or `wave`).
+    #[serde(flatten)]
+    pub law: TeleopLaw,
     /// What the search found.
     #[serde(flatten)]
     pub verdict: TeleopVerdict,
@@ -42,8 +43,9 @@ pub struct TeleopCheckReport {
     /// Whether the operator was held to the human bound (else any
     /// passive operator).
     pub human_bound: bool,
-    /// The law's gains.
-    pub gains: FourChannelGains,
+    /// The law (JSON: `gains` or `wave`).
+    #[serde(flatten)]
+    pub law: TeleopLaw,
     /// What the proof found.
     #[serde(flatten)]
     pub check: TeleopCheck,
@@ -59,13 +61,24 @@ fn heading(
     (master, slave): (&str, &str),
     period_s: f64,
     delay_ticks: usize,
-    g: &FourChannelGains,
+    law: &TeleopLaw,
 ) -> fmt::Result {
     writeln!(
         f,
         "Teleoperator: {master} (master) and {slave} (slave) at T = {} ms, {delay_ticks} ticks of delay each way",
         period_s * 1e3,
     )?;
+    match law {
+        TeleopLaw::FourChannel(g) => four_channel(f, g),
+        TeleopLaw::Wave(w) => writeln!(
+            f,
+            "  wave channel: impedance {} N s/m, incoming waves filtered at pole {}",
+            w.b_nspm, w.filter_pole
+        ),
+    }
+}
+
+fn four_channel(f: &mut fmt::Formatter<'_>, g: &FourChannelGains) -> fmt::Result {
     writeln!(
         f,
         "  master: k_m {} N/m, b_m {} N s/m, own damping {} N s/m; slave: k_s {} N/m, b_s {} N s/m",
@@ -81,7 +94,7 @@ fn heading(
 impl fmt::Display for TeleopCheckReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let names = (self.master.as_str(), self.slave.as_str());
-        heading(f, names, self.period_s, self.delay_ticks, &self.gains)?;
+        heading(f, names, self.period_s, self.delay_ticks, &self.law)?;
         let c = &self.check;
         let who = if self.human_bound {
             "every operator within the human bound"
@@ -126,9 +139,9 @@ impl fmt::Display for TeleopCheckReport {
 
 impl fmt::Display for TeleopVerifyReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (g, v) = (&self.gains, &self.verdict);
+        let v = &self.verdict;
         let names = (self.master.as_str(), self.slave.as_str());
-        heading(f, names, self.period_s, self.delay_ticks, g)?;
+        heading(f, names, self.period_s, self.delay_ticks, &self.law)?;
         let verdict = if v.unstable {
             "UNSTABLE: a passive operator and environment break this teleoperator"
         } else {
