@@ -145,12 +145,22 @@ fn share(h: &HandForms, q: Complex64, lx: [Complex64; 2], lf: [Complex64; 2]) ->
     }
 }
 
-/// `max |(c + d ζ)/(a + b ζ)|` over `|ζ| <= 1`, for `|a| > |b|`: the
-/// Möbius image of the unit disk is the disk of centre
-/// `(c ā - d b̄)/(|a|² - |b|²)` and radius `|c b - d a|/(|a|² - |b|²)`.
-fn max_ratio(a: Complex64, b: Complex64, c: Complex64, d: Complex64) -> f64 {
+/// The Möbius image of the unit disk under `ζ -> (c + d ζ)/(a + b ζ)`,
+/// for `|a| > |b|`: the disk of centre `(c ā - d b̄)/(|a|² - |b|²)` and
+/// radius `|c b - d a|/(|a|² - |b|²)`.
+fn mobius_image(a: Complex64, b: Complex64, c: Complex64, d: Complex64) -> (Complex64, f64) {
     let den = a.norm_sqr() - b.norm_sqr();
-    ((c * a.conj() - d * b.conj()).norm() + (c * b - d * a).norm()) / den
+    (
+        (c * a.conj() - d * b.conj()) / den,
+        (c * b - d * a).norm() / den,
+    )
+}
+
+/// `max |(c + d ζ)/(a + b ζ)|` over `|ζ| <= 1`, for `|a| > |b|`: the
+/// far edge of the [`mobius_image`].
+fn max_ratio(a: Complex64, b: Complex64, c: Complex64, d: Complex64) -> f64 {
+    let (centre, radius) = mobius_image(a, b, c, d);
+    centre.norm() + radius
 }
 
 /// The determinant without the load cells' share,
@@ -228,12 +238,10 @@ fn point_slack(m: &Share, s: &Share) -> f64 {
 fn zeroing(m: &Share, s: &Share) -> Option<(Complex64, Complex64)> {
     let one = Complex64::new(1.0, 0.0);
     let [a, b, c, d] = bilinear(m, s);
-    let den = a.norm_sqr() - b.norm_sqr();
-    if den <= 0.0 {
+    if a.norm_sqr() <= b.norm_sqr() {
         return None;
     }
-    let centre = (c * a.conj() - d * b.conj()) / den;
-    let radius = (c * b - d * a).norm() / den;
+    let (centre, radius) = mobius_image(a, b, c, d);
     let u = if centre.norm() > 0.0 {
         centre * (1.0 + radius / centre.norm())
     } else {
@@ -259,20 +267,35 @@ pub fn closing_hands(
     law: &TeleopTransfer,
     i: usize,
 ) -> Option<[Complex64; 2]> {
-    let (ma, sa) = (&ta.master.1, &ta.slave.1);
-    let (pm, ps) = (ma.points.get(i)?, sa.points.get(i)?);
-    let hm = hand_forms(ma.plant(), (i, pm), None, ma.aliases())?;
-    let hs = hand_forms(sa.plant(), (i, ps), None, sa.aliases())?;
-    let l = law.eval(pm.z);
-    let q = (Complex64::new(1.0, 0.0) - pm.z.inv()) / ma.period_s;
-    let m = share(&hm, q, [l[0][0], l[1][0]], [l[0][3], l[1][3]]);
-    let s = share(&hs, q, [l[0][1], l[1][1]], [l[0][2], l[1][2]]);
+    let [(hm, m), (hs, s)] = shares(ta, law, None, i)?;
     let (zm, zs) = zeroing(&m, &s)?;
+    let (pm, ps) = (&ta.master.1.points[i], &ta.slave.1.points[i]);
     let hand = |h: &HandForms, z: Complex64, yhh: Complex64| {
         let y = 1.0 / (h.w.centre + h.w.radius * z) - yhh;
         Complex64::new(y.re.max(0.0), y.im)
     };
     Some([hand(&hm, zm, pm.y[0][0]), hand(&hs, zs, ps.y[0][0])])
+}
+
+/// Each device's forms at grid point `i` (the human bound on the
+/// master's), and its share of the two forces through `law`; `None`
+/// where a handle is lossless there or an alias sum unbounded.
+fn shares(
+    ta: &TeleopAnalysis,
+    law: &TeleopTransfer,
+    human: Option<HumanBound>,
+    i: usize,
+) -> Option<[(HandForms, Share); 2]> {
+    let (ma, sa) = (&ta.master.1, &ta.slave.1);
+    let (pm, ps) = (ma.points.get(i)?, sa.points.get(i)?);
+    let hm = hand_forms(ma.plant(), (i, pm), human, ma.aliases())?;
+    let hs = hand_forms(sa.plant(), (i, ps), None, sa.aliases())?;
+    let l = law.eval(pm.z);
+    let q = (Complex64::new(1.0, 0.0) - pm.z.inv()) / ma.period_s;
+    Some([
+        (hm, share(&hm, q, [l[0][0], l[1][0]], [l[0][3], l[1][3]])),
+        (hs, share(&hs, q, [l[0][1], l[1][1]], [l[0][2], l[1][2]])),
+    ])
 }
 
 /// The proof's margin at each grid point for the law `law` (its forms,
@@ -286,21 +309,8 @@ pub fn teleop_slack(
     human: Option<HumanBound>,
 ) -> Result<Vec<f64>, Error> {
     ta.sensors_for(law)?;
-    let (ma, sa) = (&ta.master.1, &ta.slave.1);
-    let period_s = ma.period_s;
-    Ok(crate::par::map(ma.points.len(), |i| {
-        let (pm, ps) = (&ma.points[i], &sa.points[i]);
-        let (Some(hm), Some(hs)) = (
-            hand_forms(ma.plant(), (i, pm), human, ma.aliases()),
-            hand_forms(sa.plant(), (i, ps), None, sa.aliases()),
-        ) else {
-            return f64::NEG_INFINITY;
-        };
-        let l = law.eval(pm.z);
-        let q = (Complex64::new(1.0, 0.0) - pm.z.inv()) / period_s;
-        let m = share(&hm, q, [l[0][0], l[1][0]], [l[0][3], l[1][3]]);
-        let s = share(&hs, q, [l[0][1], l[1][1]], [l[0][2], l[1][2]]);
-        point_slack(&m, &s)
+    Ok(crate::par::map(ta.master.1.points.len(), |i| {
+        shares(ta, law, human, i).map_or(f64::NEG_INFINITY, |[(_, m), (_, s)]| point_slack(&m, &s))
     }))
 }
 
