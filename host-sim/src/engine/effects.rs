@@ -3,7 +3,7 @@
 //! nothing of the scene, and each effect's measured cost has a slot of its
 //! own instead of a name to look up.
 
-use crate::engine::scene::{Effects, SlackEffect, StopSide};
+use crate::engine::scene::{Effects, SlackEffect, StopOn, StopSide};
 use std::collections::VecDeque;
 use std::time::Instant;
 use twoport_control::servo::SensorFrame;
@@ -132,11 +132,14 @@ impl Costs {
     }
 }
 
+/// A xorshift stream: the effects' noise, a link's jitter. Seeded
+/// nonzero.
 #[derive(Clone, Debug)]
-struct Rng(u64);
+pub(crate) struct Rng(pub(crate) u64);
 
 impl Rng {
-    fn uniform(&mut self) -> f64 {
+    /// Uniform in `[0, 1)`.
+    pub(crate) fn uniform(&mut self) -> f64 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
         self.0 ^= self.0 << 17;
@@ -175,8 +178,9 @@ pub struct Forces {
     /// Cable slack: half the play (m) and the cable's stiffness (N/m).
     slack: Option<(f64, f64)>,
     /// Hard stop: face (m), +1 solid above or -1 below, stiffness (N/m),
-    /// damping (N s/m).
-    stop: Option<(f64, f64, f64, f64)>,
+    /// damping (N s/m), and whether it stops the handle (else the
+    /// actuator).
+    stop: Option<(f64, f64, f64, f64, bool)>,
     /// Which of them run (their cost is shared): the first `count` of
     /// `names`, kept inline so that charging them allocates nothing.
     names: [Effect; 4],
@@ -185,27 +189,34 @@ pub struct Forces {
 
 impl Forces {
     /// The forces on the coordinates (N) at state `x` (`n` coordinates),
-    /// added into `f`; the actuator acts along `dir`.
-    pub fn add(&self, n: usize, dir: &[f64], x: &[f64], f: &mut [f64]) {
+    /// added into `f`; the actuator acts along `dir`, the handle along
+    /// `handle`.
+    pub fn add(&self, n: usize, [dir, handle]: [&[f64]; 2], x: &[f64], f: &mut [f64]) {
         let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
         let xa = dot(dir, &x[..n]);
         let va = dot(dir, &x[n..2 * n]);
         let mut fa = 0.0;
+        let mut fh = 0.0;
         if let Some((force_n, smoothing_mps)) = self.coulomb {
             fa -= force_n * (va / smoothing_mps).tanh();
         }
         if let Some((amplitude_n, period_m)) = self.cogging {
             fa += amplitude_n * (2.0 * std::f64::consts::PI * xa / period_m).sin();
         }
-        if let Some((face_m, side, k, b)) = self.stop {
+        if let Some((face_m, side, k, b, on_handle)) = self.stop {
+            let (x, v, into) = if on_handle {
+                (dot(handle, &x[..n]), dot(handle, &x[n..2 * n]), &mut fh)
+            } else {
+                (xa, va, &mut fa)
+            };
             // Penetration into the solid side, and a push that never pulls.
-            let depth = side * (xa - face_m);
+            let depth = side * (x - face_m);
             if depth > 0.0 {
-                fa -= side * (k * depth + b * side * va).max(0.0);
+                *into -= side * (k * depth + b * side * v).max(0.0);
             }
         }
-        for (fi, di) in f.iter_mut().zip(dir) {
-            *fi += di * fa;
+        for ((fi, di), hi) in f.iter_mut().zip(dir).zip(handle) {
+            *fi += di * fa + hi * fh;
         }
         if let Some((half_play_m, cable_k)) = self.slack {
             // The linear K has the cable as k_c (q1 - q2); with free play the
@@ -265,7 +276,14 @@ impl<const N: usize> Pipeline<N> {
                     StopSide::Above => 1.0,
                     StopSide::Below => -1.0,
                 };
-                (s.position_m, side, s.stiffness_npm, s.damping_nspm)
+                let on_handle = s.on == StopOn::Handle;
+                (
+                    s.position_m,
+                    side,
+                    s.stiffness_npm,
+                    s.damping_nspm,
+                    on_handle,
+                )
             }),
             names,
             count,
@@ -362,6 +380,7 @@ mod tests {
                 solid,
                 stiffness_npm: 2.0e5,
                 damping_nspm: 50.0,
+                on: StopOn::Actuator,
             }),
             ..Effects::default()
         };
@@ -369,7 +388,7 @@ mod tests {
             let mut p = Pipeline::<1>::new(e, 0.0);
             let (forces, _) = p.forces().expect("a hard stop is a nonlinear force");
             let mut f = [0.0];
-            forces.add(1, &[1.0], &[x, v], &mut f);
+            forces.add(1, [&[1.0], &[1.0]], &[x, v], &mut f);
             f[0]
         };
         let below = stop(StopSide::Below);

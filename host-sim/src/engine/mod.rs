@@ -13,5 +13,6 @@ pub mod scene;
 pub mod servo;
 pub mod sim;
 pub mod stability;
+pub mod teleop;
 pub mod ve;
 pub mod world;

@@ -1,12 +1,81 @@
 //! A PNG of a run: handle position over time, and the forces.
 
+use crate::engine::teleop::TeleopSample;
 use crate::Error;
 use crate::Sample;
 use plotters::prelude::*;
 use std::path::Path;
 
+/// One line of a panel: its legend, colour and value per sample.
+type Series<'a, T> = (&'a str, RGBColor, &'a dyn Fn(&T) -> f64);
+
 /// Draw the first axis of `samples` to `out` (PNG).
 pub fn png<const N: usize>(samples: &[Sample<N>], title: &str, out: &Path) -> Result<(), Error> {
+    panels_png(
+        samples,
+        &|s| s.t_s,
+        title,
+        out,
+        &[
+            (
+                "position (m)",
+                &[
+                    ("handle", BLUE, &|s| s.handle_m[0]),
+                    ("VE", RED, &|s| s.ve_m[0]),
+                ],
+            ),
+            (
+                "force (N)",
+                &[
+                    ("human", GREEN, &|s| s.human_n[0]),
+                    ("actuator (delivered)", BLUE, &|s| s.actuator_n[0]),
+                    ("VE", RED, &|s| s.ve_n[0]),
+                ],
+            ),
+        ],
+    )
+}
+
+/// A teleoperation run to `out` (PNG): both devices' positions, and the
+/// operator's, the environment's and both actuators' forces.
+pub fn teleop_png(samples: &[TeleopSample], title: &str, out: &Path) -> Result<(), Error> {
+    panels_png(
+        samples,
+        &|s| s.master.t_s,
+        title,
+        out,
+        &[
+            (
+                "position (m)",
+                &[
+                    ("master", BLUE, &|s| s.master.handle_m[0]),
+                    ("slave", RED, &|s| s.slave.handle_m[0]),
+                ],
+            ),
+            (
+                "force (N)",
+                &[
+                    ("operator", GREEN, &|s| s.master.human_n[0]),
+                    ("slave's hand (environment)", MAGENTA, &|s| {
+                        s.slave.human_n[0]
+                    }),
+                    ("master actuator", BLUE, &|s| s.master.actuator_n[0]),
+                    ("slave actuator", RED, &|s| s.slave.actuator_n[0]),
+                ],
+            ),
+        ],
+    )
+}
+
+/// `samples` against `time` (s) to `out` (PNG), one panel over another,
+/// each its y label and its lines.
+fn panels_png<T>(
+    samples: &[T],
+    time: &dyn Fn(&T) -> f64,
+    title: &str,
+    out: &Path,
+    panels: &[(&str, &[Series<T>])],
+) -> Result<(), Error> {
     let _ =
         plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
     if samples.is_empty() {
@@ -16,9 +85,9 @@ pub fn png<const N: usize>(samples: &[Sample<N>], title: &str, out: &Path) -> Re
     let e = |e: DrawingAreaErrorKind<_>| Error::Output(format!("{}: {e}", out.display()));
     root.fill(&WHITE).map_err(e)?;
     let root = root.titled(title, ("sans-serif", 22)).map_err(e)?;
-    let (top, bottom) = root.split_vertically(340);
-    let t1 = samples.last().map_or(1.0, |s| s.t_s);
-    let range = |f: &dyn Fn(&Sample<N>) -> f64| {
+    let areas = root.split_evenly((panels.len(), 1));
+    let t1 = samples.last().map_or(1.0, time);
+    let range = |f: &dyn Fn(&T) -> f64| {
         let (lo, hi) = samples
             .iter()
             .map(f)
@@ -29,11 +98,7 @@ pub fn png<const N: usize>(samples: &[Sample<N>], title: &str, out: &Path) -> Re
         let pad = ((hi - lo) * 0.05).max(1e-9);
         (lo - pad)..(hi + pad)
     };
-    type Series<'a, const M: usize> = (&'a str, RGBColor, &'a dyn Fn(&Sample<M>) -> f64);
-    let panel = |area: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
-                 y_desc: &str,
-                 series: &[Series<N>]|
-     -> Result<(), Error> {
+    for (area, (y_desc, series)) in areas.iter().zip(panels) {
         let lo = series
             .iter()
             .map(|s| range(s.2).start)
@@ -51,15 +116,15 @@ pub fn png<const N: usize>(samples: &[Sample<N>], title: &str, out: &Path) -> Re
         chart
             .configure_mesh()
             .x_desc("time (s)")
-            .y_desc(y_desc)
+            .y_desc(*y_desc)
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(e)?;
-        for (name, color, f) in series {
+        for (name, color, f) in series.iter() {
             let color = *color;
             chart
                 .draw_series(LineSeries::new(
-                    samples.iter().map(|s| (s.t_s, f(s))),
+                    samples.iter().map(|s| (time(s), f(s))),
                     color.stroke_width(2),
                 ))
                 .map_err(e)?
@@ -75,25 +140,7 @@ pub fn png<const N: usize>(samples: &[Sample<N>], title: &str, out: &Path) -> Re
             .label_font(("sans-serif", 14))
             .draw()
             .map_err(e)?;
-        Ok(())
-    };
-    panel(
-        &top,
-        "position (m)",
-        &[
-            ("handle", BLUE, &|s| s.handle_m[0]),
-            ("VE", RED, &|s| s.ve_m[0]),
-        ],
-    )?;
-    panel(
-        &bottom,
-        "force (N)",
-        &[
-            ("human", GREEN, &|s| s.human_n[0]),
-            ("actuator (delivered)", BLUE, &|s| s.actuator_n[0]),
-            ("VE", RED, &|s| s.ve_n[0]),
-        ],
-    )?;
+    }
     root.present().map_err(e)
 }
 

@@ -19,9 +19,11 @@ pub struct TeleopStep<R = f32> {
 /// The gains of a [`FourChannel`] teleoperator, SI units. Each side's
 /// coupling is a spring and damper on its position error against the
 /// other side's delayed motion (Lawrence's local controller and position
-/// channel in one, `C_m = -C_4`, `C_s = -C_1`).
+/// channel in one, `C_m = -C_4`, `C_s = -C_1`). Read from text, a gain
+/// not named is off ([`OFF`](Self::OFF)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
 pub struct FourChannelGains {
     /// The master's coupling to the slave's motion: stiffness (N/m).
     pub k_m_npm: f32,
@@ -42,6 +44,12 @@ pub struct FourChannelGains {
     pub c5: f32,
     /// `C_6`: the operator's force fed back on the master itself.
     pub c6: f32,
+}
+
+impl Default for FourChannelGains {
+    fn default() -> Self {
+        FourChannelGains::OFF
+    }
 }
 
 impl FourChannelGains {

@@ -14,7 +14,7 @@ use crate::linalg::balance;
 use crate::rational::{mul, realise, scale, Rational, Ss};
 use crate::DeviceModel;
 use nalgebra::DMatrix;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use twoport_control::teleop::{
     Delayed, FourChannel, FourChannelGains, Sparse, TeleopTransfer, WaveVariables,
 };
@@ -243,8 +243,10 @@ pub fn verify_teleop(t: &Teleoperator) -> Result<TeleopVerdict, String> {
 pub const MAX_DELAY_TICKS: usize = 1024;
 
 /// A teleoperator's law as a lab names it: Lawrence's four channels (in
-/// JSON, `"gains"`), or the wave-variable channel (`"wave"`).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+/// JSON and scene files, `"gains"`, each channel not named off), or the
+/// wave-variable channel (`"wave"`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum TeleopLaw {
     /// Lawrence's four channels.
     #[serde(rename = "gains")]
@@ -255,11 +257,14 @@ pub enum TeleopLaw {
 }
 
 /// The wave-variable channel's parameters.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct WaveGains {
     /// The wave impedance (N s/m, > 0).
     pub b_nspm: f32,
-    /// Each side's incoming-wave filter pole, in `[0, 1)` (0: none).
+    /// Each side's incoming-wave filter pole, in `[0, 1)` (0, the
+    /// default: none).
+    #[serde(default)]
     pub filter_pole: f32,
 }
 

@@ -37,6 +37,7 @@ mod pil;
 mod run;
 mod scope;
 mod study;
+mod teleop;
 
 use clap::{Parser, Subcommand};
 use host_sim::Error;
@@ -48,6 +49,7 @@ use study::{
     accuracy, latency_fit, passivity, sweep, table1, AccuracyArgs, LatencyFitArgs, PassivityArgs,
     SweepArgs, Table1Args,
 };
+use teleop::{teleop, TeleopArgs};
 
 /// Simulate a haptic device around the board's own control code.
 #[derive(Parser)]
@@ -76,6 +78,9 @@ enum Cmd {
     Accuracy(AccuracyArgs),
     /// The passivity layer's scenes: off, on, and at passive settings.
     Passivity(PassivityArgs),
+    /// Two devices through one teleoperator: a master under the operator,
+    /// a slave on the environment, the channel between them.
+    Teleop(TeleopArgs),
     /// Processor-in-the-loop: this plant against a board over a serial port
     /// (the firmware in QEMU, or a real board), compared with the same
     /// board loop run in-process.
@@ -107,6 +112,7 @@ fn subcommand(c: &Cmd) -> Result<(), Error> {
         Cmd::Table1(a) => table1(a),
         Cmd::LatencyFit(a) => latency_fit(a),
         Cmd::Accuracy(a) => accuracy(a),
+        Cmd::Teleop(a) => teleop(a),
         Cmd::Pil(a) => pil(a),
     }
 }

@@ -8,7 +8,7 @@ use twoport_control::servo::Display;
 
 impl Scene {
     /// Physical checks beyond the types; the message names the field.
-    pub(super) fn check(&self) -> Result<(), Error> {
+    pub(crate) fn check(&self) -> Result<(), Error> {
         if !(1..=MAX_AXES).contains(&self.axes) {
             return Err(sim_err!(
                 "axes = {}: the simulator runs devices of 1 to {MAX_AXES} axes",

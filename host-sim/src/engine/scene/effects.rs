@@ -109,8 +109,9 @@ pub struct SlackEffect {
     pub width_m: f64,
 }
 
-/// A hard stop on the actuator: a stiff, damped spring that only pushes,
-/// where the actuator passes `position_m`.
+/// A hard stop: a stiff, damped spring that only pushes, where the
+/// actuator (the end of travel) or the handle (a wall it touches) passes
+/// `position_m`.
 #[derive(Clone, Copy, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HardStopEffect {
@@ -125,6 +126,20 @@ pub struct HardStopEffect {
     /// Its damping while pressed (N s/m).
     #[serde(default = "default_stop_damping")]
     pub damping_nspm: f64,
+    /// What it stops: `actuator` (the default) or `handle`.
+    #[serde(default)]
+    pub on: StopOn,
+}
+
+/// What a hard stop stops.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StopOn {
+    /// The actuator: the end of the device's travel.
+    #[default]
+    Actuator,
+    /// The handle: a wall in the environment.
+    Handle,
 }
 fn default_stop_side() -> StopSide {
     StopSide::Below

@@ -373,7 +373,7 @@ fn integrator_of(scene: &Scene, nonlinear: bool) -> (Method, u32) {
 /// The board's encoder for the scene's effects, the mask of its count
 /// and its picometres per count: ideal sensing counts 1 nm, the
 /// resolution of a Position.
-fn encoder_of(e: &crate::engine::scene::Effects) -> Result<(Encoder, u32, f64), Error> {
+pub(crate) fn encoder_of(e: &crate::engine::scene::Effects) -> Result<(Encoder, u32, f64), Error> {
     let (bits, pm_per_count) = match e.encoder {
         Some(enc) => (enc.bits, (enc.resolution_m * 1e12).round()),
         None => (32, 1000.0),

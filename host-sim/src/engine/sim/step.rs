@@ -172,14 +172,14 @@ impl<const N: usize> Simulation<N> {
             }
         };
         let steppers = &mut self.steppers[at].1;
-        let dir = &self.actuator_dir;
+        let dirs = [&self.actuator_dir[..], &self.device.handle[..]];
         let substeps = self.substeps;
         let held = std::mem::replace(&mut axis.held_n, force_n);
         let (forces, costs) = self.effects.parts();
         let x = &mut axis.x;
         let mut run = |stepper: &mut Stepper, f: f64| match forces {
             Some(forces) => {
-                let mut nl = |x: &[f64], f: &mut [f64]| forces.add(n, dir, x, f);
+                let mut nl = |x: &[f64], f: &mut [f64]| forces.add(n, dirs, x, f);
                 for _ in 0..substeps {
                     stepper.step(x, [u[0], f], Some(&mut nl));
                 }
