@@ -276,3 +276,47 @@ fn a_scene_the_teleoperator_cannot_run_is_refused_by_name() {
     let typo = refused(&["law.gains.k_q=1"]);
     assert!(typo.contains("k_q"), "{typo}");
 }
+
+#[test]
+fn a_pair_of_boards_runs_the_law_the_designer_proves() {
+    use host_sim::link::{LinkFaults, LocalBoard};
+    use host_sim::pil::teleop::run_pair;
+    use twoport_control::teleop::FourChannel;
+    use twoport_control::Position;
+    let path = root().join("scenes/pil/teleop_pair.toml");
+    let scene = rooted(TeleopScene::load(&path, &[]).unwrap());
+    let ticks = 4_000;
+    let boards = || LocalBoard::excalibur().unwrap();
+    let pair = run_pair(&scene, ticks, [boards(), boards()], LinkFaults::default()).unwrap();
+    // Each board's coupling against the host's held point is the
+    // position-position law across the host's two ticks: stepped on what
+    // the boards read, the law gives each board's force to its
+    // amplifier's resolution.
+    let TeleopLaw::FourChannel(gains) = scene.law else {
+        panic!("a four-channel law")
+    };
+    let mut law = FourChannel::<f32, 8>::new(gains, 1e-3, 2, Position::ZERO).unwrap();
+    let read = |i: usize, t: usize| Position::from_nm((pair.read_pm[i][t] / 1000) as i32);
+    let motion = |i: usize, t: usize| {
+        let before = read(i, t.saturating_sub(1));
+        (read(i, t), read(i, t).nm_from::<f32>(before) * 1e-9 / 1e-3)
+    };
+    let lsb_n = 200.0 / 32_767.0;
+    let mut worst = 0.0f64;
+    let mut peak = 0.0f64;
+    for t in 0..ticks as usize {
+        let f = law.step(motion(0, t), motion(1, t), 0.0, 0.0);
+        let armed = t as u64 >= pair.runs[0].armed_at_tick;
+        for (run, want) in pair.runs.iter().zip([f.master_n, f.slave_n]) {
+            let got = run.samples[t].actuator_n[0];
+            let want = if armed { f64::from(want) } else { 0.0 };
+            worst = worst.max((got - want).abs());
+            peak = peak.max(got.abs());
+        }
+    }
+    assert!(peak > 1.0, "the slave pressed the wall: {peak} N");
+    assert!(
+        worst <= lsb_n,
+        "{worst} N from the law (one step {lsb_n} N)"
+    );
+}

@@ -192,8 +192,9 @@ fn design_lib() -> Result<(), String> {
 /// touches that QEMU does not model): the plain scene, homing onto the
 /// hard stop then armed (the state machine bit for bit too), an
 /// identification experiment streaming every tick, the
-/// three-axis image on its building-block world, and the serial-arm and
-/// delta images against their nonlinear arms.
+/// three-axis image on its building-block world, the serial-arm and
+/// delta images against their nonlinear arms, and a teleoperator: two
+/// boards joined through the host.
 fn pil_boards() -> Result<(), String> {
     for board in ["an386", "stm32f405"] {
         let linkage = |device| {
@@ -208,7 +209,7 @@ fn pil_boards() -> Result<(), String> {
             ]
         };
         let (arm, delta) = (linkage("serial-arm"), linkage("delta"));
-        let runs: [&[&str]; 7] = [
+        let runs: [&[&str]; 8] = [
             &["--seconds", "4", "--link-loss-at-s", "3", "--check"],
             // The 4 kHz image with the VE on the host at 1 kHz.
             &[
@@ -240,6 +241,14 @@ fn pil_boards() -> Result<(), String> {
             ],
             &arm,
             &delta,
+            // Two boards through the host: a teleoperator.
+            &[
+                "--teleop",
+                "scenes/pil/teleop_pair.toml",
+                "--seconds",
+                "2",
+                "--check",
+            ],
         ];
         for args in runs {
             let mut all = vec!["--board".to_string(), board.to_string()];

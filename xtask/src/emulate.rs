@@ -75,6 +75,37 @@ pub(crate) fn pil(extra: &[String]) -> Result<(), String> {
             Command::new(&exe).args(["pil", "--port", pty]).args(&args),
         )
     };
+    // A teleoperation pair: two boards of the one-axis image, each in its
+    // own QEMU, the host between them.
+    if args.iter().any(|a| a == "--teleop") {
+        let pair = |qemu: &dyn Fn() -> Result<Command, String>| {
+            with_board_in_qemu(qemu()?, |master| {
+                with_board_in_qemu(qemu().map_err(|e| e.to_string())?, |slave| {
+                    run(
+                        "host-sim pil --teleop",
+                        Command::new(&exe)
+                            .args(["pil", "--port", master, "--slave-port", slave])
+                            .args(&args),
+                    )
+                })
+            })
+        };
+        return match board.as_str() {
+            "an386" => pair(&|| {
+                let mut q = qemu_an386(&firmware()?.join("twoport-an386"));
+                q.args(["-serial", "pty"]);
+                Ok(q)
+            }),
+            "stm32f405" => pair(&|| {
+                let mut q = qemu_netduino(&stm32f405_qemu_image(false)?);
+                q.args(["-serial", "null", "-serial", "pty"]);
+                Ok(q)
+            }),
+            other => Err(format!(
+                "pil: no board image called {other:?} (an386 or stm32f405)"
+            )),
+        };
+    }
     let xyz = args.iter().any(|a| declares_three_axes(a));
     // (host-sim reads it too: the 4 kHz image's reference and period.)
     let fast = args.iter().any(|a| a == "--fast");

@@ -11,6 +11,7 @@
 mod check;
 pub mod linkage;
 mod record;
+pub mod teleop;
 
 pub use check::{compare, failures, Comparison};
 pub use record::Run;
@@ -92,22 +93,33 @@ impl Setup {
 /// this process its plant.
 pub trait Lockstep {
     /// One tick of `sim` with the board as its controller; returns the
-    /// sample and the duties the board answered.
-    fn step<const N: usize>(
+    /// sample, the duties the board answered and the encoder counts it
+    /// was sent.
+    fn step_read<const N: usize>(
         &mut self,
         sim: &mut Simulation<N>,
-    ) -> Result<(Sample<N>, Axes<i16>), Error>;
-}
+    ) -> Result<(Sample<N>, Axes<i16>, [u32; N]), Error>;
 
-impl<P: BoardPort> Lockstep for Session<P> {
+    /// [`step_read`](Self::step_read) without the counts.
     fn step<const N: usize>(
         &mut self,
         sim: &mut Simulation<N>,
     ) -> Result<(Sample<N>, Axes<i16>), Error> {
+        self.step_read(sim).map(|(s, d, _)| (s, d))
+    }
+}
+
+impl<P: BoardPort> Lockstep for Session<P> {
+    fn step_read<const N: usize>(
+        &mut self,
+        sim: &mut Simulation<N>,
+    ) -> Result<(Sample<N>, Axes<i16>, [u32; N]), Error> {
         let tick = self.tick_heartbeat()?;
+        let mut raw = [0u32; N];
         let mut answer: Result<Axes<i16>, Error> = Ok(Axes::default());
         let io = self.io;
         let mut ctl = |f: &SensorFrame<f32, N>| -> ServoOutput<f32, N> {
+            raw = f.encoder_raw;
             // The encoder's index is on the first axis.
             let index = self.index_crossing(f.encoder_raw[0]);
             let sensors = PilSensors {
@@ -131,7 +143,7 @@ impl<P: BoardPort> Lockstep for Session<P> {
             }
         };
         let sample = sim.step_external(&mut ctl);
-        Ok((sample, answer?))
+        Ok((sample, answer?, raw))
     }
 }
 
@@ -239,7 +251,16 @@ fn record<P: BoardPort, const N: usize>(
     sim: &mut Simulation<N>,
     r: &mut Run<N>,
 ) -> Result<Vec<Status>, Error> {
-    let (s, duty) = session.step(sim)?;
+    record_read(session, sim, r).map(|(statuses, _)| statuses)
+}
+
+/// [`record`], with the encoder counts the board was sent.
+fn record_read<P: BoardPort, const N: usize>(
+    session: &mut Session<P>,
+    sim: &mut Simulation<N>,
+    r: &mut Run<N>,
+) -> Result<(Vec<Status>, [u32; N]), Error> {
+    let (s, duty, raw) = session.step_read(sim)?;
     r.samples.push(s);
     r.duties.push(duty);
     let mut statuses = Vec::new();
@@ -250,7 +271,7 @@ fn record<P: BoardPort, const N: usize>(
             _ => {}
         }
     }
-    Ok(statuses)
+    Ok((statuses, raw))
 }
 
 /// Run the one-axis `scene` for `ticks` against the board at `port`: the

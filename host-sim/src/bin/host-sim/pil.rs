@@ -65,7 +65,15 @@ pub(crate) struct PilArgs {
     /// The sines' frequency (Hz).
     #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
     pub(crate) sine_hz: f64,
-    /// Print one JSON object on stdout.
+    /// The scene is a teleoperation scene: its master and its slave each
+    /// on a board of the one-axis image (`--port` the master's,
+    /// `--slave-port` the slave's), the host the channel between them.
+    #[arg(long)]
+    pub(crate) teleop: bool,
+    /// With --teleop: the slave's board's serial port.
+    #[arg(long, requires = "teleop")]
+    pub(crate) slave_port: Option<String>,
+    /// Print one JSON object on stdout (with --teleop, one per side).
     #[arg(long)]
     pub(crate) json: bool,
     /// Fail unless the board matched the in-process loop bit for bit,
@@ -148,6 +156,9 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
     if !(a.seconds.is_finite() && a.seconds > 0.0 && a.seconds <= 3600.0) {
         return Err(err!("--seconds {}: must be in (0, 3600]", a.seconds));
     }
+    if a.teleop {
+        return pair(a);
+    }
     let scene = load(&a.scene, &a.sets)?;
     // The board's period: the scene must tick at it.
     let (period, deadline) = if a.fast {
@@ -199,7 +210,9 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
         let run = port
             .map(|p| pil::run_with::<_, 1>(scene, ticks, p, faults, host_ve))
             .transpose()?;
-        return pil_report(a, ticks, faults, reference, run, local_s, start, deadline);
+        return pil_report(
+            a, None, ticks, faults, reference, run, local_s, start, deadline,
+        );
     }
     if let Some(device) = a.linkage {
         use host_sim::pil::linkage;
@@ -211,7 +224,9 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
         let run = port
             .map(|p| linkage::run(device, ticks, p, faults))
             .transpose()?;
-        return pil_report(a, ticks, faults, reference, run, local_s, start, deadline);
+        return pil_report(
+            a, None, ticks, faults, reference, run, local_s, start, deadline,
+        );
     }
     if scene.axes == 3 {
         if a.passivity {
@@ -227,7 +242,9 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
         let run = port
             .map(|p| pil::run_axes::<_, 3>(scene, ticks, p, faults))
             .transpose()?;
-        return pil_report(a, ticks, faults, reference, run, local_s, start, deadline);
+        return pil_report(
+            a, None, ticks, faults, reference, run, local_s, start, deadline,
+        );
     }
     let reference = if a.passivity {
         pil::run(
@@ -254,7 +271,9 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
             })??;
         std::fs::write(path, log.to_csv()).map_err(|e| err!("--log {}: {e}", path.display()))?;
     }
-    pil_report(a, ticks, faults, reference, run, local_s, start, deadline)
+    pil_report(
+        a, None, ticks, faults, reference, run, local_s, start, deadline,
+    )
 }
 
 /// `--host-ve-hz` as the host's VE period in board ticks (`period` s),
@@ -297,6 +316,7 @@ fn faults(a: &PilArgs, period: f64) -> Result<link::LinkFaults, Error> {
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn pil_report<const N: usize>(
     a: &PilArgs,
+    side: Option<&str>,
     ticks: u64,
     faults: host_sim::link::LinkFaults,
     reference: host_sim::pil::Run<N>,
@@ -306,10 +326,11 @@ pub(crate) fn pil_report<const N: usize>(
     deadline: u32,
 ) -> Result<(), Error> {
     use host_sim::pil;
-    let board = if run.is_some() {
-        "serial"
-    } else {
-        "in-process"
+    let board = match (run.is_some(), side) {
+        (true, None) => "serial".to_string(),
+        (false, None) => "in-process".to_string(),
+        (true, Some(s)) => format!("serial, {s}"),
+        (false, Some(s)) => format!("in-process, {s}"),
     };
     let (run, remote_s) = match run {
         Some(r) => (r, start.elapsed().as_secs_f64() - local_s),
@@ -349,6 +370,7 @@ pub(crate) fn pil_report<const N: usize>(
         "homing_ticks": run.homing.map(|h| h.0),
         "homing_error_m": run.homing.map(|h| h.1),
         "board": board,
+        "side": side,
         "wall_s": remote_s,
     });
     if a.json {
@@ -382,8 +404,77 @@ pub(crate) fn pil_report<const N: usize>(
     if a.check {
         let bad = pil::failures(&run, &c, ticks, faults, u64::from(deadline));
         if !bad.is_empty() {
-            return Err(err!("PIL check failed: {}", bad.join("; ")));
+            let on = side.map(|s| format!(" ({s})")).unwrap_or_default();
+            return Err(err!("PIL check failed{on}: {}", bad.join("; ")));
         }
     }
     Ok(())
+}
+
+/// `--teleop`: the scene's master and slave each on a board, the host
+/// between them, against the same pair of board loops in-process.
+fn pair(a: &PilArgs) -> Result<(), Error> {
+    use host_sim::engine::teleop::TeleopScene;
+    use host_sim::pil::teleop::run_pair;
+    if a.fast || a.passivity || a.linkage.is_some() || a.host_ve_hz.is_some() || a.log.is_some() {
+        return Err(err!(
+            "--teleop: a pair runs the one-axis image (no --fast, --passivity, --linkage, --host-ve-hz or --log)"
+        ));
+    }
+    let scene = TeleopScene::load(&a.scene, &a.sets)?;
+    let (period, deadline) = (1e-3, twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS);
+    if (scene.period() - period).abs() > 1e-6 * period {
+        return Err(err!(
+            "{}: a PIL pair ticks at the board's 1000 Hz (period_s = {period})",
+            a.scene.display()
+        ));
+    }
+    let ticks = (a.seconds / period).round() as u64;
+    let faults = faults(a, period)?;
+    let ports = match (&a.port, &a.slave_port) {
+        (Some(m), Some(s)) => Some([link::SerialBoard::open(m)?, link::SerialBoard::open(s)?]),
+        (None, None) => None,
+        _ => {
+            return Err(err!(
+                "--teleop: give both boards' ports (--port and --slave-port), or neither"
+            ))
+        }
+    };
+    let start = std::time::Instant::now();
+    let local = || link::LocalBoard::excalibur();
+    let reference = run_pair(&scene, ticks, [local()?, local()?], faults)?;
+    let local_s = start.elapsed().as_secs_f64();
+    let runs = ports
+        .map(|p| run_pair(&scene, ticks, p, faults))
+        .transpose()?;
+    let [rm, rs] = reference.runs;
+    let (m, s) = match runs {
+        Some(p) => {
+            let [m, s] = p.runs;
+            (Some(m), Some(s))
+        }
+        None => (None, None),
+    };
+    pil_report(
+        a,
+        Some("master"),
+        ticks,
+        faults,
+        rm,
+        m,
+        local_s,
+        start,
+        deadline,
+    )?;
+    pil_report(
+        a,
+        Some("slave"),
+        ticks,
+        faults,
+        rs,
+        s,
+        local_s,
+        start,
+        deadline,
+    )
 }
