@@ -32,6 +32,7 @@ fn twoport_py(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<design::HostCheck>()?;
     m.add_class::<teleop::TeleopVerdict>()?;
     m.add_class::<teleop::TeleopGains>()?;
+    m.add_class::<teleop::WaveLaw>()?;
     m.add_class::<teleop::TeleopCheck>()?;
     m.add_class::<model::Model>()?;
     m.add_class::<board::Board>()?;

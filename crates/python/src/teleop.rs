@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use twoport_control::teleop::FourChannelGains;
 use twoport_design::designer::{TeleopCheckReport, TeleopDesigner};
 use twoport_design::network::HumanBound;
-use twoport_design::verify::{verify_four_channel, Hand, TeleopLaw};
+use twoport_design::verify::{verify_law, Hand, TeleopLaw, WaveGains};
 
 /// What `verify_teleop` found: the worst operator and environment of the
 /// exact teleoperator loop over those searched.
@@ -43,59 +43,16 @@ fn lumped(h: &Hand) -> (f64, f64, f64) {
 }
 
 /// Lawrence's four-channel gains from Python's keywords.
-#[pyclass(frozen, get_all, module = "twoport")]
+#[pyclass(frozen, module = "twoport")]
 #[derive(Clone, Copy)]
-pub(crate) struct TeleopGains {
-    /// The master's coupling to the slave's motion (N/m) and its damping
-    /// (N s/m), and the master's own damping (N s/m).
-    k_m: f32,
-    b_m: f32,
-    b_local: f32,
-    /// The slave's coupling to the master's motion (N/m) and its damping.
-    k_s: f32,
-    b_s: f32,
-    /// The force channels (dimensionless).
-    c2: f32,
-    c3: f32,
-    c5: f32,
-    c6: f32,
-}
-
-impl From<TeleopGains> for FourChannelGains {
-    fn from(g: TeleopGains) -> Self {
-        FourChannelGains {
-            k_m_npm: g.k_m,
-            b_m_nspm: g.b_m,
-            b_local_nspm: g.b_local,
-            k_s_npm: g.k_s,
-            b_s_nspm: g.b_s,
-            c2: g.c2,
-            c3: g.c3,
-            c5: g.c5,
-            c6: g.c6,
-        }
-    }
-}
-
-impl From<FourChannelGains> for TeleopGains {
-    fn from(g: FourChannelGains) -> Self {
-        TeleopGains {
-            k_m: g.k_m_npm,
-            b_m: g.b_m_nspm,
-            b_local: g.b_local_nspm,
-            k_s: g.k_s_npm,
-            b_s: g.b_s_nspm,
-            c2: g.c2,
-            c3: g.c3,
-            c5: g.c5,
-            c6: g.c6,
-        }
-    }
-}
+pub(crate) struct TeleopGains(FourChannelGains);
 
 #[pymethods]
 impl TeleopGains {
-    /// Gains by name (0 where left out). Position-position is `k_m = k_s`,
+    /// Gains by name (0 where left out): the master's coupling to the
+    /// slave's motion `k_m` (N/m) and `b_m` (N s/m), its own damping
+    /// `b_local` (N s/m), the slave's coupling `k_s`, `b_s`, and the force
+    /// channels `c2`, `c3`, `c5`, `c6`. Position-position is `k_m = k_s`,
     /// `b_m = b_s` and nothing else; force reflection is `k_s`, `b_s`,
     /// `c2` and the master's `b_local`.
     #[new]
@@ -112,32 +69,125 @@ impl TeleopGains {
         c5: f32,
         c6: f32,
     ) -> Self {
-        TeleopGains {
-            k_m,
-            b_m,
-            b_local,
-            k_s,
-            b_s,
+        TeleopGains(FourChannelGains {
+            k_m_npm: k_m,
+            b_m_nspm: b_m,
+            b_local_nspm: b_local,
+            k_s_npm: k_s,
+            b_s_nspm: b_s,
             c2,
             c3,
             c5,
             c6,
-        }
+        })
+    }
+
+    #[getter]
+    fn k_m(&self) -> f32 {
+        self.0.k_m_npm
+    }
+    #[getter]
+    fn b_m(&self) -> f32 {
+        self.0.b_m_nspm
+    }
+    #[getter]
+    fn b_local(&self) -> f32 {
+        self.0.b_local_nspm
+    }
+    #[getter]
+    fn k_s(&self) -> f32 {
+        self.0.k_s_npm
+    }
+    #[getter]
+    fn b_s(&self) -> f32 {
+        self.0.b_s_nspm
+    }
+    #[getter]
+    fn c2(&self) -> f32 {
+        self.0.c2
+    }
+    #[getter]
+    fn c3(&self) -> f32 {
+        self.0.c3
+    }
+    #[getter]
+    fn c5(&self) -> f32 {
+        self.0.c5
+    }
+    #[getter]
+    fn c6(&self) -> f32 {
+        self.0.c6
+    }
+
+    fn __repr__(&self) -> String {
+        format!("TeleopGains({:?})", self.0)
+    }
+}
+
+/// The wave-variable channel: its wave impedance `b` (N s/m, > 0) and
+/// each side's incoming-wave filter pole `filter_pole` in `[0, 1)` (0:
+/// none).
+#[pyclass(frozen, module = "twoport")]
+#[derive(Clone, Copy)]
+pub(crate) struct WaveLaw(WaveGains);
+
+#[pymethods]
+impl WaveLaw {
+    #[new]
+    #[pyo3(signature = (*, b, filter_pole=0.0))]
+    fn new(b: f32, filter_pole: f32) -> Self {
+        WaveLaw(WaveGains {
+            b_nspm: b,
+            filter_pole,
+        })
+    }
+
+    /// The wave impedance (N s/m).
+    #[getter]
+    fn b(&self) -> f32 {
+        self.0.b_nspm
+    }
+
+    /// The incoming waves' filter pole.
+    #[getter]
+    fn filter_pole(&self) -> f32 {
+        self.0.filter_pole
     }
 
     fn __repr__(&self) -> String {
         format!(
-            "TeleopGains(k_m={}, b_m={}, b_local={}, k_s={}, b_s={}, c2={}, c3={}, c5={}, c6={})",
-            self.k_m,
-            self.b_m,
-            self.b_local,
-            self.k_s,
-            self.b_s,
-            self.c2,
-            self.c3,
-            self.c5,
-            self.c6
+            "WaveLaw(b={}, filter_pole={})",
+            self.0.b_nspm, self.0.filter_pole
         )
+    }
+}
+
+/// A teleoperator's law as Python gives it: `TeleopGains` or `WaveLaw`.
+#[derive(FromPyObject)]
+pub(crate) enum Law {
+    Four(TeleopGains),
+    Wave(WaveLaw),
+}
+
+impl From<Law> for TeleopLaw {
+    fn from(l: Law) -> Self {
+        match l {
+            Law::Four(g) => TeleopLaw::FourChannel(g.0),
+            Law::Wave(w) => TeleopLaw::Wave(w.0),
+        }
+    }
+}
+
+impl<'py> IntoPyObject<'py> for Law {
+    type Target = PyAny;
+    type Output = Bound<'py, PyAny>;
+    type Error = PyErr;
+
+    fn into_pyobject(self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Ok(match self {
+            Law::Four(g) => Bound::new(py, g)?.into_any(),
+            Law::Wave(w) => Bound::new(py, w)?.into_any(),
+        })
     }
 }
 
@@ -155,8 +205,8 @@ pub(crate) struct TeleopCheck {
     holds_toward_dc: bool,
     /// The spectral radius with both ends let go.
     let_go_radius: f64,
-    /// The gains proven (or not).
-    gains: TeleopGains,
+    /// The law proven (or not): `TeleopGains` or `WaveLaw`.
+    law: Py<PyAny>,
     /// What the operator feels at the lowest frequency: through free
     /// space the mass (kg) and damping (N s/m), against a rigid wall the
     /// stiffness (N/m).
@@ -165,34 +215,44 @@ pub(crate) struct TeleopCheck {
 
 #[pymethods]
 impl TeleopCheck {
-    fn __repr__(&self) -> String {
+    /// The four-channel gains proven (or not); `None` for a wave channel.
+    #[getter]
+    fn gains(&self, py: Python<'_>) -> Option<TeleopGains> {
+        self.law.extract::<TeleopGains>(py).ok()
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
         format!(
             "TeleopCheck(proven={}, slack={:.3e} at {:.2} Hz, {})",
             self.proven,
             self.slack,
             self.frequency_hz,
-            self.gains.__repr__()
+            self.law
+                .bind(py)
+                .repr()
+                .map(|r| r.to_string())
+                .unwrap_or_default()
         )
     }
 }
 
-impl From<TeleopCheckReport> for TeleopCheck {
-    fn from(r: TeleopCheckReport) -> Self {
-        TeleopCheck {
+impl TeleopCheck {
+    fn of(py: Python<'_>, r: TeleopCheckReport) -> PyResult<Self> {
+        let law = match r.law {
+            TeleopLaw::FourChannel(g) => Law::Four(TeleopGains(g)),
+            TeleopLaw::Wave(w) => Law::Wave(WaveLaw(w)),
+        };
+        Ok(TeleopCheck {
             proven: r.check.proven,
             slack: r.check.slack,
             frequency_hz: r.check.frequency_hz,
             holds_toward_dc: r.check.holds_toward_dc,
             let_go_radius: r.check.let_go_radius,
-            // (Python proves four-channel laws only.)
-            gains: match r.law {
-                TeleopLaw::FourChannel(g) => g.into(),
-                TeleopLaw::Wave(_) => FourChannelGains::OFF.into(),
-            },
+            law: law.into_pyobject(py)?.unbind(),
             felt: r
                 .felt
                 .map(|t| (t.free_mass_kg, t.free_damping_nspm, t.wall_stiffness_npm)),
-        }
+        })
     }
 }
 
@@ -209,23 +269,26 @@ fn designer(
 }
 
 /// Prove the teleoperator between `master` and `slave` (model files or
-/// `Model`s at one period) with `gains`, its channel `delay` ticks long
-/// each way: absolutely stable for every passive operator (within the
-/// human bound if `human_bound`) and every passive environment.
+/// `Model`s at one period) with `law` (`TeleopGains` or `WaveLaw`), its
+/// channel `delay` ticks long each way: absolutely stable for every
+/// passive operator (within the human bound if `human_bound`) and every
+/// passive environment.
 #[pyfunction]
-#[pyo3(signature = (master, slave, gains, *, delay=0, human_bound=false))]
+#[pyo3(signature = (master, slave, law, *, delay=0, human_bound=false))]
 pub(crate) fn check_teleop(
     py: Python<'_>,
     master: Pose,
     slave: Pose,
-    gains: TeleopGains,
+    law: Law,
     delay: usize,
     human_bound: bool,
 ) -> PyResult<TeleopCheck> {
     let d = designer(master, slave, delay, human_bound)?;
-    py.detach(move || d.check(gains.into()))
-        .map(TeleopCheck::from)
-        .map_err(|e| PyValueError::new_err(e.to_string()))
+    let law = TeleopLaw::from(law);
+    let r = py
+        .detach(move || d.check_law(law))
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    TeleopCheck::of(py, r)
 }
 
 /// The stiffest proven position-position coupling at damping `b`
@@ -253,41 +316,30 @@ pub(crate) fn design_teleop(
             100.0,
         ),
     });
-    found
-        .map(|f| f.map(|(_, r)| r.into()))
-        .map_err(|e| PyValueError::new_err(e.to_string()))
+    match found.map_err(|e| PyValueError::new_err(e.to_string()))? {
+        Some((_, r)) => TeleopCheck::of(py, r).map(Some),
+        None => Ok(None),
+    }
 }
 
 /// Search the exact sampled teleoperator between `master` and `slave`
 /// (model files or `Model`s at one period) for a passive operator and
-/// environment that make it unstable: Lawrence's four-channel law with
-/// these gains (N/m, N s/m; the force channels' `c2`, `c3`, `c5`, `c6`
-/// dimensionless), its channel `delay` ticks long each way, with the
-/// proof's own worst hands where the proof fails.
-/// Position-position is `k_m = k_s`, `b_m = b_s` and nothing else; force
-/// reflection is `k_s`, `b_s`, `c2` and the master's `b_local`.
+/// environment that make it unstable: `law` (`TeleopGains` or
+/// `WaveLaw`), its channel `delay` ticks long each way, with the proof's
+/// own worst hands where the proof fails.
 #[pyfunction]
-#[pyo3(signature = (master, slave, *, k_m=0.0, b_m=0.0, b_local=0.0, k_s=0.0, b_s=0.0, c2=0.0, c3=0.0, c5=0.0, c6=0.0, delay=0))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (master, slave, law, *, delay=0))]
 pub(crate) fn verify_teleop(
     py: Python<'_>,
     master: Pose,
     slave: Pose,
-    k_m: f32,
-    b_m: f32,
-    b_local: f32,
-    k_s: f32,
-    b_s: f32,
-    c2: f32,
-    c3: f32,
-    c5: f32,
-    c6: f32,
+    law: Law,
     delay: usize,
 ) -> PyResult<TeleopVerdict> {
     let (master, slave) = (master.load()?, slave.load()?);
-    let gains = TeleopGains::new(k_m, b_m, b_local, k_s, b_s, c2, c3, c5, c6).into();
+    let law = TeleopLaw::from(law);
     let r = py
-        .detach(move || verify_four_channel(&master, &slave, gains, delay))
+        .detach(move || verify_law(&master, &slave, law, delay))
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     let v = r.verdict;
     Ok(TeleopVerdict {

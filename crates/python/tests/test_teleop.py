@@ -1,10 +1,14 @@
 """Teleoperators from Python: two models, the four-channel gains and the
 channel's delay, searched on the exact sampled loop."""
 
+import pathlib
+
 import numpy as np
 import pytest
 
 import twoport
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
 
 
 def rigid(mass=0.1, damping=1.0, period_s=1e-3):
@@ -14,26 +18,30 @@ def rigid(mass=0.1, damping=1.0, period_s=1e-3):
         period_s=period_s, peak_force_n=50.0, continuous_force_n=20.0, name="rigid")
 
 
+def pp(k, b=0.0):
+    return twoport.TeleopGains(k_m=k, k_s=k, b_m=b, b_s=b)
+
+
 def test_position_position_meets_colgates_edge_for_the_relative_motion():
     # Two rigid 0.1 kg, 1 N s/m handles: their relative motion holds below
     # k = b / T = 1,000 N/m and grows above it; a delay breaks it below.
     m, s = rigid(), rigid()
-    below = twoport.verify_teleop(m, s, k_m=980.0, k_s=980.0)
-    above = twoport.verify_teleop(m, s, k_m=1020.0, k_s=1020.0)
+    below = twoport.verify_teleop(m, s, pp(980.0))
+    above = twoport.verify_teleop(m, s, pp(1020.0))
     assert not below.unstable, below
     assert above.unstable and abs(above.frequency_hz - 22.7) < 1.0, above
     assert above.operator == (0.0, 0.0, 0.0)
-    late = twoport.verify_teleop(m, s, k_m=980.0, k_s=980.0, delay=4)
+    late = twoport.verify_teleop(m, s, pp(980.0), delay=4)
     assert late.unstable, late
 
 
 def test_a_bad_teleoperator_raises_naming_it():
     with pytest.raises(ValueError, match="one period"):
-        twoport.verify_teleop(rigid(), rigid(period_s=5e-4), k_m=100.0, k_s=100.0)
+        twoport.verify_teleop(rigid(), rigid(period_s=5e-4), pp(100.0))
     with pytest.raises(ValueError, match="at most 1024"):
-        twoport.verify_teleop(rigid(), rigid(), k_m=100.0, k_s=100.0, delay=2000)
+        twoport.verify_teleop(rigid(), rigid(), pp(100.0), delay=2000)
     with pytest.raises(ValueError, match="k_m"):
-        twoport.verify_teleop(rigid(), rigid(), k_m=-1.0)
+        twoport.verify_teleop(rigid(), rigid(), twoport.TeleopGains(k_m=-1.0))
 
 
 def test_the_proof_holds_inside_colgates_edge_and_design_finds_it():
@@ -51,10 +59,29 @@ def test_the_proof_holds_inside_colgates_edge_and_design_finds_it():
     best = twoport.design_teleop(m, s, b=0.0)
     assert best is not None and best.proven, best
     assert 995.0 < best.gains.k_m <= 1000.0 and best.gains.k_s == best.gains.k_m, best
-    there = twoport.verify_teleop(m, s, k_m=best.gains.k_m, k_s=best.gains.k_s)
+    there = twoport.verify_teleop(m, s, best.law)
     assert not there.unstable, there
 
 
 def test_a_force_channel_without_a_load_cell_raises():
     with pytest.raises(ValueError, match="load cell"):
         twoport.check_teleop(rigid(), rigid(), twoport.TeleopGains(k_s=100.0, c2=0.5))
+
+
+def test_a_filtered_wave_channel_is_proven_and_a_bare_one_breaks():
+    # Two capstan handles, one tick each way: waves low-passed at 0.9 are
+    # proven and the search finds nothing; bare, the line resonates with a
+    # stiff termination at Nyquist.
+    capstan = str(ROOT / "models" / "capstan.toml")
+    filtered = twoport.WaveLaw(b=0.5, filter_pole=0.9)
+    proof = twoport.check_teleop(capstan, capstan, filtered, delay=1)
+    assert proof.proven and proof.gains is None, proof
+    assert proof.law.b == 0.5 and abs(proof.law.filter_pole - 0.9) < 1e-6, proof.law
+    mass, damping, stiffness = proof.felt
+    assert 0.3 < mass < 0.6 and stiffness > 0.0, proof.felt
+    assert not twoport.verify_teleop(capstan, capstan, filtered, delay=1).unstable
+    bare = twoport.WaveLaw(b=0.5)
+    assert not twoport.check_teleop(capstan, capstan, bare, delay=1).proven
+    assert twoport.verify_teleop(capstan, capstan, bare, delay=1).unstable
+    with pytest.raises(ValueError, match="filter"):
+        twoport.check_teleop(capstan, capstan, twoport.WaveLaw(b=0.5, filter_pole=1.5), delay=1)
