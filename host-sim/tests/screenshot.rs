@@ -33,7 +33,9 @@ fn shots(scene: &str, seconds: u32) -> (std::path::PathBuf, RgbaImage, RgbaImage
     let dir = std::env::temp_dir().join(format!("twoport-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("shot.png");
+    // (From the repository's root, where scenes name their model files.)
     let status = Command::new("xvfb-run")
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
         .args(["-a", "-s", "-screen 0 1400x900x24"])
         .arg(env!("CARGO_BIN_EXE_host-sim"))
         .arg("--scene")
@@ -92,5 +94,32 @@ fn the_world_view_draws_and_its_blocks_move() {
     // The projections (the upper half) changed: the block was carried.
     let world = changed(&first, &last, (0, w), (60, h / 2));
     assert!(world > 0.001, "world view changed by {world:.4}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A teleoperation scene under Xvfb: both devices' positions and forces
+/// are drawn on one time axis, and they moved between the two shots
+/// while the heading and the controls did not.
+#[test]
+#[ignore = "needs xvfb-run (CI installs xvfb); run with --ignored"]
+fn the_scope_shows_both_sides_of_a_teleoperator() {
+    let (dir, first, last) = shots("teleop/capstan_wall.toml", 3);
+    let (w, h) = last.dimensions();
+    let mut colours: Vec<[u8; 4]> = last.pixels().map(|p| p.0).collect();
+    colours.sort_unstable();
+    colours.dedup();
+    assert!(colours.len() > 50, "{} colours", colours.len());
+    // Each device has its colour: the master's blue and the slave's red
+    // traces are both drawn.
+    let near = |c: [u8; 3]| {
+        last.pixels()
+            .filter(|p| (0..3).all(|i| p.0[i].abs_diff(c[i]) < 12))
+            .count()
+    };
+    assert!(near([31, 119, 180]) > 200 && near([214, 39, 40]) > 200);
+    let plots = changed(&first, &last, (60, w - 20), (80, h - 20));
+    assert!(plots > 0.01, "plot area changed by {plots:.4}");
+    let heading = changed(&first, &last, (0, w / 2), (0, 20));
+    assert!(heading < 0.001, "heading changed by {heading:.4}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -113,6 +113,22 @@ impl Shots {
     }
 }
 
+/// The scope of a teleoperation scene: both devices.
+struct TeleopApp {
+    state: crate::scope::teleop::TeleopState,
+    shots: Shots,
+}
+
+impl eframe::App for TeleopApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        self.state.advance(self.shots.frame());
+        crate::scope::teleop_ui::teleop(ui, &mut self.state);
+        self.shots.scripted(&ctx);
+        ctx.request_repaint();
+    }
+}
+
 impl eframe::App for ScopeApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
@@ -156,6 +172,16 @@ fn open_device(
 pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, Error> {
     let shots = Shots::new(script);
     let saved = shots.saved.clone();
+    if crate::engine::teleop::TeleopScene::is_one(scene)? {
+        if shots.script.device.is_some() {
+            return Err(Error::Sim(format!(
+                "{}: a teleoperation scene runs two simulated devices; a device the PC drives opens on a one-device scene",
+                scene.display()
+            )));
+        }
+        let state = crate::scope::teleop::TeleopState::open(scene)?;
+        return show(Box::new(TeleopApp { state, shots }), saved);
+    }
     let parsed = crate::Scene::load(scene, &[])?;
     let device = shots.script.device.clone();
     if device.is_some() && parsed.axes < 2 {
@@ -179,6 +205,15 @@ pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, Error> {
             shots,
         })
     };
+    show(app, saved)
+}
+
+/// Show `app` in the scope's window until it closes; the screenshots it
+/// saved.
+fn show(
+    app: Box<dyn eframe::App>,
+    saved: Arc<Mutex<Vec<Result<PathBuf, Error>>>>,
+) -> Result<Vec<PathBuf>, Error> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_inner_size([1280.0, 860.0])

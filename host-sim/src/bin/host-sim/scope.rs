@@ -66,6 +66,9 @@ pub(crate) fn scope(a: &ScopeArgs) -> Result<(), Error> {
         "host-sim: {why_headless}; running {} headless instead",
         a.scene.display()
     );
+    if host_sim::engine::teleop::TeleopScene::is_one(&a.scene)? {
+        return crate::teleop::teleop(&crate::teleop::TeleopArgs::of(a.scene.clone()));
+    }
     run(&RunArgs {
         scene: SceneArgs {
             scene: a.scene.clone(),

@@ -20,6 +20,21 @@ pub(crate) struct TeleopArgs {
     png: Option<PathBuf>,
 }
 
+impl TeleopArgs {
+    /// A plain run of `scene`: its report, nothing written.
+    pub(crate) fn of(scene: PathBuf) -> Self {
+        TeleopArgs {
+            scene: SceneArgs {
+                scene,
+                sets: Vec::new(),
+                json: false,
+            },
+            csv: None,
+            png: None,
+        }
+    }
+}
+
 const COLUMNS: &str = "t_s,master_position_m,slave_position_m,master_velocity_mps,\
 slave_velocity_mps,operator_force_n,environment_force_n,master_actuator_force_n,\
 slave_actuator_force_n,master_guard_nspm,slave_guard_nspm";

@@ -235,6 +235,12 @@ impl Teleoperation {
         self.sides[0].total_ticks()
     }
 
+    /// Push the master's handle with `force_n` (N) beside its script
+    /// (the scope's mouse).
+    pub fn set_push(&mut self, force_n: f64) {
+        self.sides[0].set_push([force_n]);
+    }
+
     /// Why the run failed so far, if it has.
     pub fn failure(&self) -> Option<&str> {
         self.failure

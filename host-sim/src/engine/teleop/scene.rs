@@ -140,6 +140,15 @@ impl TeleopScene {
         Ok(scene)
     }
 
+    /// Whether the scene file at `path` is a teleoperation scene (it has
+    /// a `[master]` table) rather than a one-device scene.
+    pub fn is_one(path: &Path) -> Result<bool, Error> {
+        let text = read(path)?;
+        let table: toml::Table = toml::from_str(&text)
+            .map_err(|e| Error::Scene(format!("{}: {}", path.display(), e.message())))?;
+        Ok(table.contains_key("master"))
+    }
+
     /// The control period (s).
     pub fn period(&self) -> f64 {
         self.period_s.unwrap_or(1e-3)
