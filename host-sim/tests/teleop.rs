@@ -176,11 +176,12 @@ fn proven_laws(
 }
 
 #[test]
-fn every_architecture_holds_at_its_proven_gains_on_three_pairs() {
+fn every_architecture_holds_at_its_proven_gains_on_four_pairs() {
     let pairs = [
         ("models/capstan.toml", "models/capstan.toml"),
         ("models/two_mass.toml", "models/two_mass.toml"),
         ("models/excalibur.toml", "models/two_mass.toml"),
+        ("models/two_mass.toml", "models/excalibur.toml"),
     ];
     let mut architectures = std::collections::BTreeSet::new();
     for (m, s) in pairs {

@@ -1,4 +1,4 @@
-"""Teleoperators on three device pairs: for each architecture the pair's
+"""Teleoperators on four device pairs: for each architecture the pair's
 sensors allow, the largest proven gain at one tick each way, what the
 operator feels through it, `verify` at that gain and 5% past it, and the
 longest channel 80% of that gain stays proven across.
@@ -17,6 +17,7 @@ PAIRS = [
     ("capstan", "capstan"),
     ("two_mass", "two_mass"),
     ("excalibur", "two_mass"),
+    ("two_mass", "excalibur"),
 ]
 FORCE_SENSED = {"capstan": False, "two_mass": True, "excalibur": True}
 
