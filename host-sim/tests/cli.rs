@@ -257,3 +257,49 @@ fn the_readme_lists_every_subcommand() {
 fn a_closed_pipe_ends_the_report_quietly() {
     HOST_SIM.closes_quietly(&["table1"]);
 }
+
+#[test]
+fn teleop_reports_both_sides_and_writes_both_to_its_csv() {
+    let path = std::env::temp_dir().join(format!("host-sim-teleop-{}.csv", std::process::id()));
+    let v = HOST_SIM.json(&[
+        "teleop",
+        "scenes/teleop/rigid_pair.toml",
+        "--set",
+        "duration_s=2",
+        "--csv",
+        path.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(v["stable"], true, "{v}");
+    for side in ["master", "slave"] {
+        assert!(v[side]["peak_force_n"].as_f64().unwrap() > 0.0, "{v}");
+    }
+    assert!(v["tracking_rms_m"].as_f64().unwrap() > 0.0, "{v}");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(
+        header[..3],
+        ["t_s", "master_position_m", "slave_position_m"]
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 2_000);
+    assert!(rows.iter().all(|r| r.len() == header.len()));
+    // The tap moved the master first and the slave after it.
+    let first_moved = |col: usize| rows.iter().position(|r| r[col] != 0.0).unwrap();
+    assert!(first_moved(1) < first_moved(2));
+    let _ = std::fs::remove_file(&path);
+    // 20% past the proven spring the same tap grows.
+    let v = HOST_SIM.json(&[
+        "teleop",
+        "scenes/teleop/rigid_pair.toml",
+        "--set",
+        "law.gains.k_m_npm=600",
+        "--set",
+        "law.gains.k_s_npm=600",
+        "--json",
+    ]);
+    assert_eq!(v["stable"], false, "{v}");
+}

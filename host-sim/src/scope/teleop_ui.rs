@@ -5,7 +5,7 @@
 use crate::scope::rings::Ring;
 use crate::scope::teleop::TeleopState;
 use eframe::egui::{self, Color32, Ui};
-use egui_plot::{Legend, Line, Plot, PlotPoints};
+use egui_plot::{Line, PlotPoints};
 use twoport_design::verify::TeleopLaw;
 
 const MASTER: Color32 = Color32::from_rgb(31, 119, 180);
@@ -108,24 +108,16 @@ fn plot(
     (t0, t1): (f64, f64),
     lines: &[(&str, Color32, &Ring)],
 ) {
-    Plot::new(id)
-        .height(height)
-        .legend(Legend::default())
-        .link_axis(egui::Id::unique("teleop-time"), [true, false])
-        .y_axis_min_width(48.0)
-        .allow_drag(false)
-        .allow_zoom(false)
-        .allow_scroll(false)
-        .show(ui, |p| {
-            p.set_plot_bounds_x(t0..=t1);
-            p.set_auto_bounds([false, true]);
-            for (name, color, ring) in lines {
-                let pts: Vec<[f64; 2]> = ring
-                    .iter()
-                    .filter(|(t, _)| *t >= t0)
-                    .map(|&(t, v)| [t, v])
-                    .collect();
-                p.line(Line::new(*name, PlotPoints::from(pts)).color(*color));
-            }
-        });
+    crate::scope::ui::time_plot(id, height, "teleop-time").show(ui, |p| {
+        p.set_plot_bounds_x(t0..=t1);
+        p.set_auto_bounds([false, true]);
+        for (name, color, ring) in lines {
+            let pts: Vec<[f64; 2]> = ring
+                .iter()
+                .filter(|(t, _)| *t >= t0)
+                .map(|&(t, v)| [t, v])
+                .collect();
+            p.line(Line::new(*name, PlotPoints::from(pts)).color(*color));
+        }
+    });
 }

@@ -42,6 +42,20 @@ const COLORS: [Color32; 6] = [
     Color32::from_rgb(140, 86, 75),
 ];
 
+/// A plot of a stack on one time axis (`link` names it), with a legend:
+/// one y-axis width for all, so their time axes line up; the scope sets
+/// the span, so the mouse does not drag or zoom it.
+pub fn time_plot<'a>(id: &'a str, height: f32, link: &str) -> Plot<'a> {
+    Plot::new(id)
+        .height(height)
+        .legend(Legend::default())
+        .link_axis(egui::Id::unique(link), [true, false])
+        .y_axis_min_width(48.0)
+        .allow_drag(false)
+        .allow_zoom(false)
+        .allow_scroll(false)
+}
+
 /// One plot of the stack: the named signals over `[t0, t1)`.
 fn signal_plot(
     ui: &mut Ui,
@@ -53,29 +67,20 @@ fn signal_plot(
     board: &[BoardSignal],
 ) {
     let px = ui.available_width().max(1.0) as usize;
-    Plot::new(id)
-        .height(height)
-        .legend(Legend::default())
-        .link_axis(egui::Id::unique("scope-time"), [true, false])
-        // One y-axis width for all four, so their time axes line up.
-        .y_axis_min_width(48.0)
-        .allow_drag(false)
-        .allow_zoom(false)
-        .allow_scroll(false)
-        .show(ui, |p| {
-            p.set_plot_bounds_x(t0..=t1);
-            p.set_auto_bounds([false, true]);
-            for (i, sig) in signals.iter().enumerate() {
-                let pts = envelope(s.ring(*sig), t0, t1, px);
-                p.line(Line::new(sig.name(), PlotPoints::from(pts)).color(COLORS[i % 6]));
+    time_plot(id, height, "scope-time").show(ui, |p| {
+        p.set_plot_bounds_x(t0..=t1);
+        p.set_auto_bounds([false, true]);
+        for (i, sig) in signals.iter().enumerate() {
+            let pts = envelope(s.ring(*sig), t0, t1, px);
+            p.line(Line::new(sig.name(), PlotPoints::from(pts)).color(COLORS[i % 6]));
+        }
+        if s.board.is_some() {
+            for b in board {
+                let pts = envelope(s.board_ring(*b), t0, t1, px);
+                p.line(Line::new(b.name(), PlotPoints::from(pts)).width(2.0));
             }
-            if s.board.is_some() {
-                for b in board {
-                    let pts = envelope(s.board_ring(*b), t0, t1, px);
-                    p.line(Line::new(b.name(), PlotPoints::from(pts)).width(2.0));
-                }
-            }
-        });
+        }
+    });
 }
 
 /// The plots on one time axis: positions, velocity, forces, energy, and

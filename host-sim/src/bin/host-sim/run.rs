@@ -3,7 +3,7 @@
 use clap::Args;
 use host_sim::engine::scene::Scene;
 use host_sim::Error;
-use host_sim::{Report, Sample, Simulation};
+use host_sim::{Report, Simulation};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -100,11 +100,9 @@ fn run_axes<const N: usize>(a: &RunArgs, scene: Scene) -> Result<(), Error> {
     }
     let name = scene.name.clone();
     let mut sim = Simulation::<N>::with_axes(scene)?;
-    let mut csv = csv_file(a.csv.as_deref(), &csv_header(N))?;
-    let mut kept: Vec<Sample<N>> = Vec::new();
-    let mut csv_err = None;
+    let mut rec = Recorder::new(a.csv.as_deref(), &csv_header(N), a.png.is_some())?;
     let report = sim.run(|s| {
-        if let Some(w) = csv.as_mut() {
+        rec.record(s, || {
             let mut row = s.t_s.to_string();
             for v in [
                 &s.handle_m,
@@ -119,31 +117,73 @@ fn run_axes<const N: usize>(a: &RunArgs, scene: Scene) -> Result<(), Error> {
                     row += &format!(",{x}");
                 }
             }
-            if let Err(e) = writeln!(w, "{row}") {
-                csv_err.get_or_insert(e);
-            }
-        }
-        if a.png.is_some() {
-            kept.push(*s);
-        }
+            row
+        })
     });
-    finish_csv(csv, csv_err)?;
+    let kept = rec.finish()?;
     if let Some(p) = &a.png {
         host_sim::study::plot::png(&kept, &name, p)?;
     }
-    if a.scene.json {
+    say_report(&report, a.scene.json, print_report)
+}
+
+/// What a run writes as it goes: each tick's CSV row, and the samples a
+/// plot needs.
+pub(crate) struct Recorder<T> {
+    csv: Option<std::io::BufWriter<std::fs::File>>,
+    err: Option<std::io::Error>,
+    kept: Option<Vec<T>>,
+}
+
+impl<T: Copy> Recorder<T> {
+    /// A CSV file at `csv` (if any) with `header`, and the samples kept
+    /// if `keep`.
+    pub(crate) fn new(csv: Option<&Path>, header: &str, keep: bool) -> Result<Self, Error> {
+        Ok(Recorder {
+            csv: csv_file(csv, header)?,
+            err: None,
+            kept: keep.then(Vec::new),
+        })
+    }
+
+    /// One tick: `row` written (made only with a CSV to write), `s` kept.
+    pub(crate) fn record(&mut self, s: &T, row: impl FnOnce() -> String) {
+        if let Some(w) = self.csv.as_mut() {
+            if let Err(e) = writeln!(w, "{}", row()) {
+                self.err.get_or_insert(e);
+            }
+        }
+        if let Some(k) = self.kept.as_mut() {
+            k.push(*s);
+        }
+    }
+
+    /// The CSV flushed (the first error writing it), and the samples kept.
+    pub(crate) fn finish(self) -> Result<Vec<T>, Error> {
+        finish_csv(self.csv, self.err)?;
+        Ok(self.kept.unwrap_or_default())
+    }
+}
+
+/// A run's report: one JSON object on stdout with `json`, else `text`.
+pub(crate) fn say_report<R: serde::Serialize>(
+    report: &R,
+    json: bool,
+    text: impl FnOnce(&R),
+) -> Result<(), Error> {
+    if json {
         say!(
             "{}",
-            serde_json::to_string(&report).map_err(|e| e.to_string())?
+            serde_json::to_string(report).map_err(|e| e.to_string())?
         );
     } else {
-        print_report(&report);
+        text(report);
     }
     Ok(())
 }
 
 /// A CSV file at `path` (if any), its `header` written.
-pub(crate) fn csv_file(
+fn csv_file(
     path: Option<&Path>,
     header: &str,
 ) -> Result<Option<std::io::BufWriter<std::fs::File>>, Error> {
@@ -155,7 +195,7 @@ pub(crate) fn csv_file(
 }
 
 /// The first error writing a CSV's rows, or the flush's.
-pub(crate) fn finish_csv(
+fn finish_csv(
     csv: Option<std::io::BufWriter<std::fs::File>>,
     row_err: Option<std::io::Error>,
 ) -> Result<(), Error> {

@@ -1,11 +1,10 @@
 //! `host-sim teleop`: one teleoperation scene, both devices judged, with
 //! its CSV or plot on request.
 
-use crate::run::{csv_file, finish_csv, print_verdict, SceneArgs};
+use crate::run::{print_verdict, say_report, Recorder, SceneArgs};
 use clap::Args;
-use host_sim::engine::teleop::{TeleopReport, TeleopSample, TeleopScene, Teleoperation};
+use host_sim::engine::teleop::{TeleopReport, TeleopScene, Teleoperation};
 use host_sim::Error;
-use std::io::Write;
 use std::path::PathBuf;
 
 #[derive(Args)]
@@ -43,13 +42,11 @@ pub(crate) fn teleop(a: &TeleopArgs) -> Result<(), Error> {
     let scene = TeleopScene::load(&a.scene.scene, &a.scene.sets)?;
     let name = scene.name.clone();
     let mut run = Teleoperation::new(scene)?;
-    let mut csv = csv_file(a.csv.as_deref(), COLUMNS)?;
-    let mut kept: Vec<TeleopSample> = Vec::new();
-    let mut csv_err = None;
+    let mut rec = Recorder::new(a.csv.as_deref(), COLUMNS, a.png.is_some())?;
     let report = run.run(|s| {
-        if let Some(w) = csv.as_mut() {
+        rec.record(s, || {
             let (m, l) = (&s.master, &s.slave);
-            let row = format!(
+            format!(
                 "{},{},{},{},{},{},{},{},{},{},{}",
                 m.t_s,
                 m.handle_m[0],
@@ -62,28 +59,14 @@ pub(crate) fn teleop(a: &TeleopArgs) -> Result<(), Error> {
                 l.actuator_n[0],
                 s.guard_nspm[0],
                 s.guard_nspm[1]
-            );
-            if let Err(e) = writeln!(w, "{row}") {
-                csv_err.get_or_insert(e);
-            }
-        }
-        if a.png.is_some() {
-            kept.push(*s);
-        }
+            )
+        })
     });
-    finish_csv(csv, csv_err)?;
+    let kept = rec.finish()?;
     if let Some(p) = &a.png {
         host_sim::study::plot::teleop_png(&kept, &name, p)?;
     }
-    if a.scene.json {
-        say!(
-            "{}",
-            serde_json::to_string(&report).map_err(|e| e.to_string())?
-        );
-    } else {
-        print_report(&report);
-    }
-    Ok(())
+    say_report(&report, a.scene.json, print_report)
 }
 
 fn print_report(r: &TeleopReport) {
