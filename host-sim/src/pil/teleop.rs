@@ -13,7 +13,7 @@
 //! law's delayed velocity does.
 
 use super::{boot_and_save, check_scene, record_read, zero_after_loss, Run};
-use crate::engine::teleop::TeleopScene;
+use crate::engine::teleop::{SideSpec, TeleopScene};
 use crate::link::{BoardPort, LinkFaults, Session};
 use crate::{Error, Simulation};
 use twoport_board::excalibur;
@@ -66,12 +66,12 @@ struct Side<P: BoardPort> {
 }
 
 impl<P: BoardPort> Side<P> {
-    fn open(scene: &TeleopScene, name: &str, port: P, faults: LinkFaults) -> Result<Self, Error> {
-        let spec = if name == "master" {
-            &scene.master
-        } else {
-            &scene.slave
-        };
+    fn open(
+        scene: &TeleopScene,
+        (name, spec): (&str, &SideSpec),
+        port: P,
+        faults: LinkFaults,
+    ) -> Result<Self, Error> {
         let side = scene.side(spec, name);
         check_scene(&side).map_err(|e| pil_err!("{name}: {e}"))?;
         let sim = Simulation::new(side)?;
@@ -177,9 +177,10 @@ pub fn run_pair<P: BoardPort>(
 ) -> Result<PairRun, Error> {
     let gains = pair_gains(scene)?;
     let d = scene.channel.delay_ticks;
+    let [m, s] = scene.sides();
     let mut sides = [
-        Side::open(scene, "master", master, faults)?,
-        Side::open(scene, "slave", slave, faults)?,
+        Side::open(scene, m, master, faults)?,
+        Side::open(scene, s, slave, faults)?,
     ];
     for s in &mut sides {
         s.tick()?;

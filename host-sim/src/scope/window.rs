@@ -172,7 +172,7 @@ fn open_device(
 pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, Error> {
     let shots = Shots::new(script);
     let saved = shots.saved.clone();
-    if crate::engine::teleop::TeleopScene::is_one(scene)? {
+    if crate::engine::teleop::TeleopScene::is_teleop(scene)? {
         if shots.script.device.is_some() {
             return Err(Error::Sim(format!(
                 "{}: a teleoperation scene runs two simulated devices; a device the PC drives opens on a one-device scene",

@@ -66,7 +66,7 @@ pub(crate) fn scope(a: &ScopeArgs) -> Result<(), Error> {
         "host-sim: {why_headless}; running {} headless instead",
         a.scene.display()
     );
-    if host_sim::engine::teleop::TeleopScene::is_one(&a.scene)? {
+    if host_sim::engine::teleop::TeleopScene::is_teleop(&a.scene)? {
         return crate::teleop::teleop(&crate::teleop::TeleopArgs::of(a.scene.clone()));
     }
     run(&RunArgs {

@@ -260,17 +260,18 @@ impl Teleoperation {
         let master_sample = master.step_external(&mut |at_master| {
             let mut to_master = ServoOutput::default();
             slave_sample = slave.step_external(&mut |at_slave| {
-                let read = [("master", at_master), ("slave", at_slave)]
-                    .into_iter()
-                    .zip(sensing.iter_mut())
-                    .map(|((name, frame), s)| {
-                        s.read(frame)
-                            .map_err(|e| format!("the {name}'s encoder: {e}"))
-                    })
-                    .collect::<Result<Vec<_>, String>>();
+                let [m, l] = &mut *sensing;
+                let read = m
+                    .read(at_master)
+                    .map_err(|e| format!("the master's encoder: {e}"))
+                    .and_then(|m| {
+                        l.read(at_slave)
+                            .map(|l| (m, l))
+                            .map_err(|e| format!("the slave's encoder: {e}"))
+                    });
                 let f = match (read, failure.is_some()) {
-                    (Ok(r), false) => {
-                        let (f, g) = law.step(tick, r[0], r[1]);
+                    (Ok((m, l)), false) => {
+                        let (f, g) = law.step(tick, m, l);
                         guard_nspm = g;
                         f
                     }

@@ -142,7 +142,7 @@ impl TeleopScene {
 
     /// Whether the scene file at `path` is a teleoperation scene (it has
     /// a `[master]` table) rather than a one-device scene.
-    pub fn is_one(path: &Path) -> Result<bool, Error> {
+    pub fn is_teleop(path: &Path) -> Result<bool, Error> {
         let text = read(path)?;
         let table: toml::Table = toml::from_str(&text)
             .map_err(|e| Error::Scene(format!("{}: {}", path.display(), e.message())))?;
