@@ -65,12 +65,12 @@ impl<R: Real> Spring<R> {
             anchor,
             probe: Integrator::new_in(t, probe),
         };
-        s.set_gains(k_npm, b_nspm)?;
+        s.set_spring(k_npm, b_nspm)?;
         Ok(s)
     }
 
     /// Change stiffness (N/m) and damping (N s/m).
-    pub fn set_gains(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
+    pub fn set_spring(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
         let k = param::non_negative("stiffness (N/m)", k_npm)?;
         let b = param::non_negative("damping (N s/m)", b_nspm)?;
         let (k, b) = (R::of(k), R::of(b));
@@ -79,7 +79,7 @@ impl<R: Real> Spring<R> {
     }
 
     /// Stiffness (N/m) and damping (N s/m).
-    pub fn gains(&self) -> (f32, f32) {
+    pub fn spring(&self) -> (f32, f32) {
         (self.k.to_f32(), self.b.to_f32())
     }
 
@@ -90,14 +90,14 @@ impl<R: Real> Spring<R> {
 
     /// The anchor, stiffness or damping; [`VirtualEnvironment::set_param`].
     fn set(&mut self, p: VeParam) -> Result<(), ParamError> {
-        let (k, b) = self.gains();
+        let (k, b) = self.spring();
         match p {
             VeParam::Surface(x) => {
                 self.set_anchor(x);
                 Ok(())
             }
-            VeParam::Stiffness(k) => self.set_gains(k, b),
-            VeParam::Damping(b) => self.set_gains(k, b),
+            VeParam::Stiffness(k) => self.set_spring(k, b),
+            VeParam::Damping(b) => self.set_spring(k, b),
         }
     }
 
@@ -211,8 +211,8 @@ impl<R: Real> TrapezoidalSpring<R> {
     }
 
     /// Change stiffness (N/m) and damping (N s/m).
-    pub fn set_gains(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
-        self.spring.set_gains(k_npm, b_nspm)
+    pub fn set_spring(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
+        self.spring.set_spring(k_npm, b_nspm)
     }
 }
 
@@ -311,13 +311,13 @@ impl<R: Real> UnilateralWall<R> {
     }
 
     /// Change stiffness and damping.
-    pub fn set_gains(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
-        self.spring.set_gains(k_npm, b_nspm)
+    pub fn set_spring(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
+        self.spring.set_spring(k_npm, b_nspm)
     }
 
     /// Stiffness (N/m) and damping (N s/m).
-    pub fn gains(&self) -> (f32, f32) {
-        self.spring.gains()
+    pub fn spring(&self) -> (f32, f32) {
+        self.spring.spring()
     }
 
     #[inline]

@@ -171,15 +171,18 @@ fn a_walls_parameters_are_set_by_name_and_checked() {
         z_nspm: 100.0,
     };
     assert_eq!(w.clone().step(port), built.clone().step(port));
-    assert_eq!(w.gains(), (5000.0, 20.0));
+    assert_eq!(w.spring(), (5000.0, 20.0));
     let e = w.set_param(VeParam::Stiffness(-1.0)).unwrap_err();
     assert_eq!(e.name, "stiffness (N/m)");
-    assert_eq!(w.gains(), (5000.0, 20.0));
+    assert_eq!(w.spring(), (5000.0, 20.0));
     let e = World::<f32, 1>::set_axis_param(&mut w, 1, VeParam::Damping(1.0)).unwrap_err();
     assert_eq!(e.problem, "is not a parameter of this VE");
     let mut axes = PerAxis([w; 3]);
     axes.set_axis_param(2, VeParam::Stiffness(7000.0)).unwrap();
-    assert_eq!((axes.0[2].gains().0, axes.0[0].gains().0), (7000.0, 5000.0));
+    assert_eq!(
+        (axes.0[2].spring().0, axes.0[0].spring().0),
+        (7000.0, 5000.0)
+    );
     let mut cursor = CursorMass::new(1.0, t, Position::ZERO).unwrap();
     let e = cursor.set_param(VeParam::Stiffness(1.0)).unwrap_err();
     assert_eq!(e.name, "VE stiffness (N/m)");

@@ -42,8 +42,8 @@ pub(crate) fn set_wall<R: Real>(
     let SceneVe::Wall(w) = ve else {
         return Err("the scene's VE is not a wall".into());
     };
-    let (_, b) = w.gains();
-    w.set_gains(k_npm, b).map_err(|e| e.to_string())?;
+    let (_, b) = w.spring();
+    w.set_spring(k_npm, b).map_err(|e| e.to_string())?;
     w.set_surface(surface);
     Ok(())
 }
