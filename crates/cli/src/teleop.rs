@@ -19,7 +19,7 @@ fn law_with(law: &TeleopLaw, free: Option<f32>) -> Option<Law> {
         }
         TeleopLaw::Wave { b, filter_pole } => {
             return Some(Law::Wave(WaveGains {
-                b_nspm: b,
+                b_nspm: b.or(free)?,
                 filter_pole,
             }))
         }
@@ -54,18 +54,16 @@ fn law(law: &TeleopLaw) -> Result<Law, String> {
             TeleopLaw::PositionForce { .. } => {
                 "position-force: give --k-f (teleop design finds it)"
             }
+            TeleopLaw::Wave { .. } => "wave: give --b (teleop design finds it)",
             _ => "position-position: give --k (teleop design finds it)",
         }
         .to_string()
     })
 }
 
-/// The four-channel gains a design varies, with `x` for the left-out one.
-fn gains_at(law: &TeleopLaw, x: f64) -> FourChannelGains {
-    match law_with(law, Some(x as f32)) {
-        Some(Law::FourChannel(g)) => g,
-        _ => FourChannelGains::OFF,
-    }
+/// The law a design varies, with `x` for the left-out gain.
+fn law_at(law: &TeleopLaw, x: f64) -> Law {
+    law_with(law, Some(x as f32)).unwrap_or(Law::FourChannel(FourChannelGains::OFF))
 }
 
 /// Both models, which must sample at one period.
@@ -135,11 +133,12 @@ fn plot_felt(a: &TeleopArgs, d: &TeleopDesigner, law: Law) -> Result<(), String>
     plot::render(&fig, out).map_err(|e| format!("--plot {}: {e}", out.display()))
 }
 
-/// The most a designed gain is searched up to: a stiffness (N/m), or a
-/// force scale.
+/// The most a designed gain is searched up to: a stiffness (N/m), a
+/// force scale or a wave impedance (N s/m).
 fn design_limit(law: &TeleopLaw) -> f64 {
     match law {
         TeleopLaw::PositionForce { .. } => 100.0,
+        TeleopLaw::Wave { .. } => 1e5,
         _ => 1e7,
     }
 }
@@ -147,32 +146,25 @@ fn design_limit(law: &TeleopLaw) -> f64 {
 /// `teleop design`: the largest left-out gain the proof allows, and its
 /// proof.
 pub(crate) fn design(a: &TeleopArgs) -> Reported {
-    if matches!(a.law, TeleopLaw::Wave { .. }) {
-        return Err(
-            "wave: design finds position-position's --k or position-force's --k-f; \
-             check a wave channel's given impedance and filter"
-                .to_string(),
-        );
-    }
     if law_with(&a.law, None).is_some() {
-        let given = if matches!(a.law, TeleopLaw::PositionForce { .. }) {
-            "--k-f"
-        } else {
-            "--k"
+        let given = match a.law {
+            TeleopLaw::PositionForce { .. } => "--k-f",
+            TeleopLaw::Wave { .. } => "--b",
+            _ => "--k",
         };
         return Err(match a.law {
             TeleopLaw::FourChannel { .. } => {
-                "four-channel: design finds position-position's --k or position-force's --k-f; \
-                 check a four-channel law's given gains"
+                "four-channel: design finds position-position's --k, position-force's --k-f \
+                 or the wave channel's --b; check a four-channel law's given gains"
                     .to_string()
             }
             _ => format!("design finds {given}: leave it out"),
         });
     }
     let d = designer(a)?;
-    let at = |x: f64| gains_at(&a.law, x);
+    let at = |x: f64| law_at(&a.law, x);
     match d
-        .largest(at, design_limit(&a.law))
+        .largest_law(at, design_limit(&a.law))
         .map_err(|e| e.to_string())?
     {
         Some((_, report)) => {

@@ -204,7 +204,8 @@ fn design_plots_what_the_operator_feels() {
 
 /// The wave channel by name: filtered, proven between two capstan
 /// handles with one tick of delay; bare, broken (its line resonates at
-/// Nyquist); with no delay, or asked of design, refused by name.
+/// Nyquist); with no delay, or designed with its impedance given,
+/// refused by name.
 #[test]
 fn the_wave_channel_is_proven_filtered_and_broken_bare() {
     let proven = handles_json("check", "--delay 1 wave --b 0.5 --filter-pole 0.9");
@@ -218,7 +219,16 @@ fn the_wave_channel_is_proven_filtered_and_broken_bare() {
             "wave --b 0.5",
             "delay (ticks) = 0 must be at least 1",
         ),
-        ("design", "--delay 1 wave --b 0.5", "wave: design finds"),
+        (
+            "design",
+            "--delay 1 wave --b 0.5",
+            "design finds --b: leave it out",
+        ),
+        (
+            "check",
+            "--delay 1 wave --filter-pole 0.9",
+            "wave: give --b",
+        ),
         (
             "check",
             "--delay 1 wave --b 0.5 --filter-pole 1",
@@ -229,4 +239,28 @@ fn the_wave_channel_is_proven_filtered_and_broken_bare() {
         let e = TWOPORT.failure(&line.split_whitespace().collect::<Vec<_>>());
         assert!(e.contains(says), "{law}: {e}");
     }
+}
+
+/// `teleop design wave` finds the largest wave impedance the proof allows
+/// at the given filter: proven there and not 5% past it. A lighter
+/// filter (its pole lower) proves less impedance, though the operator
+/// feels a stiffer wall through it (`b (1 - pole) / T`); the bare
+/// channel proves none.
+#[test]
+fn design_finds_the_largest_proven_wave_impedance() {
+    let b_at = |pole: f64| {
+        let d = handles_json("design", &format!("--delay 1 wave --filter-pole {pole}"));
+        assert_eq!(d["proven"], true, "{d}");
+        d["wave"]["b_nspm"].as_f64().unwrap()
+    };
+    let (light, heavy) = (b_at(0.5), b_at(0.9));
+    assert!(light > 0.1 && heavy > light, "{light} then {heavy}");
+    let past = handles_json(
+        "check",
+        &format!("--delay 1 wave --b {} --filter-pole 0.9", 1.05 * heavy),
+    );
+    assert_eq!(past["proven"], false, "{past}");
+    let line = format!("teleop design --master {CAPSTAN} --slave {CAPSTAN} --delay 1 wave");
+    let e = TWOPORT.failure(&line.split_whitespace().collect::<Vec<_>>());
+    assert!(e.contains("no gain is proven"), "{e}");
 }

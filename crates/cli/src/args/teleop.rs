@@ -14,8 +14,9 @@ pub(crate) enum Teleop {
     /// and environment: the sampled loop's two-port, aliasing at both
     /// handles.
     Check(TeleopArgs),
-    /// The largest gain the proof allows: position-position's --k, or
-    /// position-force's --k-f, left out and found.
+    /// The largest gain the proof allows: position-position's --k,
+    /// position-force's --k-f or the wave channel's --b, left out and
+    /// found.
     Design(TeleopArgs),
 }
 
@@ -84,9 +85,9 @@ pub(crate) enum TeleopLaw {
     /// --filter-pole (0: none; a bare channel's line resonates with a
     /// stiff termination at Nyquist).
     Wave {
-        /// The wave impedance (N s/m).
+        /// The wave impedance (N s/m); design finds the largest proven.
         #[arg(long, allow_negative_numbers = true)]
-        b: f32,
+        b: Option<f32>,
         /// The incoming-wave filter's pole, in [0, 1).
         #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
         filter_pole: f32,

@@ -77,7 +77,18 @@ impl TeleopDesigner {
         gains_at: impl Fn(f64) -> FourChannelGains,
         x_max: f64,
     ) -> Result<Option<(f64, TeleopCheckReport)>, Error> {
-        let at = |x: f64| self.check(gains_at(x));
+        self.largest_law(|x| TeleopLaw::FourChannel(gains_at(x)), x_max)
+    }
+
+    /// [`largest`](Self::largest) for any law: `law_at(x)` four channels
+    /// or waves (the wave channel's largest proven impedance at a given
+    /// filter).
+    pub fn largest_law(
+        &self,
+        law_at: impl Fn(f64) -> TeleopLaw,
+        x_max: f64,
+    ) -> Result<Option<(f64, TeleopCheckReport)>, Error> {
+        let at = |x: f64| self.check_law(law_at(x));
         let mut x = x_max * 1e-8;
         let mut best = None;
         while x <= x_max {
