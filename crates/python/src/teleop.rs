@@ -291,31 +291,55 @@ pub(crate) fn check_teleop(
     TeleopCheck::of(py, r)
 }
 
-/// The stiffest proven position-position coupling at damping `b`
-/// (N s/m) between `master` and `slave`, or, with `k` given, the largest
-/// proven force-reflection scale `k_f` at the slave's `k`, `b` and the
-/// master's `b_m`; `None` where none is proven.
+/// The largest gain the proof allows between `master` and `slave`: the
+/// stiffest position-position coupling at damping `b` (N s/m), or, with
+/// `k` given, force reflection's largest scale `k_f` at the slave's `k`,
+/// `b` and the master's `b_m`, or, with `filter_pole` given (and no `b`),
+/// the wave channel's largest impedance at that filter. `None` where
+/// none is proven.
 #[pyfunction]
-#[pyo3(signature = (master, slave, *, b, k=None, b_m=0.0, delay=0, human_bound=false))]
+#[pyo3(signature = (master, slave, *, b=None, k=None, b_m=0.0, filter_pole=None, delay=0, human_bound=false))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn design_teleop(
     py: Python<'_>,
     master: Pose,
     slave: Pose,
-    b: f32,
+    b: Option<f32>,
     k: Option<f32>,
     b_m: f32,
+    filter_pole: Option<f32>,
     delay: usize,
     human_bound: bool,
 ) -> PyResult<Option<TeleopCheck>> {
-    let d = designer(master, slave, delay, human_bound)?;
-    let found = py.detach(move || match k {
-        None => d.largest(|x| FourChannelGains::position_position(x as f32, b), 1e7),
-        Some(k) => d.largest(
-            |x| FourChannelGains::position_force(k, b, x as f32, b_m),
+    let wave = |b_nspm: f64| {
+        TeleopLaw::Wave(WaveGains {
+            b_nspm: b_nspm as f32,
+            filter_pole: filter_pole.unwrap_or(0.0),
+        })
+    };
+    let (law_at, most): (Box<dyn Fn(f64) -> TeleopLaw + Send>, f64) = match (b, k, filter_pole) {
+        (None, None, Some(_)) => (Box::new(wave), 1e5),
+        (Some(b), None, None) => (
+            Box::new(move |x| {
+                TeleopLaw::FourChannel(FourChannelGains::position_position(x as f32, b))
+            }),
+            1e7,
+        ),
+        (Some(b), Some(k), None) => (
+            Box::new(move |x| {
+                TeleopLaw::FourChannel(FourChannelGains::position_force(k, b, x as f32, b_m))
+            }),
             100.0,
         ),
-    });
+        _ => {
+            return Err(PyValueError::new_err(
+                "design_teleop: give b (position-position), b and k (force reflection), \
+                 or filter_pole alone (the wave channel's impedance)",
+            ))
+        }
+    };
+    let d = designer(master, slave, delay, human_bound)?;
+    let found = py.detach(move || d.largest_law(law_at, most));
     match found.map_err(|e| PyValueError::new_err(e.to_string()))? {
         Some((_, r)) => TeleopCheck::of(py, r).map(Some),
         None => Ok(None),

@@ -85,3 +85,15 @@ def test_a_filtered_wave_channel_is_proven_and_a_bare_one_breaks():
     assert twoport.verify_teleop(capstan, capstan, bare, delay=1).unstable
     with pytest.raises(ValueError, match="filter"):
         twoport.check_teleop(capstan, capstan, twoport.WaveLaw(b=0.5, filter_pole=1.5), delay=1)
+
+
+def test_design_finds_the_wave_channels_largest_proven_impedance():
+    capstan = str(ROOT / "models" / "capstan.toml")
+    best = twoport.design_teleop(capstan, capstan, filter_pole=0.9, delay=1)
+    assert best is not None and best.proven and best.gains is None, best
+    assert 1.0 < best.law.b < 3.0 and abs(best.law.filter_pole - 0.9) < 1e-6, best.law
+    past = twoport.WaveLaw(b=1.05 * best.law.b, filter_pole=0.9)
+    assert not twoport.check_teleop(capstan, capstan, past, delay=1).proven
+    assert twoport.design_teleop(capstan, capstan, filter_pole=0.0, delay=1) is None
+    with pytest.raises(ValueError, match="filter_pole alone"):
+        twoport.design_teleop(capstan, capstan, b=0.5, filter_pole=0.9, delay=1)
