@@ -7,8 +7,8 @@ use crate::{BoardPort, LinkError, LinkFaults, SerialBoard, Session};
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 use twoport_link::{
-    Axes, BoardMode, ConfigSource, Contact, Gains, GainsReply, Message, Spec, Status, Telemetry,
-    VeParam, VeSource,
+    Axes, BoardMode, ConfigSource, Contact, Gains, Message, Spec, Status, Telemetry, VeParam,
+    VeSource,
 };
 
 /// States kept for the application before the oldest are dropped (about
@@ -234,16 +234,7 @@ impl<P: BoardPort> HostBoard<P> {
             given: gains.len(),
             board: self.axes(),
         })?;
-        let r = self
-            .session
-            .call(&Message::SetGains(g), "SetGains", |m| match m {
-                Message::GainsReply(r) => Some(*r),
-                _ => None,
-            })?;
-        match r {
-            GainsReply::Accepted(g) => Ok(g),
-            GainsReply::Refused(why) => Err(LinkError::GainsRefused(why)),
-        }
+        self.session.set_gains(g)
     }
 
     /// Stream the state every `every_ticks` ticks (0: none).

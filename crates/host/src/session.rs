@@ -7,8 +7,9 @@ use std::sync::atomic::{AtomicU16, Ordering};
 use std::time::{Duration, Instant};
 use twoport_board::excalibur;
 use twoport_link::{
-    encode, Axes, BoardMode, ConfigSource, Contact, Decoder, LinkStats, Message, ModeRequest,
-    PilSensors, Role, Spec, Status, VeParam, VeSource, VeUpdate, MAX_FRAME, NO_SESSION,
+    encode, Axes, BoardMode, ConfigSource, Contact, Decoder, Gains, GainsReply, LinkStats, Message,
+    ModeRequest, PilSensors, Role, Spec, Status, VeParam, VeSource, VeUpdate, MAX_FRAME,
+    NO_SESSION,
 };
 
 /// How long the host waits for the board's answer to one frame.
@@ -200,6 +201,19 @@ impl<P: BoardPort> Session<P> {
             Message::Stream { every_ticks: e } if *e == every_ticks => Some(()),
             _ => None,
         })
+    }
+
+    /// New gains, one per axis: all in force from the next tick, or none,
+    /// with the first axis the board refused and why.
+    pub fn set_gains(&mut self, gains: Axes<Gains>) -> Result<Axes<Gains>, LinkError> {
+        let r = self.call(&Message::SetGains(gains), "SetGains", |m| match m {
+            Message::GainsReply(r) => Some(*r),
+            _ => None,
+        })?;
+        match r {
+            GainsReply::Accepted(g) => Ok(g),
+            GainsReply::Refused(why) => Err(LinkError::GainsRefused(why)),
+        }
     }
 
     /// Run the VE on the board or on the host (disarmed only), and wait

@@ -19,7 +19,7 @@ use crate::{Error, Simulation};
 use twoport_board::excalibur;
 use twoport_control::{Encoder, Position};
 use twoport_design::verify::TeleopLaw;
-use twoport_link::{Axes, Contact, Gains, GainsReply, Message, VeSource};
+use twoport_link::{Axes, Contact, Gains, VeSource};
 
 /// The gains each board runs: the law's spring (N/m) and damper (N s/m),
 /// the same on both sides (position-position), refused otherwise.
@@ -122,19 +122,9 @@ impl<P: BoardPort> Side<P> {
             k_npm: k,
             b_nspm: b,
         };
-        let reply = self.session.call(
-            &Message::SetGains(Axes::one(gains)),
-            "SetGains",
-            |m| match m {
-                Message::GainsReply(r) => Some(*r),
-                _ => None,
-            },
-        )?;
-        if let GainsReply::Refused(why) = reply {
-            return Err(pil_err!(
-                "the board refused law.gains ({k} N/m, {b} N s/m): {why:?}"
-            ));
-        }
+        self.session
+            .set_gains(Axes::one(gains))
+            .map_err(|e| pil_err!("law.gains ({k} N/m, {b} N s/m): {e}"))?;
         self.session.set_ve(VeSource::Host {
             ramp_ticks: 1,
             deadline_ticks,

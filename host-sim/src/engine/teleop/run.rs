@@ -192,10 +192,11 @@ pub struct Teleoperation {
     law: Law,
     tick: u64,
     failure: Option<String>,
-    /// The run's tracking error: its sum of squares (m²), the ticks, and
-    /// the last second's peak (m).
+    /// The run's tracking error: its sum of squares (m²), and its peak
+    /// (m) from `late_from`, the first tick of the run's last second.
     error_sq: f64,
     late_error_m: f64,
+    late_from: u64,
 }
 
 impl Teleoperation {
@@ -208,7 +209,9 @@ impl Teleoperation {
         };
         let (m, m_sense) = build("master", &scene.master)?;
         let (s, s_sense) = build("slave", &scene.slave)?;
+        let per_second = (1.0 / scene.period()).round() as u64;
         Ok(Teleoperation {
+            late_from: m.total_ticks().saturating_sub(per_second),
             law: Law::new(&scene)?,
             scene,
             sides: [m, s],
@@ -289,8 +292,7 @@ impl Teleoperation {
         self.tick += 1;
         let e = master_sample.handle_m[0] - slave_sample.handle_m[0];
         self.error_sq += e * e;
-        let per_second = (1.0 / self.scene.period()).round() as u64;
-        if self.tick + per_second > self.total_ticks() {
+        if self.tick > self.late_from {
             self.late_error_m = self.late_error_m.max(e.abs());
         }
         TeleopSample {
