@@ -241,8 +241,9 @@ fn trapezoidal_spring_ve_matches_its_z_form_and_is_lossless() {
     // (At Nyquist a lossless trapezoidal spring has impedance exactly 0:
     // the damped case below covers that bin.)
     for p in BINS.into_iter().filter(|p| 2 * *p != WINDOW) {
-        let mut ve =
-            TrapezoidalSpring::new(20_000.0, 0.0, Position::ZERO, T, Position::ZERO).unwrap();
+        let mut ve = TrapezoidalSpring::from(
+            Spring::new(20_000.0, 0.0, Position::ZERO, T, Position::ZERO).unwrap(),
+        );
         let got = ve_response(p, &mut ve, 0.0, 30.0);
         let want = ve_tf(&ve).eval(z_of(p));
         assert_close("spring b + (kT/2)(1 + z^-1)/(1 - z^-1)", p, got, want);
@@ -250,8 +251,9 @@ fn trapezoidal_spring_ve_matches_its_z_form_and_is_lossless() {
         assert!(want.re.abs() < 1e-9 * want.norm(), "{want}");
     }
     for p in BINS {
-        let mut ve =
-            TrapezoidalSpring::new(20_000.0, 50.0, Position::ZERO, T, Position::ZERO).unwrap();
+        let mut ve = TrapezoidalSpring::from(
+            Spring::new(20_000.0, 50.0, Position::ZERO, T, Position::ZERO).unwrap(),
+        );
         let got = ve_response(p, &mut ve, 0.0, 30.0);
         assert_close("with damping", p, got, ve_tf(&ve).eval(z_of(p)));
     }
@@ -297,7 +299,7 @@ fn fig7a_impedance_coupling_with_trapezoidal_spring() {
         let x0 = Position::ZERO;
         let mut est = FirstDifference::new(T, x0).unwrap();
         let mut c = ImpedanceCoupling::new(51_000.0, 90.0, T).unwrap();
-        let mut ve = TrapezoidalSpring::new(20_000.0, 50.0, x0, T, x0).unwrap();
+        let mut ve = TrapezoidalSpring::from(Spring::new(20_000.0, 50.0, x0, T, x0).unwrap());
         let got = measure(p, |u| {
             let x = pos(1e-4 * u);
             let v = est.step(x);

@@ -24,6 +24,13 @@ fn analysis(m: &DeviceModel, spec: GridSpec) -> Analysis {
     Analysis::new(&Plant::new(m, T).unwrap(), spec)
 }
 
+/// The stiffest coupling proven for `m` with damping `b_nspm` (N s/m)
+/// against every passive hand.
+fn stiffest(m: &DeviceModel, b_nspm: f64) -> f64 {
+    let a = analysis(m, GridSpec::DEFAULT);
+    max_stiffness(&a, &a.impedance_bound(None), b_nspm).unwrap()
+}
+
 fn excalibur() -> DeviceModel {
     DeviceModel::excalibur().unwrap()
 }
@@ -222,8 +229,7 @@ fn verify_breaks_the_rigid_counterexample_and_not_the_design() {
 #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
 fn verify_breaks_the_delayed_rigid_design_one_percent_past() {
     let m = rigid(1.0, 20.0, 1);
-    let a = analysis(&m, GridSpec::DEFAULT);
-    let k = max_stiffness(&a, &a.impedance_bound(None), 0.0).unwrap();
+    let k = stiffest(&m, 0.0);
     assert!((k - 10_000.0).abs() < 50.0, "{k}");
     let over = assert_tight(&m, imp(k, 0.0), imp(1.01 * k, 0.0), None);
     assert_constructed(&m, &over);
@@ -444,8 +450,7 @@ fn narrow_family() -> Vec<DeviceModel> {
 #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
 fn the_rigid_bound_at_b_10_is_conservative_and_by_how_much() {
     let m = rigid(1.0, 20.0, 0);
-    let a = analysis(&m, GridSpec::DEFAULT);
-    let k = max_stiffness(&a, &a.impedance_bound(None), 10.0).unwrap();
+    let k = stiffest(&m, 10.0);
     assert!((k - 20_000.0).abs() < 20.0, "{k}");
     let inside = verify(&m, T, &imp(29_000.0, 10.0), None).unwrap();
     assert!(

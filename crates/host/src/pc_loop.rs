@@ -357,8 +357,9 @@ const END_WAIT: Duration = Duration::from_secs(1);
 pub const STALL: Duration = Duration::from_millis(500);
 
 impl PcBoard {
-    /// Start `board` ticking every `period_s` (s) against `io`, in a
-    /// thread of its own ([`LoopThread`]).
+    /// Start `board` ticking every `period_s` (s) against `io`, its
+    /// ticks run by `ticker`: a thread of its own ([`LoopThread`]) or a
+    /// device library's scheduler.
     ///
     /// The force a tick computes reaches the device at the next tick's
     /// exchange, so the latency is a period and more: `board`'s regions
@@ -367,22 +368,6 @@ impl PcBoard {
     /// faults the board to zero force ("force late"), unless a passivity
     /// layer guards its port, as on every image for the PC's loop.
     pub fn start<Io, W, L, D, const N: usize, const R: usize>(
-        board: Board<W, R, N, L, D>,
-        io: Io,
-        period_s: f64,
-    ) -> Result<Self, LinkError>
-    where
-        Io: DeviceIo<N> + 'static,
-        W: World<f32, N> + Send + 'static,
-        L: PortLayer + Send + 'static,
-        D: Drive<N, World = W, Layer = L> + Send + 'static,
-    {
-        Self::start_on(board, io, period_s, LoopThread::default())
-    }
-
-    /// Start `board` ticking every `period_s` (s) against `io`, its ticks
-    /// run by `ticker`.
-    pub fn start_on<Io, W, L, D, const N: usize, const R: usize>(
         board: Board<W, R, N, L, D>,
         io: Io,
         period_s: f64,

@@ -4,7 +4,7 @@
 //! what the device object's tests drive.
 
 use crate::in_process::ByteQueues;
-use crate::{BoardPort, DeviceIo, LinkError, PcBoard};
+use crate::{BoardPort, DeviceIo, LinkError, LoopThread, PcBoard};
 use std::time::{Duration, Instant};
 use twoport_board::excalibur::{self, REGION_POINTS};
 use twoport_board::{Board, BoardSupport, IoScale, RawSensors, SimAxis, Simulated};
@@ -154,6 +154,7 @@ impl PcBoard {
             board,
             SimulatedDevice::excalibur(hand_n),
             f64::from(excalibur::PERIOD_S),
+            LoopThread::default(),
         )
     }
 }

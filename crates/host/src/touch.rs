@@ -200,6 +200,6 @@ impl PcBoard {
             image::board().map_err(|e| LinkError::Image(format!("the {NAME}'s image: {e:?}")))?;
         let board =
             crate::accept_unproven_gains(board, config.unproven_gains.as_deref(), &shown(config));
-        PcBoard::start_on(board, io, f64::from(PERIOD_S), scheduler)
+        PcBoard::start(board, io, f64::from(PERIOD_S), scheduler)
     }
 }

@@ -12,7 +12,8 @@ use twoport_board::excalibur::{self, pc};
 use twoport_board::RawSensors;
 use twoport_control::Faults;
 use twoport_host::{
-    BoardMode, DeviceIo, HostBoard, LinkError, PcBoard, Priority, SimulatedDevice, VeParam,
+    BoardMode, DeviceIo, HostBoard, LinkError, LoopThread, PcBoard, Priority, SimulatedDevice,
+    VeParam,
 };
 
 /// The wall the board's own VE is moved to (m): solid above.
@@ -22,7 +23,13 @@ const WALL_M: f64 = 0.005;
 /// latency of up to 5 ms.
 fn start(io: impl DeviceIo<1> + 'static) -> PcBoard {
     let board = pc::board().unwrap();
-    PcBoard::start(board, io, f64::from(excalibur::PERIOD_S)).unwrap()
+    PcBoard::start(
+        board,
+        io,
+        f64::from(excalibur::PERIOD_S),
+        LoopThread::default(),
+    )
+    .unwrap()
 }
 
 /// An application opens the loop as it opens a board, moves the image's
@@ -61,7 +68,13 @@ fn the_pc_loop_holds_the_images_wall_as_a_board_does() {
 #[test]
 fn a_boards_image_on_the_pc_loop_faults_its_late_force() {
     let board = excalibur::stiff_wall_board().unwrap();
-    let pc = PcBoard::start(board, SimulatedDevice::excalibur(2.0), 1e-3).unwrap();
+    let pc = PcBoard::start(
+        board,
+        SimulatedDevice::excalibur(2.0),
+        1e-3,
+        LoopThread::default(),
+    )
+    .unwrap();
     let mut b = HostBoard::open(pc, 1).unwrap();
     assert_eq!(b.spec().latency_budget_s, excalibur::region::LATENCY_S);
     b.calibrate(&[0.0]).unwrap();

@@ -107,7 +107,8 @@ impl core::error::Error for LinkageError {}
 /// let safety = [SafetyConfig::new(1e-3, 8.0, 3.0); 3];
 /// let motors = [MotorConfig::new(5.0, 1.0); 3];
 /// let limits = [[-1.6, 1.6], [-2.2, 2.1], [-0.5, 3.7]];
-/// let mut s = LinkageServo::new(arm, joints, limits, gains, safety, motors, world)?;
+/// // (The arm computes in f32 or f64: the servo says which.)
+/// let mut s = LinkageServo::<_, _, f32, 3>::new(arm, joints, limits, gains, safety, motors, world)?;
 /// s.enable().unwrap();
 /// // The base turns 100 counts, one a tick: the handle moves 7.9 mm along
 /// // +y, and the base's motor resists with `τ_1 = J^T f`, 800 N/m ·
@@ -134,21 +135,8 @@ pub struct LinkageServo<K, W, R = f32, const N: usize = 3, L = Direct> {
     gravity: Gravity,
 }
 
-impl<K: Kinematics<f32, N>, W: World<f32, N>, const N: usize> LinkageServo<K, W, f32, N> {
-    /// A disabled f32 servo: see [`LinkageServo::new_in`].
-    pub fn new(
-        kinematics: K,
-        joints: [JointEncoder; N],
-        limits: JointLimits<N>,
-        gains: [Gains; N],
-        safety: [SafetyConfig; N],
-        motors: [MotorConfig; N],
-        world: W,
-    ) -> Result<Self, LinkageError> {
-        Self::new_in(kinematics, joints, limits, gains, safety, motors, world)
-    }
-
-    /// A disabled f32 servo on `hardware`: its encoders on `bits`-wide
+impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<K, W, R, N> {
+    /// A disabled servo on `hardware`: its encoders on `bits`-wide
     /// counters that read the pose `zero_rad` (rad) where they count 0, its
     /// joint limits and its motors.
     pub fn on(
@@ -171,14 +159,12 @@ impl<K: Kinematics<f32, N>, W: World<f32, N>, const N: usize> LinkageServo<K, W,
             world,
         )
     }
-}
 
-impl<K: Kinematics<R, N>, W: World<R, N>, R: Real, const N: usize> LinkageServo<K, W, R, N> {
-    /// A disabled servo computing in `R`: the kinematics, each joint's encoder and the
-    /// limits the proof covered, each Cartesian axis's gains and limits,
+    /// A disabled servo computing in `R`, the kinematics' number type: the
+    /// kinematics, each joint's encoder and the limits the proof covered, each Cartesian axis's gains and limits,
     /// each motor's torque limits, and the world. A device powered on at a
     /// pose the kinematics cannot serve starts with the fault latched.
-    pub fn new_in(
+    pub fn new(
         kinematics: K,
         joints: [JointEncoder; N],
         limits: JointLimits<N>,

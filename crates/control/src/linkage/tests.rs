@@ -275,11 +275,13 @@ fn bad_limits_are_refused() {
     let ok = [MotorConfig::new(5.0, 2.0); 3];
     let mut limits = LIMITS;
     limits[2] = [1.0, 1.0];
-    let e = LinkageServo::new(arm(), joints, limits, gains, safety, ok, world).unwrap_err();
+    let e = LinkageServo::<_, _, f32, 3>::new(arm(), joints, limits, gains, safety, ok, world)
+        .unwrap_err();
     assert_eq!(e, LinkageError::JointLimit(2));
     let mut bad = ok;
     bad[1] = MotorConfig::new(1.0, 2.0);
-    let e = LinkageServo::new(arm(), joints, LIMITS, gains, safety, bad, world).unwrap_err();
+    let e = LinkageServo::<_, _, f32, 3>::new(arm(), joints, LIMITS, gains, safety, bad, world)
+        .unwrap_err();
     assert!(
         matches!(e, LinkageError::Motor(AxisError { axis: 1, .. })),
         "{e}"

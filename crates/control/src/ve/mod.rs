@@ -20,7 +20,10 @@ mod spring;
 mod tests;
 
 pub use constraint::BilateralConstraint;
-pub use cursor::{CursorMass, ExplicitCursor, LosslessCursor, PAPER_MIN_CURSOR_MASS_KG};
+pub use cursor::{
+    Cursor, CursorMass, Explicit, ExplicitCursor, Implicit, Lossless, LosslessCursor, Scheme,
+    PAPER_MIN_CURSOR_MASS_KG,
+};
 pub use host_body::HostBody;
 pub use spring::{Solid, Spring, TrapezoidalSpring, UnilateralWall};
 

@@ -179,37 +179,19 @@ pub struct TrapezoidalSpring<R = f32> {
     held: Integrator<R>,
 }
 
-impl TrapezoidalSpring {
-    /// A spring of `k_npm` (N/m) and damper `b_nspm` (N s/m) to `anchor`;
-    /// the probe starts at rest at `probe`.
-    pub fn new(
-        k_npm: f32,
-        b_nspm: f32,
-        anchor: Position,
-        period_s: f32,
-        probe: Position,
-    ) -> Result<Self, ParamError> {
-        Self::new_in(k_npm, b_nspm, anchor, period_s, probe)
+impl<R: Real> From<Spring<R>> for TrapezoidalSpring<R> {
+    /// `spring`'s gains, anchor and probe, discretised by the trapezoidal
+    /// rule.
+    fn from(spring: Spring<R>) -> Self {
+        TrapezoidalSpring {
+            held: spring.probe,
+            spring,
+            v_prev: R::ZERO,
+        }
     }
 }
 
 impl<R: Real> TrapezoidalSpring<R> {
-    /// [`TrapezoidalSpring::new`] computing in `R`.
-    pub fn new_in(
-        k_npm: f32,
-        b_nspm: f32,
-        anchor: Position,
-        period_s: f32,
-        probe: Position,
-    ) -> Result<Self, ParamError> {
-        let spring = Spring::new_in(k_npm, b_nspm, anchor, period_s, probe)?;
-        Ok(TrapezoidalSpring {
-            held: Integrator::new_in(period_s, probe),
-            spring,
-            v_prev: R::ZERO,
-        })
-    }
-
     /// Change stiffness (N/m) and damping (N s/m).
     pub fn set_spring(&mut self, k_npm: f32, b_nspm: f32) -> Result<(), ParamError> {
         self.spring.set_spring(k_npm, b_nspm)

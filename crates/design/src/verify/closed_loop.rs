@@ -36,10 +36,9 @@ impl Ve {
             Ve::TrapezoidalSpring {
                 stiffness_npm: k,
                 damping_nspm: b,
-            } => VirtualEnvironment::<f32>::tf(
-                &twoport_control::ve::TrapezoidalSpring::new(k as f32, b as f32, p, t32, p)
-                    .map_err(e)?,
-            ),
+            } => VirtualEnvironment::<f32>::tf(&twoport_control::ve::TrapezoidalSpring::from(
+                twoport_control::ve::Spring::new(k as f32, b as f32, p, t32, p).map_err(e)?,
+            )),
         };
         Ok(match tf {
             VeTransfer::Admittance(y) => from_tf(&y),

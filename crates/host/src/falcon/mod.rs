@@ -13,7 +13,7 @@
 pub mod protocol;
 
 use crate::device_port::{DevicePort, Grip};
-use crate::{DeviceIo, LinkError, PcBoard};
+use crate::{DeviceIo, LinkError, LoopThread, PcBoard};
 use protocol::{Command, Status, CHUNK, PACKET};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -286,6 +286,6 @@ impl PcBoard {
         let board = falcon_pc::board()
             .map_err(|e| LinkError::Image(format!("the Falcon's image: {e:?}")))?;
         let board = crate::accept_unproven_gains(board, config.unproven_gains.as_deref(), path);
-        PcBoard::start(board, io, f64::from(PERIOD_S))
+        PcBoard::start(board, io, f64::from(PERIOD_S), LoopThread::default())
     }
 }

@@ -9,7 +9,7 @@ pub use crate::device_port::Grip;
 pub use io::{sensors, torques_nm, HaplyIo};
 
 use crate::device_port::DevicePort;
-use crate::{DeviceIo, LinkError, PcBoard};
+use crate::{DeviceIo, LinkError, LoopThread, PcBoard};
 use protocol::{Direction, Joint, Setup};
 use twoport_board::linkage::haply::{self as image, HAPLY};
 use twoport_board::linkage::{io as io_scale, PERIOD_S};
@@ -111,6 +111,6 @@ impl PcBoard {
         let board =
             image::board().map_err(|e| LinkError::Image(format!("the 2DIY's image: {e:?}")))?;
         let board = crate::accept_unproven_gains(board, config.unproven_gains.as_deref(), path);
-        PcBoard::start(board, io, f64::from(PERIOD_S))
+        PcBoard::start(board, io, f64::from(PERIOD_S), LoopThread::default())
     }
 }

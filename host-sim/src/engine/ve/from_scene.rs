@@ -7,8 +7,7 @@ use crate::engine::scene::{Discretization, Integration, LayerPort, Scene, VeSpec
 use crate::Error;
 use twoport_control::passivity::{ParallelLimits, PassiveVe};
 use twoport_control::ve::{
-    BilateralConstraint, CursorMass, ExplicitCursor, LosslessCursor, Spring, TrapezoidalSpring,
-    UnilateralWall,
+    BilateralConstraint, CursorMass, ExplicitCursor, LosslessCursor, Spring, UnilateralWall,
 };
 use twoport_control::{Position, Real, SafetyConfig};
 
@@ -101,14 +100,10 @@ fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, Error> {
             discretization,
         } => {
             let (k, b, a) = (*stiffness_npm as f32, *damping_nspm as f32, pos(*anchor_m)?);
+            let spring = Spring::new_in(k, b, a, t32, Position::ZERO).map_err(|e| e.to_string())?;
             match discretization {
-                Discretization::BackwardEuler => SceneVe::Spring(
-                    Spring::new_in(k, b, a, t32, Position::ZERO).map_err(|e| e.to_string())?,
-                ),
-                Discretization::Trapezoidal => SceneVe::TrapezoidalSpring(
-                    TrapezoidalSpring::new_in(k, b, a, t32, Position::ZERO)
-                        .map_err(|e| e.to_string())?,
-                ),
+                Discretization::BackwardEuler => SceneVe::Spring(spring),
+                Discretization::Trapezoidal => SceneVe::TrapezoidalSpring(spring.into()),
             }
         }
         VeSpec::World { .. } => {
