@@ -231,6 +231,146 @@ impl Geometry {
     }
 }
 
+/// `name = v` is finite and positive.
+fn positive(name: &str, v: f64) -> Result<(), String> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(format!("{name} = {v}: must be finite and > 0"))
+    }
+}
+
+/// `name = v` is finite and not negative.
+fn at_least_zero(name: &str, v: f64) -> Result<(), String> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(format!("{name} = {v}: must be finite and >= 0"))
+    }
+}
+
+/// The list `name` has an entry for each of `n` joints.
+fn count(name: &str, len: usize, n: usize) -> Result<(), String> {
+    if len == n {
+        Ok(())
+    } else {
+        Err(format!(
+            "{name} has {len} entries: a {n}-joint linkage needs {n}"
+        ))
+    }
+}
+
+/// Whether `[lo, hi]` is a range: finite, low below high.
+fn range(name: &str, [lo, hi]: [f64; 2]) -> Result<(), String> {
+    if lo.is_finite() && hi.is_finite() && lo < hi {
+        Ok(())
+    } else {
+        Err(format!(
+            "{name} = [{lo}, {hi}]: must be finite, low below high"
+        ))
+    }
+}
+
+impl Motors {
+    /// The motors' fields, for `n` joints.
+    fn check(&self, n: usize) -> Result<(), String> {
+        let m = self;
+        positive("motors.torque_constant_nmpa", m.torque_constant_nmpa)?;
+        positive("motors.peak_torque_nm", m.peak_torque_nm)?;
+        positive("motors.continuous_torque_nm", m.continuous_torque_nm)?;
+        if m.continuous_torque_nm > m.peak_torque_nm {
+            return Err(format!(
+                "motors.continuous_torque_nm = {} exceeds motors.peak_torque_nm = {}",
+                m.continuous_torque_nm, m.peak_torque_nm
+            ));
+        }
+        if m.encoder_counts_per_rev == 0 {
+            return Err("motors.encoder_counts_per_rev = 0: must be at least 1".into());
+        }
+        at_least_zero("motors.rotor_inertia_kgm2", m.rotor_inertia_kgm2)?;
+        count("motors.ratios", m.ratios.len(), n)?;
+        for (i, r) in m.ratios.iter().enumerate() {
+            positive(&format!("motors.ratios[{i}]"), *r)?;
+        }
+        Ok(())
+    }
+}
+
+impl Joints {
+    /// The joints' losses and limits, for `n` joints.
+    fn check(&self, n: usize) -> Result<(), String> {
+        let j = self;
+        count("joints.damping_nmsprad", j.damping_nmsprad.len(), n)?;
+        count("joints.friction_nm", j.friction_nm.len(), n)?;
+        count("joints.limits_rad", j.limits_rad.len(), n)?;
+        for (i, d) in j.damping_nmsprad.iter().enumerate() {
+            at_least_zero(&format!("joints.damping_nmsprad[{i}]"), *d)?;
+        }
+        for (i, f) in j.friction_nm.iter().enumerate() {
+            at_least_zero(&format!("joints.friction_nm[{i}]"), *f)?;
+        }
+        for (i, lim) in j.limits_rad.iter().enumerate() {
+            range(&format!("joints.limits_rad[{i}]"), *lim)?;
+        }
+        for (r, lim) in j.relative.iter().enumerate() {
+            let [a, b] = lim.joints;
+            if a >= n || b >= n || a == b {
+                return Err(format!(
+                    "joints.relative[{r}].joints = [{a}, {b}]: two different joints below {n}"
+                ));
+            }
+            range(&format!("joints.relative[{r}].rad"), lim.rad)?;
+        }
+        Ok(())
+    }
+}
+
+impl Inertia {
+    /// The masses and inertias, for `geometry`'s `n` joints.
+    fn check(&self, geometry: &Geometry, n: usize) -> Result<(), String> {
+        match self {
+            Inertia::Lumped {
+                handle_mass_kg,
+                link_inertia_kgm2,
+            } => {
+                at_least_zero("inertia.handle_mass_kg", *handle_mass_kg)?;
+                count("inertia.link_inertia_kgm2", link_inertia_kgm2.len(), n)?;
+                for (i, x) in link_inertia_kgm2.iter().enumerate() {
+                    at_least_zero(&format!("inertia.link_inertia_kgm2[{i}]"), *x)?;
+                }
+            }
+            Inertia::SerialArmLinks {
+                l3_m,
+                l5_m,
+                l6_m,
+                masses_kg,
+                inertias_kgm2,
+                base_yy_kgm2,
+            } => {
+                if !matches!(geometry, Geometry::SerialArm { .. }) {
+                    return Err("inertia.kind = \"serial_arm_links\": only for geometry.kind = \"serial_arm\"".into());
+                }
+                at_least_zero("inertia.l3_m", *l3_m)?;
+                for (name, x) in [("inertia.l5_m", l5_m), ("inertia.l6_m", l6_m)] {
+                    if !x.is_finite() {
+                        return Err(format!("{name} = {x}: must be finite"));
+                    }
+                }
+                at_least_zero("inertia.base_yy_kgm2", *base_yy_kgm2)?;
+                for (i, m) in masses_kg.iter().enumerate() {
+                    at_least_zero(&format!("inertia.masses_kg[{i}]"), *m)?;
+                }
+                for (i, row) in inertias_kgm2.iter().enumerate() {
+                    for (k, x) in row.iter().enumerate() {
+                        at_least_zero(&format!("inertia.inertias_kgm2[{i}][{k}]"), *x)?;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
 impl LinkageFile {
     /// The delay from sampling to the torques at the file's period: whole
     /// ticks and a fraction of one.
@@ -294,20 +434,6 @@ impl LinkageFile {
     }
 
     fn check(&self) -> Result<(), String> {
-        let positive = |name: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(format!("{name} = {v}: must be finite and > 0"))
-            }
-        };
-        let at_least_zero = |name: &str, v: f64| {
-            if v.is_finite() && v >= 0.0 {
-                Ok(())
-            } else {
-                Err(format!("{name} = {v}: must be finite and >= 0"))
-            }
-        };
         positive("period_s", self.period_s)?;
         at_least_zero("latency_s", self.latency_s)?;
         if self.latency_s > crate::model::MAX_LATENCY_S {
@@ -318,105 +444,10 @@ impl LinkageFile {
             ));
         }
         self.geometry.check()?;
-        let m = &self.motors;
-        positive("motors.torque_constant_nmpa", m.torque_constant_nmpa)?;
-        positive("motors.peak_torque_nm", m.peak_torque_nm)?;
-        positive("motors.continuous_torque_nm", m.continuous_torque_nm)?;
-        if m.continuous_torque_nm > m.peak_torque_nm {
-            return Err(format!(
-                "motors.continuous_torque_nm = {} exceeds motors.peak_torque_nm = {}",
-                m.continuous_torque_nm, m.peak_torque_nm
-            ));
-        }
-        if m.encoder_counts_per_rev == 0 {
-            return Err("motors.encoder_counts_per_rev = 0: must be at least 1".into());
-        }
-        at_least_zero("motors.rotor_inertia_kgm2", m.rotor_inertia_kgm2)?;
         let n = self.geometry.joints();
-        let count = |name: &str, len: usize| {
-            if len == n {
-                Ok(())
-            } else {
-                Err(format!(
-                    "{name} has {len} entries: a {n}-joint linkage needs {n}"
-                ))
-            }
-        };
-        count("motors.ratios", m.ratios.len())?;
-        for (i, r) in m.ratios.iter().enumerate() {
-            positive(&format!("motors.ratios[{i}]"), *r)?;
-        }
-        let j = &self.joints;
-        count("joints.damping_nmsprad", j.damping_nmsprad.len())?;
-        count("joints.friction_nm", j.friction_nm.len())?;
-        count("joints.limits_rad", j.limits_rad.len())?;
-        for (i, d) in j.damping_nmsprad.iter().enumerate() {
-            at_least_zero(&format!("joints.damping_nmsprad[{i}]"), *d)?;
-        }
-        for (i, f) in j.friction_nm.iter().enumerate() {
-            at_least_zero(&format!("joints.friction_nm[{i}]"), *f)?;
-        }
-        for (i, [lo, hi]) in j.limits_rad.iter().enumerate() {
-            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-                return Err(format!(
-                    "joints.limits_rad[{i}] = [{lo}, {hi}]: must be finite, low below high"
-                ));
-            }
-        }
-        for (r, lim) in j.relative.iter().enumerate() {
-            let [a, b] = lim.joints;
-            if a >= n || b >= n || a == b {
-                return Err(format!(
-                    "joints.relative[{r}].joints = [{a}, {b}]: two different joints below {n}"
-                ));
-            }
-            let [lo, hi] = lim.rad;
-            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-                return Err(format!(
-                    "joints.relative[{r}].rad = [{lo}, {hi}]: must be finite, low below high"
-                ));
-            }
-        }
-        match &self.inertia {
-            Inertia::Lumped {
-                handle_mass_kg,
-                link_inertia_kgm2,
-            } => {
-                at_least_zero("inertia.handle_mass_kg", *handle_mass_kg)?;
-                count("inertia.link_inertia_kgm2", link_inertia_kgm2.len())?;
-                for (i, x) in link_inertia_kgm2.iter().enumerate() {
-                    at_least_zero(&format!("inertia.link_inertia_kgm2[{i}]"), *x)?;
-                }
-            }
-            Inertia::SerialArmLinks {
-                l3_m,
-                l5_m,
-                l6_m,
-                masses_kg,
-                inertias_kgm2,
-                base_yy_kgm2,
-            } => {
-                if !matches!(self.geometry, Geometry::SerialArm { .. }) {
-                    return Err("inertia.kind = \"serial_arm_links\": only for geometry.kind = \"serial_arm\"".into());
-                }
-                at_least_zero("inertia.l3_m", *l3_m)?;
-                for (name, x) in [("inertia.l5_m", l5_m), ("inertia.l6_m", l6_m)] {
-                    if !x.is_finite() {
-                        return Err(format!("{name} = {x}: must be finite"));
-                    }
-                }
-                at_least_zero("inertia.base_yy_kgm2", *base_yy_kgm2)?;
-                for (i, m) in masses_kg.iter().enumerate() {
-                    at_least_zero(&format!("inertia.masses_kg[{i}]"), *m)?;
-                }
-                for (i, row) in inertias_kgm2.iter().enumerate() {
-                    for (k, x) in row.iter().enumerate() {
-                        at_least_zero(&format!("inertia.inertias_kgm2[{i}][{k}]"), *x)?;
-                    }
-                }
-            }
-        }
-        Ok(())
+        self.motors.check(n)?;
+        self.joints.check(n)?;
+        self.inertia.check(&self.geometry, n)
     }
 }
 

@@ -90,7 +90,79 @@ pub fn dissipation(
     place: &str,
 ) -> Result<Dissipation, IdentifyError> {
     let n = axes.len();
-    if n == 0 {
+    let (period, harmonics, periods) = orbit(axes, skip, place)?;
+    let t = axes[0].period_s;
+    // A period's work, `Σ f_n (x_{n+1} - x_n)`, in its harmonics:
+    // `(2/N) Σ_h Re(X_h (z_h - 1) conj(F_h))`, `z_h = e^{j2πh/N}`, over the
+    // band the rates are taken in. Past it, the reading's quantisation
+    // and the hold's damping on it would add a power of their own
+    // (`b q²/12T²` for steps `q` that differ tick to tick), which the
+    // joints never took. The estimate is the mean spectra's; the periods'
+    // own give its spread.
+    let cycle = |h: usize| {
+        Complex64::from_polar(1.0, std::f64::consts::TAU * h as f64 / period as f64) - 1.0
+    };
+    let work = |x: &[Complex64], f: &[Complex64]| -> f64 {
+        x.iter()
+            .zip(f)
+            .zip(&harmonics)
+            .map(|((x, f), &h)| (x * cycle(h) * f.conj()).re)
+            .sum::<f64>()
+            * 2.0
+            / period as f64
+    };
+    let spectra = |s: &[f64]| spectra(s, period, &harmonics, skip, periods);
+    let mut per_period = vec![0.0; periods];
+    let mut mean = 0.0;
+    // Each axis's mean position spectrum, for the rates below.
+    let mut positions = Vec::with_capacity(n);
+    let mut centre = Vec::with_capacity(n);
+    for l in axes {
+        let (x, f) = (spectra(&l.position_m), spectra(&l.force_n));
+        for (w, (x, f)) in per_period.iter_mut().zip(x.iter().zip(&f)) {
+            *w += work(x, f);
+        }
+        let xm = mean_of(&x);
+        mean += work(&xm, &mean_of(&f));
+        positions.push(xm);
+        let used = &l.position_m[skip * period..(skip + periods) * period];
+        centre.push(used.iter().sum::<f64>() / used.len() as f64);
+    }
+    let avg = per_period.iter().sum::<f64>() / periods as f64;
+    let var = per_period.iter().map(|w| (w - avg).powi(2)).sum::<f64>() / (periods as f64 - 1.0);
+    let duration = period as f64 * t;
+    pose_at(jacobian_at, &centre, place)?;
+    let (rate_sq, rate_abs) = joint_rates(
+        &positions,
+        &centre,
+        jacobian_at,
+        &harmonics,
+        period,
+        duration,
+    )
+    .ok_or_else(|| {
+        bad(
+            place.into(),
+            "the handle's orbit leaves the linkage's reach, or passes a singular pose".into(),
+        )
+    })?;
+    Ok(Dissipation {
+        power_w: mean / duration,
+        power_sd_w: (var / periods as f64).sqrt() / duration,
+        rate_sq,
+        rate_abs,
+    })
+}
+
+/// Experiment `place`'s periodic excitation, checked alike on every axis:
+/// its period (ticks), the harmonics the losses are read in, and how
+/// many whole periods past the first `skip` every axis recorded.
+fn orbit(
+    axes: &[Log],
+    skip: usize,
+    place: &str,
+) -> Result<(usize, Vec<usize>, usize), IdentifyError> {
+    if axes.is_empty() {
         return Err(bad(place.into(), "no axis recorded".into()));
     }
     let e = axes[0].excitation.ok_or_else(|| {
@@ -135,80 +207,24 @@ pub fn dissipation(
     if periods < 2 {
         return Err(bad(place.into(), "fewer than two whole periods".into()));
     }
-    // A period's work, `Σ f_n (x_{n+1} - x_n)`, in its harmonics:
-    // `(2/N) Σ_h Re(X_h (z_h - 1) conj(F_h))`, `z_h = e^{j2πh/N}`, over the
-    // band the rates are taken in. Past it, the reading's quantisation
-    // and the hold's damping on it would add a power of their own
-    // (`b q²/12T²` for steps `q` that differ tick to tick), which the
-    // joints never took. The estimate is the mean spectra's; the periods'
-    // own give its spread.
-    let cycle = |h: usize| {
-        Complex64::from_polar(1.0, std::f64::consts::TAU * h as f64 / period as f64) - 1.0
-    };
-    let work = |x: &[Complex64], f: &[Complex64]| -> f64 {
-        x.iter()
-            .zip(f)
-            .zip(&harmonics)
-            .map(|((x, f), &h)| (x * cycle(h) * f.conj()).re)
-            .sum::<f64>()
-            * 2.0
-            / period as f64
-    };
-    let spectra = |s: &[f64]| spectra(s, period, &harmonics, skip, periods);
-    let mut per_period = vec![0.0; periods];
-    let mut mean = 0.0;
-    // Each axis's mean position spectrum, for the rates below.
-    let mut positions = Vec::with_capacity(n);
-    let mut centre = Vec::with_capacity(n);
-    for l in axes {
-        let (x, f) = (spectra(&l.position_m), spectra(&l.force_n));
-        for (w, (x, f)) in per_period.iter_mut().zip(x.iter().zip(&f)) {
-            *w += work(x, f);
-        }
-        let xm = mean_of(&x);
-        mean += work(&xm, &mean_of(&f));
-        positions.push(xm);
-        let used = &l.position_m[skip * period..(skip + periods) * period];
-        centre.push(used.iter().sum::<f64>() / used.len() as f64);
-    }
-    let avg = per_period.iter().sum::<f64>() / periods as f64;
-    let var = per_period.iter().map(|w| (w - avg).powi(2)).sum::<f64>() / (periods as f64 - 1.0);
-    let duration = period as f64 * t;
-    match jacobian_at(&centre) {
-        Some(j) if j.nrows() == n && j.ncols() == n => {}
-        Some(j) => {
-            return Err(bad(
-                place.into(),
-                format!("{n} axes recorded, but the pose has {} joints", j.ncols()),
-            ))
-        }
-        None => {
-            return Err(bad(
-                place.into(),
-                "no pose of the linkage puts the handle where the records centre".into(),
-            ))
-        }
-    }
-    let (rate_sq, rate_abs) = joint_rates(
-        &positions,
-        &centre,
-        jacobian_at,
-        &harmonics,
-        period,
-        duration,
-    )
-    .ok_or_else(|| {
-        bad(
+    Ok((period, harmonics, periods))
+}
+
+/// That the linkage has a pose, with as many joints as `centre` has
+/// axes, that puts the handle at `centre` (m).
+fn pose_at(jacobian_at: JacobianAt, centre: &[f64], place: &str) -> Result<(), IdentifyError> {
+    let n = centre.len();
+    match jacobian_at(centre) {
+        Some(j) if j.nrows() == n && j.ncols() == n => Ok(()),
+        Some(j) => Err(bad(
             place.into(),
-            "the handle's orbit leaves the linkage's reach, or passes a singular pose".into(),
-        )
-    })?;
-    Ok(Dissipation {
-        power_w: mean / duration,
-        power_sd_w: (var / periods as f64).sqrt() / duration,
-        rate_sq,
-        rate_abs,
-    })
+            format!("{n} axes recorded, but the pose has {} joints", j.ncols()),
+        )),
+        None => Err(bad(
+            place.into(),
+            "no pose of the linkage puts the handle where the records centre".into(),
+        )),
+    }
 }
 
 /// The joints' mean square and mean absolute rates (rad²/s², rad/s) over

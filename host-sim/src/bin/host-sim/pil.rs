@@ -146,7 +146,6 @@ fn sines(a: &PilArgs, device: host_sim::pil::linkage::Device) -> Result<(), Erro
 }
 
 pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
-    use host_sim::pil;
     if !a.sines.is_empty() {
         let device = a
             .linkage
@@ -171,10 +170,6 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
         (1e-3, twoport_board::excalibur::HEARTBEAT_TIMEOUT_TICKS)
     };
     let host_ve = host_ve(a, period)?;
-    let ticks = (a.seconds / period).round() as u64;
-    let faults = faults(a, period)?;
-    let port = a.port.as_deref().map(link::SerialBoard::open).transpose()?;
-    let start = std::time::Instant::now();
     // (The board's f32 period, to its rounding.)
     if (scene.period() - period).abs() > 1e-6 * period {
         return Err(err!(
@@ -183,97 +178,141 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
             1.0 / period
         ));
     }
+    let run = Compared {
+        a,
+        side: None,
+        ticks: (a.seconds / period).round() as u64,
+        faults: faults(a, period)?,
+        start: std::time::Instant::now(),
+        deadline,
+    };
+    let port = a.port.as_deref().map(link::SerialBoard::open).transpose()?;
     if a.fast || host_ve.is_some() {
+        return run.wall_image(scene, port, host_ve);
+    }
+    if let Some(device) = a.linkage {
+        return run.linkage(device, port);
+    }
+    if scene.axes == 3 {
+        return run.three_axes(scene, port);
+    }
+    run.one_axis(scene, port)
+}
+
+/// One run against a board, and the same run against the board's loop in
+/// this process: what every kind of run shares.
+pub(crate) struct Compared<'a> {
+    a: &'a PilArgs,
+    /// Which side of a teleoperator, if one.
+    side: Option<&'static str>,
+    ticks: u64,
+    faults: link::LinkFaults,
+    /// When the in-process run began.
+    start: std::time::Instant,
+    /// The board's heartbeat deadline (ticks).
+    deadline: u32,
+}
+
+impl Compared<'_> {
+    /// The one-axis wall images with `--fast` or a host VE.
+    fn wall_image(
+        &self,
+        scene: host_sim::Scene,
+        port: Option<link::SerialBoard>,
+        host_ve: Option<host_sim::pil::HostVe>,
+    ) -> Result<(), Error> {
+        use host_sim::pil::run_with;
+        let a = self.a;
         if a.passivity || a.linkage.is_some() || scene.axes != 1 {
             return Err(
                 "--fast and --host-ve-hz run the one-axis wall images (no --passivity, --linkage or three axes)".into(),
             );
         }
+        let (ticks, faults) = (self.ticks, self.faults);
         let reference = if a.fast {
-            pil::run_with::<_, 1>(
-                scene.clone(),
-                ticks,
-                link::LocalFast::excalibur_fast()?,
-                faults,
-                host_ve,
-            )?
+            let board = link::LocalFast::excalibur_fast()?;
+            run_with::<_, 1>(scene.clone(), ticks, board, faults, host_ve)?
         } else {
-            pil::run_with::<_, 1>(
-                scene.clone(),
-                ticks,
-                link::LocalBoard::excalibur()?,
-                faults,
-                host_ve,
-            )?
+            let board = link::LocalBoard::excalibur()?;
+            run_with::<_, 1>(scene.clone(), ticks, board, faults, host_ve)?
         };
-        let local_s = start.elapsed().as_secs_f64();
+        let local_s = self.start.elapsed().as_secs_f64();
         let run = port
-            .map(|p| pil::run_with::<_, 1>(scene, ticks, p, faults, host_ve))
+            .map(|p| run_with::<_, 1>(scene, ticks, p, faults, host_ve))
             .transpose()?;
-        return pil_report(
-            a, None, ticks, faults, reference, run, local_s, start, deadline,
-        );
+        self.report(reference, run, local_s)
     }
-    if let Some(device) = a.linkage {
+
+    /// `--linkage`: a linkage image pressing its floor.
+    fn linkage(
+        &self,
+        device: host_sim::pil::linkage::Device,
+        port: Option<link::SerialBoard>,
+    ) -> Result<(), Error> {
         use host_sim::pil::linkage;
-        if a.passivity {
+        if self.a.passivity {
             return Err("--passivity: the linkage images have no passivity build".into());
         }
+        let (ticks, faults) = (self.ticks, self.faults);
         let reference = linkage::run_local(device, ticks, faults, linkage::Plan::Press)?;
-        let local_s = start.elapsed().as_secs_f64();
+        let local_s = self.start.elapsed().as_secs_f64();
         let run = port
             .map(|p| linkage::run(device, ticks, p, faults))
             .transpose()?;
-        return pil_report(
-            a, None, ticks, faults, reference, run, local_s, start, deadline,
-        );
+        self.report(reference, run, local_s)
     }
-    if scene.axes == 3 {
-        if a.passivity {
+
+    /// The three-axis image.
+    fn three_axes(
+        &self,
+        scene: host_sim::Scene,
+        port: Option<link::SerialBoard>,
+    ) -> Result<(), Error> {
+        use host_sim::pil::run_axes;
+        if self.a.passivity {
             return Err("--passivity: the three-axis image has no passivity build".into());
         }
-        let reference = pil::run_axes::<_, 3>(
-            scene.clone(),
-            ticks,
-            link::LocalBoard::excalibur_xyz()?,
-            faults,
-        )?;
-        let local_s = start.elapsed().as_secs_f64();
+        let (ticks, faults) = (self.ticks, self.faults);
+        let board = link::LocalBoard::excalibur_xyz()?;
+        let reference = run_axes::<_, 3>(scene.clone(), ticks, board, faults)?;
+        let local_s = self.start.elapsed().as_secs_f64();
         let run = port
-            .map(|p| pil::run_axes::<_, 3>(scene, ticks, p, faults))
+            .map(|p| run_axes::<_, 3>(scene, ticks, p, faults))
             .transpose()?;
-        return pil_report(
-            a, None, ticks, faults, reference, run, local_s, start, deadline,
-        );
+        self.report(reference, run, local_s)
     }
-    let reference = if a.passivity {
-        pil::run(
-            scene.clone(),
-            ticks,
-            link::LocalBoard::excalibur_with_passivity()?,
-            faults,
-        )?
-    } else {
-        pil::run(scene.clone(), ticks, link::LocalBoard::excalibur()?, faults)?
-    };
-    let local_s = start.elapsed().as_secs_f64();
-    let load_cell = scene.effects.load_cell;
-    let run = port
-        .map(|p| pil::run(scene, ticks, p, faults))
-        .transpose()?;
-    if let Some(path) = &a.log {
-        let log = run
-            .as_ref()
-            .unwrap_or(&reference)
-            .experiment_log(load_cell)
-            .ok_or_else(|| {
-                err!("--log: the scene plays no experiment (add an [identify] section)")
-            })??;
-        std::fs::write(path, log.to_csv()).map_err(|e| err!("--log {}: {e}", path.display()))?;
+
+    /// The one-axis image, with or without its passivity layer, and the
+    /// experiment's log on request.
+    fn one_axis(
+        &self,
+        scene: host_sim::Scene,
+        port: Option<link::SerialBoard>,
+    ) -> Result<(), Error> {
+        use host_sim::pil::run;
+        let (a, ticks, faults) = (self.a, self.ticks, self.faults);
+        let reference = if a.passivity {
+            let board = link::LocalBoard::excalibur_with_passivity()?;
+            run(scene.clone(), ticks, board, faults)?
+        } else {
+            run(scene.clone(), ticks, link::LocalBoard::excalibur()?, faults)?
+        };
+        let local_s = self.start.elapsed().as_secs_f64();
+        let load_cell = scene.effects.load_cell;
+        let remote = port.map(|p| run(scene, ticks, p, faults)).transpose()?;
+        if let Some(path) = &a.log {
+            let log = remote
+                .as_ref()
+                .unwrap_or(&reference)
+                .experiment_log(load_cell)
+                .ok_or_else(|| {
+                    err!("--log: the scene plays no experiment (add an [identify] section)")
+                })??;
+            std::fs::write(path, log.to_csv())
+                .map_err(|e| err!("--log {}: {e}", path.display()))?;
+        }
+        self.report(reference, remote, local_s)
     }
-    pil_report(
-        a, None, ticks, faults, reference, run, local_s, start, deadline,
-    )
 }
 
 /// `--host-ve-hz` as the host's VE period in board ticks (`period` s),
@@ -314,75 +353,82 @@ fn faults(a: &PilArgs, period: f64) -> Result<link::LinkFaults, Error> {
 /// board's `run` over the serial port where there was one; the board's
 /// watchdog waits `deadline` ticks.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn pil_report<const N: usize>(
-    a: &PilArgs,
-    side: Option<&str>,
-    ticks: u64,
-    faults: host_sim::link::LinkFaults,
-    reference: host_sim::pil::Run<N>,
-    run: Option<host_sim::pil::Run<N>>,
-    local_s: f64,
-    start: std::time::Instant,
-    deadline: u32,
-) -> Result<(), Error> {
-    use host_sim::pil;
-    let board = match (run.is_some(), side) {
-        (true, None) => "serial".to_string(),
-        (false, None) => "in-process".to_string(),
-        (true, Some(s)) => format!("serial, {s}"),
-        (false, Some(s)) => format!("in-process, {s}"),
-    };
-    let (run, remote_s) = match run {
-        Some(r) => (r, start.elapsed().as_secs_f64() - local_s),
-        None => (reference.clone(), local_s),
-    };
-    let c = pil::compare(&run, &reference);
-    let frames_dropped = run.board_stats.rx.dropped() + run.host_dropped;
-    let loop_cycles = run.telemetry.last().map(|t| t.loop_cycles);
-    let axes = run.duties.first().map_or(1, |d| d.len());
-    let peak = run
-        .samples
-        .iter()
-        .flat_map(|s| s.actuator_n.iter().map(|f| f.abs()))
-        .fold(0.0, f64::max);
-    let v = json!({
-        "ticks": c.ticks,
-        "max_position_error_m": c.max_position_error_m,
-        "max_force_error_n": c.max_force_error_n,
-        "duty_mismatches": c.duty_mismatches,
-        "frames_dropped": frames_dropped,
-        "corrupted_sent": run.corrupted_sent,
-        "board_frames_received": run.board_stats.rx.frames,
-        "zero_force_after_link_loss_ticks": run.zero_after_loss_ticks,
-        "watchdog_deadline_ticks": deadline,
-        "ve_updates_sent": run.ve_updates_sent,
-        "ve_seq_held": run.telemetry.last().map(|t| t.ve_seq),
-        "telemetry_frames": run.telemetry.len(),
-        "axes": axes,
-        "peak_force_n": peak,
-        "last_loop_cycles": loop_cycles,
-        "last_stage_cycles": run.telemetry.last().map(|t| t.stage_cycles),
-        "worst_latency_cycles": run.telemetry.last().map(|t| t.worst_latency_cycles),
-        "start": run.start,
-        "config_booted": run.config.map(|c| format!("{:?}", c.0)),
-        "config_saved": run.config.map(|c| format!("{:?}", c.1)),
-        "armed_at_tick": run.armed_at_tick,
-        "homing_ticks": run.homing.map(|h| h.0),
-        "homing_error_m": run.homing.map(|h| h.1),
-        "board": board,
-        "side": side,
-        "wall_s": remote_s,
-    });
-    if a.json {
-        say!("{v}");
-    } else {
-        say!(
+impl Compared<'_> {
+    /// Compare `run` (the board's, if one ran) with `reference`, the
+    /// in-process run that took `local_s` (s); say how they compare, and
+    /// with `--check` fail where the board broke a promise.
+    fn report<const N: usize>(
+        &self,
+        reference: host_sim::pil::Run<N>,
+        run: Option<host_sim::pil::Run<N>>,
+        local_s: f64,
+    ) -> Result<(), Error> {
+        let Compared {
+            a,
+            side,
+            ticks,
+            faults,
+            start,
+            deadline,
+        } = *self;
+        use host_sim::pil;
+        let board = match (run.is_some(), side) {
+            (true, None) => "serial".to_string(),
+            (false, None) => "in-process".to_string(),
+            (true, Some(s)) => format!("serial, {s}"),
+            (false, Some(s)) => format!("in-process, {s}"),
+        };
+        let (run, remote_s) = match run {
+            Some(r) => (r, start.elapsed().as_secs_f64() - local_s),
+            None => (reference.clone(), local_s),
+        };
+        let c = pil::compare(&run, &reference);
+        let frames_dropped = run.board_stats.rx.dropped() + run.host_dropped;
+        let loop_cycles = run.telemetry.last().map(|t| t.loop_cycles);
+        let axes = run.duties.first().map_or(1, |d| d.len());
+        let peak = run
+            .samples
+            .iter()
+            .flat_map(|s| s.actuator_n.iter().map(|f| f.abs()))
+            .fold(0.0, f64::max);
+        let v = json!({
+            "ticks": c.ticks,
+            "max_position_error_m": c.max_position_error_m,
+            "max_force_error_n": c.max_force_error_n,
+            "duty_mismatches": c.duty_mismatches,
+            "frames_dropped": frames_dropped,
+            "corrupted_sent": run.corrupted_sent,
+            "board_frames_received": run.board_stats.rx.frames,
+            "zero_force_after_link_loss_ticks": run.zero_after_loss_ticks,
+            "watchdog_deadline_ticks": deadline,
+            "ve_updates_sent": run.ve_updates_sent,
+            "ve_seq_held": run.telemetry.last().map(|t| t.ve_seq),
+            "telemetry_frames": run.telemetry.len(),
+            "axes": axes,
+            "peak_force_n": peak,
+            "last_loop_cycles": loop_cycles,
+            "last_stage_cycles": run.telemetry.last().map(|t| t.stage_cycles),
+            "worst_latency_cycles": run.telemetry.last().map(|t| t.worst_latency_cycles),
+            "start": run.start,
+            "config_booted": run.config.map(|c| format!("{:?}", c.0)),
+            "config_saved": run.config.map(|c| format!("{:?}", c.1)),
+            "armed_at_tick": run.armed_at_tick,
+            "homing_ticks": run.homing.map(|h| h.0),
+            "homing_error_m": run.homing.map(|h| h.1),
+            "board": board,
+            "side": side,
+            "wall_s": remote_s,
+        });
+        if a.json {
+            say!("{v}");
+        } else {
+            say!(
             "PIL ({board}): {} ticks in {remote_s:.2} s; position error {:.3e} m, force error {:.3e} N, \
              {} duty mismatches; {} corrupted frames sent, {frames_dropped} dropped",
             c.ticks, c.max_position_error_m, c.max_force_error_n, c.duty_mismatches,
             run.corrupted_sent
         );
-        match run.homing {
+            match run.homing {
             Some((n, err)) => say!(
                 "  homed onto the hard stop in {n} ticks (calibration {:+.1} um off the plant), armed at tick {}",
                 err * 1e6,
@@ -390,25 +436,26 @@ pub(crate) fn pil_report<const N: usize>(
             ),
             None => say!("  calibrated at rest, armed at tick {}", run.armed_at_tick),
         }
-        if run.ve_updates_sent > 0 {
-            say!(
-                "  host VE: {} updates sent, the board's last telemetry holds update {}",
-                run.ve_updates_sent,
-                run.telemetry.last().map_or(0, |t| t.ve_seq)
-            );
+            if run.ve_updates_sent > 0 {
+                say!(
+                    "  host VE: {} updates sent, the board's last telemetry holds update {}",
+                    run.ve_updates_sent,
+                    run.telemetry.last().map_or(0, |t| t.ve_seq)
+                );
+            }
+            if let Some(z) = run.zero_after_loss_ticks {
+                say!("  link loss: zero force after {z} ticks (watchdog deadline {deadline})");
+            }
         }
-        if let Some(z) = run.zero_after_loss_ticks {
-            say!("  link loss: zero force after {z} ticks (watchdog deadline {deadline})");
+        if a.check {
+            let bad = pil::failures(&run, &c, ticks, faults, u64::from(deadline));
+            if !bad.is_empty() {
+                let on = side.map(|s| format!(" ({s})")).unwrap_or_default();
+                return Err(err!("PIL check failed{on}: {}", bad.join("; ")));
+            }
         }
+        Ok(())
     }
-    if a.check {
-        let bad = pil::failures(&run, &c, ticks, faults, u64::from(deadline));
-        if !bad.is_empty() {
-            let on = side.map(|s| format!(" ({s})")).unwrap_or_default();
-            return Err(err!("PIL check failed{on}: {}", bad.join("; ")));
-        }
-    }
-    Ok(())
 }
 
 /// `--teleop`: the scene's master and slave each on a board, the host
@@ -455,26 +502,15 @@ fn pair(a: &PilArgs) -> Result<(), Error> {
         }
         None => (None, None),
     };
-    pil_report(
+    let mut run = Compared {
         a,
-        Some("master"),
+        side: Some("master"),
         ticks,
         faults,
-        rm,
-        m,
-        local_s,
         start,
         deadline,
-    )?;
-    pil_report(
-        a,
-        Some("slave"),
-        ticks,
-        faults,
-        rs,
-        s,
-        local_s,
-        start,
-        deadline,
-    )
+    };
+    run.report(rm, m, local_s)?;
+    run.side = Some("slave");
+    run.report(rs, s, local_s)
 }
