@@ -5,6 +5,10 @@
 //! identify crate's unit tests and the CLI's, so that both simulate the
 //! one body.
 
+// (`crate::log` is the identify crate's module, or the CLI tests'
+// import of it.)
+use crate::log::{Excitation, Log};
+
 /// The period (s), ticks a period, and periods.
 pub const SINE: (f64, usize, usize) = (1e-3, 100, 24);
 
@@ -31,4 +35,21 @@ pub fn sine_body(mass: f64, b: f64, c: f64, quantum: f64, peak: f64) -> (Vec<f64
         }
     }
     (force, position)
+}
+
+/// [`sine_body`] as the record the board writes of it.
+pub fn sine_log(mass: f64, b: f64, c: f64, quantum: f64, peak: f64) -> Log {
+    let (force_n, position_m) = sine_body(mass, b, c, quantum, peak);
+    let (period_s, period_ticks, _) = SINE;
+    Log {
+        period_s,
+        force_n,
+        position_m,
+        load_cell_n: None,
+        excitation: Some(Excitation::Periodic {
+            period_ticks,
+            first: 1,
+            last: 1,
+        }),
+    }
 }

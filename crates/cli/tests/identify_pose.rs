@@ -10,7 +10,7 @@ mod support;
 use std::path::{Path, PathBuf};
 use support::scratch;
 use twoport_design::linkage::LinkageFile;
-use twoport_identify::log::{Excitation, Log};
+use twoport_identify::log;
 
 /// `twoport`, run from the repository root.
 const TWOPORT: support::Tool = support::Tool {
@@ -37,19 +37,7 @@ fn level(dir: &Path, peak: f64) -> PathBuf {
     let j = pose.jacobian[(0, 0)];
     let c = file.joints.friction_nm[0] / j;
     let quantum = j * std::f64::consts::TAU / f64::from(file.motors.encoder_counts_per_rev);
-    let (force, position) = body::sine_body(m, b, c, quantum, peak);
-    let (t, period, _) = body::SINE;
-    let log = Log {
-        period_s: t,
-        force_n: force,
-        position_m: position,
-        load_cell_n: None,
-        excitation: Some(Excitation::Periodic {
-            period_ticks: period,
-            first: 1,
-            last: 1,
-        }),
-    };
+    let log = body::sine_log(m, b, c, quantum, peak);
     let dir = dir.join(format!("{peak}N"));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("x-x.csv"), log.to_csv()).unwrap();

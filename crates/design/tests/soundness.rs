@@ -25,10 +25,13 @@ fn analysis(m: &DeviceModel, spec: GridSpec) -> Analysis {
 }
 
 /// The stiffest coupling proven for `m` with damping `b_nspm` (N s/m)
-/// against every passive hand.
-fn stiffest(m: &DeviceModel, b_nspm: f64) -> f64 {
+/// against every passive hand, checked to be `want_npm` within `tol_npm`
+/// (N/m).
+fn stiffest(m: &DeviceModel, b_nspm: f64, want_npm: f64, tol_npm: f64) -> f64 {
     let a = analysis(m, GridSpec::DEFAULT);
-    max_stiffness(&a, &a.impedance_bound(None), b_nspm).unwrap()
+    let k = max_stiffness(&a, &a.impedance_bound(None), b_nspm).unwrap();
+    assert!((k - want_npm).abs() < tol_npm, "{k} N/m, not {want_npm}");
+    k
 }
 
 fn excalibur() -> DeviceModel {
@@ -229,8 +232,7 @@ fn verify_breaks_the_rigid_counterexample_and_not_the_design() {
 #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
 fn verify_breaks_the_delayed_rigid_design_one_percent_past() {
     let m = rigid(1.0, 20.0, 1);
-    let k = stiffest(&m, 0.0);
-    assert!((k - 10_000.0).abs() < 50.0, "{k}");
+    let k = stiffest(&m, 0.0, 10_000.0, 50.0);
     let over = assert_tight(&m, imp(k, 0.0), imp(1.01 * k, 0.0), None);
     assert_constructed(&m, &over);
 }
@@ -450,8 +452,7 @@ fn narrow_family() -> Vec<DeviceModel> {
 #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
 fn the_rigid_bound_at_b_10_is_conservative_and_by_how_much() {
     let m = rigid(1.0, 20.0, 0);
-    let k = stiffest(&m, 10.0);
-    assert!((k - 20_000.0).abs() < 20.0, "{k}");
+    stiffest(&m, 10.0, 20_000.0, 20.0);
     let inside = verify(&m, T, &imp(29_000.0, 10.0), None).unwrap();
     assert!(
         !inside.unstable && inside.constructed.is_none(),

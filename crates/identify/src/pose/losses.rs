@@ -429,25 +429,12 @@ mod sine_body;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::log::Excitation;
 
     use super::sine_body as support;
 
-    /// [`support::sine_body`] of 0.1 kg read in 1 µm steps, as a record.
+    /// [`support::sine_log`] read in 1 µm steps.
     fn sine(mass: f64, b: f64, c: f64, peak: f64) -> Log {
-        let (force, position) = support::sine_body(mass, b, c, 1e-6, peak);
-        let (t, period, _) = support::SINE;
-        Log {
-            period_s: t,
-            force_n: force,
-            position_m: position,
-            load_cell_n: None,
-            excitation: Some(Excitation::Periodic {
-                period_ticks: period,
-                first: 1,
-                last: 1,
-            }),
-        }
+        support::sine_log(mass, b, c, 1e-6, peak)
     }
 
     /// One pose's Jacobian, wherever the handle is.
