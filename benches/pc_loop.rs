@@ -1,26 +1,28 @@
 //! The PC loop's own work in a tick, for a 3-DOF linkage (goal: at most
-//! 3 µs): the device's answer turned into the board's sensors, the
-//! image's whole control tick armed (the linkage servo: kinematics,
-//! Jacobian, the three-axis coupling and VE, safety, the latency gate), a
-//! host heartbeat read, and the command made. For the Falcon that is its
-//! status packet decoded and its command packet encoded; for the 2DIY (two
-//! joints), its reply decoded and its torques packet encoded; for the Touch,
-//! OpenHaptics' joint angles read and its joint torques written. The
-//! device's own exchange (USB, the HD library's frame) is not the PC's
-//! work.
+//! 3 µs), on the loop the drivers run ([`SteppedPc`], stepped): the
+//! device's answer turned into the board's sensors, the image's whole
+//! control tick armed (the linkage servo: kinematics, Jacobian, the
+//! three-axis coupling and VE, safety), a host heartbeat read, the
+//! command made, and the loop's bookkeeping (the link's lock, the tick's
+//! timing). For the Falcon that is its status packet decoded and its
+//! command packet encoded; for the 2DIY (two joints), its reply decoded
+//! and its torques packet encoded; for the Touch, OpenHaptics' joint
+//! angles read and its joint torques written. The device's own exchange
+//! (USB, the HD library's frame) is not the PC's work.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::cell::RefCell;
-use std::collections::VecDeque;
 use std::hint::black_box;
 use std::rc::Rc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 use twoport_board::linkage::haply::{self as haply_image, HAPLY};
 use twoport_board::linkage::pc::PcLinkageBoard;
 use twoport_board::linkage::touch::{self, TOUCH};
 use twoport_board::linkage::LinkageWorld;
 use twoport_board::linkage::{falcon_pc, ImageSpec, FALCON};
-use twoport_board::{BoardSupport, RawSensors};
+use twoport_board::RawSensors;
 use twoport_control::kinematics::Kinematics;
 use twoport_control::world::World;
 use twoport_hd::Frame;
@@ -28,7 +30,7 @@ use twoport_host::device_port::Grip;
 use twoport_host::falcon::protocol::{Status, PACKET};
 use twoport_host::falcon::{command, sensors};
 use twoport_host::haply::{self, protocol::Setup, HaplyConfig};
-use twoport_host::{BoardMode, BoardPort, HostBoard, LinkError};
+use twoport_host::{BoardMode, BoardPort, DeviceIo, HostBoard, LinkError, SteppedPc};
 use twoport_link::{encode, Message, MAX_FRAME};
 
 /// A device's side of the exchange, in memory: the command out, the
@@ -117,82 +119,49 @@ impl HaplyPackets {
     }
 }
 
-/// The board's peripherals in memory: the device's exchange, the link's
-/// bytes both ways.
-struct Memory<E, const N: usize> {
+/// A device in memory as the PC's loop drives it: once `sweeping`, its
+/// encoders sweep 0 to 40 counts and back, a count an exchange; `on` is
+/// the amplifiers' last state.
+struct Swept<E> {
     device: E,
-    rx: VecDeque<u8>,
-    tx: Vec<u8>,
-    duty: [i16; N],
-    on: bool,
-    cycles: u32,
+    k: i16,
+    flags: Arc<Flags>,
 }
 
-impl<E: Exchange<N>, const N: usize> BoardSupport<N> for Memory<E, N> {
-    /// The exchange, as the driver's: last tick's command out, the
-    /// sensors in.
-    fn sample(&mut self) -> RawSensors<N> {
-        self.device.exchange(self.duty, self.on)
-    }
-    fn set_duty(&mut self, duty: [i16; N]) {
-        self.duty = duty;
-    }
-    fn set_outputs(&mut self, on: bool) {
-        self.on = on;
-    }
-    fn feed_watchdog(&mut self) {}
-    fn read_byte(&mut self) -> Option<u8> {
-        self.rx.pop_front()
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        self.tx.extend_from_slice(bytes);
-    }
-    fn cycles(&mut self) -> u32 {
-        self.cycles = self.cycles.wrapping_add(1);
-        self.cycles
-    }
-    fn cycles_per_tick(&self) -> u32 {
-        1_000_000
-    }
+#[derive(Default)]
+struct Flags {
+    sweeping: AtomicBool,
+    on: AtomicBool,
 }
 
-/// The board and its memory, ticked as the host's calls arrive.
-struct Lockstep<K: Kinematics<f32, N>, E, const N: usize> {
-    board: PcLinkageBoard<K, N>,
-    io: Memory<E, N>,
-}
-
-struct Port<K: Kinematics<f32, N>, E, const N: usize>(Rc<RefCell<Lockstep<K, E, N>>>);
-
-impl<K: Kinematics<f32, N>, E: Exchange<N>, const N: usize> BoardPort for Port<K, E, N>
-where
-    LinkageWorld<N>: World<f32, N>,
-{
-    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
-        let mut l = self.0.borrow_mut();
-        let Lockstep { board, io } = &mut *l;
-        io.rx.extend(bytes);
-        while !io.rx.is_empty() {
-            board.poll_link(io);
-            board.control_tick(io);
-            board.flush(io);
+impl<E: Exchange<N> + Send, const N: usize> DeviceIo<N> for Swept<E> {
+    fn exchange(&mut self, duty: [i16; N], on: bool) -> Result<RawSensors<N>, String> {
+        if self.flags.sweeping.load(Ordering::Relaxed) {
+            self.k = self.k.wrapping_add(1);
+            self.device.sweep(40 - (self.k % 80 - 40).abs());
         }
-        board.control_tick(io);
-        board.flush(io);
-        Ok(())
-    }
-    fn recv(&mut self, buf: &mut [u8], _: Duration) -> Result<usize, LinkError> {
-        let mut l = self.0.borrow_mut();
-        let n = buf.len().min(l.io.tx.len());
-        buf[..n].copy_from_slice(&l.io.tx[..n]);
-        l.io.tx.drain(..n);
-        Ok(n)
+        self.flags.on.store(on, Ordering::Relaxed);
+        Ok(self.device.exchange(duty, on))
     }
 }
 
-/// Arm `board` (the device at rest, its grip held) and time its ticks
-/// with the encoders sweeping 0 to 40 counts and back, a count a tick.
-fn bench_device<K: Kinematics<f32, N>, E: Exchange<N>, const N: usize>(
+/// The stepped loop, shared between the application's board and the
+/// bench's ticks.
+struct Port<P>(Rc<RefCell<P>>);
+
+impl<P: BoardPort> BoardPort for Port<P> {
+    fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        self.0.borrow_mut().send(bytes)
+    }
+    fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> Result<usize, LinkError> {
+        self.0.borrow_mut().recv(buf, timeout)
+    }
+}
+
+/// Arm `board` (the device at rest, its grip held) on the PC's loop,
+/// stepped, and time its ticks with the encoders sweeping: each tick, a
+/// host heartbeat sent and the board's bytes read back.
+fn bench_device<K: Kinematics<f32, N> + Send, E: Exchange<N> + Send, const N: usize>(
     c: &mut Criterion,
     name: &str,
     board: PcLinkageBoard<K, N>,
@@ -202,44 +171,35 @@ fn bench_device<K: Kinematics<f32, N>, E: Exchange<N>, const N: usize>(
     LinkageWorld<N>: World<f32, N>,
 {
     device.sweep(0);
-    let lock = Rc::new(RefCell::new(Lockstep {
-        board,
-        io: Memory {
-            device,
-            rx: VecDeque::new(),
-            tx: Vec::new(),
-            duty: [0; N],
-            on: false,
-            cycles: 0,
-        },
-    }));
-    let mut b = HostBoard::open(Port(Rc::clone(&lock)), N as u8).unwrap();
+    let flags = Arc::new(Flags::default());
+    let io = Swept {
+        device,
+        k: 0,
+        flags: Arc::clone(&flags),
+    };
+    let pc = Rc::new(RefCell::new(SteppedPc::new(board, io)));
+    let mut b = HostBoard::open(Port(Rc::clone(&pc)), N as u8).unwrap();
     b.calibrate(&spec.rest_rad.map(f64::from)).unwrap();
     assert_eq!(b.arm().unwrap().mode, BoardMode::Armed);
+    flags.sweeping.store(true, Ordering::Relaxed);
     let mut heartbeat = [0u8; MAX_FRAME];
     let n = encode(0, &Message::Heartbeat, &mut heartbeat).unwrap();
     let heartbeat = heartbeat[..n].to_vec();
-    let mut l = lock.borrow_mut();
-    let mut k = 0i16;
-    let mut tick = |l: &mut Lockstep<K, E, N>| {
-        k = k.wrapping_add(1);
-        l.io.device.sweep(40 - (k % 80 - 40).abs());
-        l.io.rx.extend(&heartbeat);
-        let Lockstep { board, io } = l;
-        board.poll_link(io);
-        black_box(board.control_tick(io));
-        board.flush(io);
-        io.tx.clear();
+    let mut buf = vec![0u8; 1 << 16];
+    let mut tick = || {
+        let mut pc = pc.borrow_mut();
+        pc.send(&heartbeat).unwrap();
+        black_box(pc.recv(&mut buf, Duration::ZERO).unwrap());
     };
     for _ in 0..1000 {
-        tick(&mut l);
+        tick();
     }
-    let out = *l.board.last_output();
     assert!(
-        l.io.on,
-        "{name}: the board is still armed, its outputs on: {out:?}"
+        flags.on.load(Ordering::Relaxed),
+        "{name}: the board is still armed, its outputs on"
     );
-    c.bench_function(name, |bench| bench.iter(|| tick(&mut l)));
+    c.bench_function(name, |bench| bench.iter(&mut tick));
+    drop(b);
 }
 
 fn pc_tick(c: &mut Criterion) {
