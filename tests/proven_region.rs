@@ -42,10 +42,7 @@ fn the_board_accepts_only_what_the_designer_proves() {
             let Some(limit) = region.limit_at(damping) else {
                 continue;
             };
-            let g = Gains::Impedance {
-                k_npm: limit * factor,
-                b_nspm: damping,
-            };
+            let g = Gains::impedance(limit * factor, damping);
             let mut buf = [0u8; MAX_FRAME];
             let n = encode(0, &Message::SetGains(Axes::one(g)), &mut buf).unwrap();
             board.on_bytes(&buf[..n]);

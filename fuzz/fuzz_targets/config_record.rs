@@ -42,10 +42,7 @@ fuzz_target!(|data: &[u8]| {
         flash.bytes_mut()[256..256 + k].copy_from_slice(&fixed[..k]);
         let mut store = Store::new(flash, 0, 256);
         let defaults = twoport_config::Config {
-            gains: twoport_link::Gains::Impedance {
-                k_npm: 1.0,
-                b_nspm: 1.0,
-            },
+            gains: twoport_link::Gains::impedance(1.0, 1.0),
             load_cell: twoport_config::LoadCell {
                 offset_counts: 0,
                 n_per_count: 1.0,

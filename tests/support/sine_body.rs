@@ -9,15 +9,19 @@
 // import of it.)
 use crate::log::{Excitation, Log};
 
-/// The period (s), ticks a period, and periods.
-pub const SINE: (f64, usize, usize) = (1e-3, 100, 24);
+/// The tick (s).
+pub const SINE_TICK_S: f64 = 1e-3;
+/// Ticks a period of the sine.
+pub const SINE_PERIOD_TICKS: usize = 100;
+/// Periods played.
+pub const SINE_PERIODS: usize = 24;
 
 /// The force the board commanded (N) and the reading (m) each tick, for
 /// a body of `mass` (kg) with damping `b` (N s/m) and friction `c` (N,
 /// rising over 1 mm/s) read in steps of `quantum` (m), under a sine of
 /// `peak` (N).
 pub fn sine_body(mass: f64, b: f64, c: f64, quantum: f64, peak: f64) -> (Vec<f64>, Vec<f64>) {
-    let (t, period, periods) = SINE;
+    let (t, period, periods) = (SINE_TICK_S, SINE_PERIOD_TICKS, SINE_PERIODS);
     let sub = 200;
     let (mut x, mut v, mut prev) = (0.0f64, 0.0f64, 0.0f64);
     let (mut force, mut position) = (Vec::new(), Vec::new());
@@ -40,14 +44,13 @@ pub fn sine_body(mass: f64, b: f64, c: f64, quantum: f64, peak: f64) -> (Vec<f64
 /// [`sine_body`] as the record the board writes of it.
 pub fn sine_log(mass: f64, b: f64, c: f64, quantum: f64, peak: f64) -> Log {
     let (force_n, position_m) = sine_body(mass, b, c, quantum, peak);
-    let (period_s, period_ticks, _) = SINE;
     Log {
-        period_s,
+        period_s: SINE_TICK_S,
         force_n,
         position_m,
         load_cell_n: None,
         excitation: Some(Excitation::Periodic {
-            period_ticks,
+            period_ticks: SINE_PERIOD_TICKS,
             first: 1,
             last: 1,
         }),

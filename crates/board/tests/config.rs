@@ -60,10 +60,7 @@ fn saved_gains_come_back_at_the_next_boot() {
     let mut b = board();
     let mut st = store(Flash::new());
     b.boot_config(&mut st);
-    let tuned = Gains::Impedance {
-        k_npm: 45_000.0,
-        b_nspm: 60.0,
-    };
+    let tuned = Gains::impedance(45_000.0, 60.0);
     say(&mut b, Message::SetGains(Axes::one(tuned)));
     say(&mut b, Message::SaveConfig);
     b.service_config(&mut st);
@@ -104,10 +101,7 @@ fn saved_gains_come_back_at_the_next_boot() {
     say(&mut again, Message::Disarm);
     say(
         &mut again,
-        Message::SetGains(Axes::one(Gains::Impedance {
-            k_npm: 40_000.0,
-            b_nspm: 60.0,
-        })),
+        Message::SetGains(Axes::one(Gains::impedance(40_000.0, 60.0))),
     );
     say(&mut again, Message::SaveConfig);
     heard(&mut again);
@@ -133,10 +127,7 @@ fn a_stored_record_with_unproven_gains_is_not_run() {
     let mut b = board();
     let defaults = b.config();
     let [mut cfg] = defaults;
-    cfg.gains = Gains::Impedance {
-        k_npm: 60_000.0,
-        b_nspm: 90.0,
-    };
+    cfg.gains = Gains::impedance(60_000.0, 90.0);
     cfg.load_cell.offset_counts = 2048;
     let mut flash = Flash::new();
     let mut buf = [0u8; MAX_RECORD + 4];

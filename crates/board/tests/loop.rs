@@ -65,18 +65,12 @@ fn handshake_and_gain_queries() {
         replies(&mut b),
         vec![
             ack(true),
-            Message::Gains(Axes::one(Gains::Impedance {
-                k_npm: 51_000.0,
-                b_nspm: 90.0
-            })),
+            Message::Gains(Axes::one(Gains::impedance(51_000.0, 90.0))),
             ack(false),
         ]
     );
     // Gains for three axes are refused whole, by count.
-    let g = Gains::Impedance {
-        k_npm: 1e4,
-        b_nspm: 10.0,
-    };
+    let g = Gains::impedance(1e4, 10.0);
     send(&mut b, 3, Message::SetGains(Axes::new([g; 3]).unwrap()));
     assert_eq!(
         replies(&mut b),
@@ -93,57 +87,25 @@ fn handshake_and_gain_queries() {
 fn gains_outside_the_proven_region_are_refused() {
     let mut b = board();
     let cases = [
+        (Gains::impedance(50_000.0, 90.0), None),
         (
-            Gains::Impedance {
-                k_npm: 50_000.0,
-                b_nspm: 90.0,
-            },
-            None,
-        ),
-        (
-            Gains::Impedance {
-                k_npm: 51_001.0,
-                b_nspm: 90.0,
-            },
+            Gains::impedance(51_001.0, 90.0),
             Some(Refusal::NotProvenStable { limit: 51_000.0 }),
         ),
         (
-            Gains::Impedance {
-                k_npm: 50_600.0,
-                b_nspm: 75.0,
-            },
+            Gains::impedance(50_600.0, 75.0),
             Some(Refusal::NotProvenStable {
                 limit: 51_000.0 * 0.99,
             }),
         ),
         (
-            Gains::Impedance {
-                k_npm: 1_000.0,
-                b_nspm: 10.0,
-            },
+            Gains::impedance(1_000.0, 10.0),
             Some(Refusal::NotProvenStable { limit: 0.0 }),
         ),
+        (Gains::impedance(f32::NAN, 90.0), Some(Refusal::NotFinite)),
+        (Gains::impedance(-1.0, 90.0), Some(Refusal::OutOfRange)),
         (
-            Gains::Impedance {
-                k_npm: f32::NAN,
-                b_nspm: 90.0,
-            },
-            Some(Refusal::NotFinite),
-        ),
-        (
-            Gains::Impedance {
-                k_npm: -1.0,
-                b_nspm: 90.0,
-            },
-            Some(Refusal::OutOfRange),
-        ),
-        (
-            Gains::Admittance {
-                kp_npm: 1.0,
-                bp_nspm: 1.0,
-                m_kg: 5.0,
-                b_nspm: 500.0,
-            },
+            Gains::admittance(1.0, 1.0, 5.0, 500.0),
             Some(Refusal::WrongDisplay),
         ),
     ];
@@ -159,10 +121,7 @@ fn gains_outside_the_proven_region_are_refused() {
     send(&mut b, 99, Message::GetGains);
     assert_eq!(
         replies(&mut b),
-        vec![Message::Gains(Axes::one(Gains::Impedance {
-            k_npm: 50_000.0,
-            b_nspm: 90.0
-        }))]
+        vec![Message::Gains(Axes::one(Gains::impedance(50_000.0, 90.0)))]
     );
 }
 
@@ -213,10 +172,7 @@ fn corrupted_frames_do_not_stop_the_loop() {
     let mut good = [0u8; MAX_FRAME];
     let n = encode(
         7,
-        &Message::SetGains(Axes::one(Gains::Impedance {
-            k_npm: 40_000.0,
-            b_nspm: 60.0,
-        })),
+        &Message::SetGains(Axes::one(Gains::impedance(40_000.0, 60.0))),
         &mut good,
     )
     .unwrap();
@@ -237,10 +193,7 @@ fn corrupted_frames_do_not_stop_the_loop() {
     assert!(s.dropped() >= 20, "{s:?}");
     assert_eq!(s.frames, 1);
     let msgs = replies(&mut b);
-    assert!(msgs.contains(&accepted(Gains::Impedance {
-        k_npm: 40_000.0,
-        b_nspm: 60.0
-    })));
+    assert!(msgs.contains(&accepted(Gains::impedance(40_000.0, 60.0))));
 }
 
 /// A host that never reads cannot grow the board's memory: telemetry keeps
@@ -284,24 +237,9 @@ fn admittance_gains_need_the_proven_regulator() {
     )
     .unwrap();
     let mut b = Board::new(s, [region], 0);
-    let ok = Gains::Admittance {
-        kp_npm: 51_000.0,
-        bp_nspm: 90.0,
-        m_kg: 5.2,
-        b_nspm: 500.0,
-    };
-    let stiffer = Gains::Admittance {
-        kp_npm: 60_000.0,
-        bp_nspm: 90.0,
-        m_kg: 5.2,
-        b_nspm: 500.0,
-    };
-    let lighter = Gains::Admittance {
-        kp_npm: 51_000.0,
-        bp_nspm: 90.0,
-        m_kg: 4.9,
-        b_nspm: 500.0,
-    };
+    let ok = Gains::admittance(51_000.0, 90.0, 5.2, 500.0);
+    let stiffer = Gains::admittance(60_000.0, 90.0, 5.2, 500.0);
+    let lighter = Gains::admittance(51_000.0, 90.0, 4.9, 500.0);
     for (g, want) in [
         (ok, accepted(ok)),
         (

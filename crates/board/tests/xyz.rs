@@ -225,10 +225,7 @@ fn calibration_and_gains_are_refused_per_axis_by_name() {
         )]
     );
     assert!(!b.calibrated());
-    let g = |k_npm| Gains::Impedance {
-        k_npm,
-        b_nspm: 90.0,
-    };
+    let g = |k_npm| Gains::impedance(k_npm, 90.0);
     let before = b.config();
     io.say(Message::SetGains(
         Axes::new([g(25_000.0), g(90_000.0), g(25_000.0)]).unwrap(),
@@ -300,10 +297,7 @@ fn every_axis_is_stored_in_one_record() {
         }
     );
     let mut io = Bench::new([-1.0; 3]);
-    let z = Gains::Impedance {
-        k_npm: 30_000.0,
-        b_nspm: 60.0,
-    };
+    let z = Gains::impedance(30_000.0, 60.0);
     let mut g = b.config().map(|c| c.gains);
     g[2] = z;
     io.say(Message::SetGains(Axes::new(g).unwrap()));

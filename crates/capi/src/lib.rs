@@ -427,10 +427,7 @@ pub unsafe extern "C" fn tp_board_set_impedance(
         let g: Vec<Gains> = k
             .iter()
             .zip(d)
-            .map(|(k, d)| Gains::Impedance {
-                k_npm: *k as f32,
-                b_nspm: *d as f32,
-            })
+            .map(|(k, d)| Gains::impedance(*k as f32, *d as f32))
             .collect();
         b.0.set_gains(&g)
             .map_or_else(|e| fail(&e), |_| TpResult::Ok)

@@ -215,13 +215,8 @@ impl Config {
     /// region belongs to its image.)
     pub fn validate(&self) -> Result<(), &'static str> {
         let gains_finite = match self.gains {
-            Gains::Impedance { k_npm, b_nspm } => [k_npm, b_nspm, 0.0, 0.0],
-            Gains::Admittance {
-                kp_npm,
-                bp_nspm,
-                m_kg,
-                b_nspm,
-            } => [kp_npm, bp_nspm, m_kg, b_nspm],
+            Gains::Impedance(g) => [g.k_npm, g.b_nspm, 0.0, 0.0],
+            Gains::Admittance(g) => [g.kp_npm, g.bp_nspm, g.m_kg, g.b_nspm],
         };
         if gains_finite.iter().any(|g| !(g.is_finite() && *g >= 0.0)) {
             return Err("gains");

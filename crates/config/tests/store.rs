@@ -10,10 +10,7 @@ type Flash = RamFlash<2048, 1024>;
 
 fn defaults() -> Config {
     Config {
-        gains: Gains::Impedance {
-            k_npm: 51_000.0,
-            b_nspm: 90.0,
-        },
+        gains: Gains::impedance(51_000.0, 90.0),
         load_cell: LoadCell {
             offset_counts: 0,
             n_per_count: 1e-3,
@@ -35,10 +32,7 @@ fn defaults() -> Config {
 
 fn tuned(k: f32) -> Config {
     Config {
-        gains: Gains::Impedance {
-            k_npm: k,
-            b_nspm: 90.0,
-        },
+        gains: Gains::impedance(k, 90.0),
         ..defaults()
     }
 }
@@ -169,10 +163,7 @@ fn values_out_of_range_are_never_saved_and_never_loaded() {
         Err(SaveError::Invalid("limits.continuous_force_n (N)"))
     );
     let mut bad = defaults();
-    bad.gains = Gains::Impedance {
-        k_npm: f32::NAN,
-        b_nspm: 90.0,
-    };
+    bad.gains = Gains::impedance(f32::NAN, 90.0);
     assert_eq!(s.save(&bad), Err(SaveError::Invalid("gains")));
     bad = defaults();
     bad.homing.force_limit_n = 500.0;
@@ -224,12 +215,7 @@ proptest! {
 #[test]
 fn a_three_axis_record_round_trips_and_names_its_axis_count() {
     let mut big = defaults();
-    big.gains = Gains::Admittance {
-        m_kg: f32::MAX,
-        b_nspm: f32::MAX,
-        kp_npm: f32::MAX,
-        bp_nspm: f32::MAX,
-    };
+    big.gains = Gains::admittance(f32::MAX, f32::MAX, f32::MAX, f32::MAX);
     big.load_cell.offset_counts = i32::MIN;
     big.homing.stop_nm = i32::MIN;
     big.homing.index_nm = Some(i32::MIN);

@@ -2,6 +2,7 @@
 //! ports with their USB ids, a Falcon the kernel has not given a port,
 //! and OpenHaptics' library for a Touch.
 
+use crate::falcon::protocol::{USB_PRODUCT_ID, USB_VENDOR_ID};
 use std::path::{Path, PathBuf};
 
 /// A serial port, and what twoport makes of it.
@@ -23,7 +24,7 @@ pub struct Port {
 /// CDC board as Haply's are.
 fn device(usb: (u16, u16)) -> Option<&'static str> {
     match usb {
-        crate::falcon::protocol::USB_ID => Some("falcon"),
+        (USB_VENDOR_ID, USB_PRODUCT_ID) => Some("falcon"),
         // Arduino's and Adafruit's vendor ids: the hAPI boards' Due and
         // SAMD21 kin.
         (0x2341 | 0x2a03 | 0x239a, _) => Some("haply-2diy"),
@@ -83,11 +84,7 @@ pub fn falcons_without_a_port() -> usize {
         .flatten()
         .filter(|e| {
             let d = e.path();
-            (id(&d, "idVendor"), id(&d, "idProduct"))
-                == (
-                    Some(crate::falcon::protocol::USB_ID.0),
-                    Some(crate::falcon::protocol::USB_ID.1),
-                )
+            (id(&d, "idVendor"), id(&d, "idProduct")) == (Some(USB_VENDOR_ID), Some(USB_PRODUCT_ID))
         })
         .count();
     plugged.saturating_sub(with_port.len())

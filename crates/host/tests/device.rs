@@ -133,10 +133,7 @@ fn wrong_calls_are_named_and_refusals_carry_the_boards_reason() {
     let e = b.send_ve(&[3.0], &[Contact::Held]).unwrap_err();
     assert!(e.to_string().contains("outside the board's range"), "{e}");
     let e = b
-        .set_gains(&[Gains::Impedance {
-            k_npm: 80_000.0,
-            b_nspm: 90.0,
-        }])
+        .set_gains(&[Gains::impedance(80_000.0, 90.0)])
         .unwrap_err();
     assert!(
         matches!(e, LinkError::GainsRefused(r) if matches!(r.why, Refusal::NotProvenStable { .. })),

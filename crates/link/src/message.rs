@@ -229,28 +229,9 @@ pub struct Status {
     pub session: u16,
 }
 
-/// Coupling (and regulator) gains.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub enum Gains {
-    /// Impedance display: `Z_cI` stiffness (N/m) and damping (N s/m).
-    Impedance {
-        /// Stiffness (N/m).
-        k_npm: f32,
-        /// Damping (N s/m).
-        b_nspm: f32,
-    },
-    /// Admittance display: regulator `K_p` and coupling `Z_cA`.
-    Admittance {
-        /// Regulator stiffness (N/m).
-        kp_npm: f32,
-        /// Regulator damping (N s/m).
-        bp_nspm: f32,
-        /// Coupling mass (kg).
-        m_kg: f32,
-        /// Coupling damping (N s/m).
-        b_nspm: f32,
-    },
-}
+/// Coupling (and regulator) gains: the servo's own type, encoded as
+/// it is.
+pub use twoport_control::Gains;
 
 /// Why the board refused gains, and for which axis.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -494,43 +475,4 @@ pub struct LinkStats {
     pub rx: Stats,
     /// Outgoing frames the board dropped because its queue was full.
     pub tx_dropped: u32,
-}
-
-/// The one conversion between the servo's gains and the wire's.
-impl From<twoport_control::Gains> for Gains {
-    fn from(g: twoport_control::Gains) -> Self {
-        match g {
-            twoport_control::Gains::Impedance(g) => Gains::Impedance {
-                k_npm: g.k_npm,
-                b_nspm: g.b_nspm,
-            },
-            twoport_control::Gains::Admittance(g) => Gains::Admittance {
-                kp_npm: g.kp_npm,
-                bp_nspm: g.bp_nspm,
-                m_kg: g.m_kg,
-                b_nspm: g.b_nspm,
-            },
-        }
-    }
-}
-
-impl From<Gains> for twoport_control::Gains {
-    fn from(g: Gains) -> Self {
-        use twoport_control::{AdmittanceGains, ImpedanceGains};
-        match g {
-            Gains::Impedance { k_npm, b_nspm } => ImpedanceGains { k_npm, b_nspm }.into(),
-            Gains::Admittance {
-                kp_npm,
-                bp_nspm,
-                m_kg,
-                b_nspm,
-            } => AdmittanceGains {
-                kp_npm,
-                bp_nspm,
-                m_kg,
-                b_nspm,
-            }
-            .into(),
-        }
-    }
 }

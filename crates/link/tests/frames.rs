@@ -7,16 +7,8 @@ use twoport_link::*;
 /// Every message, at its extremes: the session, the gains, the modes and
 /// the PIL frames here, the rest in [`spec_and_ve_messages`].
 fn all_messages() -> Vec<Message> {
-    let gi = Gains::Impedance {
-        k_npm: 51_000.0,
-        b_nspm: 90.0,
-    };
-    let ga = Gains::Admittance {
-        kp_npm: 51_000.0,
-        bp_nspm: 90.0,
-        m_kg: 5.0,
-        b_nspm: 500.0,
-    };
+    let gi = Gains::impedance(51_000.0, 90.0);
+    let ga = Gains::admittance(51_000.0, 90.0, 5.0, 500.0);
     vec![
         Message::hello(Role::Host, 3, u16::MAX),
         Message::HelloAck {
@@ -289,10 +281,7 @@ fn every_single_byte_corruption_is_dropped_and_survived() {
 fn truncated_and_overlong_frames_are_dropped() {
     let good = frame(
         5,
-        &Message::SetGains(Axes::one(Gains::Impedance {
-            k_npm: 1e4,
-            b_nspm: 10.0,
-        })),
+        &Message::SetGains(Axes::one(Gains::impedance(1e4, 10.0))),
     );
     let mut stream = good[..good.len() / 2].to_vec();
     stream.push(0);
@@ -416,30 +405,17 @@ proptest! {
     }
 }
 
+/// The link carries the servo's own gains, in the bytes the link's own
+/// mirror of them had (the variant, then each field in order, as
+/// little-endian f32): boards and records written before read the same.
 #[test]
-fn wire_gains_convert_to_the_servos_and_back() {
-    let wire = [
-        Gains::Impedance {
-            k_npm: 51_000.0,
-            b_nspm: 90.0,
-        },
-        Gains::Admittance {
-            kp_npm: 1.0,
-            bp_nspm: 2.0,
-            m_kg: 3.0,
-            b_nspm: 4.0,
-        },
-    ];
-    for g in wire {
-        let servo: twoport_control::Gains = g.into();
-        assert_eq!(Gains::from(servo), g);
-    }
-    let a: twoport_control::Gains = wire[1].into();
-    let twoport_control::Gains::Admittance(a) = a else {
-        panic!("admittance gains stay admittance gains");
-    };
+fn gains_keep_their_wire_bytes() {
+    let mut buf = [0u8; 32];
+    let impedance = postcard::to_slice(&Gains::impedance(51_000.0, 90.0), &mut buf).unwrap();
+    assert_eq!(impedance, [0, 0, 56, 71, 71, 0, 0, 180, 66]);
+    let admittance = postcard::to_slice(&Gains::admittance(1.0, 2.0, 3.0, 4.0), &mut buf).unwrap();
     assert_eq!(
-        (a.kp_npm, a.bp_nspm, a.m_kg, a.b_nspm),
-        (1.0, 2.0, 3.0, 4.0)
+        admittance,
+        [1, 0, 0, 128, 63, 0, 0, 0, 64, 0, 0, 64, 64, 0, 0, 128, 64]
     );
 }

@@ -14,7 +14,6 @@ use host_sim::emulate::Trace;
 use std::path::PathBuf;
 use std::time::Duration;
 use twoport_board::linkage::touch::{self as image, TOUCH};
-use twoport_control::servo::ImpedanceGains;
 use twoport_host::touch::TouchConfig;
 use twoport_host::{BoardPort, Gains, HostBoard, LinkError, PcBoard, SteppedPc};
 
@@ -197,8 +196,7 @@ fn the_scope_runs_the_touch_live() {
 #[test]
 fn gains_past_the_region_need_the_users_choice() {
     let _turn = turn();
-    let stiff: [Gains; 3] =
-        [twoport_control::Gains::from(ImpedanceGains::new(800.0, 1.0)).into(); 3];
+    let stiff: [Gains; 3] = [twoport_control::Gains::impedance(800.0, 1.0); 3];
     let mut b = HostBoard::open(PcBoard::touch(&config("")).unwrap(), 3).unwrap();
     match b.set_gains(&stiff) {
         Err(LinkError::GainsRefused(why)) => assert_eq!(why.axis, 0, "{why:?}"),

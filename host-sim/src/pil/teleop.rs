@@ -118,10 +118,7 @@ impl<P: BoardPort> Side<P> {
     /// to the host (each update reached in one tick), armed.
     fn arm(&mut self, (k, b): (f32, f32), deadline_ticks: u32) -> Result<(), Error> {
         self.session.calibrate(Axes::one(0))?;
-        let gains = Gains::Impedance {
-            k_npm: k,
-            b_nspm: b,
-        };
+        let gains = Gains::impedance(k, b);
         self.session
             .set_gains(Axes::one(gains))
             .map_err(|e| pil_err!("law.gains ({k} N/m, {b} N s/m): {e}"))?;

@@ -387,7 +387,7 @@ impl ScopeState {
         }
         self.gains = g;
         if let Some(b) = self.board.as_mut() {
-            if let Err(e) = b.tell(&Message::SetGains(Axes::one(g.into()))) {
+            if let Err(e) = b.tell(&Message::SetGains(Axes::one(g))) {
                 self.message = Some(format!("board: {e}"));
             }
         }

@@ -31,7 +31,7 @@ where
         let h = &self.homing_cfg[i];
         let io = &self.io[i];
         Config {
-            gains: gains.into(),
+            gains,
             load_cell: LoadCell {
                 offset_counts: io.load_cell_offset_counts,
                 n_per_count: io.load_cell_n_per_count,
@@ -64,7 +64,7 @@ where
         if self.mode != BoardMode::Disarmed || cfg.iter().any(|c| c.validate().is_err()) {
             return Err(ConfigFallback::Invalid);
         }
-        let gains = cfg.map(|c| Gains::from(c.gains));
+        let gains = cfg.map(|c| c.gains);
         if self.check(&gains).is_err() {
             return Err(ConfigFallback::NotProven);
         }

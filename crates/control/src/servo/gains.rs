@@ -1,5 +1,6 @@
 //! The gains of either display, as one value: what a scene file, a slider
-//! and a link message all become before they reach a servo.
+//! and a link message all carry to a servo (with the `serde` feature,
+//! the link's and the flash record's encoding).
 
 use crate::ParamError;
 use core::fmt;
@@ -30,6 +31,7 @@ impl fmt::Display for Display {
 
 /// The impedance display's coupling `Z_cI` (paper eq 20).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ImpedanceGains {
     /// Coupling stiffness `k_c` (N/m).
     pub k_npm: f32,
@@ -47,6 +49,7 @@ impl ImpedanceGains {
 /// The admittance display's regulator `K_p` (eq 30) and coupling `Z_cA`
 /// (eq 21).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct AdmittanceGains {
     /// Regulator stiffness `k_p` (N/m).
     pub kp_npm: f32,
@@ -83,6 +86,7 @@ impl AdmittanceGains {
 /// assert!(g.all_finite());
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Gains {
     /// Impedance display.
     Impedance(ImpedanceGains),
@@ -91,6 +95,17 @@ pub enum Gains {
 }
 
 impl Gains {
+    /// The impedance display's coupling: stiffness (N/m) and damping (N s/m).
+    pub const fn impedance(k_npm: f32, b_nspm: f32) -> Self {
+        Gains::Impedance(ImpedanceGains::new(k_npm, b_nspm))
+    }
+
+    /// The admittance display's regulator, stiffness (N/m) and damping
+    /// (N s/m), and coupling, mass (kg) and damping (N s/m).
+    pub const fn admittance(kp_npm: f32, bp_nspm: f32, m_kg: f32, b_nspm: f32) -> Self {
+        Gains::Admittance(AdmittanceGains::new(kp_npm, bp_nspm, m_kg, b_nspm))
+    }
+
     /// The display these gains are for.
     pub fn display(&self) -> Display {
         match self {

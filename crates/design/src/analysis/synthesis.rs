@@ -2,6 +2,7 @@
 //! damping or at the best one, on one pose or every pose.
 
 use super::{admittance_coupling_tf, dc_series, impedance_coupling_tf, slack, Analysis};
+use core::ops::RangeInclusive;
 
 /// Largest `x` in `[lo, hi]` with `ok(x)`, assuming `ok` holds below a
 /// threshold and fails above it; `None` if `ok(lo)` fails. Log bisection to
@@ -26,11 +27,11 @@ fn largest(lo: f64, hi: f64, ok: impl Fn(f64) -> bool) -> Option<f64> {
 }
 
 /// Search range for the coupling stiffness (N/m).
-pub const K_RANGE: (f64, f64) = (1.0, 1.0e8);
+pub const K_RANGE: RangeInclusive<f64> = 1.0..=1.0e8;
 /// Search range for the coupling mass (kg).
-pub const M_RANGE: (f64, f64) = (1.0e-3, 1.0e4);
+pub const M_RANGE: RangeInclusive<f64> = 1.0e-3..=1.0e4;
 /// Search range for coupling damping in the best-pair search (N s/m).
-pub const B_RANGE: (f64, f64) = (1.0, 1.0e4);
+pub const B_RANGE: RangeInclusive<f64> = 1.0..=1.0e4;
 
 /// Where a design is impossible at any gain because of the limit toward
 /// DC: every coupling's real part vanishes as `ω -> 0`, so a bound whose
@@ -60,10 +61,10 @@ pub fn max_stiffness(a: &Analysis, bound: &[f64], b_nspm: f64) -> Option<f64> {
 /// searches below the least limit so far, so a pose that allows it costs
 /// one check.
 pub fn max_stiffness_poses(poses: &Poses, b_nspm: f64) -> Option<f64> {
-    let mut hi = K_RANGE.1;
+    let mut hi = *K_RANGE.end();
     for (a, bound) in poses {
         let t = a.period_s;
-        hi = largest(K_RANGE.0, hi, |k| {
+        hi = largest(*K_RANGE.start(), hi, |k| {
             impedance_coupling_tf(k, b_nspm, t)
                 .map(|tf| slack(a, bound, |z| tf.eval(z).inv().re) >= 0.0)
                 .unwrap_or(false)
@@ -82,7 +83,7 @@ pub fn min_mass(a: &Analysis, bound: &[f64], b_nspm: f64) -> Option<f64> {
 /// searches above the greatest so far).
 pub fn min_mass_poses(poses: &Poses, b_nspm: f64) -> Option<f64> {
     // Heavier is more stable: search 1/m for the largest feasible.
-    let mut hi = 1.0 / M_RANGE.0;
+    let mut hi = 1.0 / M_RANGE.start();
     for (a, bound) in poses {
         let t = a.period_s;
         let ok = |m: f64| {
@@ -90,7 +91,7 @@ pub fn min_mass_poses(poses: &Poses, b_nspm: f64) -> Option<f64> {
                 .map(|tf| slack(a, bound, |z| tf.eval(z).re) >= 0.0)
                 .unwrap_or(false)
         };
-        hi = largest(1.0 / M_RANGE.1, hi, |inv| ok(1.0 / inv))?;
+        hi = largest(1.0 / M_RANGE.end(), hi, |inv| ok(1.0 / inv))?;
     }
     Some(1.0 / hi)
 }
@@ -99,7 +100,7 @@ pub fn min_mass_poses(poses: &Poses, b_nspm: f64) -> Option<f64> {
 /// section; returns `(b, score)` or `None` if nowhere feasible.
 fn best_over_b(score: impl Fn(f64) -> Option<f64>) -> Option<(f64, f64)> {
     let n = 33;
-    let (lo, hi) = (B_RANGE.0.ln(), B_RANGE.1.ln());
+    let (lo, hi) = (B_RANGE.start().ln(), B_RANGE.end().ln());
     let at = |i: usize| lo + (hi - lo) * i as f64 / (n - 1) as f64;
     let (mut best_i, mut best) = (None, f64::NEG_INFINITY);
     for i in 0..n {

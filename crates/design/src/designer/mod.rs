@@ -303,10 +303,11 @@ impl Designer {
     /// Why no coupling `what` meets `bounds`: the limit toward DC, or the
     /// range searched.
     fn infeasible(&self, bounds: &[Vec<f64>], what: Infeasible, b: Option<f64>) -> String {
-        let (name, bound_unit, (lo, hi), unit) = match what {
+        let (name, bound_unit, range, unit) = match what {
             Infeasible::Stiffness => ("stiffness", "m/(N s)", analysis::K_RANGE, "N/m"),
             Infeasible::Mass(_) => ("mass", "N s/m", analysis::M_RANGE, "kg"),
         };
+        let (lo, hi) = range.into_inner();
         if let Some(limit) = self
             .with(bounds)
             .iter()
@@ -319,7 +320,7 @@ impl Designer {
         // Where even the most cautious gain of the search fails (the
         // softest stiffness, the heaviest mass) at the damping asked for,
         // or the search's least.
-        let b_c = b.unwrap_or(analysis::B_RANGE.0);
+        let b_c = b.unwrap_or(*analysis::B_RANGE.start());
         let worst = match what {
             Infeasible::Stiffness => {
                 self.worst_check(|p| analysis::check_impedance(&p.analysis, lo, b_c, self.human))

@@ -21,8 +21,10 @@
 
 pub use crate::PacketError;
 
-/// The Falcon's USB vendor and product ids.
-pub const USB_ID: (u16, u16) = (0x0403, 0xcb48);
+/// The Falcon's USB vendor id (its FTDI chip's).
+pub const USB_VENDOR_ID: u16 = 0x0403;
+/// The Falcon's USB product id.
+pub const USB_PRODUCT_ID: u16 = 0xcb48;
 /// The loader's first handshake's rate (baud).
 pub const CHECK_BAUD: u32 = 9_600;
 /// The firmware upload's rate (baud).
