@@ -16,6 +16,7 @@ pub mod identify;
 pub mod identify_ui;
 #[cfg(feature = "gui")]
 pub mod log_plot;
+pub mod pace;
 pub mod rings;
 pub mod signals;
 pub mod teleop;

@@ -51,7 +51,7 @@ pub struct TeleopState {
     pub push_n: f64,
     /// Why the run stopped, if it has.
     pub stopped: Option<String>,
-    debt_s: f64,
+    pace: crate::scope::pace::Pace,
 }
 
 impl TeleopState {
@@ -70,7 +70,7 @@ impl TeleopState {
             running: true,
             push_n: 0.0,
             stopped: None,
-            debt_s: 0.0,
+            pace: Default::default(),
         })
     }
 
@@ -105,9 +105,7 @@ impl TeleopState {
             return;
         }
         let period = self.scene().period();
-        self.debt_s = (self.debt_s + wall_s).min(0.2);
-        while self.debt_s >= period {
-            self.debt_s -= period;
+        for _ in 0..self.pace.due(wall_s, period) {
             if self.run.ticks() >= self.run.total_ticks() {
                 self.stopped = Some("the scene's time is up".into());
                 break;

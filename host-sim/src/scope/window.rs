@@ -42,18 +42,6 @@ struct Shots {
     saved: Arc<Mutex<Vec<Result<PathBuf, Error>>>>,
 }
 
-struct ScopeApp {
-    state: ScopeState,
-    link: crate::scope::board::BoardChoice,
-    shots: Shots,
-}
-
-/// The scope of a scene of two or three axes: the world view.
-struct WorldApp<const N: usize> {
-    state: crate::scope::world::WorldState<N>,
-    shots: Shots,
-}
-
 fn save_png(img: &egui::ColorImage, path: &Path) -> Result<PathBuf, Error> {
     let [w, h] = img.size;
     let bytes: Vec<u8> = img.pixels.iter().flat_map(|c| c.to_array()).collect();
@@ -113,37 +101,62 @@ impl Shots {
     }
 }
 
+/// What a window shows: a state that advances by the wall time, and
+/// its drawing.
+trait View {
+    /// Advance by `dt_s` (s) of wall time.
+    fn advance(&mut self, dt_s: f64);
+    /// Draw into `ui`.
+    fn draw(&mut self, ui: &mut egui::Ui);
+}
+
+/// One device's scope, and the board it may drive.
+struct DeviceView {
+    state: ScopeState,
+    link: crate::scope::board::BoardChoice,
+}
+
+impl View for DeviceView {
+    fn advance(&mut self, dt_s: f64) {
+        self.state.advance(dt_s);
+    }
+    fn draw(&mut self, ui: &mut egui::Ui) {
+        crate::scope::ui::scope(ui, &mut self.state, &mut self.link);
+    }
+}
+
+/// The scope of a scene of two or three axes: the world view.
+impl<const N: usize> View for crate::scope::world::WorldState<N> {
+    fn advance(&mut self, dt_s: f64) {
+        crate::scope::world::WorldState::advance(self, dt_s);
+    }
+    fn draw(&mut self, ui: &mut egui::Ui) {
+        crate::scope::world_ui::world(ui, self);
+    }
+}
+
 /// The scope of a teleoperation scene: both devices.
-struct TeleopApp {
-    state: crate::scope::teleop::TeleopState,
+impl View for crate::scope::teleop::TeleopState {
+    fn advance(&mut self, dt_s: f64) {
+        crate::scope::teleop::TeleopState::advance(self, dt_s);
+    }
+    fn draw(&mut self, ui: &mut egui::Ui) {
+        crate::scope::teleop_ui::teleop(ui, self);
+    }
+}
+
+/// The window: each frame advances the view by the wall time since the
+/// last, draws it, and takes the script's screenshots.
+struct App<V> {
+    view: V,
     shots: Shots,
 }
 
-impl eframe::App for TeleopApp {
+impl<V: View> eframe::App for App<V> {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
-        self.state.advance(self.shots.frame());
-        crate::scope::teleop_ui::teleop(ui, &mut self.state);
-        self.shots.scripted(&ctx);
-        ctx.request_repaint();
-    }
-}
-
-impl eframe::App for ScopeApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
-        let ctx = ui.ctx().clone();
-        self.state.advance(self.shots.frame());
-        crate::scope::ui::scope(ui, &mut self.state, &mut self.link);
-        self.shots.scripted(&ctx);
-        ctx.request_repaint();
-    }
-}
-
-impl<const N: usize> eframe::App for WorldApp<N> {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
-        let ctx = ui.ctx().clone();
-        self.state.advance(self.shots.frame());
-        crate::scope::world_ui::world(ui, &mut self.state);
+        self.view.advance(self.shots.frame());
+        self.view.draw(ui);
         self.shots.scripted(&ctx);
         ctx.request_repaint();
     }
@@ -180,7 +193,7 @@ pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, Error> {
             )));
         }
         let state = crate::scope::teleop::TeleopState::open(scene)?;
-        return show(Box::new(TeleopApp { state, shots }), saved);
+        return show(Box::new(App { view: state, shots }), saved);
     }
     let parsed = crate::Scene::load(scene, &[])?;
     let device = shots.script.device.clone();
@@ -193,17 +206,17 @@ pub fn run(scene: &Path, script: Script) -> Result<Vec<PathBuf>, Error> {
     let app: Box<dyn eframe::App> = if parsed.axes == 3 {
         let mut state = crate::scope::world::WorldState::<3>::new(parsed)?;
         open_device(&mut state, device);
-        Box::new(WorldApp::<3> { state, shots })
+        Box::new(App { view: state, shots })
     } else if parsed.axes == 2 {
         let mut state = crate::scope::world::WorldState::<2>::new(parsed)?;
         open_device(&mut state, device);
-        Box::new(WorldApp::<2> { state, shots })
+        Box::new(App { view: state, shots })
     } else {
-        Box::new(ScopeApp {
+        let view = DeviceView {
             state: ScopeState::open(scene)?,
             link: crate::scope::board::BoardChoice::default(),
-            shots,
-        })
+        };
+        Box::new(App { view, shots })
     };
     show(app, saved)
 }

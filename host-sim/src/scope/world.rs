@@ -42,7 +42,7 @@ pub struct WorldState<const N: usize = 3> {
     /// The span each projection shows on each axis (m): the Excalibur's
     /// workspace, widened to take in a linkage's arm as it starts.
     pub span_m: [(f64, f64); 3],
-    debt_s: f64,
+    pace: crate::scope::pace::Pace,
 }
 
 /// The Excalibur's workspace (m), the world view's span by default.
@@ -78,7 +78,7 @@ impl<const N: usize> WorldState<N> {
             link: BoardChoice::default(),
             board_forces: core::array::from_fn(|_| Ring::new(n)),
             message: None,
-            debt_s: 0.0,
+            pace: Default::default(),
         })
     }
 
@@ -95,9 +95,10 @@ impl<const N: usize> WorldState<N> {
                 self.lost(e);
             }
         }
-        self.debt_s = (self.debt_s + wall_s).min(0.2);
-        while self.debt_s >= 1e-3 && self.stopped.is_none() {
-            self.debt_s -= 1e-3;
+        for _ in 0..self.pace.due(wall_s, self.sim.period()) {
+            if self.stopped.is_some() {
+                break;
+            }
             if self.sim.ticks() >= self.sim.total_ticks() {
                 self.stopped = Some("the scene's time is up".into());
                 break;
