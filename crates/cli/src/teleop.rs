@@ -23,32 +23,40 @@ fn law_with(law: &TeleopLaw, free: Option<f32>) -> Option<Law> {
                 filter_pole,
             }))
         }
-        TeleopLaw::FourChannel {
-            k_m,
-            b_m,
-            b_local,
-            k_s,
-            b_s,
-            c2,
-            c3,
-            c5,
-            c6,
-        } => FourChannelGains {
-            k_m_npm: k_m,
-            b_m_nspm: b_m,
-            b_local_nspm: b_local,
-            k_s_npm: k_s,
-            b_s_nspm: b_s,
-            c2,
-            c3,
-            c5,
-            c6,
-        },
+        TeleopLaw::FourChannel { ref gains } => {
+            return four_channel(gains).ok().map(Law::FourChannel)
+        }
     }))
+}
+
+/// `--gain NAME=VALUE`s as four-channel gains, the others off.
+fn four_channel(gains: &[String]) -> Result<FourChannelGains, String> {
+    let mut g = FourChannelGains::OFF;
+    for given in gains {
+        let (name, value) = given
+            .split_once('=')
+            .ok_or_else(|| format!("--gain {given}: give NAME=VALUE"))?;
+        let value: f32 = value
+            .trim()
+            .parse()
+            .map_err(|_| format!("--gain {given}: `{}` is not a number", value.trim()))?;
+        if !g.set(name.trim(), value) {
+            let names: Vec<&str> = g.named().iter().map(|(n, _)| *n).collect();
+            return Err(format!(
+                "--gain {given}: no gain `{}`; the gains are {}",
+                name.trim(),
+                names.join(", ")
+            ));
+        }
+    }
+    Ok(g)
 }
 
 /// The law, every gain given.
 fn law(law: &TeleopLaw) -> Result<Law, String> {
+    if let TeleopLaw::FourChannel { gains } = law {
+        return four_channel(gains).map(Law::FourChannel);
+    }
     law_with(law, None).ok_or_else(|| {
         match law {
             TeleopLaw::PositionForce { .. } => {

@@ -68,7 +68,7 @@ fn each_law_reports_its_gains() {
     );
     assert_eq!(g["b_local_nspm"], 3.0);
     assert_eq!(g["k_m_npm"], 0.0);
-    let args = between("four-channel --k-m 300 --k-s 400 --c3 1");
+    let args = between("four-channel --gain k_m_npm=300 --gain k_s_npm=400 --gain c3=1");
     let text = TWOPORT.run(&args.iter().map(String::as_str).collect::<Vec<_>>());
     let text = String::from_utf8_lossy(&text.stdout);
     assert!(
@@ -170,15 +170,27 @@ fn check_proves_inside_the_edge_only() {
             "position-position --k 100 --b 0",
             "design finds --k: leave it out",
         ),
-        ("four-channel --k-m 100", "four-channel: design finds"),
+        (
+            "four-channel --gain k_m_npm=100",
+            "four-channel: design finds",
+        ),
     ] {
         let line = format!("teleop design --master {CAPSTAN} --slave {CAPSTAN} {law}");
         let e = TWOPORT.failure(&line.split_whitespace().collect::<Vec<_>>());
         assert!(e.contains(says), "{law}: {e}");
     }
-    let line = format!("teleop check --master {CAPSTAN} --slave {CAPSTAN} position-position --b 0");
-    let e = TWOPORT.failure(&line.split_whitespace().collect::<Vec<_>>());
-    assert!(e.contains("give --k"), "{e}");
+    for (law, says) in [
+        ("position-position --b 0", "give --k"),
+        (
+            "four-channel --gain k_m=1",
+            "no gain `k_m`; the gains are k_m_npm",
+        ),
+        ("four-channel --gain c2", "--gain c2: give NAME=VALUE"),
+    ] {
+        let line = format!("teleop check --master {CAPSTAN} --slave {CAPSTAN} {law}");
+        let e = TWOPORT.failure(&line.split_whitespace().collect::<Vec<_>>());
+        assert!(e.contains(says), "{law}: {e}");
+    }
 }
 
 /// `--plot` draws what the operator feels through the designed law, and

@@ -30,17 +30,17 @@ def laws(master, slave):
     """(architecture, the gain's name, law at a gain, the largest proven
     gain at one tick) for each law the pair's sensors allow."""
     m, s = model(master), model(slave)
-    pp = twoport.design_teleop(m, s, b=0.5, delay=1).gains.k_m
+    pp = twoport.design_teleop(m, s, b=0.5, delay=1).gains.k_m_npm
     yield ("position-position", "k (N/m)",
-           lambda k: twoport.TeleopGains(k_m=k, k_s=k, b_m=0.5, b_s=0.5), pp)
+           lambda k: twoport.TeleopGains(k_m_npm=k, k_s_npm=k, b_m_nspm=0.5, b_s_nspm=0.5), pp)
     if FORCE_SENSED[slave]:
         k = 0.5 * pp
         pf = twoport.design_teleop(m, s, b=0.5, k=k, b_m=0.5, delay=1).gains.c2
         yield ("force reflection", "k_f",
-               lambda c: twoport.TeleopGains(k_s=k, b_s=0.5, b_local=0.5, c2=c), pf)
+               lambda c: twoport.TeleopGains(k_s_npm=k, b_s_nspm=0.5, b_local_nspm=0.5, c2=c), pf)
     if FORCE_SENSED[slave] and FORCE_SENSED[master]:
         k = 0.5 * pp
-        four = lambda c: twoport.TeleopGains(k_m=k, k_s=k, b_m=0.5, b_s=0.5, c2=c, c3=c)
+        four = lambda c: twoport.TeleopGains(k_m_npm=k, k_s_npm=k, b_m_nspm=0.5, b_s_nspm=0.5, c2=c, c3=c)
         lo, hi = 0.0, 1.0
         while hi - lo > 1e-3 * max(lo, 1e-4):
             mid = 0.5 * (lo + hi)

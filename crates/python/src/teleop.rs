@@ -3,8 +3,9 @@
 //! sampled loop.
 
 use crate::model::Pose;
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyAttributeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use twoport_control::teleop::FourChannelGains;
 use twoport_design::designer::{TeleopCheckReport, TeleopDesigner};
 use twoport_design::network::HumanBound;
@@ -42,6 +43,12 @@ fn lumped(h: &Hand) -> (f64, f64, f64) {
     (h.mass_kg, h.stiffness_npm, h.damping_nspm)
 }
 
+/// The gains' names, for an error.
+fn names(g: &FourChannelGains) -> String {
+    let names: Vec<&str> = g.named().iter().map(|(n, _)| *n).collect();
+    names.join(", ")
+}
+
 /// Lawrence's four-channel gains from Python's keywords.
 #[pyclass(frozen, module = "twoport")]
 #[derive(Clone, Copy)]
@@ -49,74 +56,39 @@ pub(crate) struct TeleopGains(FourChannelGains);
 
 #[pymethods]
 impl TeleopGains {
-    /// Gains by name (0 where left out): the master's coupling to the
-    /// slave's motion `k_m` (N/m) and `b_m` (N s/m), its own damping
-    /// `b_local` (N s/m), the slave's coupling `k_s`, `b_s`, and the force
-    /// channels `c2`, `c3`, `c5`, `c6`. Position-position is `k_m = k_s`,
-    /// `b_m = b_s` and nothing else; force reflection is `k_s`, `b_s`,
-    /// `c2` and the master's `b_local`.
+    /// Gains by name (0 where left out), as a teleoperation scene's
+    /// `[law.gains]` and the reports name them: the master's coupling to
+    /// the slave's motion `k_m_npm` (N/m) and `b_m_nspm` (N s/m), its own
+    /// damping `b_local_nspm` (N s/m), the slave's coupling `k_s_npm`,
+    /// `b_s_nspm`, and the force channels `c2`, `c3`, `c5`, `c6`.
+    /// Position-position is `k_m_npm = k_s_npm`, `b_m_nspm = b_s_nspm` and
+    /// nothing else; force reflection is `k_s_npm`, `b_s_nspm`, `c2` and
+    /// the master's `b_local_nspm`. Each gain reads back as an attribute.
     #[new]
-    #[pyo3(signature = (*, k_m=0.0, b_m=0.0, b_local=0.0, k_s=0.0, b_s=0.0, c2=0.0, c3=0.0, c5=0.0, c6=0.0))]
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        k_m: f32,
-        b_m: f32,
-        b_local: f32,
-        k_s: f32,
-        b_s: f32,
-        c2: f32,
-        c3: f32,
-        c5: f32,
-        c6: f32,
-    ) -> Self {
-        TeleopGains(FourChannelGains {
-            k_m_npm: k_m,
-            b_m_nspm: b_m,
-            b_local_nspm: b_local,
-            k_s_npm: k_s,
-            b_s_nspm: b_s,
-            c2,
-            c3,
-            c5,
-            c6,
-        })
+    #[pyo3(signature = (**gains))]
+    fn new(gains: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let mut g = FourChannelGains::OFF;
+        for (name, value) in gains.into_iter().flatten() {
+            let name: String = name.extract()?;
+            let value: f32 = value.extract()?;
+            if !g.set(&name, value) {
+                return Err(PyTypeError::new_err(format!(
+                    "TeleopGains: no gain `{name}`; the gains are {}",
+                    names(&g)
+                )));
+            }
+        }
+        Ok(TeleopGains(g))
     }
 
-    #[getter]
-    fn k_m(&self) -> f32 {
-        self.0.k_m_npm
-    }
-    #[getter]
-    fn b_m(&self) -> f32 {
-        self.0.b_m_nspm
-    }
-    #[getter]
-    fn b_local(&self) -> f32 {
-        self.0.b_local_nspm
-    }
-    #[getter]
-    fn k_s(&self) -> f32 {
-        self.0.k_s_npm
-    }
-    #[getter]
-    fn b_s(&self) -> f32 {
-        self.0.b_s_nspm
-    }
-    #[getter]
-    fn c2(&self) -> f32 {
-        self.0.c2
-    }
-    #[getter]
-    fn c3(&self) -> f32 {
-        self.0.c3
-    }
-    #[getter]
-    fn c5(&self) -> f32 {
-        self.0.c5
-    }
-    #[getter]
-    fn c6(&self) -> f32 {
-        self.0.c6
+    fn __getattr__(&self, name: &str) -> PyResult<f32> {
+        let found = self.0.named().into_iter().find(|(n, _)| *n == name);
+        found.map(|(_, v)| v).ok_or_else(|| {
+            PyAttributeError::new_err(format!(
+                "TeleopGains has no `{name}`; the gains are {}",
+                names(&self.0)
+            ))
+        })
     }
 
     fn __repr__(&self) -> String {

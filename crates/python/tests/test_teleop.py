@@ -19,7 +19,7 @@ def rigid(mass=0.1, damping=1.0, period_s=1e-3):
 
 
 def pp(k, b=0.0):
-    return twoport.TeleopGains(k_m=k, k_s=k, b_m=b, b_s=b)
+    return twoport.TeleopGains(k_m_npm=k, k_s_npm=k, b_m_nspm=b, b_s_nspm=b)
 
 
 def test_position_position_meets_colgates_edge_for_the_relative_motion():
@@ -41,7 +41,7 @@ def test_a_bad_teleoperator_raises_naming_it():
     with pytest.raises(ValueError, match="at most 1024"):
         twoport.verify_teleop(rigid(), rigid(), pp(100.0), delay=2000)
     with pytest.raises(ValueError, match="k_m"):
-        twoport.verify_teleop(rigid(), rigid(), twoport.TeleopGains(k_m=-1.0))
+        twoport.verify_teleop(rigid(), rigid(), twoport.TeleopGains(k_m_npm=-1.0))
 
 
 def test_the_proof_holds_inside_colgates_edge_and_design_finds_it():
@@ -49,8 +49,8 @@ def test_the_proof_holds_inside_colgates_edge_and_design_finds_it():
     # the stiffest proven coupling is within 0.5% below the edge, and
     # verify finds nothing there.
     m, s = rigid(), rigid()
-    inside = twoport.check_teleop(m, s, twoport.TeleopGains(k_m=980.0, k_s=980.0))
-    past = twoport.check_teleop(m, s, twoport.TeleopGains(k_m=1020.0, k_s=1020.0))
+    inside = twoport.check_teleop(m, s, twoport.TeleopGains(k_m_npm=980.0, k_s_npm=980.0))
+    past = twoport.check_teleop(m, s, twoport.TeleopGains(k_m_npm=1020.0, k_s_npm=1020.0))
     assert inside.proven and inside.slack > 0.0, inside
     mass, damping, stiffness = inside.felt
     assert abs(mass - 0.2) < 2e-3 and abs(damping - 2.0) < 0.02, inside.felt
@@ -58,14 +58,23 @@ def test_the_proof_holds_inside_colgates_edge_and_design_finds_it():
     assert not past.proven and past.slack < 0.0, past
     best = twoport.design_teleop(m, s, b=0.0)
     assert best is not None and best.proven, best
-    assert 995.0 < best.gains.k_m <= 1000.0 and best.gains.k_s == best.gains.k_m, best
+    assert 995.0 < best.gains.k_m_npm <= 1000.0 and best.gains.k_s_npm == best.gains.k_m_npm, best
     there = twoport.verify_teleop(m, s, best.law)
     assert not there.unstable, there
 
 
+def test_gains_are_named_as_the_scene_files_name_them():
+    g = twoport.TeleopGains(k_m_npm=300.0, b_local_nspm=0.5, c3=1.0)
+    assert (g.k_m_npm, g.b_local_nspm, g.c3, g.k_s_npm) == (300.0, 0.5, 1.0, 0.0)
+    with pytest.raises(TypeError, match="no gain `k_m`; the gains are k_m_npm"):
+        twoport.TeleopGains(k_m=300.0)
+    with pytest.raises(AttributeError, match="no `k_q`"):
+        g.k_q
+
+
 def test_a_force_channel_without_a_load_cell_raises():
     with pytest.raises(ValueError, match="load cell"):
-        twoport.check_teleop(rigid(), rigid(), twoport.TeleopGains(k_s=100.0, c2=0.5))
+        twoport.check_teleop(rigid(), rigid(), twoport.TeleopGains(k_s_npm=100.0, c2=0.5))
 
 
 def test_a_filtered_wave_channel_is_proven_and_a_bare_one_breaks():

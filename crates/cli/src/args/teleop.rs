@@ -92,34 +92,18 @@ pub(crate) enum TeleopLaw {
         #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
         filter_pole: f32,
     },
-    /// Lawrence's four channels, each gain given (0 where left out).
+    /// Lawrence's four channels, each gain given by name (0 where left
+    /// out): `k_m_npm`, `b_m_nspm` (the master's coupling to the slave's
+    /// motion), `b_local_nspm` (the master's own damping), `k_s_npm`,
+    /// `b_s_nspm` (the slave's coupling), `c2`, `c3`, `c5`, `c6` (the
+    /// force channels), as a teleoperation scene's `[law.gains]` names them.
     FourChannel {
-        /// The master's coupling to the slave's motion (N/m).
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-        k_m: f32,
-        /// Its damping (N s/m).
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-        b_m: f32,
-        /// The master's own damping (N s/m).
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-        b_local: f32,
-        /// The slave's coupling to the master's motion (N/m).
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-        k_s: f32,
-        /// Its damping (N s/m).
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-        b_s: f32,
-        /// C2: the environment's sensed force fed to the master.
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-        c2: f32,
-        /// C3: the operator's sensed force fed to the slave.
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-        c3: f32,
-        /// C5: the environment's force fed back on the slave.
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-        c5: f32,
-        /// C6: the operator's force fed back on the master.
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-        c6: f32,
+        /// A gain, e.g. `--gain k_m_npm=300` (repeatable).
+        #[arg(
+            long = "gain",
+            value_name = "NAME=VALUE",
+            allow_negative_numbers = true
+        )]
+        gains: Vec<String>,
     },
 }

@@ -66,6 +66,40 @@ impl FourChannelGains {
         c6: 0.0,
     };
 
+    /// Each gain by its name (as files, reports, the command line and
+    /// Python spell it), in the struct's order, to read or set.
+    pub fn named_mut(&mut self) -> [(&'static str, &mut f32); 9] {
+        [
+            ("k_m_npm", &mut self.k_m_npm),
+            ("b_m_nspm", &mut self.b_m_nspm),
+            ("b_local_nspm", &mut self.b_local_nspm),
+            ("k_s_npm", &mut self.k_s_npm),
+            ("b_s_nspm", &mut self.b_s_nspm),
+            ("c2", &mut self.c2),
+            ("c3", &mut self.c3),
+            ("c5", &mut self.c5),
+            ("c6", &mut self.c6),
+        ]
+    }
+
+    /// Each gain by its name, as [`named_mut`](Self::named_mut) gives them.
+    pub fn named(&self) -> [(&'static str, f32); 9] {
+        let mut copy = *self;
+        copy.named_mut().map(|(name, v)| (name, *v))
+    }
+
+    /// Set the gain called `name` to `value`; `false` where no gain has
+    /// that name.
+    pub fn set(&mut self, name: &str, value: f32) -> bool {
+        match self.named_mut().into_iter().find(|(n, _)| *n == name) {
+            Some((_, gain)) => {
+                *gain = value;
+                true
+            }
+            None => false,
+        }
+    }
+
     /// Position-position: each side held to the other's motion by the
     /// spring `k_npm` (N/m) and damper `b_nspm` (N s/m), no force sensed.
     pub const fn position_position(k_npm: f32, b_nspm: f32) -> Self {
@@ -349,5 +383,32 @@ impl<R: Real, const D: usize> FourChannel<R, D> {
                 ],
             ],
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FourChannelGains;
+
+    #[test]
+    fn each_gain_is_set_by_its_own_name() {
+        let mut g = FourChannelGains::OFF;
+        for (i, (name, _)) in FourChannelGains::OFF.named().into_iter().enumerate() {
+            assert!(g.set(name, i as f32 + 1.0), "{name}");
+        }
+        let want = FourChannelGains {
+            k_m_npm: 1.0,
+            b_m_nspm: 2.0,
+            b_local_nspm: 3.0,
+            k_s_npm: 4.0,
+            b_s_nspm: 5.0,
+            c2: 6.0,
+            c3: 7.0,
+            c5: 8.0,
+            c6: 9.0,
+        };
+        assert_eq!(g, want);
+        assert!(!g.set("k_m", 1.0));
+        assert_eq!(g, want);
     }
 }
