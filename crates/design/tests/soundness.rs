@@ -349,6 +349,17 @@ fn narrow_modes_the_old_grid_missed_are_resolved() {
     assert_tight(&heavy, g(k_npm), g(1.01 * k_npm), None);
 }
 
+/// `verify` finds nothing that breaks `g` on `model`.
+fn assert_unbroken(model: &DeviceModel, g: &Gains, human: Option<HumanBound>) {
+    let v = verify(model, T, g, human).unwrap();
+    let with = human.is_some();
+    assert!(
+        !v.unstable,
+        "{} (human {with}): {g:?} broken: {v:?}",
+        model.name
+    );
+}
+
 /// A generated family: light parts on springs at damping ratios down to
 /// 1e-6, below and past Nyquist, with the encoder collocated with the
 /// hand or not; heavy actuators with light handles, whose narrow mode is
@@ -364,15 +375,8 @@ fn no_design_in_a_family_of_narrow_modes_is_broken() {
             let Some((k, b)) = designed(model, human, None) else {
                 continue;
             };
-            let g = imp(k, b);
             proven += 1;
-            let v = verify(model, T, &g, human).unwrap();
-            assert!(
-                !v.unstable,
-                "{} (human {}): {g:?} broken: {v:?}",
-                model.name,
-                human.is_some()
-            );
+            assert_unbroken(model, &imp(k, b), human);
         }
     }
     assert!(proven >= 20, "only {proven} designs proven");
@@ -404,15 +408,8 @@ fn no_admittance_design_in_the_family_is_broken() {
             };
             proven += 1;
             without_human += usize::from(human.is_none());
-            let g: Gains =
-                AdmittanceGains::new(r.kp as f32, r.bp as f32, m as f32, b as f32).into();
-            let v = verify(model, T, &g, human).unwrap();
-            assert!(
-                !v.unstable,
-                "{} (human {}): {g:?} broken: {v:?}",
-                model.name,
-                human.is_some()
-            );
+            let g = Gains::admittance(r.kp as f32, r.bp as f32, m as f32, b as f32);
+            assert_unbroken(model, &g, human);
         }
     }
     // With the human bound, all but the 1 g part at 420 Hz; without it,
