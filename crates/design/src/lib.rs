@@ -6,6 +6,7 @@ pub mod analysis;
 pub mod designer;
 pub mod device;
 mod error;
+pub mod field;
 #[cfg(feature = "plot")]
 pub mod figures;
 pub mod host_ve;

@@ -248,13 +248,7 @@ impl DeviceModel {
                 .map_err(&err)?,
             coulomb_friction_n: raw
                 .coulomb_friction_n
-                .map(|v| {
-                    if v.is_finite() && v >= 0.0 {
-                        Ok(v)
-                    } else {
-                        Err(format!("coulomb_friction_n = {v} must be finite and >= 0"))
-                    }
-                })
+                .map(|v| crate::field::non_negative("coulomb_friction_n", v))
                 .transpose()
                 .map_err(&err)?,
         };
@@ -402,13 +396,7 @@ impl DeviceModel {
     }
 }
 
-fn scalar(name: &str, v: f64) -> Result<f64, String> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(format!("{name} = {v} must be finite and > 0"))
-    }
-}
+use crate::field::positive as scalar;
 
 /// `name` as an `r x c` matrix; `n` is the model's coordinate count (from
 /// `M`), named in the error.

@@ -226,28 +226,12 @@ impl Geometry {
                 .split(' ')
                 .next()
                 .unwrap_or(e.name);
-            format!("geometry.{field} = {}: {}", e.value, e.problem)
+            format!("geometry.{field} = {} {}", e.value, e.problem)
         })
     }
 }
 
-/// `name = v` is finite and positive.
-fn positive(name: &str, v: f64) -> Result<(), String> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(format!("{name} = {v}: must be finite and > 0"))
-    }
-}
-
-/// `name = v` is finite and not negative.
-fn at_least_zero(name: &str, v: f64) -> Result<(), String> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(())
-    } else {
-        Err(format!("{name} = {v}: must be finite and >= 0"))
-    }
-}
+use crate::field::{non_negative as at_least_zero, positive};
 
 /// The list `name` has an entry for each of `n` joints.
 fn count(name: &str, len: usize, n: usize) -> Result<(), String> {
@@ -389,7 +373,7 @@ impl LinkageFile {
     /// assert_eq!(hapkit.geometry.joints(), 1);
     /// let bad = text.replace("r_p_m = 0.005", "r_p_m = -0.005");
     /// let e = LinkageFile::from_toml(&bad, "hapkit.toml").unwrap_err();
-    /// assert_eq!(e.to_string(), "hapkit.toml: geometry.r_p_m = -0.005: must be finite and > 0");
+    /// assert_eq!(e.to_string(), "hapkit.toml: geometry.r_p_m = -0.005 must be finite and > 0");
     /// # Ok::<(), twoport_design::ModelError>(())
     /// ```
     pub fn from_toml(text: &str, source: &str) -> Result<Self, ModelError> {
@@ -485,7 +469,7 @@ mod tests {
     fn bad_fields_are_named() {
         assert_eq!(
             refused(HAPLY, "l_m = 0.07", "l_m = 0.0"),
-            "x.toml: geometry.l_m = 0: must be finite and > 0"
+            "x.toml: geometry.l_m = 0 must be finite and > 0"
         );
         assert_eq!(
             refused(HAPLY, "ratios = [1.0, 1.0]", "ratios = [1.0]"),
@@ -518,7 +502,7 @@ mod tests {
         );
         assert_eq!(
             refused(HAPLY, "handle_mass_kg = 0.02", "handle_mass_kg = -0.02"),
-            "x.toml: inertia.handle_mass_kg = -0.02: must be finite and >= 0"
+            "x.toml: inertia.handle_mass_kg = -0.02 must be finite and >= 0"
         );
         assert_eq!(
             refused(

@@ -5,6 +5,7 @@ use super::{Coupling, LayerPort, Scene, VeSpec, MAX_AXES, MAX_BLOCKS};
 use crate::engine::human::AxisValue;
 use crate::Error;
 use twoport_control::servo::Display;
+use twoport_design::field;
 
 impl Scene {
     /// Physical checks beyond the types; the message names the field.
@@ -419,18 +420,10 @@ impl Scene {
 
 /// `Ok` where `v` (the field `name`) is finite and > 0.
 fn pos(name: &str, v: f64) -> Result<(), Error> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(sim_err!("{name} = {v} must be finite and > 0"))
-    }
+    field::positive(name, v).map(drop).map_err(Error::Sim)
 }
 
 /// `Ok` where `v` (the field `name`) is finite and >= 0.
 fn nonneg(name: &str, v: f64) -> Result<(), Error> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(())
-    } else {
-        Err(sim_err!("{name} = {v} must be finite and >= 0"))
-    }
+    field::non_negative(name, v).map(drop).map_err(Error::Sim)
 }

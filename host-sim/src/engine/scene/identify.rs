@@ -63,9 +63,7 @@ impl IdentifySpec {
             ("identify.hold_b_nspm", self.hold_b_nspm),
             ("identify.start_s", self.start_s),
         ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(sim_err!("{name} = {v} must be finite and >= 0"));
-            }
+            twoport_design::field::non_negative(name, v).map_err(Error::Sim)?;
         }
         if self.periods < 2 {
             return Err(sim_err!(
