@@ -178,15 +178,17 @@ pub(crate) fn pil(a: &PilArgs) -> Result<(), Error> {
             1.0 / period
         ));
     }
+    let faults = faults(a, period)?;
+    let port = a.port.as_deref().map(link::SerialBoard::open).transpose()?;
     let run = Compared {
         a,
         side: None,
         ticks: (a.seconds / period).round() as u64,
-        faults: faults(a, period)?,
+        faults,
+        // (After the port opens: the in-process run's time starts here.)
         start: std::time::Instant::now(),
         deadline,
     };
-    let port = a.port.as_deref().map(link::SerialBoard::open).transpose()?;
     if a.fast || host_ve.is_some() {
         return run.wall_image(scene, port, host_ve);
     }
