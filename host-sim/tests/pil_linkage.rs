@@ -44,7 +44,7 @@ fn a_linkage_board_holds_the_floor_and_stops_after_a_link_loss() {
         let rest = device.spec().rest_rad.map(f64::from);
         let start = LinkagePlant::at_rest(&file, &rest);
         let (x0, _) = start.kinematics(&start.q).unwrap();
-        let floor = x0[2] - f64::from(FLOOR.below_m);
+        let floor = x0[2] + f64::from(FLOOR.surface_m);
         let s = &r.samples[2400];
         let into = floor - s.handle_m[2];
         assert!(

@@ -18,7 +18,7 @@
 //! - `python`: build the wheel into a venv of its own and run pytest.
 //! - `overhead [rounds]`: a design call from Python against the same work
 //!   from Rust, in turns (default 7 rounds); the ratio.
-//! - `fuzz [seconds]`: run each cargo-fuzz target (default 60 s each).
+//! - `fuzz [seconds]`: build and run each fuzz target (default 60 s each).
 //! - `accuracy`: regenerate docs/accuracy.md and docs/accuracy.png.
 
 mod ci;

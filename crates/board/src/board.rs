@@ -18,8 +18,7 @@ use heapless::{Deque, Vec};
 use twoport_control::drive::Drive;
 use twoport_control::experiment::Experiment;
 use twoport_control::homing::{Homing, HomingConfig};
-use twoport_control::servo::PortLayer;
-use twoport_control::servo::{Direct, Gains, SensorFrame, Servo, ServoOutput};
+use twoport_control::servo::{Gains, SensorFrame, Servo, ServoOutput};
 use twoport_control::world::World;
 use twoport_control::{Faults, Position};
 use twoport_link::{
@@ -34,16 +33,14 @@ pub type Frame = Vec<u8, MAX_FRAME>;
 /// telemetry in the other, so a telemetry flood never crowds out an answer.
 pub const TX_FRAMES: usize = 8;
 
-/// The portable firmware loop around a [`Servo`] of `N` axes (one by
-/// default) on the world `W`, with the port layer `L` ([`Direct`]: none),
-/// or around the [`Drive`] `D` that holds such a servo (a linkage's: its
-/// `N` motors turn joints). Each Cartesian axis has its own proven region
-/// of `R` grid points, load-cell scaling and homing; the handshake
-/// declares `N`.
-///
-/// [`Direct`]: twoport_control::servo::Direct
+/// The portable firmware loop around the [`Drive`] `D` of `N` axes (one by
+/// default): a [`Servo`] on its world with its port layer
+/// (`Board<Servo<UnilateralWall>, R>`), or a linkage's servo whose `N`
+/// motors turn joints. Each Cartesian axis has its own proven region of
+/// `R` grid points, load-cell scaling and homing; the handshake declares
+/// `N`.
 #[derive(Clone, Debug)]
-pub struct Board<W, const R: usize, const N: usize = 1, L = Direct, D = Servo<W, f32, N, L>> {
+pub struct Board<D, const R: usize, const N: usize = 1> {
     servo: D,
     regions: [Region<R>; N],
     decoder: Decoder,
@@ -120,15 +117,9 @@ pub struct Board<W, const R: usize, const N: usize = 1, L = Direct, D = Servo<W,
     /// Loop timing: the last tick's stages, its start, the overruns and
     /// the worst jitter since boot.
     timing: Timing,
-    _cartesian: core::marker::PhantomData<(W, L)>,
 }
 
-impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
-where
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
-{
+impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
     /// A board running `servo`, accepting gain changes on each axis inside
     /// its region of `regions`, and sending telemetry every
     /// `telemetry_every` ticks (0: never). It boots disarmed and
@@ -183,7 +174,6 @@ where
             index: [None; N],
             pending_index: [None; N],
             timing: Timing::default(),
-            _cartesian: core::marker::PhantomData,
         }
     }
 
@@ -262,7 +252,7 @@ where
     }
 
     /// The Cartesian servo (gains, safety state).
-    pub fn servo(&self) -> &Servo<W, f32, N, L> {
+    pub fn servo(&self) -> &Servo<D::World, f32, N, D::Layer> {
         self.servo.servo()
     }
 

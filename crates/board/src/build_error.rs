@@ -19,7 +19,8 @@ pub enum BuildError {
     Servo(AxisError<GainsError>),
     /// A linkage servo's.
     Linkage(LinkageError),
-    /// The rest pose is not one the kinematics serve.
+    /// The rest pose is not one the kinematics serve, or a wall placed
+    /// from it is out of range.
     RestPose,
 }
 

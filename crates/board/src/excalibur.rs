@@ -8,7 +8,7 @@
 use crate::io::{EncoderScale, IoScale};
 use crate::region::Region;
 use crate::Board;
-use crate::BuildError;
+use crate::{BuildError, Wall};
 use twoport_control::homing::HomingConfig;
 use twoport_control::passivity::{PassivityLimits, SeriesDamper};
 use twoport_control::servo::PortLayer;
@@ -36,20 +36,10 @@ pub const ENCODER: EncoderScale = EncoderScale {
 /// damping (45,770 N/m at 90 N s/m). The paper's 51,000 N/m sits on the
 /// boundary proven with no latency, and any latency leaves it outside.
 pub const COUPLING: ImpedanceGains = ImpedanceGains::new(43_500.0, 90.0);
-/// The image's wall, solid above its surface.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StiffWall {
-    /// Where its surface is (nm).
-    pub surface_nm: i32,
-    /// Its stiffness (N/m).
-    pub stiffness_npm: f32,
-    /// Its damping (N s/m).
-    pub damping_nspm: f32,
-}
-
-/// The wall: 1 cm up, 5 MN/m and 200 N s/m.
-pub const WALL: StiffWall = StiffWall {
-    surface_nm: 10_000_000,
+/// The wall: 1 cm up, solid above, 5 MN/m and 200 N s/m.
+pub const WALL: Wall = Wall {
+    surface_m: 0.010,
+    solid: Solid::Above,
     stiffness_npm: 5.0e6,
     damping_nspm: 200.0,
 };
@@ -92,14 +82,7 @@ pub(crate) fn wall_servo(
     safety: SafetyConfig,
 ) -> Result<Servo<UnilateralWall>, BuildError> {
     let enc = Encoder::new(ENCODER.bits, ENCODER.pm_per_count, 0, Position::ZERO)?;
-    let ve = UnilateralWall::new(
-        WALL.stiffness_npm,
-        WALL.damping_nspm,
-        Position::from_nm(WALL.surface_nm),
-        Solid::Above,
-        safety.period_s,
-        Position::ZERO,
-    )?;
+    let ve = WALL.build(0.0, safety.period_s, Position::ZERO)?;
     Ok(Servo::new([coupling.into()], [enc], [safety], ve)?)
 }
 
@@ -133,7 +116,7 @@ pub fn stiff_wall_servo_with_passivity(
 /// The passivity image's board: [`stiff_wall_board`] with the series
 /// damper between the actuator's port and the coupling.
 pub fn stiff_wall_board_with_passivity(
-) -> Result<Board<UnilateralWall, REGION_POINTS, 1, SeriesDamper>, BuildError> {
+) -> Result<Board<Servo<UnilateralWall, f32, 1, SeriesDamper>, REGION_POINTS>, BuildError> {
     Ok(wall_board(
         stiff_wall_servo_with_passivity()?,
         proven_region()?,
@@ -144,7 +127,7 @@ pub fn stiff_wall_board_with_passivity(
 
 /// The whole board: servo, region, telemetry rate, I/O scaling. It reads its
 /// own sensors; the processor-in-the-loop images add `.with_pil(true)`.
-pub fn stiff_wall_board() -> Result<Board<UnilateralWall, REGION_POINTS>, BuildError> {
+pub fn stiff_wall_board() -> Result<Board<Servo<UnilateralWall>, REGION_POINTS>, BuildError> {
     Ok(wall_board(
         stiff_wall_servo()?,
         proven_region()?,
@@ -161,7 +144,7 @@ pub(crate) fn wall_board<L: PortLayer, const R: usize>(
     region: Region<R>,
     telemetry_every: u32,
     homing: HomingConfig,
-) -> Board<UnilateralWall, R, 1, L> {
+) -> Board<Servo<UnilateralWall, f32, 1, L>, R> {
     Board::new(servo, [region], telemetry_every)
         .with_io([IoScale::EXCALIBUR])
         .with_homing([homing])

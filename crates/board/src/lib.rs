@@ -11,6 +11,7 @@ pub mod linkage;
 mod region;
 mod simulated;
 mod support;
+mod wall;
 
 pub use board::{Board, Frame, GUARD_TICKS, TX_FRAMES};
 pub use build_error::BuildError;
@@ -18,3 +19,4 @@ pub use io::{EncoderScale, IoScale, DUTY_FULL_SCALE};
 pub use region::{check_axes, Bound, Region, RegionError};
 pub use simulated::{SimAxis, Simulated};
 pub use support::{BoardSupport, RawSensors};
+pub use wall::Wall;

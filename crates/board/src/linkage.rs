@@ -17,7 +17,7 @@ pub mod touch;
 
 use crate::io::IoScale;
 use crate::region::{Bound, Region};
-use crate::{Board, BuildError};
+use crate::{Board, BuildError, Wall};
 use twoport_control::kinematics::{Delta, Kinematics, SerialArm};
 use twoport_control::linkage::{Gravity, Hardware, LinkageServo};
 use twoport_control::servo::ImpedanceGains;
@@ -32,20 +32,11 @@ pub const PERIOD_S: f32 = 1.0e-3;
 pub const GRASP_NSPM: f32 = 2.0;
 /// The coupling both images run: inside their regions at 2 N s/m.
 pub const COUPLING: ImpedanceGains = ImpedanceGains::new(1_500.0, 0.5);
-/// The floor a linkage image renders under its rest pose.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Floor {
-    /// How far under the handle's rest position its surface is (m).
-    pub below_m: f32,
-    /// Its stiffness (N/m).
-    pub stiffness_npm: f32,
-    /// Its damping (N s/m).
-    pub damping_nspm: f32,
-}
-
-/// The floor: 5 mm under the rest pose, 100 kN/m and 10 N s/m.
-pub const FLOOR: Floor = Floor {
-    below_m: 0.005,
+/// The floor a linkage image renders along its last axis: 5 mm under the
+/// rest pose, 100 kN/m and 10 N s/m.
+pub const FLOOR: Wall = Wall {
+    surface_m: -0.005,
+    solid: Solid::Below,
     stiffness_npm: 1.0e5,
     damping_nspm: 10.0,
 };
@@ -154,13 +145,7 @@ pub type LinkageWorld<const N: usize = 3> = PerAxis<UnilateralWall, N>;
 pub type LinkageImageServo<K, const N: usize = 3> = LinkageServo<K, LinkageWorld<N>, f32, N>;
 
 /// A linkage image's board.
-pub type LinkageBoard<K, const N: usize = 3> = Board<
-    LinkageWorld<N>,
-    REGION_POINTS,
-    N,
-    twoport_control::servo::Direct,
-    LinkageImageServo<K, N>,
->;
+pub type LinkageBoard<K, const N: usize = 3> = Board<LinkageImageServo<K, N>, REGION_POINTS, N>;
 
 /// The serial-arm image's board.
 pub type SerialArmBoard = LinkageBoard<SerialArm>;
@@ -244,21 +229,18 @@ where
         .forward(&spec.rest_rad)
         .map_err(|_| BuildError::RestPose)?
         .position_m;
-    let Floor {
-        below_m: below,
-        stiffness_npm: k,
-        damping_nspm: b,
-    } = FLOOR;
     let p = |x: f32| Position::from_m(x).ok_or(BuildError::RestPose);
-    let far = p(0.5)?;
-    let wall = |surface, solid, probe| {
-        UnilateralWall::new(k, b, surface, solid, PERIOD_S, probe).map_err(BuildError::Param)
+    // The other axes' walls: the floor's law, far above.
+    let far = Wall {
+        surface_m: 0.5,
+        solid: Solid::Above,
+        ..FLOOR
     };
     let last = N.checked_sub(1).ok_or(BuildError::RestPose)?;
-    let floor = wall(p(at[last] - below)?, Solid::Below, p(at[last])?)?;
+    let floor = FLOOR.build(at[last], PERIOD_S, p(at[last])?)?;
     let mut walls = [floor; N];
     for (i, w) in walls.iter_mut().enumerate().take(last) {
-        *w = wall(far, Solid::Above, p(at[i])?)?;
+        *w = far.build(0.0, PERIOD_S, p(at[i])?)?;
     }
     let world = PerAxis(walls);
     LinkageServo::on(

@@ -17,13 +17,13 @@ fn safety() -> SafetyConfig {
     common::safety()
 }
 
-fn board() -> Board<BilateralConstraint, 3> {
+fn board() -> Board<Servo<BilateralConstraint>, 3> {
     common::board(51_000.0, safety(), 10)
 }
 
 /// Tick 0 (the board then knows the dead-man is closed), calibrate where
 /// it stands and arm; the next tick is 1.
-fn arm(b: &mut Board<BilateralConstraint, 3>, raw: u32) {
+fn arm(b: &mut Board<Servo<BilateralConstraint>, 3>, raw: u32) {
     b.tick(&frame(0, raw));
     send(
         b,

@@ -17,7 +17,7 @@ fn safety() -> SafetyConfig {
     common::safety()
 }
 
-fn board() -> Board<BilateralConstraint, 3> {
+fn board() -> Board<Servo<BilateralConstraint>, 3> {
     common::board(51_000.0, safety(), 10)
 }
 
@@ -110,11 +110,14 @@ type LateRun = (Vec<ServoOutput<f32, 1>>, i16, twoport_link::Spec, u32, bool);
 /// Calibrate and tick `b` disarmed once with a slow tick, arm it, move the
 /// handle off the constraint for 199 ticks, then one tick whose force
 /// comes 24 counts after its sample and `after` on time.
-fn late_run<L: PortLayer>(b: Board<BilateralConstraint, 3, 1, L>, after: u16) -> LateRun {
+fn late_run<L: PortLayer>(
+    b: Board<Servo<BilateralConstraint, f32, 1, L>, 3>,
+    after: u16,
+) -> LateRun {
     let mut b = b;
     assert_eq!(b.spec().latency_budget_s, 3e-6);
     let mut io = Io::calibrating(0);
-    let tick = |b: &mut Board<BilateralConstraint, 3, 1, L>, io: &mut Io, k: u16| {
+    let tick = |b: &mut Board<Servo<BilateralConstraint, f32, 1, L>, 3>, io: &mut Io, k: u16| {
         io.queue(1 + k, Message::Heartbeat);
         b.poll_link(io);
         let out = b.control_tick(io);
@@ -338,7 +341,7 @@ fn deadline_misses_the_worst_jitter_and_latency_are_counted_and_reported() {
         ..Io::default()
     };
     // One tick, and the telemetry it sent.
-    let tick = |b: &mut Board<BilateralConstraint, 3>, io: &mut Io| {
+    let tick = |b: &mut Board<Servo<BilateralConstraint>, 3>, io: &mut Io| {
         b.control_tick(io);
         b.flush(io);
         io.messages()

@@ -8,7 +8,10 @@ use twoport_link::{
     encode, Axes, BoardMode, Decoder, Message, ModeRefusal, ModeRequest, VeParam, MAX_FRAME,
 };
 
-type Wall = twoport_board::Board<twoport_control::ve::UnilateralWall, { excalibur::REGION_POINTS }>;
+type Wall = twoport_board::Board<
+    twoport_control::Servo<twoport_control::ve::UnilateralWall>,
+    { excalibur::REGION_POINTS },
+>;
 
 fn send(b: &mut Wall, seq: u16, m: Message) -> Vec<Message> {
     let mut buf = [0u8; MAX_FRAME];

@@ -19,52 +19,75 @@ fn shipped(file: &str) -> LinkageFile {
     LinkageFile::load(std::path::Path::new(&path)).unwrap()
 }
 
-/// A hand: mass, damping and stiffness matrices (kg, N s/m, N/m), each
-/// symmetric positive semidefinite, attached at the handle.
-struct Hand {
+/// A mechanical network: mass, damping and stiffness matrices (kg, N s/m,
+/// N/m), each symmetric positive semidefinite; a hand is one attached at
+/// the handle.
+struct Network {
     m: DMatrix<f64>,
     d: DMatrix<f64>,
     k: DMatrix<f64>,
 }
 
-/// The spectral radius of the loop at `pose` with `hand`, coupling `(k, b)`.
-fn radius(pose: &PoseDynamics, hand: &Hand, (kc, bc): (f64, f64), t: f64) -> f64 {
-    let n = pose.q_rad.len();
-    let m = &pose.mass_kg + &hand.m;
-    let minv = m.try_inverse().unwrap();
-    let d = &pose.damping_nspm + &hand.d;
-    // [x; v]' = A [x; v] + B f, then the hold: exp([[A, B], [0, 0]] T).
-    let mut big = DMatrix::zeros(3 * n, 3 * n);
-    let a_vx = -&minv * &hand.k;
-    let a_vv = -&minv * d;
-    for i in 0..n {
-        big[(i, n + i)] = 1.0;
-        for j in 0..n {
-            big[(n + i, j)] = a_vx[(i, j)];
-            big[(n + i, n + j)] = a_vv[(i, j)];
-            big[(n + i, 2 * n + j)] = minv[(i, j)];
-        }
-    }
+/// The spectral radius of the loop at `pose` with `hand`, coupling `(k, b)`:
+/// the hand's matrices add to the handle's.
+fn radius(pose: &PoseDynamics, hand: &Network, (kc, bc): (f64, f64), t: f64) -> f64 {
+    let network = Network {
+        m: &pose.mass_kg + &hand.m,
+        d: &pose.damping_nspm + &hand.d,
+        k: hand.k.clone(),
+    };
+    sampled_radius(&network, pose.q_rad.len(), (kc, bc), t)
+}
+
+/// The spectral radius of the sampled loop around a mechanical network
+/// `M q'' + D q' + K q = E f` whose first `n` coordinates are the handle's
+/// position, where the coupling's force acts: the network and the force
+/// held over each tick discretised together, `exp([[A, B], [0, 0]] T)`,
+/// and `f_n = -k_c x_n - b_c (x_n - x_{n-1})/T`. The state is
+/// `[q, q', x_prev]`.
+fn sampled_radius(network: &Network, n: usize, (kc, bc): (f64, f64), t: f64) -> f64 {
+    let q = network.m.nrows();
+    let minv = network.m.clone().try_inverse().unwrap();
+    let mut big = DMatrix::zeros(2 * q + n, 2 * q + n);
+    big.view_mut((0, q), (q, q))
+        .copy_from(&DMatrix::identity(q, q));
+    big.view_mut((q, 0), (q, q))
+        .copy_from(&(-&minv * &network.k));
+    big.view_mut((q, q), (q, q))
+        .copy_from(&(-&minv * &network.d));
+    big.view_mut((q, 2 * q), (q, n))
+        .copy_from(&minv.columns(0, n));
     let e = expm_balanced(&(big * t)).unwrap();
-    let ad = e.view((0, 0), (2 * n, 2 * n)).into_owned();
-    let bd = e.view((0, 2 * n), (2 * n, n)).into_owned();
-    // f_n = -k x_n - b (x_n - x_{n-1})/T; the state is [x, v, x_prev].
-    let mut cl = DMatrix::zeros(3 * n, 3 * n);
-    let mut gain = DMatrix::zeros(n, 3 * n);
-    for i in 0..n {
-        gain[(i, i)] = -(kc + bc / t);
-        gain[(i, 2 * n + i)] = bc / t;
+    let ad = e.view((0, 0), (2 * q, 2 * q)).into_owned();
+    let bd = e.view((0, 2 * q), (2 * q, n)).into_owned();
+    let mut gain = DMatrix::zeros(n, 2 * q + n);
+    for j in 0..n {
+        gain[(j, j)] = -(kc + bc / t);
+        gain[(j, 2 * q + j)] = bc / t;
     }
-    let top = &ad * DMatrix::identity(2 * n, 3 * n) + &bd * gain;
-    cl.view_mut((0, 0), (2 * n, 3 * n)).copy_from(&top);
-    for i in 0..n {
-        cl[(2 * n + i, i)] = 1.0;
+    let mut cl = DMatrix::zeros(2 * q + n, 2 * q + n);
+    let top = &ad * DMatrix::identity(2 * q, 2 * q + n) + &bd * gain;
+    cl.view_mut((0, 0), (2 * q, 2 * q + n)).copy_from(&top);
+    for j in 0..n {
+        cl[(2 * q + j, j)] = 1.0;
     }
     twoport_design::linalg::eigenvalues(&cl)
         .unwrap()
         .iter()
         .map(|z| z.norm())
         .fold(0.0, f64::max)
+}
+
+/// Two nodes joined by `series` (each with `own` to ground): the matrix
+/// `[[a + s, -s], [-s, b + s]]` a spring or a damper between them adds.
+fn joined(a: &DMatrix<f64>, b: &DMatrix<f64>, series: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = a.nrows();
+    let mut m = DMatrix::zeros(2 * n, 2 * n);
+    m.view_mut((0, 0), (n, n)).copy_from(&(a + series));
+    m.view_mut((0, n), (n, n)).copy_from(&(-series));
+    m.view_mut((n, 0), (n, n)).copy_from(&(-series));
+    m.view_mut((n, n), (n, n)).copy_from(&(b + series));
+    m
 }
 
 fn rng(seed: &mut u64) -> f64 {
@@ -82,11 +105,11 @@ fn psd(n: usize, (lo, hi): (f64, f64), seed: &mut u64) -> DMatrix<f64> {
 }
 
 /// Hands that hold every direction but `x` stiffly, with nothing along it.
-fn holding(x: &[f64], stiffness: f64) -> Hand {
+fn holding(x: &[f64], stiffness: f64) -> Network {
     let n = x.len();
     let x = DVector::from_column_slice(x);
     let k = (DMatrix::identity(n, n) - &x * x.transpose()) * stiffness;
-    Hand {
+    Network {
         m: DMatrix::zeros(n, n),
         d: DMatrix::zeros(n, n),
         k,
@@ -115,7 +138,7 @@ fn random_n_port_hands_do_not_break_the_workspace_design() {
             let mut checked = 0;
             for pose in std::iter::once(&d.binding.pose).chain(poses.iter().step_by(10)) {
                 for _ in 0..20 {
-                    let hand = Hand {
+                    let hand = Network {
                         m: psd(n, (-4.0, 0.0), &mut seed),
                         d: psd(n, (-3.0, 2.0), &mut seed) + DMatrix::identity(n, n) * grasp,
                         k: psd(n, (0.0, 7.0), &mut seed),
@@ -146,58 +169,29 @@ fn random_n_port_hands_do_not_break_the_workspace_design() {
 /// paper's `Z_max = b_z + k_z/s`: that spring and damper (isotropic) in
 /// series with the passive N-port `inner` (mass, damping and stiffness to
 /// ground at the node between them), and a grasp damper `grasp` at the
-/// handle. State `[x, v, y, w, x_prev]`.
+/// handle. The node behind `Z_max` gets 0.1 g in every direction, so that
+/// it has dynamics of its own.
 fn radius_bounded(
     pose: &PoseDynamics,
-    inner: &Hand,
+    inner: &Network,
     grasp: f64,
     (kc, bc): (f64, f64),
     t: f64,
 ) -> f64 {
     let n = pose.q_rad.len();
-    let (bz, kz) = (
-        twoport_design::network::HumanBound::PAPER.damping_nspm,
-        twoport_design::network::HumanBound::PAPER.stiffness_npm,
-    );
+    let bound = twoport_design::network::HumanBound::PAPER;
     let i = DMatrix::<f64>::identity(n, n);
-    let minv = pose.mass_kg.clone().try_inverse().unwrap();
-    let mpinv = (&inner.m + &i * 1e-4).try_inverse().unwrap();
-    let d = &pose.damping_nspm + &i * grasp;
-    // [x, v, y, w]' = A [..] + B f.
-    let mut big = DMatrix::zeros(5 * n, 5 * n);
-    let mut put = |r: usize, c: usize, m: &DMatrix<f64>| {
-        big.view_mut((r * n, c * n), (n, n)).copy_from(m);
+    let zero = DMatrix::zeros(n, n);
+    let network = Network {
+        m: joined(&pose.mass_kg, &(&inner.m + &i * 1e-4), &zero),
+        d: joined(
+            &(&pose.damping_nspm + &i * grasp),
+            &inner.d,
+            &(&i * bound.damping_nspm),
+        ),
+        k: joined(&zero, &inner.k, &(&i * bound.stiffness_npm)),
     };
-    put(0, 1, &i);
-    put(1, 0, &(-&minv * kz));
-    put(1, 1, &(-&minv * (&d + &i * bz)));
-    put(1, 2, &(&minv * kz));
-    put(1, 3, &(&minv * bz));
-    put(1, 4, &minv);
-    put(2, 3, &i);
-    put(3, 0, &(&mpinv * kz));
-    put(3, 1, &(&mpinv * bz));
-    put(3, 2, &(-&mpinv * (&inner.k + &i * kz)));
-    put(3, 3, &(-&mpinv * (&inner.d + &i * bz)));
-    let e = expm_balanced(&(big * t)).unwrap();
-    let ad = e.view((0, 0), (4 * n, 4 * n)).into_owned();
-    let bd = e.view((0, 4 * n), (4 * n, n)).into_owned();
-    let mut gain = DMatrix::zeros(n, 5 * n);
-    for j in 0..n {
-        gain[(j, j)] = -(kc + bc / t);
-        gain[(j, 4 * n + j)] = bc / t;
-    }
-    let mut cl = DMatrix::zeros(5 * n, 5 * n);
-    let top = &ad * DMatrix::identity(4 * n, 5 * n) + &bd * gain;
-    cl.view_mut((0, 0), (4 * n, 5 * n)).copy_from(&top);
-    for j in 0..n {
-        cl[(4 * n + j, j)] = 1.0;
-    }
-    twoport_design::linalg::eigenvalues(&cl)
-        .unwrap()
-        .iter()
-        .map(|z| z.norm())
-        .fold(0.0, f64::max)
+    sampled_radius(&network, n, (kc, bc), t)
 }
 
 /// Under the paper's bound on the grasp: 0.1 % inside the bounded design,
@@ -230,7 +224,7 @@ fn hands_under_the_papers_bound_do_not_break_the_bounded_design() {
             let t = l.period_s;
             for pose in std::iter::once(&d.binding.pose).chain(poses.iter().step_by(10)) {
                 for _ in 0..10 {
-                    let inner = Hand {
+                    let inner = Network {
                         m: psd(n, (-3.0, 0.0), &mut seed),
                         d: psd(n, (-3.0, 3.0), &mut seed),
                         k: psd(n, (0.0, 6.0), &mut seed),
@@ -239,14 +233,14 @@ fn hands_under_the_papers_bound_do_not_break_the_bounded_design() {
                     assert!(r < 1.0 + 1e-9, "{name}, grasp {grasp}: radius {r}");
                 }
             }
-            let none = Hand {
+            let none = Network {
                 m: DMatrix::zeros(n, n),
                 d: DMatrix::zeros(n, n),
                 k: DMatrix::zeros(n, n),
             };
             let past = radius(
                 &d.binding.pose,
-                &Hand {
+                &Network {
                     d: DMatrix::identity(n, n) * grasp,
                     ..none
                 },

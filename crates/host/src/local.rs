@@ -12,35 +12,24 @@ use twoport_config::{RamFlash, Store};
 use twoport_control::drive::Drive;
 use twoport_control::kinematics::{Delta, SerialArm};
 use twoport_control::passivity::SeriesDamper;
-use twoport_control::servo::{Direct, PortLayer, Servo};
+use twoport_control::servo::Servo;
 use twoport_control::ve::UnilateralWall;
-use twoport_control::world::World;
 
 /// A board image's loop, in this process: the Excalibur's plain image,
-/// its passivity image (`L`, the series damper), its three-axis image
+/// its passivity image (`D` with the series damper), its three-axis image
 /// (`N` = 3), or a linkage image (`D`, the linkage's servo, with a region
 /// of `R` points).
-pub struct LocalBoard<
-    W = UnilateralWall,
-    const N: usize = 1,
-    L = Direct,
-    D = Servo<W, f32, N, L>,
-    const R: usize = REGION_POINTS,
-> {
-    board: Board<W, R, N, L, D>,
+pub struct LocalBoard<D = Servo<UnilateralWall>, const N: usize = 1, const R: usize = REGION_POINTS>
+{
+    board: Board<D, R, N>,
     link: ByteQueues,
     /// Its stored configuration, in RAM as on the QEMU images.
     store: Store<RamFlash<512, 256>>,
 }
 
-impl<W, L, D, const N: usize, const R: usize> LocalBoard<W, N, L, D, R>
-where
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
-{
+impl<D: Drive<N>, const N: usize, const R: usize> LocalBoard<D, N, R> {
     /// `board`, driven by the link's sensor frames.
-    fn driven(board: Board<W, R, N, L, D>) -> Self {
+    fn driven(board: Board<D, R, N>) -> Self {
         let mut board = board.with_pil(true);
         // As the QEMU images boot: the configuration from a RAM flash.
         let mut store = Store::new(RamFlash::<512, 256>::new(), 0, 256);
@@ -51,14 +40,7 @@ where
             store,
         }
     }
-}
 
-impl<W, L, D, const N: usize, const R: usize> LocalBoard<W, N, L, D, R>
-where
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
-{
     /// The same board with each axis homing with its `cfg` (e.g. on an
     /// encoder's index).
     pub fn with_homing(mut self, cfg: [twoport_control::homing::HomingConfig; N]) -> Self {
@@ -76,7 +58,7 @@ impl LocalBoard {
     }
 }
 
-impl LocalBoard<UnilateralWall, 1, SeriesDamper> {
+impl LocalBoard<Servo<UnilateralWall, f32, 1, SeriesDamper>> {
     /// The passivity image ([`excalibur::stiff_wall_board_with_passivity`]).
     pub fn excalibur_with_passivity() -> Result<Self, LinkError> {
         excalibur::stiff_wall_board_with_passivity()
@@ -86,8 +68,7 @@ impl LocalBoard<UnilateralWall, 1, SeriesDamper> {
 }
 
 /// The 4 kHz image's loop.
-pub type LocalFast =
-    LocalBoard<UnilateralWall, 1, Direct, Servo<UnilateralWall>, { fast::REGION_POINTS }>;
+pub type LocalFast = LocalBoard<Servo<UnilateralWall>, 1, { fast::REGION_POINTS }>;
 
 impl LocalFast {
     /// The 4 kHz image ([`fast::board`]).
@@ -99,8 +80,7 @@ impl LocalFast {
 }
 
 /// The three-axis image's loop.
-pub type LocalXyz =
-    LocalBoard<xyz::XyzWorld, 3, Direct, Servo<xyz::XyzWorld, f32, 3>, { xyz::REGION_POINTS }>;
+pub type LocalXyz = LocalBoard<Servo<xyz::XyzWorld, f32, 3>, 3, { xyz::REGION_POINTS }>;
 
 impl LocalXyz {
     /// The three-axis image ([`xyz::board`]).
@@ -112,22 +92,12 @@ impl LocalXyz {
 }
 
 /// The serial-arm image's loop.
-pub type LocalSerialArm = LocalBoard<
-    linkage_image::LinkageWorld,
-    3,
-    Direct,
-    linkage_image::LinkageImageServo<SerialArm>,
-    { linkage_image::REGION_POINTS },
->;
+pub type LocalSerialArm =
+    LocalBoard<linkage_image::LinkageImageServo<SerialArm>, 3, { linkage_image::REGION_POINTS }>;
 
 /// The delta image's loop.
-pub type LocalDelta = LocalBoard<
-    linkage_image::LinkageWorld,
-    3,
-    Direct,
-    linkage_image::LinkageImageServo<Delta>,
-    { linkage_image::REGION_POINTS },
->;
+pub type LocalDelta =
+    LocalBoard<linkage_image::LinkageImageServo<Delta>, 3, { linkage_image::REGION_POINTS }>;
 
 impl LocalSerialArm {
     /// The serial-arm image ([`linkage_image::serial_arm_board`]).
@@ -147,12 +117,7 @@ impl LocalDelta {
     }
 }
 
-impl<W, L, D, const N: usize, const R: usize> BoardPort for LocalBoard<W, N, L, D, R>
-where
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
-{
+impl<D: Drive<N>, const N: usize, const R: usize> BoardPort for LocalBoard<D, N, R> {
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
         // What the images do: the control tick runs each sensor frame as
         // it completes, and the main loop sends what was queued.

@@ -19,8 +19,6 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 use twoport_board::{Board, BoardSupport, RawSensors};
 use twoport_control::drive::Drive;
-use twoport_control::servo::PortLayer;
-use twoport_control::world::World;
 
 /// A device's I/O as the PC's loop uses it: one exchange a tick.
 pub trait DeviceIo<const N: usize>: Send {
@@ -257,16 +255,11 @@ impl<Io: DeviceIo<N>, const N: usize> BoardSupport<N> for PcSupport<Io, N> {
 
 /// `board`, accepting gains outside its proven region where the user
 /// chose so (`why`), the choice logged for the device at `path`.
-pub fn accept_unproven_gains<W, L, D, const N: usize, const R: usize>(
-    board: Board<W, R, N, L, D>,
+pub fn accept_unproven_gains<D: Drive<N>, const N: usize, const R: usize>(
+    board: Board<D, R, N>,
     why: Option<&str>,
     path: &str,
-) -> Board<W, R, N, L, D>
-where
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
-{
+) -> Board<D, R, N> {
     match why {
         Some(why) => {
             eprintln!(
@@ -343,7 +336,7 @@ impl Drop for LoopThread {
 }
 
 /// A board image's loop on the PC against the device `Io`: the image's
-/// board `Board<W, R, N, L, D>` ticking every period.
+/// board `Board<D, R, N>` ticking every period.
 pub struct PcBoard {
     shared: Arc<(Mutex<Shared>, Condvar)>,
     ticker: Option<Box<dyn Ticker>>,
@@ -367,17 +360,15 @@ impl PcBoard {
     /// `excalibur::pc`'s, for up to 5 ms). A force later than they allow
     /// faults the board to zero force ("force late"), unless a passivity
     /// layer guards its port, as on every image for the PC's loop.
-    pub fn start<Io, W, L, D, const N: usize, const R: usize>(
-        board: Board<W, R, N, L, D>,
+    pub fn start<Io, D, const N: usize, const R: usize>(
+        board: Board<D, R, N>,
         io: Io,
         period_s: f64,
         mut ticker: impl Ticker,
     ) -> Result<Self, LinkError>
     where
         Io: DeviceIo<N> + 'static,
-        W: World<f32, N> + Send + 'static,
-        L: PortLayer + Send + 'static,
-        D: Drive<N, World = W, Layer = L> + Send + 'static,
+        D: Drive<N> + Send + 'static,
     {
         if !(period_s.is_finite() && period_s > 1e-6 && period_s < 1.0) {
             return Err(LinkError::Device(format!(
@@ -436,21 +427,15 @@ impl PcBoard {
 }
 
 /// The loop: the image's board against the device, one tick a call.
-struct Looped<Io, W, L, D, const N: usize, const R: usize> {
-    board: Board<W, R, N, L, D>,
+struct Looped<Io, D, const N: usize, const R: usize> {
+    board: Board<D, R, N>,
     support: PcSupport<Io, N>,
     period_s: f64,
     last_start: Option<Instant>,
     slot: usize,
 }
 
-impl<Io, W, L, D, const N: usize, const R: usize> Looped<Io, W, L, D, N, R>
-where
-    Io: DeviceIo<N>,
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
-{
+impl<Io: DeviceIo<N>, D: Drive<N>, const N: usize, const R: usize> Looped<Io, D, N, R> {
     /// One tick, its timing recorded; `false` once told to stop or the
     /// device has failed, after zero force with the outputs off.
     fn tick(&mut self) -> bool {
@@ -508,19 +493,13 @@ fn record(ring: &mut Vec<f64>, slot: usize, v: f64) {
 /// latency gate is off: what it shows is the image, the driver and the
 /// device, tick by tick, whatever the machine's load. For tests and
 /// studies of a driver; a device is run by [`PcBoard`].
-pub struct SteppedPc<Io, W, L, D, const N: usize, const R: usize> {
-    looped: Looped<Io, W, L, D, N, R>,
+pub struct SteppedPc<Io, D, const N: usize, const R: usize> {
+    looped: Looped<Io, D, N, R>,
 }
 
-impl<Io, W, L, D, const N: usize, const R: usize> SteppedPc<Io, W, L, D, N, R>
-where
-    Io: DeviceIo<N>,
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
-{
+impl<Io: DeviceIo<N>, D: Drive<N>, const N: usize, const R: usize> SteppedPc<Io, D, N, R> {
     /// `board` against `io`, stepped by reads of its link.
-    pub fn new(board: Board<W, R, N, L, D>, io: Io) -> Self {
+    pub fn new(board: Board<D, R, N>, io: Io) -> Self {
         SteppedPc {
             looped: Looped {
                 board,
@@ -534,12 +513,8 @@ where
     }
 }
 
-impl<Io, W, L, D, const N: usize, const R: usize> BoardPort for SteppedPc<Io, W, L, D, N, R>
-where
-    Io: DeviceIo<N>,
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
+impl<Io: DeviceIo<N>, D: Drive<N>, const N: usize, const R: usize> BoardPort
+    for SteppedPc<Io, D, N, R>
 {
     fn send(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
         self.looped.support.shared().send(bytes)

@@ -9,6 +9,7 @@ use std::time::{Duration, Instant};
 use twoport_board::excalibur::{self, REGION_POINTS};
 use twoport_board::{Board, BoardSupport, IoScale, RawSensors, SimAxis, Simulated};
 use twoport_control::ve::UnilateralWall;
+use twoport_control::Servo;
 
 /// How a simulated board's ticks keep time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -25,7 +26,7 @@ pub enum Pace {
 /// layer) running on one simulated axis: the actuator's 0.93 kg with
 /// 4 N s/m, a hand pushing with a constant force, a 1 µm encoder.
 pub struct SimulatedBoard {
-    board: Board<UnilateralWall, REGION_POINTS>,
+    board: Board<Servo<UnilateralWall>, REGION_POINTS>,
     io: Simulated<ByteQueues, 1>,
     pace: Pace,
     last: Option<Instant>,

@@ -93,16 +93,11 @@ fn main() -> ! {
 
 /// Lockstep: each control tick waits for the host's sensor frame.
 #[cfg(not(feature = "sim-device"))]
-fn run_lockstep<W, L, D, const R: usize, const N: usize>(
-    mut board: twoport_board::Board<W, R, N, L, D>,
+fn run_lockstep<D: twoport_control::drive::Drive<N>, const R: usize, const N: usize>(
+    mut board: twoport_board::Board<D, R, N>,
     mut io: uart::Uart,
     mut store: Store<RamFlash<512, 256>>,
-) -> !
-where
-    W: twoport_control::world::World<f32, N>,
-    L: twoport_control::servo::PortLayer,
-    D: twoport_control::drive::Drive<N, World = W, Layer = L>,
-{
+) -> ! {
     hprintln!("twoport-an386: board loop up, waiting on UART0");
     #[cfg(feature = "watchdog-test")]
     let mut armed_ticks = 0u32;
@@ -149,7 +144,7 @@ const HAND_N: f32 = 2.0;
 #[cfg(feature = "sim-device")]
 fn run_free(
     mut board: twoport_board::Board<
-        twoport_control::ve::UnilateralWall,
+        twoport_control::Servo<twoport_control::ve::UnilateralWall>,
         { twoport_board::excalibur::REGION_POINTS },
     >,
     mut io: uart::Uart,

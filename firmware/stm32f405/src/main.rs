@@ -76,11 +76,15 @@ pub const AXES: usize = 1;
 pub const AXES: usize = 3;
 
 #[cfg(not(any(feature = "xyz", feature = "fast")))]
-type TheBoard =
-    twoport_board::Board<twoport_control::ve::UnilateralWall, { excalibur::REGION_POINTS }>;
+type TheBoard = twoport_board::Board<
+    twoport_control::Servo<twoport_control::ve::UnilateralWall>,
+    { excalibur::REGION_POINTS },
+>;
 #[cfg(feature = "fast")]
-type TheBoard =
-    twoport_board::Board<twoport_control::ve::UnilateralWall, { excalibur::fast::REGION_POINTS }>;
+type TheBoard = twoport_board::Board<
+    twoport_control::Servo<twoport_control::ve::UnilateralWall>,
+    { excalibur::fast::REGION_POINTS },
+>;
 #[cfg(all(feature = "xyz", not(any(feature = "serial-arm", feature = "delta"))))]
 type TheBoard = excalibur::xyz::XyzBoard;
 #[cfg(feature = "serial-arm")]

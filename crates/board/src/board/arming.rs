@@ -17,18 +17,11 @@ use super::Board;
 use crate::support::BoardSupport;
 use twoport_control::drive::Drive;
 use twoport_control::homing::{Homing, HomingState};
-use twoport_control::servo::PortLayer;
 use twoport_control::servo::ServoOutput;
-use twoport_control::world::World;
 use twoport_control::Faults;
 use twoport_link::{Axes, BoardMode, Message, ModeRefusal, ModeRequest, Status};
 
-impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
-where
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
-{
+impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
     /// Where the state machine is.
     pub fn mode(&self) -> BoardMode {
         self.mode

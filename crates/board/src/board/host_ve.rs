@@ -5,7 +5,6 @@
 
 use super::Board;
 use twoport_control::drive::Drive;
-use twoport_control::servo::PortLayer;
 use twoport_control::world::{Held, World};
 use twoport_control::{Faults, Position};
 use twoport_link::{BoardMode, Message, ModeRefusal, ModeRequest, VeSource, VeUpdate};
@@ -30,12 +29,7 @@ impl<const N: usize> HostVe<N> {
     }
 }
 
-impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
-where
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
-{
+impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
     /// Where the VE the coupling holds runs.
     pub fn ve_source(&self) -> VeSource {
         match &self.host {

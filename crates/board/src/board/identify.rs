@@ -18,17 +18,11 @@ use super::Board;
 use twoport_control::drive::Drive;
 use twoport_control::experiment::Experiment;
 use twoport_control::multisine::Multisine;
-use twoport_control::servo::{Display, Gains, ImpedanceGains, PortLayer};
-use twoport_control::world::World;
+use twoport_control::servo::{Display, Gains, ImpedanceGains};
 use twoport_control::ImpedanceCoupling;
 use twoport_link::{BoardMode, ExperimentRequest as Request, ModeRefusal, ModeRequest};
 
-impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
-where
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
-{
+impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
     /// The experiment in progress, if any.
     pub fn experiment(&self) -> Option<&Experiment<N>> {
         self.experiment.as_ref()

@@ -5,7 +5,6 @@
 use super::Board;
 use twoport_control::drive::Drive;
 use twoport_control::servo::PortLayer;
-use twoport_control::world::World;
 use twoport_control::Faults;
 use twoport_link::BoardMode;
 
@@ -51,12 +50,7 @@ impl Timing {
     }
 }
 
-impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
-where
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
-{
+impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
     /// The same board stating the rate of its support's
     /// [`cycles`](crate::BoardSupport::cycles) count (Hz: its core clock; in an
     /// emulator that counts instructions, the core clock at one cycle per
@@ -110,7 +104,7 @@ where
         // and a tick that ends them may run long).
         let coupled = self.mode == BoardMode::Armed && self.outputs_on;
         if coupled && self.late_after.is_some_and(|budget| latency > budget) {
-            if L::GUARDS_LATENCY {
+            if <D::Layer as PortLayer>::GUARDS_LATENCY {
                 // Past the proof, the passivity layer keeps the port
                 // passive: the loop runs on with it engaged, until it has
                 // been on time for a while.

@@ -9,17 +9,10 @@ use twoport_config::{Config, HomingSetup, Limits, LoadCell, Store};
 use twoport_control::drive::Drive;
 use twoport_control::homing::HomingConfig;
 use twoport_control::servo::Gains;
-use twoport_control::servo::PortLayer;
-use twoport_control::world::World;
 use twoport_control::{Position, SafetyConfig};
 use twoport_link::{BoardMode, ConfigFallback, ConfigSource, Message, ModeRefusal, ModeRequest};
 
-impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
-where
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
-{
+impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
     /// The configuration in force, each axis's as a record would store it.
     pub fn config(&self) -> [Config; N] {
         let limits = *self.servo.servo().safety().configs();

@@ -3,16 +3,9 @@
 
 use super::Board;
 use twoport_control::drive::Drive;
-use twoport_control::servo::PortLayer;
-use twoport_control::world::World;
 use twoport_link::{AxisSpec, Message, Spec};
 
-impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
-where
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
-{
+impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
     /// The board's specification: its period, each axis's safety limits and
     /// proven region, and the telemetry rate in force.
     pub fn spec(&self) -> Spec {

@@ -4,16 +4,10 @@
 
 use super::Board;
 use twoport_control::drive::Drive;
-use twoport_control::servo::PortLayer;
 use twoport_control::world::World;
 use twoport_link::{BoardMode, Message, ModeRefusal, ModeRequest, VeParam};
 
-impl<W, L, D, const R: usize, const N: usize> Board<W, R, N, L, D>
-where
-    W: World<f32, N>,
-    L: PortLayer,
-    D: Drive<N, World = W, Layer = L>,
-{
+impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
     /// `SetVeParam`: disarmed only; an axis the board has not, a value
     /// out of range or a parameter its VE has not are refused
     /// (`BadVeParam`), the VE unchanged.

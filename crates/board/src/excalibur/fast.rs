@@ -8,7 +8,7 @@ use super::{safety_at, wall_servo, BuildError};
 use crate::Board;
 use twoport_control::homing::HomingConfig;
 use twoport_control::ve::UnilateralWall;
-use twoport_control::{ImpedanceGains, Position, SafetyConfig};
+use twoport_control::{ImpedanceGains, Position, SafetyConfig, Servo};
 
 crate::region::shipped_region!(
     /// The proven region (impedance display, paper human bound,
@@ -35,7 +35,7 @@ pub const fn safety() -> SafetyConfig {
 }
 
 /// The whole 4 kHz board.
-pub fn board() -> Result<Board<UnilateralWall, REGION_POINTS>, BuildError> {
+pub fn board() -> Result<Board<Servo<UnilateralWall>, REGION_POINTS>, BuildError> {
     Ok(super::wall_board(
         wall_servo(COUPLING, safety())?,
         proven_region()?,

@@ -12,7 +12,7 @@ use crate::Board;
 use twoport_control::passivity::{PassivityLimits, SeriesDamper};
 use twoport_control::servo::OnDemand;
 use twoport_control::ve::UnilateralWall;
-use twoport_control::ImpedanceGains;
+use twoport_control::{ImpedanceGains, Servo};
 
 crate::region::shipped_region!(
     /// The proven region (impedance display, paper human bound, T = 1 ms,
@@ -25,7 +25,8 @@ crate::region::shipped_region!(
 pub const COUPLING: ImpedanceGains = ImpedanceGains::new(3_000.0, 4.0);
 
 /// The whole board, for the PC's loop.
-pub fn board() -> Result<Board<UnilateralWall, REGION_POINTS, 1, OnDemand<SeriesDamper>>, BuildError>
+pub fn board(
+) -> Result<Board<Servo<UnilateralWall, f32, 1, OnDemand<SeriesDamper>>, REGION_POINTS>, BuildError>
 {
     let port = ACTUATOR_PORT;
     let mut limits = PassivityLimits::for_device(port.mass_kg, PERIOD_S, safety().peak_force_n)?;

@@ -52,7 +52,7 @@ pub type XyzWorld = Vbb<f32, MAX_BLOCKS>;
 pub type XyzServo = Servo<XyzWorld, f32, 3>;
 
 /// The image's board type.
-pub type XyzBoard = Board<XyzWorld, REGION_POINTS, 3>;
+pub type XyzBoard = Board<Servo<XyzWorld, f32, 3>, REGION_POINTS, 3>;
 
 /// The image's world, its cursor at rest at the workspace's centre, 10 mm
 /// above the floor.

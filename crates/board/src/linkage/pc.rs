@@ -48,8 +48,7 @@ pub type PcLayer = OnDemand<SeriesDamper>;
 pub type PcServo<K, const N: usize> = LinkageServo<K, LinkageWorld<N>, f32, N, PcLayer>;
 
 /// A PC image's board.
-pub type PcLinkageBoard<K, const N: usize> =
-    Board<LinkageWorld<N>, REGION_POINTS, N, PcLayer, PcServo<K, N>>;
+pub type PcLinkageBoard<K, const N: usize> = Board<PcServo<K, N>, REGION_POINTS, N>;
 
 impl<const N: usize> PcImage<N> {
     /// Its region, stating its latency.

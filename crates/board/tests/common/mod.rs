@@ -18,7 +18,7 @@ pub fn safety() -> SafetyConfig {
 }
 
 /// The board every test drives.
-pub type TestBoard = Board<BilateralConstraint, 3>;
+pub type TestBoard = Board<Servo<BilateralConstraint>, 3>;
 
 /// A proven region of three damping points (N s/m) and their largest
 /// stiffness (N/m).
