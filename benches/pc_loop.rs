@@ -25,9 +25,9 @@ use twoport_board::linkage::{falcon_pc, ImageSpec, FALCON};
 use twoport_board::RawSensors;
 use twoport_control::kinematics::Kinematics;
 use twoport_control::world::World;
-use twoport_hd::Frame;
+use twoport_hd::HdFrame;
 use twoport_host::device_port::Grip;
-use twoport_host::falcon::protocol::{Status, PACKET};
+use twoport_host::falcon::protocol::{FalconStatus, PACKET};
 use twoport_host::falcon::{command, sensors};
 use twoport_host::haply::{self, protocol::Setup, HaplyConfig};
 use twoport_host::{BoardMode, BoardPort, DeviceIo, HostBoard, LinkError, SteppedPc};
@@ -52,11 +52,11 @@ impl Exchange<3> for FalconPackets {
         let io = twoport_board::linkage::io(&FALCON);
         self.command = command(duty, on, &io, 0).encode();
         black_box(self.command);
-        let s = Status::decode(&self.status).unwrap_or_default();
+        let s = FalconStatus::decode(&self.status).unwrap_or_default();
         sensors(&s, Grip::Button { mask: 1 })
     }
     fn sweep(&mut self, c: i16) {
-        let s = Status {
+        let s = FalconStatus {
             encoder: [c, -c, c / 2],
             buttons: 1,
             homed: 7,
@@ -67,7 +67,7 @@ impl Exchange<3> for FalconPackets {
 
 /// The Touch's frame: angles in, joint torques out.
 struct TouchFrame {
-    frame: Frame,
+    frame: HdFrame,
     torque_mnm: [f64; 3],
 }
 
@@ -82,7 +82,7 @@ impl Exchange<3> for TouchFrame {
         let per_count = core::f64::consts::TAU / f64::from(TOUCH.hardware.counts_per_rev);
         let c = f64::from(c) * per_count;
         let rest = TOUCH.rest_rad.map(f64::from);
-        self.frame = Frame {
+        self.frame = HdFrame {
             joint_rad: [rest[0] + c, rest[1] - c, rest[2] + c / 2.0],
             buttons: 1,
         };
@@ -227,7 +227,7 @@ fn pc_tick(c: &mut Criterion) {
         "PC loop: a Touch tick's work (HD's angles, serial-arm image armed, torques)",
         touch::board().unwrap(),
         TouchFrame {
-            frame: Frame::default(),
+            frame: HdFrame::default(),
             torque_mnm: [0.0; 3],
         },
         &TOUCH,

@@ -3,14 +3,14 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use host_sim::engine::human::GraspKind;
-use host_sim::engine::plant::{Device, Method, Stepper};
+use host_sim::engine::plant::{Method, SimDevice, Stepper};
 use std::hint::black_box;
 use twoport_design::DeviceModel;
 
 fn plant(c: &mut Criterion) {
     let model =
         DeviceModel::from_toml(include_str!("../models/excalibur.toml"), "excalibur").unwrap();
-    let dev = Device::flexible(&model).unwrap();
+    let dev = SimDevice::flexible(&model).unwrap();
     let sys = dev.system(GraspKind::Maximum.grasp(), false);
     for (method, subs) in [
         (Method::ExactZoh, &[1u32, 8][..]),

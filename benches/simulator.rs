@@ -7,7 +7,7 @@
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use host_sim::engine::human::GraspKind;
-use host_sim::engine::plant::{Device, Method, Stepper};
+use host_sim::engine::plant::{Method, SimDevice, Stepper};
 use host_sim::engine::servo::SceneServo;
 
 use host_sim::{Scene, Simulation};
@@ -63,7 +63,7 @@ fn parts(c: &mut Criterion) {
     let s = scene(&[]);
     let model = DeviceModel::from_toml(include_str!("../models/excalibur.toml"), "excalibur")
         .expect("the shipped model");
-    let dev = Device::flexible(&model).expect("a device");
+    let dev = SimDevice::flexible(&model).expect("a device");
     let sys = dev.system(GraspKind::Maximum.grasp(), false);
     let mut st = Stepper::new(&sys, Method::ExactZoh, 1e-3).expect("a stepper");
     let mut x = vec![0.0; sys.states()];

@@ -5,7 +5,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use twoport_host::falcon::protocol::{Command, Status, PACKET};
+use twoport_host::falcon::protocol::{Command, FalconStatus, PACKET};
 use twoport_host::haply::protocol::{Direction, Joint, Setup};
 
 fuzz_target!(|data: &[u8]| {
@@ -44,8 +44,8 @@ fuzz_target!(|data: &[u8]| {
         if let Ok(c) = Command::decode(&p) {
             assert_eq!(Command::decode(&c.encode()), Ok(c));
         }
-        if let Ok(st) = Status::decode(&p) {
-            assert_eq!(Status::decode(&st.encode()), Ok(st));
+        if let Ok(st) = FalconStatus::decode(&p) {
+            assert_eq!(FalconStatus::decode(&st.encode()), Ok(st));
         }
     }
 });

@@ -3,7 +3,7 @@
 //! bound is detected; RK4 converges to the exact-ZOH trajectory; the exact
 //! ZOH plant conserves energy without damping; effects run only when named.
 
-use host_sim::engine::plant::{Device, Grasp, Method, Stepper};
+use host_sim::engine::plant::{Grasp, Method, SimDevice, Stepper};
 use host_sim::{Scene, Simulation};
 use std::path::{Path, PathBuf};
 
@@ -101,7 +101,7 @@ fn rk4_converges_to_exact_zoh() {
 #[test]
 fn exact_zoh_conserves_energy_without_damping() {
     let model = twoport_design::DeviceModel::load(&root().join("models/excalibur.toml")).unwrap();
-    let dev = Device::flexible(&model).unwrap().without_damping();
+    let dev = SimDevice::flexible(&model).unwrap().without_damping();
     let sys = dev.system(
         Grasp {
             damping_nspm: 0.0,
@@ -145,7 +145,7 @@ fn exact_zoh_conserves_energy_without_damping() {
         "RK4 should not conserve it"
     );
     // The same with damping loses energy: the test can fail.
-    let damped = Device::flexible(&model).unwrap().system(
+    let damped = SimDevice::flexible(&model).unwrap().system(
         Grasp {
             damping_nspm: 0.0,
             stiffness_npm: 0.0,

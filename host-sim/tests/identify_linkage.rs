@@ -21,7 +21,7 @@ mod support;
 
 use host_sim::engine::scene::IdentifySpec;
 use host_sim::link::LinkFaults;
-use host_sim::pil::linkage::{self, Device, Plan, Sines};
+use host_sim::pil::linkage::{self, LinkageImage, Plan, Sines};
 use nalgebra::DMatrix;
 use twoport_design::linkage::{
     bounded_workspace_design, verify_linkage, HandAssumption, PoseDynamics,
@@ -51,7 +51,7 @@ fn spec(axis: u8) -> IdentifySpec {
 
 /// Every axis's record of experiment `s`, the joints' friction acting or
 /// not.
-fn record(device: Device, s: IdentifySpec, friction: bool) -> Vec<Log> {
+fn record(device: LinkageImage, s: IdentifySpec, friction: bool) -> Vec<Log> {
     let experiment = s.experiment(1e-3).unwrap();
     let plan = Plan::Identify {
         experiment,
@@ -70,7 +70,7 @@ fn record(device: Device, s: IdentifySpec, friction: bool) -> Vec<Log> {
 
 /// The stiffest coupling at `b_c = 0` proven over `poses` for every
 /// hand that grasps with at least `grasp` (N s/m) under the paper's bound.
-fn design(device: Device, poses: &[PoseDynamics], grasp: f64) -> f64 {
+fn design(device: LinkageImage, poses: &[PoseDynamics], grasp: f64) -> f64 {
     let file = device.file().unwrap();
     bounded_workspace_design(&file, poses, 0.0, grasp, HumanBound::PAPER)
         .unwrap()
@@ -86,14 +86,14 @@ fn eigen(m: &DMatrix<f64>) -> Vec<f64> {
 
 /// The Jacobian where the handle is, from the device's kinematics near
 /// its calibration pose.
-fn along(device: Device) -> impl Fn(&[f64]) -> Option<DMatrix<f64>> + Sync {
+fn along(device: LinkageImage) -> impl Fn(&[f64]) -> Option<DMatrix<f64>> + Sync {
     let file = device.file().unwrap();
     let rest = truth(device).q_rad;
     move |x| twoport_design::linkage::inverse(&file.geometry, x, &rest).map(|(_, j)| j)
 }
 
 /// The device's true pose at its calibration pose.
-fn truth(device: Device) -> PoseDynamics {
+fn truth(device: LinkageImage) -> PoseDynamics {
     let rest: Vec<f64> = device
         .spec()
         .rest_rad
@@ -117,7 +117,12 @@ struct Closed {
 /// the truth's (the heaviest within `heavy_tol`), its design within 3% of
 /// the truth's, the design over `set` no stiffer than the truth's, and
 /// `verify` on the true pose silent there.
-fn closes(device: Device, ident: &PoseDynamics, set: &[PoseDynamics], heavy_tol: f64) -> Closed {
+fn closes(
+    device: LinkageImage,
+    ident: &PoseDynamics,
+    set: &[PoseDynamics],
+    heavy_tol: f64,
+) -> Closed {
     let truth = truth(device);
     let (want, got) = (eigen(&truth.mass_kg), eigen(&ident.mass_kg));
     for (i, (w, g)) in want.iter().zip(&got).enumerate() {
@@ -160,7 +165,7 @@ fn closes(device: Device, ident: &PoseDynamics, set: &[PoseDynamics], heavy_tol:
 #[test]
 #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
 fn the_linkages_close_at_their_calibration_pose() {
-    for (device, heavy_tol) in [(Device::SerialArm, 0.2), (Device::Delta, 0.02)] {
+    for (device, heavy_tol) in [(LinkageImage::SerialArm, 0.2), (LinkageImage::Delta, 0.02)] {
         let logs: Vec<Vec<Log>> = (0..3).map(|a| record(device, spec(a), false)).collect();
         // (Two periods skipped while the hold's mode settles.)
         let data = PoseMeasured::from_logs(&logs, 2).unwrap();
@@ -203,7 +208,7 @@ fn the_linkages_close_at_their_calibration_pose() {
 #[cfg_attr(debug_assertions, ignore = "release only (CI runs it)")]
 fn a_pose_whose_joints_stick_is_refused() {
     let logs: Vec<Vec<Log>> = (0..3)
-        .map(|a| record(Device::SerialArm, spec(a), true))
+        .map(|a| record(LinkageImage::SerialArm, spec(a), true))
         .collect();
     let data = PoseMeasured::from_logs(&logs, 2).unwrap();
     match fit(&data) {
@@ -229,8 +234,8 @@ fn the_linkages_close_with_their_joints_friction() {
     use twoport_identify::pose::{fit::mass, losses};
     const SKIP: usize = 8;
     for (device, levels, heavy_tol) in [
-        (Device::SerialArm, [0.5, 1.0, 1.5], 0.1),
-        (Device::Delta, [1.0, 2.0, 4.0], 0.02),
+        (LinkageImage::SerialArm, [0.5, 1.0, 1.5], 0.1),
+        (LinkageImage::Delta, [1.0, 2.0, 4.0], 0.02),
     ] {
         let file = device.file().unwrap();
         let truth = truth(device);
@@ -325,8 +330,8 @@ fn host_sim_writes_the_sines_identify_pose_reads() {
             records.push(axes);
         }
     }
-    let l = losses::fit(&records, &along(Device::Delta), 8).unwrap();
-    let c = Device::Delta.file().unwrap().joints.friction_nm;
+    let l = losses::fit(&records, &along(LinkageImage::Delta), 8).unwrap();
+    let c = LinkageImage::Delta.file().unwrap().joints.friction_nm;
     for (got, want) in l.friction_nm.iter().zip(&c) {
         assert!((got / want - 1.0).abs() < 0.02, "{l:?}");
     }
@@ -365,7 +370,7 @@ fn the_phantoms_joints_come_apart_at_two_frequencies() {
     use twoport_design::linkage::certified_design;
     use twoport_identify::pose::losses;
     const SKIP: usize = 8;
-    let device = Device::SerialArm;
+    let device = LinkageImage::SerialArm;
     let file = device.file().unwrap();
     let truth = truth(device);
     let records: Vec<Vec<Log>> = [(10.0, [0.5, 1.0, 1.5]), (4.0, [0.3, 0.6, 0.9])]

@@ -6,13 +6,13 @@
 use host_sim::engine::linkage::LinkagePlant;
 use host_sim::link::{LinkError, LinkFaults, LocalSerialArm, Session};
 use host_sim::pil::{self, linkage};
-use linkage::Device;
+use linkage::LinkageImage;
 use nalgebra::DVector;
 use twoport_board::linkage::FLOOR;
 use twoport_control::linkage::Gravity;
 use twoport_link::{Axes, ModeRefusal, ModeRequest};
 
-fn run(device: Device, ticks: u64, faults: LinkFaults) -> pil::Run<3> {
+fn run(device: LinkageImage, ticks: u64, faults: LinkFaults) -> pil::Run<3> {
     linkage::run_local(device, ticks, faults, linkage::Plan::Press).unwrap()
 }
 
@@ -25,7 +25,7 @@ fn run(device: Device, ticks: u64, faults: LinkFaults) -> pil::Run<3> {
 /// every motor is at zero within the watchdog's deadline.
 #[test]
 fn a_linkage_board_holds_the_floor_and_stops_after_a_link_loss() {
-    for device in [Device::SerialArm, Device::Delta] {
+    for device in [LinkageImage::SerialArm, LinkageImage::Delta] {
         let faults = LinkFaults {
             corrupt_every: 50,
             link_loss_at: Some(2500),
@@ -137,7 +137,7 @@ fn a_linkage_board_refuses_homing_and_a_pose_it_cannot_serve() {
 fn the_images_are_their_device_files_and_their_proof() {
     use twoport_board::linkage::{region, GRASP_NSPM, PERIOD_S};
     use twoport_design::linkage::{certified_design_from, least_damping, Geometry, LinkageFile};
-    for device in [Device::SerialArm, Device::Delta] {
+    for device in [LinkageImage::SerialArm, LinkageImage::Delta] {
         let file = device.file().unwrap();
         let spec = device.spec();
         let close = |a: f32, b: f64| (f64::from(a) - b).abs() <= 1e-6 * b.abs().max(1e-3);
@@ -168,12 +168,12 @@ fn the_images_are_their_device_files_and_their_proof() {
             );
         }
         match (device, &file.geometry) {
-            (Device::SerialArm, Geometry::SerialArm { l1_m, l2_m }) => {
+            (LinkageImage::SerialArm, Geometry::SerialArm { l1_m, l2_m }) => {
                 let arm = twoport_board::linkage::PHANTOM_ARM;
                 assert!(close(arm.l1_m, *l1_m) && close(arm.l2_m, *l2_m));
             }
             (
-                Device::Delta,
+                LinkageImage::Delta,
                 Geometry::Delta {
                     base_m,
                     effector_m,

@@ -140,7 +140,7 @@ fn pil_runs_fail_for_any_difference_and_a_late_zero() {
     ignore = "several hundred runs: release only (CI runs it)"
 )]
 fn a_latency_explains_table_ones_impedance_boundary_and_not_its_admittance_one() {
-    use host_sim::study::latency::{fit, Fit};
+    use host_sim::study::latency::{fit, LatencySearch};
     let to = |case: &str, param: &str, range: (f64, f64), target: f64| {
         let path = format!("../scenes/table1/{case}.toml");
         fit(
@@ -158,13 +158,13 @@ fn a_latency_explains_table_ones_impedance_boundary_and_not_its_admittance_one()
         (1e4, 2e6),
         75_000.0,
     );
-    let Fit::Found { alpha, marginal } = k else {
+    let LatencySearch::Found { alpha, marginal } = k else {
         panic!("{k:?}")
     };
     assert!((alpha - 0.5).abs() < 0.02, "{alpha}");
     assert!((marginal / 75_000.0 - 1.0).abs() < 0.02, "{marginal}");
     let m = to("admittance_free_maximum", "coupling.m", (50.0, 0.01), 4.3);
-    let Fit::NotReached {
+    let LatencySearch::NotReached {
         at_zero,
         last,
         at_last,
@@ -181,5 +181,5 @@ fn a_latency_explains_table_ones_impedance_boundary_and_not_its_admittance_one()
         (1e4, 2e6),
         400_000.0,
     );
-    assert!(matches!(up, Fit::NotReached { .. }), "{up:?}");
+    assert!(matches!(up, LatencySearch::NotReached { .. }), "{up:?}");
 }

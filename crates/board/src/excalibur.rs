@@ -88,7 +88,7 @@ pub(crate) fn wall_servo(
 
 /// A device's port as the passivity layer sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DevicePort {
+pub struct ActuatorPort {
     /// The moving mass at the encoder (kg).
     pub mass_kg: f32,
     /// A lower bound of its own viscous damping (N s/m).
@@ -97,7 +97,7 @@ pub struct DevicePort {
 
 /// The actuator's port: the model's actuator inertia, and 4 N s/m of its
 /// damping.
-pub const ACTUATOR_PORT: DevicePort = DevicePort {
+pub const ACTUATOR_PORT: ActuatorPort = ActuatorPort {
     mass_kg: 0.93,
     damping_nspm: 4.0,
 };

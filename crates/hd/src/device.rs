@@ -13,14 +13,14 @@ use std::sync::Arc;
 const ROOM: usize = 16;
 
 /// A device the library has opened (`HHD`); disabled when dropped.
-pub struct Device {
+pub struct HdDevice {
     lib: Arc<HdLibrary>,
     handle: Hhd,
 }
 
 /// What a servo frame read.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Frame {
+pub struct HdFrame {
     /// The first three joints' angles (rad), as `HD_CURRENT_JOINT_ANGLES`
     /// gives them.
     pub joint_rad: [f64; 3],
@@ -28,9 +28,9 @@ pub struct Frame {
     pub buttons: i32,
 }
 
-impl Device {
+impl HdDevice {
     pub(crate) fn new(lib: Arc<HdLibrary>, handle: Hhd) -> Self {
-        Device { lib, handle }
+        HdDevice { lib, handle }
     }
 
     /// Its handle.
@@ -41,8 +41,8 @@ impl Device {
     /// One servo frame: the first three joints' torques (mN m, as
     /// `HD_CURRENT_JOINT_TORQUE` takes them) out, the joints' angles and
     /// the buttons in. Call it from the scheduler's thread (a closure
-    /// [`Device::schedule`] runs).
-    pub fn frame(&self, torque_mnm: [f64; 3]) -> Result<Frame, HdError> {
+    /// [`HdDevice::schedule`] runs).
+    pub fn frame(&self, torque_mnm: [f64; 3]) -> Result<HdFrame, HdError> {
         let c = &self.lib.calls;
         let mut q = [0.0f64; ROOM];
         let mut b = [0i32; ROOM];
@@ -64,7 +64,7 @@ impl Device {
                 "the library gave joint angles {joint_rad:?} rad: not a device's"
             )));
         }
-        Ok(Frame {
+        Ok(HdFrame {
             joint_rad,
             buttons: b[0],
         })
@@ -117,7 +117,7 @@ impl Device {
     }
 }
 
-impl Drop for Device {
+impl Drop for HdDevice {
     fn drop(&mut self) {
         // SAFETY: the handle is the library's and is disabled once.
         unsafe { (self.lib.calls.disable_device)(self.handle) };

@@ -7,6 +7,6 @@ mod error;
 mod library;
 
 pub use consts::*;
-pub use device::{Device, Frame, Scheduled};
+pub use device::{HdDevice, HdFrame, Scheduled};
 pub use error::HdError;
 pub use library::{HdLibrary, DEFAULT_NAME};

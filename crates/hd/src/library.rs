@@ -1,7 +1,7 @@
 //! Loading the library and resolving its documented calls.
 
 use crate::consts::*;
-use crate::device::Device;
+use crate::device::HdDevice;
 use crate::HdError;
 use core::ffi::{c_char, c_ulong, c_void};
 use libloading::Library;
@@ -103,7 +103,7 @@ impl HdLibrary {
 
     /// Open the device Touch Setup named `name` (`None`: the default
     /// device).
-    pub fn init_device(self: &Arc<Self>, name: Option<&str>) -> Result<Device, HdError> {
+    pub fn init_device(self: &Arc<Self>, name: Option<&str>) -> Result<HdDevice, HdError> {
         let name = name
             .map(|n| CString::new(n).map_err(|_| HdError::Name(n.to_string())))
             .transpose()?;
@@ -117,7 +117,7 @@ impl HdLibrary {
                 "hdInitDevice gave no device and no error".into(),
             ));
         }
-        Ok(Device::new(Arc::clone(self), handle))
+        Ok(HdDevice::new(Arc::clone(self), handle))
     }
 
     /// The library's latest error, as `call`'s.

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 /// A serial port, and what twoport makes of it.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Port {
+pub struct AttachedPort {
     /// Its path (`/dev/ttyUSB0`).
     pub path: String,
     /// Its USB vendor and product ids, where it is a USB device.
@@ -33,7 +33,7 @@ fn device(usb: (u16, u16)) -> Option<&'static str> {
 }
 
 /// Every serial port this computer has.
-pub fn ports() -> Vec<Port> {
+pub fn ports() -> Vec<AttachedPort> {
     let mut out = Vec::new();
     for p in serialport::available_ports().unwrap_or_default() {
         let (usb, product) = match &p.port_type {
@@ -54,7 +54,7 @@ pub fn ports() -> Vec<Port> {
                 }),
             None => Ok(()),
         };
-        out.push(Port {
+        out.push(AttachedPort {
             path: p.port_name,
             usb,
             product,

@@ -12,7 +12,7 @@ use std::sync::Arc;
 use twoport_board::linkage::touch::{self as image, TOUCH};
 use twoport_board::linkage::{io as io_scale, PERIOD_S};
 use twoport_board::{IoScale, RawSensors};
-use twoport_hd::{Device, Frame, HdError, HdLibrary, Scheduled, HD_DEVICE_BUTTON_1};
+use twoport_hd::{HdDevice, HdError, HdFrame, HdLibrary, Scheduled, HD_DEVICE_BUTTON_1};
 
 /// The device's name in messages.
 const NAME: &str = "Touch";
@@ -71,7 +71,7 @@ fn shown(config: &TouchConfig) -> String {
 
 /// A Touch, open, one servo frame an exchange.
 pub struct TouchIo {
-    device: Arc<Device>,
+    device: Arc<HdDevice>,
     io: [IoScale; 3],
     directions: [f32; 3],
     grip: Grip,
@@ -97,7 +97,7 @@ pub fn torques_mnm(duty: [i16; 3], on: bool, io: &[IoScale; 3], directions: [f32
 /// from the image's rest pose (as the image's joints read until the host
 /// calibrates them) at its quantum, turned by `directions`; the grip from
 /// the buttons.
-pub fn sensors(frame: &Frame, directions: [f32; 3], grip: Grip) -> RawSensors<3> {
+pub fn sensors(frame: &HdFrame, directions: [f32; 3], grip: Grip) -> RawSensors<3> {
     let counts = core::array::from_fn(|i| {
         let rad = frame.joint_rad[i] * f64::from(directions[i]) - f64::from(TOUCH.rest_rad[i]);
         let c = (rad * f64::from(TOUCH.hardware.counts_per_rev) / core::f64::consts::TAU).round();
@@ -127,7 +127,7 @@ impl DeviceIo<3> for TouchIo {
 
 /// OpenHaptics' scheduler running the loop's ticks.
 pub struct HdScheduler {
-    device: Arc<Device>,
+    device: Arc<HdDevice>,
     scheduled: Option<Scheduled>,
 }
 

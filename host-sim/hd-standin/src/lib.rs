@@ -7,7 +7,7 @@ mod scenario;
 mod scheduler;
 
 use core::ffi::{c_char, c_ulong, c_void};
-use host_sim::emulate::{Device, Fault};
+use host_sim::emulate::{EmulatedDevice, Fault};
 use scenario::Scenario;
 use std::ffi::CStr;
 use std::sync::{Mutex, MutexGuard};
@@ -20,7 +20,7 @@ const HANDLE: Hhd = 1;
 
 /// An open device: the simulated arm and what the frames set.
 struct Open {
-    device: Device<3>,
+    device: EmulatedDevice<3>,
     scenario: Scenario,
     force_on: bool,
     angles_rad: [f64; 3],
@@ -94,7 +94,7 @@ pub unsafe extern "C" fn hdInitDevice(name: *const c_char) -> Hhd {
     }
     let device = touch_file()
         .map_err(host_sim::Error::Sim)
-        .and_then(|f| Device::new(&f, TOUCH, true, scenario.hand, None));
+        .and_then(|f| EmulatedDevice::new(&f, TOUCH, true, scenario.hand, None));
     match device {
         Ok(device) => {
             device.note("open");

@@ -1,12 +1,12 @@
 //! The scenario a test names the device by.
 
-use host_sim::emulate::{Fault, Hand, PRESSING};
+use host_sim::emulate::{EmulatedHand, Fault, PRESSING};
 use twoport_hd::{HdErrorCode, HD_COMM_CONFIG_ERROR, HD_DEVICE_ALREADY_INITIATED};
 
 /// What the device does.
 pub struct Scenario {
     pub trace: Option<String>,
-    pub hand: Option<Hand>,
+    pub hand: Option<EmulatedHand>,
     /// The fault, and how many periods after the motors are enabled.
     pub fault: Option<(u64, Fault)>,
     pub refuse_open: Option<HdErrorCode>,

@@ -6,11 +6,11 @@
 //! whose upload was short or garbled runs nothing and answers nothing, as
 //! one with the wrong firmware does.
 
-use super::{Device, Emulator, Fault, Firmware, Hand};
+use super::{EmulatedDevice, EmulatedHand, Emulator, Fault, Firmware};
 use crate::Error;
 use twoport_board::linkage::FALCON;
 use twoport_design::linkage::LinkageFile;
-use twoport_host::falcon::protocol::{self as p, Command, Status, PACKET};
+use twoport_host::falcon::protocol::{self as p, Command, FalconStatus, PACKET};
 
 /// The shipped Falcon-like file.
 pub fn file() -> Result<LinkageFile, Error> {
@@ -37,7 +37,7 @@ pub struct Loader {
 /// `hand`, going wrong as `fault` says from that command on.
 pub fn start(
     loader: Loader,
-    hand: Option<Hand>,
+    hand: Option<EmulatedHand>,
     fault: Option<(u64, Fault)>,
 ) -> Result<Emulator<3>, Error> {
     let firmware = Falcon {
@@ -71,7 +71,7 @@ impl Firmware<3> for Falcon {
         &mut self,
         rx: &mut Vec<u8>,
         baud: u32,
-        device: &mut Device<3>,
+        device: &mut EmulatedDevice<3>,
         tx: &mut Vec<u8>,
     ) -> Result<(), String> {
         loop {
@@ -150,7 +150,7 @@ impl Firmware<3> for Falcon {
                         -f32::from(c.motor[i]) / p::MOTOR_PER_NM / FALCON.hardware.ratios[i]
                     });
                     let period = device.tick(torque)?;
-                    let status = Status {
+                    let status = FalconStatus {
                         encoder: period.counts.map(|c| c as i16),
                         buttons: u8::from(period.grip),
                         homed: 0b111,

@@ -4,7 +4,7 @@
 //! and answers with the encoders' angles as the board does. A board not
 //! set up answers nothing.
 
-use super::{Device, Emulator, Fault, Firmware, Hand};
+use super::{EmulatedDevice, EmulatedHand, Emulator, Fault, Firmware};
 use crate::Error;
 use twoport_board::linkage::haply::HAPLY;
 use twoport_design::linkage::LinkageFile;
@@ -25,7 +25,10 @@ pub fn file() -> Result<LinkageFile, Error> {
 
 /// The 2DIY on a pseudo-terminal, at the image's rest pose under `hand`,
 /// going wrong as `fault` says from that torque packet on.
-pub fn start(hand: Option<Hand>, fault: Option<(u64, Fault)>) -> Result<Emulator<2>, Error> {
+pub fn start(
+    hand: Option<EmulatedHand>,
+    fault: Option<(u64, Fault)>,
+) -> Result<Emulator<2>, Error> {
     Emulator::start(&file()?, HAPLY, false, Board::default(), hand, fault)
 }
 
@@ -40,7 +43,7 @@ impl Firmware<2> for Board {
         &mut self,
         rx: &mut Vec<u8>,
         _baud: u32,
-        device: &mut Device<2>,
+        device: &mut EmulatedDevice<2>,
         tx: &mut Vec<u8>,
     ) -> Result<(), String> {
         loop {

@@ -47,7 +47,7 @@ pub enum Fault {
 /// anchor `push_m` past the rest pose along the last axis, downward (into
 /// the images' wall); its grip switch closed (open with no hand).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hand {
+pub struct EmulatedHand {
     /// The grasp's damping (N s/m).
     pub grasp_nspm: f64,
     /// The spring's stiffness (N/m).
@@ -60,7 +60,7 @@ pub struct Hand {
 /// The hand of the drivers' wall runs: a 2 N s/m grasp (the PC images'
 /// least) and a 100 N/m spring pressing 10 mm past the rest pose, 5 mm
 /// past the images' wall.
-pub const PRESSING: Hand = Hand {
+pub const PRESSING: EmulatedHand = EmulatedHand {
     grasp_nspm: 2.0,
     stiffness_npm: 100.0,
     push_m: 0.010,
@@ -143,17 +143,17 @@ pub trait Firmware<const N: usize>: Send + 'static {
         &mut self,
         rx: &mut Vec<u8>,
         baud: u32,
-        device: &mut Device<N>,
+        device: &mut EmulatedDevice<N>,
         tx: &mut Vec<u8>,
     ) -> Result<(), String>;
 }
 
 /// The plant behind the firmware, the hand on it, and what it is told to
 /// do wrong.
-pub struct Device<const N: usize> {
+pub struct EmulatedDevice<const N: usize> {
     arm: LinkageArm<N>,
     spec: ImageSpec<N>,
-    hand: Option<Hand>,
+    hand: Option<EmulatedHand>,
     rest_m: [f64; N],
     fault: Option<(u64, Fault)>,
     shared: Arc<Shared<N>>,
@@ -189,7 +189,7 @@ pub struct Period<const N: usize> {
     pub grip: bool,
 }
 
-impl<const N: usize> Device<N> {
+impl<const N: usize> EmulatedDevice<N> {
     /// The linkage `file` (its image `spec`) at rest at the image's rest
     /// pose under `hand`, with gravity along `-z` where `gravity`, going
     /// wrong as `fault` says from that command on.
@@ -197,7 +197,7 @@ impl<const N: usize> Device<N> {
         file: &LinkageFile,
         spec: ImageSpec<N>,
         gravity: bool,
-        hand: Option<Hand>,
+        hand: Option<EmulatedHand>,
         fault: Option<(u64, Fault)>,
     ) -> Result<Self, Error> {
         let plant = |e| Error::Sim(format!("the emulated device's plant: {e}"));
@@ -207,7 +207,7 @@ impl<const N: usize> Device<N> {
             arm.plant.gravity_mps2 = crate::pil::linkage::GRAVITY_MPS2;
         }
         let (rest_m, _) = arm.handle().map_err(plant)?;
-        Ok(Device {
+        Ok(EmulatedDevice {
             arm,
             spec,
             hand,
@@ -335,10 +335,10 @@ impl<const N: usize> Emulator<N> {
         spec: ImageSpec<N>,
         gravity: bool,
         firmware: impl Firmware<N>,
-        hand: Option<Hand>,
+        hand: Option<EmulatedHand>,
         fault: Option<(u64, Fault)>,
     ) -> Result<Self, Error> {
-        let device = Device::new(file, spec, gravity, hand, fault)?;
+        let device = EmulatedDevice::new(file, spec, gravity, hand, fault)?;
         let shared = Arc::clone(&device.shared);
         let (master, slave) =
             TTYPort::pair().map_err(|e| Error::Sim(format!("a pseudo-terminal: {e}")))?;
@@ -389,7 +389,11 @@ impl<const N: usize> Drop for Emulator<N> {
 
 /// The emulator's thread: read, serve, answer, until stopped or unplugged
 /// (the terminal's master closes with it).
-fn run<const N: usize>(mut port: TTYPort, mut firmware: impl Firmware<N>, mut device: Device<N>) {
+fn run<const N: usize>(
+    mut port: TTYPort,
+    mut firmware: impl Firmware<N>,
+    mut device: EmulatedDevice<N>,
+) {
     let _ = port.set_timeout(Duration::from_millis(20));
     let mut rx = Vec::new();
     let why = loop {

@@ -8,7 +8,7 @@ use twoport_control::{Position, ZTransfer};
 
 /// One block.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Block {
+pub struct LineBlock {
     /// Left edge.
     pub left: Position,
     /// Width (nm).
@@ -19,7 +19,7 @@ pub struct Block {
     pub velocity_mps: f32,
 }
 
-impl Block {
+impl LineBlock {
     fn right(&self) -> Position {
         self.left + self.width_nm
     }
@@ -31,7 +31,7 @@ impl Block {
 pub struct Blocks {
     period_s: f32,
     cursor: CursorMass,
-    blocks: Vec<Block>,
+    blocks: Vec<LineBlock>,
     limits: [Position; 2],
     stick_n: f32,
     floor_nspm: f32,
@@ -52,7 +52,7 @@ impl Blocks {
     pub fn new(
         period_s: f32,
         cursor_mass_kg: f32,
-        blocks: Vec<Block>,
+        blocks: Vec<LineBlock>,
         limits: [Position; 2],
         stick_n: f32,
         floor_nspm: f32,
@@ -78,7 +78,7 @@ impl Blocks {
     }
 
     /// The blocks.
-    pub fn blocks(&self) -> &[Block] {
+    pub fn blocks(&self) -> &[LineBlock] {
         &self.blocks
     }
 
@@ -280,7 +280,7 @@ mod tests {
     }
 
     fn world(stick: f32) -> Blocks {
-        let b = |left_m: f64| Block {
+        let b = |left_m: f64| LineBlock {
             left: at(left_m),
             width_nm: 20_000_000,
             mass_kg: 0.5,

@@ -53,7 +53,7 @@ enum Gauge {
 
 /// A device model ready for simulation.
 #[derive(Clone, Debug)]
-pub struct Device {
+pub struct SimDevice {
     /// Coordinates.
     pub n: usize,
     m: DMatrix<f64>,
@@ -72,14 +72,14 @@ pub struct Device {
     pub name: String,
 }
 
-impl Device {
+impl SimDevice {
     /// The flexible model of a designer model file.
     pub fn flexible(model: &DeviceModel) -> Result<Self, Error> {
         let n = model.dof();
         let minv = Cholesky::new(model.m.clone())
             .ok_or("M is not positive definite")?
             .inverse();
-        Ok(Device {
+        Ok(SimDevice {
             n,
             m: model.m.clone(),
             minv,
@@ -99,7 +99,7 @@ impl Device {
     /// to ground, handle and actuator at one point; the gauge reads the hand
     /// force through the load-cell filter.
     pub fn rigid(m_kg: f64, b_nspm: f64, load_cell_pole_rad_s: f64) -> Self {
-        Device {
+        SimDevice {
             n: 1,
             m: DMatrix::from_element(1, 1, m_kg),
             minv: DMatrix::from_element(1, 1, 1.0 / m_kg),

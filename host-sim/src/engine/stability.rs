@@ -42,7 +42,7 @@ pub struct Detector {
 
 /// The verdict.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Verdict {
+pub struct StabilityVerdict {
     /// Stable by the criterion.
     pub stable: bool,
     /// Why not, when not.
@@ -106,7 +106,7 @@ impl Detector {
     }
 
     /// The verdict on what was fed.
-    pub fn verdict(&self) -> Verdict {
+    pub fn verdict(&self) -> StabilityVerdict {
         let rms = |w: std::ops::Range<usize>| {
             let n: u64 = self.count[w.clone()].iter().sum();
             if n == 0 {
@@ -119,7 +119,7 @@ impl Detector {
         let late = [rms(0..half), rms(half..WINDOWS)];
         let envelope = self.envelope_per_s();
         let undamped = late[1] > FLOOR_N && envelope > DECAY_PER_S;
-        Verdict {
+        StabilityVerdict {
             stable: !undamped,
             reason: undamped.then(|| {
                 format!(
@@ -166,7 +166,7 @@ impl Detector {
 mod tests {
     use super::*;
 
-    fn run(f: impl Fn(f64) -> f64) -> Verdict {
+    fn run(f: impl Fn(f64) -> f64) -> StabilityVerdict {
         let mut d = Detector::new(3000, 1000, 1000);
         for k in 0..3000 {
             d.push(f(k as f64 * 1e-3));

@@ -24,22 +24,22 @@ use twoport_link::{Axes, Message, PilSensors};
 
 /// The linkage images a PIL run drives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
-pub enum Device {
+pub enum LinkageImage {
     /// The PHANToM Premium 1.5 serial arm.
     SerialArm,
     /// The Falcon-like rotary delta.
     Delta,
 }
 
-impl Device {
+impl LinkageImage {
     /// The device file the plant integrates.
     pub fn file(self) -> Result<LinkageFile, Error> {
         let (text, name) = match self {
-            Device::SerialArm => (
+            LinkageImage::SerialArm => (
                 include_str!("../../../models/linkages/phantom_premium_1_5.toml"),
                 "phantom_premium_1_5.toml",
             ),
-            Device::Delta => (
+            LinkageImage::Delta => (
                 include_str!("../../../models/linkages/falcon_like.toml"),
                 "falcon_like.toml",
             ),
@@ -50,8 +50,8 @@ impl Device {
     /// The board image's constants.
     pub fn spec(self) -> &'static ImageSpec {
         match self {
-            Device::SerialArm => &image::PHANTOM,
-            Device::Delta => &image::FALCON,
+            LinkageImage::SerialArm => &image::PHANTOM,
+            LinkageImage::Delta => &image::FALCON,
         }
     }
 }
@@ -107,7 +107,7 @@ struct PilArm {
 }
 
 impl PilArm {
-    fn new(device: Device, plan: Plan) -> Result<PilArm, Error> {
+    fn new(device: LinkageImage, plan: Plan) -> Result<PilArm, Error> {
         let file = device.file()?;
         let spec = device.spec();
         let mut arm =
@@ -195,7 +195,7 @@ fn record<P: BoardPort>(
 /// Run `device`'s image at `port` for `ticks`, the hand pressing
 /// ([`Plan::Press`]).
 pub fn run<P: BoardPort>(
-    device: Device,
+    device: LinkageImage,
     ticks: u64,
     port: P,
     faults: LinkFaults,
@@ -205,7 +205,7 @@ pub fn run<P: BoardPort>(
 
 /// Run `device`'s image at `port` for `ticks` under `plan`.
 pub fn run_plan<P: BoardPort>(
-    device: Device,
+    device: LinkageImage,
     ticks: u64,
     port: P,
     faults: LinkFaults,
@@ -255,15 +255,17 @@ pub fn run_plan<P: BoardPort>(
 
 /// [`run_plan`] against `device`'s image in-process.
 pub fn run_local(
-    device: Device,
+    device: LinkageImage,
     ticks: u64,
     faults: LinkFaults,
     plan: Plan,
 ) -> Result<Run<3>, Error> {
     use crate::link::{LocalDelta, LocalSerialArm};
     match device {
-        Device::SerialArm => run_plan(device, ticks, LocalSerialArm::serial_arm()?, faults, plan),
-        Device::Delta => run_plan(device, ticks, LocalDelta::delta()?, faults, plan),
+        LinkageImage::SerialArm => {
+            run_plan(device, ticks, LocalSerialArm::serial_arm()?, faults, plan)
+        }
+        LinkageImage::Delta => run_plan(device, ticks, LocalDelta::delta()?, faults, plan),
     }
 }
 
@@ -307,7 +309,10 @@ impl Sines {
     /// `[level][pushed axis][recorded axis]`, each run from the arm at
     /// rest at the calibration pose and stopped at the sine's last period
     /// (the board then disarms, and the arm would fall).
-    pub fn play(&self, device: Device) -> Result<Vec<Vec<Vec<twoport_identify::log::Log>>>, Error> {
+    pub fn play(
+        &self,
+        device: LinkageImage,
+    ) -> Result<Vec<Vec<Vec<twoport_identify::log::Log>>>, Error> {
         let tick = f64::from(image::PERIOD_S);
         self.levels_n
             .iter()

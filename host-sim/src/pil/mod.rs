@@ -59,7 +59,7 @@ impl HostVe {
 
 /// How a PIL run gets its board going.
 #[derive(Clone, Copy, Debug)]
-pub struct Setup {
+pub struct Startup {
     /// Calibrated or homed, then armed.
     pub start: Start,
     /// Where each axis stands at rest before the run, as the host tells a
@@ -69,19 +69,19 @@ pub struct Setup {
     pub index_m: Option<f64>,
 }
 
-impl Setup {
+impl Startup {
     /// How `sim`'s run begins, once its scene's device is checked to be
     /// the board's (its sensors, its world): calibrated where the device
     /// starts (the 3-D world's cursor, or 0), or homed onto the scene's
     /// hard stop.
-    pub fn for_sim<const N: usize>(sim: &Simulation<N>) -> Result<Setup, Error> {
+    pub fn for_sim<const N: usize>(sim: &Simulation<N>) -> Result<Startup, Error> {
         let scene = sim.scene();
         check_scene(scene)?;
         let at_rest: Vec<i64> = match sim.servo().blocks() {
             Some(w) => w.cursor.iter().map(|p| p.nm() as i64 * 1000).collect(),
             None => vec![0; N],
         };
-        Ok(Setup {
+        Ok(Startup {
             start: Start::for_scene(scene),
             at_rest_pm: Axes::from_slice(&at_rest).ok_or("a device of at most 3 axes")?,
             index_m: scene.effects.encoder.and_then(|e| e.index_m),
@@ -309,7 +309,7 @@ pub fn run_with<P: BoardPort, const N: usize>(
 ) -> Result<Run<N>, Error> {
     let surface = host_ve.map(|_| HostVe::surface(&scene)).transpose()?;
     let mut sim = Simulation::<N>::with_axes(scene)?;
-    let setup = Setup::for_sim(&sim)?;
+    let setup = Startup::for_sim(&sim)?;
     let start = setup.start;
     let mut session = Session::open_axes(port, faults, N as u8)?;
     session.set_index(setup.index_m);

@@ -4,11 +4,11 @@
 /// Wall time owed to a run in real time (s). At most 0.2 s is owed: a
 /// window that stalled (dragged, hidden) does not make the run leap.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Pace {
+pub struct Pacer {
     debt_s: f64,
 }
 
-impl Pace {
+impl Pacer {
     /// How many ticks of `period_s` (s) are due after `wall_s` (s) more
     /// wall time; they are counted as paid.
     pub fn due(&mut self, wall_s: f64, period_s: f64) -> usize {
@@ -25,7 +25,7 @@ mod tests {
 
     #[test]
     fn ticks_are_paid_in_whole_and_the_rest_carried() {
-        let mut p = Pace::default();
+        let mut p = Pacer::default();
         assert_eq!(p.due(2.5e-3, 1e-3), 2);
         assert_eq!(p.due(0.6e-3, 1e-3), 1);
         // A long stall owes 0.2 s at the most.

@@ -51,7 +51,7 @@ pub struct TeleopState {
     pub push_n: f64,
     /// Why the run stopped, if it has.
     pub stopped: Option<String>,
-    pace: crate::scope::pace::Pace,
+    pace: crate::scope::pace::Pacer,
 }
 
 impl TeleopState {

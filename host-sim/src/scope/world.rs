@@ -42,7 +42,7 @@ pub struct WorldState<const N: usize = 3> {
     /// The span each projection shows on each axis (m): the Excalibur's
     /// workspace, widened to take in a linkage's arm as it starts.
     pub span_m: [(f64, f64); 3],
-    pace: crate::scope::pace::Pace,
+    pace: crate::scope::pace::Pacer,
 }
 
 /// The Excalibur's workspace (m), the world view's span by default.
@@ -151,7 +151,7 @@ impl<const N: usize> WorldState<N> {
     /// Where the device stands at rest before a run, as a board is told
     /// when calibrated (pm): where the world's cursor starts.
     pub fn at_rest_pm(&self) -> Result<twoport_link::Axes<i64>, Error> {
-        crate::pil::Setup::for_sim(&self.sim).map(|s| s.at_rest_pm)
+        crate::pil::Startup::for_sim(&self.sim).map(|s| s.at_rest_pm)
     }
 
     /// Drag the hand by `d_m` (m) along each axis (x, y, z; those past

@@ -9,7 +9,7 @@ use std::path::Path;
 
 /// What the search found.
 #[derive(Clone, Debug, PartialEq)]
-pub enum Fit {
+pub enum LatencySearch {
     /// The boundary meets the target at `alpha` of a tick (within the
     /// search's tolerance), where it is `marginal`.
     Found {
@@ -57,7 +57,7 @@ pub fn fit(
     (param, range, tol): (&str, (f64, f64), f64),
     target: f64,
     step: &mut dyn FnMut(),
-) -> Result<Fit, Error> {
+) -> Result<LatencySearch, Error> {
     if !(target.is_finite() && target > 0.0) {
         return Err(sim_err!("target {target}: must be finite and > 0"));
     }
@@ -91,7 +91,7 @@ pub fn fit(
         }
     }
     let Some(mut bad) = crossed else {
-        return Ok(Fit::NotReached {
+        return Ok(LatencySearch::NotReached {
             at_zero,
             last: good,
             at_last: last,
@@ -108,13 +108,13 @@ pub fn fit(
     // The side of the crossing nearer the target.
     if let Some(b) = at(bad) {
         if (b - target).abs() < (found - target).abs() {
-            return Ok(Fit::Found {
+            return Ok(LatencySearch::Found {
                 alpha: bad,
                 marginal: b,
             });
         }
     }
-    Ok(Fit::Found {
+    Ok(LatencySearch::Found {
         alpha: good,
         marginal: found,
     })

@@ -14,7 +14,7 @@ pub mod protocol;
 
 use crate::device_port::{DevicePort, Grip};
 use crate::{DeviceIo, LinkError, LoopThread, PcBoard};
-use protocol::{Command, Status, CHUNK, PACKET};
+use protocol::{Command, FalconStatus, CHUNK, PACKET};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 use twoport_board::linkage::{falcon_pc, io as io_scale, FALCON, PERIOD_S};
@@ -69,11 +69,11 @@ pub struct FalconIo {
 
 impl FalconIo {
     /// One packet out, its answer in.
-    fn send(&mut self, command: &Command) -> Result<Status, String> {
+    fn send(&mut self, command: &Command) -> Result<FalconStatus, String> {
         self.port.send(&command.encode())?;
         let mut p = [0; PACKET];
         self.port.receive(&mut p)?;
-        Status::decode(&p).map_err(|e| format!("the Falcon's answer: {e}"))
+        FalconStatus::decode(&p).map_err(|e| format!("the Falcon's answer: {e}"))
     }
 }
 
@@ -104,7 +104,7 @@ pub fn command(duty: [i16; 3], on: bool, io: &[IoScale; 3], leds: u8) -> Command
 
 /// What the board image reads from the Falcon's `status`, its dead-man
 /// switch from `grip`.
-pub fn sensors(status: &Status, grip: Grip) -> RawSensors<3> {
+pub fn sensors(status: &FalconStatus, grip: Grip) -> RawSensors<3> {
     RawSensors {
         encoder_raw: status.encoder.map(|c| i32::from(c) as u32),
         dead_man_closed: grip.closed(|_| None, status.buttons),
@@ -170,7 +170,7 @@ fn running(port: &mut DevicePort, path: &str) -> Result<bool, String> {
     rate(port, protocol::RUN_BAUD)?;
     port.send(&Command::default().encode())?;
     let mut p = [0; PACKET];
-    let answered = port.receive(&mut p).is_ok() && Status::decode(&p).is_ok();
+    let answered = port.receive(&mut p).is_ok() && FalconStatus::decode(&p).is_ok();
     let _ = port.port_mut().clear(serialport::ClearBuffer::All);
     Ok(answered)
 }

@@ -69,7 +69,7 @@ pub struct Command {
 
 /// What the running firmware answers.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Status {
+pub struct FalconStatus {
     /// Each encoder's count since power-up (wrapping at 16 bits).
     pub encoder: [i16; 3],
     /// The grip's buttons, a bit each.
@@ -137,7 +137,7 @@ impl Command {
     }
 }
 
-impl Status {
+impl FalconStatus {
     /// Its bytes (the Falcon's side).
     pub fn encode(&self) -> [u8; PACKET] {
         let mut p = [OFFSET; PACKET];
@@ -157,7 +157,7 @@ impl Status {
             .filter(|f| *f < 0x80)
             .ok_or(PacketError::Nibble(13))?;
         nibble(p, 14)?;
-        Ok(Status {
+        Ok(FalconStatus {
             encoder: [get(p, 1)?, get(p, 5)?, get(p, 9)?],
             buttons: flags & 0x0f,
             homed: flags >> 4,
@@ -187,28 +187,28 @@ mod tests {
     #[test]
     fn a_status_reads_back() {
         for s in [
-            Status::default(),
-            Status {
+            FalconStatus::default(),
+            FalconStatus {
                 encoder: [i16::MIN, i16::MAX, -1234],
                 buttons: 0b1010,
                 homed: 0b101,
             },
         ] {
-            assert_eq!(Status::decode(&s.encode()), Ok(s));
+            assert_eq!(FalconStatus::decode(&s.encode()), Ok(s));
         }
     }
 
     /// A broken frame or a byte that is no nibble is named, never read.
     #[test]
     fn bad_packets_are_named() {
-        let mut p = Status::default().encode();
+        let mut p = FalconStatus::default().encode();
         p[0] = b'x';
-        assert_eq!(Status::decode(&p), Err(PacketError::Frame));
-        let mut p = Status::default().encode();
+        assert_eq!(FalconStatus::decode(&p), Err(PacketError::Frame));
+        let mut p = FalconStatus::default().encode();
         p[6] = 0x00;
-        assert_eq!(Status::decode(&p), Err(PacketError::Nibble(6)));
-        let mut p = Status::default().encode();
+        assert_eq!(FalconStatus::decode(&p), Err(PacketError::Nibble(6)));
+        let mut p = FalconStatus::default().encode();
         p[14] = b'>';
-        assert_eq!(Status::decode(&p), Err(PacketError::Nibble(14)));
+        assert_eq!(FalconStatus::decode(&p), Err(PacketError::Nibble(14)));
     }
 }

@@ -30,7 +30,7 @@ pub struct Found {
 
 /// The record's mean motion: what cogging's shapes are computed from.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Motion {
+pub struct MeanMotion {
     /// The mean period's position, band-limited to the played harmonics
     /// with its mean, at eight instants across each tick (m).
     pub at: Vec<Vec<f64>>,
@@ -40,7 +40,7 @@ pub struct Motion {
     pub harmonics: Vec<usize>,
 }
 
-impl Motion {
+impl MeanMotion {
     /// The motion of `position_m` under `force` (its mean spectrum at
     /// `harmonics`), `None` where the record has no whole period to average.
     pub fn new(
@@ -49,9 +49,9 @@ impl Motion {
         harmonics: &[usize],
         force: Vec<Complex64>,
         skip: usize,
-    ) -> Option<Motion> {
+    ) -> Option<MeanMotion> {
         let top = *harmonics.last()?;
-        Some(Motion {
+        Some(MeanMotion {
             at: band_limited(position_m, period, top, skip, false)?,
             force,
             harmonics: harmonics.to_vec(),
@@ -72,7 +72,7 @@ impl Motion {
 }
 
 /// Cogging's two shapes at a period of `period_m`, per unit force.
-pub fn shapes(motion: &Motion, period_m: f64) -> [Regressor; 2] {
+pub fn shapes(motion: &MeanMotion, period_m: f64) -> [Regressor; 2] {
     let (sin, cos) = Sweep::new(motion, 1.0 / period_m, 0.0).next();
     [
         Regressor {
@@ -156,14 +156,14 @@ impl Band {
 /// phasor `e^{j k x}` by `e^{j step x}`, and one FFT of their tick means
 /// gives the sine's and the cosine's spectra.
 struct Sweep<'a> {
-    motion: &'a Motion,
+    motion: &'a MeanMotion,
     z: Vec<Vec<Complex64>>,
     turn: Vec<Vec<Complex64>>,
     fft: std::sync::Arc<dyn rustfft::Fft<f64>>,
 }
 
 impl<'a> Sweep<'a> {
-    fn new(motion: &'a Motion, from: f64, step: f64) -> Sweep<'a> {
+    fn new(motion: &'a MeanMotion, from: f64, step: f64) -> Sweep<'a> {
         let phasors = |k: f64| -> Vec<Vec<Complex64>> {
             motion
                 .at
@@ -216,7 +216,7 @@ impl<'a> Sweep<'a> {
 /// no period explains more than the search would find in noise.
 pub fn find(
     data: &Measured,
-    motion: &Motion,
+    motion: &MeanMotion,
     period_s: f64,
     below_hz: f64,
 ) -> Option<[Regressor; 2]> {

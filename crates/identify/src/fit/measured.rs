@@ -23,7 +23,7 @@ pub struct Measured {
     pub encoder_quantum_m: Option<f64>,
     /// The record's mean motion, where it gave one: cogging's shapes at
     /// any period come from it.
-    pub motion: Option<cogging::Motion>,
+    pub motion: Option<cogging::MeanMotion>,
     /// The same experiment with a known mass clamped on the handle, if it
     /// was played: fitted together with this one, it shows the handle's
     /// side of the device, which the actuator's push alone barely moves.
@@ -177,7 +177,8 @@ impl Measured {
             })
             .into_iter()
             .collect();
-        let motion = cogging::Motion::new(&log.position_m, period_ticks, &harmonics, force, skip);
+        let motion =
+            cogging::MeanMotion::new(&log.position_m, period_ticks, &harmonics, force, skip);
         let mut data = Measured {
             position,
             load_cell,

@@ -38,7 +38,7 @@ pub(crate) struct PilArgs {
     /// The board runs a linkage image: the device file's nonlinear arm
     /// against it, pressed into the image's floor (the scene is not read).
     #[arg(long, value_enum)]
-    pub(crate) linkage: Option<host_sim::pil::linkage::Device>,
+    pub(crate) linkage: Option<host_sim::pil::linkage::LinkageImage>,
     /// The board runs the 4 kHz image (`twoport_board::excalibur::fast`):
     /// the scene's period must be its 0.25 ms.
     #[arg(long)]
@@ -85,7 +85,7 @@ pub(crate) struct PilArgs {
 
 /// `--linkage --sines`: every level's records written for
 /// `twoport identify-pose`.
-fn sines(a: &PilArgs, device: host_sim::pil::linkage::Device) -> Result<(), Error> {
+fn sines(a: &PilArgs, device: host_sim::pil::linkage::LinkageImage) -> Result<(), Error> {
     use twoport_identify::pose::record_file;
     let dir = a
         .log
@@ -248,7 +248,7 @@ impl Compared<'_> {
     /// `--linkage`: a linkage image pressing its floor.
     fn linkage(
         &self,
-        device: host_sim::pil::linkage::Device,
+        device: host_sim::pil::linkage::LinkageImage,
         port: Option<link::SerialBoard>,
     ) -> Result<(), Error> {
         use host_sim::pil::linkage;

@@ -137,19 +137,19 @@ pub(crate) fn latency_fit(a: &LatencyFitArgs) -> Result<(), Error> {
     )?;
     b.finish_and_clear();
     match (fit, s.scene.json) {
-        (latency::Fit::Found { alpha, marginal }, true) => {
+        (latency::LatencySearch::Found { alpha, marginal }, true) => {
             say!("{}", json!({"param": s.param, "target": a.target, "latency_periods": alpha, "marginal": marginal}));
         }
-        (latency::Fit::Found { alpha, marginal }, false) => say!(
+        (latency::LatencySearch::Found { alpha, marginal }, false) => say!(
             "{}: {marginal:.6} at a latency of {alpha:.3} T (the target {})",
             s.param,
             a.target
         ),
-        (latency::Fit::NotReached { at_zero, last, at_last }, true) => {
+        (latency::LatencySearch::NotReached { at_zero, last, at_last }, true) => {
             say!("{}", json!({"param": s.param, "target": a.target, "latency_periods": null,
                 "at_zero": at_zero, "last_periods": last, "at_last": at_last}));
         }
-        (latency::Fit::NotReached { at_zero, last, at_last }, false) => say!(
+        (latency::LatencySearch::NotReached { at_zero, last, at_last }, false) => say!(
             "{}: no latency in [0, 1) gives {}: {at_zero:.6} with none, {at_last:.6} at {last:.3} T, \
              and past it no boundary in the range",
             s.param,

@@ -9,7 +9,7 @@ pub use step::External;
 
 use crate::engine::effects::{Pipeline, TIMING_STRIDE};
 use crate::engine::human::{GraspKind, Human};
-use crate::engine::plant::{Device, Method, Stepper, System};
+use crate::engine::plant::{Method, SimDevice, Stepper, System};
 use crate::engine::scene::Scene;
 use crate::engine::servo::SceneServo;
 use crate::engine::stability::Detector;
@@ -220,7 +220,7 @@ impl Steppers {
 pub struct Simulation<const N: usize = 1> {
     scene: Scene,
     period: f64,
-    device: Device,
+    device: SimDevice,
     load_cell: bool,
     /// A stepper per grasp the hands take, shared by the axes (each has
     /// its own state).
@@ -308,9 +308,9 @@ pub fn integrator_warning(sys: &System, method: Method, h: f64) -> Option<String
 
 /// The scene's plant: its model's flexible device (whose own delay joins
 /// the scene's delay effect), or the rigid reduction.
-fn device_of(scene: &mut Scene) -> Result<Device, Error> {
+fn device_of(scene: &mut Scene) -> Result<SimDevice, Error> {
     if !scene.effects.flexibility {
-        return Ok(Device::rigid(
+        return Ok(SimDevice::rigid(
             scene.plant.rigid_mass_kg + scene.plant.handle_mass_kg,
             scene.plant.rigid_damping_nspm,
             235.0,
@@ -336,7 +336,7 @@ fn device_of(scene: &mut Scene) -> Result<Device, Error> {
             periods: None,
         });
     }
-    Device::flexible(&model)
+    SimDevice::flexible(&model)
 }
 
 /// The scene's latency split at its period: the whole ticks join the

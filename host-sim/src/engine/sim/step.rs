@@ -5,7 +5,7 @@ use crate::engine::effects::Effect;
 use crate::engine::human::HandState;
 use crate::engine::plant::Stepper;
 use crate::engine::servo::{frame_f32, output_f64};
-use crate::engine::stability::Verdict;
+use crate::engine::stability::StabilityVerdict;
 use std::time::Instant;
 use twoport_control::servo::{SensorFrame, ServoOutput};
 
@@ -259,7 +259,8 @@ impl<const N: usize> Simulation<N> {
 
     /// The report so far, given the wall time spent.
     pub fn report(&self, wall: f64) -> Report {
-        let verdicts: Vec<Verdict> = self.axes.iter().map(|a| a.detector.verdict()).collect();
+        let verdicts: Vec<StabilityVerdict> =
+            self.axes.iter().map(|a| a.detector.verdict()).collect();
         let unstable = verdicts.iter().position(|v| !v.stable);
         let reason = self.failure.clone().or_else(|| {
             unstable.map(|a| {

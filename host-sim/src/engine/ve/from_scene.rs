@@ -2,7 +2,7 @@
 //! changes to it while it runs.
 
 use super::SceneVe;
-use crate::engine::blocks::{Block, Blocks};
+use crate::engine::blocks::{Blocks, LineBlock};
 use crate::engine::scene::{Discretization, Integration, LayerPort, Scene, VeSpec};
 use crate::Error;
 use twoport_control::passivity::{ParallelLimits, PassiveVe};
@@ -121,7 +121,7 @@ fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, Error> {
             let bs = blocks
                 .iter()
                 .map(|b| {
-                    Ok(Block {
+                    Ok(LineBlock {
                         left: pos(b.at_m)?,
                         width_nm: pos(b.width_m)?.nm(),
                         mass_kg: b.mass_kg as f32,
