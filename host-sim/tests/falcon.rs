@@ -119,21 +119,26 @@ fn a_failing_falcon_gets_zero_force_and_a_named_error() {
 fn a_falcon_that_will_not_start_says_why() {
     let _turn = turn();
     let (path, image) = firmware("start.bin");
-    let emu = falcon::start(loader(image.clone()), Some(HAND), None).unwrap();
-    let e = PcBoard::falcon(emu.path(), &config("/nonexistent/test_firmware.bin"))
-        .err()
-        .unwrap()
-        .to_string();
+    // Why the driver would not start on an emulated Falcon with `loader`,
+    // the firmware file at `file`.
+    let refused = |loader: Loader, file: &std::path::Path| {
+        let emu = falcon::start(loader, Some(HAND), None).unwrap();
+        let why = PcBoard::falcon(emu.path(), &config(file))
+            .err()
+            .unwrap()
+            .to_string();
+        (emu, why)
+    };
+    let (_, e) = refused(
+        loader(image.clone()),
+        std::path::Path::new("/nonexistent/test_firmware.bin"),
+    );
     assert!(e.contains("does not ship it"), "{e}");
     let silent = Loader {
         answers: false,
         ..loader(image.clone())
     };
-    let emu = falcon::start(silent, Some(HAND), None).unwrap();
-    let e = PcBoard::falcon(emu.path(), &config(&path))
-        .err()
-        .unwrap()
-        .to_string();
+    let (_, e) = refused(silent, &path);
     assert!(
         e.contains("did not answer its first handshake") && e.contains("unplug"),
         "{e}"
@@ -142,19 +147,11 @@ fn a_falcon_that_will_not_start_says_why() {
         garble_at: Some(123),
         ..loader(image.clone())
     };
-    let emu = falcon::start(garbled, Some(HAND), None).unwrap();
-    let e = PcBoard::falcon(emu.path(), &config(&path))
-        .err()
-        .unwrap()
-        .to_string();
+    let (_, e) = refused(garbled, &path);
     assert!(e.contains("garbled at byte 123"), "{e}");
     let mut other = image;
     other[500] ^= 1;
-    let emu = falcon::start(loader(other), Some(HAND), None).unwrap();
-    let e = PcBoard::falcon(emu.path(), &config(&path))
-        .err()
-        .unwrap()
-        .to_string();
+    let (emu, e) = refused(loader(other), &path);
     assert!(e.contains("Novint's Falcon firmware"), "{e}");
     assert!(emu
         .trace()

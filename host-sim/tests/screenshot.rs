@@ -62,10 +62,8 @@ fn the_scope_draws_and_its_plots_move() {
     let (w, h) = last.dimensions();
     assert!(w >= 800 && h >= 600, "{w} x {h}");
     // Not blank: many distinct colours (text, traces, light, grid).
-    let mut colours: Vec<[u8; 4]> = last.pixels().map(|p| p.0).collect();
-    colours.sort_unstable();
-    colours.dedup();
-    assert!(colours.len() > 50, "{} colours", colours.len());
+    let colours = distinct_colours(&last);
+    assert!(colours > 50, "{colours} colours");
     // The plot area (left of the 330-pt control panel, below the transport
     // bar) moved; the control panel's lower half (hand, wall, trigger,
     // board) did not.
@@ -87,10 +85,8 @@ fn the_scope_draws_and_its_plots_move() {
 fn the_world_view_draws_and_its_blocks_move() {
     let (dir, first, last) = shots("xyz/stack_three.toml", 6);
     let (w, h) = last.dimensions();
-    let mut colours: Vec<[u8; 4]> = last.pixels().map(|p| p.0).collect();
-    colours.sort_unstable();
-    colours.dedup();
-    assert!(colours.len() > 30, "{} colours", colours.len());
+    let colours = distinct_colours(&last);
+    assert!(colours > 30, "{colours} colours");
     // The projections (the upper half) changed: the block was carried.
     let world = changed(&first, &last, (0, w), (60, h / 2));
     assert!(world > 0.001, "world view changed by {world:.4}");
@@ -105,10 +101,8 @@ fn the_world_view_draws_and_its_blocks_move() {
 fn the_scope_shows_both_sides_of_a_teleoperator() {
     let (dir, first, last) = shots("teleop/capstan_wall.toml", 3);
     let (w, h) = last.dimensions();
-    let mut colours: Vec<[u8; 4]> = last.pixels().map(|p| p.0).collect();
-    colours.sort_unstable();
-    colours.dedup();
-    assert!(colours.len() > 50, "{} colours", colours.len());
+    let colours = distinct_colours(&last);
+    assert!(colours > 50, "{colours} colours");
     // Each device has its colour: the master's blue and the slave's red
     // traces are both drawn.
     let near = |c: [u8; 3]| {
@@ -122,4 +116,13 @@ fn the_scope_shows_both_sides_of_a_teleoperator() {
     let heading = changed(&first, &last, (0, w / 2), (0, 20));
     assert!(heading < 0.001, "heading changed by {heading:.4}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// How many distinct colours `shot` has: many where text, traces, light
+/// and grid are drawn, few where a window is blank.
+fn distinct_colours(shot: &RgbaImage) -> usize {
+    let mut colours: Vec<[u8; 4]> = shot.pixels().map(|p| p.0).collect();
+    colours.sort_unstable();
+    colours.dedup();
+    colours.len()
 }

@@ -12,29 +12,17 @@ use pyo3::prelude::*;
 /// twoport: haptic interfaces that are stable by design.
 #[pymodule]
 #[pyo3(name = "twoport")]
-fn twoport_py(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(design::design_impedance, m)?)?;
-    m.add_function(wrap_pyfunction!(design::design_admittance, m)?)?;
-    m.add_function(wrap_pyfunction!(design::check_impedance, m)?)?;
-    m.add_function(wrap_pyfunction!(design::check_admittance, m)?)?;
-    m.add_function(wrap_pyfunction!(design::verify, m)?)?;
-    m.add_function(wrap_pyfunction!(design::zrange, m)?)?;
-    m.add_function(wrap_pyfunction!(design::region, m)?)?;
-    m.add_function(wrap_pyfunction!(design::host_ve, m)?)?;
-    m.add_function(wrap_pyfunction!(teleop::verify_teleop, m)?)?;
-    m.add_function(wrap_pyfunction!(teleop::check_teleop, m)?)?;
-    m.add_function(wrap_pyfunction!(teleop::design_teleop, m)?)?;
-    m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
-    m.add_function(wrap_pyfunction!(model::load_device, m)?)?;
-    m.add_class::<design::Design>()?;
-    m.add_class::<design::Check>()?;
-    m.add_class::<design::Verdict>()?;
-    m.add_class::<design::HostCheck>()?;
-    m.add_class::<teleop::TeleopVerdict>()?;
-    m.add_class::<teleop::TeleopGains>()?;
-    m.add_class::<teleop::WaveLaw>()?;
-    m.add_class::<teleop::TeleopCheck>()?;
-    m.add_class::<model::Model>()?;
-    m.add_class::<board::Board>()?;
-    Ok(())
+mod twoport_py {
+    #[pymodule_export]
+    use super::design::{
+        check_admittance, check_impedance, design_admittance, design_impedance, host_ve, region,
+        verify, zrange, Check, Design, HostCheck, Verdict,
+    };
+    #[pymodule_export]
+    use super::teleop::{
+        check_teleop, design_teleop, verify_teleop, TeleopCheck, TeleopGains, TeleopVerdict,
+        WaveLaw,
+    };
+    #[pymodule_export]
+    use super::{board::Board, model::load_device, model::Model, simulate::simulate};
 }
