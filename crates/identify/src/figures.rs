@@ -50,29 +50,35 @@ pub fn figures(data: &Measured, f: &Fit) -> Option<Vec<(&'static str, Figure)>> 
         y_label: y_label.into(),
         curves,
     };
-    let mut out = vec![(
-        "encoder",
-        figure(
+    // Each sensor's response, and its coherence on one figure. On a log
+    // axis as what the coherence leaves, 1 - γ²: the noise's share of one
+    // period's response, from 1e-6 to one half at a glance.
+    let sensors = [
+        Some((
+            "encoder",
             "Actuator force to encoder: measured and fitted",
             "|X/F| (m/N)",
-            fitted(x, |m| m.0),
-        ),
-    )];
-    // On a log axis as what the coherence leaves, 1 - γ²: the noise's
-    // share of one period's response, from 1e-6 to one half at a glance.
-    let cx = x.coherence();
-    let mut coherence = vec![curve("encoder", plot::BLUE, 2, false, x, &|i| 1.0 - cx[i])];
-    if let Some(lc) = &data.load_cell {
-        out.push((
-            "load_cell",
-            figure(
+            x,
+            plot::BLUE,
+            (|m| m.0) as fn(&(Complex64, Complex64)) -> Complex64,
+        )),
+        data.load_cell.as_ref().map(|lc| {
+            (
+                "load_cell",
                 "Actuator force to load cell: measured and fitted",
                 "|F_lc/F| (N/N)",
-                fitted(lc, |m| m.1),
-            ),
-        ));
-        let c = lc.coherence();
-        coherence.push(curve("load cell", plot::RED, 2, false, lc, &|i| 1.0 - c[i]));
+                lc,
+                plot::RED,
+                (|m| m.1) as fn(&(Complex64, Complex64)) -> Complex64,
+            )
+        }),
+    ];
+    let (mut out, mut coherence) = (Vec::new(), Vec::new());
+    for (stem, title, y_label, frf, color, pick) in sensors.into_iter().flatten() {
+        out.push((stem, figure(title, y_label, fitted(frf, pick))));
+        let c = frf.coherence();
+        let label = stem.replace('_', " ");
+        coherence.push(curve(&label, color, 2, false, frf, &|i| 1.0 - c[i]));
     }
     out.push((
         "coherence",

@@ -1,7 +1,7 @@
 //! The physical checks a scene's types cannot express; each message
 //! names the field.
 
-use super::{Coupling, LayerPort, Scene, VeSpec, MAX_AXES, MAX_BLOCKS};
+use super::{BlocksSpec, Coupling, LayerPort, Scene, VeSpec, MAX_AXES, MAX_BLOCKS};
 use crate::engine::human::AxisValue;
 use crate::Error;
 use twoport_control::servo::Display;
@@ -99,38 +99,7 @@ impl Scene {
                 damping_nspm: b,
                 ..
             } => spring("ve.anchor_m", *at, *k, *b)?,
-            VeSpec::Blocks {
-                cursor_mass_kg,
-                blocks,
-                limits_m,
-                stick_force_n,
-                floor_damping_nspm,
-                ..
-            } => {
-                pos("ve.cursor_mass_kg", *cursor_mass_kg)?;
-                nonneg("ve.stick_force_n", *stick_force_n)?;
-                nonneg("ve.floor_damping_nspm", *floor_damping_nspm)?;
-                if !(limits_m[0].is_finite()
-                    && limits_m[1].is_finite()
-                    && limits_m[0] < limits_m[1])
-                {
-                    return Err("ve.limits_m must be [low, high] with low < high".into());
-                }
-                let mut edge = limits_m[0];
-                for (i, b) in blocks.iter().enumerate() {
-                    pos(&format!("ve.blocks[{i}].width_m"), b.width_m)?;
-                    pos(&format!("ve.blocks[{i}].mass_kg"), b.mass_kg)?;
-                    if !(b.at_m.is_finite() && b.at_m >= edge - 1e-12) {
-                        return Err(sim_err!(
-                            "ve.blocks[{i}] overlaps the block or limit to its left"
-                        ));
-                    }
-                    edge = b.at_m + b.width_m;
-                }
-                if edge > limits_m[1] + 1e-12 {
-                    return Err("ve.blocks extend past ve.limits_m[1]".into());
-                }
-            }
+            VeSpec::Blocks(w) => check_blocks(w)?,
             VeSpec::World {
                 blocks,
                 cursor_mass_kg,
@@ -419,6 +388,32 @@ impl Scene {
 }
 
 /// `Ok` where `v` (the field `name`) is finite and > 0.
+/// The 1-D world's fields: a cursor's mass, blocks of positive width and
+/// mass left to right between the limits, not overlapping.
+fn check_blocks(w: &BlocksSpec) -> Result<(), Error> {
+    pos("ve.cursor_mass_kg", w.cursor_mass_kg)?;
+    nonneg("ve.stick_force_n", w.stick_force_n)?;
+    nonneg("ve.floor_damping_nspm", w.floor_damping_nspm)?;
+    if !(w.limits_m[0].is_finite() && w.limits_m[1].is_finite() && w.limits_m[0] < w.limits_m[1]) {
+        return Err("ve.limits_m must be [low, high] with low < high".into());
+    }
+    let mut edge = w.limits_m[0];
+    for (i, b) in w.blocks.iter().enumerate() {
+        pos(&format!("ve.blocks[{i}].width_m"), b.width_m)?;
+        pos(&format!("ve.blocks[{i}].mass_kg"), b.mass_kg)?;
+        if !(b.at_m.is_finite() && b.at_m >= edge - 1e-12) {
+            return Err(sim_err!(
+                "ve.blocks[{i}] overlaps the block or limit to its left"
+            ));
+        }
+        edge = b.at_m + b.width_m;
+    }
+    if edge > w.limits_m[1] + 1e-12 {
+        return Err("ve.blocks extend past ve.limits_m[1]".into());
+    }
+    Ok(())
+}
+
 fn pos(name: &str, v: f64) -> Result<(), Error> {
     field::positive(name, v).map(drop).map_err(Error::Sim)
 }

@@ -362,23 +362,7 @@ pub enum VeSpec {
         discretization: Discretization,
     },
     /// The 1-D building-block world.
-    Blocks {
-        /// Cursor mass (kg).
-        cursor_mass_kg: f64,
-        /// The blocks, left to right, not overlapping.
-        blocks: Vec<BlockSpec>,
-        /// World limits (m): blocks stop at these walls.
-        limits_m: [f64; 2],
-        /// Force that separates two touching blocks (N).
-        stick_force_n: f64,
-        /// Viscous drag of free blocks on the floor (N s/m).
-        #[serde(default = "default_floor")]
-        floor_damping_nspm: f64,
-        /// Grab the block under the cursor at this time (s).
-        grab_at_s: Option<f64>,
-        /// Release it at this time (s).
-        release_at_s: Option<f64>,
-    },
+    Blocks(BlocksSpec),
     /// The building-block world in 3-D, on a three-axis device: a cursor,
     /// blocks on a floor, gravity. With no blocks it is a free cursor over
     /// a floor. The device's zero is where the cursor starts (the
@@ -406,6 +390,27 @@ pub enum VeSpec {
         #[serde(default)]
         release_at_s: Vec<f64>,
     },
+}
+
+/// The 1-D building-block world: a cursor among blocks between two walls.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlocksSpec {
+    /// Cursor mass (kg).
+    pub cursor_mass_kg: f64,
+    /// The blocks, left to right, not overlapping.
+    pub blocks: Vec<BlockSpec>,
+    /// World limits (m): blocks stop at these walls.
+    pub limits_m: [f64; 2],
+    /// Force that separates two touching blocks (N).
+    pub stick_force_n: f64,
+    /// Viscous drag of free blocks on the floor (N s/m).
+    #[serde(default = "default_floor")]
+    pub floor_damping_nspm: f64,
+    /// Grab the block under the cursor at this time (s).
+    pub grab_at_s: Option<f64>,
+    /// Release it at this time (s).
+    pub release_at_s: Option<f64>,
 }
 
 /// One block of the 3-D world.

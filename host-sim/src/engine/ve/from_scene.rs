@@ -109,16 +109,9 @@ fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, Error> {
         VeSpec::World { .. } => {
             return Err("ve.kind = \"world\" is a 3-D world, not one axis's VE".into())
         }
-        VeSpec::Blocks {
-            cursor_mass_kg,
-            blocks,
-            limits_m,
-            stick_force_n,
-            floor_damping_nspm,
-            grab_at_s,
-            release_at_s,
-        } => {
-            let bs = blocks
+        VeSpec::Blocks(w) => {
+            let bs = w
+                .blocks
                 .iter()
                 .map(|b| {
                     Ok(LineBlock {
@@ -131,13 +124,13 @@ fn scene_ve<R: Real>(scene: &Scene, t32: f32) -> Result<SceneVe<R>, Error> {
                 .collect::<Result<Vec<_>, Error>>()?;
             SceneVe::Blocks(Box::new(Blocks::new(
                 t32,
-                *cursor_mass_kg as f32,
+                w.cursor_mass_kg as f32,
                 bs,
-                [pos(limits_m[0])?, pos(limits_m[1])?],
-                *stick_force_n as f32,
-                *floor_damping_nspm as f32,
-                *grab_at_s,
-                *release_at_s,
+                [pos(w.limits_m[0])?, pos(w.limits_m[1])?],
+                w.stick_force_n as f32,
+                w.floor_damping_nspm as f32,
+                w.grab_at_s,
+                w.release_at_s,
             )?))
         }
     })
