@@ -5,7 +5,7 @@ use crate::firmware::{
     an386_image_with, firmware, passivity_image, stm32f405_qemu_image, stm32f405_variant,
 };
 use crate::{cargo, cross_target_dir, root, run};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 /// QEMU's Cortex-M4F board running `elf`, with semihosting (prints and
@@ -58,6 +58,14 @@ pub(crate) fn workspace_release_build() -> Result<std::path::PathBuf, String> {
 /// `--board stm32f405`, the STM32F405 image's own loop on netduinoplus2,
 /// whose accesses to devices QEMU does not model are logged and summed up.
 pub(crate) fn pil(extra: &[String]) -> Result<(), String> {
+    let (board, args) = board_of(extra)?;
+    let elf = pil_image(&board, &args)?;
+    pil_on(&workspace_release_build()?, &board, &args, &elf)
+}
+
+/// The board a PIL command line names (`--board NAME`, an386 by default)
+/// and the rest of it.
+pub(crate) fn board_of(extra: &[String]) -> Result<(String, Vec<String>), String> {
     let mut args = extra.to_vec();
     let board = match args.iter().position(|a| a == "--board") {
         Some(i) if i + 1 < args.len() => {
@@ -68,47 +76,18 @@ pub(crate) fn pil(extra: &[String]) -> Result<(), String> {
         Some(_) => return Err("pil: --board needs a name (an386 or stm32f405)".into()),
         None => "an386".into(),
     };
-    let exe = workspace_release_build()?.join("host-sim");
-    let host = |pty: &str| {
-        run(
-            "host-sim pil",
-            Command::new(&exe).args(["pil", "--port", pty]).args(&args),
-        )
-    };
-    // A teleoperation pair: two boards of the one-axis image, each in its
-    // own QEMU, the host between them.
-    if args.iter().any(|a| a == "--teleop") {
-        let pair = |qemu: &dyn Fn() -> Result<Command, String>| {
-            with_board_in_qemu(qemu()?, |master| {
-                with_board_in_qemu(qemu().map_err(|e| e.to_string())?, |slave| {
-                    run(
-                        "host-sim pil --teleop",
-                        Command::new(&exe)
-                            .args(["pil", "--port", master, "--slave-port", slave])
-                            .args(&args),
-                    )
-                })
-            })
-        };
-        return match board.as_str() {
-            "an386" => pair(&|| {
-                let mut q = qemu_an386(&firmware()?.join("twoport-an386"));
-                q.args(["-serial", "pty"]);
-                Ok(q)
-            }),
-            "stm32f405" => pair(&|| {
-                let mut q = qemu_netduino(&stm32f405_qemu_image(false)?);
-                q.args(["-serial", "null", "-serial", "pty"]);
-                Ok(q)
-            }),
-            other => Err(format!(
-                "pil: no board image called {other:?} (an386 or stm32f405)"
-            )),
-        };
-    }
-    let xyz = args.iter().any(|a| declares_three_axes(a));
+    Ok((board, args))
+}
+
+/// The image a PIL run with `args` needs on `board`, built, as an ELF of
+/// its own: the next build of another image leaves it as it is, so that
+/// runs can go on while other images are built or run.
+pub(crate) fn pil_image(board: &str, args: &[String]) -> Result<PathBuf, String> {
+    let has = |flag: &str| args.iter().any(|a| a == flag);
+    // A teleoperation pair: two boards of the one-axis image.
+    let xyz = !has("--teleop") && args.iter().any(|a| declares_three_axes(a));
     // (host-sim reads it too: the 4 kHz image's reference and period.)
-    let fast = args.iter().any(|a| a == "--fast");
+    let fast = !has("--teleop") && has("--fast");
     // (host-sim checks the name; the image is built with it as a feature.)
     let linkage = match args.iter().position(|a| a == "--linkage") {
         Some(i) => match args.get(i + 1) {
@@ -121,49 +100,89 @@ pub(crate) fn pil(extra: &[String]) -> Result<(), String> {
         },
         None => None,
     };
-    match board.as_str() {
-        "an386" => {
-            let elf = if args.iter().any(|a| a == "--passivity") {
-                passivity_image()?
-            } else if let Some(l) = &linkage {
-                an386_image_with(l)?
-            } else if xyz {
-                an386_image_with("xyz")?
-            } else if fast {
-                an386_image_with("fast")?
-            } else {
-                firmware()?.join("twoport-an386")
-            };
-            let mut qemu = qemu_an386(&elf);
-            qemu.args(["-serial", "pty"]);
-            with_board_in_qemu(qemu, host)
-        }
-        "stm32f405" => {
-            if args.iter().any(|a| a == "--passivity") {
-                return Err("pil: the STM32F405 image has no passivity build".into());
+    match board {
+        "an386" if has("--passivity") => passivity_image(),
+        "an386" => match &linkage {
+            Some(l) => an386_image_with(l),
+            None if xyz => an386_image_with("xyz"),
+            None if fast => an386_image_with("fast"),
+            None => {
+                let out = firmware()?;
+                let elf = out.join("twoport-an386-plain");
+                std::fs::copy(out.join("twoport-an386"), &elf)
+                    .map_err(|e| format!("copy the an386 image: {e}"))?;
+                Ok(elf)
             }
-            let elf = match &linkage {
-                Some(l) => {
-                    stm32f405_variant(&format!("qemu,{l}"), &format!("twoport-stm32f405-qemu-{l}"))?
-                }
-                None if fast => stm32f405_variant("qemu,fast", "twoport-stm32f405-qemu-fast")?,
-                None => stm32f405_qemu_image(xyz)?,
-            };
-            let log = cross_target_dir("firmware").join("qemu-unmodelled-stm32f405.log");
-            let _ = std::fs::remove_file(&log);
-            let mut qemu = qemu_netduino(&elf);
-            // USART2 is the second serial port.
-            qemu.args(["-serial", "null", "-serial", "pty"])
-                .args(["-d", "unimp,guest_errors", "-D"])
-                .arg(&log);
-            let result = with_board_in_qemu(qemu, host);
-            eprint!("{}", unmodelled_summary(&log));
-            result
+        },
+        "stm32f405" if has("--passivity") => {
+            Err("pil: the STM32F405 image has no passivity build".into())
         }
+        "stm32f405" => match &linkage {
+            Some(l) => {
+                stm32f405_variant(&format!("qemu,{l}"), &format!("twoport-stm32f405-qemu-{l}"))
+            }
+            None if fast => stm32f405_variant("qemu,fast", "twoport-stm32f405-qemu-fast"),
+            None => stm32f405_qemu_image(xyz),
+        },
         other => Err(format!(
             "pil: no board image called {other:?} (an386 or stm32f405)"
         )),
     }
+}
+
+/// One PIL run of `elf` on `board` against the host program in `bin`
+/// (the workspace's release build); a teleoperation pair (`--teleop`) runs
+/// two boards of the image, each in its own QEMU, the host between them.
+pub(crate) fn pil_on(bin: &Path, board: &str, args: &[String], elf: &Path) -> Result<(), String> {
+    let exe = bin.join("host-sim");
+    let qemu = || -> Command {
+        match board {
+            "an386" => {
+                let mut q = qemu_an386(elf);
+                q.args(["-serial", "pty"]);
+                q
+            }
+            // USART2 is the second serial port.
+            _ => {
+                let mut q = qemu_netduino(elf);
+                q.args(["-serial", "null", "-serial", "pty"]);
+                q
+            }
+        }
+    };
+    if args.iter().any(|a| a == "--teleop") {
+        return with_board_in_qemu(qemu(), |master| {
+            with_board_in_qemu(qemu(), |slave| {
+                run(
+                    "host-sim pil --teleop",
+                    Command::new(&exe)
+                        .args(["pil", "--port", master, "--slave-port", slave])
+                        .args(args),
+                )
+            })
+        });
+    }
+    let host = |pty: &str| {
+        run(
+            "host-sim pil",
+            Command::new(&exe).args(["pil", "--port", pty]).args(args),
+        )
+    };
+    if board == "an386" {
+        return with_board_in_qemu(qemu(), host);
+    }
+    let log = cross_target_dir("firmware").join(format!(
+        "qemu-unmodelled-{}.log",
+        elf.file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("stm32f405")
+    ));
+    let _ = std::fs::remove_file(&log);
+    let mut q = qemu();
+    q.args(["-d", "unimp,guest_errors", "-D"]).arg(&log);
+    let result = with_board_in_qemu(q, host);
+    eprint!("{}", unmodelled_summary(&log));
+    result
 }
 
 /// Whether `arg` names a scene file that declares three axes (`axes = 3`
