@@ -285,7 +285,8 @@ typedef struct TpLoopTiming {
 } TpLoopTiming;
 
 /**
- * One axis at one tick.
+ * One axis at one tick, in SI units. Its layout is C's: the C ABI hands
+ * it over as `TpAxisState`.
  */
 typedef struct TpAxisState {
   /**

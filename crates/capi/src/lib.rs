@@ -14,8 +14,8 @@ use twoport_host::{
     BoardPort, Contact, Gains, HostBoard, LinkError, Pace, PcBoard, SerialBoard, SimulatedBoard,
 };
 pub use types::{
-    TpAxisSpec, TpAxisState, TpDisplay, TpLoopTiming, TpMode, TpPercentiles, TpResult, TpSpec,
-    TpState, TP_CONTACT_ABOVE, TP_CONTACT_BELOW, TP_CONTACT_FREE, TP_CONTACT_HELD, TP_MAX_AXES,
+    TpAxisSpec, TpDisplay, TpLoopTiming, TpMode, TpPercentiles, TpResult, TpSpec, TpState,
+    TP_CONTACT_ABOVE, TP_CONTACT_BELOW, TP_CONTACT_FREE, TP_CONTACT_HELD, TP_MAX_AXES,
     TP_VE_DAMPING, TP_VE_STIFFNESS, TP_VE_SURFACE,
 };
 

@@ -1,7 +1,7 @@
 //! The C ABI's plain data: what a board can do, its state at one tick, and
 //! the codes every call returns. Units are SI.
 
-use twoport_host::{BoardMode, Contact, Spec, State};
+use twoport_host::{AxisState, BoardMode, Contact, Spec, State};
 
 /// The most axes a board has (a three-axis device).
 pub const TP_MAX_AXES: usize = 3;
@@ -142,24 +142,6 @@ pub struct TpSpec {
     pub axis: [TpAxisSpec; TP_MAX_AXES],
 }
 
-/// One axis at one tick.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct TpAxisState {
-    /// Handle position (m).
-    pub position_m: f64,
-    /// Handle velocity (m/s).
-    pub velocity_mps: f64,
-    /// Load-cell force (N).
-    pub load_cell_n: f64,
-    /// Force the law commanded (N; positive resists positive motion).
-    pub commanded_n: f64,
-    /// Force sent to the amplifier, after the safety layer (N).
-    pub actuator_n: f64,
-    /// The VE point the coupling holds (m).
-    pub ve_position_m: f64,
-}
-
 /// The board at one tick.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -183,7 +165,7 @@ pub struct TpState {
     /// The board's axes.
     pub axes: u8,
     /// Each axis's, the first `axes` of them.
-    pub axis: [TpAxisState; TP_MAX_AXES],
+    pub axis: [AxisState; TP_MAX_AXES],
 }
 
 impl From<&Spec> for TpSpec {
@@ -252,16 +234,9 @@ impl From<&Spec> for TpSpec {
 
 impl From<&State> for TpState {
     fn from(s: &State) -> Self {
-        let mut axis = [TpAxisState::default(); TP_MAX_AXES];
+        let mut axis = [AxisState::default(); TP_MAX_AXES];
         for (out, a) in axis.iter_mut().zip(s.axes.iter()) {
-            *out = TpAxisState {
-                position_m: a.position_m,
-                velocity_mps: a.velocity_mps,
-                load_cell_n: a.load_cell_n,
-                commanded_n: a.commanded_n,
-                actuator_n: a.actuator_n,
-                ve_position_m: a.ve_position_m,
-            };
+            *out = *a;
         }
         TpState {
             tick: s.tick,

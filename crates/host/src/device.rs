@@ -22,7 +22,9 @@ pub const HEARTBEAT_PERIOD: Duration = Duration::from_millis(10);
 /// ... or every this many polls, whichever comes first.
 pub const HEARTBEAT_POLLS: u32 = 10;
 
-/// One axis at one tick, in SI units.
+/// One axis at one tick, in SI units. Its layout is C's: the C ABI hands
+/// it over as `TpAxisState`.
+#[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct AxisState {
     /// Handle position (m).
