@@ -62,8 +62,9 @@ pub struct Board<D, const R: usize, const N: usize = 1> {
     /// loop). A board with real sensors must never let the host move it.
     pil: bool,
     pil_refused: u32,
-    /// The host's sensor frame waiting for the next control tick (PIL).
-    pending: Option<SensorFrame<f32, N>>,
+    /// The host's sensor frame waiting for the next control tick, with
+    /// the encoders' index counts it carries (PIL).
+    pending: Option<(SensorFrame<f32, N>, [Option<u32>; N])>,
     /// Ticks run from the board's own sensors (their frame's `tick`).
     ticks: u32,
     /// The state machine: disarmed at boot.
@@ -88,15 +89,6 @@ pub struct Board<D, const R: usize, const N: usize = 1> {
     /// and what the link carries (bytes/s): stated in the spec.
     workspace: [Option<(Position, Position)>; N],
     link_bytes_per_s: Option<u32>,
-    /// The rate of the count `cycles` gives (Hz), where the image knows it.
-    count_hz: Option<u32>,
-    /// The greatest latency, in that count, the regions are proven for.
-    late_after: Option<u32>,
-    /// Armed ticks whose force came later than the regions allow, run on
-    /// under the passivity layer.
-    late_guarded: u32,
-    /// Ticks the passivity layer stays engaged for (none: idle).
-    guarding: u32,
     /// Gains outside the proven regions are accepted: the user's explicit
     /// choice ([`Board::accepting_unproven_gains`]).
     unproven_allowed: bool,
@@ -112,10 +104,8 @@ pub struct Board<D, const R: usize, const N: usize = 1> {
     save_pending: bool,
     /// The encoder counts index pulses latched, for this tick.
     index: [Option<u32>; N],
-    /// The host's index counts waiting with its sensor frame (PIL).
-    pending_index: [Option<u32>; N],
-    /// Loop timing: the last tick's stages, its start, the overruns and
-    /// the worst jitter since boot.
+    /// Loop timing (the last tick's stages, its start, the overruns and
+    /// the worst jitter since boot) and the latency gate's state.
     timing: Timing,
 }
 
@@ -161,10 +151,6 @@ impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
             host: None,
             workspace: [None; N],
             link_bytes_per_s: None,
-            count_hz: None,
-            late_after: None,
-            late_guarded: 0,
-            guarding: 0,
             unproven_allowed: false,
             unproven_sets: 0,
             dead_man_closed: false,
@@ -172,7 +158,6 @@ impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
             config_source: None,
             save_pending: false,
             index: [None; N],
-            pending_index: [None; N],
             timing: Timing::default(),
         }
     }
@@ -404,13 +389,13 @@ impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
                     self.pil_refused = self.pil_refused.saturating_add(1);
                     return;
                 };
-                self.pending_index = index;
-                self.pending = Some(SensorFrame {
+                let frame = SensorFrame {
                     tick: s.tick,
                     encoder_raw: enc,
                     load_cell_n: core::array::from_fn(|i| self.io[i].load_cell_n(cells[i])),
                     dead_man_closed: s.dead_man_closed,
-                });
+                };
+                self.pending = Some((frame, index));
             }
             _ => {}
         }
@@ -492,13 +477,13 @@ impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
             let frame = loop {
                 io.feed_watchdog();
                 self.poll_link(io);
-                if let Some(f) = self.pending.take() {
+                if let Some((f, index)) = self.pending.take() {
+                    self.index = index;
                     break f;
                 }
                 serve(self);
                 self.flush(io);
             };
-            self.index = core::mem::replace(&mut self.pending_index, [None; N]);
             (frame, io.cycles())
         } else {
             let start = io.cycles();

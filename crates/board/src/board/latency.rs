@@ -22,6 +22,15 @@ pub(super) struct Timing {
     pub(super) worst_jitter: u32,
     /// The longest from the sample to the amplifiers' command since boot.
     pub(super) worst_latency: u32,
+    /// The rate of the count `cycles` gives (Hz), where the image knows it.
+    pub(super) count_hz: Option<u32>,
+    /// The greatest latency, in that count, the regions are proven for.
+    late_after: Option<u32>,
+    /// Armed ticks whose force came later than the regions allow, run on
+    /// under the passivity layer.
+    late_guarded: u32,
+    /// Ticks the passivity layer stays engaged for (none: idle).
+    guarding: u32,
 }
 
 impl Timing {
@@ -64,10 +73,10 @@ impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
     /// and lets it go idle again [`GUARD_TICKS`] ticks after the last late
     /// one ([`late_guarded`](Self::late_guarded) counts them).
     pub fn with_count_rate(mut self, hz: u32) -> Self {
-        self.count_hz = Some(hz);
+        self.timing.count_hz = Some(hz);
         // (f64: a budget of microseconds at a GHz count is exact.)
         let counts = f64::from(self.latency_budget_s()) * f64::from(hz);
-        self.late_after = Some(if counts < f64::from(u32::MAX) {
+        self.timing.late_after = Some(if counts < f64::from(u32::MAX) {
             counts as u32
         } else {
             u32::MAX
@@ -77,13 +86,13 @@ impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
 
     /// Whether the passivity layer is engaged after a late force.
     pub fn guarding(&self) -> bool {
-        self.guarding > 0
+        self.timing.guarding > 0
     }
 
     /// Armed ticks whose force came later than the regions allow, run on
     /// with the passivity layer engaged.
     pub fn late_guarded(&self) -> u32 {
-        self.late_guarded
+        self.timing.late_guarded
     }
 
     /// The latency from sampling to the force (s) every axis's region is
@@ -103,22 +112,27 @@ impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
         // late (homing's and an experiment's laws are not the coupling,
         // and a tick that ends them may run long).
         let coupled = self.mode == BoardMode::Armed && self.outputs_on;
-        if coupled && self.late_after.is_some_and(|budget| latency > budget) {
+        if coupled
+            && self
+                .timing
+                .late_after
+                .is_some_and(|budget| latency > budget)
+        {
             if <D::Layer as PortLayer>::GUARDS_LATENCY {
                 // Past the proof, the passivity layer keeps the port
                 // passive: the loop runs on with it engaged, until it has
                 // been on time for a while.
-                self.late_guarded = self.late_guarded.saturating_add(1);
-                if self.guarding == 0 {
+                self.timing.late_guarded = self.timing.late_guarded.saturating_add(1);
+                if self.timing.guarding == 0 {
                     self.servo.servo_mut().engage_layers();
                 }
-                self.guarding = GUARD_TICKS;
+                self.timing.guarding = GUARD_TICKS;
             } else {
                 self.servo.servo_mut().trip(Faults::LATE_FORCE);
             }
-        } else if self.guarding > 0 {
-            self.guarding -= 1;
-            if self.guarding == 0 {
+        } else if self.timing.guarding > 0 {
+            self.timing.guarding -= 1;
+            if self.timing.guarding == 0 {
                 self.servo.servo_mut().disengage_layers();
             }
         }

@@ -24,7 +24,7 @@ impl<D: Drive<N>, const R: usize, const N: usize> Board<D, R, N> {
             linkage: !D::HOMES,
             ve: self.ve_source(),
             link_bytes_per_s: self.link_bytes_per_s,
-            count_hz: self.count_hz,
+            count_hz: self.timing.count_hz,
             worst_latency_cycles: self.timing.worst_latency,
             latency_budget_s: self.latency_budget_s(),
             axes: Self::axes(axes),
