@@ -5,7 +5,7 @@
 //! it and how its force reaches the motors.
 
 use crate::kinematics::Kinematics;
-use crate::linkage::LinkageServo;
+use crate::linkage::{LinkageOutput, LinkageServo};
 use crate::servo::{PortLayer, SensorFrame, Servo, ServoOutput};
 use crate::world::World;
 use crate::Position;
@@ -18,6 +18,27 @@ pub struct Driven<const N: usize> {
     pub cartesian: ServoOutput<f32, N>,
     /// Each motor's command (N or N m).
     pub motor: [f32; N],
+}
+
+impl<const N: usize> From<ServoOutput<f32, N>> for Driven<N> {
+    /// A Cartesian servo's tick: a motor on each axis, driven with the
+    /// axis's force.
+    fn from(cartesian: ServoOutput<f32, N>) -> Self {
+        Driven {
+            cartesian,
+            motor: cartesian.actuator_force_n,
+        }
+    }
+}
+
+impl<const N: usize> From<LinkageOutput<f32, N>> for Driven<N> {
+    /// A linkage's tick: a motor on each joint, driven with its torque.
+    fn from(out: LinkageOutput<f32, N>) -> Self {
+        Driven {
+            cartesian: out.cartesian,
+            motor: out.torque_nm,
+        }
+    }
 }
 
 /// A device's servo as a board runs it, in f32.
@@ -69,33 +90,21 @@ impl<W: World<f32, N>, L: PortLayer, const N: usize> Drive<N> for Servo<W, f32, 
         self
     }
     fn tick(&mut self, frame: &SensorFrame<f32, N>) -> Driven<N> {
-        let cartesian = Servo::tick(self, frame);
-        Driven {
-            cartesian,
-            motor: cartesian.actuator_force_n,
-        }
+        Servo::tick(self, frame).into()
     }
     fn tick_on<V: World<f32, N>>(
         &mut self,
         frame: &SensorFrame<f32, N>,
         world: &mut V,
     ) -> Driven<N> {
-        let cartesian = Servo::tick_on(self, frame, world);
-        Driven {
-            cartesian,
-            motor: cartesian.actuator_force_n,
-        }
+        Servo::tick_on(self, frame, world).into()
     }
     fn tick_with(
         &mut self,
         frame: &SensorFrame<f32, N>,
         law: impl FnMut(usize, Position, f32) -> f32,
     ) -> Driven<N> {
-        let cartesian = Servo::tick_with(self, frame, law);
-        Driven {
-            cartesian,
-            motor: cartesian.actuator_force_n,
-        }
+        Servo::tick_with(self, frame, law).into()
     }
     fn clear(&mut self) {
         Servo::clear(self);
@@ -126,33 +135,21 @@ impl<K: Kinematics<f32, N>, W: World<f32, N>, L: PortLayer, const N: usize> Driv
         self.cartesian_mut()
     }
     fn tick(&mut self, frame: &SensorFrame<f32, N>) -> Driven<N> {
-        let out = LinkageServo::tick(self, frame);
-        Driven {
-            cartesian: out.cartesian,
-            motor: out.torque_nm,
-        }
+        LinkageServo::tick(self, frame).into()
     }
     fn tick_on<V: World<f32, N>>(
         &mut self,
         frame: &SensorFrame<f32, N>,
         world: &mut V,
     ) -> Driven<N> {
-        let out = LinkageServo::tick_on(self, frame, world);
-        Driven {
-            cartesian: out.cartesian,
-            motor: out.torque_nm,
-        }
+        LinkageServo::tick_on(self, frame, world).into()
     }
     fn tick_with(
         &mut self,
         frame: &SensorFrame<f32, N>,
         law: impl FnMut(usize, Position, f32) -> f32,
     ) -> Driven<N> {
-        let out = LinkageServo::tick_with(self, frame, law);
-        Driven {
-            cartesian: out.cartesian,
-            motor: out.torque_nm,
-        }
+        LinkageServo::tick_with(self, frame, law).into()
     }
     fn clear(&mut self) {
         LinkageServo::clear(self);
