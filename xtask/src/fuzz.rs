@@ -7,7 +7,7 @@
 //! <target>` in `fuzz/` still works for a longer session by hand.
 
 use crate::{cargo, cross_target_dir, root, run, target_dir};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The fuzz targets in fuzz/.
@@ -36,32 +36,64 @@ const RUSTFLAGS: [&str; 9] = [
 ];
 
 /// Build every target, then run each for `secs` seconds on a scratch copy
-/// of its seed corpus.
+/// of its seed corpus, two at a time (libFuzzer runs on one core).
 pub(crate) fn fuzz(secs: u32) -> Result<(), String> {
     let bins = build()?;
-    for t in FUZZ_TARGETS {
-        let work = cross_target_dir("fuzz-corpus").join(t);
-        std::fs::create_dir_all(&work).map_err(|e| format!("{}: {e}", work.display()))?;
-        let seeds = root().join("fuzz/corpus").join(t);
-        for f in std::fs::read_dir(&seeds)
-            .map_err(|e| format!("{}: {e}", seeds.display()))?
-            .flatten()
-        {
-            let _ = std::fs::copy(f.path(), work.join(f.file_name()));
-        }
-        run(
-            &format!("fuzz {t} for {secs} s"),
-            Command::new(bins.join(t)).arg(&work).args([
-                &format!("-max_total_time={secs}"),
-                // A slow input is a finding (a model once spun the matrix
-                // exponential forever), not a 20-minute stall.
-                "-timeout=10",
-                "-max_len=4096",
-                "-print_final_stats=1",
-            ]),
-        )?;
+    for pair in FUZZ_TARGETS.chunks(2) {
+        std::thread::scope(|s| {
+            let running: Vec<_> = pair
+                .iter()
+                .map(|t| {
+                    let bins = &bins;
+                    s.spawn(move || fuzz_one(bins, t, secs))
+                })
+                .collect();
+            running.into_iter().try_for_each(|h| {
+                h.join()
+                    .unwrap_or_else(|_| Err("a fuzz run panicked".into()))
+            })
+        })?;
     }
     Ok(())
+}
+
+/// Run target `t` (its binary in `bins`) for `secs` seconds; its output
+/// is printed when it ends, so that two runs' lines do not interleave.
+fn fuzz_one(bins: &Path, t: &str, secs: u32) -> Result<(), String> {
+    let work = cross_target_dir("fuzz-corpus").join(t);
+    std::fs::create_dir_all(&work).map_err(|e| format!("{}: {e}", work.display()))?;
+    let seeds = root().join("fuzz/corpus").join(t);
+    for f in std::fs::read_dir(&seeds)
+        .map_err(|e| format!("{}: {e}", seeds.display()))?
+        .flatten()
+    {
+        let _ = std::fs::copy(f.path(), work.join(f.file_name()));
+    }
+    let out = Command::new(bins.join(t))
+        .arg(&work)
+        .args([
+            &format!("-max_total_time={secs}"),
+            // A slow input is a finding (a model once spun the matrix
+            // exponential forever), not a 20-minute stall.
+            "-timeout=10",
+            "-max_len=4096",
+            "-print_final_stats=1",
+        ])
+        .output()
+        .map_err(|e| format!("fuzz {t}: could not start: {e}"))?;
+    let log = String::from_utf8_lossy(&out.stderr);
+    if out.status.success() {
+        // The final stats, not every new input's line.
+        let stats: Vec<&str> = log
+            .lines()
+            .filter(|l| l.starts_with("stat::") || l.starts_with("Done"))
+            .collect();
+        eprintln!("xtask: fuzz {t} for {secs} s\n{}", stats.join("\n"));
+        Ok(())
+    } else {
+        eprintln!("{log}");
+        Err(format!("fuzz {t}: failed ({})", out.status))
+    }
 }
 
 /// Build the targets for the host named as a target, so that the flags
