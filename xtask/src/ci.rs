@@ -9,7 +9,7 @@ use crate::emulate::{
 use crate::firmware::thumb;
 use crate::fuzz::fuzz;
 use crate::probe::qemu;
-use crate::{cargo, run};
+use crate::{at_once, cargo, run};
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 
@@ -265,23 +265,15 @@ fn pil_boards() -> Result<(), String> {
     // Then the two boards side by side: a run is one QEMU and one host
     // program in lockstep, about a core, and nothing in it waits on the
     // wall clock but a 5 s answer timeout.
-    std::thread::scope(|s| {
-        let each = |board: &'static str| {
-            let (plans, bin) = (&plans, &bin);
-            s.spawn(move || {
-                plans
-                    .iter()
-                    .filter(|(b, _, _)| *b == board)
-                    .try_for_each(|(b, args, elf)| pil_on(bin, b, args, elf))
-            })
-        };
-        let running = [each("an386"), each("stm32f405")];
-        // (The scope waits for the other board's runs before it returns.)
-        running.into_iter().try_for_each(|h| {
-            h.join()
-                .unwrap_or_else(|_| Err("a PIL run panicked".into()))
-        })
-    })
+    at_once(["an386", "stm32f405"].map(|board| {
+        let (plans, bin) = (&plans, &bin);
+        move || {
+            plans
+                .iter()
+                .filter(|(b, _, _)| *b == board)
+                .try_for_each(|(b, args, elf)| pil_on(bin, b, args, elf))
+        }
+    }))
 }
 
 /// The passivity image: the layered tick on the M4F against the same code

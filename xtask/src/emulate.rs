@@ -65,7 +65,7 @@ pub(crate) fn pil(extra: &[String]) -> Result<(), String> {
 
 /// The board a PIL command line names (`--board NAME`, an386 by default)
 /// and the rest of it.
-pub(crate) fn board_of(extra: &[String]) -> Result<(String, Vec<String>), String> {
+fn board_of(extra: &[String]) -> Result<(String, Vec<String>), String> {
     let mut args = extra.to_vec();
     let board = match args.iter().position(|a| a == "--board") {
         Some(i) if i + 1 < args.len() => {

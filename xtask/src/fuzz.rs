@@ -6,7 +6,7 @@
 //! than cargo-fuzz's single codegen unit with debug info. `cargo fuzz run
 //! <target>` in `fuzz/` still works for a longer session by hand.
 
-use crate::{cargo, cross_target_dir, root, run, target_dir};
+use crate::{at_once, cargo, cross_target_dir, root, run, target_dir};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -40,19 +40,7 @@ const RUSTFLAGS: [&str; 9] = [
 pub(crate) fn fuzz(secs: u32) -> Result<(), String> {
     let bins = build()?;
     for pair in FUZZ_TARGETS.chunks(2) {
-        std::thread::scope(|s| {
-            let running: Vec<_> = pair
-                .iter()
-                .map(|t| {
-                    let bins = &bins;
-                    s.spawn(move || fuzz_one(bins, t, secs))
-                })
-                .collect();
-            running.into_iter().try_for_each(|h| {
-                h.join()
-                    .unwrap_or_else(|_| Err("a fuzz run panicked".into()))
-            })
-        })?;
+        at_once(pair.iter().map(|t| || fuzz_one(&bins, t, secs)))?;
     }
     Ok(())
 }

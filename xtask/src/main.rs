@@ -140,6 +140,21 @@ pub(crate) fn run(what: &str, cmd: &mut Command) -> Result<(), String> {
     }
 }
 
+/// Run `jobs` at once, a thread each, and wait for all of them; the first
+/// error, in the order given (a panic is one).
+pub(crate) fn at_once<F>(jobs: impl IntoIterator<Item = F>) -> Result<(), String>
+where
+    F: FnOnce() -> Result<(), String> + Send,
+{
+    std::thread::scope(|s| {
+        let running: Vec<_> = jobs.into_iter().map(|job| s.spawn(job)).collect();
+        running.into_iter().try_for_each(|h| {
+            h.join()
+                .unwrap_or_else(|_| Err("a job run at once panicked".into()))
+        })
+    })
+}
+
 pub(crate) fn cargo() -> Command {
     let mut c = Command::new(std::env::var("CARGO").unwrap_or("cargo".into()));
     c.current_dir(root());
